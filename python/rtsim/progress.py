@@ -1,0 +1,79 @@
+"""A rich progress bar that the C++ tracer drives through its progress callback."""
+
+from __future__ import annotations
+
+from types import TracebackType
+
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    ProgressColumn,
+    Task,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.text import Text
+
+
+class RateColumn(ProgressColumn):
+    """Items per second, e.g. ``1.2 M rays/s``."""
+
+    def render(self, task: Task) -> Text:
+        speed = task.finished_speed or task.speed
+        if not speed:
+            return Text("-", style="progress.data.speed")
+        for scale, prefix in ((1e9, "G"), (1e6, "M"), (1e3, "k")):
+            if speed >= scale:
+                return Text(f"{speed / scale:.1f} {prefix}rays/s", style="progress.data.speed")
+        return Text(f"{speed:.0f} rays/s", style="progress.data.speed")
+
+
+class TraceProgress:
+    """Context manager and callable ``(done, total, stage)``: one bar per tracer stage."""
+
+    def __init__(self, console: Console | None = None, disable: bool = False) -> None:
+        self._progress = Progress(
+            TextColumn("[bold]{task.description:<10}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            RateColumn(),
+            TimeElapsedColumn(),
+            TextColumn("eta"),
+            TimeRemainingColumn(),
+            console=console or Console(stderr=True),
+            disable=disable,
+            transient=False,
+        )
+        self._stage: str | None = None
+        self._task: int | None = None
+
+    def __enter__(self) -> TraceProgress:
+        self._progress.start()
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        if exc_type is None:
+            self._finish_stage()
+        self._progress.stop()
+
+    def _finish_stage(self) -> None:
+        if self._task is not None:
+            task = self._progress.tasks[-1]
+            if task.total is not None:
+                self._progress.update(self._task, completed=task.total)
+
+    def __call__(self, done: int, total: int, stage: str) -> None:
+        if stage != self._stage:
+            self._finish_stage()
+            self._stage = stage
+            self._task = self._progress.add_task(stage, total=max(total, 1))
+        assert self._task is not None
+        self._progress.update(self._task, completed=done, total=max(total, done, 1))

@@ -1,0 +1,74 @@
+"""Where scenes come from: built-in procedural scenes and the shared glTF scene folder.
+
+The shared folder is ``$RTSIM_SCENES`` if set, else the first ``shared/scenes`` found beside
+the current directory or one of its parents (a clone of the repo sits next to ``shared/``).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from rtsim._core import procedural_scene_names
+
+SCENE_SUFFIXES = (".gltf", ".glb")
+
+
+@dataclass(frozen=True)
+class SceneEntry:
+    """A scene the CLI can name: a built-in, or a glTF file under the shared folder."""
+
+    name: str
+    kind: str  # "built-in" or "shared"
+    path: Path | None = None
+
+
+def shared_scenes_dir() -> Path | None:
+    """The shared scene folder, or None if there is none."""
+    env = os.environ.get("RTSIM_SCENES")
+    if env:
+        path = Path(env).expanduser()
+        return path if path.is_dir() else None
+    cwd = Path.cwd().resolve()
+    for base in (cwd, *cwd.parents):
+        for candidate in (base / "shared" / "scenes", base / "scenes"):
+            if candidate.is_dir() and any(_scene_files(candidate)):
+                return candidate
+    return None
+
+
+def _scene_files(folder: Path) -> list[Path]:
+    files = [p for p in folder.iterdir() if p.suffix.lower() in SCENE_SUFFIXES]
+    for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
+        files += [p for p in sub.iterdir() if p.suffix.lower() in SCENE_SUFFIXES]
+    return sorted(files)
+
+
+def shared_scenes() -> list[SceneEntry]:
+    folder = shared_scenes_dir()
+    if folder is None:
+        return []
+    entries = []
+    for path in _scene_files(folder):
+        name = path.parent.name if path.parent != folder else path.stem
+        entries.append(SceneEntry(name=name, kind="shared", path=path))
+    return entries
+
+
+def list_scenes() -> list[SceneEntry]:
+    built_in = [SceneEntry(name=n, kind="built-in") for n in procedural_scene_names()]
+    return built_in + shared_scenes()
+
+
+def resolve_scene(text: str) -> str:
+    """A path for an existing file; a built-in name as is; a shared scene's folder or file name
+    (case-insensitive) as its glTF path; anything else unchanged (the loader names it)."""
+    if Path(text).is_file() or text in procedural_scene_names():
+        return text
+    wanted = text.lower()
+    for entry in shared_scenes():
+        assert entry.path is not None
+        if wanted in (entry.name.lower(), entry.path.stem.lower(), entry.path.name.lower()):
+            return str(entry.path)
+    return text

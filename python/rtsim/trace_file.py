@@ -1,0 +1,210 @@
+"""Trace folders as numpy arrays: each section of ``trace.rtt`` memory-mapped at its offset.
+
+The dtypes below mirror the packed C++ records in ``traces/format/trace_format.h`` field by
+field; ``open_trace`` checks each against the record size the file declares, so a layout change
+on one side is caught instead of silently misread.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rtsim._core import RtsimError, trace_sections, verify_trace
+
+TRACE_FILE = "trace.rtt"
+MANIFEST_FILE = "manifest.json"
+
+#: RayRecord (40 bytes).
+RAY_DTYPE = np.dtype(
+    [
+        ("origin", "<f4", (3,)),
+        ("tmin", "<f4"),
+        ("direction", "<f4", (3,)),
+        ("tmax", "<f4"),
+        ("pixel", "<u4"),
+        ("kind", "u1"),
+        ("flags", "u1"),
+        ("depth", "<u2"),
+    ]
+)
+#: HitRecord (20 bytes).
+HIT_DTYPE = np.dtype([("prim", "<i4"), ("inst", "<i4"), ("t", "<f4"), ("u", "<f4"), ("v", "<f4")])
+#: WorkRecord (20 bytes).
+WORK_DTYPE = np.dtype(
+    [
+        ("nodes", "<u4"),
+        ("box_tests", "<u4"),
+        ("tri_tests", "<u4"),
+        ("anyhit_calls", "<u4"),
+        ("transforms", "<u4"),
+    ]
+)
+#: HwNode (64 bytes): two child boxes, child references and leaf sizes.
+NODE_DTYPE = np.dtype(
+    [
+        ("lo", "<f4", (2, 3)),
+        ("hi", "<f4", (2, 3)),
+        ("child_ref", "<u4", (2,)),
+        ("child_count", "<u4", (2,)),
+    ]
+)
+#: HwTriangle (48 bytes).
+TRIANGLE_DTYPE = np.dtype(
+    [
+        ("v0", "<f4", (3,)),
+        ("v1", "<f4", (3,)),
+        ("v2", "<f4", (3,)),
+        ("prim", "<u4"),
+        ("inst", "<u4"),
+        ("flags", "<u4"),
+    ]
+)
+
+#: Section name (as the C++ section_name() spells it, lower-cased) -> record dtype.
+SECTION_DTYPES: dict[str, np.dtype] = {
+    "rays": RAY_DTYPE,
+    "hits": HIT_DTYPE,
+    "work": WORK_DTYPE,
+    "bvh_nodes": NODE_DTYPE,
+    "triangles": TRIANGLE_DTYPE,
+}
+_FOURCC_NAMES = {
+    0x53594152: "rays",
+    0x53544948: "hits",
+    0x4B524F57: "work",
+    0x45444F4E: "bvh_nodes",
+    0x53495254: "triangles",
+}
+
+#: RayKind values stored in RayRecord.kind.
+RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
+
+
+@dataclass(frozen=True)
+class Section:
+    """One section of a trace file, as its section table describes it."""
+
+    name: str
+    record_bytes: int
+    record_count: int
+    offset: int
+    bytes: int
+
+
+@dataclass
+class Trace:
+    """An opened trace folder. Record arrays are read-only memory maps, loaded on access."""
+
+    path: Path
+    folder: Path
+    sections: dict[str, Section]
+    manifest: dict[str, Any] = field(default_factory=dict)
+
+    def _map(self, name: str) -> np.ndarray:
+        section = self.sections.get(name)
+        if section is None:
+            raise RtsimError(f"{self.path}: trace has no '{name}' section")
+        dtype = SECTION_DTYPES[name]
+        if section.record_count == 0:
+            return np.zeros(0, dtype=dtype)
+        return np.memmap(
+            self.path, dtype=dtype, mode="r", offset=section.offset, shape=(section.record_count,)
+        )
+
+    def has(self, name: str) -> bool:
+        return name in self.sections
+
+    @cached_property
+    def rays(self) -> np.ndarray:
+        return self._map("rays")
+
+    @cached_property
+    def hits(self) -> np.ndarray:
+        return self._map("hits")
+
+    @cached_property
+    def work(self) -> np.ndarray:
+        return self._map("work")
+
+    @cached_property
+    def nodes(self) -> np.ndarray | None:
+        return self._map("bvh_nodes") if self.has("bvh_nodes") else None
+
+    @cached_property
+    def triangles(self) -> np.ndarray | None:
+        return self._map("triangles") if self.has("triangles") else None
+
+    @property
+    def ray_count(self) -> int:
+        return self.sections["rays"].record_count if self.has("rays") else 0
+
+    @property
+    def scene_name(self) -> str:
+        scene = self.manifest.get("scene")
+        if isinstance(scene, dict):
+            for key in ("name", "source", "path"):
+                if isinstance(scene.get(key), str):
+                    return Path(scene[key]).stem if key != "name" else scene[key]
+        if isinstance(scene, str):
+            return Path(scene).stem
+        return self.folder.name
+
+    def verify(self) -> None:
+        """Checks the CRC32 of every chunk of every section (raises RtsimError)."""
+        verify_trace(self.path)
+
+
+def _section_name(info: dict[str, Any]) -> str:
+    fourcc = info.get("fourcc")
+    if isinstance(fourcc, int) and fourcc in _FOURCC_NAMES:
+        return _FOURCC_NAMES[fourcc]
+    return str(info.get("kind", "")).lower()
+
+
+def _resolve(path: str | Path) -> tuple[Path, Path]:
+    path = Path(path)
+    if path.is_dir():
+        return path / TRACE_FILE, path
+    return path, path.parent
+
+
+def open_trace(path: str | Path) -> Trace:
+    """Opens a trace folder (or its ``trace.rtt``); validates the header and section table.
+
+    Raises RtsimError naming the file if it is missing, truncated, corrupted or of another
+    version, or if a section's record size differs from the dtype this package expects.
+    """
+    file, folder = _resolve(path)
+    if not file.is_file():
+        raise RtsimError(f"{file}: no trace file (expected a trace folder or a .rtt file)")
+    sections: dict[str, Section] = {}
+    for info in trace_sections(file):
+        name = _section_name(info)
+        section = Section(
+            name=name,
+            record_bytes=int(info["record_bytes"]),
+            record_count=int(info["record_count"]),
+            offset=int(info["offset"]),
+            bytes=int(info["bytes"]),
+        )
+        dtype = SECTION_DTYPES.get(name)
+        if dtype is not None and dtype.itemsize != section.record_bytes:
+            raise RtsimError(
+                f"{file}: section '{name}' has {section.record_bytes}-byte records but this "
+                f"rtsim reads {dtype.itemsize}-byte records (trace written by another version?)"
+            )
+        sections[name] = section
+    manifest: dict[str, Any] = {}
+    manifest_path = folder / MANIFEST_FILE
+    if manifest_path.is_file():
+        try:
+            manifest = json.loads(manifest_path.read_text())
+        except json.JSONDecodeError as err:
+            raise RtsimError(f"{manifest_path}: not valid JSON ({err})") from err
+    return Trace(path=file, folder=folder, sections=sections, manifest=manifest)

@@ -1,0 +1,17 @@
+// rtsim._core: the C++ reference tracer seen from Python. rtsim::Error becomes
+// rtsim.RtsimError (a RuntimeError) so bad input reads as a message, not a crash.
+#include <pybind11/pybind11.h>
+
+#include "python/src/bindings.h"
+#include "traces/common/error.h"
+
+namespace py = pybind11;
+
+PYBIND11_MODULE(_core, m) {
+    m.doc() = "rtsim reference tracer bindings (scenes, rays, traces)";
+    py::register_exception<rtsim::Error>(m, "RtsimError", PyExc_RuntimeError);
+    m.attr("__version__") = RTSIM_VERSION;
+    m.attr("git_hash") = RTSIM_GIT_HASH;
+    rtsim::py_bind::bind_scene(m);
+    rtsim::py_bind::bind_trace(m);
+}

@@ -1,0 +1,270 @@
+// Trace format: record layouts, round trips of every section kind, empty sections and the
+// writer's all-or-nothing output.
+#include <cstddef>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "tests/cpp/format/format_test_util.h"
+#include "traces/bvh/hw_layout.h"
+#include "traces/format/trace_reader.h"
+#include "traces/format/trace_writer.h"
+
+namespace rtsim {
+namespace {
+
+using test::ScratchDir;
+
+// Record layouts are part of the file format (docs/trace_format.md): check every offset.
+TEST(TraceRecords, OffsetsMatchTheDocumentedLayout) {
+    EXPECT_EQ(offsetof(RayRecord, origin), 0u);
+    EXPECT_EQ(offsetof(RayRecord, tmin), 12u);
+    EXPECT_EQ(offsetof(RayRecord, direction), 16u);
+    EXPECT_EQ(offsetof(RayRecord, tmax), 28u);
+    EXPECT_EQ(offsetof(RayRecord, pixel), 32u);
+    EXPECT_EQ(offsetof(RayRecord, kind), 36u);
+    EXPECT_EQ(offsetof(RayRecord, flags), 37u);
+    EXPECT_EQ(offsetof(RayRecord, depth), 38u);
+    EXPECT_EQ(offsetof(HitRecord, prim), 0u);
+    EXPECT_EQ(offsetof(HitRecord, inst), 4u);
+    EXPECT_EQ(offsetof(HitRecord, t), 8u);
+    EXPECT_EQ(offsetof(HitRecord, u), 12u);
+    EXPECT_EQ(offsetof(HitRecord, v), 16u);
+    EXPECT_EQ(offsetof(WorkRecord, nodes), 0u);
+    EXPECT_EQ(offsetof(WorkRecord, box_tests), 4u);
+    EXPECT_EQ(offsetof(WorkRecord, tri_tests), 8u);
+    EXPECT_EQ(offsetof(WorkRecord, anyhit_calls), 12u);
+    EXPECT_EQ(offsetof(WorkRecord, transforms), 16u);
+    EXPECT_EQ(offsetof(HwNode, lo), 0u);
+    EXPECT_EQ(offsetof(HwNode, hi), 24u);
+    EXPECT_EQ(offsetof(HwNode, child_ref), 48u);
+    EXPECT_EQ(offsetof(HwNode, child_count), 56u);
+    EXPECT_EQ(offsetof(HwTriangle, prim), 36u);
+    EXPECT_EQ(offsetof(HwTriangle, inst), 40u);
+    EXPECT_EQ(offsetof(HwTriangle, flags), 44u);
+}
+
+TEST(TraceRecords, SectionNamesAndSizes) {
+    EXPECT_STREQ(section_name(SectionKind::rays), "RAYS");
+    EXPECT_STREQ(section_name(SectionKind::triangles), "TRIS");
+    EXPECT_STREQ(section_name(SectionKind(0x12345678)), "unknown");
+    // The fourcc value spells the name in file byte order.
+    const auto kind = static_cast<uint32_t>(SectionKind::bvh_nodes);
+    EXPECT_EQ(std::memcmp(&kind, "NODE", 4), 0);
+    EXPECT_EQ(section_record_bytes(SectionKind::rays), 40u);
+    EXPECT_EQ(section_record_bytes(SectionKind::bvh_nodes), 64u);
+    EXPECT_EQ(section_record_bytes(SectionKind(0x12345678)), 0u);
+}
+
+TEST(TraceRecords, ConversionsRoundTrip) {
+    Ray ray;
+    ray.origin = Vec3(1.0f, -2.0f, 3.5f);
+    ray.direction = Vec3(0.0f, 1.0f, -1.0f);
+    ray.tmin = 0.001f;
+    ray.tmax = 99.0f;
+    const RayRecord r = to_record(ray, RayKind::shadow, 1234, 3, true);
+    EXPECT_EQ(r.kind, uint8_t(RayKind::shadow));
+    EXPECT_EQ(r.flags, kRayFlagAnyHit);
+    EXPECT_EQ(r.pixel, 1234u);
+    EXPECT_EQ(r.depth, 3u);
+    const Ray back = ray_from_record(r);
+    EXPECT_EQ(back.origin, ray.origin);
+    EXPECT_EQ(back.direction, ray.direction);
+    EXPECT_EQ(back.tmin, ray.tmin);
+    EXPECT_EQ(back.tmax, ray.tmax);
+    EXPECT_EQ(to_record(ray, RayKind::primary, 0, 0, false).flags, 0u);
+
+    const Hit hit{42, 7, 2.5f, 0.25f, 0.5f};
+    const Hit hb = hit_from_record(to_record(hit));
+    EXPECT_EQ(hb.prim, 42);
+    EXPECT_EQ(hb.inst, 7);
+    EXPECT_EQ(hb.t, 2.5f);
+    EXPECT_EQ(hb.u, 0.25f);
+    EXPECT_EQ(hb.v, 0.5f);
+    const WorkCounts w{10, 20, 30, 4, 5};
+    const WorkCounts wb = work_from_record(to_record(w));
+    EXPECT_EQ(wb.nodes, 10u);
+    EXPECT_EQ(wb.box_tests, 20u);
+    EXPECT_EQ(wb.tri_tests, 30u);
+    EXPECT_EQ(wb.anyhit_calls, 4u);
+    EXPECT_EQ(wb.transforms, 5u);
+}
+
+/// Byte-exact equality of two record vectors.
+template <class T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+TEST(TraceRoundTrip, InterleavedAppendsOfAllKindsAcrossManyChunks) {
+    ScratchDir dir;
+    const std::string path = dir.file("trace.rtt");
+    std::vector<RayRecord> rays;
+    std::vector<HitRecord> hits;
+    std::vector<WorkRecord> work;
+    std::vector<HwNode> nodes;
+    std::vector<HwTriangle> tris;
+    // Random batch sizes and an interleaving that touches every kind many times.
+    std::mt19937 rng(7);
+    {
+        TraceWriter writer(path, 256);
+        for (int step = 0; step < 600; ++step) {
+            const uint64_t n = rng() % 40;
+            const uint64_t base = rays.size();
+            std::vector<RayRecord> r;
+            std::vector<HitRecord> h;
+            std::vector<WorkRecord> w;
+            for (uint64_t i = 0; i < n; ++i) {
+                r.push_back(test::ray_at(base + i));
+                h.push_back(test::hit_at(base + i));
+                w.push_back(test::work_at(base + i));
+            }
+            writer.append(SectionKind::rays, r);
+            if (step % 3 == 0) {
+                HwNode node{};
+                node.child_ref[0] = uint32_t(step);
+                node.lo[1][2] = float(step);
+                nodes.push_back(node);
+                writer.append(SectionKind::bvh_nodes, std::vector<HwNode>{node});
+            }
+            writer.append(SectionKind::hits, h);
+            HwTriangle tri{};
+            tri.prim = uint32_t(step);
+            tri.v2[1] = -float(step);
+            tris.push_back(tri);
+            writer.append(SectionKind::triangles, &tri, 1, sizeof tri);
+            writer.append(SectionKind::work, w);
+            rays.insert(rays.end(), r.begin(), r.end());
+            hits.insert(hits.end(), h.begin(), h.end());
+            work.insert(work.end(), w.begin(), w.end());
+        }
+        writer.close();
+    }
+    EXPECT_EQ(dir.listing(), std::vector<std::string>{"trace.rtt"});
+
+    TraceReader reader(path);
+    EXPECT_EQ(reader.version(), kTraceVersion);
+    ASSERT_EQ(reader.sections().size(), 5u);
+    EXPECT_EQ(reader.sections()[0].kind, SectionKind::rays);  // order of first append
+    EXPECT_EQ(reader.sections()[1].kind, SectionKind::bvh_nodes);
+    const std::vector<uint8_t> file = test::read_bytes(path);
+    for (const SectionInfo& s : reader.sections()) {
+        EXPECT_EQ(s.offset % 64, 0u);
+        EXPECT_EQ(s.bytes, s.record_bytes * s.record_count);
+        EXPECT_EQ(s.chunk_bytes, 256u);
+        EXPECT_LE(s.offset + s.bytes, file.size());
+    }
+    EXPECT_GT(reader.section(SectionKind::rays).bytes / 256, 100u);  // many chunks
+    EXPECT_TRUE(same_bytes(reader.read_all<RayRecord>(SectionKind::rays), rays));
+    EXPECT_TRUE(same_bytes(reader.read_all<HitRecord>(SectionKind::hits), hits));
+    EXPECT_TRUE(same_bytes(reader.read_all<WorkRecord>(SectionKind::work), work));
+    EXPECT_TRUE(same_bytes(reader.read_all<HwNode>(SectionKind::bvh_nodes), nodes));
+    EXPECT_TRUE(same_bytes(reader.read_all<HwTriangle>(SectionKind::triangles), tris));
+    // The payload is the records verbatim at the section's offset (what np.memmap relies on).
+    const SectionInfo& rs = reader.section(SectionKind::rays);
+    EXPECT_EQ(std::memcmp(file.data() + rs.offset, rays.data(), rs.bytes), 0);
+    reader.verify_all();
+}
+
+TEST(TraceRoundTrip, RandomSubrangesFromAFreshReader) {
+    ScratchDir dir;
+    const std::string path = dir.file("t.rtt");
+    std::vector<HitRecord> hits;
+    for (uint64_t i = 0; i < 5000; ++i) hits.push_back(test::hit_at(i));
+    {
+        TraceWriter writer(path, 300);  // chunks not a multiple of the record size
+        writer.append(SectionKind::hits, hits);
+        writer.close();
+    }
+    TraceReader reader(path);
+    std::mt19937 rng(3);
+    for (int k = 0; k < 300; ++k) {
+        const uint64_t first = rng() % 5000, count = rng() % (5000 - first + 1);
+        std::vector<HitRecord> part(count);
+        reader.read(SectionKind::hits, first, count, part.data());
+        ASSERT_EQ(std::memcmp(part.data(), hits.data() + first, count * sizeof(HitRecord)), 0) << first;
+    }
+    const std::string msg = test::error_of([&] { reader.read(SectionKind::hits, 4990, 11, hits.data()); });
+    EXPECT_NE(msg.find("out of range"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+}
+
+TEST(TraceRoundTrip, EmptySectionsAndEmptyTraces) {
+    ScratchDir dir;
+    const std::string path = dir.file("empty.rtt");
+    {
+        TraceWriter writer(path, 256);
+        writer.append(SectionKind::rays, nullptr, 0, sizeof(RayRecord));
+        writer.append(SectionKind::hits, std::vector<HitRecord>{});
+        writer.append(SectionKind::work, std::vector<WorkRecord>{test::work_at(1)});
+        writer.close();
+    }
+    TraceReader reader(path);
+    ASSERT_EQ(reader.sections().size(), 3u);
+    EXPECT_TRUE(reader.has(SectionKind::rays));
+    EXPECT_EQ(reader.section(SectionKind::rays).record_count, 0u);
+    EXPECT_TRUE(reader.read_all<RayRecord>(SectionKind::rays).empty());
+    EXPECT_TRUE(reader.read_all<HitRecord>(SectionKind::hits).empty());
+    EXPECT_EQ(reader.read_all<WorkRecord>(SectionKind::work).size(), 1u);
+    reader.verify_all();
+
+    // A trace with no sections at all is valid; asking for one names what is missing.
+    const std::string none = dir.file("none.rtt");
+    TraceWriter(none).close();
+    TraceReader empty(none);
+    EXPECT_TRUE(empty.sections().empty());
+    EXPECT_FALSE(empty.has(SectionKind::rays));
+    const std::string msg = test::error_of([&] { empty.section(SectionKind::rays); });
+    EXPECT_NE(msg.find("no section RAYS"), std::string::npos) << msg;
+}
+
+TEST(TraceWriterSafety, DestroyedWithoutCloseLeavesNothingAndKeepsExistingOutput) {
+    ScratchDir dir;
+    const std::string path = dir.file("trace.rtt");
+    test::write_bytes(path, {'k', 'e', 'e', 'p'});
+    {
+        TraceWriter writer(path, 256);
+        std::vector<RayRecord> rays(10000, test::ray_at(5));
+        writer.append(SectionKind::rays, rays);
+        writer.append(SectionKind::hits, std::vector<HitRecord>(100));
+        EXPECT_GE(dir.listing().size(), 3u);  // OUT + two spools while writing
+    }
+    EXPECT_EQ(dir.listing(), std::vector<std::string>{"trace.rtt"});
+    EXPECT_EQ(test::read_bytes(path), (std::vector<uint8_t>{'k', 'e', 'e', 'p'}));
+
+    // Without an existing output nothing at all remains.
+    const std::string other = dir.file("other.rtt");
+    { TraceWriter(other).append(SectionKind::work, std::vector<WorkRecord>(3)); }
+    EXPECT_EQ(dir.listing(), std::vector<std::string>{"trace.rtt"});
+
+    // A successful close replaces the old file atomically.
+    TraceWriter writer(path);
+    writer.append(SectionKind::hits, std::vector<HitRecord>(4));
+    writer.close();
+    EXPECT_EQ(TraceReader(path).section(SectionKind::hits).record_count, 4u);
+    EXPECT_EQ(dir.listing(), std::vector<std::string>{"trace.rtt"});
+}
+
+TEST(TraceWriterSafety, RejectsMisuseWithTheFileInTheMessage) {
+    ScratchDir dir;
+    const std::string path = dir.file("t.rtt");
+    TraceWriter writer(path);
+    std::string msg = test::error_of([&] { writer.append(SectionKind::rays, std::vector<HitRecord>(1)); });
+    EXPECT_NE(msg.find("RAYS needs 40-byte records"), std::string::npos) << msg;
+    const uint32_t custom = 0x54534554;  // 'TEST': a kind this build does not know
+    writer.append(SectionKind(custom), std::vector<uint64_t>(2));
+    msg = test::error_of([&] { writer.append(SectionKind(custom), std::vector<uint32_t>(2)); });
+    EXPECT_NE(msg.find("TEST has 8-byte records"), std::string::npos) << msg;
+    writer.close();
+    msg = test::error_of([&] { writer.append(SectionKind::hits, std::vector<HitRecord>(1)); });
+    EXPECT_NE(msg.find("after close"), std::string::npos) << msg;
+    // Unknown kinds survive a round trip (a newer writer's extra section).
+    EXPECT_EQ(TraceReader(path).section(SectionKind(custom)).record_count, 2u);
+
+    const std::string bad = dir.file("no_such_folder/t.rtt");
+    msg = test::error_of([&] { TraceWriter(bad).append(SectionKind::hits, std::vector<HitRecord>(1)); });
+    EXPECT_NE(msg.find(bad), std::string::npos) << msg;
+}
+
+}  // namespace
+}  // namespace rtsim

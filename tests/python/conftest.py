@@ -1,0 +1,71 @@
+"""Shared fixtures: the cornell scene, the shared scene folder, and one small traced folder."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import rtsim
+
+REPO = Path(__file__).resolve().parents[2]
+TRACE_WIDTH, TRACE_HEIGHT = 64, 48
+TRACE_WORKLOAD = "primary,shadow,reflection,diffuse"
+
+
+def rtsim_command() -> list[str]:
+    """The installed console script next to this Python, else `python -m rtsim`."""
+    script = Path(sys.executable).parent / "rtsim"
+    if script.exists():
+        return [str(script)]
+    found = shutil.which("rtsim")
+    return [found] if found else [sys.executable, "-m", "rtsim"]
+
+
+def run_rtsim(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [*rtsim_command(), *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=600,
+        check=False,
+    )
+
+
+@pytest.fixture(scope="session")
+def cornell() -> rtsim.Scene:
+    return rtsim.load_scene("cornell")
+
+
+@pytest.fixture(scope="session")
+def scenes_dir() -> Path:
+    env = os.environ.get("RTSIM_SCENES")
+    path = Path(env) if env else REPO.parent / "shared" / "scenes"
+    if not path.is_dir():
+        pytest.skip(f"shared scenes not found (RTSIM_SCENES={env!r})")
+    return path
+
+
+@pytest.fixture(scope="session")
+def cornell_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """`rtsim trace cornell` run once through the command line; returns the trace folder."""
+    out = tmp_path_factory.mktemp("cornell") / "trace"
+    result = run_rtsim(
+        "trace",
+        "cornell",
+        "-o",
+        str(out),
+        "--workload",
+        TRACE_WORKLOAD,
+        "--resolution",
+        f"{TRACE_WIDTH}x{TRACE_HEIGHT}",
+        "--bounces",
+        "2",
+    )
+    assert result.returncode == 0, result.stderr
+    return out

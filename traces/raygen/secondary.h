@@ -1,0 +1,36 @@
+#pragma once
+// Secondary rays spawned at the hit of a path ray (primary, reflection, refraction or diffuse):
+// shadow rays to the lights, a mirror reflection, a refraction, a cosine-weighted diffuse bounce,
+// each only if the plan generates that kind. Random numbers come from (seed, pixel, depth, slot)
+// so the result does not depend on thread count or order.
+#include <cstdint>
+#include <vector>
+
+#include "traces/common/ray.h"
+#include "traces/raygen/workload.h"
+#include "traces/scene/scene.h"
+
+namespace rtsim {
+
+struct PendingRay {
+    Ray ray;
+    RayKind kind = RayKind::primary;
+    uint32_t pixel = 0;
+    uint16_t depth = 0;
+    bool any_hit = false;
+    float shade = 0.0f;  ///< shadow rays: cosine at the surface (for the preview render)
+};
+
+struct SpawnContext {
+    const Scene* scene;
+    const WorkloadPlan* plan;
+    uint32_t bounces;  ///< path rays deeper than this are not spawned
+    uint64_t seed;
+};
+
+/// Appends the secondaries of `parent` (which hit `hit`) to out; `index` is the parent's position
+/// in its wavefront, used only to decorrelate random numbers.
+void spawn_secondaries(const SpawnContext& ctx, const PendingRay& parent, const Hit& hit, uint64_t index,
+                       std::vector<PendingRay>* out);
+
+}  // namespace rtsim

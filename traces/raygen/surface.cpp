@@ -1,0 +1,88 @@
+#include "traces/raygen/surface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rtsim {
+
+namespace {
+
+// gamma(n) of Higham / pbrt: bound on the relative error of n float operations.
+constexpr float gamma(int n) {
+    constexpr float eps = std::numeric_limits<float>::epsilon() * 0.5f;
+    return (n * eps) / (1.0f - n * eps);
+}
+
+}  // namespace
+
+SurfacePoint surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
+    const Triangle& tri = scene.triangles[hit.prim];
+    float b0 = 1.0f - hit.u - hit.v;
+    SurfacePoint sp;
+    // Barycentric interpolation and its error bound (pbrt-v4 Triangle::InteractionFromIntersection).
+    sp.position = b0 * tri.v0 + hit.u * tri.v1 + hit.v * tri.v2;
+    Vec3 abs_sum = glm::abs(b0 * tri.v0) + glm::abs(hit.u * tri.v1) + glm::abs(hit.v * tri.v2);
+    // pbrt's bound is zero in an axis where all three vertices are 0 (a wall in the plane x = 0),
+    // and then the offset vanishes while the shear in the triangle test can still turn the exact
+    // t = 0 of a self-hit into ~1e-9. A floor relative to the point's magnitude keeps the offset
+    // non-zero and scale-invariant.
+    float floor = std::max(abs_sum.x, std::max(abs_sum.y, abs_sum.z));
+    sp.error = gamma(7) * (abs_sum + Vec3(floor));
+    Vec3 n = glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+    float len = glm::length(n);
+    n = len > 0.0f ? n / len : Vec3(0.0f, 0.0f, 1.0f);
+    sp.front = glm::dot(n, ray.direction) <= 0.0f;
+    if (!sp.front) n = -n;
+    sp.normal = n;
+    sp.prim = uint32_t(hit.prim);
+    sp.material = scene.tri_material[hit.prim];
+    return sp;
+}
+
+Vec3 offset_ray_origin(const SurfacePoint& p, const Vec3& w) {
+    float d = glm::dot(glm::abs(p.normal), p.error);
+    Vec3 offset = d * p.normal;
+    if (glm::dot(w, p.normal) < 0.0f) offset = -offset;
+    Vec3 po = p.position + offset;
+    // Round away from the surface so the offset survives the addition.
+    for (int i = 0; i < 3; ++i) {
+        if (offset[i] > 0.0f)
+            po[i] = std::nextafter(po[i], std::numeric_limits<float>::infinity());
+        else if (offset[i] < 0.0f)
+            po[i] = std::nextafter(po[i], -std::numeric_limits<float>::infinity());
+    }
+    return po;
+}
+
+void make_basis(const Vec3& n, Vec3* b1, Vec3* b2) {
+    float sign = std::copysign(1.0f, n.z);
+    float a = -1.0f / (sign + n.z);
+    float b = n.x * n.y * a;
+    *b1 = Vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    *b2 = Vec3(b, sign + n.y * n.y * a, -n.y);
+}
+
+Vec3 cosine_hemisphere(const Vec3& n, float u1, float u2) {
+    float r = std::sqrt(u1);
+    float phi = 6.28318530718f * u2;
+    float x = r * std::cos(phi), y = r * std::sin(phi);
+    float z = std::sqrt(std::max(0.0f, 1.0f - u1));
+    Vec3 b1, b2;
+    make_basis(n, &b1, &b2);
+    return glm::normalize(x * b1 + y * b2 + z * n);
+}
+
+Vec3 reflect(const Vec3& d, const Vec3& n) { return d - 2.0f * glm::dot(d, n) * n; }
+
+bool refract(const Vec3& d, const Vec3& n, float eta_i, float eta_t, Vec3* out) {
+    float eta = eta_i / eta_t;
+    float cos_i = -glm::dot(d, n);
+    float sin2_t = eta * eta * std::max(0.0f, 1.0f - cos_i * cos_i);
+    if (sin2_t >= 1.0f) return false;
+    float cos_t = std::sqrt(1.0f - sin2_t);
+    *out = glm::normalize(eta * d + (eta * cos_i - cos_t) * n);
+    return true;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,141 @@
+#include "traces/raygen/workload.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace rtsim {
+
+namespace {
+
+/// "3 materials (a, b, c)", naming at most four.
+std::string count_names(const std::vector<std::string>& names, const char* noun) {
+    std::ostringstream out;
+    out << names.size() << " " << noun << (names.size() == 1 ? "" : "s");
+    if (!names.empty()) {
+        out << " (";
+        for (size_t i = 0; i < names.size() && i < 4; ++i) out << (i ? ", " : "") << names[i];
+        if (names.size() > 4) out << ", ...";
+        out << ")";
+    }
+    return out.str();
+}
+
+std::string material_label(const Material& m, size_t index) {
+    return m.name.empty() ? "material " + std::to_string(index) : m.name;
+}
+
+/// Materials used by at least one triangle, so unused entries do not trigger effects.
+std::vector<bool> used_materials(const Scene& scene) {
+    std::vector<bool> used(scene.materials.size(), false);
+    for (uint32_t m : scene.tri_material) used[m] = true;
+    return used;
+}
+
+void plan_emissive(const Scene& scene, const std::vector<bool>& used, WorkloadPlan* plan) {
+    double total = 0.0;
+    std::vector<double> areas;
+    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+        if (!scene.materials[scene.tri_material[i]].is_emissive()) continue;
+        const Triangle& t = scene.triangles[i];
+        double area = 0.5 * glm::length(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
+        if (!(area > 0.0)) continue;
+        plan->emissive_prims.push_back(uint32_t(i));
+        total += area;
+        areas.push_back(total);
+    }
+    for (double a : areas) plan->emissive_cdf.push_back(float(a / total));
+    if (!plan->emissive_cdf.empty()) plan->emissive_cdf.back() = 1.0f;
+}
+
+}  // namespace
+
+bool material_reflects(const Material& m) { return m.metallic >= 0.5f || m.roughness <= 0.2f; }
+bool material_refracts(const Material& m) { return m.transmission > 0.0f; }
+
+WorkloadPlan plan_workload(const Scene& scene, const std::vector<RayKind>& requested) {
+    WorkloadPlan plan;
+    auto asked = [&](RayKind k) { return std::find(requested.begin(), requested.end(), k) != requested.end(); };
+    std::vector<bool> used = used_materials(scene);
+    plan_emissive(scene, used, &plan);
+
+    std::vector<std::string> reflective, transmissive, masked, emissive;
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        if (!used[i]) continue;
+        const Material& m = scene.materials[i];
+        if (material_reflects(m)) reflective.push_back(material_label(m, i));
+        if (material_refracts(m)) transmissive.push_back(material_label(m, i));
+        if (m.alpha_mode == AlphaMode::mask) masked.push_back(material_label(m, i));
+        if (m.is_emissive()) emissive.push_back(material_label(m, i));
+    }
+    plan.reflective_materials = uint32_t(reflective.size());
+    plan.transmissive_materials = uint32_t(transmissive.size());
+
+    // One entry per ray kind: called for by the scene? asked for by the user?
+    auto decide = [&](RayKind kind, bool called_for, const std::string& because, const std::string& not_because) {
+        Effect e{ray_kind_name(kind), false, ""};
+        if (!asked(kind)) {
+            e.why = "not requested" + (called_for ? " (the scene has " + because + ")" : "");
+        } else if (!called_for) {
+            e.why = "requested, but " + not_because;
+        } else {
+            e.simulated = true;
+            e.why = because;
+        }
+        plan.generate[size_t(kind)] = e.simulated;
+        plan.effects.push_back(e);
+    };
+    decide(RayKind::primary, true, "camera rays, one per pixel", "");
+    std::string lights;
+    if (!scene.lights.empty()) lights = std::to_string(scene.lights.size()) + " punctual light" + (scene.lights.size() == 1 ? "" : "s");
+    if (!plan.emissive_prims.empty())
+        lights += (lights.empty() ? "" : " and ") + std::to_string(plan.emissive_prims.size()) +
+                  " emissive triangles of " + count_names(emissive, "material");
+    decide(RayKind::shadow, !lights.empty(), lights, "the scene has no punctual light and no emissive material");
+    decide(RayKind::reflection, !reflective.empty(), count_names(reflective, "metallic or smooth material"),
+           "no material is metallic (>= 0.5) or smooth (roughness <= 0.2)");
+    decide(RayKind::diffuse, true, "cosine-weighted bounces from every surface", "");
+    decide(RayKind::refraction, !transmissive.empty(), count_names(transmissive, "transmissive material"),
+           "no material has KHR_materials_transmission");
+
+    // Model features the scene calls for (used by the SystemC model to instantiate blocks).
+    plan.effects.push_back({"alpha_mask", !masked.empty(),
+                            masked.empty() ? "no alphaMode MASK material"
+                                           : count_names(masked, "MASK material") +
+                                                 ": any-hit alpha test, stochastic by textureAlphaCoverage"});
+    size_t meshes_used = scene.meshes.size();
+    plan.effects.push_back({"instancing", false,
+                            scene.uses_instancing()
+                                ? std::to_string(scene.instances.size()) + " instances of " + std::to_string(meshes_used) +
+                                      " meshes, flattened to one world-space BVH (two-level BVH not modelled yet)"
+                                : "every mesh is placed once"});
+    return plan;
+}
+
+std::vector<LightSample> light_samples(const Scene& scene, const WorkloadPlan& plan, float u0, float u1, float u2) {
+    std::vector<LightSample> out;
+    for (const Light& light : scene.lights) {
+        LightSample s;
+        if (light.type == LightType::directional) {
+            s.direction = -glm::normalize(light.direction);
+            s.at_infinity = true;
+        } else {
+            s.point = light.position;
+        }
+        out.push_back(s);
+    }
+    if (!plan.emissive_cdf.empty()) {
+        size_t i = std::lower_bound(plan.emissive_cdf.begin(), plan.emissive_cdf.end(), u0) - plan.emissive_cdf.begin();
+        i = std::min(i, plan.emissive_cdf.size() - 1);
+        const Triangle& t = scene.triangles[plan.emissive_prims[i]];
+        // Uniform point on the triangle (square-root parameterisation).
+        float su = std::sqrt(u1);
+        float b1 = 1.0f - su, b2 = u2 * su;
+        LightSample s;
+        s.point = (1.0f - b1 - b2) * t.v0 + b1 * t.v1 + b2 * t.v2;
+        out.push_back(s);
+    }
+    return out;
+}
+
+}  // namespace rtsim

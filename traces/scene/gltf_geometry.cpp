@@ -1,0 +1,131 @@
+// glTF meshes to rtsim::Mesh: every primitive's triangles, in primitive order, as a triangle list.
+#include <cstring>
+#include <vector>
+
+#include "traces/scene/gltf_internal.h"
+
+namespace rtsim::gltf {
+
+namespace {
+
+const char* mode_name(int mode) {
+    switch (mode) {
+        case TINYGLTF_MODE_POINTS: return "POINTS";
+        case TINYGLTF_MODE_LINE: return "LINES";
+        case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
+        case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
+        case TINYGLTF_MODE_TRIANGLES: return "TRIANGLES";
+        case TINYGLTF_MODE_TRIANGLE_STRIP: return "TRIANGLE_STRIP";
+        case TINYGLTF_MODE_TRIANGLE_FAN: return "TRIANGLE_FAN";
+        default: return "unknown";
+    }
+}
+
+/// Vertex indices of a primitive as a triangle list. Strips and fans follow the glTF 2.0 spec
+/// (section 3.7.2.1) so that every triangle keeps the winding of the first one:
+/// strip triangle i = {i, i + 1 + i%2, i + 2 - i%2}; fan triangle i = {i + 1, i + 2, 0}.
+std::vector<uint32_t> triangle_list(const std::vector<uint32_t>& idx, int mode) {
+    std::vector<uint32_t> out;
+    size_t n = idx.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        out.assign(idx.begin(), idx.begin() + (n / 3) * 3);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP && n >= 3) {
+        out.reserve(3 * (n - 2));
+        for (size_t i = 0; i + 2 < n; ++i) {
+            size_t odd = i % 2;
+            out.insert(out.end(), {idx[i], idx[i + 1 + odd], idx[i + 2 - odd]});
+        }
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN && n >= 3) {
+        out.reserve(3 * (n - 2));
+        for (size_t i = 0; i + 2 < n; ++i) out.insert(out.end(), {idx[i + 1], idx[i + 2], idx[0]});
+    }
+    return out;
+}
+
+/// Reads a primitive's index accessor (u8/u16/u32 SCALAR) or makes 0..vertex_count-1.
+std::vector<uint32_t> read_indices(const Source& src, const tinygltf::Primitive& prim,
+                                   size_t vertex_count, const std::string& where) {
+    std::vector<uint32_t> idx;
+    if (prim.indices < 0) {
+        idx.resize(vertex_count);
+        for (size_t i = 0; i < vertex_count; ++i) idx[i] = uint32_t(i);
+        return idx;
+    }
+    AccessorView view = view_accessor(src, prim.indices, where + " indices");
+    int ct = view.component_type;
+    bool integer = ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                   ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+                   ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    if (!integer || view.components != 1)
+        src.fail(where + ": indices must be SCALAR unsigned byte/short/int (componentType " +
+                 std::to_string(ct) + ")");
+    idx.resize(view.count);
+    for (size_t i = 0; i < view.count; ++i) {
+        idx[i] = view.index(i);
+        if (idx[i] >= vertex_count)
+            src.fail(where + ": index " + std::to_string(idx[i]) + " out of range (vertex count " +
+                     std::to_string(vertex_count) + ")");
+    }
+    return idx;
+}
+
+/// Appends one primitive's triangles (positions and material ids) to `out`.
+void read_primitive(const Source& src, const tinygltf::Primitive& prim, const std::string& where,
+                    Scene& scene, Mesh& out) {
+    int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN)
+        src.fail(where + ": unsupported primitive mode " + std::to_string(mode) + " (" +
+                 mode_name(mode) + "); only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are traced");
+    auto pos_it = prim.attributes.find("POSITION");
+    if (pos_it == prim.attributes.end()) src.fail(where + ": no POSITION attribute");
+    AccessorView pos = view_accessor(src, pos_it->second, where + " POSITION");
+    if (pos.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT || pos.components != 3)
+        src.fail(where + ": POSITION must be float VEC3 (componentType " +
+                 std::to_string(pos.component_type) + ", " + std::to_string(pos.components) +
+                 " components; KHR_mesh_quantization is not supported)");
+
+    const tinygltf::Model& m = *src.model;
+    uint32_t material;
+    if (prim.material < 0) {
+        material = scene.default_material();
+    } else if (size_t(prim.material) < m.materials.size()) {
+        material = uint32_t(prim.material);
+    } else {
+        src.fail(where + ": material index " + std::to_string(prim.material) + " out of range (" +
+                 std::to_string(m.materials.size()) + " materials)");
+    }
+
+    std::vector<uint32_t> list = triangle_list(read_indices(src, prim, pos.count, where), mode);
+    if (mode == TINYGLTF_MODE_TRIANGLES && prim.indices >= 0 &&
+        m.accessors[size_t(prim.indices)].count % 3 != 0)
+        scene.warnings.push_back(where + ": index count not a multiple of 3; extra indices ignored");
+    out.positions.reserve(out.positions.size() + list.size());
+    for (uint32_t i : list) {
+        const unsigned char* p = pos.data + size_t(i) * pos.stride;
+        float xyz[3];
+        std::memcpy(xyz, p, sizeof(xyz));
+        out.positions.emplace_back(xyz[0], xyz[1], xyz[2]);
+    }
+    out.materials.insert(out.materials.end(), list.size() / 3, material);
+}
+
+}  // namespace
+
+uint32_t read_mesh(const Source& src, int mesh_index, Scene& scene) {
+    const tinygltf::Mesh& gm = src.model->meshes[size_t(mesh_index)];
+    std::string mesh_name = element("mesh", size_t(mesh_index), gm.name);
+    Mesh mesh;
+    mesh.name = gm.name.empty() ? "mesh_" + std::to_string(mesh_index) : gm.name;
+    for (size_t p = 0; p < gm.primitives.size(); ++p) {
+        const tinygltf::Primitive& prim = gm.primitives[p];
+        std::string where = mesh_name + " primitive " + std::to_string(p);
+        if (!prim.targets.empty())
+            scene.warnings.push_back(where + ": morph targets ignored (base positions used)");
+        read_primitive(src, prim, where, scene, mesh);
+    }
+    scene.meshes.push_back(std::move(mesh));
+    return uint32_t(scene.meshes.size() - 1);
+}
+
+}  // namespace rtsim::gltf

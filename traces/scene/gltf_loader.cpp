@@ -1,0 +1,226 @@
+// load_gltf: reads the file through tinygltf, walks the default scene's node hierarchy in double
+// precision and turns meshes, EXT_mesh_gpu_instancing entries, lights and cameras into a Scene.
+#include "traces/scene/gltf_loader.h"
+
+#include <fstream>
+#include <set>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "traces/scene/gltf_internal.h"
+
+namespace rtsim {
+
+namespace {
+
+using gltf::element;
+using gltf::Source;
+
+/// Extensions whose meaning rtsim reads or which cannot change the geometry.
+bool extension_supported(const std::string& name) {
+    static const std::set<std::string> kGeometry = {"EXT_mesh_gpu_instancing", "KHR_lights_punctual",
+                                                    "KHR_texture_transform", "KHR_materials_variants"};
+    return kGeometry.count(name) || name.rfind("KHR_materials_", 0) == 0;
+}
+
+/// Loads the model (binary if the file starts with the GLB magic) or throws naming the file.
+void load_model(const std::string& path, tinygltf::Model& model, Scene& scene) {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw Error(path + ": cannot open file");
+    char magic[4] = {0, 0, 0, 0};
+    probe.read(magic, 4);
+    bool binary = probe.gcount() == 4 && std::string(magic, 4) == "glTF";
+    probe.close();
+
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                     : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    if (!ok || !err.empty()) {
+        while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+        throw Error(path + ": " + (err.empty() ? std::string("tinygltf failed to load the file") : err));
+    }
+    if (!warn.empty()) scene.warnings.push_back(warn);
+    for (const std::string& ext : model.extensionsRequired)
+        if (!extension_supported(ext)) throw Error(path + ": required extension " + ext + " is not supported");
+}
+
+/// A node's local matrix: `matrix` if present, else T * R * S (glTF 2.0 section 3.5.3).
+glm::dmat4 local_matrix(const Source& src, const tinygltf::Node& node, size_t index) {
+    std::string where = element("node", index, node.name);
+    if (!node.matrix.empty()) {
+        if (node.matrix.size() != 16) src.fail(where + ": matrix must have 16 numbers");
+        glm::dmat4 m;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m[c][r] = node.matrix[size_t(4 * c + r)];  // column-major
+        return m;
+    }
+    glm::dmat4 t(1.0), r(1.0), s(1.0);
+    if (!node.translation.empty()) {
+        if (node.translation.size() != 3) src.fail(where + ": translation must have 3 numbers");
+        t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+    }
+    if (!node.rotation.empty()) {
+        if (node.rotation.size() != 4) src.fail(where + ": rotation must have 4 numbers");
+        const auto& q = node.rotation;  // glTF order x, y, z, w
+        r = glm::mat4_cast(glm::normalize(glm::dquat(q[3], q[0], q[1], q[2])));
+    }
+    if (!node.scale.empty()) {
+        if (node.scale.size() != 3) src.fail(where + ": scale must have 3 numbers");
+        s = glm::scale(glm::dmat4(1.0), glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+    }
+    return t * r * s;
+}
+
+/// Instance transforms of an EXT_mesh_gpu_instancing node: world x T_i x R_i x S_i.
+std::vector<glm::dmat4> gpu_instances(const Source& src, const tinygltf::Value& ext, size_t node,
+                                      const glm::dmat4& world) {
+    std::string where = element("node", node, src.model->nodes[node].name) + " EXT_mesh_gpu_instancing";
+    const tinygltf::Value& attrs = ext.IsObject() ? ext.Get("attributes") : ext;
+    if (!attrs.IsObject()) src.fail(where + ": no attributes object");
+    const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+    const int sizes[3] = {3, 4, 3};
+    gltf::AccessorView views[3];
+    bool present[3] = {false, false, false};
+    size_t count = 0;
+    bool have_count = false;
+    for (int a = 0; a < 3; ++a) {
+        if (!attrs.Has(names[a])) continue;
+        const tinygltf::Value& v = attrs.Get(names[a]);
+        if (!v.IsNumber()) src.fail(where + ": " + names[a] + " is not an accessor index");
+        views[a] = gltf::view_accessor(src, gltf::as_index(v.GetNumberAsDouble()), where + " " + names[a]);
+        if (views[a].components != sizes[a]) src.fail(where + ": " + names[a] + " has the wrong type");
+        if (have_count && views[a].count != count) src.fail(where + ": attribute counts differ");
+        count = views[a].count;
+        have_count = present[a] = true;
+    }
+    if (!have_count) src.fail(where + ": no TRANSLATION, ROTATION or SCALE attribute");
+    std::vector<glm::dmat4> out(count);
+    for (size_t i = 0; i < count; ++i) {
+        glm::dmat4 t(1.0), r(1.0), s(1.0);
+        auto comp = [&](int a, int c) { return double(views[a].component(i, c)); };
+        if (present[0]) t[3] = glm::dvec4(comp(0, 0), comp(0, 1), comp(0, 2), 1.0);
+        if (present[1]) r = glm::mat4_cast(glm::normalize(glm::dquat(comp(1, 3), comp(1, 0), comp(1, 1), comp(1, 2))));
+        if (present[2]) s = glm::scale(glm::dmat4(1.0), glm::dvec3(comp(2, 0), comp(2, 1), comp(2, 2)));
+        out[i] = world * t * r * s;
+    }
+    return out;
+}
+
+/// Depth-first walk of the scene's nodes (order documented in scene.h).
+class NodeWalker {
+public:
+    NodeWalker(const Source& src, Scene& scene)
+        : m_src(src), m_scene(scene), m_state(src.model->nodes.size(), 0),
+          m_mesh_of(src.model->meshes.size(), -1) {}
+
+    void walk_root(int node) {
+        check_index(node, "scene root");
+        // Explicit stack: deep hierarchies cannot overflow the call stack.
+        struct Frame {
+            size_t node;
+            glm::dmat4 world;
+            size_t next_child;
+        };
+        std::vector<Frame> stack;
+        stack.push_back({size_t(node), enter(size_t(node), glm::dmat4(1.0)), 0});
+        while (!stack.empty()) {
+            Frame& f = stack.back();
+            const tinygltf::Node& gn = m_src.model->nodes[f.node];
+            if (f.next_child == gn.children.size()) {
+                m_state[f.node] = 2;
+                stack.pop_back();
+                continue;
+            }
+            int child = gn.children[f.next_child++];
+            check_index(child, element("node", f.node, gn.name) + " child");
+            glm::dmat4 world = f.world;  // copy: push_back may move the frame
+            stack.push_back({size_t(child), enter(size_t(child), world), 0});
+        }
+    }
+
+private:
+    void check_index(int node, const std::string& where) {
+        if (node < 0 || size_t(node) >= m_state.size())
+            m_src.fail(where + ": node index " + std::to_string(node) + " out of range (" +
+                       std::to_string(m_state.size()) + " nodes)");
+    }
+
+    /// Marks the node visited, emits what it carries and returns its world matrix.
+    glm::dmat4 enter(size_t index, const glm::dmat4& parent) {
+        const tinygltf::Node& node = m_src.model->nodes[index];
+        std::string where = element("node", index, node.name);
+        if (m_state[index] == 1) m_src.fail(where + ": node cycle (the node is its own ancestor)");
+        if (m_state[index] == 2) m_src.fail(where + ": reached twice (a node may have only one parent)");
+        m_state[index] = 1;
+        glm::dmat4 world = parent * local_matrix(m_src, node, index);
+        if (node.mesh >= 0 || node.mesh < -1) emit_mesh(index, world);
+        auto light = node.extensions.find("KHR_lights_punctual");
+        if (light != node.extensions.end())
+            m_scene.lights.push_back(gltf::read_light(
+                m_src, gltf::as_index(gltf::value_number(light->second, "light", -1.0)), world, int(index)));
+        if (node.camera >= 0)
+            m_scene.cameras.push_back(gltf::read_camera(m_src, node.camera, world, int(index), m_scene));
+        if (node.skin >= 0) m_scene.warnings.push_back(where + ": skin ignored (bind pose used)");
+        return world;
+    }
+
+    void emit_mesh(size_t index, const glm::dmat4& world) {
+        const tinygltf::Node& node = m_src.model->nodes[index];
+        if (node.mesh < 0 || size_t(node.mesh) >= m_mesh_of.size())
+            m_src.fail(element("node", index, node.name) + ": mesh index " + std::to_string(node.mesh) +
+                       " out of range (" + std::to_string(m_mesh_of.size()) + " meshes)");
+        // One rtsim::Mesh per glTF mesh, however many nodes use it.
+        int& mesh = m_mesh_of[size_t(node.mesh)];
+        if (mesh < 0) mesh = int(gltf::read_mesh(m_src, node.mesh, m_scene));
+        auto inst = node.extensions.find("EXT_mesh_gpu_instancing");
+        if (inst == node.extensions.end()) {
+            m_scene.instances.push_back({uint32_t(mesh), world, 0, int32_t(index)});
+            return;
+        }
+        for (const glm::dmat4& m : gpu_instances(m_src, inst->second, index, world))
+            m_scene.instances.push_back({uint32_t(mesh), m, 0, int32_t(index)});
+    }
+
+    const Source& m_src;
+    Scene& m_scene;
+    std::vector<uint8_t> m_state;  ///< 0 unvisited, 1 on the current path, 2 done
+    std::vector<int> m_mesh_of;    ///< glTF mesh index -> Scene::meshes index (-1 not read yet)
+};
+
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+    Scene scene;
+    scene.source = path;
+    tinygltf::Model model;
+    load_model(path, model, scene);
+    Source src{path, &model};
+    gltf::read_materials(src, scene);
+
+    // Default scene: model.defaultScene, else scene 0, else every root node.
+    std::vector<int> roots;
+    if (!model.scenes.empty()) {
+        int s = model.defaultScene >= 0 ? model.defaultScene : 0;
+        if (size_t(s) >= model.scenes.size())
+            src.fail("default scene " + std::to_string(s) + " out of range (" +
+                     std::to_string(model.scenes.size()) + " scenes)");
+        roots = model.scenes[size_t(s)].nodes;
+    } else {
+        std::vector<bool> is_child(model.nodes.size(), false);
+        for (const auto& n : model.nodes)
+            for (int c : n.children)
+                if (c >= 0 && size_t(c) < model.nodes.size()) is_child[size_t(c)] = true;
+        for (size_t i = 0; i < model.nodes.size(); ++i)
+            if (!is_child[i]) roots.push_back(int(i));
+    }
+    NodeWalker walker(src, scene);
+    for (int r : roots) walker.walk_root(r);
+
+    if (scene.materials.empty()) scene.default_material();
+    scene.flatten();
+    return scene;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,46 @@
+// The procedural scene registry: names to writers.
+#include "traces/scene/procedural.h"
+
+#include "traces/common/error.h"
+#include "traces/scene/procedural_shapes.h"
+
+namespace rtsim {
+
+namespace {
+
+struct Entry {
+    const char* name;
+    std::string (*write)(const std::string&, const ProceduralOptions&);
+};
+
+const Entry kScenes[] = {
+    {"cornell", write_cornell},
+    {"hairball", write_hairball},
+    {"teapot_stadium", write_teapot_stadium},
+    {"rotated_walls", write_rotated_walls},
+};
+
+}  // namespace
+
+std::vector<std::string> procedural_scene_names() {
+    std::vector<std::string> names;
+    for (const Entry& e : kScenes) names.push_back(e.name);
+    return names;
+}
+
+bool is_procedural_scene(const std::string& name) {
+    for (const Entry& e : kScenes)
+        if (name == e.name) return true;
+    return false;
+}
+
+std::string write_procedural_scene(const std::string& name, const std::string& dir,
+                                   const ProceduralOptions& options) {
+    for (const Entry& e : kScenes)
+        if (name == e.name) return e.write(dir, options);
+    std::string known;
+    for (const Entry& e : kScenes) known += std::string(known.empty() ? "" : ", ") + e.name;
+    throw Error("unknown procedural scene '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace rtsim

@@ -1,0 +1,24 @@
+#pragma once
+// Scenes the project generates itself, written as glTF so they take the same path as real ones.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rtsim {
+
+struct ProceduralOptions {
+    /// Exact triangle count of the hairball; up to millions (the other scenes have fixed detail).
+    uint32_t hairball_triangles = 200000;
+    uint64_t seed = 1;
+};
+
+/// Names of the built-in scenes: "cornell", "hairball", "teapot_stadium", "rotated_walls".
+std::vector<std::string> procedural_scene_names();
+bool is_procedural_scene(const std::string& name);
+
+/// Writes scene `name` as `<dir>/<name>.gltf` (+ .bin) and returns the .gltf path.
+/// Throws rtsim::Error for an unknown name, listing the known ones.
+std::string write_procedural_scene(const std::string& name, const std::string& dir,
+                                   const ProceduralOptions& options = {});
+
+}  // namespace rtsim

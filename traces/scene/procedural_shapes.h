@@ -1,0 +1,36 @@
+#pragma once
+// Tessellated shapes for the procedural scenes, and the per-scene writers. Internal to traces/scene.
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "traces/scene/gltf_writer.h"
+#include "traces/scene/procedural.h"
+
+namespace rtsim {
+
+/// Closed surface of revolution about +Y: `profile` holds (radius, height) points from bottom to
+/// top; `segments` around. Faces wound outward when the profile runs bottom to top.
+void add_lathe(TriangleSoup& soup, const std::vector<glm::vec2>& profile, int segments,
+               const glm::dmat4& m = glm::dmat4(1.0));
+/// UV sphere of `rings` x `segments` quads (poles as triangle fans).
+void add_sphere(TriangleSoup& soup, const Vec3& center, float radius, int rings, int segments);
+/// Torus about the local Z axis (major radius R, minor r), transformed by m.
+void add_torus(TriangleSoup& soup, float major, float minor, int major_segs, int minor_segs,
+               const glm::dmat4& m);
+/// Tube of circular section swept along `path` with per-point radius.
+void add_tube(TriangleSoup& soup, const std::vector<Vec3>& path, const std::vector<float>& radius,
+              int sides);
+
+/// Builds a Material in one line.
+Material make_material(const std::string& name, const Vec3& color, float metallic, float roughness,
+                       const Vec3& emissive = Vec3(0.0f));
+
+// One writer per scene (procedural_*.cpp); each returns the .gltf path.
+std::string write_cornell(const std::string& dir, const ProceduralOptions& options);
+std::string write_hairball(const std::string& dir, const ProceduralOptions& options);
+std::string write_teapot_stadium(const std::string& dir, const ProceduralOptions& options);
+std::string write_rotated_walls(const std::string& dir, const ProceduralOptions& options);
+
+}  // namespace rtsim

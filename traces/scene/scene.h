@@ -1,0 +1,112 @@
+#pragma once
+// The scene as the tracer sees it: unique meshes in object space, instances placing them in the
+// world, materials, lights and cameras, plus the flattened world-space triangle list.
+//
+// Stable primitive ids. Instances are numbered in the order a depth-first walk of the glTF
+// default scene meets them: root nodes in `scene.nodes` order, children in `node.children`
+// order, a node's mesh before its children; a node with EXT_mesh_gpu_instancing yields one
+// instance per entry, in accessor order. Within an instance, triangles follow the mesh's
+// primitives in order and each primitive's indices in order (strips and fans converted to
+// triangle lists first). The primitive id of a triangle is instance.prim_base + its index in
+// the mesh, so ids run 0..N-1 over the whole scene and `triangles()` is indexed by them.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "traces/common/aabb.h"
+
+namespace rtsim {
+
+enum class AlphaMode : uint8_t { opaque = 0, mask = 1, blend = 2 };
+
+struct Material {
+    std::string name;
+    glm::vec4 base_color{1.0f};
+    float metallic = 1.0f;   ///< glTF default
+    float roughness = 1.0f;  ///< glTF default
+    AlphaMode alpha_mode = AlphaMode::opaque;
+    float alpha_cutoff = 0.5f;
+    float transmission = 0.0f;  ///< KHR_materials_transmission
+    float ior = 1.5f;           ///< KHR_materials_ior
+    Vec3 emissive{0.0f};        ///< emissiveFactor x KHR_materials_emissive_strength
+    /// Fraction of texels passing the alpha cutoff (extras.textureAlphaCoverage); 1 if unknown.
+    /// Drives the deterministic stochastic alpha test of MASK materials.
+    float alpha_coverage = 1.0f;
+
+    bool is_emissive() const { return emissive.x > 0.0f || emissive.y > 0.0f || emissive.z > 0.0f; }
+};
+
+enum class LightType : uint8_t { point = 0, spot = 1, directional = 2 };
+
+/// KHR_lights_punctual light, in world space.
+struct Light {
+    std::string name;
+    LightType type = LightType::point;
+    Vec3 position{0.0f};
+    Vec3 direction{0.0f, 0.0f, -1.0f};  ///< direction the light points to (spot, directional)
+    Vec3 color{1.0f};
+    float intensity = 1.0f;
+    float range = 0.0f;  ///< 0 means infinite
+    float inner_cone = 0.0f;
+    float outer_cone = 0.785398163f;
+};
+
+/// Perspective camera, in world space (orthographic cameras are read as perspective with a
+/// warning in the manifest; rtsim only generates pinhole rays).
+struct Camera {
+    std::string name;
+    Vec3 eye{0.0f};
+    Vec3 forward{0.0f, 0.0f, -1.0f};  ///< unit
+    Vec3 up{0.0f, 1.0f, 0.0f};        ///< unit, orthogonal to forward
+    float yfov = 0.8f;                ///< radians
+    float aspect = 0.0f;              ///< 0: take it from the image resolution
+};
+
+/// Unique geometry in object space: one glTF mesh, all its triangle primitives concatenated.
+struct Mesh {
+    std::string name;
+    std::vector<Vec3> positions;      ///< 3 per triangle (v0, v1, v2)
+    std::vector<uint32_t> materials;  ///< one per triangle, index into Scene::materials
+    size_t triangle_count() const { return materials.size(); }
+};
+
+/// One placement of a mesh in the world.
+struct Instance {
+    uint32_t mesh = 0;
+    glm::dmat4 object_to_world{1.0};
+    uint32_t prim_base = 0;  ///< primitive id of the mesh's first triangle in this instance
+    int32_t node = -1;       ///< glTF node index it came from (-1 for procedural)
+};
+
+struct Triangle {
+    Vec3 v0, v1, v2;
+};
+
+struct Scene {
+    std::string source;  ///< file the scene was read from
+    std::vector<Mesh> meshes;
+    std::vector<Instance> instances;
+    std::vector<Material> materials;  ///< never empty: a default material is appended if needed
+    std::vector<Light> lights;
+    std::vector<Camera> cameras;
+    std::vector<std::string> warnings;  ///< non-fatal oddities (ignored extensions, ...)
+
+    // Flattened world space, indexed by primitive id (filled by flatten()).
+    std::vector<Triangle> triangles;
+    std::vector<uint32_t> tri_material;
+    std::vector<uint32_t> tri_instance;
+    Aabb bounds;
+
+    /// Fills triangles/tri_material/tri_instance/bounds from meshes and instances. Vertices are
+    /// transformed in double precision and rounded once to float.
+    void flatten();
+    size_t triangle_count() const { return triangles.size(); }
+    /// True if some mesh is placed more than once (shared meshes or GPU instancing).
+    bool uses_instancing() const;
+    /// Index of the default material (white, rough dielectric) appended on demand.
+    uint32_t default_material();
+};
+
+}  // namespace rtsim

@@ -1,0 +1,174 @@
+#include "traces/tracer/tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "traces/bvh/builder.h"
+#include "traces/common/error.h"
+#include "traces/format/trace_writer.h"
+#include "traces/raygen/auto_framing.h"
+#include "traces/raygen/camera.h"
+#include "traces/scene/gltf_loader.h"
+#include "traces/tracer/manifest.h"
+#include "traces/tracer/preview_render.h"
+#include "traces/tracer/wavefront.h"
+
+namespace rtsim {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The camera the user gave, else the scene's first camera, else automatic framing.
+Camera choose_camera(const TraceOptions& o, const Scene& scene, const HwBvh& bvh, std::string* source) {
+    if (o.camera) {
+        *source = "command line";
+        return look_at(o.camera->eye, o.camera->target, o.camera->yfov_degrees);
+    }
+    if (!scene.cameras.empty()) {
+        *source = "glTF camera '" + scene.cameras[0].name + "'";
+        return scene.cameras[0];
+    }
+    return auto_frame(scene, bvh, float(o.width) / float(o.height), source);
+}
+
+std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint32_t h) {
+    std::vector<PendingRay> rays(size_t(w) * h);
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            PendingRay& r = rays[size_t(y) * w + x];
+            r.ray = primary_ray(cam, x, y, w, h);
+            r.kind = RayKind::primary;
+            r.pixel = y * w + x;
+        }
+    return rays;
+}
+
+/// Writes the rays of a traced wavefront that the workload asked for, in order.
+void write_wavefront(TraceWriter& writer, const WorkloadPlan& plan, const std::vector<PendingRay>& rays,
+                     const WavefrontResult& res, RayCounts* counts) {
+    std::vector<RayRecord> ray_rec;
+    std::vector<HitRecord> hit_rec;
+    std::vector<WorkRecord> work_rec;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const PendingRay& r = rays[i];
+        bool written = plan.wants(r.kind);
+        counts->add(r.kind, r.depth, res.hits[i], res.work[i], written);
+        if (!written) continue;
+        ray_rec.push_back(to_record(r.ray, r.kind, r.pixel, r.depth, r.any_hit));
+        hit_rec.push_back(to_record(res.hits[i]));
+        work_rec.push_back(to_record(res.work[i]));
+    }
+    writer.append(SectionKind::rays, ray_rec);
+    writer.append(SectionKind::hits, hit_rec);
+    writer.append(SectionKind::work, work_rec);
+}
+
+/// Next wavefront: secondaries of every path ray, grouped by kind (stable), so a trace lists
+/// depth by depth and, within a depth, shadow, reflection, diffuse, refraction rays.
+std::vector<PendingRay> next_wavefront(const SpawnContext& ctx, const std::vector<PendingRay>& rays,
+                                       const std::vector<Hit>& hits) {
+    std::vector<PendingRay> next;
+    for (size_t i = 0; i < rays.size(); ++i)
+        if (rays[i].kind != RayKind::shadow) spawn_secondaries(ctx, rays[i], hits[i], i, &next);
+    std::stable_sort(next.begin(), next.end(),
+                     [](const PendingRay& a, const PendingRay& b) { return a.kind < b.kind; });
+    return next;
+}
+
+std::string resolve_scene(const TraceOptions& o, bool* procedural) {
+    *procedural = is_procedural_scene(o.scene);
+    if (!*procedural) return o.scene;
+    return write_procedural_scene(o.scene, (fs::path(o.out_dir) / "scene").string(), o.procedural);
+}
+
+void validate(const TraceOptions& o) {
+    require(!o.scene.empty(), "no scene given");
+    require(!o.out_dir.empty(), "no output folder given");
+    require(o.width > 0 && o.height > 0 && uint64_t(o.width) * o.height <= (1ull << 28),
+            "resolution " + std::to_string(o.width) + "x" + std::to_string(o.height) + " is out of range");
+    require(o.bounces <= 64, "bounces " + std::to_string(o.bounces) + " is out of range (0..64)");
+    if (o.camera)
+        require(o.camera->yfov_degrees > 0.0f && o.camera->yfov_degrees < 180.0f,
+                "camera field of view must be in (0, 180) degrees");
+}
+
+}  // namespace
+
+json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
+    validate(o);
+    auto t_start = std::chrono::steady_clock::now();
+    auto report = [&](uint64_t done, uint64_t total, const std::string& stage) {
+        if (progress) progress(done, total, stage);
+    };
+    fs::create_directories(o.out_dir);
+
+    report(0, 1, "load");
+    bool procedural = false;
+    std::string path = resolve_scene(o, &procedural);
+    Scene scene = load_gltf(path);
+    double load_ms = ms_since(t_start);
+    require(scene.triangle_count() > 0, path + ": the scene has no triangles");
+
+    report(0, 1, "bvh");
+    HwBvh bvh = build_bvh(scene, o.bvh);
+    WorkloadPlan plan = plan_workload(scene, o.workload);
+    std::string camera_source;
+    Camera camera = choose_camera(o, scene, bvh, &camera_source);
+    PinholeCamera pinhole = make_camera(camera, o.width, o.height);
+
+    auto t_trace = std::chrono::steady_clock::now();
+    TraceWriter writer((fs::path(o.out_dir) / "trace.rtt").string());
+    writer.append(SectionKind::bvh_nodes, bvh.nodes);
+    writer.append(SectionKind::triangles, bvh.triangles);
+    uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
+    PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
+    SpawnContext ctx{&scene, &plan, o.bounces, o.seed};
+    RayCounts counts;
+
+    std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height);
+    for (uint32_t depth = 0; !wave.empty(); ++depth) {
+        std::string stage = depth == 0 ? "primary" : "depth " + std::to_string(depth);
+        WavefrontResult res = trace_wavefront(bvh, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
+        counts.add_rejected(res.rejected);
+        write_wavefront(writer, plan, wave, res, &counts);
+        render.add(scene, wave, res.hits);
+        wave = next_wavefront(ctx, wave, res.hits);
+    }
+    writer.close();
+    double trace_ms = ms_since(t_trace);
+    render.write_png((fs::path(o.out_dir) / "render.png").string());
+
+    std::string name = procedural ? o.scene : fs::path(path).stem().string();
+    json requested = json::array();
+    for (RayKind k : o.workload) requested.push_back(ray_kind_name(k));
+    json manifest = {
+        {"format", "rtsim-trace"},
+        {"trace_version", kTraceVersion},
+        {"rtsim_version", RTSIM_VERSION},
+        {"git", RTSIM_GIT_HASH},
+        {"scene", scene_json(scene, name, procedural)},
+        {"bvh", bvh_json(bvh, o.bvh)},
+        {"camera", camera_json(camera, camera_source)},
+        {"workload",
+         {{"requested", requested},
+          {"resolution", {o.width, o.height}},
+          {"bounces", o.bounces},
+          {"seed", o.seed},
+          {"effects", effects_json(plan)}}},
+        {"counts", counts.to_json()},
+        {"files", {{"trace", "trace.rtt"}, {"render", "render.png"}}},
+        {"timing_ms", {{"load", load_ms}, {"bvh", bvh.stats.build_ms}, {"trace", trace_ms}, {"total", ms_since(t_start)}}},
+    };
+    std::ofstream((fs::path(o.out_dir) / "manifest.json").string()) << manifest.dump(2) << "\n";
+    return manifest;
+}
+
+}  // namespace rtsim

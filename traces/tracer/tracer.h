@@ -1,0 +1,51 @@
+#pragma once
+// The reference tracer's front door: scene in, trace folder out.
+//   OUT/trace.rtt      rays, reference hits, per-ray work, BVH image (docs/trace_format.md)
+//   OUT/manifest.json  scene, BVH parameters and SAH cost, workload and effects, counts
+//   OUT/render.png     simple shading of the primary hits
+// (Heatmaps of work per pixel are drawn from the trace by the Python package.)
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "traces/bvh/config.h"
+#include "traces/common/ray.h"
+#include "traces/scene/procedural.h"
+
+namespace rtsim {
+
+/// A camera given on the command line: eye, target, vertical field of view in degrees.
+struct CameraOverride {
+    Vec3 eye{0.0f};
+    Vec3 target{0.0f, 0.0f, -1.0f};
+    float yfov_degrees = 60.0f;
+};
+
+struct TraceOptions {
+    std::string scene;    ///< .gltf/.glb path, or a procedural scene name ("cornell", ...)
+    std::string out_dir;  ///< created if missing
+    /// Ray kinds requested. Kinds the scene does not call for are skipped, and the manifest says
+    /// why. Empty means primary only.
+    std::vector<RayKind> workload{RayKind::primary};
+    uint32_t width = 320;
+    uint32_t height = 240;
+    uint32_t bounces = 1;  ///< diffuse bounce depth (and reflection/refraction depth)
+    uint64_t seed = 1;
+    std::optional<CameraOverride> camera;
+    BuildConfig bvh;
+    ProceduralOptions procedural;
+    unsigned threads = 0;  ///< 0: all hardware threads. Output does not depend on it.
+};
+
+/// Progress callback: rays traced so far, rays expected (an estimate until the last wavefront),
+/// and the stage ("load", "bvh", "primary", ...). Called from the calling thread only.
+using ProgressFn = std::function<void(uint64_t done, uint64_t total, const std::string& stage)>;
+
+/// Runs the whole pipeline and returns the manifest it wrote. Throws rtsim::Error on bad input.
+nlohmann::json trace_scene(const TraceOptions& options, const ProgressFn& progress = {});
+
+}  // namespace rtsim

@@ -1,0 +1,23 @@
+#pragma once
+// Traces a wavefront of rays on all threads. Results land at the ray's index, so the output is
+// identical whatever the thread count.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "traces/bvh/hw_layout.h"
+#include "traces/raygen/secondary.h"
+
+namespace rtsim {
+
+struct WavefrontResult {
+    std::vector<Hit> hits;
+    std::vector<WorkCounts> work;
+    uint64_t rejected = 0;  ///< rays failing ray_is_valid (never traversed)
+};
+
+/// progress(done) is called from the calling thread only.
+WavefrontResult trace_wavefront(const HwBvh& bvh, const std::vector<PendingRay>& rays, unsigned threads,
+                                const std::function<void(uint64_t)>& progress);
+
+}  // namespace rtsim
