@@ -17,7 +17,7 @@ fi
 APT_PACKAGES=(
   cmake ninja-build g++ pkg-config
   libsystemc-dev libglm-dev libtinygltf-dev libembree-dev nlohmann-json3-dev libstb-dev
-  libgtest-dev googletest zlib1g-dev
+  libgtest-dev googletest zlib1g-dev libcli11-dev
 )
 
 missing=()

@@ -1,0 +1,45 @@
+#include "rtl_model/common/calendar.h"
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+const char* data_kind_name(DataKind kind) {
+    switch (kind) {
+        case DataKind::node: return "node";
+        case DataKind::triangle: return "triangle";
+        case DataKind::ray: return "ray";
+        case DataKind::hit: return "hit";
+        case DataKind::stack: return "stack";
+    }
+    return "unknown";
+}
+
+BandwidthCalendar::BandwidthCalendar(uint64_t capacity, uint32_t window_cycles, uint32_t horizon)
+    : m_capacity(capacity), m_window(window_cycles) {
+    require(capacity > 0 && window_cycles > 0, "BandwidthCalendar: capacity and window must be positive");
+    uint64_t size = 1;
+    while (size < horizon) size <<= 1;
+    m_mask = size - 1;
+    m_slots.resize(size);
+}
+
+Cycle BandwidthCalendar::reserve(Cycle time, uint64_t amount) {
+    if (amount > m_capacity) amount = m_capacity;  // one request never needs more than a window
+    m_total += amount;
+    for (uint64_t w = time / m_window;; ++w) {
+        Slot& s = m_slots[w & m_mask];
+        if (s.window != w) {
+            if (s.window != ~0ull && s.window > w) continue;  // slot holds a later window: treat as full
+            s.window = w;
+            s.used = 0;
+        }
+        if (s.used + amount > m_capacity) continue;
+        // Start inside the window after what it already serves (fluid approximation).
+        Cycle start = w * m_window + (s.used * m_window) / m_capacity;
+        s.used += amount;
+        return start > time ? start : time;
+    }
+}
+
+}  // namespace rtsim

@@ -1,0 +1,74 @@
+#pragma once
+// The interfaces the model's blocks talk through (SystemC interface method calls, bound with
+// sc_port). Time is carried as cycle counts in the requests: a traversal unit runs ahead of
+// SystemC time by at most a quantum (TLM-2.0 style temporal decoupling) and every block returns
+// when its answer is ready, so no block needs a clock process (DESIGN rule 7).
+#include <cstdint>
+
+#include <systemc>
+
+#include "traces/common/ray.h"
+
+namespace rtsim {
+
+using Cycle = uint64_t;
+
+/// What a memory access carries, for per-kind byte and hit-rate accounting.
+enum class DataKind : uint8_t { node = 0, triangle = 1, ray = 2, hit = 3, stack = 4 };
+constexpr int kDataKindCount = 5;
+const char* data_kind_name(DataKind kind);
+
+struct MemRequest {
+    uint64_t addr = 0;
+    uint32_t bytes = 0;
+    bool write = false;
+    DataKind kind = DataKind::node;
+    Cycle time = 0;  ///< cycle the request is issued
+};
+
+/// Contract: returns the cycle the data is available (reads) or accepted (writes), >= req.time.
+/// Requests from one issuer arrive in non-decreasing time; different issuers may be out of order
+/// by up to a quantum.
+class MemIf : public virtual sc_core::sc_interface {
+public:
+    virtual Cycle access(const MemRequest& req) = 0;
+};
+
+/// Contract: `tests` tests issued at or after `time`; returns the cycle the last result is ready.
+class PipeIf : public virtual sc_core::sc_interface {
+public:
+    virtual Cycle issue(Cycle time, uint32_t tests) = 0;
+};
+
+/// A ray handed to a traversal unit: its index in the trace and the ray itself.
+struct RayJob {
+    uint64_t id = 0;
+    Ray ray;
+    bool any_hit = false;
+};
+
+/// Contract: hands out each ray of the workload exactly once; false when none are left.
+class RaySourceIf : public virtual sc_core::sc_interface {
+public:
+    virtual bool next_ray(RayJob* job) = 0;
+    virtual uint64_t total_rays() const = 0;
+};
+
+/// A finished ray: what the model computed, for the hit checker and statistics.
+struct RayResult {
+    uint64_t id = 0;
+    Hit hit;
+    WorkCounts work;
+    Cycle start = 0;  ///< cycle the ray entered a context
+    Cycle end = 0;    ///< cycle its hit was written
+    uint32_t unit = 0;     ///< traversal unit that traced it
+    uint32_t context = 0;  ///< ray context within the unit
+};
+
+/// Contract: called once per ray when it completes, in completion order.
+class RaySinkIf : public virtual sc_core::sc_interface {
+public:
+    virtual void ray_done(const RayResult& result) = 0;
+};
+
+}  // namespace rtsim

@@ -1,0 +1,38 @@
+#include "rtl_model/isect/pipeline.h"
+
+namespace rtsim {
+
+Pipeline::Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared)
+    : sc_core::sc_module(name), m_config(config), m_shared(shared) {
+    if (shared) m_pool = std::make_unique<BandwidthCalendar>(config.shared_count, config.initiation_interval);
+}
+
+Cycle Pipeline::issue(Cycle time, uint32_t tests) {
+    const uint32_t issues = (tests + m_config.width - 1) / m_config.width;
+    if (issues == 0) return time;
+    m_issues += issues;
+    m_tests += tests;
+    const Cycle ii = m_config.initiation_interval;
+    Cycle first, last;
+    if (!m_shared) {
+        first = m_private.reserve(time, issues * ii);
+        last = first + (issues - 1) * ii;
+    } else {
+        // Each issue takes one pipeline slot of one initiation interval somewhere in the pool.
+        first = last = m_pool->reserve(time, 1);
+        for (uint32_t i = 1; i < issues; ++i) last = m_pool->reserve(last, 1);
+    }
+    m_wait_cycles += first - time;
+    return last + m_config.latency;
+}
+
+nlohmann::json Pipeline::stats_json(Cycle total_cycles) const {
+    double capacity = double(total_cycles) * pipelines() / double(m_config.initiation_interval);
+    return {{"issues", m_issues},
+            {"tests", m_tests},
+            {"pipelines", pipelines()},
+            {"utilization", capacity > 0 ? double(m_issues) / capacity : 0.0},
+            {"avg_wait_cycles", m_issues ? double(m_wait_cycles) / double(m_issues) : 0.0}};
+}
+
+}  // namespace rtsim

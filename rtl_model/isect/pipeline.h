@@ -1,0 +1,41 @@
+#pragma once
+// A fixed-function test pipeline (ray-box or ray-triangle): `width` tests per issue, one issue
+// every `initiation_interval` cycles, results `latency` cycles after issue. The tests themselves
+// are computed by the traversal stepper with the arithmetic of traces/isect; this block adds time.
+//
+// Private pipelines are used by one unit in time order (exact reservation). A shared pool of
+// `shared_count` pipelines is a bandwidth calendar of shared_count issues per initiation interval,
+// so units that run ahead within a quantum still contend correctly.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <systemc>
+
+#include "rtl_model/common/calendar.h"
+#include "sim/config/config.h"
+
+namespace rtsim {
+
+class Pipeline : public sc_core::sc_module, public PipeIf {
+public:
+    /// count: pipelines behind this block (1 when private, shared_count when shared).
+    Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared);
+
+    Cycle issue(Cycle time, uint32_t tests) override;
+
+    uint64_t issues() const { return m_issues; }
+    uint64_t tests() const { return m_tests; }
+    uint32_t pipelines() const { return m_shared ? m_config.shared_count : 1; }
+    nlohmann::json stats_json(Cycle total_cycles) const;
+
+private:
+    PipelineConfig m_config;
+    bool m_shared;
+    InOrderResource m_private;
+    std::unique_ptr<BandwidthCalendar> m_pool;
+    uint64_t m_issues = 0, m_tests = 0, m_wait_cycles = 0;
+};
+
+}  // namespace rtsim

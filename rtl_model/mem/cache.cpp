@@ -1,0 +1,111 @@
+#include "rtl_model/mem/cache.h"
+
+#include <algorithm>
+
+namespace rtsim {
+
+namespace {
+uint32_t log2_exact(uint64_t x) {
+    uint32_t s = 0;
+    while ((1ull << s) < x) ++s;
+    return s;
+}
+}  // namespace
+
+Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency)
+    : sc_core::sc_module(name),
+      m_config(config),
+      m_mshrs_enabled(mshrs_enabled),
+      m_next_latency(next_latency),
+      m_line_shift(log2_exact(config.line_bytes)) {
+    uint64_t sets = uint64_t(config.size_kib) * 1024 / config.line_bytes / config.ways;
+    m_set_mask = sets - 1;
+    m_lines.resize(sets * config.ways);
+    m_mshr_free.assign(config.mshrs, 0);
+    for (uint32_t b = 0; b < config.banks; ++b) m_banks.emplace_back(1, config.bank_cycles);
+}
+
+Cycle Cache::access(const MemRequest& req) {
+    uint64_t first = req.addr >> m_line_shift;
+    uint64_t last = (req.addr + (req.bytes ? req.bytes : 1) - 1) >> m_line_shift;
+    Cycle done = req.time;
+    for (uint64_t line = first; line <= last; ++line) done = std::max(done, access_line(line, req));
+    return done;
+}
+
+Cycle Cache::bank_start(uint64_t line, Cycle time) {
+    if (m_banks.size() == 1 && m_config.bank_cycles == 1) return time;  // fast path: one access per cycle
+    return m_banks[line % m_banks.size()].reserve(time, 1);
+}
+
+Cycle Cache::access_line(uint64_t line, const MemRequest& req) {
+    const uint64_t line_lo = line << m_line_shift, line_hi = line_lo + m_config.line_bytes;
+    const uint64_t lo = std::max(req.addr, line_lo), hi = std::min(req.addr + req.bytes, line_hi);
+    const uint32_t bytes = uint32_t(hi > lo ? hi - lo : 0);
+    MemCounters& c = m_stats[req.kind];
+    Cycle tag_done = bank_start(line, req.time) + m_config.latency;
+
+    if (req.write) {
+        // Write-through, no-write-allocate, posted.
+        ++c.writes;
+        c.write_bytes += bytes;
+        MemRequest down = req;
+        down.addr = lo;
+        down.bytes = bytes;
+        down.time = tag_done + m_next_latency;
+        next->access(down);
+        return tag_done;
+    }
+    ++c.reads;
+    c.read_bytes += bytes;
+    Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
+    for (uint32_t w = 0; w < m_config.ways; ++w) {
+        if (set[w].tag != line) continue;
+        set[w].last_use = ++m_use_clock;
+        if (set[w].ready > tag_done) {
+            ++c.merged;
+            return set[w].ready;
+        }
+        ++c.read_hits;
+        return tag_done;
+    }
+    return miss(line, req, tag_done);
+}
+
+Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done) {
+    Cycle issue = tag_done;
+    size_t mshr = 0;
+    if (m_mshrs_enabled) {
+        mshr = size_t(std::min_element(m_mshr_free.begin(), m_mshr_free.end()) - m_mshr_free.begin());
+        if (m_mshr_free[mshr] > issue) {
+            m_mshr_stall_cycles += m_mshr_free[mshr] - issue;
+            issue = m_mshr_free[mshr];
+        }
+    }
+    MemRequest down{line << m_line_shift, m_config.line_bytes, false, req.kind, issue + m_next_latency};
+    Cycle fill = next->access(down) + m_next_latency;
+    if (m_mshrs_enabled) m_mshr_free[mshr] = fill;
+
+    // LRU victim (invalid lines have last_use 0 and go first).
+    Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
+    Line* victim = set;
+    for (uint32_t w = 1; w < m_config.ways; ++w)
+        if (set[w].last_use < victim->last_use) victim = &set[w];
+    if (victim->tag != ~0ull) ++m_evictions;
+    victim->tag = line;
+    victim->ready = fill;
+    victim->last_use = ++m_use_clock;
+    return fill;
+}
+
+nlohmann::json Cache::stats_json() const {
+    nlohmann::json j = m_stats.to_json();
+    j["evictions"] = m_evictions;
+    j["mshr_stall_cycles"] = m_mshr_stall_cycles;
+    j["config"] = {{"size_kib", m_config.size_kib}, {"ways", m_config.ways}, {"line_bytes", m_config.line_bytes},
+                   {"latency", m_config.latency},   {"mshrs", m_mshrs_enabled ? m_config.mshrs : 0},
+                   {"banks", m_config.banks}};
+    return j;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,60 @@
+#pragma once
+// A set-associative cache with LRU replacement, MSHRs, banks and a latency, as a SystemC
+// channel implementing MemIf; misses go to `next` (the L2 or DRAM).
+//
+// Reads: a hit returns after the hit latency (or when a line still being filled arrives: a merged
+// miss). A miss takes the earliest free MSHR (waiting if all are busy), goes to the next level
+// after the tag latency, allocates the line at once (LRU victim) and holds the MSHR until the fill.
+// Writes are write-through and no-write-allocate (ray hits and stack spills are written once and
+// not read back soon); they are posted: the issuer does not wait beyond the tag access.
+// MSHRs are exact when one issuer accesses the cache in time order (a private L1); for a shared
+// cache accessed out of order within a quantum they are not modelled (mshrs_enabled = false).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <systemc>
+
+#include "rtl_model/common/calendar.h"
+#include "rtl_model/mem/mem_stats.h"
+#include "sim/config/config.h"
+
+namespace rtsim {
+
+class Cache : public sc_core::sc_module, public MemIf {
+public:
+    sc_core::sc_port<MemIf> next;
+
+    /// extra_latency: cycles added to every request forwarded to `next` and back (interconnect).
+    Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency);
+
+    Cycle access(const MemRequest& req) override;
+
+    const MemStats& stats() const { return m_stats; }
+    nlohmann::json stats_json() const;
+
+private:
+    struct Line {
+        uint64_t tag = ~0ull;
+        Cycle ready = 0;     ///< cycle the fill completes
+        uint64_t last_use = 0;
+    };
+    Cycle access_line(uint64_t line_addr, const MemRequest& req);
+    Cycle miss(uint64_t line_addr, const MemRequest& req, Cycle tag_done);
+    Cycle bank_start(uint64_t line_addr, Cycle time);
+
+    CacheConfig m_config;
+    bool m_mshrs_enabled;
+    Cycle m_next_latency;
+    uint32_t m_line_shift;
+    uint64_t m_set_mask;
+    std::vector<Line> m_lines;  ///< sets x ways
+    std::vector<Cycle> m_mshr_free;
+    std::vector<BandwidthCalendar> m_banks;
+    uint64_t m_use_clock = 0;
+    MemStats m_stats;
+    uint64_t m_evictions = 0;
+    uint64_t m_mshr_stall_cycles = 0;
+};
+
+}  // namespace rtsim

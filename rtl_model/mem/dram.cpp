@@ -1,0 +1,61 @@
+#include "rtl_model/mem/dram.h"
+
+#include <algorithm>
+
+namespace rtsim {
+
+namespace {
+constexpr uint32_t kWindowCycles = 32;  // calendar granularity; bandwidth is exact per window
+constexpr size_t kTimelinePoints = 256;
+}  // namespace
+
+Dram::Dram(sc_core::sc_module_name name, const DramConfig& config) : sc_core::sc_module(name), m_config(config) {
+    for (uint32_t c = 0; c < config.channels; ++c)
+        m_channels.emplace_back(uint64_t(config.bytes_per_cycle) * kWindowCycles, kWindowCycles);
+}
+
+Cycle Dram::access(const MemRequest& req) {
+    MemCounters& c = m_stats[req.kind];
+    if (req.write) {
+        ++c.writes;
+        c.write_bytes += req.bytes;
+    } else {
+        ++c.reads;
+        ++c.read_hits;  // DRAM serves every read
+        c.read_bytes += req.bytes;
+    }
+    BandwidthCalendar& channel = m_channels[(req.addr / m_config.interleave_bytes) % m_channels.size()];
+    Cycle start = channel.reserve(req.time, req.bytes);
+    m_queue_cycles += start - req.time;
+    size_t bucket = size_t(start / bucket_cycles());
+    if (bucket >= m_timeline.size()) m_timeline.resize(bucket + 1, 0);
+    m_timeline[bucket] += req.bytes;
+    Cycle transfer = (req.bytes + m_config.bytes_per_cycle - 1) / m_config.bytes_per_cycle;
+    return start + m_config.latency + transfer;
+}
+
+nlohmann::json Dram::stats_json(Cycle total_cycles, double clock_ghz) const {
+    nlohmann::json j = m_stats.to_json();
+    MemCounters t = m_stats.total();
+    double seconds = double(total_cycles) / (clock_ghz * 1e9);
+    double peak = double(m_config.bytes_per_cycle) * m_config.channels * clock_ghz;  // GB/s
+    double achieved = seconds > 0 ? double(t.read_bytes + t.write_bytes) / seconds / 1e9 : 0.0;
+    j["bandwidth_gbps"] = achieved;
+    j["peak_bandwidth_gbps"] = peak;
+    j["bandwidth_utilization"] = peak > 0 ? achieved / peak : 0.0;
+    j["avg_queue_cycles"] = (t.reads + t.writes) ? double(m_queue_cycles) / double(t.reads + t.writes) : 0.0;
+    // Bandwidth over time, resampled to at most kTimelinePoints points.
+    size_t n = m_timeline.size(), group = std::max<size_t>(1, (n + kTimelinePoints - 1) / kTimelinePoints);
+    nlohmann::json series = nlohmann::json::array();
+    for (size_t i = 0; i < n; i += group) {
+        uint64_t bytes = 0;
+        size_t end = std::min(n, i + group);
+        for (size_t k = i; k < end; ++k) bytes += m_timeline[k];
+        double cycles = double((end - i) * bucket_cycles());
+        series.push_back({{"cycle", i * bucket_cycles()}, {"gbps", double(bytes) / cycles * clock_ghz}});
+    }
+    j["bandwidth_over_time"] = series;
+    return j;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,37 @@
+#pragma once
+// DRAM: channels interleaved by address, each a bandwidth calendar of bytes per cycle, plus a
+// fixed latency. When requests exceed a channel's bandwidth they queue (start later), so the
+// delivered bandwidth saturates at channels x bytes_per_cycle (tested).
+#include <cstdint>
+#include <vector>
+
+#include <systemc>
+
+#include "rtl_model/common/calendar.h"
+#include "rtl_model/mem/mem_stats.h"
+#include "sim/config/config.h"
+
+namespace rtsim {
+
+class Dram : public sc_core::sc_module, public MemIf {
+public:
+    Dram(sc_core::sc_module_name name, const DramConfig& config);
+
+    Cycle access(const MemRequest& req) override;
+
+    const MemStats& stats() const { return m_stats; }
+    /// Bytes moved per bucket of `bucket_cycles()` cycles, from cycle 0.
+    const std::vector<uint64_t>& bytes_over_time() const { return m_timeline; }
+    static constexpr Cycle bucket_cycles() { return 1024; }
+    uint64_t queue_cycles() const { return m_queue_cycles; }
+    nlohmann::json stats_json(Cycle total_cycles, double clock_ghz) const;
+
+private:
+    DramConfig m_config;
+    std::vector<BandwidthCalendar> m_channels;
+    MemStats m_stats;
+    std::vector<uint64_t> m_timeline;
+    uint64_t m_queue_cycles = 0;
+};
+
+}  // namespace rtsim

@@ -1,0 +1,128 @@
+#include "rtl_model/top/top.h"
+
+#include <algorithm>
+
+namespace rtsim {
+
+bool MemoryImage::has_anyhit_triangles() const {
+    return std::any_of(triangles.begin(), triangles.end(), [](const HwTriangle& t) { return t.flags & kTriAnyHit; });
+}
+
+/// Memory where every access hits at the L1 latency: the performance upper bound.
+class IdealMemory : public sc_core::sc_module, public MemIf {
+public:
+    IdealMemory(sc_core::sc_module_name name, Cycle latency) : sc_core::sc_module(name), m_latency(latency) {}
+    Cycle access(const MemRequest& req) override {
+        MemCounters& c = m_stats[req.kind];
+        (req.write ? c.writes : c.reads) += 1;
+        (req.write ? c.write_bytes : c.read_bytes) += req.bytes;
+        if (!req.write) ++c.read_hits;
+        return req.time + m_latency;
+    }
+    nlohmann::json stats_json() const { return m_stats.to_json(); }
+
+private:
+    Cycle m_latency;
+    MemStats m_stats;
+};
+
+Top::Top(sc_core::sc_module_name name, const SimConfig& config, const MemoryImage& image, RayStream& rays,
+         RaySinkIf& sink, const WorkloadFeatures& features)
+    : sc_core::sc_module(name), m_config(config) {
+    m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, rays);
+    build_memory();
+    build_pipelines(features);
+    for (uint32_t u = 0; u < config.traversal.units; ++u) {
+        auto unit = std::make_unique<TraversalUnit>(("tu" + std::to_string(u)).c_str(), config, image, u);
+        unit->rays(*m_dispatch);
+        unit->sink(sink);
+        if (m_ideal) unit->mem(*m_ideal);
+        else unit->mem(*m_l1[u]);
+        size_t b = m_box.size() == 1 ? 0 : u, t = m_tri.size() == 1 ? 0 : u, a = m_anyhit.size() == 1 ? 0 : u;
+        unit->box(*m_box[b]);
+        unit->triangle(*m_tri[t]);
+        if (!m_anyhit.empty()) unit->anyhit(*m_anyhit[a]);
+        m_units.push_back(std::move(unit));
+    }
+    m_instantiated.push_back({{"block", "traversal"}, {"instantiated", true},
+                              {"why", std::to_string(config.traversal.units) + " units x " +
+                                          std::to_string(config.traversal.ray_contexts) + " ray contexts"}});
+    m_instantiated.push_back({{"block", "occlusion_early_exit"}, {"instantiated", features.occlusion_rays > 0},
+                              {"why", features.occlusion_rays ? std::to_string(features.occlusion_rays) +
+                                                                    " any-hit (shadow) rays stop at their first hit"
+                                                              : "no any-hit (shadow) rays in the trace"}});
+    m_instantiated.push_back({{"block", "instance_transform"}, {"instantiated", false},
+                              {"why", features.instancing ? "two-level BVHs are not modelled yet"
+                                                          : "single-level BVH: the trace has no instance transforms"}});
+}
+
+Top::~Top() = default;
+
+void Top::build_memory() {
+    const SimConfig& c = m_config;
+    if (c.ideal_memory) {
+        m_ideal = std::make_unique<IdealMemory>("ideal_memory", c.l1.latency);
+        m_instantiated.push_back({{"block", "memory"}, {"instantiated", false},
+                                  {"why", "ideal_memory: every access hits at L1 latency, no L2/DRAM"}});
+        return;
+    }
+    m_dram = std::make_unique<Dram>("dram", c.dram);
+    // The L2 is shared: units reach it out of time order within a quantum, so its MSHRs are not
+    // modelled (docs/model.md); the private L1s model theirs exactly.
+    m_l2 = std::make_unique<Cache>("l2", c.l2, false, 0);
+    m_l2->next(*m_dram);
+    for (uint32_t u = 0; u < c.traversal.units; ++u) {
+        m_l1.push_back(std::make_unique<Cache>(("l1_" + std::to_string(u)).c_str(), c.l1, true, c.interconnect_latency));
+        m_l1.back()->next(*m_l2);
+    }
+    m_instantiated.push_back({{"block", "memory"}, {"instantiated", true},
+                              {"why", "per-unit L1, shared " + std::to_string(c.l2.banks) + "-bank L2, " +
+                                          std::to_string(c.dram.channels) + " DRAM channels"}});
+}
+
+std::unique_ptr<Pipeline> Top::make_pipeline(const std::string& name, const PipelineConfig& c) {
+    return std::make_unique<Pipeline>(name.c_str(), c, c.sharing == "shared");
+}
+
+void Top::build_pipelines(const WorkloadFeatures& features) {
+    auto build = [&](const char* base, const PipelineConfig& c, std::vector<std::unique_ptr<Pipeline>>* out) {
+        if (c.sharing == "shared") {
+            out->push_back(make_pipeline(std::string(base) + "_pool", c));
+        } else {
+            for (uint32_t u = 0; u < m_config.traversal.units; ++u)
+                out->push_back(make_pipeline(std::string(base) + "_" + std::to_string(u), c));
+        }
+    };
+    build("box", m_config.box, &m_box);
+    build("triangle", m_config.triangle, &m_tri);
+    if (features.anyhit_triangles) build("anyhit", m_config.anyhit, &m_anyhit);
+    m_instantiated.push_back({{"block", "anyhit"}, {"instantiated", features.anyhit_triangles},
+                              {"why", features.anyhit_triangles ? "the BVH has alpha-MASK triangles: alpha test stage"
+                                                                : "no alpha-MASK triangle in the BVH"}});
+}
+
+Cycle Top::total_cycles() const {
+    Cycle t = 0;
+    for (const auto& u : m_units) t = std::max(t, u->finish_cycle());
+    return t;
+}
+
+nlohmann::json Top::stats_json() const {
+    const Cycle total = total_cycles();
+    nlohmann::json j;
+    j["dispatch"] = m_dispatch->stats_json();
+    for (const auto& u : m_units) j["units"][u->basename()] = u->stats_json(total);
+    auto pipes = [&](const char* key, const std::vector<std::unique_ptr<Pipeline>>& v) {
+        for (const auto& p : v) j[key][p->basename()] = p->stats_json(total);
+    };
+    pipes("box", m_box);
+    pipes("triangle", m_tri);
+    pipes("anyhit", m_anyhit);
+    if (m_ideal) j["ideal_memory"] = m_ideal->stats_json();
+    for (const auto& l1 : m_l1) j["l1"][l1->basename()] = l1->stats_json();
+    if (m_l2) j["l2"] = m_l2->stats_json();
+    if (m_dram) j["dram"] = m_dram->stats_json(total, m_config.clock_ghz);
+    return j;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,232 @@
+#include "sim/config/config.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+std::string join_path(const std::string& prefix, const char* name) {
+    return prefix.empty() ? std::string(name) : prefix + "." + name;
+}
+
+std::string format_number(double x) {
+    std::ostringstream out;
+    out << x;
+    return out.str();
+}
+
+/// Reads fields from a JSON object; every key of the object must be visited (else: unknown).
+class JsonReader {
+public:
+    JsonReader(const json& j, std::string prefix) : m_json(j), m_prefix(std::move(prefix)) {
+        require(j.is_object(), "config: '" + (m_prefix.empty() ? std::string("(root)") : m_prefix) + "' must be an object");
+    }
+
+    template <class T>
+    void field(const char* name, T& value, const char*, const char*, double, double) {
+        const json* j = take(name);
+        if (!j) return;
+        require(j->is_number() && !j->is_boolean(), "config: '" + join_path(m_prefix, name) + "' must be a number");
+        if constexpr (std::is_integral_v<T>) {
+            double d = j->get<double>();
+            require(d >= 0 && std::floor(d) == d && d <= double(std::numeric_limits<T>::max()),
+                    "config: '" + join_path(m_prefix, name) + "' must be a non-negative integer, got " + j->dump());
+            value = T(d);
+        } else {
+            value = j->get<T>();
+        }
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*>, const char*) {
+        const json* j = take(name);
+        if (!j) return;
+        require(j->is_string(), "config: '" + join_path(m_prefix, name) + "' must be a string");
+        value = j->get<std::string>();
+    }
+    void flag(const char* name, bool& value, const char*) {
+        const json* j = take(name);
+        if (!j) return;
+        require(j->is_boolean(), "config: '" + join_path(m_prefix, name) + "' must be true or false");
+        value = j->get<bool>();
+    }
+    template <class S>
+    void section(const char* name, S& s) {
+        const json* j = take(name);
+        if (!j) return;
+        JsonReader inner(*j, join_path(m_prefix, name));
+        s.visit(inner);
+        inner.finish();
+    }
+    /// Unknown keys are errors: a misspelt key must never be silently ignored.
+    void finish() const {
+        for (auto it = m_json.begin(); it != m_json.end(); ++it)
+            if (std::find(m_seen.begin(), m_seen.end(), it.key()) == m_seen.end())
+                throw Error("config: unknown key '" + join_path(m_prefix, it.key().c_str()) + "'" + known_keys());
+    }
+
+private:
+    const json* take(const char* name) {
+        m_seen.emplace_back(name);
+        auto it = m_json.find(name);
+        return it == m_json.end() ? nullptr : &*it;
+    }
+    std::string known_keys() const {
+        std::string s = " (known keys here: ";
+        for (size_t i = 0; i < m_seen.size(); ++i) s += (i ? ", " : "") + m_seen[i];
+        return s + ")";
+    }
+    const json& m_json;
+    std::string m_prefix;
+    std::vector<std::string> m_seen;
+};
+
+class JsonWriter {
+public:
+    explicit JsonWriter(json& out) : m_out(out) { m_out = json::object(); }
+    template <class T>
+    void field(const char* name, T& value, const char*, const char*, double, double) { m_out[name] = value; }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*>, const char*) { m_out[name] = value; }
+    void flag(const char* name, bool& value, const char*) { m_out[name] = value; }
+    template <class S>
+    void section(const char* name, S& s) {
+        JsonWriter inner(m_out[name]);
+        s.visit(inner);
+    }
+
+private:
+    json& m_out;
+};
+
+class SchemaWriter {
+public:
+    explicit SchemaWriter(json& out) : m_out(out) { m_out = json::object(); }
+    template <class T>
+    void field(const char* name, T& value, const char* unit, const char* doc, double lo, double hi) {
+        m_out[name] = {{"type", std::is_integral_v<T> ? "int" : "float"}, {"default", value}, {"unit", unit},
+                       {"min", lo}, {"max", hi}, {"doc", doc}};
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*> options, const char* doc) {
+        m_out[name] = {{"type", "choice"}, {"default", value}, {"choices", std::vector<std::string>(options.begin(), options.end())}, {"doc", doc}};
+    }
+    void flag(const char* name, bool& value, const char* doc) {
+        m_out[name] = {{"type", "bool"}, {"default", value}, {"doc", doc}};
+    }
+    template <class S>
+    void section(const char* name, S& s) {
+        json& sec = m_out[name];
+        sec = {{"type", "section"}};
+        SchemaWriter inner(sec["fields"]);
+        s.visit(inner);
+    }
+
+private:
+    json& m_out;
+};
+
+class RangeValidator {
+public:
+    explicit RangeValidator(std::string prefix = "") : m_prefix(std::move(prefix)) {}
+    template <class T>
+    void field(const char* name, T& value, const char* unit, const char*, double lo, double hi) {
+        double d = double(value);
+        require(std::isfinite(d) && d >= lo && d <= hi,
+                "config: '" + join_path(m_prefix, name) + "' = " + format_number(d) + " is out of range [" +
+                    format_number(lo) + ", " + format_number(hi) + "] " + unit);
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*> options, const char*) {
+        for (const char* o : options)
+            if (value == o) return;
+        std::string list;
+        for (const char* o : options) list += (list.empty() ? "" : ", ") + std::string(o);
+        throw Error("config: '" + join_path(m_prefix, name) + "' = '" + value + "' is not one of: " + list);
+    }
+    void flag(const char*, bool&, const char*) {}
+    template <class S>
+    void section(const char* name, S& s) {
+        RangeValidator inner(join_path(m_prefix, name));
+        s.visit(inner);
+    }
+
+private:
+    std::string m_prefix;
+};
+
+bool power_of_two(uint64_t x) { return x && !(x & (x - 1)); }
+
+void validate_cache(const CacheConfig& c, const char* name) {
+    std::string p = std::string("config: '") + name;
+    require(power_of_two(c.line_bytes), p + ".line_bytes' must be a power of two");
+    uint64_t lines = uint64_t(c.size_kib) * 1024 / c.line_bytes;
+    require(lines >= c.ways && lines % c.ways == 0,
+            p + ".size_kib' must hold a whole number of sets of " + std::to_string(c.ways) + " ways of " +
+                std::to_string(c.line_bytes) + "-byte lines");
+    require(power_of_two(lines / c.ways), p + ".size_kib' / (ways x line_bytes) must be a power of two (sets)");
+}
+
+}  // namespace
+
+SimConfig config_from_json(const json& j, const SimConfig& base) {
+    SimConfig c = base;
+    JsonReader reader(j, "");
+    c.visit(reader);
+    reader.finish();
+    return c;
+}
+
+void config_set(SimConfig& config, const std::string& assignment) {
+    size_t eq = assignment.find('=');
+    require(eq != std::string::npos && eq > 0, "config: --set expects key=value, got '" + assignment + "'");
+    std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+    json value = json::parse(text, nullptr, false);
+    if (value.is_discarded()) value = text;  // bare strings: --set box.sharing=shared
+    // Build {"a": {"b": value}} and read it over the current config.
+    json patch = value;
+    std::vector<std::string> parts;
+    for (size_t start = 0;;) {
+        size_t dot = path.find('.', start);
+        parts.push_back(path.substr(start, dot - start));
+        if (dot == std::string::npos) break;
+        start = dot + 1;
+    }
+    for (auto it = parts.rbegin(); it != parts.rend(); ++it) patch = json{{*it, patch}};
+    config = config_from_json(patch, config);
+}
+
+json config_to_json(const SimConfig& config) {
+    json out;
+    SimConfig copy = config;
+    JsonWriter writer(out);
+    copy.visit(writer);
+    return out;
+}
+
+json config_schema() {
+    json out;
+    SimConfig defaults;
+    SchemaWriter writer(out);
+    defaults.visit(writer);
+    return out;
+}
+
+void validate(const SimConfig& config) {
+    SimConfig copy = config;
+    RangeValidator ranges;
+    copy.visit(ranges);
+    validate_cache(config.l1, "l1");
+    validate_cache(config.l2, "l2");
+    require(config.l1.line_bytes == config.l2.line_bytes,
+            "config: 'l1.line_bytes' (" + std::to_string(config.l1.line_bytes) + ") must equal 'l2.line_bytes' (" +
+                std::to_string(config.l2.line_bytes) + ")");
+    require(power_of_two(config.dram.interleave_bytes) && config.dram.interleave_bytes >= config.l2.line_bytes,
+            "config: 'dram.interleave_bytes' must be a power of two and at least the line size");
+}
+
+}  // namespace rtsim

@@ -1,0 +1,139 @@
+#pragma once
+// The one config tree of the simulator (DESIGN rule 5): plain structs with defaults and units.
+// Each struct lists its fields once in visit() with name, unit, range and a one-line doc; the
+// JSON reader, writer, schema dump (for the Python dataclasses) and validate() are all visitors,
+// so a field cannot be documented, defaulted or range-checked in one place and not another.
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace rtsim {
+
+/// A ray-box or ray-triangle pipeline (timing only; the arithmetic is traces/isect/).
+struct PipelineConfig {
+    uint32_t latency = 8;              ///< cycles from issue to result
+    uint32_t initiation_interval = 1;  ///< cycles between issues into one pipeline
+    uint32_t width = 1;                ///< tests per issue (boxes per issue for the box pipeline)
+    std::string sharing = "private";   ///< "private": one pipeline per unit; "shared": a pool
+    uint32_t shared_count = 4;         ///< pipelines in the shared pool (sharing = "shared")
+
+    template <class V>
+    void visit(V& v) {
+        v.field("latency", latency, "cycles", "Cycles from issue to result", 1, 1000);
+        v.field("initiation_interval", initiation_interval, "cycles", "Cycles between two issues into one pipeline", 1, 1000);
+        v.field("width", width, "tests", "Tests per issue (boxes: 2 tests a whole node in one issue)", 1, 64);
+        v.choice("sharing", sharing, {"private", "shared"}, "One pipeline per traversal unit, or a pool shared by all units");
+        v.field("shared_count", shared_count, "pipelines", "Pipelines in the shared pool (sharing = shared)", 1, 1024);
+    }
+};
+
+struct CacheConfig {
+    uint32_t size_kib = 16;   ///< capacity
+    uint32_t ways = 4;        ///< associativity
+    uint32_t line_bytes = 64; ///< line size
+    uint32_t latency = 4;     ///< hit latency in cycles
+    uint32_t mshrs = 8;       ///< outstanding misses (miss status holding registers)
+    uint32_t banks = 1;       ///< independently accessible banks (line-interleaved)
+    uint32_t bank_cycles = 1; ///< cycles a bank is busy per access
+
+    template <class V>
+    void visit(V& v) {
+        v.field("size_kib", size_kib, "KiB", "Capacity", 1, 1u << 20);
+        v.field("ways", ways, "ways", "Associativity (LRU replacement)", 1, 64);
+        v.field("line_bytes", line_bytes, "bytes", "Line size (power of two, same at every level)", 16, 1024);
+        v.field("latency", latency, "cycles", "Hit latency", 1, 1000);
+        v.field("mshrs", mshrs, "entries", "Outstanding misses; a miss waits for a free MSHR", 1, 1024);
+        v.field("banks", banks, "banks", "Line-interleaved banks, each serving one access per bank_cycles", 1, 256);
+        v.field("bank_cycles", bank_cycles, "cycles", "Cycles a bank is busy per access", 1, 100);
+    }
+};
+
+struct DramConfig {
+    uint32_t channels = 2;          ///< independent channels, interleaved every interleave_bytes
+    uint32_t bytes_per_cycle = 16;  ///< peak bandwidth of one channel in bytes per core cycle
+    uint32_t latency = 120;         ///< cycles from request to first data, unloaded
+    uint32_t interleave_bytes = 256;///< address interleaving granule across channels
+
+    template <class V>
+    void visit(V& v) {
+        v.field("channels", channels, "channels", "Independent DRAM channels", 1, 64);
+        v.field("bytes_per_cycle", bytes_per_cycle, "B/cycle", "Peak bandwidth per channel, bytes per core cycle", 1, 4096);
+        v.field("latency", latency, "cycles", "Unloaded access latency (request to data)", 1, 100000);
+        v.field("interleave_bytes", interleave_bytes, "bytes", "Channel interleaving granule (power of two, >= line size)", 64, 1u << 20);
+    }
+};
+
+struct TraversalConfig {
+    uint32_t units = 8;              ///< MIMD traversal units
+    uint32_t ray_contexts = 16;      ///< rays in flight per unit, each advancing independently
+    uint32_t stack_entries = 8;      ///< on-chip traversal stack entries per ray; deeper entries spill
+    uint32_t stack_entry_bytes = 8;  ///< bytes per stack entry (node reference + entry distance)
+    uint32_t issue_cycles = 1;       ///< cycles the unit's scheduler needs per traversal step
+
+    template <class V>
+    void visit(V& v) {
+        v.field("units", units, "units", "MIMD traversal units", 1, 4096);
+        v.field("ray_contexts", ray_contexts, "rays", "Ray contexts per unit (rays in flight)", 1, 4096);
+        v.field("stack_entries", stack_entries, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64);
+        v.field("stack_entry_bytes", stack_entry_bytes, "bytes", "Bytes per stack entry (spill traffic)", 4, 64);
+        v.field("issue_cycles", issue_cycles, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100);
+    }
+};
+
+struct DispatchConfig {
+    uint32_t chunk_rays = 16384;  ///< rays read from the trace at a time (host memory bound)
+    uint32_t latency = 2;         ///< cycles to hand a ray to a free context (plus the ray fetch)
+
+    template <class V>
+    void visit(V& v) {
+        v.field("chunk_rays", chunk_rays, "rays", "Rays streamed from the trace file per chunk", 64, 1u << 24);
+        v.field("latency", latency, "cycles", "Cycles to assign a ray to a free context, before its fetch", 0, 1000);
+    }
+};
+
+struct SimConfig {
+    double clock_ghz = 1.0;          ///< converts cycles to seconds
+    std::string fidelity = "approx"; ///< functional | approx (more levels: docs/fidelity.md)
+    uint32_t quantum_cycles = 256;   ///< how far a unit may run ahead of SystemC time
+    uint32_t interconnect_latency = 8;  ///< L1 to L2 one-way cycles
+    bool ideal_memory = false;       ///< every access hits in L1 (upper bound on performance)
+    DispatchConfig dispatch;
+    TraversalConfig traversal;
+    PipelineConfig box{8, 1, 2, "private", 4};
+    PipelineConfig triangle{20, 1, 1, "private", 4};
+    PipelineConfig anyhit{10, 1, 1, "private", 4};
+    CacheConfig l1{16, 4, 64, 4, 8, 1, 1};
+    CacheConfig l2{1024, 16, 64, 20, 32, 8, 1};
+    DramConfig dram;
+
+    template <class V>
+    void visit(V& v) {
+        v.field("clock_ghz", clock_ghz, "GHz", "Core clock: converts cycles to seconds", 0.001, 100.0);
+        v.choice("fidelity", fidelity, {"functional", "approx"}, "Simulation level: functional (counts only) or approx (timed SystemC model)");
+        v.field("quantum_cycles", quantum_cycles, "cycles", "How far a traversal unit may run ahead of the others (temporal decoupling)", 1, 1u << 20);
+        v.field("interconnect_latency", interconnect_latency, "cycles", "One-way latency between an L1 and the L2", 0, 10000);
+        v.flag("ideal_memory", ideal_memory, "Every access hits in L1 at L1 latency: the upper bound on performance");
+        v.section("dispatch", dispatch);
+        v.section("traversal", traversal);
+        v.section("box", box);
+        v.section("triangle", triangle);
+        v.section("anyhit", anyhit);
+        v.section("l1", l1);
+        v.section("l2", l2);
+        v.section("dram", dram);
+    }
+};
+
+/// Reads a config from JSON over the defaults; unknown keys and bad values throw rtsim::Error
+/// naming the key path (e.g. "l1.size_kib").
+SimConfig config_from_json(const nlohmann::json& j, const SimConfig& base = {});
+/// Applies "key.path=value" (value parsed by the field's type).
+void config_set(SimConfig& config, const std::string& assignment);
+nlohmann::json config_to_json(const SimConfig& config);
+/// Every field with default, unit, range, choices and doc: the schema the Python side mirrors.
+nlohmann::json config_schema();
+/// Range checks plus cross-field rules; throws rtsim::Error naming the field.
+void validate(const SimConfig& config);
+
+}  // namespace rtsim

@@ -1,0 +1,57 @@
+#include "sim/harness/hit_checker.h"
+
+#include <cstring>
+#include <sstream>
+
+namespace rtsim {
+
+namespace {
+constexpr size_t kExamples = 20;
+uint32_t bits(float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+}
+}  // namespace
+
+std::string compare_with_reference(const RayResult& r, const HitRecord& h, const WorkRecord& w, bool* hit_differs) {
+    std::ostringstream out;
+    *hit_differs = r.hit.prim != h.prim || (h.prim >= 0 && bits(r.hit.t) != bits(h.t));
+    if (*hit_differs)
+        out << "hit: model prim " << r.hit.prim << " t " << r.hit.t << ", reference prim " << h.prim << " t " << h.t;
+    const WorkCounts& m = r.work;
+    if (m.nodes != w.nodes || m.box_tests != w.box_tests || m.tri_tests != w.tri_tests || m.anyhit_calls != w.anyhit_calls) {
+        if (*hit_differs) out << "; ";
+        out << "work: model nodes/box/tri/alpha " << m.nodes << "/" << m.box_tests << "/" << m.tri_tests << "/"
+            << m.anyhit_calls << ", reference " << w.nodes << "/" << w.box_tests << "/" << w.tri_tests << "/" << w.anyhit_calls;
+    }
+    return out.str();
+}
+
+HitChecker::HitChecker(sc_core::sc_module_name name, ReferenceWindow& reference, uint64_t total, Progress progress)
+    : sc_core::sc_module(name), m_reference(reference), m_total(total), m_progress(std::move(progress)) {}
+
+void HitChecker::ray_done(const RayResult& r) {
+    bool hit_differs = false;
+    std::string diff = compare_with_reference(r, m_reference.hit(r.id), m_reference.work(r.id), &hit_differs);
+    if (!diff.empty()) {
+        if (hit_differs) ++m_hit_mismatches;
+        else ++m_work_mismatches;
+        if (m_examples.size() < kExamples) m_examples.push_back({{"ray", r.id}, {"difference", diff}});
+    }
+    m_reference.checked(r.id);
+    m_latency.add(r.end - r.start);
+    if (on_ray) on_ray(r);
+    ++m_checked;
+    if (m_progress && (m_checked % 4096 == 0 || m_checked == m_total)) m_progress(m_checked, m_total);
+}
+
+nlohmann::json HitChecker::to_json() const {
+    return {{"rays_checked", m_checked},
+            {"rays_expected", m_total},
+            {"hit_mismatches", m_hit_mismatches},
+            {"work_mismatches", m_work_mismatches},
+            {"first_mismatches", m_examples}};
+}
+
+}  // namespace rtsim

@@ -1,0 +1,47 @@
+#pragma once
+// The hit checker (DESIGN rule 2): every ray the model finishes is compared with the trace's
+// reference hit (primitive id and the bits of t) and reference work (nodes, box and triangle
+// tests, alpha tests). Mismatches are counted, the first ones listed, and make rtsim-sim exit
+// non-zero. It also keeps the per-ray latency histogram and reports progress.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <systemc>
+
+#include "rtl_model/common/interfaces.h"
+#include "sim/harness/latency_histogram.h"
+#include "sim/harness/trace_stream.h"
+
+namespace rtsim {
+
+class HitChecker : public sc_core::sc_module, public RaySinkIf {
+public:
+    using Progress = std::function<void(uint64_t done, uint64_t total)>;
+    HitChecker(sc_core::sc_module_name name, ReferenceWindow& reference, uint64_t total, Progress progress = {});
+
+    void ray_done(const RayResult& r) override;
+
+    uint64_t checked() const { return m_checked; }
+    uint64_t hit_mismatches() const { return m_hit_mismatches; }
+    uint64_t work_mismatches() const { return m_work_mismatches; }
+    const LatencyHistogram& latency() const { return m_latency; }
+    nlohmann::json to_json() const;
+    /// Optional per-ray hook (the timeline records ray residency through it).
+    std::function<void(const RayResult&)> on_ray;
+
+private:
+    ReferenceWindow& m_reference;
+    uint64_t m_total;
+    Progress m_progress;
+    uint64_t m_checked = 0, m_hit_mismatches = 0, m_work_mismatches = 0;
+    nlohmann::json m_examples = nlohmann::json::array();
+    LatencyHistogram m_latency;
+};
+
+/// Compares one result with the reference; returns "" when equal, else a description.
+std::string compare_with_reference(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work,
+                                   bool* hit_differs);
+
+}  // namespace rtsim

@@ -1,0 +1,57 @@
+#include "sim/harness/latency_histogram.h"
+
+namespace rtsim {
+
+namespace {
+constexpr int kSub = 3;  // 2^3 = 8 sub-buckets per octave
+}
+
+size_t LatencyHistogram::bucket(uint64_t v) {
+    if (v < (1u << kSub)) return size_t(v);
+    int msb = 63 - __builtin_clzll(v);
+    uint64_t sub = (v >> (msb - kSub)) & ((1u << kSub) - 1);
+    return size_t((msb - kSub + 1) << kSub) + size_t(sub);
+}
+
+uint64_t LatencyHistogram::upper(size_t b) {
+    if (b < (1u << kSub)) return b;
+    int octave = int(b >> kSub) + kSub - 1;
+    uint64_t sub = b & ((1u << kSub) - 1);
+    return ((uint64_t(1) << kSub | sub) + 1) << (octave - kSub);
+}
+
+void LatencyHistogram::add(uint64_t cycles) {
+    size_t b = bucket(cycles);
+    if (b >= m_buckets.size()) m_buckets.resize(b + 1, 0);
+    ++m_buckets[b];
+    ++m_count;
+    m_sum += cycles;
+    if (cycles > m_max) m_max = cycles;
+}
+
+uint64_t LatencyHistogram::quantile(double q) const {
+    uint64_t target = uint64_t(q * double(m_count)), seen = 0;
+    for (size_t b = 0; b < m_buckets.size(); ++b) {
+        seen += m_buckets[b];
+        if (seen > target) return upper(b) < m_max ? upper(b) : m_max;
+    }
+    return m_max;
+}
+
+nlohmann::json LatencyHistogram::to_json() const {
+    nlohmann::json upper_bounds = nlohmann::json::array(), counts = nlohmann::json::array();
+    for (size_t b = 0; b < m_buckets.size(); ++b) {
+        if (!m_buckets[b]) continue;
+        upper_bounds.push_back(upper(b));
+        counts.push_back(m_buckets[b]);
+    }
+    return {{"rays", m_count},
+            {"mean_cycles", mean()},
+            {"p50_cycles", quantile(0.5)},
+            {"p95_cycles", quantile(0.95)},
+            {"p99_cycles", quantile(0.99)},
+            {"max_cycles", m_max},
+            {"histogram", {{"bucket_upper_cycles", upper_bounds}, {"rays", counts}}}};
+}
+
+}  // namespace rtsim

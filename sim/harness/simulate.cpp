@@ -1,0 +1,157 @@
+#include "sim/harness/simulate.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "rtl_model/top/top.h"
+#include "sim/harness/hit_checker.h"
+#include "sim/harness/summary.h"
+#include "sim/harness/timeline.h"
+#include "sim/harness/trace_stream.h"
+#include "traces/common/error.h"
+#include "traces/isect/traversal.h"
+
+namespace rtsim {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string trace_file(const std::string& path) {
+    fs::path p(path);
+    if (fs::is_directory(p)) p /= "trace.rtt";
+    require(fs::exists(p), path + ": no trace here (expected a trace folder or a .rtt file)");
+    return p.string();
+}
+
+json read_manifest(const std::string& rtt) {
+    fs::path m = fs::path(rtt).parent_path() / "manifest.json";
+    if (!fs::exists(m)) return json::object();
+    std::ifstream in(m);
+    json j = json::parse(in, nullptr, false);
+    require(!j.is_discarded(), m.string() + ": not valid JSON");
+    return j;
+}
+
+/// One pass over the rays: counts per kind and occlusion rays (what the workload calls for).
+json scan_workload(TraceReader& reader, WorkloadFeatures* features) {
+    const uint64_t n = reader.section(SectionKind::rays).record_count;
+    std::vector<RayRecord> buf(65536);
+    uint64_t kinds[kRayKindCount] = {};
+    for (uint64_t first = 0; first < n; first += buf.size()) {
+        uint64_t count = std::min<uint64_t>(buf.size(), n - first);
+        reader.read(SectionKind::rays, first, count, buf.data());
+        for (uint64_t i = 0; i < count; ++i) {
+            if (buf[i].kind < kRayKindCount) ++kinds[buf[i].kind];
+            features->occlusion_rays += (buf[i].flags & kRayFlagAnyHit) != 0;
+        }
+    }
+    json by_kind = json::object();
+    for (int k = 0; k < kRayKindCount; ++k)
+        if (kinds[k]) by_kind[ray_kind_name(RayKind(k))] = kinds[k];
+    return {{"rays", n}, {"by_kind", by_kind}, {"occlusion_rays", features->occlusion_rays}};
+}
+
+void report_progress(uint64_t done, uint64_t total) {
+    std::cerr << "{\"progress\": " << done << ", \"total\": " << total << "}" << std::endl;
+}
+
+/// Functional level: the reference traversal in a loop, no time. Counts and the hit check only.
+json run_functional(const MemoryImage& image, TraceReader& reader, ReferenceWindow& ref, HitChecker& checker) {
+    HwBvh bvh;
+    bvh.nodes = image.nodes;
+    bvh.triangles = image.triangles;
+    TraceRayStream stream(reader);
+    std::vector<RayJob> jobs;
+    while (stream.read_chunk(65536, &jobs)) {
+        for (const RayJob& job : jobs) {
+            RayResult r;
+            r.id = job.id;
+            r.hit = trace_ray(bvh, job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
+            checker.ray_done(r);
+        }
+        jobs.clear();
+    }
+    return json::object();
+}
+
+void write_json(const fs::path& path, const json& j) {
+    std::ofstream out(path);
+    require(bool(out), path.string() + ": cannot write");
+    out << j.dump(2) << "\n";
+}
+
+}  // namespace
+
+SimOutcome run_simulation(const SimOptions& o) {
+    auto t0 = std::chrono::steady_clock::now();
+    validate(o.config);
+    const std::string rtt = trace_file(o.trace);
+    TraceReader reader(rtt);
+    json manifest = read_manifest(rtt);
+    MemoryImage image;
+    image.nodes = reader.read_all<HwNode>(SectionKind::bvh_nodes);
+    image.triangles = reader.read_all<HwTriangle>(SectionKind::triangles);
+    require(!image.nodes.empty(), rtt + ": the trace has no BVH nodes (section NODE)");
+    WorkloadFeatures features;
+    features.anyhit_triangles = image.has_anyhit_triangles();
+    json workload = scan_workload(reader, &features);
+    const uint64_t total = workload["rays"];
+
+    fs::create_directories(o.out_dir);
+    write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(o.config));
+    ReferenceWindow reference(reader, o.config.dispatch.chunk_rays);
+    HitChecker checker("checker", reference, total, o.progress ? HitChecker::Progress(report_progress) : HitChecker::Progress());
+
+    json model, instantiated = json::array();
+    Cycle cycles = 0;
+    std::vector<uint8_t> kinds;  // only for the timeline
+    Timeline timeline(o.config.clock_ghz);
+    if (o.config.fidelity == "functional") {
+        run_functional(image, reader, reference, checker);
+    } else {
+        TraceRayStream stream(reader);
+        Top top("top", o.config, image, stream, checker, features);
+        if (o.timeline) {
+            TraceReader kind_reader(rtt);
+            checker.on_ray = [&](const RayResult& r) {
+                if (r.id < Timeline::kMaxRays) {
+                    RayRecord rec;
+                    kind_reader.read(SectionKind::rays, r.id, 1, &rec);
+                    timeline.ray(r, rec.kind);
+                }
+            };
+        }
+        sc_core::sc_start();
+        cycles = top.total_cycles();
+        model = top.stats_json();
+        instantiated = top.instantiated();
+        if (o.timeline && top.dram())
+            timeline.write((fs::path(o.out_dir) / "timeline.json").string(), top.units(), top.dram()->bytes_over_time(),
+                           Dram::bucket_cycles());
+    }
+    require(checker.checked() == total, "simulation ended with " + std::to_string(checker.checked()) + " of " +
+                                            std::to_string(total) + " rays finished");
+    double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    SimOutcome out;
+    out.stats = {{"schema", "rtsim-stats/1"},
+                 {"fidelity", o.config.fidelity},
+                 {"summary", summarize(o.config, cycles, total, model, checker, wall)},
+                 {"validation", checker.to_json()},
+                 {"latency", checker.latency().to_json()},
+                 {"workload", workload},
+                 {"instantiated", instantiated},
+                 {"effects", manifest.value("workload", json::object()).value("effects", json::array())},
+                 {"model", model},
+                 {"provenance", provenance(o.command_line, rtt, manifest)}};
+    write_json(fs::path(o.out_dir) / "stats.json", out.stats);
+    write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
+    out.exit_code = (checker.hit_mismatches() || checker.work_mismatches()) ? 3 : 0;
+    return out;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,60 @@
+#include "sim/harness/trace_stream.h"
+
+#include <algorithm>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+TraceRayStream::TraceRayStream(TraceReader& reader)
+    : m_reader(reader), m_total(reader.section(SectionKind::rays).record_count) {}
+
+size_t TraceRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
+    size_t n = size_t(std::min<uint64_t>(max, m_total - m_next));
+    if (n == 0) return 0;
+    m_buffer.resize(n);
+    m_reader.read(SectionKind::rays, m_next, n, m_buffer.data());
+    for (size_t i = 0; i < n; ++i) {
+        RayJob job;
+        job.id = m_next + i;
+        job.ray = ray_from_record(m_buffer[i]);
+        job.any_hit = m_buffer[i].flags & kRayFlagAnyHit;
+        out->push_back(job);
+    }
+    m_next += n;
+    return n;
+}
+
+ReferenceWindow::ReferenceWindow(TraceReader& reader, uint64_t chunk_rays)
+    : m_reader(reader), m_chunk(chunk_rays), m_total(reader.section(SectionKind::hits).record_count) {
+    require(reader.section(SectionKind::work).record_count == m_total &&
+                reader.section(SectionKind::rays).record_count == m_total,
+            reader.path() + ": sections RAYS, HITS and WORK have different record counts");
+}
+
+ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {
+    const uint64_t index = id / m_chunk;
+    require(id < m_total, "ray " + std::to_string(id) + " is beyond the trace (" + std::to_string(m_total) + " rays)");
+    if (!m_chunks.empty() && index >= m_chunks.front().index && index < m_chunks.front().index + m_chunks.size())
+        return m_chunks[index - m_chunks.front().index];
+    require(m_chunks.empty() || index >= m_chunks.front().index, "reference window: ray " + std::to_string(id) + " already retired");
+    // Load consecutive chunks up to the one needed.
+    uint64_t next = m_chunks.empty() ? index : m_chunks.back().index + 1;
+    while (next <= index) {
+        uint64_t first = next * m_chunk, n = std::min(m_chunk, m_total - first);
+        Chunk c{next, std::vector<HitRecord>(n), std::vector<WorkRecord>(n), n};
+        m_reader.read(SectionKind::hits, first, n, c.hits.data());
+        m_reader.read(SectionKind::work, first, n, c.work.data());
+        m_chunks.push_back(std::move(c));
+        ++next;
+    }
+    return m_chunks.back();
+}
+
+void ReferenceWindow::checked(uint64_t id) {
+    Chunk& c = chunk_for(id);
+    --c.remaining;
+    while (!m_chunks.empty() && m_chunks.front().remaining == 0) m_chunks.pop_front();
+}
+
+}  // namespace rtsim

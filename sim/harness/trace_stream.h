@@ -1,0 +1,53 @@
+#pragma once
+// Streams a trace into the model and the checker in chunks, so memory stays bounded however long
+// the trace is (DESIGN rule 8).
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "rtl_model/dispatch/dispatch.h"
+#include "traces/format/trace_reader.h"
+
+namespace rtsim {
+
+/// Rays of the trace, in order, as RayJobs.
+class TraceRayStream : public RayStream {
+public:
+    explicit TraceRayStream(TraceReader& reader);
+    size_t read_chunk(size_t max, std::vector<RayJob>* out) override;
+    uint64_t total_rays() const override { return m_total; }
+
+private:
+    TraceReader& m_reader;
+    uint64_t m_total;
+    uint64_t m_next = 0;
+    std::vector<RayRecord> m_buffer;
+};
+
+/// Reference hits and work of the trace, looked up by ray index over a sliding window of chunks.
+/// Rays complete roughly in order (within the rays in flight), so only a few chunks are resident.
+class ReferenceWindow {
+public:
+    ReferenceWindow(TraceReader& reader, uint64_t chunk_rays);
+    const HitRecord& hit(uint64_t id) { return chunk_for(id).hits[id % m_chunk]; }
+    const WorkRecord& work(uint64_t id) { return chunk_for(id).work[id % m_chunk]; }
+    /// Marks a ray as checked; chunks whose rays are all checked are dropped.
+    void checked(uint64_t id);
+    size_t resident_chunks() const { return m_chunks.size(); }
+
+private:
+    struct Chunk {
+        uint64_t index;
+        std::vector<HitRecord> hits;
+        std::vector<WorkRecord> work;
+        uint64_t remaining;
+    };
+    Chunk& chunk_for(uint64_t id);
+
+    TraceReader& m_reader;
+    uint64_t m_chunk, m_total;
+    std::deque<Chunk> m_chunks;  ///< consecutive chunk indices, oldest first
+};
+
+}  // namespace rtsim
