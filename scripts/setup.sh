@@ -18,6 +18,7 @@ APT_PACKAGES=(
   cmake ninja-build g++ pkg-config
   libsystemc-dev libglm-dev libtinygltf-dev libembree-dev nlohmann-json3-dev libstb-dev
   libgtest-dev googletest zlib1g-dev libcli11-dev
+  chromium  # headless, in the tests only: checks that sweep reports render
 )
 
 missing=()

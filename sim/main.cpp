@@ -71,6 +71,11 @@ int sc_main(int argc, char** argv) {
     } catch (const rtsim::Error& e) {
         std::cerr << "rtsim-sim: error: " << e.what() << "\n";
         return 2;
+    } catch (const sc_core::sc_report& e) {
+        // An error thrown inside a SystemC process reaches us wrapped in a report (E549); its
+        // text carries the original message (file, field or ray).
+        std::cerr << "rtsim-sim: error: " << e.what() << "\n";
+        return 2;
     }
 }
 

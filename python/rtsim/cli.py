@@ -3,12 +3,21 @@
 rtsim trace SCENE -o OUT [--workload ...] [--resolution WxH] ...   trace a scene
 rtsim scene NAME -o DIR                                              write a built-in scene
 rtsim scenes                                                         list scenes
-rtsim demo [-o OUT]                                                  the main job
+rtsim demo [-o OUT]                                                  the main job: sweep + report
+rtsim simulate TRACE [--config CFG] [--set k=v ...] -o RUN [--timeline]  replay on the model
+rtsim config --defaults | --schema                                   the simulator's config
+rtsim bench [SCENE] [--json FILE] [--repeat N]                       rtsim against Embree
+rtsim sweep SPEC.yaml -o SWEEP [--scheduler tcp://HOST:PORT]        a design-space sweep
+rtsim results SWEEP [--csv [FILE]]                                  its tidy table
+rtsim report SWEEP [-o report.html]                                 its HTML report
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import shutil
+import subprocess
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -21,11 +30,12 @@ from rtsim._core import RtsimError
 from rtsim.heatmaps import write_heatmaps
 from rtsim.progress import TraceProgress
 from rtsim.scenes import list_scenes, resolve_scene, shared_scenes_dir
+from rtsim.simulate import add_parsers as add_simulate_parsers
 from rtsim.summary import print_summary
+from rtsim.sweep.cli import add_parsers as add_sweep_parsers
 from rtsim.trace_file import open_trace
 
 RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
-DEMO_WORKLOAD = ("primary", "shadow", "reflection", "diffuse")
 
 
 @dataclass
@@ -148,16 +158,44 @@ def cmd_scenes(args: argparse.Namespace, console: Console) -> int:
 
 
 def cmd_demo(args: argparse.Namespace, console: Console) -> int:
-    out = Path(args.output)
-    console.print(f"[bold]rtsim demo[/]: tracing the built-in cornell scene into {out}")
-    job = TraceJob(
-        scene="cornell", out_dir=out, workload=list(DEMO_WORKLOAD), width=320, height=240
-    )
-    run_trace(job, console)
-    console.print(
-        f"\nImages are in {out.resolve()}: render.png, heatmap_nodes.png, heatmap_tris.png"
-    )
-    return 0
+    from rtsim.sweep.demo import run_demo
+
+    return run_demo(Path(args.output), console, workers=args.workers, scheduler=args.scheduler)
+
+
+def find_bench() -> Path | None:
+    """The rtsim-bench executable: $RTSIM_BENCH, else the one installed in the package
+    (rtsim/bin), else one on PATH."""
+    env = os.environ.get("RTSIM_BENCH")
+    if env:
+        return Path(env)
+    installed = Path(__file__).resolve().parent / "bin" / "rtsim-bench"
+    if installed.is_file():
+        return installed
+    found = shutil.which("rtsim-bench")
+    return Path(found) if found else None
+
+
+def cmd_bench(args: argparse.Namespace, console: Console) -> int:
+    exe = find_bench()
+    if exe is None or not exe.is_file():
+        print(
+            "rtsim: error: rtsim-bench is not built (it needs Embree: install libembree-dev and "
+            "rebuild with RTSIM_WITH_EMBREE=ON, e.g. `bash scripts/setup.sh`)",
+            file=sys.stderr,
+        )
+        return 2
+    cmd = [str(exe)]
+    if args.scene:
+        cmd.append(resolve_scene(args.scene))
+    cmd += ["--repeat", str(args.repeat)]
+    if args.json:
+        cmd += ["--json", str(args.json)]
+    if args.resolution:
+        cmd += ["--resolution", f"{args.resolution[0]}x{args.resolution[1]}"]
+    if args.hairball_triangles:
+        cmd += ["--hairball-triangles", str(args.hairball_triangles)]
+    return subprocess.run(cmd, check=False).returncode
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -198,9 +236,35 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scenes", help="list built-in and shared scenes")
     p.set_defaults(func=cmd_scenes)
 
-    p = sub.add_parser("demo", help="run the main job (trace the cornell box, draw heatmaps)")
-    p.add_argument("-o", "--output", default="out/demo", metavar="OUT")
+    p = sub.add_parser(
+        "demo",
+        help="run the main job: a small design-space sweep on two built-in scenes and its "
+        "HTML report (OUT/report.html)",
+    )
+    p.add_argument("-o", "--output", default="out/demo", metavar="OUT", help="sweep folder")
+    p.add_argument("--workers", type=int, default=0, metavar="N", help="default: one per core")
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT", help="a Dask cluster")
     p.set_defaults(func=cmd_demo)
+
+    add_simulate_parsers(sub)
+    add_sweep_parsers(sub)
+
+    p = sub.add_parser(
+        "bench",
+        help="benchmark the reference tracer against Embree (BVH build, rays/s, one thread)",
+    )
+    p.add_argument(
+        "scene",
+        metavar="SCENE",
+        nargs="?",
+        default=None,
+        help="glTF file, built-in or shared scene name (default: the shared Sponza)",
+    )
+    p.add_argument("--json", metavar="FILE", default=None, help="also write the figures as JSON")
+    p.add_argument("--repeat", type=positive_int, default=5, metavar="N", help="runs per figure")
+    p.add_argument("--resolution", type=parse_resolution, default=None, metavar="WxH")
+    p.add_argument("--hairball-triangles", type=positive_int, default=None, metavar="N")
+    p.set_defaults(func=cmd_bench)
     return parser
 
 

@@ -46,10 +46,10 @@ WORK_DTYPE = np.dtype(
     ]
 )
 #: HwNode (64 bytes): two child boxes, child references and leaf sizes.
+#: bounds[axis][0 = min, 1 = max][child] (docs/bvh_layout.md).
 NODE_DTYPE = np.dtype(
     [
-        ("lo", "<f4", (2, 3)),
-        ("hi", "<f4", (2, 3)),
+        ("bounds", "<f4", (3, 2, 2)),
         ("child_ref", "<u4", (2,)),
         ("child_count", "<u4", (2,)),
     ]

@@ -4,7 +4,8 @@ namespace rtsim {
 
 Pipeline::Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared)
     : sc_core::sc_module(name), m_config(config), m_shared(shared) {
-    if (shared) m_pool = std::make_unique<BandwidthCalendar>(config.shared_count, config.initiation_interval);
+    // shared_count issues per initiation interval, counted per window of 16 intervals.
+    if (shared) m_pool = std::make_unique<BandwidthCalendar>(16ull * config.shared_count, 16 * config.initiation_interval);
 }
 
 Cycle Pipeline::issue(Cycle time, uint32_t tests) {

@@ -22,7 +22,9 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
     m_set_mask = sets - 1;
     m_lines.resize(sets * config.ways);
     m_mshr_free.assign(config.mshrs, 0);
-    for (uint32_t b = 0; b < config.banks; ++b) m_banks.emplace_back(1, config.bank_cycles);
+    // Each bank serves one access per bank_cycles; the calendar counts them per 16-access window
+    // (a finer window only makes the forward search longer when a bank is busy).
+    for (uint32_t b = 0; b < config.banks; ++b) m_banks.emplace_back(16, 16 * config.bank_cycles);
 }
 
 Cycle Cache::access(const MemRequest& req) {

@@ -36,6 +36,12 @@ Cycle Dram::access(const MemRequest& req) {
 
 nlohmann::json Dram::stats_json(Cycle total_cycles, double clock_ghz) const {
     nlohmann::json j = m_stats.to_json();
+    // DRAM serves every read: hit rates and merges mean nothing at this level.
+    auto drop_cache_fields = [](nlohmann::json& c) {
+        for (const char* k : {"read_hits", "merged", "hit_rate"}) c.erase(k);
+    };
+    drop_cache_fields(j);
+    for (auto& [kind, c] : j["by_kind"].items()) drop_cache_fields(c);
     MemCounters t = m_stats.total();
     double seconds = double(total_cycles) / (clock_ghz * 1e9);
     double peak = double(m_config.bytes_per_cycle) * m_config.channels * clock_ghz;  // GB/s

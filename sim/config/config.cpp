@@ -197,7 +197,12 @@ void config_set(SimConfig& config, const std::string& assignment) {
         start = dot + 1;
     }
     for (auto it = parts.rbegin(); it != parts.rend(); ++it) patch = json{{*it, patch}};
-    config = config_from_json(patch, config);
+    try {
+        config = config_from_json(patch, config);
+    } catch (const Error& e) {
+        // Name the whole assignment too: for "nonsense.key=1" the reader only sees 'nonsense'.
+        throw Error(std::string(e.what()) + " (in '" + assignment + "')");
+    }
 }
 
 json config_to_json(const SimConfig& config) {

@@ -22,7 +22,7 @@ struct PipelineConfig {
     void visit(V& v) {
         v.field("latency", latency, "cycles", "Cycles from issue to result", 1, 1000);
         v.field("initiation_interval", initiation_interval, "cycles", "Cycles between two issues into one pipeline", 1, 1000);
-        v.field("width", width, "tests", "Tests per issue (boxes: 2 tests a whole node in one issue)", 1, 64);
+        v.field("width", width, "tests", "Tests per issue (a node has 2 child boxes: width 2 tests a node in one issue)", 1, 64);
         v.choice("sharing", sharing, {"private", "shared"}, "One pipeline per traversal unit, or a pool shared by all units");
         v.field("shared_count", shared_count, "pipelines", "Pipelines in the shared pool (sharing = shared)", 1, 1024);
     }

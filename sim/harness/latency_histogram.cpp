@@ -17,7 +17,8 @@ uint64_t LatencyHistogram::upper(size_t b) {
     if (b < (1u << kSub)) return b;
     int octave = int(b >> kSub) + kSub - 1;
     uint64_t sub = b & ((1u << kSub) - 1);
-    return ((uint64_t(1) << kSub | sub) + 1) << (octave - kSub);
+    // Inclusive: the last value of the bucket (buckets below 8 hold one value each).
+    return (((uint64_t(1) << kSub | sub) + 1) << (octave - kSub)) - 1;
 }
 
 void LatencyHistogram::add(uint64_t cycles) {

@@ -13,7 +13,7 @@ public:
     uint64_t count() const { return m_count; }
     double mean() const { return m_count ? double(m_sum) / double(m_count) : 0.0; }
     uint64_t max() const { return m_max; }
-    /// Upper bound of the bucket holding quantile q (0..1).
+    /// Upper bound (inclusive, at most max()) of the bucket holding quantile q (0..1).
     uint64_t quantile(double q) const;
     nlohmann::json to_json() const;
 

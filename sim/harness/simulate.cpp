@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "rtl_model/top/top.h"
 #include "sim/harness/hit_checker.h"
@@ -88,6 +89,7 @@ void write_json(const fs::path& path, const json& j) {
 
 SimOutcome run_simulation(const SimOptions& o) {
     auto t0 = std::chrono::steady_clock::now();
+    const std::time_t started = std::time(nullptr);
     validate(o.config);
     const std::string rtt = trace_file(o.trace);
     TraceReader reader(rtt);
@@ -99,6 +101,10 @@ SimOutcome run_simulation(const SimOptions& o) {
     WorkloadFeatures features;
     features.anyhit_triangles = image.has_anyhit_triangles();
     json workload = scan_workload(reader, &features);
+    // Check every chunk's CRC now (one streaming pass): the reference window reads HITS and WORK
+    // during sc_start, where a corrupt chunk would surface as a SystemC report (exit 1) instead
+    // of an error naming the file (exit 2).
+    reader.verify_all();
     const uint64_t total = workload["rays"];
 
     fs::create_directories(o.out_dir);
@@ -115,12 +121,13 @@ SimOutcome run_simulation(const SimOptions& o) {
     } else {
         TraceRayStream stream(reader);
         Top top("top", o.config, image, stream, checker, features);
+        std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
         if (o.timeline) {
-            TraceReader kind_reader(rtt);
+            kind_reader = std::make_unique<TraceReader>(rtt);
             checker.on_ray = [&](const RayResult& r) {
                 if (r.id < Timeline::kMaxRays) {
                     RayRecord rec;
-                    kind_reader.read(SectionKind::rays, r.id, 1, &rec);
+                    kind_reader->read(SectionKind::rays, r.id, 1, &rec);
                     timeline.ray(r, rec.kind);
                 }
             };
@@ -147,7 +154,7 @@ SimOutcome run_simulation(const SimOptions& o) {
                  {"instantiated", instantiated},
                  {"effects", manifest.value("workload", json::object()).value("effects", json::array())},
                  {"model", model},
-                 {"provenance", provenance(o.command_line, rtt, manifest)}};
+                 {"provenance", provenance(o.command_line, rtt, manifest, started)}};
     write_json(fs::path(o.out_dir) / "stats.json", out.stats);
     write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
     out.exit_code = (checker.hit_mismatches() || checker.work_mismatches()) ? 3 : 0;

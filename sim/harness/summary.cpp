@@ -70,12 +70,11 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
     return s;
 }
 
-json provenance(const std::string& command_line, const std::string& trace, const json& manifest) {
+json provenance(const std::string& command_line, const std::string& trace, const json& manifest, std::time_t started) {
     char host[256] = {};
     gethostname(host, sizeof(host) - 1);
-    std::time_t now = std::time(nullptr);
     char when[64];
-    std::strftime(when, sizeof(when), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+    std::strftime(when, sizeof(when), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&started));
     return {{"rtsim_version", RTSIM_VERSION},
             {"git", RTSIM_GIT_HASH},
             {"command_line", command_line},

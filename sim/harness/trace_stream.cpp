@@ -37,9 +37,10 @@ ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {
     require(id < m_total, "ray " + std::to_string(id) + " is beyond the trace (" + std::to_string(m_total) + " rays)");
     if (!m_chunks.empty() && index >= m_chunks.front().index && index < m_chunks.front().index + m_chunks.size())
         return m_chunks[index - m_chunks.front().index];
-    require(m_chunks.empty() || index >= m_chunks.front().index, "reference window: ray " + std::to_string(id) + " already retired");
-    // Load consecutive chunks up to the one needed.
-    uint64_t next = m_chunks.empty() ? index : m_chunks.back().index + 1;
+    require(index >= m_loaded_end, "reference window: ray " + std::to_string(id) + " already retired");
+    // Load consecutive chunks up to the one needed. Always from the first chunk never loaded, even
+    // when every resident chunk has retired: rays of the chunks in between may still be in flight.
+    uint64_t next = m_loaded_end;
     while (next <= index) {
         uint64_t first = next * m_chunk, n = std::min(m_chunk, m_total - first);
         Chunk c{next, std::vector<HitRecord>(n), std::vector<WorkRecord>(n), n};
@@ -48,6 +49,7 @@ ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {
         m_chunks.push_back(std::move(c));
         ++next;
     }
+    m_loaded_end = next;
     return m_chunks.back();
 }
 

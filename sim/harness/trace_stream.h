@@ -48,6 +48,7 @@ private:
     TraceReader& m_reader;
     uint64_t m_chunk, m_total;
     std::deque<Chunk> m_chunks;  ///< consecutive chunk indices, oldest first
+    uint64_t m_loaded_end = 0;   ///< chunks [0, m_loaded_end) have been loaded (some retired)
 };
 
 }  // namespace rtsim

@@ -29,6 +29,6 @@ def test_ray_record_offsets() -> None:
 
 def test_hw_node_offsets() -> None:
     offsets = {name: NODE_DTYPE.fields[name][1] for name in NODE_DTYPE.names}
-    assert offsets == {"lo": 0, "hi": 24, "child_ref": 48, "child_count": 56}
+    assert offsets == {"bounds": 0, "child_ref": 48, "child_count": 56}
     tri = {name: TRIANGLE_DTYPE.fields[name][1] for name in TRIANGLE_DTYPE.names}
     assert tri == {"v0": 0, "v1": 12, "v2": 24, "prim": 36, "inst": 40, "flags": 44}

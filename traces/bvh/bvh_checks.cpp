@@ -14,8 +14,8 @@ namespace {
 constexpr uint32_t kMaxLeafDepth = 64;
 
 Aabb slot_box(const HwNode& node, int slot) {
-    return Aabb{Vec3(node.lo[slot][0], node.lo[slot][1], node.lo[slot][2]),
-                Vec3(node.hi[slot][0], node.hi[slot][1], node.hi[slot][2])};
+    return Aabb{Vec3(node.lo(slot, 0), node.lo(slot, 1), node.lo(slot, 2)),
+                Vec3(node.hi(slot, 0), node.hi(slot, 1), node.hi(slot, 2))};
 }
 
 bool inside(const Aabb& box, const float* v) {

@@ -15,8 +15,8 @@ namespace {
 
 void set_slot_box(HwNode& node, int slot, const Aabb& box) {
     for (int a = 0; a < 3; ++a) {
-        node.lo[slot][a] = box.lo[a];
-        node.hi[slot][a] = box.hi[a];
+        node.lo(slot, a) = box.lo[a];
+        node.hi(slot, a) = box.hi[a];
     }
 }
 

@@ -14,11 +14,17 @@ namespace rtsim {
 /// child_count value of an unused child slot (only in the root of a one-leaf tree).
 constexpr uint32_t kEmptyChild = 0xFFFFFFFFu;
 
-struct HwNode {                 // 64 bytes, 64-byte aligned in memory
-    float lo[2][3];             //  0: child 0 box min xyz, 12: child 1 box min xyz
-    float hi[2][3];             // 24: child 0 box max xyz, 36: child 1 box max xyz
+struct alignas(64) HwNode {     // 64 bytes, 64-byte aligned in memory (one line per fetch)
+    /// Both child boxes, one axis per 16 bytes so one 4-lane operation covers an axis of both
+    /// children: bounds[axis][0 = min, 1 = max][child], axis a at offset 16 * a.
+    float bounds[3][2][2];      //  0: x, 16: y, 32: z, each {min c0, min c1, max c0, max c1}
     uint32_t child_ref[2];      // 48: interior child: node index; leaf: first triangle index
     uint32_t child_count[2];    // 56: 0: interior child; kEmptyChild: no child; else leaf size
+
+    float lo(int child, int axis) const { return bounds[axis][0][child]; }
+    float hi(int child, int axis) const { return bounds[axis][1][child]; }
+    float& lo(int child, int axis) { return bounds[axis][0][child]; }
+    float& hi(int child, int axis) { return bounds[axis][1][child]; }
 };
 static_assert(sizeof(HwNode) == 64, "HwNode must be one 64-byte line");
 

@@ -14,7 +14,7 @@
 namespace rtsim {
 
 constexpr char kTraceMagic[8] = {'R', 'T', 'S', 'I', 'M', 'T', 'R', 'C'};
-constexpr uint32_t kTraceVersion = 1;
+constexpr uint32_t kTraceVersion = 2;  // 2: HwNode boxes in the per-axis bounds layout
 
 /// Section kinds (fourcc, little-endian). Never renumber; add new kinds instead.
 enum class SectionKind : uint32_t {

@@ -1,6 +1,8 @@
 // Public entry points of the robust ray/box test; the arithmetic is in ray_box_kernel.h.
 #include "traces/isect/ray_box.h"
 
+#include <cmath>
+
 #include "traces/isect/ray_box_kernel.h"
 
 namespace rtsim {
@@ -16,6 +18,17 @@ RayBoxPre ray_box_precompute(const Ray& ray) {
     }
     pre.origin4[3] = 0.0f;
     pre.inv_dir4[3] = 0.0f;
+    for (int lane = 0; lane < 4; ++lane) {
+        pre.origin_xy[lane] = pre.origin[lane / 2];
+        pre.inv_dir_xy[lane] = pre.inv_dir[lane / 2];
+        pre.origin_z[lane] = pre.origin.z;
+        pre.inv_dir_z[lane] = pre.inv_dir.z;
+    }
+    for (int a = 0; a < 3; ++a) {
+        const uint32_t near_max = std::signbit(pre.inv_dir[a]) ? 1u : 0u;
+        pre.near_offset[a] = 16u * uint32_t(a) + 8u * near_max;
+        pre.far_offset[a] = 16u * uint32_t(a) + 8u * (1u - near_max);
+    }
     return pre;
 }
 

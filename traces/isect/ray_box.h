@@ -13,6 +13,15 @@ struct RayBoxPre {
     /// The same two vectors padded to 4 lanes (lane 3 = 0) for the SIMD node test.
     alignas(16) float origin4[4];
     alignas(16) float inv_dir4[4];
+    /// For the SIMD node test: (ox, ox, oy, oy), (1/dx, 1/dx, 1/dy, 1/dy) and z in all lanes.
+    alignas(16) float origin_xy[4];
+    alignas(16) float inv_dir_xy[4];
+    alignas(16) float origin_z[4];   ///< oz in every lane
+    alignas(16) float inv_dir_z[4];  ///< 1/dz in every lane
+    /// Byte offsets from HwNode::bounds of both children's near and far planes per axis:
+    /// axis a at 16 * a, the max plane (+8) is near where inv_dir is negative (sign bit set).
+    uint32_t near_offset[3];
+    uint32_t far_offset[3];
 };
 
 RayBoxPre ray_box_precompute(const Ray& ray);

@@ -11,7 +11,9 @@
 // origin lies exactly in that slab plane. Such a distance is ignored (the fold keeps the running
 // value), so a ray lying in a slab plane counts as inside that slab.
 // The SSE2 node test computes exactly the scalar box test lane by lane (IEEE single-precision
-// add/mul; MAXPS/MINPS return their second operand on NaN, which is the fold above).
+// add/mul; MAXPS/MINPS return their second operand on NaN, which is the fold above). It reads
+// the HwNode::bounds layout, one axis of both children per 16 bytes, and takes the near and far
+// plane of each axis at byte offsets fixed per ray, so no per-node select is needed.
 #include <cmath>
 #include <limits>
 
@@ -50,50 +52,74 @@ inline bool box_kernel(const RayBoxPre& pre, const float lo[3], const float hi[3
 }
 
 #if defined(__SSE2__)
-/// Both children of a node at once: lanes hold x, y, z of one child, then a 2x3 transpose.
+/// Bitwise select of the far-distance scale: kFarDown + (far >= 0 ? kFarStep : 0) is exactly
+/// kFarUp or kFarDown (both are 1 -+ 3 * 2^-23; their difference and the sum are exact).
+constexpr float kFarStep = kFarUp - kFarDown;
+static_assert(kFarDown + kFarStep == kFarUp, "far scale select must be exact");
+
+/// Lanes of constants, loaded as one memory operand each.
+alignas(16) constexpr float kInf4[4] = {std::numeric_limits<float>::infinity(),
+                                        std::numeric_limits<float>::infinity(),
+                                        std::numeric_limits<float>::infinity(),
+                                        std::numeric_limits<float>::infinity()};
+alignas(16) constexpr float kFarDown4[4] = {kFarDown, kFarDown, kFarDown, kFarDown};
+alignas(16) constexpr float kFarStep4[4] = {kFarStep, kFarStep, kFarStep, kFarStep};
+
+/// Both children of a node at once, in the HwNode::bounds layout: the ray's near and far planes
+/// are picked per axis by the byte offsets of RayBoxPre (no per-node select), lanes 0 and 1 hold
+/// child 0 and child 1. Lane for lane the same operations, in the same order, as box_kernel.
+/// tmin4 and tmax4 hold the interval in every lane. Returns the movemask of the hit lanes
+/// (bits 0 and 1; lanes 2 and 3 undefined) and the entry distances in lanes 0 and 1 of *tnear.
+inline unsigned node_kernel_sse(const RayBoxPre& pre, const HwNode& node, __m128 tmin4,
+                                __m128 tmax4, __m128* tnear) {
+    const char* b = reinterpret_cast<const char*>(node.bounds);
+    const auto pair = [b](uint32_t offset) {  // two floats: the plane of both children
+        return _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(b + offset)));
+    };
+    const auto high = [b](__m128 lo, uint32_t offset) {
+        return _mm_loadh_pi(lo, reinterpret_cast<const __m64*>(b + offset));
+    };
+    // (near x, near y) and (far x, far y) of both children; z: (near z, far z).
+    const __m128 n_xy = high(pair(pre.near_offset[0]), pre.near_offset[1]);
+    const __m128 f_xy = high(pair(pre.far_offset[0]), pre.far_offset[1]);
+    const __m128 nf_z = high(pair(pre.near_offset[2]), pre.far_offset[2]);
+    const __m128 org_xy = _mm_load_ps(pre.origin_xy), inv_xy = _mm_load_ps(pre.inv_dir_xy);
+    const __m128 org_z = _mm_load_ps(pre.origin_z), inv_z = _mm_load_ps(pre.inv_dir_z);
+    const __m128 tn_xy = _mm_mul_ps(_mm_sub_ps(n_xy, org_xy), inv_xy);
+    const __m128 tf_xy = _mm_mul_ps(_mm_sub_ps(f_xy, org_xy), inv_xy);
+    const __m128 t_z = _mm_mul_ps(_mm_sub_ps(nf_z, org_z), inv_z);
+    // NaN-ignoring folds, slab value first (MAXPS/MINPS return the second operand on NaN):
+    // the same order as the scalar loop, x then y then z.
+    __m128 tn = _mm_max_ps(tn_xy, tmin4);
+    tn = _mm_max_ps(_mm_movehl_ps(tn_xy, tn_xy), tn);
+    tn = _mm_max_ps(t_z, tn);
+    __m128 tf = _mm_min_ps(tf_xy, _mm_load_ps(kInf4));
+    tf = _mm_min_ps(_mm_movehl_ps(tf_xy, tf_xy), tf);
+    tf = _mm_min_ps(_mm_movehl_ps(t_z, t_z), tf);
+    const __m128 pos = _mm_cmpge_ps(tf, _mm_setzero_ps());
+    const __m128 scale = _mm_add_ps(_mm_load_ps(kFarDown4), _mm_and_ps(pos, _mm_load_ps(kFarStep4)));
+    tf = _mm_min_ps(_mm_mul_ps(tf, scale), tmax4);
+    *tnear = tn;
+    return unsigned(_mm_movemask_ps(_mm_cmple_ps(tn, tf)));
+}
+
 inline unsigned node_kernel(const RayBoxPre& pre, const HwNode& node, float tmin, float tmax,
                             float tnear[2]) {
-    const __m128 org = _mm_load_ps(pre.origin4);
-    const __m128 inv = _mm_load_ps(pre.inv_dir4);
-    const __m128 neg = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(inv), 31));
-    // Slab distances of both planes; lane 3 holds a neighbouring box coordinate and is never
-    // used. (hi[1] is loaded from hi[0][2] and rotated: the word after it is child_ref[0], an
-    // integer that reads as a denormal float, and denormal operands cost a microcode assist.)
-    const __m128 hi1_raw = _mm_loadu_ps(&node.hi[0][2]);
-    const __m128 lo0 = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.lo[0]), org), inv);
-    const __m128 lo1 = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.lo[1]), org), inv);
-    const __m128 hi0 = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.hi[0]), org), inv);
-    const __m128 hi1 = _mm_mul_ps(
-        _mm_sub_ps(_mm_shuffle_ps(hi1_raw, hi1_raw, _MM_SHUFFLE(0, 3, 2, 1)), org), inv);
-    // Near plane = hi where inv_dir is negative, else lo; far the other one.
-    const __m128 n0 = _mm_or_ps(_mm_and_ps(neg, hi0), _mm_andnot_ps(neg, lo0));
-    const __m128 n1 = _mm_or_ps(_mm_and_ps(neg, hi1), _mm_andnot_ps(neg, lo1));
-    const __m128 f0 = _mm_or_ps(_mm_and_ps(neg, lo0), _mm_andnot_ps(neg, hi0));
-    const __m128 f1 = _mm_or_ps(_mm_and_ps(neg, lo1), _mm_andnot_ps(neg, hi1));
-    // Transpose to (child 0, child 1) pairs per axis: xy = (x0, x1, y0, y1), z = (z0, z1, ..).
-    const __m128 nxy = _mm_unpacklo_ps(n0, n1), nz = _mm_unpackhi_ps(n0, n1);
-    const __m128 fxy = _mm_unpacklo_ps(f0, f1), fz = _mm_unpackhi_ps(f0, f1);
-    // NaN-ignoring folds, slab value first: the same order as the scalar loop.
-    __m128 tn = _mm_max_ps(nxy, _mm_set1_ps(tmin));
-    tn = _mm_max_ps(_mm_movehl_ps(nxy, nxy), tn);
-    tn = _mm_max_ps(nz, tn);
-    __m128 tf = _mm_min_ps(fxy, _mm_set1_ps(std::numeric_limits<float>::infinity()));
-    tf = _mm_min_ps(_mm_movehl_ps(fxy, fxy), tf);
-    tf = _mm_min_ps(fz, tf);
-    const __m128 pos = _mm_cmpge_ps(tf, _mm_setzero_ps());
-    const __m128 scale = _mm_or_ps(_mm_and_ps(pos, _mm_set1_ps(kFarUp)),
-                                   _mm_andnot_ps(pos, _mm_set1_ps(kFarDown)));
-    tf = _mm_min_ps(_mm_mul_ps(tf, scale), _mm_set1_ps(tmax));
-    const unsigned mask = unsigned(_mm_movemask_ps(_mm_cmple_ps(tn, tf))) & 3u;
+    __m128 tn;
+    const unsigned mask = node_kernel_sse(pre, node, _mm_set1_ps(tmin), _mm_set1_ps(tmax), &tn);
     _mm_storel_pi(reinterpret_cast<__m64*>(tnear), tn);
-    return mask;
+    return mask & 3u;
 }
 #else
 inline unsigned node_kernel(const RayBoxPre& pre, const HwNode& node, float tmin, float tmax,
                             float tnear[2]) {
-    const bool h0 = box_kernel(pre, node.lo[0], node.hi[0], tmin, tmax, &tnear[0]);
-    const bool h1 = box_kernel(pre, node.lo[1], node.hi[1], tmin, tmax, &tnear[1]);
-    return unsigned(h0) | (unsigned(h1) << 1);
+    unsigned mask = 0;
+    for (int c = 0; c < 2; ++c) {
+        const float lo[3] = {node.lo(c, 0), node.lo(c, 1), node.lo(c, 2)};
+        const float hi[3] = {node.hi(c, 0), node.hi(c, 1), node.hi(c, 2)};
+        mask |= unsigned(box_kernel(pre, lo, hi, tmin, tmax, &tnear[c])) << c;
+    }
+    return mask;
 }
 #endif
 

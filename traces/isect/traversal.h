@@ -70,8 +70,14 @@ private:
     StackEntry m_stack[kTraversalStackSize];
 };
 
-/// Reference tracing of one ray through the hardware BVH (the stepper in a loop).
+/// Reference tracing of one ray through the hardware BVH: the stepper's steps fused into one
+/// loop per mode (trace_ray.cpp). Same visits, hits and work counts as trace_ray_stepper.
 Hit trace_ray(const HwBvh& bvh, const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr);
+
+/// The same ray driven through the Traversal stepper, step by step, as the model drives it.
+/// Slower than trace_ray; the tests check the two agree on every ray.
+Hit trace_ray_stepper(const HwBvh& bvh, const Ray& ray, TraversalMode mode,
+                      WorkCounts* work = nullptr);
 
 /// Brute-force closest/any hit over all triangles, same arithmetic and tie-breaking; for tests.
 Hit trace_ray_brute_force(const HwBvh& bvh, const Ray& ray, TraversalMode mode);

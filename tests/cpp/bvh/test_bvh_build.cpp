@@ -75,8 +75,8 @@ TEST(BvhBuild, OneLeafSceneGetsInteriorRootWithEmptySecondChild) {
     EXPECT_EQ(root.child_count[0], 1u);
     EXPECT_EQ(root.child_count[1], kEmptyChild);
     for (int a = 0; a < 3; ++a) {
-        EXPECT_EQ(root.lo[1][a], std::numeric_limits<float>::infinity());
-        EXPECT_EQ(root.hi[1][a], -std::numeric_limits<float>::infinity());
+        EXPECT_EQ(root.lo(1, a), std::numeric_limits<float>::infinity());
+        EXPECT_EQ(root.hi(1, a), -std::numeric_limits<float>::infinity());
     }
     EXPECT_EQ(bvh.stats.leaves, 1u);
     EXPECT_EQ(bvh.stats.max_depth, 1u);

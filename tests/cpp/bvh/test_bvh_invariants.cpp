@@ -53,26 +53,26 @@ TEST_F(Corruption, TrianglesSwappedAcrossLeaves) {
 
 TEST_F(Corruption, ShrunkenLeafBox) {
     uint32_t node = find_leaf_slot(m_bvh, 1);
-    m_bvh.nodes[node].hi[1][2] = m_bvh.nodes[node].lo[1][2];
+    m_bvh.nodes[node].hi(1, 2) = m_bvh.nodes[node].lo(1, 2);
     expect_caught(m_bvh, m_scene, "BVH node " + std::to_string(node) + " child 1");
 }
 
 TEST_F(Corruption, ShrunkenInteriorBox) {
     ASSERT_EQ(m_bvh.nodes[0].child_count[0], 0u);
-    m_bvh.nodes[0].hi[0][0] -= 0.1f;  // the grandchildren now stick out
+    m_bvh.nodes[0].hi(0, 0) -= 0.1f;  // the grandchildren now stick out
     expect_caught(m_bvh, m_scene, "box outside its parent's box");
 }
 
 TEST_F(Corruption, TriangleReferencedTwice) {
     uint32_t node = find_leaf_slot(m_bvh, 0);
     m_bvh.nodes[node].child_count[0] += 1;  // overlaps the next leaf's first triangle
-    m_bvh.nodes[node].hi[0][0] = m_bvh.nodes[node].hi[0][1] = m_bvh.nodes[node].hi[0][2] = 2.0f;
-    m_bvh.nodes[node].lo[0][0] = m_bvh.nodes[node].lo[0][1] = m_bvh.nodes[node].lo[0][2] = -1.0f;
+    m_bvh.nodes[node].hi(0, 0) = m_bvh.nodes[node].hi(0, 1) = m_bvh.nodes[node].hi(0, 2) = 2.0f;
+    m_bvh.nodes[node].lo(0, 0) = m_bvh.nodes[node].lo(0, 1) = m_bvh.nodes[node].lo(0, 2) = -1.0f;
     // Widen every ancestor box too so only the double reference is wrong.
     for (HwNode& n : m_bvh.nodes)
         for (int s = 0; s < 2; ++s)
             if (n.child_count[s] == 0)
-                for (int a = 0; a < 3; ++a) n.lo[s][a] = -1.0f, n.hi[s][a] = 2.0f;
+                for (int a = 0; a < 3; ++a) n.lo(s, a) = -1.0f, n.hi(s, a) = 2.0f;
     m_bvh.bounds = Aabb{Vec3(-1.0f), Vec3(2.0f)};
     expect_caught(m_bvh, m_scene, "referenced twice");
 }

@@ -152,9 +152,9 @@ TEST_F(CorruptionTest, WrongVersionAndForeignFilesAreRefused) {
     // A well-formed header (valid CRC) from a future version.
     std::vector<uint8_t> b = m_bytes;
     tl::FileHeader h = m_header;
-    h.version = 2;
+    h.version = kTraceVersion + 1;
     tl::encode_header(h, b.data());
-    EXPECT_EQ(open_error(b), m_bad + ": trace version 2 is not supported by this build (reads version 1)");
+    EXPECT_EQ(open_error(b), m_bad + ": trace version 3 is not supported by this build (reads version 2)");
 
     const std::string text = "This is a text file, long enough to fill a whole trace header, honestly.\n";
     EXPECT_EQ(open_error(std::vector<uint8_t>(text.begin(), text.end())),

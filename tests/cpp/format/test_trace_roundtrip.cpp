@@ -35,8 +35,8 @@ TEST(TraceRecords, OffsetsMatchTheDocumentedLayout) {
     EXPECT_EQ(offsetof(WorkRecord, tri_tests), 8u);
     EXPECT_EQ(offsetof(WorkRecord, anyhit_calls), 12u);
     EXPECT_EQ(offsetof(WorkRecord, transforms), 16u);
-    EXPECT_EQ(offsetof(HwNode, lo), 0u);
-    EXPECT_EQ(offsetof(HwNode, hi), 24u);
+    EXPECT_EQ(offsetof(HwNode, bounds), 0u);
+    EXPECT_EQ(sizeof(HwNode::bounds), 48u);
     EXPECT_EQ(offsetof(HwNode, child_ref), 48u);
     EXPECT_EQ(offsetof(HwNode, child_count), 56u);
     EXPECT_EQ(offsetof(HwTriangle, prim), 36u);
@@ -123,7 +123,7 @@ TEST(TraceRoundTrip, InterleavedAppendsOfAllKindsAcrossManyChunks) {
             if (step % 3 == 0) {
                 HwNode node{};
                 node.child_ref[0] = uint32_t(step);
-                node.lo[1][2] = float(step);
+                node.lo(1, 2) = float(step);
                 nodes.push_back(node);
                 writer.append(SectionKind::bvh_nodes, std::vector<HwNode>{node});
             }

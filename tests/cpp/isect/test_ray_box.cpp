@@ -84,10 +84,10 @@ TEST(RayBox, EmptySlotNeverHits) {
     Rng rng(2);
     HwNode node{};
     for (int a = 0; a < 3; ++a) {
-        node.lo[0][a] = -1.0f;
-        node.hi[0][a] = 1.0f;
-        node.lo[1][a] = kInf;
-        node.hi[1][a] = -kInf;
+        node.lo(0, a) = -1.0f;
+        node.hi(0, a) = 1.0f;
+        node.lo(1, a) = kInf;
+        node.hi(1, a) = -kInf;
     }
     const float zeros[2] = {0.0f, -0.0f};
     for (int i = 0; i < 20000; ++i) {
@@ -131,8 +131,8 @@ TEST(RayBox, NodeTestEqualsTwoBoxTestsBitForBit) {
             for (int a = 0; a < 3; ++a) {
                 float x = grid[int(rng.next() * 5) % 5], y = grid[int(rng.next() * 5) % 5];
                 if (rng.next() < 0.5f) x = rng.next() * 2 - 1, y = rng.next() * 2 - 1;
-                node.lo[c][a] = std::min(x, y);
-                node.hi[c][a] = std::max(x, y);
+                node.lo(c, a) = std::min(x, y);
+                node.hi(c, a) = std::max(x, y);
             }
         Vec3 o, d;
         for (int a = 0; a < 3; ++a) {
@@ -144,8 +144,12 @@ TEST(RayBox, NodeTestEqualsTwoBoxTestsBitForBit) {
         const RayBoxPre pre = ray_box_precompute(r);
         float tn[2] = {0, 0}, t0 = 0, t1 = 0;
         const unsigned mask = intersect_node_boxes(pre, node, r.tmin, r.tmax, tn);
-        const bool h0 = intersect_box(pre, node.lo[0], node.hi[0], r.tmin, r.tmax, &t0);
-        const bool h1 = intersect_box(pre, node.lo[1], node.hi[1], r.tmin, r.tmax, &t1);
+        const float lo0[3] = {node.lo(0, 0), node.lo(0, 1), node.lo(0, 2)};
+        const float hi0[3] = {node.hi(0, 0), node.hi(0, 1), node.hi(0, 2)};
+        const float lo1[3] = {node.lo(1, 0), node.lo(1, 1), node.lo(1, 2)};
+        const float hi1[3] = {node.hi(1, 0), node.hi(1, 1), node.hi(1, 2)};
+        const bool h0 = intersect_box(pre, lo0, hi0, r.tmin, r.tmax, &t0);
+        const bool h1 = intersect_box(pre, lo1, hi1, r.tmin, r.tmax, &t1);
         ASSERT_EQ(mask, unsigned(h0) | (unsigned(h1) << 1)) << i;
         if (h0) {
             ASSERT_EQ(test::float_bits(tn[0]), test::float_bits(t0)) << i;

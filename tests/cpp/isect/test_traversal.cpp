@@ -30,8 +30,8 @@ HwTriangle make_tri(const Vec3& a, const Vec3& b, const Vec3& c, uint32_t prim, 
 
 void set_box(HwNode& n, int slot, const Vec3& lo, const Vec3& hi, uint32_t ref, uint32_t count) {
     for (int a = 0; a < 3; ++a) {
-        n.lo[slot][a] = lo[a];
-        n.hi[slot][a] = hi[a];
+        n.lo(slot, a) = lo[a];
+        n.hi(slot, a) = hi[a];
     }
     n.child_ref[slot] = ref;
     n.child_count[slot] = count;

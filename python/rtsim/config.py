@@ -1,0 +1,345 @@
+"""The simulator's config tree as typed dataclasses (DESIGN rule 5).
+
+Mirrors ``sim/config/config.h`` exactly: the same sections, field names and defaults, with the
+unit, range and doc of each field in its metadata. ``tests/python/test_config_py.py`` compares
+this tree with ``rtsim-sim --dump-schema`` both ways, so the two cannot drift.
+
+Configs are composed Accel-Sim style from a named preset plus modifiers, e.g.
+``compose("base+tu16+l1-64k")``. Presets and modifiers are data (nested dict patches), so a new
+one is one dict entry; every patch is checked against this tree when it is applied, so a patch
+naming a key the C++ side does not have fails with the key's full path.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import json
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, TypeVar
+
+T = TypeVar("T")
+
+
+class ConfigError(ValueError):
+    """A config dict, key path or patch that does not fit the tree; the message names the key."""
+
+
+def _f(default: Any, unit: str, doc: str, lo: float, hi: float) -> Any:
+    return field(default=default, metadata={"unit": unit, "doc": doc, "min": lo, "max": hi})
+
+
+def _choice(default: str, choices: tuple[str, ...], doc: str) -> Any:
+    return field(default=default, metadata={"choices": choices, "doc": doc})
+
+
+def _flag(default: bool, doc: str) -> Any:
+    return field(default=default, metadata={"doc": doc})
+
+
+@dataclass
+class PipelineConfig:
+    """A ray-box or ray-triangle pipeline (timing only; the arithmetic is traces/isect/)."""
+
+    latency: int = _f(8, "cycles", "Cycles from issue to result", 1, 1000)
+    initiation_interval: int = _f(
+        1, "cycles", "Cycles between two issues into one pipeline", 1, 1000
+    )
+    width: int = _f(
+        1,
+        "tests",
+        "Tests per issue (a node has 2 child boxes: width 2 tests a node in one issue)",
+        1,
+        64,
+    )
+    sharing: str = _choice(
+        "private",
+        ("private", "shared"),
+        "One pipeline per traversal unit, or a pool shared by all units",
+    )
+    shared_count: int = _f(
+        4, "pipelines", "Pipelines in the shared pool (sharing = shared)", 1, 1024
+    )
+
+
+@dataclass
+class CacheConfig:
+    """One cache level (every L1 has the same config)."""
+
+    size_kib: int = _f(16, "KiB", "Capacity", 1, 1 << 20)
+    ways: int = _f(4, "ways", "Associativity (LRU replacement)", 1, 64)
+    line_bytes: int = _f(64, "bytes", "Line size (power of two, same at every level)", 16, 1024)
+    latency: int = _f(4, "cycles", "Hit latency", 1, 1000)
+    mshrs: int = _f(8, "entries", "Outstanding misses; a miss waits for a free MSHR", 1, 1024)
+    banks: int = _f(
+        1, "banks", "Line-interleaved banks, each serving one access per bank_cycles", 1, 256
+    )
+    bank_cycles: int = _f(1, "cycles", "Cycles a bank is busy per access", 1, 100)
+
+
+@dataclass
+class DramConfig:
+    channels: int = _f(2, "channels", "Independent DRAM channels", 1, 64)
+    bytes_per_cycle: int = _f(
+        16, "B/cycle", "Peak bandwidth per channel, bytes per core cycle", 1, 4096
+    )
+    latency: int = _f(120, "cycles", "Unloaded access latency (request to data)", 1, 100000)
+    interleave_bytes: int = _f(
+        256, "bytes", "Channel interleaving granule (power of two, >= line size)", 64, 1 << 20
+    )
+
+
+@dataclass
+class TraversalConfig:
+    units: int = _f(8, "units", "MIMD traversal units", 1, 4096)
+    ray_contexts: int = _f(16, "rays", "Ray contexts per unit (rays in flight)", 1, 4096)
+    stack_entries: int = _f(
+        8, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64
+    )
+    stack_entry_bytes: int = _f(8, "bytes", "Bytes per stack entry (spill traffic)", 4, 64)
+    issue_cycles: int = _f(1, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100)
+
+
+@dataclass
+class DispatchConfig:
+    chunk_rays: int = _f(16384, "rays", "Rays streamed from the trace file per chunk", 64, 1 << 24)
+    latency: int = _f(
+        2, "cycles", "Cycles to assign a ray to a free context, before its fetch", 0, 1000
+    )
+
+
+@dataclass
+class SimConfig:
+    """The whole simulator config: the root of the tree rtsim-sim reads with --config."""
+
+    clock_ghz: float = _f(1.0, "GHz", "Core clock: converts cycles to seconds", 0.001, 100.0)
+    fidelity: str = _choice(
+        "approx",
+        ("functional", "approx"),
+        "Simulation level: functional (counts only) or approx (timed SystemC model)",
+    )
+    quantum_cycles: int = _f(
+        256,
+        "cycles",
+        "How far a traversal unit may run ahead of the others (temporal decoupling)",
+        1,
+        1 << 20,
+    )
+    interconnect_latency: int = _f(
+        8, "cycles", "One-way latency between an L1 and the L2", 0, 10000
+    )
+    ideal_memory: bool = _flag(
+        False, "Every access hits in L1 at L1 latency: the upper bound on performance"
+    )
+    # Sections: the box, triangle and any-hit pipelines and the two cache levels share a struct
+    # with per-section defaults, as in config.h.
+    dispatch: DispatchConfig = field(default_factory=DispatchConfig)
+    traversal: TraversalConfig = field(default_factory=TraversalConfig)
+    box: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 2, "private", 4))
+    triangle: PipelineConfig = field(default_factory=lambda: PipelineConfig(20, 1, 1, "private", 4))
+    anyhit: PipelineConfig = field(default_factory=lambda: PipelineConfig(10, 1, 1, "private", 4))
+    l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 8, 1, 1))
+    l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 32, 8, 1))
+    dram: DramConfig = field(default_factory=DramConfig)
+
+    sections: ClassVar[tuple[str, ...]] = (
+        "dispatch",
+        "traversal",
+        "box",
+        "triangle",
+        "anyhit",
+        "l1",
+        "l2",
+        "dram",
+    )
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SimConfig:
+        """A config from a (partial) dict over the defaults; unknown keys and wrong types raise
+        ConfigError naming the key's full path (e.g. 'l1.size_kb')."""
+        return _read(cls, data, "")
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2, sort_keys=True)
+
+    def get(self, key: str) -> Any:
+        """The value at a dotted key path ('l1.size_kib')."""
+        node: Any = self
+        for part in key.split("."):
+            if not dataclasses.is_dataclass(node) or part not in _names(type(node)):
+                raise ConfigError(f"config: unknown key '{key}'")
+            node = getattr(node, part)
+        if dataclasses.is_dataclass(node):
+            raise ConfigError(f"config: '{key}' is a section, not a field")
+        return node
+
+    def with_values(self, values: dict[str, Any]) -> SimConfig:
+        """A copy with dotted keys set ({'l1.size_kib': 64}); types checked, ranges left to the
+        one validate() in rtsim-sim."""
+        return apply_patch(self, unflatten(values))
+
+    def sram_bytes(self) -> int:
+        """On-chip SRAM of the accelerator: the L1s, the L2 and the traversal stacks."""
+        t = self.traversal
+        stacks = t.units * t.ray_contexts * t.stack_entries * t.stack_entry_bytes
+        return (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks
+
+
+def _names(cls: type) -> dict[str, dataclasses.Field[Any]]:
+    return {f.name: f for f in dataclasses.fields(cls)}
+
+
+def _join(prefix: str, name: str) -> str:
+    return f"{prefix}.{name}" if prefix else name
+
+
+def _check_value(f: dataclasses.Field[Any], value: Any, path: str) -> Any:
+    kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", "")
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise ConfigError(f"config: '{path}' must be true or false, got {value!r}")
+        return value
+    if kind == "int":
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise ConfigError(f"config: '{path}' must be a non-negative integer, got {value!r}")
+        return value
+    if kind == "float":
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"config: '{path}' must be a number, got {value!r}")
+        return float(value)
+    if not isinstance(value, str):
+        raise ConfigError(f"config: '{path}' must be a string, got {value!r}")
+    choices = f.metadata.get("choices")
+    if choices and value not in choices:
+        raise ConfigError(f"config: '{path}' = '{value}' is not one of: {', '.join(choices)}")
+    return value
+
+
+def _read(cls: type[T], data: Any, prefix: str, base: Any = None) -> T:
+    if not isinstance(data, dict):
+        raise ConfigError(f"config: '{prefix or '(root)'}' must be a mapping, got {data!r}")
+    fields = _names(cls)
+    unknown = sorted(set(data) - set(fields))
+    if unknown:
+        raise ConfigError(
+            f"config: unknown key '{_join(prefix, unknown[0])}' (known here: {', '.join(fields)})"
+        )
+    obj = copy.deepcopy(base) if base is not None else cls()
+    for name, value in data.items():
+        f, path = fields[name], _join(prefix, name)
+        current = getattr(obj, name)
+        if dataclasses.is_dataclass(current):
+            setattr(obj, name, _read(type(current), value, path, current))
+        else:
+            setattr(obj, name, _check_value(f, value, path))
+    return obj
+
+
+def apply_patch(config: SimConfig, patch: dict[str, Any]) -> SimConfig:
+    """A copy of config with a nested patch applied (unknown keys raise ConfigError)."""
+    return _read(SimConfig, patch, "", config)
+
+
+def unflatten(values: dict[str, Any]) -> dict[str, Any]:
+    """{'l1.size_kib': 64} -> {'l1': {'size_kib': 64}}."""
+    out: dict[str, Any] = {}
+    for key, value in values.items():
+        node = out
+        *parents, leaf = key.split(".")
+        for part in parents:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise ConfigError(f"config: '{key}' conflicts with another key")
+        node[leaf] = value
+    return out
+
+
+def flatten(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """{'l1': {'size_kib': 64}} -> {'l1.size_kib': 64}, in tree order."""
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        path = _join(prefix, key)
+        if isinstance(value, dict):
+            out.update(flatten(value, path))
+        else:
+            out[path] = value
+    return out
+
+
+def field_info(key: str) -> dataclasses.Field[Any]:
+    """The dataclass field (with unit, doc, range metadata) at a dotted key path."""
+    cls: type = SimConfig
+    *parents, leaf = key.split(".")
+    for part in parents:
+        fields = _names(cls)
+        if part not in fields or part not in SimConfig.sections:
+            raise ConfigError(f"config: unknown key '{key}'")
+        cls = type(getattr(SimConfig(), part))
+    fields = _names(cls)
+    if leaf not in fields or (cls is SimConfig and leaf in SimConfig.sections):
+        raise ConfigError(f"config: unknown key '{key}'")
+    return fields[leaf]
+
+
+def config_keys() -> list[str]:
+    """Every dotted field key, in tree order."""
+    return list(flatten(SimConfig().to_dict()))
+
+
+# Named presets and composable modifiers (Accel-Sim style: "base+tu16+l1-64k"). Each is a nested
+# patch over the C++ defaults; compose() checks every key against the tree above. Add the treelet
+# ray buffer as {"treelets": {"treelets": {"enabled": True}}} once the C++ tree has that section.
+PRESETS: dict[str, dict[str, Any]] = {
+    "base": {},
+    "functional": {"fidelity": "functional"},
+}
+
+MODIFIERS: dict[str, dict[str, Any]] = {
+    "tu4": {"traversal": {"units": 4}},
+    "tu16": {"traversal": {"units": 16}},
+    "tu32": {"traversal": {"units": 32}},
+    "ctx8": {"traversal": {"ray_contexts": 8}},
+    "ctx32": {"traversal": {"ray_contexts": 32}},
+    "stack4": {"traversal": {"stack_entries": 4}},
+    "stack16": {"traversal": {"stack_entries": 16}},
+    "l1-8k": {"l1": {"size_kib": 8}},
+    "l1-32k": {"l1": {"size_kib": 32}},
+    "l1-64k": {"l1": {"size_kib": 64}},
+    "l2-512k": {"l2": {"size_kib": 512}},
+    "l2-2m": {"l2": {"size_kib": 2048}},
+    "l2-4m": {"l2": {"size_kib": 4096}},
+    "dram-half": {"dram": {"bytes_per_cycle": 8}},
+    "dram-2x": {"dram": {"bytes_per_cycle": 32}},
+    "dram-4x": {"dram": {"bytes_per_cycle": 64}},
+    "ideal-mem": {"ideal_memory": True},
+    "shared-pipes": {"box": {"sharing": "shared"}, "triangle": {"sharing": "shared"}},
+    "box-wide": {"box": {"width": 4}},
+    "clock-2g": {"clock_ghz": 2.0},
+    "functional": PRESETS["functional"],
+}
+
+
+def compose(name: str) -> SimConfig:
+    """The config named by 'preset+modifier+...' (the first part may also be a modifier, over
+    'base'). Unknown names raise ConfigError listing what exists."""
+    parts = [p.strip() for p in name.split("+") if p.strip()]
+    if not parts:
+        raise ConfigError("config: empty preset name")
+    config = SimConfig()
+    for i, part in enumerate(parts):
+        table = PRESETS if i == 0 and part in PRESETS else MODIFIERS
+        if part not in table:
+            raise ConfigError(
+                f"config: unknown preset or modifier '{part}' in '{name}' "
+                f"(presets: {', '.join(PRESETS)}; modifiers: {', '.join(MODIFIERS)})"
+            )
+        try:
+            config = apply_patch(config, table[part])
+        except ConfigError as err:
+            raise ConfigError(f"{err} (in modifier '{part}')") from err
+    return config

@@ -1,0 +1,337 @@
+"""The report's matplotlib figures. Each function takes the sweep's data and returns a Figure
+(or None when the sweep has nothing to draw for it); html.py embeds them as PNG."""
+
+from __future__ import annotations
+
+import math
+import statistics
+from collections.abc import Callable
+from typing import Any
+
+import matplotlib
+import matplotlib.ticker
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
+
+from rtsim.report.data import (
+    Group,
+    SweepData,
+    axis_label,
+    mrays,
+    pareto_front,
+    sram_kib,
+)
+from rtsim.sweep.results import DATA_KINDS, bytes_per_ray_by_kind
+from rtsim.sweep.store import RunRecord
+
+KIND_COLORS = {
+    "node": "#4C72B0",
+    "triangle": "#DD8452",
+    "ray": "#55A868",
+    "hit": "#C44E52",
+    "stack": "#8172B3",
+    "ray_buffer": "#937860",
+}
+KIND_NAMES = {
+    "node": "BVH nodes",
+    "triangle": "triangles",
+    "ray": "rays",
+    "hit": "hits",
+    "stack": "stack spills",
+    "ray_buffer": "ray-buffer spills",
+}
+MAX_BARS = 24
+
+plt.rcParams.update(
+    {
+        "font.size": 11,
+        "axes.titlesize": 12,
+        "axes.labelsize": 11,
+        "figure.titlesize": 14,
+        "legend.fontsize": 10,
+        "axes.grid": True,
+        "grid.alpha": 0.3,
+        "axes.spines.top": False,
+        "axes.spines.right": False,
+    }
+)
+
+
+def _panels(n: int, width: float, height: float, ncols: int = 2) -> tuple[Figure, list[Any]]:
+    ncols = min(ncols, n)
+    nrows = math.ceil(n / ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(width * ncols, height * nrows), squeeze=False)
+    flat = list(axes.flat)
+    for ax in flat[n:]:
+        ax.set_visible(False)
+    return fig, flat[:n]
+
+
+def _line_colors(n: int) -> list[Any]:
+    cmap = plt.get_cmap("tab10")
+    return [cmap(i % 10) for i in range(n)]
+
+
+def _breakdown_clusters(data: SweepData, g: Group) -> list[tuple[str, dict[str, float]]]:
+    """The group's runs merged where their breakdown agrees within 1%: (label, bytes by kind)."""
+    clusters: list[tuple[list[RunRecord], dict[str, float]]] = []
+    for r in sorted(g.ok, key=lambda r: sum(bytes_per_ray_by_kind(r).values())):
+        kinds = bytes_per_ray_by_kind(r)
+        for runs, ref in clusters:
+            tol = 0.01 * max(sum(ref.values()), 1e-9)
+            if all(abs(kinds.get(k, 0) - ref.get(k, 0)) <= tol for k in {*kinds, *ref}):
+                runs.append(r)
+                break
+        else:
+            clusters.append(([r], kinds))
+    out = []
+    for runs, kinds in clusters[:MAX_BARS]:
+        if len(runs) == len(g.ok) and len(runs) > 1:
+            label = f"all {len(runs)} configurations"
+        else:
+            label = data.label(runs[0]) + (f" (+{len(runs) - 1} alike)" if len(runs) > 1 else "")
+        out.append((f"{g.title}: {label}", kinds))
+    return out
+
+
+def bytes_per_ray(data: SweepData) -> Figure | None:
+    bars = [b for g in data.groups() if g.ok for b in _breakdown_clusters(data, g)]
+    if not bars:
+        return None
+    present = [k for k in DATA_KINDS if any(kinds.get(k) for _, kinds in bars)]
+    fig, ax = plt.subplots(figsize=(12, 0.42 * len(bars) + 1.8))
+    labels = [label for label, _ in bars][::-1]
+    left = [0.0] * len(bars)
+    for kind in present:
+        vals = [kinds.get(kind, 0.0) for _, kinds in bars][::-1]
+        ax.barh(labels, vals, left=left, color=KIND_COLORS[kind], label=KIND_NAMES[kind])
+        left = [a + b for a, b in zip(left, vals, strict=True)]
+    for y, total in enumerate(left):
+        ax.annotate(
+            f"{total:.0f} B",
+            (total, y),
+            xytext=(4, 0),
+            textcoords="offset points",
+            va="center",
+            fontsize=9,
+        )
+    ax.set_xlabel("DRAM bytes per ray (read + write)")
+    ax.set_xlim(right=max(left) * 1.1)
+    ax.grid(axis="y", visible=False)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=len(present), frameon=False)
+    fig.suptitle("DRAM traffic per ray by data kind (configurations within 1% merged)")
+    fig.tight_layout()
+    return fig
+
+
+def bandwidth_over_time(data: SweepData) -> Figure | None:
+    groups = [g for g in data.groups() if any(_bw_series(r) for r in g.ok)]
+    if not groups:
+        return None
+    fig, axes = _panels(len(groups), 7.0, 4.6)
+    for ax, g in zip(axes, groups, strict=True):
+        runs = sorted((r for r in g.ok if _bw_series(r)), key=mrays)
+        picks = {"slowest": runs[0], "median": runs[len(runs) // 2], "fastest": runs[-1]}
+        seen = set()
+        for (what, r), color in zip(picks.items(), ("#C44E52", "#8C8C8C", "#4C72B0"), strict=True):
+            if r.run_id in seen:
+                continue
+            seen.add(r.run_id)
+            t, gbps = _bw_series(r)
+            ax.plot(
+                t,
+                gbps,
+                color=color,
+                lw=1.4,
+                label=f"{what}: {data.label(r)} ({mrays(r):.0f} Mrays/s)",
+            )
+            peak = (r.stats or {}).get("model", {}).get("dram", {}).get("peak_bandwidth_gbps")
+            if peak:
+                ax.axhline(peak, color=color, ls="--", lw=1, alpha=0.7)
+        ax.set_title(f"{g.title}  (dashed: peak bandwidth)")
+        ax.set_xlabel("simulated time (µs)")
+        ax.set_ylabel("DRAM bandwidth (GB/s)")
+        ax.set_ylim(bottom=0)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=9, frameon=False)
+    fig.suptitle("DRAM bandwidth over time: the slowest, median and fastest configuration")
+    fig.tight_layout()
+    return fig
+
+
+def _bw_series(r: RunRecord) -> tuple[list[float], list[float]] | None:
+    series = (r.stats or {}).get("model", {}).get("dram", {}).get("bandwidth_over_time") or []
+    if not series:
+        return None
+    clock = float(r.config.get("clock_ghz", 1.0))
+    return [p["cycle"] / clock / 1000 for p in series], [p["gbps"] for p in series]
+
+
+def _numeric(values: list[Any]) -> bool:
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+
+
+def _versus_key(
+    ax: Any,
+    data: SweepData,
+    key: str,
+    groups: list[Group],
+    metric: Callable[[RunRecord], float | None],
+) -> None:
+    """metric against one swept key: a line per group through the median over the other keys,
+    a band from min to max, and every run as a faint dot."""
+    values = sorted({r.params[key] for g in groups for r in g.ok if key in r.params}, key=str)
+    numeric = _numeric(values)
+    if numeric:
+        values = sorted(values)
+    xs = {v: (v if numeric else i) for i, v in enumerate(values)}
+    for g, color in zip(groups, _line_colors(len(groups)), strict=True):
+        by_value: dict[Any, list[float]] = {}
+        for r in g.ok:
+            m = metric(r)
+            if key in r.params and m is not None:
+                by_value.setdefault(r.params[key], []).append(m)
+        vs = [v for v in values if v in by_value]
+        if not vs:
+            continue
+        x = [xs[v] for v in vs]
+        style = "o" if numeric and len(values) > 8 else "o-"  # sampled keys: points, no line
+        ax.plot(x, [statistics.median(by_value[v]) for v in vs], style, color=color, label=g.title)
+        ax.fill_between(
+            x,
+            [min(by_value[v]) for v in vs],
+            [max(by_value[v]) for v in vs],
+            color=color,
+            alpha=0.12,
+            lw=0,
+        )
+    if numeric and len(values) > 1 and min(values) > 0 and max(values) / min(values) >= 4:
+        ax.set_xscale("log", base=2)
+    if not numeric or len(values) <= 8:
+        ax.set_xticks([xs[v] for v in values], [f"{v:.3g}" if isinstance(v, float) else str(v)
+                                                for v in values])  # fmt: skip
+    else:  # sampled keys: every run has its own value
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:.3g}"))
+    ax.minorticks_off()
+    ax.set_xlabel(axis_label(key))
+
+
+def rays_per_second(data: SweepData) -> Figure | None:
+    groups = [g for g in data.groups() if g.ok]
+    keys = [k for k in data.keys if any(k in r.params for g in groups for r in g.ok)]
+    if not groups or not keys:
+        return None
+    scenes = list(dict.fromkeys(g.scene for g in groups))
+    fig, axes = plt.subplots(
+        len(scenes), len(keys), figsize=(4.8 * len(keys), 3.6 * len(scenes)), squeeze=False
+    )
+    for row, scene in enumerate(scenes):
+        for col, key in enumerate(keys):
+            ax = axes[row][col]
+            _versus_key(ax, data, key, [g for g in groups if g.scene == scene], mrays)
+            ax.set_ylabel("simulated Mrays/s")
+            ax.set_ylim(bottom=0)
+            ax.set_title(f"{scene}: rays/s against {key}", fontsize=11)
+    _fig_legend(fig, axes[0][0])
+    fig.suptitle(
+        "Performance against each swept key (line: median over the other keys; band: min to max)",
+        y=1.0,
+    )
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    return fig
+
+
+def _fig_legend(fig: Figure, ax: Any) -> None:
+    handles, names = ax.get_legend_handles_labels()
+    fig.legend(
+        handles,
+        names,
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.97),
+        ncol=len(names),
+        frameon=False,
+    )
+
+
+def hit_rates(data: SweepData) -> Figure | None:
+    groups = [g for g in data.groups() if g.ok]
+    keys = [k for k in data.keys if any(k in r.params for g in groups for r in g.ok)]
+    if not groups or not keys:
+        return None
+    fig, axes = plt.subplots(2, len(keys), figsize=(4.8 * len(keys), 7.4), squeeze=False)
+    for row, level in enumerate(("l1", "l2")):
+
+        def metric(r: RunRecord, level: str = level) -> float | None:
+            v = r.summary.get(f"{level}_hit_rate")
+            return None if v is None else 100 * v
+
+        for col, key in enumerate(keys):
+            ax = axes[row][col]
+            _versus_key(ax, data, key, groups, metric)
+            ax.set_ylim(0, 102)
+            ax.set_ylabel(f"{level.upper()} hit rate (%)")
+            ax.set_title(f"{level.upper()} hit rate against {key}", fontsize=11)
+    _fig_legend(fig, axes[0][0])
+    fig.suptitle("Cache hit rates per level (reads served, including merged misses)", y=1.0)
+    fig.tight_layout(rect=(0, 0, 1, 0.94))
+    return fig
+
+
+def pareto(data: SweepData) -> tuple[Figure | None, dict[str, list[RunRecord]]]:
+    groups = [g for g in data.groups() if g.ok]
+    if not groups:
+        return None, {}
+    fig, axes = _panels(len(groups), 7.0, 4.6)
+    fronts: dict[str, list[RunRecord]] = {}
+    for ax, g in zip(axes, groups, strict=True):
+        ax.scatter(
+            [sram_kib(r) for r in g.ok],
+            [mrays(r) for r in g.ok],
+            s=22,
+            color="#A0A0A0",
+            label="every configuration",
+            zorder=2,
+        )
+        front = pareto_front(g.ok)
+        fronts[g.title] = front
+        ax.plot(
+            [sram_kib(r) for r in front],
+            [mrays(r) for r in front],
+            "o-",
+            color="#C44E52",
+            drawstyle="steps-post",
+            label="Pareto front",
+            zorder=3,
+        )
+        for i, r in enumerate(front):
+            ax.annotate(
+                f"{i + 1}",
+                (sram_kib(r), mrays(r)),
+                textcoords="offset points",
+                xytext=(-4, 7),
+                fontsize=10,
+                fontweight="bold",
+                color="#C44E52",
+            )
+        _sram_axis(ax, [sram_kib(r) for r in g.ok])
+        ax.set_xlabel("on-chip SRAM: L1s + L2 + traversal stacks (KiB)")
+        ax.set_ylabel("simulated Mrays/s")
+        ax.set_ylim(bottom=0, top=max(mrays(r) for r in g.ok) * 1.15)
+        ax.set_title(f"{g.title}  (numbers: table below)")
+        ax.legend(loc="lower right", fontsize=9)
+    fig.suptitle("Performance against on-chip SRAM: the Pareto front")
+    fig.tight_layout()
+    return fig, fronts
+
+
+def _sram_axis(ax: Any, kib: list[float]) -> None:
+    """Log scale for wide ranges, plain numbers (KiB) as tick labels either way."""
+    lo, hi = min(kib), max(kib)
+    if lo > 0 and hi / lo >= 8:
+        ax.set_xscale("log", base=2)
+    ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:,.0f}"))
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    pad = (hi - lo) * 0.06 or hi * 0.05
+    if ax.get_xscale() == "linear":
+        ax.set_xlim(lo - pad, hi + pad)

@@ -1,0 +1,163 @@
+"""The tables `rtsim simulate` prints from RUN/stats.json (keys: docs/stats.md)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from rtsim.summary import effects_table
+
+
+def _get(stats: dict[str, Any], path: str) -> Any:
+    node: Any = stats
+    for part in path.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+def _is_num(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def fmt_int(value: Any) -> str:
+    return f"{int(value):,}" if _is_num(value) else "-"
+
+
+def fmt_float(value: Any, digits: int = 2) -> str:
+    return f"{value:,.{digits}f}" if _is_num(value) else "-"
+
+
+def fmt_pct(value: Any) -> str:
+    return f"{value:.1%}" if _is_num(value) else "-"
+
+
+def fmt_bytes(value: Any) -> str:
+    if not _is_num(value):
+        return "-"
+    for scale, unit in ((1 << 30, "GiB"), (1 << 20, "MiB"), (1 << 10, "KiB")):
+        if value >= scale:
+            return f"{value / scale:,.2f} {unit}"
+    return f"{value:,.0f} B"
+
+
+def _two_column(title: str) -> Table:
+    table = Table(title=title, title_justify="left", show_header=False)
+    table.add_column("what")
+    table.add_column("value", justify="right")
+    return table
+
+
+def clock_ghz(stats: dict[str, Any]) -> float | None:
+    """The simulated clock, from cycles and seconds (stats.json does not repeat the config)."""
+    cycles, seconds = _get(stats, "summary.cycles"), _get(stats, "summary.seconds")
+    if _is_num(cycles) and _is_num(seconds) and seconds > 0:
+        return round(cycles / seconds / 1e9, 6)
+    return None
+
+
+def performance_table(stats: dict[str, Any]) -> Table:
+    s = stats.get("summary", {}) or {}
+    clock = clock_ghz(stats)
+    table = _two_column("performance" + (f" at {clock:g} GHz" if clock else ""))
+    table.add_row("fidelity", str(stats.get("fidelity", "-")))
+    table.add_row("rays", fmt_int(s.get("rays")))
+    if s.get("cycles") is not None:
+        table.add_row("cycles", fmt_int(s.get("cycles")))
+        table.add_row("simulated time (us)", fmt_float(_scaled(s.get("seconds"), 1e6)))
+        table.add_row("Mrays/s", fmt_float(s.get("mrays_per_second")))
+        table.add_row("mean ray latency (cycles)", fmt_float(s.get("avg_ray_latency_cycles"), 1))
+    table.add_row("hit mismatches", fmt_int(s.get("hit_mismatches")))
+    table.add_row("work mismatches", fmt_int(s.get("work_mismatches")))
+    table.add_row("wall time (s)", fmt_float(s.get("wall_seconds")))
+    table.add_row("simulated rays / wall s", fmt_int(s.get("simulated_rays_per_wall_second")))
+    return table
+
+
+def _scaled(value: Any, factor: float) -> Any:
+    return value * factor if _is_num(value) else None
+
+
+def utilisation_table(stats: dict[str, Any]) -> Table:
+    s = stats.get("summary", {}) or {}
+    model = stats.get("model", {}) or {}
+    table = _two_column("utilisation and memory")
+    table.add_row("traversal units busy", fmt_pct(s.get("unit_busy_fraction")))
+    table.add_row("box pipelines", fmt_pct(s.get("box_utilization")))
+    table.add_row("triangle pipelines", fmt_pct(s.get("triangle_utilization")))
+    anyhit = model.get("anyhit")
+    if isinstance(anyhit, dict) and anyhit:
+        mean = sum(b.get("utilization", 0.0) for b in anyhit.values()) / len(anyhit)
+        table.add_row("any-hit pipelines", fmt_pct(mean))
+    if "ideal_memory" in model:
+        table.add_row("memory", "ideal (every access hits at L1 latency)")
+        return table
+    table.add_row("L1 hit rate (merged misses count as hits)", fmt_pct(s.get("l1_hit_rate")))
+    table.add_row("L2 hit rate (merged misses count as hits)", fmt_pct(s.get("l2_hit_rate")))
+    table.add_row("DRAM bytes", fmt_bytes(s.get("dram_bytes")))
+    table.add_row("DRAM bytes / ray", fmt_float(s.get("dram_bytes_per_ray"), 1))
+    peak = _get(stats, "model.dram.peak_bandwidth_gbps")
+    bw = fmt_float(s.get("dram_bandwidth_gbps"))
+    table.add_row("DRAM bandwidth (GB/s)", bw + (f" of {peak:,.1f}" if _is_num(peak) else ""))
+    table.add_row("DRAM bandwidth utilisation", fmt_pct(s.get("dram_bandwidth_utilization")))
+    return table
+
+
+def latency_table(stats: dict[str, Any]) -> Table:
+    lat = stats.get("latency", {}) or {}
+    table = Table(title="ray latency (cycles)", title_justify="left")
+    for column in ("mean", "p50", "p95", "p99", "max"):
+        table.add_column(column, justify="right")
+    table.add_row(
+        fmt_float(lat.get("mean_cycles"), 1),
+        fmt_int(lat.get("p50_cycles")),
+        fmt_int(lat.get("p95_cycles")),
+        fmt_int(lat.get("p99_cycles")),
+        fmt_int(lat.get("max_cycles")),
+    )
+    return table
+
+
+def instantiated_table(stats: dict[str, Any]) -> Table:
+    table = Table(title="instantiated blocks", title_justify="left")
+    table.add_column("block")
+    table.add_column("built")
+    table.add_column("why")
+    for entry in stats.get("instantiated", []) or []:
+        if isinstance(entry, dict):
+            built = entry.get("instantiated")
+            table.add_row(
+                str(entry.get("block", "?")), "yes" if built else "no", str(entry.get("why", ""))
+            )
+    return table
+
+
+def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> None:
+    """Prints the run's headline numbers, utilisation, latency and what was built and why."""
+    console = console or Console()
+    console.print(performance_table(stats))
+    if _get(stats, "summary.cycles") is not None:
+        console.print(utilisation_table(stats))
+        console.print(latency_table(stats))
+        console.print(instantiated_table(stats))
+    if stats.get("effects"):
+        console.print(effects_table({"effects": stats["effects"]}))
+
+
+def print_mismatches(stats: dict[str, Any], console: Console | None = None) -> None:
+    """The loud message of exit code 3: how many rays differ and the first of them."""
+    console = console or Console(stderr=True)
+    v = stats.get("validation", {}) or {}
+    console.print(
+        f"[bold red]MISMATCH: {fmt_int(v.get('hit_mismatches'))} hit(s) and "
+        f"{fmt_int(v.get('work_mismatches'))} work count(s) differ from the reference tracer "
+        f"(of {fmt_int(v.get('rays_checked'))} rays checked)[/]"
+    )
+    for example in (v.get("first_mismatches") or [])[:10]:
+        if isinstance(example, dict):
+            console.print(
+                f"[red]  ray {example.get('ray')}: {example.get('difference')}[/]", highlight=False
+            )

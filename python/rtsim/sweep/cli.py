@@ -1,0 +1,146 @@
+"""`rtsim sweep`, `rtsim results` and `rtsim report` (registered on the rtsim command line).
+
+rtsim sweep SPEC.yaml -o SWEEP [--scheduler tcp://HOST:PORT] [--workers N] [--timeout S]
+rtsim results SWEEP [--csv [FILE]]
+rtsim report SWEEP [-o report.html]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from rich.console import Console
+from rich.table import Table
+
+from rtsim.sweep.results import tidy_rows, to_csv
+from rtsim.sweep.runner import SweepOptions, SweepOutcome, run_sweep
+from rtsim.sweep.spec import SpecError, load_spec
+from rtsim.sweep.store import open_store
+
+
+def print_outcome(outcome: SweepOutcome, out: Path, console: Console) -> None:
+    console.print(
+        f"sweep: {outcome.total} runs: {outcome.skipped} already done, {outcome.ok} ok, "
+        f"{outcome.mismatch} hit mismatches, {outcome.failed} failed "
+        f"in {outcome.wall_seconds:.1f} s -> {out / 'results.sqlite'}"
+    )
+    for name, error in outcome.failures[:10]:
+        first = error.splitlines()[0] if error else ""
+        console.print(f"  [red]failed[/] {name}: {first}", highlight=False)
+    if len(outcome.failures) > 10:
+        console.print(f"  ... and {len(outcome.failures) - 10} more (rtsim results {out})")
+
+
+def cmd_sweep(args: argparse.Namespace, console: Console) -> int:
+    try:
+        spec = load_spec(Path(args.spec))
+    except SpecError as err:
+        print(f"rtsim: error: {err}", file=sys.stderr)
+        return 2
+    opts = SweepOptions(
+        out_dir=Path(args.output),
+        scheduler=args.scheduler,
+        workers=args.workers,
+        timeout=args.timeout,
+        retry_failed=args.retry_failed,
+        progress=not args.no_progress,
+    )
+    outcome = run_sweep(spec, opts, console)
+    print_outcome(outcome, opts.out_dir, console)
+    return 0 if outcome.failed == 0 and outcome.mismatch == 0 else 1
+
+
+def cmd_results(args: argparse.Namespace, console: Console) -> int:
+    with open_store(Path(args.sweep), readonly=True) as store:
+        records = list(store.runs())
+    if args.csv is not None:
+        text = to_csv(tidy_rows(records))
+        if args.csv == "-":
+            sys.stdout.write(text)
+        else:
+            Path(args.csv).write_text(text)
+            console.print(f"wrote {len(records)} runs to {args.csv}")
+        return 0
+    keys = list(dict.fromkeys(k for r in records for k in r.params))
+    table = Table(title=f"{args.sweep}: {len(records)} runs")
+    for col in ("scene", "workload", *keys, "status", "Mrays/s", "DRAM B/ray", "wall s"):
+        table.add_column(col, justify="left" if col in ("scene", "workload", "status") else "right")
+    for r in records:
+        s = r.summary
+        table.add_row(
+            r.scene,
+            r.workload,
+            *(str(r.params.get(k, "")) for k in keys),
+            r.status if r.status == "ok" else f"[red]{r.status}[/]",
+            f"{s['mrays_per_second']:.1f}" if s.get("mrays_per_second") is not None else "-",
+            f"{s['dram_bytes_per_ray']:.0f}" if s.get("dram_bytes_per_ray") is not None else "-",
+            f"{r.wall_seconds:.2f}" if r.wall_seconds is not None else "-",
+        )
+    console.print(table)
+    return 0
+
+
+def cmd_report(args: argparse.Namespace, console: Console) -> int:
+    from rtsim.report import write_report
+
+    out = Path(args.output) if args.output else Path(args.sweep) / "report.html"
+    write_report(Path(args.sweep), out)
+    console.print(f"report: {out}")
+    return 0
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Registers `sweep`, `results` and `report` on the `rtsim` subcommand parser."""
+    p = sub.add_parser(
+        "sweep",
+        help="run a design-space sweep (scenes x workloads x configs) on Dask",
+        description="Runs every scene x workload x config point of SPEC (docs/sweeps.md), one "
+        "rtsim-sim process per run, into SWEEP/results.sqlite. Re-running resumes: finished runs "
+        "are skipped. Exit 0 when every run is ok, 1 if any failed, 2 for a bad spec.",
+    )
+    p.add_argument("spec", metavar="SPEC.yaml")
+    p.add_argument("-o", "--output", required=True, metavar="SWEEP", help="sweep folder")
+    p.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        default=None,
+        help="an existing Dask scheduler (default: a local cluster)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=0,
+        metavar="N",
+        help="local cluster worker processes (default: one per core)",
+    )
+    p.add_argument(
+        "--timeout",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="per-run time limit (default: the spec's timeout, else 3600)",
+    )
+    p.add_argument("--retry-failed", action="store_true", help="re-run runs recorded as failed")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("results", help="a sweep's results: a summary table, or --csv")
+    p.add_argument("sweep", metavar="SWEEP", help="sweep folder (holds results.sqlite)")
+    p.add_argument(
+        "--csv",
+        nargs="?",
+        const="-",
+        default=None,
+        metavar="FILE",
+        help="write the tidy table (one row per run) as CSV to FILE or stdout",
+    )
+    p.set_defaults(func=cmd_results)
+
+    p = sub.add_parser("report", help="write a sweep's HTML report (figures embedded)")
+    p.add_argument("sweep", metavar="SWEEP", help="sweep folder (holds results.sqlite)")
+    p.add_argument(
+        "-o", "--output", default=None, metavar="report.html", help="default: SWEEP/report.html"
+    )
+    p.set_defaults(func=cmd_report)

@@ -1,0 +1,244 @@
+"""Runs a sweep: traces once per scene and workload, one rtsim-sim process per run, all
+scheduled on Dask (a LocalCluster of single-threaded worker processes by default, or an existing
+cluster with --scheduler tcp://HOST:PORT). The client is the store's only writer: each result is
+written in its own transaction as it arrives, so a killed sweep resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+from rtsim import __version__
+from rtsim.sweep.spec import RunPlan, SweepSpec, TracePlan
+from rtsim.sweep.store import ResultsStore, RunRecord, open_store
+from rtsim.sweep.tasks import SimTask, TraceTask, make_trace, run_sim, utc_now
+
+DEFAULT_TIMEOUT = 3600.0
+TRACE_TIMEOUT = 3600.0
+
+
+@dataclass
+class SweepOptions:
+    out_dir: Path
+    scheduler: str | None = None  # tcp://HOST:PORT, else a LocalCluster
+    workers: int = 0  # LocalCluster workers; 0: one per core
+    timeout: float | None = None  # per run, seconds; None: the spec's, else DEFAULT_TIMEOUT
+    retry_failed: bool = False
+    progress: bool = True
+
+
+@dataclass
+class SweepOutcome:
+    total: int
+    skipped: int
+    ok: int = 0
+    mismatch: int = 0
+    failed: int = 0
+    wall_seconds: float = 0.0
+    failures: list[tuple[str, str]] = field(default_factory=list)  # (run dir name, error)
+
+
+def run_dir_name(run: RunPlan) -> str:
+    return f"{run.trace.scene.label}-{run.trace.workload.label}-{run.run_id[:12]}"
+
+
+def _trace_task(plan: TracePlan, out: Path) -> TraceTask:
+    from rtsim.scenes import resolve_scene
+
+    w = plan.workload
+    return TraceTask(
+        trace_dir=str(out / "traces" / plan.folder_name),
+        scene=resolve_scene(plan.scene.source),
+        rays=list(w.rays),
+        width=w.width,
+        height=w.height,
+        bounces=w.bounces,
+        seed=w.seed,
+        hairball_triangles=plan.scene.hairball_triangles,
+    )
+
+
+def _record(run: RunPlan, result: dict[str, Any]) -> RunRecord:
+    return RunRecord(
+        run_id=run.run_id,
+        scene=run.trace.scene.label,
+        workload=run.trace.workload.label,
+        trace_id=run.trace.trace_id,
+        preset=run.preset,
+        status=result["status"],
+        params=run.params,
+        config=run.config.to_dict(),
+        exit_code=result.get("exit_code"),
+        error=result.get("error"),
+        started_utc=result.get("started_utc"),
+        finished_utc=result.get("finished_utc"),
+        wall_seconds=result.get("wall_seconds"),
+        worker=result.get("worker"),
+        stats=result.get("stats"),
+        provenance=result.get("provenance"),
+    )
+
+
+class _Bar:
+    """done / failed / remaining with an ETA."""
+
+    def __init__(self, total: int, enabled: bool, console: Console) -> None:
+        self.progress = Progress(
+            TextColumn("[bold]sweep"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn(
+                "[green]ok {task.fields[ok]}[/] [red]failed {task.fields[failed]}[/] "
+                "remaining {task.fields[remaining]}"
+            ),
+            TimeElapsedColumn(),
+            TextColumn("eta"),
+            TimeRemainingColumn(),
+            console=console,
+            disable=not enabled,
+        )
+        self.total, self.ok, self.failed = total, 0, 0
+        self.task = self.progress.add_task("sweep", total=total, ok=0, failed=0, remaining=total)
+
+    def add(self, status: str) -> None:
+        self.ok += status != "failed"
+        self.failed += status == "failed"
+        self.progress.update(
+            self.task,
+            advance=1,
+            ok=self.ok,
+            failed=self.failed,
+            remaining=self.total - self.ok - self.failed,
+        )
+
+
+def _client(opts: SweepOptions) -> Any:
+    from distributed import Client, LocalCluster
+
+    if opts.scheduler:
+        return Client(opts.scheduler, timeout="30s")
+    workers = opts.workers or os.cpu_count() or 1
+    cluster = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",
+        silence_logs=logging.ERROR,
+    )
+    return Client(cluster)
+
+
+def run_sweep(spec: SweepSpec, opts: SweepOptions, console: Console) -> SweepOutcome:
+    """Runs every run of the spec not yet in the store (and failed ones with retry_failed)."""
+    out = opts.out_dir.resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    runs = spec.runs()
+    timeout = opts.timeout if opts.timeout is not None else (spec.timeout or DEFAULT_TIMEOUT)
+    with open_store(out) as store:
+        store.set_meta(
+            {
+                "name": spec.name,
+                "spec": spec.text,
+                "rtsim_version": __version__,
+                "swept_keys": ",".join(spec.swept_keys),
+            }
+        )
+        store.meta().get("created_utc") or store.set_meta({"created_utc": utc_now()})
+        store.ensure_columns([k for k in spec.swept_keys if k != "preset"])
+        status = store.statuses()
+        skip = {"ok", "mismatch"} | (set() if opts.retry_failed else {"failed"})
+        todo = [r for r in runs if status.get(r.run_id) not in skip]
+        outcome = SweepOutcome(total=len(runs), skipped=len(runs) - len(todo))
+        console.print(
+            f"[bold]rtsim sweep[/] {spec.name}: {len(runs)} runs "
+            f"({len(spec.scenes)} scenes x {len(spec.workloads)} workloads x "
+            f"{len(spec.points())} configs), {outcome.skipped} already in {store.path.name}, "
+            f"{len(todo)} to run"
+        )
+        t0 = time.monotonic()
+        if todo:
+            _execute(todo, out, timeout, opts, store, outcome, console)
+        outcome.wall_seconds = time.monotonic() - t0
+    return outcome
+
+
+def _execute(
+    todo: list[RunPlan],
+    out: Path,
+    timeout: float,
+    opts: SweepOptions,
+    store: ResultsStore,
+    outcome: SweepOutcome,
+    console: Console,
+) -> None:
+    from distributed import as_completed
+
+    client = _client(opts)
+    try:
+        where = (
+            opts.scheduler
+            or f"a local Dask cluster of {len(client.scheduler_info()['workers'])} workers"
+        )
+        console.print(f"scheduling on {where}")
+        traces: dict[str, Any] = {}
+        futures: dict[Any, RunPlan] = {}
+        for run in todo:
+            tid = run.trace.trace_id
+            if tid not in traces:
+                traces[tid] = client.submit(
+                    make_trace,
+                    _trace_task(run.trace, out),
+                    TRACE_TIMEOUT,
+                    key=f"trace-{tid}",
+                    pure=False,
+                    retries=0,
+                    priority=10,
+                )
+            task = SimTask(
+                run.run_id,
+                str(out / "traces" / run.trace.folder_name),
+                str(out / "runs" / run_dir_name(run)),
+                run.config.to_dict(),
+                timeout,
+            )
+            fut = client.submit(
+                run_sim, task, traces[tid], key=f"sim-{run.run_id}", pure=False, retries=0
+            )
+            futures[fut] = run
+        bar = _Bar(len(todo), opts.progress, console)
+        with bar.progress:
+            for fut in as_completed(list(futures)):
+                run = futures[fut]
+                try:
+                    result = fut.result()
+                except Exception as err:  # a worker died under the run, or Dask cancelled it
+                    result = {
+                        "status": "failed",
+                        "error": f"{type(err).__name__}: {err}",
+                        "finished_utc": utc_now(),
+                    }
+                store.record(_record(run, result))
+                bar.add(result["status"])
+                setattr(outcome, result["status"], getattr(outcome, result["status"]) + 1)
+                if result["status"] != "ok":
+                    outcome.failures.append((run_dir_name(run), str(result.get("error"))))
+    finally:
+        cluster = getattr(client, "cluster", None)
+        client.close()
+        if cluster is not None:
+            cluster.close()

@@ -1,0 +1,386 @@
+"""The sweep spec (YAML): scenes x workloads x config points, parsed with line numbers.
+
+Every error names the spec file, the line and the key (``demo.yaml:12: grid.l1.size_kb: ...``).
+The format is documented in docs/sweeps.md; python/rtsim/specs/demo.yaml is an example.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from rtsim.config import ConfigError, SimConfig, apply_patch, compose, field_info, unflatten
+from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
+
+RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
+SAMPLING_METHODS = ("random", "latin_hypercube")
+PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
+TOP_KEYS = ("name", "scenes", "workloads", "config", "grid", "sampling", "timeout")
+
+
+class SpecError(ValueError):
+    """A spec that cannot be run; the message names the file, line and key."""
+
+
+def stable_hash(data: Any, length: int = 16) -> str:
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:length]
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    label: str
+    source: str  # built-in name, shared scene name or glTF path (resolved at trace time)
+    hairball_triangles: int = 200_000
+    seed: int = 1
+
+    def key(self) -> dict[str, Any]:
+        return {
+            "source": self.source,
+            "hairball_triangles": self.hairball_triangles,
+            "seed": self.seed,
+        }
+
+
+@dataclass(frozen=True)
+class WorkloadSpec:
+    label: str
+    rays: tuple[str, ...]
+    width: int
+    height: int
+    bounces: int = 1
+    seed: int = 1
+
+    def key(self) -> dict[str, Any]:
+        return {
+            "rays": list(self.rays),
+            "width": self.width,
+            "height": self.height,
+            "bounces": self.bounces,
+            "seed": self.seed,
+        }
+
+
+@dataclass(frozen=True)
+class TracePlan:
+    """One trace: a scene under a workload, shared by every config point."""
+
+    scene: SceneSpec
+    workload: WorkloadSpec
+
+    @property
+    def trace_id(self) -> str:
+        return stable_hash({"scene": self.scene.key(), "workload": self.workload.key()}, 12)
+
+    @property
+    def folder_name(self) -> str:
+        return f"{self.scene.label}-{self.workload.label}-{self.trace_id[:8]}"
+
+
+@dataclass
+class RunPlan:
+    """One simulation: a trace and a resolved config; run_id hashes both."""
+
+    trace: TracePlan
+    preset: str
+    params: dict[str, Any]  # the swept values of this point
+    config: SimConfig
+
+    @property
+    def run_id(self) -> str:
+        return stable_hash({"trace": self.trace.trace_id, "config": self.config.to_dict()})
+
+
+@dataclass
+class SamplingSpec:
+    method: str
+    n: int
+    seed: int
+    ranges: dict[str, dict[str, Any]]  # key -> {"min", "max"} or {"values"}
+
+
+@dataclass
+class SweepSpec:
+    name: str
+    scenes: list[SceneSpec]
+    workloads: list[WorkloadSpec]
+    preset: str = "base"
+    sets: dict[str, Any] = field(default_factory=dict)
+    grid: dict[str, list[Any]] = field(default_factory=dict)
+    sampling: SamplingSpec | None = None
+    timeout: float | None = None
+    text: str = ""
+
+    @property
+    def swept_keys(self) -> list[str]:
+        keys = list(self.grid)
+        if self.sampling:
+            keys += [k for k in self.sampling.ranges if k not in keys]
+        return keys
+
+    def points(self) -> list[dict[str, Any]]:
+        """Grid points x sampled points (either may be absent: one empty point)."""
+        grid = [
+            dict(zip(self.grid, v, strict=True)) for v in itertools.product(*self.grid.values())
+        ]
+        samples = sample_points(self.sampling) if self.sampling else [{}]
+        return [{**g, **s} for g in grid for s in samples]
+
+    def traces(self) -> list[TracePlan]:
+        return [TracePlan(s, w) for s in self.scenes for w in self.workloads]
+
+    def runs(self) -> list[RunPlan]:
+        """Every run, traces outermost, without duplicates (same trace and resolved config)."""
+        base_sets = unflatten(self.sets)
+        runs, seen = [], set()
+        for trace in self.traces():
+            for point in self.points():
+                preset = str(point.get(PRESET_KEY, self.preset))
+                values = {k: v for k, v in point.items() if k != PRESET_KEY}
+                config = apply_patch(apply_patch(compose(preset), base_sets), unflatten(values))
+                run = RunPlan(trace, preset, point, config)
+                if run.run_id not in seen:
+                    seen.add(run.run_id)
+                    runs.append(run)
+        return runs
+
+
+def sample_points(s: SamplingSpec) -> list[dict[str, Any]]:
+    """n points over the ranges: uniform random, or Latin hypercube (one sample per stratum
+    in every dimension; McKay, Beckman & Conover 1979)."""
+    rng = np.random.default_rng(s.seed)
+    keys = list(s.ranges)
+    if s.method == "random":
+        u = rng.random((s.n, len(keys)))
+    else:
+        strata = np.stack([rng.permutation(s.n) for _ in keys], axis=1)
+        u = (strata + rng.random((s.n, len(keys)))) / s.n
+    points = []
+    for row in u:
+        point = {}
+        for key, x in zip(keys, row, strict=True):
+            r = s.ranges[key]
+            if "values" in r:
+                point[key] = r["values"][min(int(x * len(r["values"])), len(r["values"]) - 1)]
+            elif r["int"]:
+                point[key] = int(min(r["min"] + int(x * (r["max"] - r["min"] + 1)), r["max"]))
+            else:
+                point[key] = float(r["min"] + x * (r["max"] - r["min"]))
+        points.append(point)
+    return points
+
+
+class _Reader:
+    """Parses one spec document, raising SpecError with file:line: key."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, container: Any, key: Any, path: str, message: str) -> SpecError:
+        return SpecError(f"{self.source}:{line_of(container, key)}: {path}: {message}")
+
+    def mapping(self, parent: Any, key: Any, path: str, allowed: tuple[str, ...] = ()) -> LineDict:
+        value = parent[key]
+        if not isinstance(value, dict):
+            raise self.fail(parent, key, path, f"expected a mapping, got {value!r}")
+        for k in value:
+            if allowed and k not in allowed:
+                raise self.fail(
+                    value,
+                    k,
+                    f"{path}.{k}" if path else str(k),
+                    f"unknown key (expected one of: {', '.join(allowed)})",
+                )
+        return value
+
+    def number(self, parent: Any, key: Any, path: str, integer: bool, minimum: float = 0) -> Any:
+        value = parent[key]
+        ok = isinstance(value, int) if integer else isinstance(value, (int, float))
+        if isinstance(value, bool) or not ok or value < minimum:
+            what = "an integer" if integer else "a number"
+            raise self.fail(parent, key, path, f"expected {what} >= {minimum}, got {value!r}")
+        return value
+
+    def scene(self, items: LineList, i: int, base: Path | None) -> SceneSpec:
+        if isinstance(items[i], str):
+            d = LineDict({"name": items[i]})
+            d.line = items.item_line(i)
+        else:
+            allowed = ("name", "label", "hairball_triangles", "seed")
+            d = self.mapping(items, i, f"scenes[{i}]", allowed)
+        if not isinstance(d.get("name"), str) or not d["name"]:
+            raise self.fail(items, i, f"scenes[{i}].name", "a scene needs a name or path")
+        source = d["name"]
+        if base is not None and ("/" in source or source.endswith((".gltf", ".glb"))):
+            candidate = base / source
+            source = str(candidate.resolve()) if candidate.exists() else source
+        label = str(d.get("label") or Path(d["name"]).stem)
+        tris = (
+            self.number(d, "hairball_triangles", f"scenes[{i}].hairball_triangles", True, 1)
+            if "hairball_triangles" in d
+            else 200_000
+        )
+        seed = self.number(d, "seed", f"scenes[{i}].seed", True) if "seed" in d else 1
+        return SceneSpec(label, source, tris, seed)
+
+    def workload(self, items: LineList, i: int) -> WorkloadSpec:
+        allowed = ("name", "rays", "resolution", "bounces", "seed")
+        d = self.mapping(items, i, f"workloads[{i}]", allowed)
+        path = f"workloads[{i}]"
+        rays = d.get("rays", ["primary"])
+        if isinstance(rays, str):
+            rays = [r.strip() for r in rays.split(",") if r.strip()]
+        bad = [r for r in rays if r not in RAY_KINDS] if isinstance(rays, list) else [rays]
+        if bad or not rays:
+            raise self.fail(
+                d,
+                "rays",
+                f"{path}.rays",
+                f"unknown ray kind(s) {bad}; choose from {', '.join(RAY_KINDS)}",
+            )
+        res = d.get("resolution", "128x96")
+        w, _, h = str(res).lower().partition("x")
+        if not (w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
+            raise self.fail(d, "resolution", f"{path}.resolution", f"expected WxH, got {res!r}")
+        bounces = self.number(d, "bounces", f"{path}.bounces", True) if "bounces" in d else 1
+        seed = self.number(d, "seed", f"{path}.seed", True) if "seed" in d else 1
+        label = str(d.get("name") or "-".join(rays))
+        return WorkloadSpec(label, tuple(rays), int(w), int(h), bounces, seed)
+
+    def config_value(self, parent: Any, key: Any, path: str, config_key: str, value: Any) -> None:
+        """Checks that config_key exists and value has its type (ranges: rtsim-sim validate())."""
+        try:
+            field_info(config_key)
+            SimConfig().with_values({config_key: value})
+        except ConfigError as err:
+            raise self.fail(parent, key, path, str(err).removeprefix("config: ")) from None
+
+    def grid(self, doc: LineDict) -> dict[str, list[Any]]:
+        g = self.mapping(doc, "grid", "grid")
+        out: dict[str, list[Any]] = {}
+        for key, values in g.items():
+            path = f"grid.{key}"
+            if not isinstance(values, list) or not values:
+                raise self.fail(g, key, path, "expected a non-empty list of values")
+            for j, v in enumerate(values):
+                if key == PRESET_KEY:
+                    try:
+                        compose(str(v))
+                    except ConfigError as err:
+                        raise self.fail(values, j, path, str(err)) from None
+                else:
+                    self.config_value(values, j, path, str(key), v)
+            out[str(key)] = list(values)
+        return out
+
+    def sampling(self, doc: LineDict) -> SamplingSpec:
+        s = self.mapping(doc, "sampling", "sampling", ("method", "n", "seed", "ranges"))
+        method = s.get("method", "latin_hypercube")
+        if method not in SAMPLING_METHODS:
+            raise self.fail(
+                s,
+                "method",
+                "sampling.method",
+                f"{method!r} is not one of: {', '.join(SAMPLING_METHODS)}",
+            )
+        if "n" not in s:
+            raise self.fail(doc, "sampling", "sampling.n", "missing (how many points to sample)")
+        n = self.number(s, "n", "sampling.n", True, 1)
+        seed = self.number(s, "seed", "sampling.seed", True) if "seed" in s else 1
+        if "ranges" not in s:
+            raise self.fail(doc, "sampling", "sampling.ranges", "missing (key: [min, max])")
+        ranges = {}
+        for key in self.mapping(s, "ranges", "sampling.ranges"):
+            ranges[str(key)] = self.range(s["ranges"], key, f"sampling.ranges.{key}")
+        return SamplingSpec(method, n, seed, ranges)
+
+    def range(self, parent: LineDict, key: str, path: str) -> dict[str, Any]:
+        r = parent[key]
+        if isinstance(r, dict) and set(r) == {"values"} and isinstance(r["values"], list):
+            for v in r["values"]:
+                self.config_value(parent, key, path, key, v)
+            return {"values": list(r["values"])}
+        ok = (
+            isinstance(r, list)
+            and len(r) == 2
+            and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in r)
+        )
+        if not ok or r[0] > r[1]:
+            raise self.fail(
+                parent, key, path, f"expected [min, max] or {{values: [...]}}, got {r!r}"
+            )
+        self.config_value(parent, key, path, key, r[0])
+        is_int = field_info(key).type in ("int", int)
+        if is_int and not all(isinstance(x, int) for x in r):
+            raise self.fail(parent, key, path, "an integer field needs integer bounds")
+        return {"min": r[0], "max": r[1], "int": is_int}
+
+
+def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> SweepSpec:
+    """A SweepSpec from YAML text; SpecError names source:line: key on any problem."""
+    rd = _Reader(source)
+    try:
+        doc = load_yaml(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else 0
+        raise SpecError(f"{source}:{line}: not valid YAML: {err}") from None
+    if not isinstance(doc, LineDict):
+        raise SpecError(f"{source}:1: (root): expected a mapping with scenes, workloads, grid")
+    holder = LineDict({"(root)": doc})
+    rd.mapping(holder, "(root)", "", TOP_KEYS)
+    for key in ("scenes", "workloads"):
+        if not isinstance(doc.get(key), list) or not doc[key]:
+            raise rd.fail(doc, key, key, "missing or empty (a list is needed)")
+    scenes = [rd.scene(doc["scenes"], i, base) for i in range(len(doc["scenes"]))]
+    workloads = [rd.workload(doc["workloads"], i) for i in range(len(doc["workloads"]))]
+    for what, items in (("scenes", scenes), ("workloads", workloads)):
+        labels = [x.label for x in items]
+        dup = next((x for x in labels if labels.count(x) > 1), None)
+        if dup:
+            raise rd.fail(doc, what, what, f"two entries named '{dup}' (give one a label/name)")
+    spec = SweepSpec(str(doc.get("name") or Path(source).stem), scenes, workloads, text=text)
+    if "config" in doc:
+        c = rd.mapping(doc, "config", "config", ("preset", "set"))
+        if "preset" in c:
+            spec.preset = str(c["preset"])
+            try:
+                compose(spec.preset)
+            except ConfigError as err:
+                raise rd.fail(c, "preset", "config.preset", str(err)) from None
+        if "set" in c:
+            for key, value in rd.mapping(c, "set", "config.set").items():
+                rd.config_value(c["set"], key, f"config.set.{key}", str(key), value)
+                spec.sets[str(key)] = value
+    if "grid" in doc:
+        spec.grid = rd.grid(doc)
+    if "sampling" in doc:
+        spec.sampling = rd.sampling(doc)
+        both = set(spec.grid) & set(spec.sampling.ranges)
+        if both:
+            key = sorted(both)[0]
+            raise rd.fail(
+                doc["sampling"]["ranges"],
+                key,
+                f"sampling.ranges.{key}",
+                "already swept by the grid",
+            )
+    if "timeout" in doc:
+        spec.timeout = float(rd.number(doc, "timeout", "timeout", False, 0))
+    return spec
+
+
+def load_spec(path: Path) -> SweepSpec:
+    """Reads and parses a spec file (relative scene paths are relative to it)."""
+    try:
+        text = Path(path).read_text()
+    except OSError as err:
+        raise SpecError(f"{path}: cannot read the spec ({err.strerror})") from None
+    return parse_spec(text, source=str(path), base=Path(path).resolve().parent)

@@ -1,0 +1,190 @@
+"""What a Dask worker runs: make one trace (`rtsim trace` as a subprocess) or one simulation
+(`rtsim-sim` as a subprocess, DESIGN rule 4). Both never raise: every failure, crash or timeout
+comes back as a dict with status "failed" and the tail of the process's stderr, so the client
+records it and the sweep goes on. Paths are absolute: with --scheduler the workers must see the
+sweep folder at the same path (a shared file system).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+TRACE_DONE = "trace.complete"  # written last: a trace folder without it is redone
+ERROR_TAIL_LINES = 15
+
+
+def utc_now() -> str:
+    return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+
+
+def stderr_tail(text: str, lines: int = ERROR_TAIL_LINES) -> str:
+    """The last lines of a process's stderr, without progress lines."""
+    kept = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("{")]
+    return "\n".join(kept[-lines:])
+
+
+@dataclass
+class TraceTask:
+    trace_dir: str
+    scene: str
+    rays: list[str]
+    width: int
+    height: int
+    bounces: int
+    seed: int
+    hairball_triangles: int
+
+    def command(self, out: str) -> list[str]:
+        return [
+            sys.executable,
+            "-m",
+            "rtsim",
+            "trace",
+            self.scene,
+            "-o",
+            out,
+            "--workload",
+            ",".join(self.rays),
+            "--resolution",
+            f"{self.width}x{self.height}",
+            "--bounces",
+            str(self.bounces),
+            "--seed",
+            str(self.seed),
+            "--hairball-triangles",
+            str(self.hairball_triangles),
+        ]
+
+
+def trace_ready(trace_dir: Path) -> bool:
+    return (trace_dir / TRACE_DONE).is_file() and (trace_dir / "trace.rtt").is_file()
+
+
+def make_trace(task: TraceTask, timeout: float | None = None) -> dict[str, Any]:
+    """Traces into a temporary folder and renames it into place, so a killed sweep never
+    leaves a half-written trace that passes for a whole one. Reuses a finished trace."""
+    final = Path(task.trace_dir)
+    if trace_ready(final):
+        return {"ok": True, "reused": True, "trace_dir": str(final)}
+    tmp = final.with_name(f"{final.name}.tmp-{socket.gethostname()}-{os.getpid()}")
+    shutil.rmtree(tmp, ignore_errors=True)
+    t0 = time.monotonic()
+    try:
+        proc = subprocess.run(
+            task.command(str(tmp)),
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            check=False,
+            errors="replace",
+        )
+    except subprocess.TimeoutExpired:
+        shutil.rmtree(tmp, ignore_errors=True)
+        return {"ok": False, "error": f"tracing timed out after {timeout:g} s"}
+    except OSError as err:
+        return {"ok": False, "error": f"cannot run rtsim trace: {err}"}
+    if proc.returncode != 0:
+        shutil.rmtree(tmp, ignore_errors=True)
+        return {
+            "ok": False,
+            "error": f"rtsim trace exited with {proc.returncode}: " + stderr_tail(proc.stderr),
+        }
+    (tmp / TRACE_DONE).write_text(
+        json.dumps({"command": task.command(str(final)), "seconds": time.monotonic() - t0})
+    )
+    if final.exists():
+        shutil.rmtree(final)
+    tmp.rename(final)
+    return {"ok": True, "reused": False, "trace_dir": str(final), "seconds": time.monotonic() - t0}
+
+
+@dataclass
+class SimTask:
+    run_id: str
+    trace_dir: str
+    run_dir: str
+    config: dict[str, Any]
+    timeout: float | None = None
+
+
+def _failed(error: str, **extra: Any) -> dict[str, Any]:
+    return {"status": "failed", "error": error, "stats": None, "provenance": None, **extra}
+
+
+def run_sim(task: SimTask, trace: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Runs one rtsim-sim process; returns its outcome (never raises).
+
+    The run folder holds config.json (input), command.txt, stderr.log and what rtsim-sim writes:
+    config.resolved.json, stats.json, provenance.json (version, git hash, command line)."""
+    started, t0 = utc_now(), time.monotonic()
+    base = {"started_utc": started, "worker": f"{socket.gethostname()}:{os.getpid()}"}
+
+    def done(outcome: dict[str, Any]) -> dict[str, Any]:
+        return {**base, **outcome, "finished_utc": utc_now(), "wall_seconds": time.monotonic() - t0}
+
+    if trace is not None and not trace.get("ok"):
+        return done(_failed(f"no trace: {trace.get('error')}", exit_code=None))
+    try:
+        from rtsim.simulate import find_sim
+
+        exe = find_sim()
+    except (ImportError, OSError) as err:
+        return done(_failed(str(err), exit_code=None))
+    run = Path(task.run_dir)
+    run.mkdir(parents=True, exist_ok=True)
+    for stale in ("stats.json", "config.resolved.json", "provenance.json"):
+        (run / stale).unlink(missing_ok=True)
+    (run / "config.json").write_text(json.dumps(task.config, indent=2, sort_keys=True) + "\n")
+    cmd = [str(exe), task.trace_dir, "--config", str(run / "config.json"), "-o", str(run)]
+    (run / "command.txt").write_text(" ".join(cmd) + "\n")
+    try:
+        proc = subprocess.run(
+            cmd, capture_output=True, text=True, timeout=task.timeout, check=False, errors="replace"
+        )
+    except subprocess.TimeoutExpired as err:
+        tail = stderr_tail(err.stderr.decode(errors="replace") if err.stderr else "")
+        msg = f"timed out after {task.timeout:g} s" + (f": {tail}" if tail else "")
+        return done(_failed(msg, exit_code=None))
+    except OSError as err:
+        return done(_failed(f"cannot run {exe}: {err}", exit_code=None))
+    (run / "stderr.log").write_text(proc.stderr)
+    return done(_outcome(proc.returncode, proc.stderr, run))
+
+
+def _outcome(code: int, stderr: str, run: Path) -> dict[str, Any]:
+    stats = _read_json(run / "stats.json")
+    if code not in (0, 3):
+        what = f"killed by signal {-code}" if code < 0 else f"exit code {code}"
+        return _failed(f"rtsim-sim {what}: {stderr_tail(stderr) or '(no message)'}", exit_code=code)
+    if stats is None:
+        return _failed(f"rtsim-sim exit code {code} but no readable stats.json", exit_code=code)
+    status = "ok" if code == 0 else "mismatch"
+    error = (
+        None if code == 0 else "simulated hits differ from the reference: " + stderr_tail(stderr)
+    )
+    return {
+        "status": status,
+        "exit_code": code,
+        "error": error,
+        "stats": stats,
+        "provenance": stats.get("provenance"),
+    }
+
+
+def _read_json(path: Path) -> dict[str, Any] | None:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError):
+        return None
+    return data if isinstance(data, dict) else None
+

@@ -1,0 +1,147 @@
+// trace_ray (the fused loop) against trace_ray_stepper (the Traversal stepper the model drives):
+// bit-identical hits and identical work counts on every ray, closest and any hit, on random
+// soups and on the procedural scenes read back through the glTF loader.
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "isect_test_util.h"
+#include "traces/isect/traversal.h"
+#include "traces/scene/gltf_loader.h"
+#include "traces/scene/procedural.h"
+
+namespace rtsim {
+namespace {
+
+/// Random soup: mixed sizes, axis-aligned (flat boxes), coincident copies, half alpha-MASK.
+Scene random_soup(uint64_t seed, int count) {
+    Rng rng(seed);
+    std::vector<Vec3> soup;
+    std::vector<uint32_t> material_of;
+    for (int i = 0; i < count; ++i) {
+        const float size = std::ldexp(1.0f, -int(rng.next() * 6.0f));
+        const Vec3 c = test::random_point(rng, Vec3(-4), Vec3(4));
+        Vec3 p[3];
+        for (Vec3& q : p) q = c + size * test::random_point(rng, Vec3(-1), Vec3(1));
+        const float kind = rng.next();
+        if (kind < 0.15f) {  // axis-aligned: a flat leaf box
+            const int axis = int(rng.next() * 3.0f) % 3;
+            for (Vec3& q : p) q[axis] = c[axis];
+        }
+        const int copies = kind > 0.9f ? 2 : 1;
+        for (int k = 0; k < copies; ++k) {
+            soup.insert(soup.end(), {p[0], p[1], p[2]});
+            material_of.push_back(rng.next() < 0.5f ? 1u : 0u);
+        }
+    }
+    Material masked;
+    masked.alpha_mode = AlphaMode::mask;
+    masked.alpha_coverage = 0.5f;
+    return test::make_scene(soup, {Material{}, masked}, material_of);
+}
+
+/// Random rays around `bounds`: random and ±0 directions, clipped intervals, some aimed at a
+/// triangle's vertex or interior, a few invalid.
+Ray random_ray(Rng& rng, const HwBvh& bvh, const Aabb& bounds) {
+    const Vec3 extent = bounds.hi - bounds.lo;
+    const Vec3 o = test::random_point(rng, bounds.lo - 0.2f * extent, bounds.hi + 0.2f * extent);
+    Vec3 d = test::random_direction(rng);
+    const float kind = rng.next();
+    if (kind < 0.3f && !bvh.triangles.empty()) {  // aimed at a triangle: vertex or interior
+        const HwTriangle& t = bvh.triangles[size_t(rng.next() * float(bvh.triangles.size())) %
+                                            bvh.triangles.size()];
+        const Vec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]),
+            v2(t.v2[0], t.v2[1], t.v2[2]);
+        const float a = rng.next(), b = rng.next() * (1.0f - a);
+        const Vec3 target = rng.next() < 0.3f ? v0 : v0 + a * (v1 - v0) + b * (v2 - v0);
+        if (target != o) d = target - o;
+    }
+    for (int a = 0; a < 3; ++a)
+        if (rng.next() < 0.05f) d[a] = rng.next() < 0.5f ? 0.0f : -0.0f;
+    if (d == Vec3(0.0f)) d.z = 1.0f;
+    const float len = glm::length(extent);
+    float tmin = 0.0f, tmax = std::numeric_limits<float>::infinity();
+    if (rng.next() < 0.3f) {
+        tmin = rng.next() * len * 0.5f;
+        tmax = tmin + rng.next() * len;
+    }
+    if (rng.next() < 0.01f) tmin = std::numeric_limits<float>::quiet_NaN();  // invalid ray
+    return test::make_ray(o, d, tmin, tmax);
+}
+
+::testing::AssertionResult same(const Hit& a, const WorkCounts& wa, const Hit& b,
+                                const WorkCounts& wb) {
+    if (a.prim != b.prim || a.inst != b.inst || test::float_bits(a.t) != test::float_bits(b.t) ||
+        test::float_bits(a.u) != test::float_bits(b.u) ||
+        test::float_bits(a.v) != test::float_bits(b.v))
+        return ::testing::AssertionFailure() << "hit: fused prim " << a.prim << " t " << a.t
+                                             << ", stepper prim " << b.prim << " t " << b.t;
+    if (wa.nodes != wb.nodes || wa.box_tests != wb.box_tests || wa.tri_tests != wb.tri_tests ||
+        wa.anyhit_calls != wb.anyhit_calls || wa.transforms != wb.transforms)
+        return ::testing::AssertionFailure()
+               << "work: fused nodes " << wa.nodes << " tris " << wa.tri_tests << " anyhit "
+               << wa.anyhit_calls << ", stepper nodes " << wb.nodes << " tris " << wb.tri_tests
+               << " anyhit " << wb.anyhit_calls;
+    return ::testing::AssertionSuccess();
+}
+
+/// Traces `rays` random rays both ways in both modes; returns the number of closest hits.
+int compare_all(const HwBvh& bvh, const Aabb& bounds, uint64_t seed, int rays) {
+    Rng rng(seed);
+    int hits = 0;
+    for (int i = 0; i < rays; ++i) {
+        const Ray r = random_ray(rng, bvh, bounds);
+        for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+            WorkCounts wa, wb;
+            const Hit a = trace_ray(bvh, r, mode, &wa);
+            const Hit b = trace_ray_stepper(bvh, r, mode, &wb);
+            EXPECT_TRUE(same(a, wa, b, wb)) << "ray " << i << " mode " << int(mode);
+            if (::testing::Test::HasFailure()) return hits;
+            hits += mode == TraversalMode::closest_hit && a.valid();
+        }
+    }
+    return hits;
+}
+
+TEST(TraceRayEquivalence, RandomSoups) {
+    const uint32_t leaf_sizes[] = {1, 2, 4, 8};
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+        const Scene scene = random_soup(seed, 50 + int(seed) * 300);
+        const HwBvh bvh = test::build(scene, leaf_sizes[seed % 4]);
+        const int hits = compare_all(bvh, scene.bounds, seed * 977, 20000);
+        EXPECT_GT(hits, 1000) << "seed " << seed;  // the rays must exercise hits, not only misses
+        std::printf("[ fused=step ] soup seed %llu: %zu triangles, 20000 rays, %d closest hits\n",
+                    (unsigned long long)seed, scene.triangles.size(), hits);
+    }
+}
+
+TEST(TraceRayEquivalence, SingleLeafAndEmptyScenes) {
+    // One triangle: the root's child 1 is an empty slot.
+    const Scene one = test::make_scene({Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(0, 1, 0)});
+    const HwBvh bvh = test::build(one);
+    ASSERT_EQ(bvh.nodes[0].child_count[1], kEmptyChild);
+    EXPECT_GT(compare_all(bvh, Aabb{Vec3(-2), Vec3(2)}, 5, 5000), 100);
+    const HwBvh empty;
+    compare_all(empty, Aabb{Vec3(-1), Vec3(1)}, 6, 100);
+}
+
+TEST(TraceRayEquivalence, ProceduralScenes) {
+    const std::string dir =
+        (std::filesystem::path(::testing::TempDir()) / "rtsim_trace_ray_equivalence").string();
+    std::filesystem::create_directories(dir);
+    ProceduralOptions options;
+    options.hairball_triangles = 20000;
+    for (const std::string& name : procedural_scene_names()) {
+        const Scene scene = load_gltf(write_procedural_scene(name, dir, options));
+        const HwBvh bvh = build_bvh(scene, BuildConfig{});
+        const int hits = compare_all(bvh, scene.bounds, 4242, 20000);
+        EXPECT_GT(hits, 1000) << name;
+        std::printf("[ fused=step ] %s: %zu triangles, 20000 rays, %d closest hits\n", name.c_str(),
+                    scene.triangles.size(), hits);
+    }
+}
+
+}  // namespace
+}  // namespace rtsim

@@ -1,0 +1,138 @@
+"""Sweep specs: errors name the file, line and key; grids, sampling and run ids."""
+
+from __future__ import annotations
+
+import textwrap
+
+import pytest
+
+from rtsim.sweep.spec import SpecError, parse_spec
+
+GOOD = """\
+name: t
+scenes:
+  - cornell
+  - {name: hairball, hairball_triangles: 1000}
+workloads:
+  - {name: primary, rays: [primary], resolution: 32x24}
+  - name: diffuse
+    rays: primary,diffuse
+    resolution: 32x24
+config:
+  preset: base+l2-4m
+  set: {dram.latency: 150}
+grid:
+  traversal.units: [4, 8]
+  l1.size_kib: [16, 64]
+"""
+
+
+def spec_error(text: str) -> str:
+    with pytest.raises(SpecError) as info:
+        parse_spec(textwrap.dedent(text), source="s.yaml")
+    return str(info.value)
+
+
+def test_good_spec_expands() -> None:
+    spec = parse_spec(GOOD, "s.yaml")
+    assert [s.label for s in spec.scenes] == ["cornell", "hairball"]
+    assert spec.workloads[1].rays == ("primary", "diffuse")
+    runs = spec.runs()
+    assert len(runs) == 2 * 2 * 4
+    assert len({r.run_id for r in runs}) == len(runs)
+    r = runs[0]
+    assert (r.config.l2.size_kib, r.config.dram.latency) == (4096, 150)
+    assert {(r.config.traversal.units, r.config.l1.size_kib) for r in runs} == {
+        (4, 16), (4, 64), (8, 16), (8, 64)}  # fmt: skip
+    # the run id depends on the resolved config and the trace, not on labels or order
+    again = parse_spec(GOOD.replace("name: t", "name: other"), "s.yaml").runs()
+    assert [x.run_id for x in again] == [x.run_id for x in runs]
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        (
+            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\ngrdi: {}\n",
+            "s.yaml:3: grdi: unknown key",
+        ),
+        (
+            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\ngrid:\n  traversal.units: [4]\n"
+            "  l1.size_kb: [16]\n",
+            "s.yaml:5: grid.l1.size_kb: unknown key 'l1.size_kb'",
+        ),
+        (
+            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\ngrid:\n  l1.size_kib:\n    - 16\n"
+            "    - big\n",
+            "s.yaml:6: grid.l1.size_kib: 'l1.size_kib' must be a non-negative integer",
+        ),
+        (
+            "scenes: [cornell]\nworkloads:\n  - rays: [primary]\n  - rays: [laser]\n",
+            "s.yaml:4: workloads[1].rays: unknown ray kind",
+        ),
+        (
+            "scenes: [cornell]\nworkloads:\n  - {rays: [primary], resolution: 32by24}\n",
+            "s.yaml:3: workloads[0].resolution: expected WxH",
+        ),
+        ("scenes: []\nworkloads: [{rays: [primary]}]\n", "s.yaml:1: scenes: missing or empty"),
+        (
+            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\nconfig:\n  preset: base+tu99\n",
+            "s.yaml:4: config.preset: config: unknown preset or modifier 'tu99'",
+        ),
+        (
+            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\nsampling:\n  method: sobol\n"
+            "  n: 4\n"
+            "  ranges: {clock_ghz: [0.5, 2]}\n",
+            "s.yaml:4: sampling.method: 'sobol' is not one of",
+        ),
+        (
+            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\nsampling:\n  n: 4\n  ranges:\n"
+            "    traversal.units: [1.5, 8]\n",
+            "s.yaml:6: sampling.ranges.traversal.units: 'traversal.units' must be a non-negative",
+        ),
+        (
+            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\ngrid:\n  traversal.units: 4\n",
+            "s.yaml:4: grid.traversal.units: expected a non-empty list",
+        ),
+        ("scenes: [cornell]\nworkloads: [{rays: [primary]\n", "s.yaml:3: not valid YAML"),
+        (
+            "scenes: [cornell, cornell]\nworkloads: [{rays: [primary]}]\n",
+            "s.yaml:1: scenes: two entries named 'cornell'",
+        ),
+    ],
+)
+def test_errors_name_line_and_key(text: str, expected: str) -> None:
+    assert expected in spec_error(text)
+
+
+def test_sampling_latin_hypercube() -> None:
+    text = """\
+    scenes: [cornell]
+    workloads: [{rays: [primary]}]
+    grid: {l1.size_kib: [16, 64]}
+    sampling:
+      method: latin_hypercube
+      n: 8
+      seed: 3
+      ranges:
+        clock_ghz: [0.5, 2.5]
+        traversal.units: [1, 8]
+        box.sharing: {values: [private, shared]}
+    """
+    spec = parse_spec(textwrap.dedent(text), "s.yaml")
+    points = spec.points()
+    assert len(points) == 2 * 8
+    samples = points[:8]
+    # one sample per stratum in every dimension
+    assert sorted(int((p["clock_ghz"] - 0.5) / 2.0 * 8) for p in samples) == list(range(8))
+    assert sorted(p["traversal.units"] for p in samples) == list(range(1, 9))
+    assert {p["box.sharing"] for p in samples} == {"private", "shared"}
+    assert parse_spec(textwrap.dedent(text), "s.yaml").points() == points  # seeded
+    assert spec.swept_keys == ["l1.size_kib", "clock_ghz", "traversal.units", "box.sharing"]
+
+
+def test_preset_grid_key() -> None:
+    text = "scenes: [cornell]\nworkloads: [{rays: [primary]}]\ngrid:\n  preset: [base, base+tu16]\n"
+    runs = parse_spec(text, "s.yaml").runs()
+    assert [r.config.traversal.units for r in runs] == [8, 16]
+    assert [r.preset for r in runs] == ["base", "base+tu16"]
