@@ -1,7 +1,8 @@
 """Where scenes come from: built-in procedural scenes and the shared glTF scene folder.
 
 The shared folder is ``$RTSIM_SCENES`` if set, else the first ``shared/scenes`` found beside
-the current directory or one of its parents (a clone of the repo sits next to ``shared/``).
+the current directory or one of its parents (a clone of the repo sits next to ``shared/``), else
+``../shared/scenes`` beside the source tree the package was built from.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from rtsim._core import procedural_scene_names
+from rtsim._core import default_scenes_dir, procedural_scene_names
 
 SCENE_SUFFIXES = (".gltf", ".glb")
 
@@ -35,7 +36,8 @@ def shared_scenes_dir() -> Path | None:
         for candidate in (base / "shared" / "scenes", base / "scenes"):
             if candidate.is_dir() and any(_scene_files(candidate)):
                 return candidate
-    return None
+    built_with = Path(default_scenes_dir).resolve()
+    return built_with if built_with.is_dir() else None
 
 
 def _scene_files(folder: Path) -> list[Path]:
@@ -71,4 +73,12 @@ def resolve_scene(text: str) -> str:
         assert entry.path is not None
         if wanted in (entry.name.lower(), entry.path.stem.lower(), entry.path.name.lower()):
             return str(entry.path)
+    if not Path(text).suffix and os.sep not in text:
+        # A bare name that is neither built in nor shared: say where we looked.
+        folder = shared_scenes_dir()
+        where = (
+            f"shared scenes in {folder}" if folder else "no shared scene folder (set RTSIM_SCENES)"
+        )
+        names = ", ".join(procedural_scene_names())
+        raise ValueError(f"unknown scene '{text}': not a file, not built in ({names}), {where}")
     return text

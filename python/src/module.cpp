@@ -12,6 +12,7 @@ PYBIND11_MODULE(_core, m) {
     py::register_exception<rtsim::Error>(m, "RtsimError", PyExc_RuntimeError);
     m.attr("__version__") = RTSIM_VERSION;
     m.attr("git_hash") = RTSIM_GIT_HASH;
+    m.attr("default_scenes_dir") = RTSIM_DEFAULT_SCENES;
     rtsim::py_bind::bind_scene(m);
     rtsim::py_bind::bind_trace(m);
 }

@@ -1,8 +1,11 @@
 #include "sim/harness/summary.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
+#include <string>
 #include <ctime>
 
 namespace rtsim {
@@ -29,6 +32,17 @@ json mean_of(const json& group, const char* key) {
     return sum / double(group.size());
 }
 
+/// Peak resident memory of this process's address space (VmHWM). getrusage's ru_maxrss would
+/// also count the parent's pages a forked child held before exec (a Python caller's, say).
+double peak_memory_mib() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // kB
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0;
+}
+
 }  // namespace
 
 json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& model, const HitChecker& checker,
@@ -37,6 +51,7 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
               {"hit_mismatches", checker.hit_mismatches()},
               {"work_mismatches", checker.work_mismatches()},
               {"wall_seconds", wall},
+              {"peak_memory_mib", peak_memory_mib()},
               {"simulated_rays_per_wall_second", wall > 0 ? double(rays) / wall : 0.0}};
     if (c.fidelity == "functional") {
         s["cycles"] = nullptr;

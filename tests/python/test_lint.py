@@ -15,6 +15,9 @@ def test_ruff_clean() -> None:
     if ruff is None:
         pytest.skip("ruff not installed")
     result = subprocess.run(
-        [ruff, "check", "python", "tests/python"], cwd=REPO, capture_output=True, text=True
+        [ruff, "check", "python", "tests/python", "scripts"],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
     )
     assert result.returncode == 0, result.stdout + result.stderr

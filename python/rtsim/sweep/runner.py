@@ -57,13 +57,21 @@ def run_dir_name(run: RunPlan) -> str:
     return f"{run.trace.scene.label}-{run.trace.workload.label}-{run.run_id[:12]}"
 
 
-def _trace_task(plan: TracePlan, out: Path) -> TraceTask:
+def _resolved(scene: str) -> str:
+    """The scene's path or name; an unknown one is passed on for `rtsim trace` to report."""
     from rtsim.scenes import resolve_scene
 
+    try:
+        return resolve_scene(scene)
+    except ValueError:
+        return scene
+
+
+def _trace_task(plan: TracePlan, out: Path) -> TraceTask:
     w = plan.workload
     return TraceTask(
         trace_dir=str(out / "traces" / plan.folder_name),
-        scene=resolve_scene(plan.scene.source),
+        scene=_resolved(plan.scene.source),
         rays=list(w.rays),
         width=w.width,
         height=w.height,
@@ -138,7 +146,7 @@ def _client(opts: SweepOptions) -> Any:
         threads_per_worker=1,
         processes=True,
         dashboard_address=":0",
-        silence_logs=logging.ERROR,
+        silence_logs=logging.CRITICAL,  # task failures come back through futures
     )
     return Client(cluster)
 
@@ -158,7 +166,8 @@ def run_sweep(spec: SweepSpec, opts: SweepOptions, console: Console) -> SweepOut
                 "swept_keys": ",".join(spec.swept_keys),
             }
         )
-        store.meta().get("created_utc") or store.set_meta({"created_utc": utc_now()})
+        if "created_utc" not in store.meta():
+            store.set_meta({"created_utc": utc_now()})
         store.ensure_columns([k for k in spec.swept_keys if k != "preset"])
         status = store.statuses()
         skip = {"ok", "mismatch"} | (set() if opts.retry_failed else {"failed"})
@@ -195,43 +204,43 @@ def _execute(
             or f"a local Dask cluster of {len(client.scheduler_info()['workers'])} workers"
         )
         console.print(f"scheduling on {where}")
-        traces: dict[str, Any] = {}
-        futures: dict[Any, RunPlan] = {}
+        # Traces first; each trace's simulations are submitted when it is done, with its result
+        # as a plain value: a future argument would pin them to the worker holding it.
+        by_trace: dict[str, list[RunPlan]] = {}
         for run in todo:
-            tid = run.trace.trace_id
-            if tid not in traces:
-                traces[tid] = client.submit(
-                    make_trace,
-                    _trace_task(run.trace, out),
-                    TRACE_TIMEOUT,
-                    key=f"trace-{tid}",
-                    pure=False,
-                    retries=0,
-                    priority=10,
-                )
-            task = SimTask(
-                run.run_id,
-                str(out / "traces" / run.trace.folder_name),
-                str(out / "runs" / run_dir_name(run)),
-                run.config.to_dict(),
-                timeout,
-            )
-            fut = client.submit(
-                run_sim, task, traces[tid], key=f"sim-{run.run_id}", pure=False, retries=0
-            )
-            futures[fut] = run
+            by_trace.setdefault(run.trace.trace_id, []).append(run)
+        traces = {
+            client.submit(
+                make_trace,
+                _trace_task(runs[0].trace, out),
+                TRACE_TIMEOUT,
+                key=f"trace-{tid}",
+                pure=False,
+                retries=0,
+                priority=10,
+            ): tid
+            for tid, runs in by_trace.items()
+        }
+        sims: dict[Any, RunPlan] = {}
+        pending = as_completed(list(traces))
         bar = _Bar(len(todo), opts.progress, console)
         with bar.progress:
-            for fut in as_completed(list(futures)):
-                run = futures[fut]
-                try:
-                    result = fut.result()
-                except Exception as err:  # a worker died under the run, or Dask cancelled it
-                    result = {
-                        "status": "failed",
-                        "error": f"{type(err).__name__}: {err}",
-                        "finished_utc": utc_now(),
-                    }
+            for fut in pending:
+                if fut in traces:
+                    trace = _result(fut)
+                    for run in by_trace[traces[fut]]:
+                        sim = client.submit(
+                            run_sim,
+                            _sim_task(run, out, timeout),
+                            trace,
+                            key=f"sim-{run.run_id}",
+                            pure=False,
+                            retries=0,
+                        )
+                        sims[sim] = run
+                        pending.add(sim)
+                    continue
+                run, result = sims.pop(fut), _result(fut)
                 store.record(_record(run, result))
                 bar.add(result["status"])
                 setattr(outcome, result["status"], getattr(outcome, result["status"]) + 1)
@@ -242,3 +251,26 @@ def _execute(
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _sim_task(run: RunPlan, out: Path, timeout: float) -> SimTask:
+    return SimTask(
+        run.run_id,
+        str(out / "traces" / run.trace.folder_name),
+        str(out / "runs" / run_dir_name(run)),
+        run.config.to_dict(),
+        timeout,
+    )
+
+
+def _result(fut: Any) -> dict[str, Any]:
+    """A task's result; a worker that died under it, or a cancelled task, is a failure."""
+    try:
+        return fut.result()
+    except Exception as err:
+        return {
+            "status": "failed",
+            "ok": False,
+            "error": f"{type(err).__name__}: {err}",
+            "finished_utc": utc_now(),
+        }

@@ -17,6 +17,7 @@ import numpy as np
 import yaml
 
 from rtsim.config import ConfigError, SimConfig, apply_patch, compose, field_info, unflatten
+from rtsim.scenes import resolve_scene
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
 RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
@@ -221,6 +222,10 @@ class _Reader:
         if base is not None and ("/" in source or source.endswith((".gltf", ".glb"))):
             candidate = base / source
             source = str(candidate.resolve()) if candidate.exists() else source
+        try:
+            resolve_scene(source)
+        except ValueError as err:
+            raise self.fail(d, "name", f"scenes[{i}].name", str(err)) from None
         label = str(d.get("label") or Path(d["name"]).stem)
         tris = (
             self.number(d, "hairball_triangles", f"scenes[{i}].hairball_triangles", True, 1)
