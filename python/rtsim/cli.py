@@ -6,6 +6,7 @@ rtsim scenes                                                         list scenes
 rtsim demo [-o OUT]                                                  the main job: sweep + report
 rtsim simulate TRACE [--config CFG] [--set k=v ...] -o RUN [--timeline]  replay on the model
 rtsim config --defaults | --schema                                   the simulator's config
+rtsim accuracy SCENE... [-o DIR] [--fractions 0.01,0.05]            fidelity: time against error
 rtsim bench [SCENE] [--json FILE] [--repeat N]                       rtsim against Embree
 rtsim sweep SPEC.yaml -o SWEEP [--scheduler tcp://HOST:PORT]        a design-space sweep
 rtsim results SWEEP [--csv [FILE]]                                  its tidy table
@@ -27,6 +28,7 @@ from rich.console import Console
 
 from rtsim import _core
 from rtsim._core import RtsimError
+from rtsim.accuracy import add_parser as add_accuracy_parser
 from rtsim.heatmaps import write_heatmaps
 from rtsim.progress import TraceProgress
 from rtsim.scenes import list_scenes, resolve_scene, shared_scenes_dir
@@ -247,6 +249,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_demo)
 
     add_simulate_parsers(sub)
+    add_accuracy_parser(sub, parse_resolution)
     add_sweep_parsers(sub)
 
     p = sub.add_parser(

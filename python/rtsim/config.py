@@ -83,9 +83,33 @@ class DramConfig:
     bytes_per_cycle: int = _f(
         16, "B/cycle", "Peak bandwidth per channel, bytes per core cycle", 1, 4096
     )
-    latency: int = _f(120, "cycles", "Unloaded access latency (request to data)", 1, 100000)
+    latency: int = _f(
+        120,
+        "cycles",
+        "Unloaded access latency (request to data; at detailed: to a closed bank)",
+        1,
+        100000,
+    )
     interleave_bytes: int = _f(
         256, "bytes", "Channel interleaving granule (power of two, >= line size)", 64, 1 << 20
+    )
+    # Banks and row buffers: used by fidelity = "detailed" only (docs/model.md).
+    banks: int = _f(16, "banks", "Banks per channel, one row buffer each (detailed only)", 1, 256)
+    row_bytes: int = _f(
+        2048, "bytes", "Row (page) size of a bank (power of two; detailed only)", 64, 1 << 20
+    )
+    page_policy: str = _choice(
+        "open",
+        ("open", "close"),
+        "Row buffer policy: keep rows open (row hits) or precharge after each access "
+        "(detailed only)",
+    )
+    t_rcd: int = _f(
+        14, "cycles", "Activate to column command, core cycles (detailed only)", 0, 10000
+    )
+    t_rp: int = _f(14, "cycles", "Precharge time, core cycles (detailed only)", 0, 10000)
+    t_cas: int = _f(
+        14, "cycles", "Column command to first data, core cycles (detailed only)", 0, 10000
     )
 
 
@@ -109,14 +133,91 @@ class DispatchConfig:
 
 
 @dataclass
+class SamplingConfig:
+    """Statistical sampling (docs/fidelity.md): a stratified sample of clusters of rays, each
+    warm-up then measured, estimating the full run's cycles with a 95% interval (SMARTS)."""
+
+    fraction: float = _f(
+        0.0,
+        "fraction",
+        "Fraction of the trace's rays to simulate, warm-up included (0: no sampling)",
+        0.0,
+        1.0,
+    )
+    count: int = _f(
+        0, "rays", "Rays to simulate instead of a fraction (0: no sampling)", 0, 2147483647
+    )
+    clusters: int = _f(
+        30,
+        "clusters",
+        "Strata of the trace, one sampled cluster each (fewer when the sample cannot hold them "
+        "with their warm-up)",
+        2,
+        100000,
+    )
+    warmup_rays: int = _f(
+        0,
+        "rays",
+        "Warm-up rays simulated before each cluster's measured rays "
+        "(0: automatic, docs/fidelity.md)",
+        0,
+        1 << 24,
+    )
+    seed: int = _f(
+        1, "seed", "Seed of each cluster's random offset within its stratum", 0, 2147483647
+    )
+
+
+@dataclass
+class TreeletConfig:
+    """Treelet scheduling with ray buffers (docs/treelets.md; Aila & Karras 2010, STRaTA)."""
+
+    enabled: bool = _flag(
+        False, "Treelet scheduling: rays queue per treelet in the ray buffer SRAM"
+    )
+    treelet_kib: int = _f(
+        16, "KiB", "Byte budget per treelet (nodes and their leaf triangles)", 1, 1 << 20
+    )
+    buffer_kib: int = _f(
+        512, "KiB", "Ray buffer SRAM capacity; rays beyond it overflow to DRAM", 1, 1 << 22
+    )
+    policy: str = _choice(
+        "largest",
+        ("largest", "oldest", "round_robin"),
+        "Queue a free unit runs next: largest queue, oldest waiting ray, or round robin",
+    )
+    threshold: int = _f(
+        64,
+        "rays",
+        "Rays a queue needs before it is run (smaller queues run only when nothing else can)",
+        1,
+        1 << 20,
+    )
+    latency: int = _f(4, "cycles", "Ray buffer SRAM access latency", 1, 1000)
+    bytes_per_cycle: int = _f(512, "B/cycle", "Ray buffer SRAM bandwidth", 1, 4096)
+    idle_poll_cycles: int = _f(
+        32, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000
+    )
+    max_rays_in_flight: int = _f(
+        0,
+        "rays",
+        "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to "
+        "DRAM (0: SRAM capacity plus the ray contexts, never overflows)",
+        0,
+        1 << 30,
+    )
+
+
+@dataclass
 class SimConfig:
     """The whole simulator config: the root of the tree rtsim-sim reads with --config."""
 
     clock_ghz: float = _f(1.0, "GHz", "Core clock: converts cycles to seconds", 0.001, 100.0)
     fidelity: str = _choice(
         "approx",
-        ("functional", "approx"),
-        "Simulation level: functional (counts only) or approx (timed SystemC model)",
+        ("functional", "analytic", "approx", "detailed"),
+        "Simulation level: functional (counts only), analytic (cache simulation + roofline), "
+        "approx (timed SystemC model) or detailed (per-cycle arbitration, L2 MSHRs, DRAM banks)",
     )
     quantum_cycles: int = _f(
         256,
@@ -141,6 +242,8 @@ class SimConfig:
     l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 8, 1, 1))
     l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 32, 8, 1))
     dram: DramConfig = field(default_factory=DramConfig)
+    treelets: TreeletConfig = field(default_factory=TreeletConfig)
+    sampling: SamplingConfig = field(default_factory=SamplingConfig)
 
     sections: ClassVar[tuple[str, ...]] = (
         "dispatch",
@@ -151,6 +254,8 @@ class SimConfig:
         "l1",
         "l2",
         "dram",
+        "treelets",
+        "sampling",
     )
 
     def to_dict(self) -> dict[str, Any]:
@@ -182,10 +287,12 @@ class SimConfig:
         return apply_patch(self, unflatten(values))
 
     def sram_bytes(self) -> int:
-        """On-chip SRAM of the accelerator: the L1s, the L2 and the traversal stacks."""
+        """On-chip SRAM of the accelerator: the L1s, the L2, the traversal stacks and, with
+        treelet scheduling, the ray buffer."""
         t = self.traversal
         stacks = t.units * t.ray_contexts * t.stack_entries * t.stack_entry_bytes
-        return (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks
+        ray_buffer = self.treelets.buffer_kib * 1024 if self.treelets.enabled else 0
+        return (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks + ray_buffer
 
 
 def _names(cls: type) -> dict[str, dataclasses.Field[Any]]:
@@ -292,11 +399,12 @@ def config_keys() -> list[str]:
 
 
 # Named presets and composable modifiers (Accel-Sim style: "base+tu16+l1-64k"). Each is a nested
-# patch over the C++ defaults; compose() checks every key against the tree above. Add the treelet
-# ray buffer as {"treelets": {"treelets": {"enabled": True}}} once the C++ tree has that section.
+# patch over the C++ defaults; compose() checks every key against the tree above.
 PRESETS: dict[str, dict[str, Any]] = {
     "base": {},
     "functional": {"fidelity": "functional"},
+    "analytic": {"fidelity": "analytic"},
+    "detailed": {"fidelity": "detailed"},
 }
 
 MODIFIERS: dict[str, dict[str, Any]] = {
@@ -321,6 +429,17 @@ MODIFIERS: dict[str, dict[str, Any]] = {
     "box-wide": {"box": {"width": 4}},
     "clock-2g": {"clock_ghz": 2.0},
     "functional": PRESETS["functional"],
+    "analytic": PRESETS["analytic"],
+    "detailed": PRESETS["detailed"],
+    "treelets": {"treelets": {"enabled": True}},
+    "rb-128k": {"treelets": {"buffer_kib": 128}},
+    "rb-1m": {"treelets": {"buffer_kib": 1024}},
+    "rb-4m": {"treelets": {"buffer_kib": 4096}},
+    "treelet-8k": {"treelets": {"treelet_kib": 8}},
+    "treelet-32k": {"treelets": {"treelet_kib": 32}},
+    "sample-1pct": {"sampling": {"fraction": 0.01}},
+    "sample-5pct": {"sampling": {"fraction": 0.05}},
+    "sample-10pct": {"sampling": {"fraction": 0.1}},
 }
 
 

@@ -11,6 +11,7 @@ const char* data_kind_name(DataKind kind) {
         case DataKind::ray: return "ray";
         case DataKind::hit: return "hit";
         case DataKind::stack: return "stack";
+        case DataKind::ray_buffer: return "ray_buffer";
     }
     return "unknown";
 }
@@ -38,6 +39,31 @@ Cycle BandwidthCalendar::reserve(Cycle time, uint64_t amount) {
         // Start inside the window after what it already serves (fluid approximation).
         Cycle start = w * m_window + (s.used * m_window) / m_capacity;
         s.used += amount;
+        return start > time ? start : time;
+    }
+}
+
+SlotCalendar::SlotCalendar(uint64_t capacity, uint32_t slot_cycles, uint32_t horizon)
+    : m_capacity(capacity), m_slot(slot_cycles) {
+    require(capacity > 0 && slot_cycles > 0, "SlotCalendar: capacity and slot must be positive");
+    uint64_t size = 1;
+    while (size < horizon) size <<= 1;
+    m_mask = size - 1;
+    m_slots.resize(size);
+}
+
+Cycle SlotCalendar::reserve(Cycle time, uint64_t amount) {
+    if (amount > m_capacity) amount = m_capacity;
+    for (uint64_t w = time / m_slot;; ++w) {
+        Slot& s = m_slots[w & m_mask];
+        if (s.slot != w) {
+            if (s.slot != ~0ull && s.slot > w) continue;  // ring entry holds a later slot: treat as full
+            s.slot = w;
+            s.used = 0;
+        }
+        if (s.used + amount > m_capacity) continue;
+        s.used += amount;
+        Cycle start = w * m_slot;
         return start > time ? start : time;
     }
 }

@@ -56,4 +56,29 @@ private:
     uint64_t m_total = 0;
 };
 
+/// Exact slot reservation for the detailed level: `capacity` units per slot of `slot_cycles`
+/// cycles (one bank access, `shared_count` pipeline issues, a channel's bytes per cycle). A request
+/// takes the first slot at or after its time with room and starts at max(time, slot start), so
+/// requests contend cycle by cycle in the order they arrive (at equal cycles: arrival order, i.e.
+/// fixed priority by SystemC process order). No fluid averaging: with units synchronised every
+/// cycle (quantum 1) arrivals are in time order and this is a per-cycle arbiter.
+class SlotCalendar {
+public:
+    SlotCalendar(uint64_t capacity_per_slot, uint32_t slot_cycles, uint32_t horizon_slots = 1u << 14);
+
+    /// Reserves `amount` units (<= capacity) in one slot at or after `time`; returns the start cycle.
+    Cycle reserve(Cycle time, uint64_t amount = 1);
+    uint32_t slot_cycles() const { return m_slot; }
+
+private:
+    struct Slot {
+        uint64_t slot = ~0ull;
+        uint64_t used = 0;
+    };
+    uint64_t m_capacity;
+    uint32_t m_slot;
+    uint64_t m_mask;
+    std::vector<Slot> m_slots;
+};
+
 }  // namespace rtsim

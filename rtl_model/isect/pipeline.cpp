@@ -2,10 +2,12 @@
 
 namespace rtsim {
 
-Pipeline::Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared)
+Pipeline::Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared, bool exact)
     : sc_core::sc_module(name), m_config(config), m_shared(shared) {
-    // shared_count issues per initiation interval, counted per window of 16 intervals.
-    if (shared) m_pool = std::make_unique<BandwidthCalendar>(16ull * config.shared_count, 16 * config.initiation_interval);
+    // shared_count issues per initiation interval: counted per window of 16 intervals (approx) or
+    // per interval exactly (detailed).
+    if (shared && exact) m_exact_pool = std::make_unique<SlotCalendar>(config.shared_count, config.initiation_interval);
+    else if (shared) m_pool = std::make_unique<BandwidthCalendar>(16ull * config.shared_count, 16 * config.initiation_interval);
 }
 
 Cycle Pipeline::issue(Cycle time, uint32_t tests) {
@@ -20,8 +22,9 @@ Cycle Pipeline::issue(Cycle time, uint32_t tests) {
         last = first + (issues - 1) * ii;
     } else {
         // Each issue takes one pipeline slot of one initiation interval somewhere in the pool.
-        first = last = m_pool->reserve(time, 1);
-        for (uint32_t i = 1; i < issues; ++i) last = m_pool->reserve(last, 1);
+        auto slot = [&](Cycle t) { return m_exact_pool ? m_exact_pool->reserve(t, 1) : m_pool->reserve(t, 1); };
+        first = last = slot(time);
+        for (uint32_t i = 1; i < issues; ++i) last = slot(last);
     }
     m_wait_cycles += first - time;
     return last + m_config.latency;

@@ -5,7 +5,9 @@
 //
 // Private pipelines are used by one unit in time order (exact reservation). A shared pool of
 // `shared_count` pipelines is a bandwidth calendar of shared_count issues per initiation interval,
-// so units that run ahead within a quantum still contend correctly.
+// so units that run ahead within a quantum still contend correctly. At the detailed level
+// (exact = true) the pool is a per-slot calendar instead: shared_count issues per initiation
+// interval, each starting at its slot, granted in arrival order (units synchronise every cycle).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -21,7 +23,7 @@ namespace rtsim {
 class Pipeline : public sc_core::sc_module, public PipeIf {
 public:
     /// count: pipelines behind this block (1 when private, shared_count when shared).
-    Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared);
+    Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared, bool exact = false);
 
     Cycle issue(Cycle time, uint32_t tests) override;
 
@@ -35,6 +37,7 @@ private:
     bool m_shared;
     InOrderResource m_private;
     std::unique_ptr<BandwidthCalendar> m_pool;
+    std::unique_ptr<SlotCalendar> m_exact_pool;  ///< shared pool at the detailed level
     uint64_t m_issues = 0, m_tests = 0, m_wait_cycles = 0;
 };
 

@@ -12,7 +12,8 @@ uint32_t log2_exact(uint64_t x) {
 }
 }  // namespace
 
-Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency)
+Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency,
+             bool exact)
     : sc_core::sc_module(name),
       m_config(config),
       m_mshrs_enabled(mshrs_enabled),
@@ -24,7 +25,11 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
     m_mshr_free.assign(config.mshrs, 0);
     // Each bank serves one access per bank_cycles; the calendar counts them per 16-access window
     // (a finer window only makes the forward search longer when a bank is busy).
-    for (uint32_t b = 0; b < config.banks; ++b) m_banks.emplace_back(16, 16 * config.bank_cycles);
+    // The detailed level reserves single accesses exactly (one per bank_cycles, no fast path).
+    for (uint32_t b = 0; b < config.banks; ++b) {
+        if (exact) m_exact_banks.emplace_back(1, config.bank_cycles);
+        else m_banks.emplace_back(16, 16 * config.bank_cycles);
+    }
 }
 
 Cycle Cache::access(const MemRequest& req) {
@@ -36,6 +41,7 @@ Cycle Cache::access(const MemRequest& req) {
 }
 
 Cycle Cache::bank_start(uint64_t line, Cycle time) {
+    if (!m_exact_banks.empty()) return m_exact_banks[line % m_exact_banks.size()].reserve(time, 1);
     if (m_banks.size() == 1 && m_config.bank_cycles == 1) return time;  // fast path: one access per cycle
     return m_banks[line % m_banks.size()].reserve(time, 1);
 }

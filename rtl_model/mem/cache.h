@@ -9,6 +9,9 @@
 // not read back soon); they are posted: the issuer does not wait beyond the tag access.
 // MSHRs are exact when one issuer accesses the cache in time order (a private L1); for a shared
 // cache accessed out of order within a quantum they are not modelled (mshrs_enabled = false).
+// At the detailed level (exact = true) units synchronise every cycle, so the shared L2 sees
+// requests in time order and models its MSHRs too; banks are then per-cycle slot calendars
+// (one access per bank_cycles, arrival order at equal cycles) instead of 16-access windows.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,7 +29,8 @@ public:
     sc_core::sc_port<MemIf> next;
 
     /// extra_latency: cycles added to every request forwarded to `next` and back (interconnect).
-    Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency);
+    Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency,
+          bool exact = false);
 
     Cycle access(const MemRequest& req) override;
 
@@ -51,6 +55,7 @@ private:
     std::vector<Line> m_lines;  ///< sets x ways
     std::vector<Cycle> m_mshr_free;
     std::vector<BandwidthCalendar> m_banks;
+    std::vector<SlotCalendar> m_exact_banks;  ///< detailed level only
     uint64_t m_use_clock = 0;
     MemStats m_stats;
     uint64_t m_evictions = 0;

@@ -9,7 +9,12 @@ constexpr uint32_t kWindowCycles = 32;  // calendar granularity; bandwidth is ex
 constexpr size_t kTimelinePoints = 256;
 }  // namespace
 
-Dram::Dram(sc_core::sc_module_name name, const DramConfig& config) : sc_core::sc_module(name), m_config(config) {
+Dram::Dram(sc_core::sc_module_name name, const DramConfig& config, bool detailed)
+    : sc_core::sc_module(name), m_config(config) {
+    if (detailed) {
+        m_banks = std::make_unique<DramBanks>(config);
+        return;
+    }
     for (uint32_t c = 0; c < config.channels; ++c)
         m_channels.emplace_back(uint64_t(config.bytes_per_cycle) * kWindowCycles, kWindowCycles);
 }
@@ -24,14 +29,24 @@ Cycle Dram::access(const MemRequest& req) {
         ++c.read_hits;  // DRAM serves every read
         c.read_bytes += req.bytes;
     }
-    BandwidthCalendar& channel = m_channels[(req.addr / m_config.interleave_bytes) % m_channels.size()];
-    Cycle start = channel.reserve(req.time, req.bytes);
+    Cycle start, ready;
+    if (m_banks) {
+        // Bank, row buffer and data bus timing; the rest of `latency` is a fixed front end.
+        const DramBanks::Timing t = m_banks->access(req.addr, req.bytes, req.time);
+        start = t.start;
+        const Cycle bank_part = Cycle(m_config.t_rcd) + m_config.t_cas;
+        ready = t.done + (m_config.latency > bank_part ? m_config.latency - bank_part : 0);
+    } else {
+        BandwidthCalendar& channel = m_channels[(req.addr / m_config.interleave_bytes) % m_channels.size()];
+        start = channel.reserve(req.time, req.bytes);
+        Cycle transfer = (req.bytes + m_config.bytes_per_cycle - 1) / m_config.bytes_per_cycle;
+        ready = start + m_config.latency + transfer;
+    }
     m_queue_cycles += start - req.time;
     size_t bucket = size_t(start / bucket_cycles());
     if (bucket >= m_timeline.size()) m_timeline.resize(bucket + 1, 0);
     m_timeline[bucket] += req.bytes;
-    Cycle transfer = (req.bytes + m_config.bytes_per_cycle - 1) / m_config.bytes_per_cycle;
-    return start + m_config.latency + transfer;
+    return ready;
 }
 
 nlohmann::json Dram::stats_json(Cycle total_cycles, double clock_ghz) const {
@@ -61,6 +76,7 @@ nlohmann::json Dram::stats_json(Cycle total_cycles, double clock_ghz) const {
         series.push_back({{"cycle", i * bucket_cycles()}, {"gbps", double(bytes) / cycles * clock_ghz}});
     }
     j["bandwidth_over_time"] = series;
+    if (m_banks) j.update(m_banks->stats_json());
     return j;
 }
 

@@ -2,12 +2,17 @@
 // DRAM: channels interleaved by address, each a bandwidth calendar of bytes per cycle, plus a
 // fixed latency. When requests exceed a channel's bandwidth they queue (start later), so the
 // delivered bandwidth saturates at channels x bytes_per_cycle (tested).
+// With `detailed`, timing comes from DramBanks instead (banks, row buffers, activate/precharge,
+// exact per-cycle data bus): `latency` is then the unloaded latency of an access to a closed bank,
+// split into tRCD + tCAS at the bank and a fixed front end of latency - tRCD - tCAS.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/mem/dram_banks.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "sim/config/config.h"
 
@@ -15,7 +20,7 @@ namespace rtsim {
 
 class Dram : public sc_core::sc_module, public MemIf {
 public:
-    Dram(sc_core::sc_module_name name, const DramConfig& config);
+    Dram(sc_core::sc_module_name name, const DramConfig& config, bool detailed = false);
 
     Cycle access(const MemRequest& req) override;
 
@@ -25,10 +30,13 @@ public:
     static constexpr Cycle bucket_cycles() { return 1024; }
     uint64_t queue_cycles() const { return m_queue_cycles; }
     nlohmann::json stats_json(Cycle total_cycles, double clock_ghz) const;
+    /// The bank model (detailed only), else null.
+    const DramBanks* banks() const { return m_banks.get(); }
 
 private:
     DramConfig m_config;
     std::vector<BandwidthCalendar> m_channels;
+    std::unique_ptr<DramBanks> m_banks;
     MemStats m_stats;
     std::vector<uint64_t> m_timeline;
     uint64_t m_queue_cycles = 0;

@@ -16,6 +16,7 @@ struct MemoryMap {
     static constexpr uint64_t kRays = 0x3'0000'0000ull;       ///< RayRecord r at kRays + 40 r
     static constexpr uint64_t kHits = 0x4'0000'0000ull;       ///< HitRecord r at kHits + 20 r
     static constexpr uint64_t kStacks = 0x5'0000'0000ull;     ///< spilled stack entries, per context
+    static constexpr uint64_t kRayBuffer = 0x6'0000'0000ull;  ///< ray states overflowing the ray buffer
 
     static uint64_t node(uint32_t i) { return kNodes + uint64_t(i) * sizeof(HwNode); }
     static uint64_t triangle(uint32_t j) { return kTriangles + uint64_t(j) * sizeof(HwTriangle); }
@@ -25,6 +26,8 @@ struct MemoryMap {
     static uint64_t stack(uint64_t context, uint32_t depth, uint32_t entry_bytes) {
         return kStacks + (context * 64 + depth) * entry_bytes;
     }
+    /// Overflow slot `slot` of the ray buffer (ray states of ray_state_bytes each).
+    static uint64_t ray_buffer(uint64_t slot, uint32_t ray_state_bytes) { return kRayBuffer + slot * ray_state_bytes; }
 };
 
 /// The BVH image the model reads functionally (contents) and times by address.

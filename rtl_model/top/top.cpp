@@ -32,6 +32,7 @@ Top::Top(sc_core::sc_module_name name, const SimConfig& config, const MemoryImag
     m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, rays);
     build_memory();
     build_pipelines(features);
+    build_ray_buffer(image);
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
         auto unit = std::make_unique<TraversalUnit>(("tu" + std::to_string(u)).c_str(), config, image, u);
         unit->rays(*m_dispatch);
@@ -42,6 +43,7 @@ Top::Top(sc_core::sc_module_name name, const SimConfig& config, const MemoryImag
         unit->box(*m_box[b]);
         unit->triangle(*m_tri[t]);
         if (!m_anyhit.empty()) unit->anyhit(*m_anyhit[a]);
+        if (m_ray_buffer) unit->ray_buffer(*m_ray_buffer);
         m_units.push_back(std::move(unit));
     }
     m_instantiated.push_back({{"block", "traversal"}, {"instantiated", true},
@@ -66,22 +68,29 @@ void Top::build_memory() {
                                   {"why", "ideal_memory: every access hits at L1 latency, no L2/DRAM"}});
         return;
     }
-    m_dram = std::make_unique<Dram>("dram", c.dram);
-    // The L2 is shared: units reach it out of time order within a quantum, so its MSHRs are not
+    // The detailed level adds DRAM banks and row buffers, exact per-cycle cache banks and the
+    // L2's MSHRs (its units synchronise every cycle, so the shared L2 sees requests in time order).
+    const bool detailed = c.fidelity == "detailed";
+    m_dram = std::make_unique<Dram>("dram", c.dram, detailed);
+    // At approx the L2 is reached out of time order within a quantum, so its MSHRs are not
     // modelled (docs/model.md); the private L1s model theirs exactly.
-    m_l2 = std::make_unique<Cache>("l2", c.l2, false, 0);
+    m_l2 = std::make_unique<Cache>("l2", c.l2, detailed, 0, detailed);
     m_l2->next(*m_dram);
     for (uint32_t u = 0; u < c.traversal.units; ++u) {
-        m_l1.push_back(std::make_unique<Cache>(("l1_" + std::to_string(u)).c_str(), c.l1, true, c.interconnect_latency));
+        m_l1.push_back(std::make_unique<Cache>(("l1_" + std::to_string(u)).c_str(), c.l1, true, c.interconnect_latency,
+                                               detailed));
         m_l1.back()->next(*m_l2);
     }
     m_instantiated.push_back({{"block", "memory"}, {"instantiated", true},
                               {"why", "per-unit L1, shared " + std::to_string(c.l2.banks) + "-bank L2, " +
-                                          std::to_string(c.dram.channels) + " DRAM channels"}});
+                                          std::to_string(c.dram.channels) + " DRAM channels" +
+                                          (detailed ? " of " + std::to_string(c.dram.banks) + " banks (" +
+                                                          c.dram.page_policy + " page), L2 MSHRs"
+                                                    : std::string())}});
 }
 
 std::unique_ptr<Pipeline> Top::make_pipeline(const std::string& name, const PipelineConfig& c) {
-    return std::make_unique<Pipeline>(name.c_str(), c, c.sharing == "shared");
+    return std::make_unique<Pipeline>(name.c_str(), c, c.sharing == "shared", m_config.fidelity == "detailed");
 }
 
 void Top::build_pipelines(const WorkloadFeatures& features) {
@@ -99,6 +108,25 @@ void Top::build_pipelines(const WorkloadFeatures& features) {
     m_instantiated.push_back({{"block", "anyhit"}, {"instantiated", features.anyhit_triangles},
                               {"why", features.anyhit_triangles ? "the BVH has alpha-MASK triangles: alpha test stage"
                                                                 : "no alpha-MASK triangle in the BVH"}});
+}
+
+void Top::build_ray_buffer(const MemoryImage& image) {
+    const TreeletConfig& t = m_config.treelets;
+    if (!t.enabled) {
+        m_instantiated.push_back({{"block", "ray_buffer"}, {"instantiated", false},
+                                  {"why", "treelets.enabled is false: rays go from dispatch straight to the units"}});
+        return;
+    }
+    m_partition = partition_treelets(image.nodes, t.treelet_kib * 1024);
+    m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", m_config, m_partition);
+    m_ray_buffer->rays(*m_dispatch);
+    if (m_ideal) m_ray_buffer->mem(*m_ideal);
+    else m_ray_buffer->mem(*m_l2);
+    m_instantiated.push_back({{"block", "ray_buffer"}, {"instantiated", true},
+                              {"why", std::to_string(m_partition.treelets.size()) + " treelets of at most " +
+                                          std::to_string(t.treelet_kib) + " KiB, " + std::to_string(t.buffer_kib) +
+                                          " KiB ray buffer (" + std::to_string(m_ray_buffer->capacity_rays()) +
+                                          " rays), policy " + t.policy}});
 }
 
 Cycle Top::total_cycles() const {
@@ -119,6 +147,7 @@ nlohmann::json Top::stats_json() const {
     pipes("triangle", m_tri);
     pipes("anyhit", m_anyhit);
     if (m_ideal) j["ideal_memory"] = m_ideal->stats_json();
+    if (m_ray_buffer) j["ray_buffer"] = m_ray_buffer->stats_json();
     for (const auto& l1 : m_l1) j["l1"][l1->basename()] = l1->stats_json();
     if (m_l2) j["l2"] = m_l2->stats_json();
     if (m_dram) j["dram"] = m_dram->stats_json(total, m_config.clock_ghz);

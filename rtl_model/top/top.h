@@ -14,6 +14,7 @@
 #include "rtl_model/isect/pipeline.h"
 #include "rtl_model/mem/cache.h"
 #include "rtl_model/mem/dram.h"
+#include "rtl_model/ray_buffer/ray_buffer.h"
 #include "rtl_model/top/memory_image.h"
 #include "rtl_model/traversal/traversal_unit.h"
 
@@ -47,6 +48,7 @@ private:
     std::unique_ptr<Pipeline> make_pipeline(const std::string& name, const PipelineConfig& c);
     void build_memory();
     void build_pipelines(const WorkloadFeatures& features);
+    void build_ray_buffer(const MemoryImage& image);
 
     const SimConfig& m_config;
     std::unique_ptr<Dispatch> m_dispatch;
@@ -56,6 +58,8 @@ private:
     std::vector<std::unique_ptr<Cache>> m_l1;
     std::vector<std::unique_ptr<Pipeline>> m_box, m_tri, m_anyhit;
     std::vector<std::unique_ptr<TraversalUnit>> m_units;
+    TreeletPartition m_partition;
+    std::unique_ptr<RayBuffer> m_ray_buffer;
     nlohmann::json m_instantiated = nlohmann::json::array();
 };
 

@@ -11,15 +11,29 @@ TraversalUnit::TraversalUnit(sc_core::sc_module_name name, const SimConfig& conf
 }
 
 void TraversalUnit::run() {
-    for (uint32_t c = 0; c < m_contexts.size(); ++c) start_ray(c, 0);
-    while (!m_events.empty()) {
+    m_treelet_mode = ray_buffer.size() > 0;
+    Cycle now = 0;
+    fill_idle_contexts(0);
+    for (;;) {
+        if (m_events.empty()) {
+            // No ray in flight here. Without treelets that means dispatch is empty: done. With
+            // treelets, rays may still be parked by other units: look again a little later.
+            if (!m_treelet_mode || ray_buffer->done()) break;
+            now += m_config.treelets.idle_poll_cycles;
+            ++m_idle_polls;
+            sync(now);
+            fill_idle_contexts(now);
+            continue;
+        }
         Event e = m_events.top();
         m_events.pop();
         // The scheduler takes one step per issue_cycles.
         Cycle t = std::max(e.time, m_sched_free);
         m_sched_free = t + m_config.traversal.issue_cycles;
+        now = t;
         sync(t);
         advance(e.context, t);
+        if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
     }
 }
 
@@ -32,17 +46,28 @@ void TraversalUnit::sync(Cycle t) {
     ++m_syncs;
 }
 
+void TraversalUnit::fill_idle_contexts(Cycle t) {
+    for (uint32_t c = 0; c < m_contexts.size(); ++c)
+        if (!m_contexts[c].active && !start_ray(c, t)) break;
+    m_next_fill = t + m_config.treelets.idle_poll_cycles;
+}
+
+void TraversalUnit::activate(uint32_t c, Cycle t) {
+    m_contexts[c].active = true;
+    if (m_active++ == 0) m_busy_since = t;
+}
+
 bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
+    if (m_treelet_mode) return take_parked_ray(c, t);
     RayJob job;
     if (!rays->next_ray(&job)) return false;
     Context& ctx = m_contexts[c];
-    ctx.trav.begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+    ctx.ray.trav.begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_rejected;
-    ctx.ray_id = job.id;
-    ctx.start = t;
-    ctx.local_stack = ctx.spilled = 0;
-    ctx.active = true;
-    if (m_active++ == 0) m_busy_since = t;
+    ctx.ray.ray_id = job.id;
+    ctx.ray.start = t;
+    ctx.ray.local_stack = ctx.ray.spilled = 0;
+    activate(c, t);
     // The ray record is read from memory before traversal starts.
     Cycle ready = mem->access({MemoryMap::ray(job.id), sizeof(RayRecord), false, DataKind::ray,
                                t + m_config.dispatch.latency});
@@ -51,8 +76,30 @@ bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
     return true;
 }
 
+bool TraversalUnit::take_parked_ray(uint32_t c, Cycle t) {
+    Context& ctx = m_contexts[c];
+    Cycle ready = t;
+    if (!ray_buffer->take(m_index, t, &ctx.ray, &ctx.treelet, &ready)) return false;
+    if (!ray_is_valid(ctx.ray.trav.ray()) && ctx.ray.trav.work().nodes == 0) ++m_rejected;
+    ++m_takes;
+    activate(c, t);
+    ctx.phase = Phase::step;
+    schedule(c, ready);
+    return true;
+}
+
+void TraversalUnit::park_ray(uint32_t c, uint32_t treelet, Cycle t) {
+    Context& ctx = m_contexts[c];
+    ray_buffer->park(treelet, ctx.ray, t);
+    ++m_parks;
+    ctx.active = false;
+    if (--m_active == 0) m_busy_cycles += t - m_busy_since;
+    start_ray(c, t);
+}
+
 void TraversalUnit::advance(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
+    Traversal& trav = ctx.ray.trav;
     ++m_steps;
     switch (ctx.phase) {
         case Phase::fetch_ray:
@@ -60,21 +107,21 @@ void TraversalUnit::advance(uint32_t c, Cycle t) {
             step(c, t);
             return;
         case Phase::boxes: {
-            const uint32_t node = ctx.trav.node_index();
+            const uint32_t node = trav.node_index();
             Cycle ready = box->issue(t, 2);
-            int before = ctx.trav.stack_size();
-            ctx.trav.visit_node(m_image.nodes[node]);
+            int before = trav.stack_size();
+            trav.visit_node(m_image.nodes[node]);
             ctx.phase = Phase::step;
             schedule(c, stack_traffic(c, before, t, ready));
             return;
         }
         case Phase::triangles: {
-            const uint32_t first = ctx.trav.leaf_first(), count = ctx.trav.leaf_count();
+            const uint32_t first = trav.leaf_first(), count = trav.leaf_count();
             Cycle ready = triangle->issue(t, count);
-            uint32_t anyhit_before = ctx.trav.work().anyhit_calls;
-            int before = ctx.trav.stack_size();
-            ctx.trav.visit_leaf(&m_image.triangles[first]);
-            uint32_t alpha_tests = ctx.trav.work().anyhit_calls - anyhit_before;
+            uint32_t anyhit_before = trav.work().anyhit_calls;
+            int before = trav.stack_size();
+            trav.visit_leaf(&m_image.triangles[first]);
+            uint32_t alpha_tests = trav.work().anyhit_calls - anyhit_before;
             if (alpha_tests) ready = anyhit->issue(ready, alpha_tests);
             ctx.phase = Phase::step;
             schedule(c, stack_traffic(c, before, t, ready));
@@ -85,16 +132,22 @@ void TraversalUnit::advance(uint32_t c, Cycle t) {
 
 void TraversalUnit::step(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
-    switch (ctx.trav.step()) {
+    Traversal& trav = ctx.ray.trav;
+    switch (trav.step()) {
         case Traversal::Step::node: {
-            Cycle ready = mem->access({MemoryMap::node(ctx.trav.node_index()), sizeof(HwNode), false, DataKind::node, t});
+            const uint32_t node = trav.node_index();
+            if (m_treelet_mode) {
+                const uint32_t target = ray_buffer->treelet_of(node);
+                if (target != ctx.treelet) return park_ray(c, target, t);  // leaves its treelet
+            }
+            Cycle ready = mem->access({MemoryMap::node(node), sizeof(HwNode), false, DataKind::node, t});
             ctx.phase = Phase::boxes;
             schedule(c, ready);
             return;
         }
         case Traversal::Step::leaf: {
-            Cycle ready = mem->access({MemoryMap::triangle(ctx.trav.leaf_first()),
-                                       uint32_t(sizeof(HwTriangle) * ctx.trav.leaf_count()), false, DataKind::triangle, t});
+            Cycle ready = mem->access({MemoryMap::triangle(trav.leaf_first()),
+                                       uint32_t(sizeof(HwTriangle) * trav.leaf_count()), false, DataKind::triangle, t});
             ctx.phase = Phase::triangles;
             schedule(c, ready);
             return;
@@ -106,29 +159,31 @@ void TraversalUnit::step(uint32_t c, Cycle t) {
 }
 
 Cycle TraversalUnit::stack_traffic(uint32_t c, int before, Cycle t, Cycle ready) {
-    Context& ctx = m_contexts[c];
-    const int after = ctx.trav.stack_size();
+    RayState& ray = m_contexts[c].ray;
+    const int after = ray.trav.stack_size();
     const uint32_t cap = m_config.traversal.stack_entries, bytes = m_config.traversal.stack_entry_bytes;
-    const uint64_t context = uint64_t(m_index) * m_contexts.size() + c;
+    // Spill slots belong to the context (reused ray after ray); with treelets they belong to the
+    // ray (its id), since the ray moves between contexts and units through the ray buffer.
+    const uint64_t owner = m_treelet_mode ? ray.ray_id : uint64_t(m_index) * m_contexts.size() + c;
     for (int i = before; i < after; ++i) {
-        if (ctx.local_stack < cap) {
-            ++ctx.local_stack;
+        if (ray.local_stack < cap) {
+            ++ray.local_stack;
             continue;
         }
         // Full on-chip stack: the oldest entry goes to memory (posted write).
-        mem->access({MemoryMap::stack(context, ctx.spilled, bytes), bytes, true, DataKind::stack, t});
-        ++ctx.spilled;
+        mem->access({MemoryMap::stack(owner, ray.spilled, bytes), bytes, true, DataKind::stack, t});
+        ++ray.spilled;
         ++m_spill_writes;
     }
     for (int i = after; i < before; ++i) {
-        if (ctx.local_stack > 0) {
-            --ctx.local_stack;
+        if (ray.local_stack > 0) {
+            --ray.local_stack;
             continue;
         }
         // On-chip stack empty but entries in memory: read one back before going on.
-        --ctx.spilled;
+        --ray.spilled;
         ++m_spill_reads;
-        ready = std::max(ready, mem->access({MemoryMap::stack(context, ctx.spilled, bytes), bytes, false, DataKind::stack, t}));
+        ready = std::max(ready, mem->access({MemoryMap::stack(owner, ray.spilled, bytes), bytes, false, DataKind::stack, t}));
     }
     return ready;
 }
@@ -136,9 +191,10 @@ Cycle TraversalUnit::stack_traffic(uint32_t c, int before, Cycle t, Cycle ready)
 void TraversalUnit::finish_ray(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
     // The hit record is written back (posted).
-    mem->access({MemoryMap::hit(ctx.ray_id), sizeof(HitRecord), true, DataKind::hit, t});
-    RayResult r{ctx.ray_id, ctx.trav.hit(), ctx.trav.work(), ctx.start, t, m_index, c};
+    mem->access({MemoryMap::hit(ctx.ray.ray_id), sizeof(HitRecord), true, DataKind::hit, t});
+    RayResult r{ctx.ray.ray_id, ctx.ray.trav.hit(), ctx.ray.trav.work(), ctx.ray.start, t, m_index, c};
     sink->ray_done(r);
+    if (m_treelet_mode) ray_buffer->finished(t);
     ++m_rays;
     m_finish = std::max(m_finish, t);
     ctx.active = false;
@@ -147,15 +203,21 @@ void TraversalUnit::finish_ray(uint32_t c, Cycle t) {
 }
 
 nlohmann::json TraversalUnit::stats_json(Cycle total_cycles) const {
-    return {{"rays", m_rays},
-            {"steps", m_steps},
-            {"busy_cycles", m_busy_cycles},
-            {"busy_fraction", total_cycles ? double(m_busy_cycles) / double(total_cycles) : 0.0},
-            {"stack_spill_writes", m_spill_writes},
-            {"stack_spill_reads", m_spill_reads},
-            {"rejected_rays", m_rejected},
-            {"quantum_syncs", m_syncs},
-            {"finish_cycle", m_finish}};
+    nlohmann::json j = {{"rays", m_rays},
+                        {"steps", m_steps},
+                        {"busy_cycles", m_busy_cycles},
+                        {"busy_fraction", total_cycles ? double(m_busy_cycles) / double(total_cycles) : 0.0},
+                        {"stack_spill_writes", m_spill_writes},
+                        {"stack_spill_reads", m_spill_reads},
+                        {"rejected_rays", m_rejected},
+                        {"quantum_syncs", m_syncs},
+                        {"finish_cycle", m_finish}};
+    if (m_treelet_mode) {
+        j["rays_taken"] = m_takes;
+        j["rays_parked"] = m_parks;
+        j["idle_polls"] = m_idle_polls;
+    }
+    return j;
 }
 
 }  // namespace rtsim

@@ -11,6 +11,11 @@
 // The on-chip stack holds `stack_entries` entries per ray; pushes beyond spill to memory (posted
 // writes), pops of spilled entries read them back (the ray waits), all counted as stack traffic.
 // The unit runs ahead of SystemC time by at most quantum_cycles, then waits (temporal decoupling).
+//
+// With treelet scheduling (ray_buffer bound), contexts take rays from the ray buffer queue of the
+// unit's current treelet instead of from dispatch; a ray whose next node lies in another treelet
+// is parked in that treelet's queue and the context takes the next ray. Traversal order, hits and
+// work counts do not change: the stepper is the same, the ray only waits in between.
 #include <cstdint>
 #include <queue>
 #include <vector>
@@ -19,6 +24,7 @@
 #include <systemc>
 
 #include "rtl_model/common/interfaces.h"
+#include "rtl_model/common/ray_state.h"
 #include "rtl_model/top/memory_image.h"
 #include "sim/config/config.h"
 #include "traces/isect/traversal.h"
@@ -33,6 +39,7 @@ public:
     sc_core::sc_port<PipeIf> triangle;
     sc_core::sc_port<PipeIf, 1, sc_core::SC_ZERO_OR_MORE_BOUND> anyhit;  ///< only with MASK triangles
     sc_core::sc_port<RaySinkIf> sink;
+    sc_core::sc_port<RayBufferIf, 1, sc_core::SC_ZERO_OR_MORE_BOUND> ray_buffer;  ///< treelet mode
 
     SC_HAS_PROCESS(TraversalUnit);
     TraversalUnit(sc_core::sc_module_name name, const SimConfig& config, const MemoryImage& image, uint32_t index);
@@ -44,12 +51,9 @@ public:
 private:
     enum class Phase : uint8_t { fetch_ray, step, boxes, triangles };
     struct Context {
-        Traversal trav;
-        uint64_t ray_id = 0;
-        Cycle start = 0;
+        RayState ray;              ///< stepper, ray id, start cycle, stack bookkeeping
         Phase phase = Phase::step;
-        uint32_t local_stack = 0;  ///< entries held on chip
-        uint32_t spilled = 0;      ///< entries in memory
+        uint32_t treelet = 0;      ///< treelet the ray is traversing (treelet mode)
         bool active = false;
     };
     struct Event {
@@ -61,6 +65,10 @@ private:
     void run();
     void sync(Cycle t);
     bool start_ray(uint32_t c, Cycle t);
+    bool take_parked_ray(uint32_t c, Cycle t);
+    void park_ray(uint32_t c, uint32_t treelet, Cycle t);
+    void fill_idle_contexts(Cycle t);
+    void activate(uint32_t c, Cycle t);
     void advance(uint32_t c, Cycle t);
     void step(uint32_t c, Cycle t);
     void finish_ray(uint32_t c, Cycle t);
@@ -78,6 +86,9 @@ private:
     uint32_t m_active = 0;
     Cycle m_busy_since = 0, m_busy_cycles = 0;
     uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0, m_syncs = 0;
+    bool m_treelet_mode = false;
+    Cycle m_next_fill = 0;
+    uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
 };
 
 }  // namespace rtsim

@@ -232,6 +232,16 @@ void validate(const SimConfig& config) {
                 std::to_string(config.l2.line_bytes) + ")");
     require(power_of_two(config.dram.interleave_bytes) && config.dram.interleave_bytes >= config.l2.line_bytes,
             "config: 'dram.interleave_bytes' must be a power of two and at least the line size");
+    require(power_of_two(config.dram.row_bytes) && power_of_two(config.dram.banks),
+            "config: 'dram.row_bytes' and 'dram.banks' must be powers of two (address bit fields)");
+    require(config.fidelity != "detailed" || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
+            "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas at fidelity detailed (it is the "
+            "latency of an access to a closed bank)");
+    require(config.sampling.fraction == 0 || config.sampling.count == 0,
+            "config: set 'sampling.fraction' or 'sampling.count', not both");
+    require(!config.sampling.enabled() || config.fidelity == "approx" || config.fidelity == "detailed",
+            "config: sampling ('sampling.fraction' or 'sampling.count') needs a timed SystemC level: fidelity approx "
+            "or detailed, not '" + config.fidelity + "'");
 }
 
 }  // namespace rtsim

@@ -54,13 +54,26 @@ struct DramConfig {
     uint32_t bytes_per_cycle = 16;  ///< peak bandwidth of one channel in bytes per core cycle
     uint32_t latency = 120;         ///< cycles from request to first data, unloaded
     uint32_t interleave_bytes = 256;///< address interleaving granule across channels
+    // Banks and row buffers: used by fidelity = "detailed" only (docs/model.md, detailed DRAM).
+    uint32_t banks = 16;            ///< banks per channel, each with one row buffer
+    uint32_t row_bytes = 2048;      ///< row (page) size per bank
+    std::string page_policy = "open";  ///< "open": rows stay open; "close": auto-precharge
+    uint32_t t_rcd = 14;            ///< activate to column command, core cycles
+    uint32_t t_rp = 14;             ///< precharge, core cycles
+    uint32_t t_cas = 14;            ///< column command to first data, core cycles
 
     template <class V>
     void visit(V& v) {
         v.field("channels", channels, "channels", "Independent DRAM channels", 1, 64);
         v.field("bytes_per_cycle", bytes_per_cycle, "B/cycle", "Peak bandwidth per channel, bytes per core cycle", 1, 4096);
-        v.field("latency", latency, "cycles", "Unloaded access latency (request to data)", 1, 100000);
+        v.field("latency", latency, "cycles", "Unloaded access latency (request to data; at detailed: to a closed bank)", 1, 100000);
         v.field("interleave_bytes", interleave_bytes, "bytes", "Channel interleaving granule (power of two, >= line size)", 64, 1u << 20);
+        v.field("banks", banks, "banks", "Banks per channel, one row buffer each (detailed only)", 1, 256);
+        v.field("row_bytes", row_bytes, "bytes", "Row (page) size of a bank (power of two; detailed only)", 64, 1u << 20);
+        v.choice("page_policy", page_policy, {"open", "close"}, "Row buffer policy: keep rows open (row hits) or precharge after each access (detailed only)");
+        v.field("t_rcd", t_rcd, "cycles", "Activate to column command, core cycles (detailed only)", 0, 10000);
+        v.field("t_rp", t_rp, "cycles", "Precharge time, core cycles (detailed only)", 0, 10000);
+        v.field("t_cas", t_cas, "cycles", "Column command to first data, core cycles (detailed only)", 0, 10000);
     }
 };
 
@@ -92,9 +105,57 @@ struct DispatchConfig {
     }
 };
 
+/// Treelet scheduling with ray buffers (Aila & Karras 2010; STRaTA, Kopta et al. 2013).
+struct TreeletConfig {
+    bool enabled = false;             ///< queue rays per treelet in the ray buffer
+    uint32_t treelet_kib = 16;        ///< byte budget per treelet (nodes + leaf triangles)
+    uint32_t buffer_kib = 512;        ///< ray buffer SRAM capacity
+    std::string policy = "largest";   ///< which queue a free unit runs next
+    uint32_t threshold = 64;          ///< rays a queue needs before it is worth running
+    uint32_t latency = 4;             ///< ray buffer SRAM access latency
+    uint32_t bytes_per_cycle = 512;   ///< ray buffer SRAM bandwidth (banked: 8 units x 64 B)
+    uint32_t idle_poll_cycles = 32;   ///< how often an idle unit looks for work again
+    uint32_t max_rays_in_flight = 0;  ///< rays admitted at once (0: what the SRAM and contexts hold)
+
+    template <class V>
+    void visit(V& v) {
+        v.flag("enabled", enabled, "Treelet scheduling: rays queue per treelet in the ray buffer SRAM");
+        v.field("treelet_kib", treelet_kib, "KiB", "Byte budget per treelet (nodes and their leaf triangles)", 1, 1u << 20);
+        v.field("buffer_kib", buffer_kib, "KiB", "Ray buffer SRAM capacity; rays beyond it overflow to DRAM", 1, 1u << 22);
+        v.choice("policy", policy, {"largest", "oldest", "round_robin"}, "Queue a free unit runs next: largest queue, oldest waiting ray, or round robin");
+        v.field("threshold", threshold, "rays", "Rays a queue needs before it is run (smaller queues run only when nothing else can)", 1, 1u << 20);
+        v.field("latency", latency, "cycles", "Ray buffer SRAM access latency", 1, 1000);
+        v.field("bytes_per_cycle", bytes_per_cycle, "B/cycle", "Ray buffer SRAM bandwidth", 1, 4096);
+        v.field("idle_poll_cycles", idle_poll_cycles, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000);
+        v.field("max_rays_in_flight", max_rays_in_flight, "rays", "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to DRAM (0: SRAM capacity plus the ray contexts, never overflows)", 0, 1u << 30);
+    }
+};
+
+/// Statistical sampling (docs/fidelity.md): simulate a stratified sample of clusters of rays, each
+/// warm-up then measured rays, and estimate the full run's cycles with a 95% confidence interval
+/// (SMARTS, Wunderlich et al. 2003). Off unless fraction or count is set; needs a timed level.
+struct SamplingConfig {
+    double fraction = 0.0;      ///< fraction of the trace's rays simulated (warm-up included); 0: off
+    uint32_t count = 0;         ///< rays simulated, instead of a fraction; 0: off
+    uint32_t clusters = 30;     ///< strata, one cluster of rays each (fewer if the sample is small)
+    uint32_t warmup_rays = 0;   ///< warm-up rays per cluster; 0: max(2 x rays in flight, L2 lines / 8)
+    uint32_t seed = 1;          ///< picks each cluster's offset within its stratum
+
+    bool enabled() const { return fraction > 0 || count > 0; }
+
+    template <class V>
+    void visit(V& v) {
+        v.field("fraction", fraction, "fraction", "Fraction of the trace's rays to simulate, warm-up included (0: no sampling)", 0.0, 1.0);
+        v.field("count", count, "rays", "Rays to simulate instead of a fraction (0: no sampling)", 0, 2147483647.0);
+        v.field("clusters", clusters, "clusters", "Strata of the trace, one sampled cluster each (fewer when the sample cannot hold them with their warm-up)", 2, 100000);
+        v.field("warmup_rays", warmup_rays, "rays", "Warm-up rays simulated before each cluster's measured rays (0: automatic, docs/fidelity.md)", 0, 1u << 24);
+        v.field("seed", seed, "seed", "Seed of each cluster's random offset within its stratum", 0, 2147483647.0);
+    }
+};
+
 struct SimConfig {
     double clock_ghz = 1.0;          ///< converts cycles to seconds
-    std::string fidelity = "approx"; ///< functional | approx (more levels: docs/fidelity.md)
+    std::string fidelity = "approx"; ///< functional | analytic | approx | detailed (docs/fidelity.md)
     uint32_t quantum_cycles = 256;   ///< how far a unit may run ahead of SystemC time
     uint32_t interconnect_latency = 8;  ///< L1 to L2 one-way cycles
     bool ideal_memory = false;       ///< every access hits in L1 (upper bound on performance)
@@ -106,11 +167,13 @@ struct SimConfig {
     CacheConfig l1{16, 4, 64, 4, 8, 1, 1};
     CacheConfig l2{1024, 16, 64, 20, 32, 8, 1};
     DramConfig dram;
+    TreeletConfig treelets;
+    SamplingConfig sampling;
 
     template <class V>
     void visit(V& v) {
         v.field("clock_ghz", clock_ghz, "GHz", "Core clock: converts cycles to seconds", 0.001, 100.0);
-        v.choice("fidelity", fidelity, {"functional", "approx"}, "Simulation level: functional (counts only) or approx (timed SystemC model)");
+        v.choice("fidelity", fidelity, {"functional", "analytic", "approx", "detailed"}, "Simulation level: functional (counts only), analytic (cache simulation + roofline), approx (timed SystemC model) or detailed (per-cycle arbitration, L2 MSHRs, DRAM banks)");
         v.field("quantum_cycles", quantum_cycles, "cycles", "How far a traversal unit may run ahead of the others (temporal decoupling)", 1, 1u << 20);
         v.field("interconnect_latency", interconnect_latency, "cycles", "One-way latency between an L1 and the L2", 0, 10000);
         v.flag("ideal_memory", ideal_memory, "Every access hits in L1 at L1 latency: the upper bound on performance");
@@ -122,6 +185,8 @@ struct SimConfig {
         v.section("l1", l1);
         v.section("l2", l2);
         v.section("dram", dram);
+        v.section("treelets", treelets);
+        v.section("sampling", sampling);
     }
 };
 

@@ -28,7 +28,7 @@ std::string compare_with_reference(const RayResult& r, const HitRecord& h, const
     return out.str();
 }
 
-HitChecker::HitChecker(sc_core::sc_module_name name, ReferenceWindow& reference, uint64_t total, Progress progress)
+HitChecker::HitChecker(sc_core::sc_module_name name, ReferenceSource& reference, uint64_t total, Progress progress)
     : sc_core::sc_module(name), m_reference(reference), m_total(total), m_progress(std::move(progress)) {}
 
 void HitChecker::ray_done(const RayResult& r) {

@@ -19,7 +19,7 @@ namespace rtsim {
 class HitChecker : public sc_core::sc_module, public RaySinkIf {
 public:
     using Progress = std::function<void(uint64_t done, uint64_t total)>;
-    HitChecker(sc_core::sc_module_name name, ReferenceWindow& reference, uint64_t total, Progress progress = {});
+    HitChecker(sc_core::sc_module_name name, ReferenceSource& reference, uint64_t total, Progress progress = {});
 
     void ray_done(const RayResult& r) override;
 
@@ -32,7 +32,7 @@ public:
     std::function<void(const RayResult&)> on_ray;
 
 private:
-    ReferenceWindow& m_reference;
+    ReferenceSource& m_reference;
     uint64_t m_total;
     Progress m_progress;
     uint64_t m_checked = 0, m_hit_mismatches = 0, m_work_mismatches = 0;

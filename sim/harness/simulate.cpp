@@ -7,7 +7,9 @@
 #include <memory>
 
 #include "rtl_model/top/top.h"
+#include "sim/harness/analytic.h"
 #include "sim/harness/hit_checker.h"
+#include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
 #include "sim/harness/timeline.h"
 #include "sim/harness/trace_stream.h"
@@ -106,21 +108,38 @@ SimOutcome run_simulation(const SimOptions& o) {
     // of an error naming the file (exit 2).
     reader.verify_all();
     const uint64_t total = workload["rays"];
+    // Sampling (sim/harness/sampling.h): only the sample's rays are simulated and checked.
+    std::unique_ptr<SampledRun> sampled;
+    if (o.config.sampling.enabled()) sampled = std::make_unique<SampledRun>(reader, o.config, total);
+    const uint64_t simulated = sampled ? sampled->plan.simulated_rays : total;
 
     fs::create_directories(o.out_dir);
     write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(o.config));
     ReferenceWindow reference(reader, o.config.dispatch.chunk_rays);
-    HitChecker checker("checker", reference, total, o.progress ? HitChecker::Progress(report_progress) : HitChecker::Progress());
+    HitChecker checker("checker", sampled ? static_cast<ReferenceSource&>(sampled->reference) : reference, simulated,
+                       o.progress ? HitChecker::Progress(report_progress) : HitChecker::Progress());
 
     json model, instantiated = json::array();
     Cycle cycles = 0;
     std::vector<uint8_t> kinds;  // only for the timeline
     Timeline timeline(o.config.clock_ghz);
+    // Detailed: units synchronise every cycle (quantum 1), so shared blocks see requests in time
+    // order (docs/model.md, "The detailed level"); the resolved config keeps the user's value.
+    SimConfig timed_config = o.config;
+    if (o.config.fidelity == "detailed") timed_config.quantum_cycles = 1;
     if (o.config.fidelity == "functional") {
         run_functional(image, reader, reference, checker);
+    } else if (o.config.fidelity == "analytic") {
+        // Counts, functional caches and a closed form (sim/harness/analytic.h); no SystemC time.
+        // (validate() refuses sampling here: it needs a timed SystemC level.)
+        TraceRayStream stream(reader);
+        AnalyticOutcome a = run_analytic(o.config, image, stream, checker, features.anyhit_triangles);
+        cycles = a.cycles;
+        model = std::move(a.model);
+        instantiated = std::move(a.instantiated);
     } else {
         TraceRayStream stream(reader);
-        Top top("top", o.config, image, stream, checker, features);
+        Top top("top", timed_config, image, sampled ? static_cast<RayStream&>(sampled->stream) : stream, checker, features);
         std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
         if (o.timeline) {
             kind_reader = std::make_unique<TraceReader>(rtt);
@@ -132,6 +151,11 @@ SimOutcome run_simulation(const SimOptions& o) {
                 }
             };
         }
+        if (sampled)
+            checker.on_ray = [&, hook = checker.on_ray](const RayResult& r) {
+                sampled->estimator.ray_done(r);
+                if (hook) hook(r);
+            };
         sc_core::sc_start();
         cycles = top.total_cycles();
         model = top.stats_json();
@@ -140,8 +164,8 @@ SimOutcome run_simulation(const SimOptions& o) {
             timeline.write((fs::path(o.out_dir) / "timeline.json").string(), top.units(), top.dram()->bytes_over_time(),
                            Dram::bucket_cycles());
     }
-    require(checker.checked() == total, "simulation ended with " + std::to_string(checker.checked()) + " of " +
-                                            std::to_string(total) + " rays finished");
+    require(checker.checked() == simulated, "simulation ended with " + std::to_string(checker.checked()) + " of " +
+                                                std::to_string(simulated) + " rays finished");
     double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     SimOutcome out;
@@ -155,6 +179,11 @@ SimOutcome run_simulation(const SimOptions& o) {
                  {"effects", manifest.value("workload", json::object()).value("effects", json::array())},
                  {"model", model},
                  {"provenance", provenance(o.command_line, rtt, manifest, started)}};
+    out.stats["summary"]["sampled"] = bool(sampled);
+    if (sampled) {
+        apply_sampling_to_summary(out.stats["summary"], o.config, sampled->plan, sampled->estimator);
+        out.stats["sampling"] = sampled->estimator.to_json(o.config, cycles, wall);
+    }
     write_json(fs::path(o.out_dir) / "stats.json", out.stats);
     write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
     out.exit_code = (checker.hit_mismatches() || checker.work_mismatches()) ? 3 : 0;

@@ -27,9 +27,14 @@ json hit_rate(const json& caches) {
 /// Mean of a field over the blocks of a group ({"box_0": {...}, ...}).
 json mean_of(const json& group, const char* key) {
     if (!group.is_object() || group.empty()) return nullptr;
-    double sum = 0;
-    for (const json& b : group) sum += b.value(key, 0.0);
-    return sum / double(group.size());
+    double sum = 0, n = 0;
+    for (const json& b : group) {
+        auto it = b.find(key);
+        if (it == b.end() || !it->is_number()) continue;  // null: this level does not produce it
+        sum += it->get<double>();
+        ++n;
+    }
+    return n > 0 ? json(sum / n) : json(nullptr);
 }
 
 /// Peak resident memory of this process's address space (VmHWM). getrusage's ru_maxrss would
@@ -48,14 +53,19 @@ double peak_memory_mib() {
 json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& model, const HitChecker& checker,
                double wall) {
     json s = {{"rays", rays},
+              {"fidelity", c.fidelity},
               {"hit_mismatches", checker.hit_mismatches()},
               {"work_mismatches", checker.work_mismatches()},
               {"wall_seconds", wall},
               {"peak_memory_mib", peak_memory_mib()},
               {"simulated_rays_per_wall_second", wall > 0 ? double(rays) / wall : 0.0}};
     if (c.fidelity == "functional") {
-        s["cycles"] = nullptr;
-        s["rays_per_second"] = nullptr;
+        // Every level reports the same keys; what the functional level cannot know is null.
+        for (const char* k : {"cycles", "seconds", "rays_per_second", "mrays_per_second", "avg_ray_latency_cycles",
+                              "unit_busy_fraction", "box_utilization", "triangle_utilization", "l1_hit_rate",
+                              "l2_hit_rate", "dram_bytes", "dram_bytes_per_ray", "dram_bandwidth_gbps",
+                              "dram_bandwidth_utilization"})
+            s[k] = nullptr;
         return s;
     }
     double seconds = double(cycles) / (c.clock_ghz * 1e9);

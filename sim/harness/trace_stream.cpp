@@ -37,13 +37,14 @@ ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {
     require(id < m_total, "ray " + std::to_string(id) + " is beyond the trace (" + std::to_string(m_total) + " rays)");
     if (!m_chunks.empty() && index >= m_chunks.front().index && index < m_chunks.front().index + m_chunks.size())
         return m_chunks[index - m_chunks.front().index];
-    require(index >= m_loaded_end, "reference window: ray " + std::to_string(id) + " already retired");
+    require(index >= m_loaded_end, "ray " + std::to_string(id) + " finished after all rays of its chunk were checked "
+                                   "(a ray was duplicated in the model)");
     // Load consecutive chunks up to the one needed. Always from the first chunk never loaded, even
     // when every resident chunk has retired: rays of the chunks in between may still be in flight.
     uint64_t next = m_loaded_end;
     while (next <= index) {
         uint64_t first = next * m_chunk, n = std::min(m_chunk, m_total - first);
-        Chunk c{next, std::vector<HitRecord>(n), std::vector<WorkRecord>(n), n};
+        Chunk c{next, std::vector<HitRecord>(n), std::vector<WorkRecord>(n), n, std::vector<bool>(n, false)};
         m_reader.read(SectionKind::hits, first, n, c.hits.data());
         m_reader.read(SectionKind::work, first, n, c.work.data());
         m_chunks.push_back(std::move(c));
@@ -55,6 +56,8 @@ ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {
 
 void ReferenceWindow::checked(uint64_t id) {
     Chunk& c = chunk_for(id);
+    require(!c.done[id % m_chunk], "ray " + std::to_string(id) + " finished twice (a ray was duplicated in the model)");
+    c.done[id % m_chunk] = true;
     --c.remaining;
     while (!m_chunks.empty() && m_chunks.front().remaining == 0) m_chunks.pop_front();
 }

@@ -25,15 +25,25 @@ private:
     std::vector<RayRecord> m_buffer;
 };
 
+/// Where the hit checker looks up a ray's reference hit and work by its trace index.
+class ReferenceSource {
+public:
+    virtual ~ReferenceSource() = default;
+    virtual const HitRecord& hit(uint64_t id) = 0;
+    virtual const WorkRecord& work(uint64_t id) = 0;
+    /// Marks a ray as checked (its reference may be dropped).
+    virtual void checked(uint64_t id) = 0;
+};
+
 /// Reference hits and work of the trace, looked up by ray index over a sliding window of chunks.
 /// Rays complete roughly in order (within the rays in flight), so only a few chunks are resident.
-class ReferenceWindow {
+class ReferenceWindow : public ReferenceSource {
 public:
     ReferenceWindow(TraceReader& reader, uint64_t chunk_rays);
-    const HitRecord& hit(uint64_t id) { return chunk_for(id).hits[id % m_chunk]; }
-    const WorkRecord& work(uint64_t id) { return chunk_for(id).work[id % m_chunk]; }
+    const HitRecord& hit(uint64_t id) override { return chunk_for(id).hits[id % m_chunk]; }
+    const WorkRecord& work(uint64_t id) override { return chunk_for(id).work[id % m_chunk]; }
     /// Marks a ray as checked; chunks whose rays are all checked are dropped.
-    void checked(uint64_t id);
+    void checked(uint64_t id) override;
     size_t resident_chunks() const { return m_chunks.size(); }
 
 private:
@@ -42,6 +52,7 @@ private:
         std::vector<HitRecord> hits;
         std::vector<WorkRecord> work;
         uint64_t remaining;
+        std::vector<bool> done;  ///< rays already checked: a second completion is a model bug
     };
     Chunk& chunk_for(uint64_t id);
 

@@ -80,7 +80,7 @@ def test_round_trip_through_rtsim_sim(cornell_trace: Path, tmp_path: Path) -> No
     [
         ({"l1": {"size_kb": 16}}, "'l1.size_kb'"),
         ({"dram": {"speed": 1}}, "'dram.speed'"),
-        ({"treelets": {"enabled": True}}, "'treelets'"),
+        ({"treelets": {"enable": True}}, "'treelets.enable'"),
         ({"l1": {"size_kib": "big"}}, "'l1.size_kib' must be a non-negative integer"),
         ({"box": {"sharing": "pooled"}}, "'box.sharing' = 'pooled' is not one of"),
         ({"ideal_memory": 1}, "'ideal_memory' must be true or false"),

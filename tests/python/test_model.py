@@ -42,11 +42,26 @@ SHARED = {
 CONFIGS = {
     "default": [],
     "functional": ["fidelity=functional"],
+    "analytic": ["fidelity=analytic"],
+    "detailed": ["fidelity=detailed"],
     "shared_pipelines": ["box.sharing=shared", "triangle.sharing=shared"],
     "stack_spills": ["traversal.stack_entries=1"],
     "ideal_memory": ["ideal_memory=true"],
     # More rays in flight than a dispatch chunk: rays finish many chunks out of order.
     "small_chunks": ["dispatch.chunk_rays=64", "traversal.ray_contexts=64"],
+    # Treelet scheduling: rays wait in per-treelet queues between steps; a 1 KiB buffer forces
+    # overflow to DRAM and tiny treelets force a park at almost every node.
+    "treelets": ["treelets.enabled=true"],
+    "treelets_overflow": [
+        "treelets.enabled=true",
+        "treelets.buffer_kib=1",
+        "treelets.policy=oldest",
+    ],
+    "treelets_tiny": [
+        "treelets.enabled=true",
+        "treelets.treelet_kib=1",
+        "treelets.policy=round_robin",
+    ],
 }
 NOISE = 1.02  # timing comparisons allow 2% (rays interleave differently when timing changes)
 

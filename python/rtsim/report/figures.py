@@ -315,7 +315,7 @@ def pareto(data: SweepData) -> tuple[Figure | None, dict[str, list[RunRecord]]]:
                 color="#C44E52",
             )
         _sram_axis(ax, [sram_kib(r) for r in g.ok])
-        ax.set_xlabel("on-chip SRAM: L1s + L2 + traversal stacks (KiB)")
+        ax.set_xlabel("on-chip SRAM: L1s + L2 + stacks + ray buffer (KiB)")
         ax.set_ylabel("simulated Mrays/s")
         ax.set_ylim(bottom=0, top=max(mrays(r) for r in g.ok) * 1.15)
         ax.set_title(f"{g.title}  (numbers: table below)")

@@ -282,8 +282,8 @@ def render_report(data: SweepData) -> str:
             pareto_fig,
             "Pareto front of rays/s against on-chip SRAM",
             "On-chip SRAM = L1 size x traversal units + L2 + traversal stacks (units x ray "
-            "contexts x stack entries x entry bytes). Front points are numbered; the table "
-            "names them.",
+            "contexts x stack entries x entry bytes), plus the ray buffer when treelet scheduling "
+            "is on. Front points are numbered; the table names them.",
         ),
         "<h3>The best configurations (Pareto front, by SRAM)</h3>",
         _front_table(data, fronts) if fronts else "",

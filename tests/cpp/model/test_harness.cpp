@@ -119,7 +119,7 @@ TEST(ReferenceWindow, RefusesRetiredAndOutOfRangeRays) {
     for (uint64_t id = 0; id < 10; ++id) window.checked(id);
     EXPECT_EQ(window.resident_chunks(), 0u);
     EXPECT_EQ(window.hit(20).prim, 20);  // loads chunks 1 and 2
-    EXPECT_NE(error_of([&] { window.hit(3); }).find("already retired"), std::string::npos);
+    EXPECT_NE(error_of([&] { window.hit(3); }).find("after all rays of its chunk were checked"), std::string::npos);
     EXPECT_NE(error_of([&] { window.hit(100); }).find("beyond the trace"), std::string::npos);
 }
 

@@ -1,0 +1,42 @@
+#pragma once
+// Everything a ray in flight carries between a traversal unit and the ray buffer: the stepper
+// (ray, hit so far, traversal stack, work counts) and the model's bookkeeping of its stack.
+#include <cstdint>
+
+#include "rtl_model/common/interfaces.h"
+#include "traces/isect/traversal.h"
+
+namespace rtsim {
+
+struct RayState {
+    Traversal trav;
+    uint64_t ray_id = 0;
+    Cycle start = 0;           ///< cycle the ray entered the machine (latency is measured from it)
+    uint32_t local_stack = 0;  ///< stack entries held on chip
+    uint32_t spilled = 0;      ///< stack entries spilled to memory
+};
+
+/// Bytes of ray-buffer SRAM one waiting ray occupies: origin, direction, tmin, tmax (32), hit so
+/// far (prim, t, u, v: 16), ray id and flags (8), and its on-chip stack entries.
+inline uint32_t ray_state_bytes(uint32_t stack_entries, uint32_t stack_entry_bytes) {
+    return 32 + 16 + 8 + stack_entries * stack_entry_bytes;
+}
+
+/// The ray buffer as the traversal units see it (treelet scheduling).
+/// Contract: take() hands each waiting ray to exactly one unit; park() accepts every ray (it
+/// overflows to memory when the SRAM is full), so units never block on it.
+class RayBufferIf : public virtual sc_core::sc_interface {
+public:
+    /// Next ray of `unit`'s current treelet, choosing a new treelet for the unit when that queue
+    /// is empty. False when no ray can be run now. *ready: cycle the ray's state is in the unit.
+    virtual bool take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) = 0;
+    /// A ray leaves its treelet for `treelet`; returns the cycle its state is written.
+    virtual Cycle park(uint32_t treelet, const RayState& ray, Cycle time) = 0;
+    /// A ray finished (its hit was written).
+    virtual void finished(Cycle time) = 0;
+    /// No ray is left anywhere: not in dispatch, not in queues, not in flight.
+    virtual bool done() const = 0;
+    virtual uint32_t treelet_of(uint32_t node) const = 0;
+};
+
+}  // namespace rtsim

@@ -1,0 +1,90 @@
+#pragma once
+// DRAM banks and row buffers for the detailed fidelity level: per channel `banks` banks, each
+// with one row buffer, an open-page or close-page policy, and activate (tRCD), precharge (tRP)
+// and column (tCAS) timing in core cycles, in front of the channel's data bus (bytes_per_cycle).
+// Timing after JEDEC DDR command rules reduced to their first-order terms (Jacob, Ng & Wang,
+// "Memory Systems", 2008, ch. 11-13), the way Ramulator's and DRAMSim's simple bank state
+// machines do; docs/model.md has the address map and the hand-worked sequences the tests check.
+//
+// Per request at channel c, bank b, row r, arriving at cycle t (no FR-FCFS reordering):
+//   s   = the first cycle >= t at which the bank is idle long enough for the request; the row
+//         state is that left by the bank's previous access in time
+//   row hit      (open page, row r open):   column at s
+//   row miss     (bank closed):             activate at s, column at s + tRCD
+//   row conflict (another row open):        precharge at s, activate s + tRP, column s + tRP + tRCD
+//   data: ceil(bytes / bytes_per_cycle) cycles on the bus, from the first free bus cycles at or
+//   after column + tCAS; done = cycle after the last data cycle.
+//   the bank is busy from s to column + burst cycles (open page; the row stays open), or to
+//   column + burst + tRP with close page (auto-precharge: every access finds the bank closed).
+// Requests normally arrive in time order (the detailed level synchronises units every cycle),
+// and then this is first come, first served. A request stamped earlier than one already booked
+// (a miss that waited for an MSHR is stamped in the future) takes an idle gap before it, the
+// way a bandwidth calendar back-fills, instead of queueing behind the future; the row outcome
+// of the later, already booked access is not revised.
+// Pure C++ (no SystemC), owned by Dram.
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rtl_model/common/calendar.h"
+#include "sim/config/config.h"
+
+namespace rtsim {
+
+struct DramAddress {
+    uint32_t channel = 0;
+    uint32_t bank = 0;
+    uint64_t row = 0;
+    uint32_t column = 0;  ///< byte offset in the row
+};
+
+class DramBanks {
+public:
+    enum class RowResult : uint8_t { hit, miss, conflict };
+
+    explicit DramBanks(const DramConfig& config);
+
+    /// Address map: channel = (addr / interleave) mod channels; the channel-local address drops
+    /// the channel bits; column = local mod row_bytes, bank = (local / row_bytes) mod banks,
+    /// row = local / (row_bytes x banks). Consecutive lines of a row stay in one bank and row.
+    DramAddress map(uint64_t addr) const;
+
+    struct Timing {
+        Cycle start = 0;   ///< cycle the bank started serving the request (>= arrival)
+        Cycle column = 0;  ///< cycle of the column command
+        Cycle done = 0;    ///< cycle after the last data cycle on the bus
+        RowResult result = RowResult::miss;
+    };
+    /// Serves one request of `bytes` bytes arriving at `time`.
+    Timing access(uint64_t addr, uint32_t bytes, Cycle time);
+
+    uint64_t row_hits() const { return m_totals[0]; }
+    uint64_t row_misses() const { return m_totals[1]; }
+    uint64_t row_conflicts() const { return m_totals[2]; }
+    /// {row_hits, row_misses, row_conflicts, row_hit_rate, page_policy, banks_per_channel,
+    ///  row_bytes, by_bank: [{channel, bank, accesses, row_hits, row_misses, row_conflicts}]}
+    nlohmann::json stats_json() const;
+
+private:
+    static constexpr uint64_t kClosed = ~0ull;
+    struct Busy {
+        Cycle end;         ///< first idle cycle after this access
+        uint64_t row;      ///< row open after it (kClosed: precharged)
+    };
+    struct Bank {
+        std::map<Cycle, Busy> busy;    ///< booked accesses by start cycle (recent ones only)
+        uint64_t base_row = kClosed;   ///< row open after the oldest forgotten access
+        uint64_t counts[3] = {};       ///< hits, misses, conflicts
+    };
+    /// Cycles from the start of service to the column command, for a row outcome.
+    Cycle to_column(RowResult r) const;
+    DramConfig m_config;
+    bool m_close_page;
+    std::vector<Bank> m_banks;          ///< channel-major: channel * banks + bank
+    std::vector<SlotCalendar> m_buses;  ///< one data bus per channel: bytes_per_cycle per cycle
+    uint64_t m_totals[3] = {};
+};
+
+}  // namespace rtsim

@@ -1,0 +1,191 @@
+#include "rtl_model/ray_buffer/ray_buffer.h"
+
+#include <algorithm>
+
+#include "rtl_model/top/memory_image.h"
+
+namespace rtsim {
+
+RayBuffer::RayBuffer(sc_core::sc_module_name name, const SimConfig& config, const TreeletPartition& partition)
+    : sc_core::sc_module(name),
+      m_config(config),
+      m_partition(partition),
+      m_state_bytes(ray_state_bytes(config.traversal.stack_entries, config.traversal.stack_entry_bytes)),
+      m_capacity(std::max<uint64_t>(1, uint64_t(config.treelets.buffer_kib) * 1024 / m_state_bytes)),
+      m_max_in_flight(config.treelets.max_rays_in_flight
+                          ? config.treelets.max_rays_in_flight
+                          : m_capacity + uint64_t(config.traversal.units) * config.traversal.ray_contexts),
+      m_queues(partition.treelets.size()),
+      m_unit_treelet(config.traversal.units, -1),
+      m_sram(16ull * config.treelets.bytes_per_cycle, 16) {}
+
+Cycle RayBuffer::sram(Cycle time) {
+    // One ray state moved through the SRAM port: bandwidth, then latency.
+    Cycle start = m_sram.reserve(time, m_state_bytes);
+    return start + m_config.treelets.latency + (m_state_bytes + m_config.treelets.bytes_per_cycle - 1) / m_config.treelets.bytes_per_cycle;
+}
+
+void RayBuffer::push(uint32_t treelet, const RayState& ray, Cycle ready, Cycle time) {
+    Waiting w{ray, ready, false, 0};
+    if (m_occupancy < m_capacity) {
+        ++m_occupancy;
+        m_max_occupancy = std::max(m_max_occupancy, m_occupancy);
+        w.ready = std::max(ready, sram(time));
+    } else {
+        // SRAM full: the state overflows to memory (posted write).
+        w.overflowed = true;
+        if (!m_free_slots.empty()) {
+            w.slot = m_free_slots.back();
+            m_free_slots.pop_back();
+        } else {
+            w.slot = m_next_slot++;
+        }
+        mem->access({MemoryMap::ray_buffer(w.slot, m_state_bytes), m_state_bytes, true, DataKind::ray_buffer, time});
+        ++m_overflows;
+    }
+    unindex(treelet);
+    m_queues[treelet].push_back(std::move(w));
+    index(treelet);
+}
+
+void RayBuffer::admit(Cycle time) {
+    // New rays enter the root treelet's queue while the machine holds fewer than the limit.
+    const uint32_t root = m_partition.node_treelet[0];
+    RayJob job;
+    // By default (no explicit limit) admission also waits for SRAM room, so it never overflows.
+    const bool may_overflow = m_config.treelets.max_rays_in_flight != 0;
+    while (!m_dispatch_empty && m_in_machine < m_max_in_flight && (may_overflow || m_occupancy < m_capacity)) {
+        if (!rays->next_ray(&job)) {
+            m_dispatch_empty = true;
+            break;
+        }
+        RayState s;
+        s.trav.begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+        s.ray_id = job.id;
+        s.start = time;
+        Cycle fetched = mem->access({MemoryMap::ray(job.id), sizeof(RayRecord), false, DataKind::ray, time});
+        push(root, s, fetched, time);
+        ++m_admitted;
+        ++m_in_machine;
+    }
+}
+
+void RayBuffer::unindex(uint32_t t) {
+    const auto& q = m_queues[t];
+    if (q.empty()) return;
+    m_by_size.erase({q.size(), t});
+    m_by_age.erase({q.front().ready, t});
+    m_nonempty.erase(t);
+}
+
+void RayBuffer::index(uint32_t t) {
+    const auto& q = m_queues[t];
+    if (q.empty()) return;
+    const std::string& policy = m_config.treelets.policy;
+    if (policy == "largest") m_by_size.insert({q.size(), t});
+    else if (policy == "oldest") m_by_age.insert({q.front().ready, t});
+    else m_nonempty.insert(t);
+}
+
+int64_t RayBuffer::pick(uint32_t) {
+    // The policy's first queue with at least `threshold` rays among the first few candidates; if
+    // none is that long, its first queue anyway (draining: waiting would stall the machine, since
+    // only running rays refill the queues).
+    constexpr int kLook = 64;
+    const uint64_t threshold = m_config.treelets.threshold;
+    const std::string& policy = m_config.treelets.policy;
+    int64_t first = -1, chosen = -1;
+    auto consider = [&](uint32_t t) {
+        if (first < 0) first = t;
+        if (m_queues[t].size() >= threshold) chosen = t;
+        return chosen >= 0;
+    };
+    if (policy == "largest") {
+        if (!m_by_size.empty()) consider(m_by_size.begin()->second);  // the largest decides
+    } else if (policy == "oldest") {
+        int k = 0;
+        for (auto it = m_by_age.begin(); it != m_by_age.end() && k < kLook; ++it, ++k)
+            if (consider(it->second)) break;
+    } else {
+        auto it = m_nonempty.upper_bound(m_round_robin);
+        for (int k = 0; k < kLook && !m_nonempty.empty(); ++k, ++it) {
+            if (it == m_nonempty.end()) it = m_nonempty.begin();
+            if (consider(*it)) break;
+        }
+    }
+    if (first < 0) return -1;
+    if (chosen < 0) {
+        chosen = first;
+        ++m_drain_picks;
+    }
+    if (policy == "round_robin") m_round_robin = uint32_t(chosen);
+    ++m_picks;
+    m_picked_queue_rays += m_queues[chosen].size();
+    return chosen;
+}
+
+bool RayBuffer::take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) {
+    int64_t& current = m_unit_treelet[unit];
+    if (current < 0 || m_queues[current].empty()) {
+        admit(time);
+        current = pick(unit);
+        if (current < 0) return false;
+    }
+    Waiting& w = m_queues[current].front();
+    *ray = std::move(w.state);
+    *treelet = uint32_t(current);
+    if (w.overflowed) {
+        *ready = mem->access({MemoryMap::ray_buffer(w.slot, m_state_bytes), m_state_bytes, false, DataKind::ray_buffer,
+                              std::max(time, w.ready)});
+        m_free_slots.push_back(w.slot);
+        ++m_overflow_reads;
+    } else {
+        *ready = sram(std::max(time, w.ready));
+        --m_occupancy;
+    }
+    unindex(uint32_t(current));
+    m_queues[current].pop_front();
+    index(uint32_t(current));
+    ++m_taken;
+    return true;
+}
+
+Cycle RayBuffer::park(uint32_t treelet, const RayState& ray, Cycle time) {
+    ++m_parked;
+    push(treelet, ray, time, time);
+    return m_queues[treelet].back().ready;
+}
+
+void RayBuffer::finished(Cycle) { --m_in_machine; }
+
+nlohmann::json RayBuffer::stats_json() const {
+    const auto& t = m_partition.treelets;
+    uint64_t max_bytes = 0, sum_bytes = 0;
+    uint32_t max_depth = 0;
+    for (const TreeletInfo& i : t) {
+        max_bytes = std::max(max_bytes, i.bytes);
+        sum_bytes += i.bytes;
+        max_depth = std::max(max_depth, i.depth);
+    }
+    return {{"ray_state_bytes", m_state_bytes},
+            {"capacity_rays", m_capacity},
+            {"max_rays_in_flight", m_max_in_flight},
+            {"max_occupancy", m_max_occupancy},
+            {"admitted", m_admitted},
+            {"parked", m_parked},
+            {"taken", m_taken},
+            {"overflow_writes", m_overflows},
+            {"overflow_reads", m_overflow_reads},
+            {"overflow_bytes", (m_overflows + m_overflow_reads) * m_state_bytes},
+            {"picks", m_picks},
+            {"drain_picks", m_drain_picks},
+            {"avg_queue_rays_at_pick", m_picks ? double(m_picked_queue_rays) / double(m_picks) : 0.0},
+            {"treelets",
+             {{"count", t.size()},
+              {"budget_bytes", m_partition.budget_bytes},
+              {"mean_bytes", t.empty() ? 0.0 : double(sum_bytes) / double(t.size())},
+              {"max_bytes", max_bytes},
+              {"max_depth", max_depth}}}};
+}
+
+}  // namespace rtsim

@@ -1,0 +1,86 @@
+#pragma once
+// The treelet ray buffer (Aila & Karras 2010; in hardware, STRaTA by Kopta et al. 2013): an SRAM
+// of `buffer_kib` holding the state of rays waiting for a treelet, one FIFO queue per treelet.
+//
+// - New rays are admitted from dispatch into the root treelet's queue while fewer than
+//   max_rays_in_flight rays are in the machine (default: what the SRAM and the ray contexts hold,
+//   so nothing overflows); their ray record is read from memory on the way in. Admitting more
+//   makes longer queues (more rays share each treelet load) at the price of overflow traffic.
+// - A unit whose treelet queue runs dry asks the scheduler for another: by policy (largest queue,
+//   oldest waiting ray, round robin) among queues of at least `threshold` rays, or — when no
+//   queue is that long and no new ray can be admitted — the best non-empty queue, so the machine
+//   always makes progress.
+// - A ray that needs a node of another treelet is parked in that treelet's queue. If the SRAM is
+//   full it overflows: its state is written to memory (data kind ray_buffer) and read back when
+//   it is taken; the traffic goes through the L2 and DRAM and is counted.
+// Requests come from units that run ahead of each other within a quantum; the queues are updated
+// in call order and each parked ray carries the cycle its state is ready, so no ray is used
+// before it exists.
+#include <cstdint>
+#include <deque>
+#include <set>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <systemc>
+
+#include "rtl_model/common/calendar.h"
+#include "rtl_model/common/ray_state.h"
+#include "sim/config/config.h"
+#include "traces/bvh/treelets.h"
+
+namespace rtsim {
+
+class RayBuffer : public sc_core::sc_module, public RayBufferIf {
+public:
+    sc_core::sc_port<RaySourceIf> rays;  ///< dispatch
+    sc_core::sc_port<MemIf> mem;          ///< ray records in, overflow out (the L2)
+
+    RayBuffer(sc_core::sc_module_name name, const SimConfig& config, const TreeletPartition& partition);
+
+    bool take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) override;
+    Cycle park(uint32_t treelet, const RayState& ray, Cycle time) override;
+    void finished(Cycle time) override;
+    bool done() const override { return m_dispatch_empty && m_in_machine == 0; }
+    uint32_t treelet_of(uint32_t node) const override { return m_partition.node_treelet[node]; }
+
+    uint64_t capacity_rays() const { return m_capacity; }
+    uint64_t max_occupancy() const { return m_max_occupancy; }
+    nlohmann::json stats_json() const;
+
+private:
+    struct Waiting {
+        RayState state;
+        Cycle ready;       ///< cycle the state is in the buffer (or in memory, if overflowed)
+        bool overflowed;   ///< state lives in memory, not in the SRAM
+        uint64_t slot;     ///< overflow slot
+    };
+    void admit(Cycle time);
+    void unindex(uint32_t treelet);
+    void index(uint32_t treelet);
+    void push(uint32_t treelet, const RayState& ray, Cycle ready, Cycle time);
+    int64_t pick(uint32_t unit);
+    Cycle sram(Cycle time);
+
+    const SimConfig& m_config;
+    const TreeletPartition& m_partition;
+    uint32_t m_state_bytes;
+    uint64_t m_capacity;
+    uint64_t m_max_in_flight;
+    std::vector<std::deque<Waiting>> m_queues;
+    std::vector<int64_t> m_unit_treelet;
+    BandwidthCalendar m_sram;
+    std::vector<uint64_t> m_free_slots;
+    uint64_t m_next_slot = 0;
+    uint32_t m_round_robin = 0;
+    // Ordered views of the non-empty queues for the scheduler (only the policy's is kept).
+    std::set<std::pair<uint64_t, uint32_t>, std::greater<>> m_by_size;  ///< largest first
+    std::set<std::pair<Cycle, uint32_t>> m_by_age;                      ///< oldest front first
+    std::set<uint32_t> m_nonempty;                                      ///< by treelet id
+    bool m_dispatch_empty = false;
+    uint64_t m_occupancy = 0, m_max_occupancy = 0, m_in_machine = 0;
+    uint64_t m_admitted = 0, m_parked = 0, m_taken = 0, m_overflows = 0, m_overflow_reads = 0;
+    uint64_t m_picks = 0, m_drain_picks = 0, m_picked_queue_rays = 0;
+};
+
+}  // namespace rtsim

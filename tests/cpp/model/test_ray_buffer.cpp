@@ -1,0 +1,150 @@
+// The treelet ray buffer on its own: admission up to capacity, overflow to memory with its traffic
+// counted, every ray handed out exactly once, and the scheduler policies' choices.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+#include "model_test_util.h"
+#include "rtl_model/ray_buffer/ray_buffer.h"
+
+using namespace rtsim;
+
+namespace {
+
+/// Dispatch stand-in: rays 0..n-1 in order.
+class FakeDispatch : public sc_core::sc_module, public RaySourceIf {
+public:
+    FakeDispatch(sc_core::sc_module_name name, uint64_t n) : sc_core::sc_module(name), m_n(n) {}
+    bool next_ray(RayJob* job) override {
+        if (m_next == m_n) return false;
+        job->id = m_next++;
+        job->ray = Ray{Vec3(0.0f), 0.0f, Vec3(0.0f, 0.0f, 1.0f), 10.0f};
+        return true;
+    }
+    uint64_t total_rays() const override { return m_n; }
+
+private:
+    uint64_t m_n, m_next = 0;
+};
+
+/// A partition of `treelets` treelets, one node each (node i in treelet i; node 0 is the root).
+TreeletPartition partition_of(uint32_t treelets) {
+    TreeletPartition p;
+    p.budget_bytes = 64;
+    for (uint32_t i = 0; i < treelets; ++i) {
+        p.node_treelet.push_back(i);
+        p.treelets.push_back(TreeletInfo{i, 1, 64, i ? 1u : 0u});
+    }
+    return p;
+}
+
+struct Bench {
+    Bench(const SimConfig& c, uint64_t rays, uint32_t treelets, const std::string& tag)
+        : config(c),
+          partition(partition_of(treelets)),
+          dispatch(("dispatch_" + tag).c_str(), rays),
+          memory(("memory_" + tag).c_str(), 100),
+          buffer(("ray_buffer_" + tag).c_str(), config, partition) {
+        buffer.rays(dispatch);
+        buffer.mem(memory);
+        kernel_elaborate();
+    }
+    void kernel_elaborate() { sc_core::sc_get_curr_simcontext()->elaborate(); }
+    SimConfig config;  ///< the buffer keeps a reference, as to Top's config
+    TreeletPartition partition;
+    FakeDispatch dispatch;
+    test::FakeMemory memory;
+    RayBuffer buffer;
+};
+
+SimConfig config_with(uint32_t buffer_kib, const std::string& policy, uint32_t threshold) {
+    SimConfig c;
+    c.traversal.units = 2;
+    c.treelets.enabled = true;
+    c.treelets.buffer_kib = buffer_kib;
+    c.treelets.policy = policy;
+    c.treelets.threshold = threshold;
+    return c;
+}
+
+}  // namespace
+
+TEST(RayBuffer, AdmitsUpToCapacityAndOverflowsParkedRays) {
+    test::TestKernel kernel;
+    SimConfig c = config_with(1, "largest", 1);  // 1 KiB: 8 rays of 120 bytes
+    Bench b(c, 100, 4, "overflow");
+    ASSERT_EQ(b.buffer.capacity_rays(), 1024u / 120u);
+    const uint64_t capacity = b.buffer.capacity_rays();
+    RayState ray;
+    uint32_t treelet = 0;
+    Cycle ready = 0;
+    // The first take admits rays until the SRAM is full; take them all out.
+    std::vector<RayState> held;
+    for (uint64_t i = 0; i < capacity; ++i) {
+        ASSERT_TRUE(b.buffer.take(0, 10, &ray, &treelet, &ready));
+        EXPECT_EQ(treelet, 0u);
+        EXPECT_EQ(ray.ray_id, i);
+        held.push_back(std::move(ray));
+    }
+    EXPECT_EQ(b.buffer.max_occupancy(), capacity);
+    // The next take refills the SRAM (admission never overflows) and takes one: one slot free.
+    ASSERT_TRUE(b.buffer.take(0, 20, &ray, &treelet, &ready));
+    EXPECT_EQ(ray.ray_id, capacity);
+    // Parking the held rays: one fits, the others overflow to memory as ray_buffer writes.
+    for (RayState& r : held) b.buffer.park(2, r, 30);
+    size_t overflow_writes = 0;
+    for (const MemRequest& r : b.memory.requests) overflow_writes += r.write && r.kind == DataKind::ray_buffer;
+    EXPECT_EQ(overflow_writes, capacity - 1);
+    EXPECT_LE(b.buffer.max_occupancy(), b.buffer.capacity_rays());
+    nlohmann::json s = b.buffer.stats_json();
+    EXPECT_EQ(s["overflow_writes"].get<uint64_t>(), overflow_writes);
+}
+
+TEST(RayBuffer, EveryRayIsHandedOutExactlyOnceUnderEveryPolicy) {
+    for (const char* policy : {"largest", "oldest", "round_robin"}) {
+        for (uint32_t kib : {1u, 64u}) {
+            SCOPED_TRACE(std::string(policy) + " " + std::to_string(kib) + " KiB");
+            test::TestKernel kernel;
+            Bench b(config_with(kib, policy, 4), 300, 6, std::string(policy) + std::to_string(kib));
+            // Each ray visits treelets 0, then 1..5 by id, then finishes: 2 takes per ray.
+            std::map<uint64_t, int> takes;
+            std::set<uint64_t> finished;
+            RayState ray;
+            uint32_t treelet = 0;
+            Cycle ready = 0, now = 0;
+            for (int guard = 0; guard < 100000 && !b.buffer.done(); ++guard, now += 3) {
+                if (!b.buffer.take(guard % 2, now, &ray, &treelet, &ready)) continue;
+                ++takes[ray.ray_id];
+                if (treelet == 0) {
+                    b.buffer.park(1 + ray.ray_id % 5, ray, now + 1);
+                } else {
+                    EXPECT_TRUE(finished.insert(ray.ray_id).second) << "ray " << ray.ray_id << " finished twice";
+                    b.buffer.finished(now + 1);
+                }
+                EXPECT_LE(b.buffer.max_occupancy(), b.buffer.capacity_rays());
+            }
+            EXPECT_TRUE(b.buffer.done());
+            EXPECT_EQ(finished.size(), 300u);
+            for (const auto& [id, n] : takes) EXPECT_EQ(n, 2) << "ray " << id;
+        }
+    }
+}
+
+TEST(RayBuffer, LargestPolicyRunsTheLongestQueue) {
+    test::TestKernel kernel;
+    Bench b(config_with(64, "largest", 1), 10, 4, "largest");
+    RayState ray;
+    uint32_t treelet = 0;
+    Cycle ready = 0;
+    std::vector<RayState> rays;
+    for (int i = 0; i < 10; ++i) {
+        ASSERT_TRUE(b.buffer.take(0, 0, &ray, &treelet, &ready));
+        rays.push_back(std::move(ray));
+    }
+    // 2 rays to treelet 1, 5 to treelet 2, 3 to treelet 3.
+    for (int i = 0; i < 10; ++i) b.buffer.park(i < 2 ? 1 : i < 7 ? 2 : 3, rays[i], 5);
+    ASSERT_TRUE(b.buffer.take(1, 10, &ray, &treelet, &ready));
+    EXPECT_EQ(treelet, 2u);
+    EXPECT_GE(ready, 10u);  // state read from the SRAM after it was written
+}

@@ -1,0 +1,141 @@
+"""The fidelity levels (docs/fidelity.md, "Levels"): one config and stats schema for all.
+
+Hit equality of every level on every scene is in test_model.py (CONFIGS "functional",
+"analytic", "detailed"); here:
+
+- the analytic model never predicts faster than the physical roofline of its own inputs, on
+  several configurations (bounds recomputed here from the counters it reports);
+- the detailed level reports DRAM row-buffer outcomes that add up, and models the L2's MSHRs;
+- every level writes the same summary keys (null where a level cannot know).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import test_model
+from test_model import Sim
+
+# The session fixtures of test_model.py (one rtsim-sim and one trace per scene).
+sim_exe = test_model.sim_exe
+sim = test_model.sim
+trace_of = test_model.trace_of
+
+LEVELS = ["functional", "analytic", "approx", "detailed"]
+ANALYTIC_CONFIGS = {
+    "default": [],
+    "shared_pipes": ["box.sharing=shared", "triangle.sharing=shared", "box.shared_count=2"],
+    "narrow_dram": ["dram.bytes_per_cycle=2", "dram.channels=1"],
+    "slow_l2_banks": ["l2.banks=1", "l2.bank_cycles=4"],
+    "few_contexts": ["traversal.ray_contexts=2", "traversal.units=4"],
+    "slow_scheduler": ["traversal.issue_cycles=32"],
+    "ideal_memory": ["ideal_memory=true"],
+}
+
+
+def stats_of(run: Path) -> dict[str, Any]:
+    return json.loads((run / "stats.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def hairball(trace_of: Callable[[str, str], Path]) -> Path:
+    return trace_of("hairball", "hairball")
+
+
+def roofline(stats: dict[str, Any], config: dict[str, Any]) -> dict[str, float]:
+    """The throughput bounds of a run, recomputed from its own counters and config."""
+    m, t = stats["model"], config["traversal"]
+    bounds = {}
+    for pipe in ("box", "triangle", "anyhit"):
+        blocks = m.get(pipe, {}).values()
+        issues = sum(b["issues"] for b in blocks)
+        pipelines = sum(b["pipelines"] for b in blocks)
+        if pipelines:
+            bounds[pipe] = issues * config[pipe]["initiation_interval"] / pipelines
+    steps = sum(u["steps"] for u in m["units"].values())
+    bounds["scheduler"] = steps * t["issue_cycles"] / t["units"]
+    if "dram" in m:
+        d, dc = m["dram"], config["dram"]
+        bounds["dram"] = (d["read_bytes"] + d["write_bytes"]) / (
+            dc["channels"] * dc["bytes_per_cycle"]
+        )
+        l2 = m["l2"]
+        bounds["l2_banks"] = (
+            (l2["reads"] + l2["writes"]) * config["l2"]["bank_cycles"] / config["l2"]["banks"]
+        )
+    return bounds
+
+
+@pytest.mark.parametrize("config", list(ANALYTIC_CONFIGS))
+def test_analytic_never_faster_than_its_roofline(
+    hairball: Path,
+    sim: Sim,
+    tmp_path: Path,
+    config: str,
+) -> None:
+    result = sim(hairball, tmp_path / "run", "fidelity=analytic", *ANALYTIC_CONFIGS[config])
+    assert result.returncode == 0, result.stderr
+    stats = stats_of(tmp_path / "run")
+    resolved = json.loads((tmp_path / "run" / "config.resolved.json").read_text())
+    cycles = stats["summary"]["cycles"]
+    analytic = stats["model"]["analytic"]
+    assert cycles == analytic["cycles"] > 0
+    # Every bound the model reports, and the same bounds recomputed from its counters.
+    for name, bound in analytic["bounds"].items():
+        assert cycles >= bound - 1e-6, f"{name}: {cycles} < {bound}"
+    recomputed = roofline(stats, resolved)
+    for name, bound in recomputed.items():
+        assert analytic["bounds"][name] == pytest.approx(bound, rel=1e-9), name
+        assert cycles >= bound - 1e-6, f"{name}: {cycles} < {bound}"
+    assert analytic["binding"] in analytic["bounds"]
+    assert cycles >= analytic["roofline_cycles"] - 1e-6
+    assert cycles >= analytic["queueing_cycles"] - 1e-6
+    # The configured limit shows up where it should.
+    expected = {"narrow_dram": "dram", "slow_l2_banks": "l2_banks", "slow_scheduler": "scheduler"}
+    if config in expected:
+        assert analytic["binding"] == expected[config]
+
+
+def test_detailed_reports_row_buffer_outcomes(hairball: Path, sim: Sim, tmp_path: Path) -> None:
+    runs = {}
+    for policy in ("open", "close"):
+        out = tmp_path / policy
+        result = sim(hairball, out, "fidelity=detailed", f"dram.page_policy={policy}")
+        assert result.returncode == 0, result.stderr
+        runs[policy] = stats_of(out)
+    for policy, stats in runs.items():
+        d = stats["model"]["dram"]
+        outcomes = d["row_hits"] + d["row_misses"] + d["row_conflicts"]
+        assert outcomes == d["reads"] + d["writes"] > 0
+        assert sum(b["accesses"] for b in d["by_bank"]) == outcomes
+        assert d["page_policy"] == policy
+        assert stats["model"]["l2"]["config"]["mshrs"] == 32  # modelled at detailed
+    # Close page never finds a row open.
+    assert runs["close"]["model"]["dram"]["row_hits"] == 0
+    assert runs["close"]["model"]["dram"]["row_conflicts"] == 0
+    assert runs["open"]["model"]["dram"]["row_hits"] > 0
+
+
+def test_every_level_writes_the_same_summary_keys(hairball: Path, sim: Sim, tmp_path: Path) -> None:
+    keys = {}
+    for level in LEVELS:
+        result = sim(hairball, tmp_path / level, f"fidelity={level}")
+        assert result.returncode == 0, result.stderr
+        stats = stats_of(tmp_path / level)
+        assert stats["fidelity"] == stats["summary"]["fidelity"] == level
+        keys[level] = set(stats["summary"])
+        if level == "functional":
+            assert stats["summary"]["cycles"] is None
+            assert stats["summary"]["dram_bytes"] is None
+        else:
+            assert stats["summary"]["cycles"] > 0
+            assert stats["summary"]["dram_bytes"] > 0
+    # Same keys everywhere (sampling may add its own to all levels alike).
+    assert all(k == keys["approx"] for k in keys.values()), {
+        k: v ^ keys["approx"] for k, v in keys.items()
+    }
