@@ -130,6 +130,15 @@ class DispatchConfig:
     latency: int = _f(
         2, "cycles", "Cycles to assign a ray to a free context, before its fetch", 0, 1000
     )
+    policy: str = _choice(
+        "interleaved",
+        ("interleaved", "on_demand"),
+        "interleaved: rays dealt to units in turn, blocks of block_rays, idle units steal; "
+        "on_demand: the next ray to whichever unit asks first (depends on quantum_cycles)",
+    )
+    block_rays: int = _f(
+        1, "rays", "Consecutive rays dealt to one unit at a time (interleaved policy)", 1, 1 << 20
+    )
 
 
 @dataclass
@@ -189,7 +198,8 @@ class TreeletConfig:
     threshold: int = _f(
         64,
         "rays",
-        "Rays a queue needs before it is run (smaller queues run only when nothing else can)",
+        "Queues of at least this many rays are preferred (oldest, round_robin); shorter ones run "
+        "only when no queue is that long. No effect with largest",
         1,
         1 << 20,
     )

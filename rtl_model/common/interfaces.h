@@ -48,9 +48,11 @@ struct RayJob {
 };
 
 /// Contract: hands out each ray of the workload exactly once; false when none are left.
+/// `unit` is the traversal unit asking (kAnyUnit: the ray buffer, which serves all units).
 class RaySourceIf : public virtual sc_core::sc_interface {
 public:
-    virtual bool next_ray(RayJob* job) = 0;
+    static constexpr uint32_t kAnyUnit = 0xFFFFFFFFu;
+    virtual bool next_ray(uint32_t unit, RayJob* job) = 0;
     virtual uint64_t total_rays() const = 0;
 };
 

@@ -1,11 +1,19 @@
 #include "rtl_model/dispatch/dispatch.h"
 
+#include <algorithm>
+
 namespace rtsim {
 
-Dispatch::Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, RayStream& stream)
-    : sc_core::sc_module(name), m_config(config), m_stream(stream) {}
+Dispatch::Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream)
+    : sc_core::sc_module(name), m_config(config), m_stream(stream), m_queues(std::max(1u, units)) {}
 
-bool Dispatch::next_ray(RayJob* job) {
+bool Dispatch::next_ray(uint32_t unit, RayJob* job) {
+    bool ok = m_config.policy == "on_demand" ? next_on_demand(job) : next_interleaved(unit, job);
+    m_dispatched += ok;
+    return ok;
+}
+
+bool Dispatch::next_on_demand(RayJob* job) {
     if (m_next == m_buffer.size()) {
         m_buffer.clear();
         m_next = 0;
@@ -13,12 +21,50 @@ bool Dispatch::next_ray(RayJob* job) {
         ++m_chunks;
     }
     *job = m_buffer[m_next++];
-    ++m_dispatched;
+    return true;
+}
+
+bool Dispatch::deal_chunk() {
+    // Deal the next chunk to the units in turn, block_rays at a time.
+    std::vector<RayJob> chunk;
+    if (m_stream_done || m_stream.read_chunk(m_config.chunk_rays, &chunk) == 0) {
+        m_stream_done = true;
+        return false;
+    }
+    ++m_chunks;
+    for (size_t i = 0; i < chunk.size(); i += m_config.block_rays) {
+        size_t end = std::min(chunk.size(), i + m_config.block_rays);
+        m_queues[m_deal_unit].insert(m_queues[m_deal_unit].end(), chunk.begin() + i, chunk.begin() + end);
+        m_deal_unit = (m_deal_unit + 1) % m_queues.size();
+    }
+    return true;
+}
+
+bool Dispatch::next_interleaved(uint32_t unit, RayJob* job) {
+    if (unit == kAnyUnit) unit = m_any_unit++ % m_queues.size();
+    unit %= m_queues.size();
+    if (m_queues[unit].empty()) deal_chunk();
+    if (!m_queues[unit].empty()) {
+        *job = m_queues[unit].front();
+        m_queues[unit].pop_front();
+        return true;
+    }
+    // Nothing left for this unit: steal the last ray of the longest queue.
+    auto longest = std::max_element(m_queues.begin(), m_queues.end(),
+                                    [](const auto& a, const auto& b) { return a.size() < b.size(); });
+    if (longest->empty()) return false;
+    *job = longest->back();
+    longest->pop_back();
+    ++m_steals;
     return true;
 }
 
 nlohmann::json Dispatch::stats_json() const {
-    return {{"rays", m_dispatched}, {"chunks", m_chunks}, {"chunk_rays", m_config.chunk_rays}};
+    return {{"rays", m_dispatched},
+            {"chunks", m_chunks},
+            {"chunk_rays", m_config.chunk_rays},
+            {"policy", m_config.policy},
+            {"steals", m_steals}};
 }
 
 }  // namespace rtsim

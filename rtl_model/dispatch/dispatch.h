@@ -1,7 +1,15 @@
 #pragma once
-// Dispatch: hands rays to free ray contexts in trace order, refilling its buffer one chunk at a
-// time from a RayStream (the harness streams the trace file; memory stays bounded, rule 8).
+// Dispatch: hands rays to the traversal units, refilling its buffer one chunk at a time from a
+// RayStream (the harness streams the trace file; memory stays bounded, rule 8).
+//
+// interleaved (default): each chunk is dealt to per-unit queues in turn, block_rays consecutive
+// rays at a time; a unit whose queue is empty steals from the back of the longest queue. The
+// assignment is the hardware's policy and does not depend on how far units run ahead of each
+// other (quantum_cycles), so the approx and detailed levels give rays to the same units.
+// on_demand: the next ray in trace order goes to whichever unit asks first. With temporal
+// decoupling a unit running ahead then takes runs of neighbouring rays, which flatters its L1.
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -23,19 +31,27 @@ public:
 
 class Dispatch : public sc_core::sc_module, public RaySourceIf {
 public:
-    Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, RayStream& stream);
+    Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream);
 
-    bool next_ray(RayJob* job) override;
+    bool next_ray(uint32_t unit, RayJob* job) override;
     uint64_t total_rays() const override { return m_stream.total_rays(); }
     uint64_t dispatched() const { return m_dispatched; }
     nlohmann::json stats_json() const;
 
 private:
+    bool next_on_demand(RayJob* job);
+    bool next_interleaved(uint32_t unit, RayJob* job);
+    bool deal_chunk();
+
     DispatchConfig m_config;
     RayStream& m_stream;
-    std::vector<RayJob> m_buffer;
+    std::vector<RayJob> m_buffer;  ///< on_demand: the current chunk
     size_t m_next = 0;
-    uint64_t m_dispatched = 0, m_chunks = 0;
+    std::vector<std::deque<RayJob>> m_queues;  ///< interleaved: per-unit queues
+    uint32_t m_deal_unit = 0;                   ///< unit the next block goes to
+    uint32_t m_any_unit = 0;                    ///< rotor for kAnyUnit requests
+    bool m_stream_done = false;
+    uint64_t m_dispatched = 0, m_chunks = 0, m_steals = 0;
 };
 
 }  // namespace rtsim

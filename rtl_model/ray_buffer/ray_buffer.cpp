@@ -55,7 +55,7 @@ void RayBuffer::admit(Cycle time) {
     // By default (no explicit limit) admission also waits for SRAM room, so it never overflows.
     const bool may_overflow = m_config.treelets.max_rays_in_flight != 0;
     while (!m_dispatch_empty && m_in_machine < m_max_in_flight && (may_overflow || m_occupancy < m_capacity)) {
-        if (!rays->next_ray(&job)) {
+        if (!rays->next_ray(RaySourceIf::kAnyUnit, &job)) {
             m_dispatch_empty = true;
             break;
         }
@@ -89,8 +89,9 @@ void RayBuffer::index(uint32_t t) {
 
 int64_t RayBuffer::pick(uint32_t) {
     // The policy's first queue with at least `threshold` rays among the first few candidates; if
-    // none is that long, its first queue anyway (draining: waiting would stall the machine, since
-    // only running rays refill the queues).
+    // none is that long, its first queue anyway (draining). Waiting for a queue to fill instead was
+    // tried and idles the machine: only running rays refill the queues (docs/treelets.md). With
+    // `largest` the threshold therefore changes nothing: the largest queue is the choice either way.
     constexpr int kLook = 64;
     const uint64_t threshold = m_config.treelets.threshold;
     const std::string& policy = m_config.treelets.policy;

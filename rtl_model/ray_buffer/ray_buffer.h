@@ -8,8 +8,8 @@
 //   makes longer queues (more rays share each treelet load) at the price of overflow traffic.
 // - A unit whose treelet queue runs dry asks the scheduler for another: by policy (largest queue,
 //   oldest waiting ray, round robin) among queues of at least `threshold` rays, or — when no
-//   queue is that long and no new ray can be admitted — the best non-empty queue, so the machine
-//   always makes progress.
+//   queue is that long — the policy's best non-empty queue, so the machine always makes progress
+//   (with `largest` the threshold changes nothing: the largest queue wins either way).
 // - A ray that needs a node of another treelet is parked in that treelet's queue. If the SRAM is
 //   full it overflows: its state is written to memory (data kind ray_buffer) and read back when
 //   it is taken; the traffic goes through the L2 and DRAM and is counted.

@@ -29,7 +29,7 @@ private:
 Top::Top(sc_core::sc_module_name name, const SimConfig& config, const MemoryImage& image, RayStream& rays,
          RaySinkIf& sink, const WorkloadFeatures& features)
     : sc_core::sc_module(name), m_config(config) {
-    m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, rays);
+    m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, config.traversal.units, rays);
     build_memory();
     build_pipelines(features);
     build_ray_buffer(image);

@@ -60,7 +60,7 @@ void TraversalUnit::activate(uint32_t c, Cycle t) {
 bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
     if (m_treelet_mode) return take_parked_ray(c, t);
     RayJob job;
-    if (!rays->next_ray(&job)) return false;
+    if (!rays->next_ray(m_index, &job)) return false;
     Context& ctx = m_contexts[c];
     ctx.ray.trav.begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_rejected;

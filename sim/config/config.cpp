@@ -237,6 +237,9 @@ void validate(const SimConfig& config) {
     require(config.fidelity != "detailed" || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
             "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas at fidelity detailed (it is the "
             "latency of an access to a closed bank)");
+    require(!config.treelets.enabled || config.fidelity != "analytic",
+            "config: 'treelets.enabled' is not supported at fidelity 'analytic' (its closed form models plain "
+            "dispatch); use approx or detailed");
     require(config.sampling.fraction == 0 || config.sampling.count == 0,
             "config: set 'sampling.fraction' or 'sampling.count', not both");
     require(!config.sampling.enabled() || config.fidelity == "approx" || config.fidelity == "detailed",

@@ -95,13 +95,17 @@ struct TraversalConfig {
 };
 
 struct DispatchConfig {
-    uint32_t chunk_rays = 16384;  ///< rays read from the trace at a time (host memory bound)
-    uint32_t latency = 2;         ///< cycles to hand a ray to a free context (plus the ray fetch)
+    uint32_t chunk_rays = 16384;          ///< rays read from the trace at a time (host memory bound)
+    uint32_t latency = 2;                 ///< cycles to hand a ray to a free context (plus the ray fetch)
+    std::string policy = "interleaved";   ///< how rays are spread over the units
+    uint32_t block_rays = 1;              ///< consecutive rays dealt to one unit (interleaved)
 
     template <class V>
     void visit(V& v) {
         v.field("chunk_rays", chunk_rays, "rays", "Rays streamed from the trace file per chunk", 64, 1u << 24);
         v.field("latency", latency, "cycles", "Cycles to assign a ray to a free context, before its fetch", 0, 1000);
+        v.choice("policy", policy, {"interleaved", "on_demand"}, "interleaved: rays dealt to units in turn, blocks of block_rays, idle units steal; on_demand: the next ray to whichever unit asks first (depends on quantum_cycles)");
+        v.field("block_rays", block_rays, "rays", "Consecutive rays dealt to one unit at a time (interleaved policy)", 1, 1u << 20);
     }
 };
 
@@ -123,7 +127,7 @@ struct TreeletConfig {
         v.field("treelet_kib", treelet_kib, "KiB", "Byte budget per treelet (nodes and their leaf triangles)", 1, 1u << 20);
         v.field("buffer_kib", buffer_kib, "KiB", "Ray buffer SRAM capacity; rays beyond it overflow to DRAM", 1, 1u << 22);
         v.choice("policy", policy, {"largest", "oldest", "round_robin"}, "Queue a free unit runs next: largest queue, oldest waiting ray, or round robin");
-        v.field("threshold", threshold, "rays", "Rays a queue needs before it is run (smaller queues run only when nothing else can)", 1, 1u << 20);
+        v.field("threshold", threshold, "rays", "Queues of at least this many rays are preferred (oldest, round_robin); shorter ones run only when no queue is that long. No effect with largest", 1, 1u << 20);
         v.field("latency", latency, "cycles", "Ray buffer SRAM access latency", 1, 1000);
         v.field("bytes_per_cycle", bytes_per_cycle, "B/cycle", "Ray buffer SRAM bandwidth", 1, 4096);
         v.field("idle_poll_cycles", idle_poll_cycles, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000);

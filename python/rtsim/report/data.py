@@ -21,10 +21,16 @@ SHORT_KEYS: dict[str, tuple[str, str]] = {
     "dram.bytes_per_cycle": ("DRAM", " B/cyc"),
     "dram.channels": ("ch", ""),
     "clock_ghz": ("clk", " GHz"),
+    "treelets.buffer_kib": ("RB", " KiB"),
+    "treelets.treelet_kib": ("treelet", " KiB"),
 }
+# On/off keys: a word when on, nothing when off.
+FLAG_KEYS: dict[str, str] = {"treelets.enabled": "treelets", "ideal_memory": "ideal mem"}
 
 
 def short_label(key: str, value: Any) -> str:
+    if key in FLAG_KEYS:
+        return FLAG_KEYS[key] if value else f"no {FLAG_KEYS[key]}"
     if key in SHORT_KEYS:
         name, unit = SHORT_KEYS[key]
         return f"{name} {value}{unit}"

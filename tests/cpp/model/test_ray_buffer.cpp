@@ -16,7 +16,7 @@ namespace {
 class FakeDispatch : public sc_core::sc_module, public RaySourceIf {
 public:
     FakeDispatch(sc_core::sc_module_name name, uint64_t n) : sc_core::sc_module(name), m_n(n) {}
-    bool next_ray(RayJob* job) override {
+    bool next_ray(uint32_t, RayJob* job) override {
         if (m_next == m_n) return false;
         job->id = m_next++;
         job->ray = Ray{Vec3(0.0f), 0.0f, Vec3(0.0f, 0.0f, 1.0f), 10.0f};
