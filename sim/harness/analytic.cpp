@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rtl_model/dispatch/dispatch.h"
 #include "rtl_model/mem/functional_cache.h"
 #include "traces/isect/traversal.h"
 
@@ -66,16 +67,15 @@ private:
     std::unique_ptr<FunctionalCache> m_l2;
     MemStats m_dram, m_ideal;
     uint32_t m_line_bytes = 64;
-    std::deque<RayJob> m_pending;
-    RayStream* m_rays = nullptr;
-    uint64_t m_chunks = 0, m_dispatched = 0;
+    std::unique_ptr<Dispatch> m_dispatch;  ///< the model's dispatch block: same ray-to-unit policy
+    uint64_t m_dispatched = 0;
     double m_latency_sum = 0;
     Cycle m_latency_max = 0;
     double m_l1_hold = 0, m_l2_hold = 0;  ///< cycles L1 / L2 misses hold an MSHR, summed
 };
 
 void AnalyticModel::run(RayStream& rays) {
-    m_rays = &rays;
+    m_dispatch = std::make_unique<Dispatch>("analytic_dispatch", m_c.dispatch, m_c.traversal.units, rays);
     const uint32_t units = m_c.traversal.units, contexts = m_c.traversal.ray_contexts;
     // The context whose unloaded clock is earliest takes the next step (ties: context-major,
     // then unit, so the first rays spread over the units); a context that finishes a ray takes
@@ -96,14 +96,8 @@ void AnalyticModel::run(RayStream& rays) {
 }
 
 bool AnalyticModel::start_ray(uint32_t unit, uint32_t slot) {
-    if (m_pending.empty()) {
-        std::vector<RayJob> jobs;
-        if (!m_rays->read_chunk(m_c.dispatch.chunk_rays, &jobs)) return false;
-        ++m_chunks;
-        m_pending.assign(jobs.begin(), jobs.end());
-    }
-    const RayJob job = m_pending.front();
-    m_pending.pop_front();
+    RayJob job;
+    if (!m_dispatch->next_ray(unit, &job)) return false;
     ++m_dispatched;
     Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
     ctx.trav.begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
@@ -349,7 +343,7 @@ AnalyticOutcome AnalyticModel::outcome(bool anyhit_triangles) const {
     out.cycles = Cycle(std::ceil(std::max(bound, queueing)));
     const double total = double(out.cycles);
     json& m = out.model;
-    m["dispatch"] = {{"rays", m_dispatched}, {"chunks", m_chunks}, {"chunk_rays", m_c.dispatch.chunk_rays}};
+    m["dispatch"] = m_dispatch->stats_json();
     for (size_t u = 0; u < m_units.size(); ++u) {
         const UnitCounts& uc = m_units[u];
         // Time-dependent counters do not exist at this level: null.

@@ -101,15 +101,7 @@ size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
     while (produced < max && m_cluster < m_plan.clusters.size()) {
         const SamplePlan::Cluster& c = m_plan.clusters[m_cluster];
         const size_t n = size_t(std::min<uint64_t>(max - produced, c.end() - m_next));
-        m_buffer.resize(n);
-        m_reader.read(SectionKind::rays, m_next, n, m_buffer.data());
-        for (size_t i = 0; i < n; ++i) {
-            RayJob job;
-            job.id = m_next + i;
-            job.ray = ray_from_record(m_buffer[i]);
-            job.any_hit = m_buffer[i].flags & kRayFlagAnyHit;
-            out->push_back(job);
-        }
+        read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
         produced += n;
         m_next += n;
         if (m_next == c.end() && ++m_cluster < m_plan.clusters.size()) m_next = m_plan.clusters[m_cluster].first;

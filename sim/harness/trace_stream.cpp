@@ -9,18 +9,23 @@ namespace rtsim {
 TraceRayStream::TraceRayStream(TraceReader& reader)
     : m_reader(reader), m_total(reader.section(SectionKind::rays).record_count) {}
 
+void read_ray_jobs(TraceReader& reader, uint64_t first, size_t n, std::vector<RayRecord>* buffer,
+                   std::vector<RayJob>* out) {
+    buffer->resize(n);
+    reader.read(SectionKind::rays, first, n, buffer->data());
+    for (size_t i = 0; i < n; ++i) {
+        RayJob job;
+        job.id = first + i;
+        job.ray = ray_from_record((*buffer)[i]);
+        job.any_hit = (*buffer)[i].flags & kRayFlagAnyHit;
+        out->push_back(job);
+    }
+}
+
 size_t TraceRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
     size_t n = size_t(std::min<uint64_t>(max, m_total - m_next));
     if (n == 0) return 0;
-    m_buffer.resize(n);
-    m_reader.read(SectionKind::rays, m_next, n, m_buffer.data());
-    for (size_t i = 0; i < n; ++i) {
-        RayJob job;
-        job.id = m_next + i;
-        job.ray = ray_from_record(m_buffer[i]);
-        job.any_hit = m_buffer[i].flags & kRayFlagAnyHit;
-        out->push_back(job);
-    }
+    read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
     m_next += n;
     return n;
 }

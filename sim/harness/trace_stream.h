@@ -11,6 +11,11 @@
 
 namespace rtsim {
 
+/// Reads rays [first, first + n) of the trace and appends them to `out` as RayJobs (ids are
+/// their trace indices); `buffer` is scratch space reused between calls.
+void read_ray_jobs(TraceReader& reader, uint64_t first, size_t n, std::vector<RayRecord>* buffer,
+                   std::vector<RayJob>* out);
+
 /// Rays of the trace, in order, as RayJobs.
 class TraceRayStream : public RayStream {
 public:

@@ -10,11 +10,8 @@
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
-import sys
-import sysconfig
 import zlib
 from collections.abc import Callable
 from pathlib import Path
@@ -24,7 +21,9 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import REPO, run_rtsim
+from conftest import run_rtsim
+from rtsim.simulate import SimNotFoundError
+from rtsim.simulate import find_sim as sim_executable
 
 SIM_EXE = "rtsim-sim"
 RESOLUTION = "48x32"
@@ -67,19 +66,11 @@ NOISE = 1.02  # timing comparisons allow 2% (rays interleave differently when ti
 
 
 def find_sim() -> Path:
-    """$RTSIM_SIM, else on PATH, else next to this Python's scripts, else the build tree."""
-    env = os.environ.get("RTSIM_SIM")
-    candidates = [Path(env)] if env else []
-    found = shutil.which(SIM_EXE)
-    if found:
-        candidates.append(Path(found))
-    for scripts in (sysconfig.get_path("scripts"), str(Path(sys.executable).parent)):
-        candidates.append(Path(scripts) / SIM_EXE)
-    candidates.append(REPO / "build" / "py" / "sim" / SIM_EXE)
-    for path in candidates:
-        if path.is_file() and os.access(path, os.X_OK):
-            return path
-    pytest.fail(f"{SIM_EXE} not found (set RTSIM_SIM or run `bash scripts/setup.sh`)")
+    """The rtsim-sim the package would run (rtsim.simulate.find_sim), or fail the test."""
+    try:
+        return sim_executable()
+    except SimNotFoundError as error:
+        pytest.fail(str(error))
 
 
 @pytest.fixture(scope="session")
