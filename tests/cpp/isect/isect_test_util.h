@@ -123,4 +123,33 @@ inline uint32_t float_bits(float f) {
     return u;
 }
 
+/// Random soup: triangles of mixed sizes, some axis-aligned, some duplicated (ties), half of
+/// them on an alpha-MASK material with coverage 0.5.
+inline Scene random_soup(uint64_t seed, int count) {
+    Rng rng(seed);
+    std::vector<Vec3> soup;
+    std::vector<uint32_t> material_of;
+    for (int i = 0; i < count; ++i) {
+        const float size = std::ldexp(1.0f, -int(rng.next() * 6.0f));
+        const Vec3 c = random_point(rng, Vec3(-4), Vec3(4));
+        Vec3 p[3];
+        for (Vec3& q : p) q = c + size * random_point(rng, Vec3(-1), Vec3(1));
+        const float kind = rng.next();
+        if (kind < 0.15f) {
+            const int axis = int(rng.next() * 3.0f) % 3;  // axis-aligned: a flat leaf box
+            for (Vec3& q : p) q[axis] = c[axis];
+        }
+        soup.insert(soup.end(), {p[0], p[1], p[2]});
+        material_of.push_back(rng.next() < 0.5f ? 1u : 0u);
+        if (kind > 0.9f) {  // a coincident copy: same vertices, another prim id
+            soup.insert(soup.end(), {p[0], p[1], p[2]});
+            material_of.push_back(0u);
+        }
+    }
+    Material masked;
+    masked.alpha_mode = AlphaMode::mask;
+    masked.alpha_coverage = 0.5f;
+    return make_scene(soup, {Material{}, masked}, material_of);
+}
+
 }  // namespace rtsim::test

@@ -15,32 +15,6 @@
 namespace rtsim {
 namespace {
 
-/// Random soup: mixed sizes, axis-aligned (flat boxes), coincident copies, half alpha-MASK.
-Scene random_soup(uint64_t seed, int count) {
-    Rng rng(seed);
-    std::vector<Vec3> soup;
-    std::vector<uint32_t> material_of;
-    for (int i = 0; i < count; ++i) {
-        const float size = std::ldexp(1.0f, -int(rng.next() * 6.0f));
-        const Vec3 c = test::random_point(rng, Vec3(-4), Vec3(4));
-        Vec3 p[3];
-        for (Vec3& q : p) q = c + size * test::random_point(rng, Vec3(-1), Vec3(1));
-        const float kind = rng.next();
-        if (kind < 0.15f) {  // axis-aligned: a flat leaf box
-            const int axis = int(rng.next() * 3.0f) % 3;
-            for (Vec3& q : p) q[axis] = c[axis];
-        }
-        const int copies = kind > 0.9f ? 2 : 1;
-        for (int k = 0; k < copies; ++k) {
-            soup.insert(soup.end(), {p[0], p[1], p[2]});
-            material_of.push_back(rng.next() < 0.5f ? 1u : 0u);
-        }
-    }
-    Material masked;
-    masked.alpha_mode = AlphaMode::mask;
-    masked.alpha_coverage = 0.5f;
-    return test::make_scene(soup, {Material{}, masked}, material_of);
-}
 
 /// Random rays around `bounds`: random and ±0 directions, clipped intervals, some aimed at a
 /// triangle's vertex or interior, a few invalid.
@@ -108,7 +82,7 @@ int compare_all(const HwBvh& bvh, const Aabb& bounds, uint64_t seed, int rays) {
 TEST(TraceRayEquivalence, RandomSoups) {
     const uint32_t leaf_sizes[] = {1, 2, 4, 8};
     for (uint64_t seed = 1; seed <= 8; ++seed) {
-        const Scene scene = random_soup(seed, 50 + int(seed) * 300);
+        const Scene scene = test::random_soup(seed, 50 + int(seed) * 300);
         const HwBvh bvh = test::build(scene, leaf_sizes[seed % 4]);
         const int hits = compare_all(bvh, scene.bounds, seed * 977, 20000);
         EXPECT_GT(hits, 1000) << "seed " << seed;  // the rays must exercise hits, not only misses

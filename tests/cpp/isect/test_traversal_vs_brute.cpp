@@ -12,34 +12,6 @@
 namespace rtsim {
 namespace {
 
-/// Random soup: triangles of mixed sizes, some axis-aligned, some duplicated (ties), half of
-/// them on an alpha-MASK material with coverage 0.5.
-Scene random_scene(uint64_t seed, int count) {
-    Rng rng(seed);
-    std::vector<Vec3> soup;
-    std::vector<uint32_t> material_of;
-    for (int i = 0; i < count; ++i) {
-        const float size = std::ldexp(1.0f, -int(rng.next() * 6.0f));
-        const Vec3 c = test::random_point(rng, Vec3(-4), Vec3(4));
-        Vec3 p[3];
-        for (Vec3& q : p) q = c + size * test::random_point(rng, Vec3(-1), Vec3(1));
-        const float kind = rng.next();
-        if (kind < 0.15f) {
-            const int axis = int(rng.next() * 3.0f) % 3;  // axis-aligned: a flat leaf box
-            for (Vec3& q : p) q[axis] = c[axis];
-        }
-        soup.insert(soup.end(), {p[0], p[1], p[2]});
-        material_of.push_back(rng.next() < 0.5f ? 1u : 0u);
-        if (kind > 0.9f) {  // a coincident copy: same vertices, another prim id
-            soup.insert(soup.end(), {p[0], p[1], p[2]});
-            material_of.push_back(0u);
-        }
-    }
-    Material masked;
-    masked.alpha_mode = AlphaMode::mask;
-    masked.alpha_coverage = 0.5f;
-    return test::make_scene(soup, {Material{}, masked}, material_of);
-}
 
 Ray random_ray(Rng& rng) {
     Vec3 d = test::random_direction(rng);
@@ -57,7 +29,7 @@ Ray random_ray(Rng& rng) {
 }
 
 void compare(uint64_t seed, int triangles, uint32_t leaf_size, int rays) {
-    const Scene scene = random_scene(seed, triangles);
+    const Scene scene = test::random_soup(seed, triangles);
     const HwBvh bvh = test::build(scene, leaf_size);
     Rng rng(seed * 31 + 1);
     int closest_diffs = 0, any_diffs = 0, hits = 0;
@@ -131,7 +103,7 @@ TEST(TraversalVsBruteForce, CubeGridVerticesFromManyOrigins) {
 
 TEST(TraversalVsBruteForce, SteppingByHandEqualsTraceRay) {
     // trace_ray is the stepper in a loop: the same hit bits and the same work, ray by ray.
-    const Scene scene = random_scene(5, 2000);
+    const Scene scene = test::random_soup(5, 2000);
     const HwBvh bvh = test::build(scene);
     Rng rng(6);
     for (int i = 0; i < 5000; ++i) {
