@@ -90,9 +90,19 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done) {
             issue = m_mshr_free[mshr];
         }
     }
+    if (m_mshr_occupancy) {
+        // Out-of-order requests: wait until the MSHRs have room for a miss of the usual length.
+        Cycle start = m_mshr_occupancy->earliest(issue, Cycle(m_expected_miss));
+        m_mshr_stall_cycles += start - issue;
+        issue = start;
+    }
     MemRequest down{line << m_line_shift, m_config.line_bytes, false, req.kind, issue + m_next_latency};
     Cycle fill = next->access(down) + m_next_latency;
     if (m_mshrs_enabled) m_mshr_free[mshr] = fill;
+    if (m_mshr_occupancy) {
+        m_mshr_occupancy->occupy(issue, fill);
+        m_expected_miss += (double(fill - issue) - m_expected_miss) / 64.0;  // running mean
+    }
 
     // LRU victim (invalid lines have last_use 0 and go first).
     Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
@@ -106,12 +116,17 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done) {
     return fill;
 }
 
+void Cache::limit_out_of_order_misses() {
+    m_mshr_occupancy = std::make_unique<OccupancyCalendar>(m_config.mshrs);
+    m_expected_miss = double(2 * m_next_latency + m_config.latency + 100);  // first guess, then learnt
+}
+
 nlohmann::json Cache::stats_json() const {
     nlohmann::json j = m_stats.to_json();
     j["evictions"] = m_evictions;
     j["mshr_stall_cycles"] = m_mshr_stall_cycles;
     j["config"] = {{"size_kib", m_config.size_kib}, {"ways", m_config.ways}, {"line_bytes", m_config.line_bytes},
-                   {"latency", m_config.latency},   {"mshrs", m_mshrs_enabled ? m_config.mshrs : 0},
+                   {"latency", m_config.latency},   {"mshrs", (m_mshrs_enabled || m_mshr_occupancy) ? m_config.mshrs : 0},
                    {"banks", m_config.banks}};
     return j;
 }

@@ -13,6 +13,7 @@
 // requests in time order and models its MSHRs too; banks are then per-cycle slot calendars
 // (one access per bank_cycles, arrival order at equal cycles) instead of 16-access windows.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,9 @@ public:
           bool exact = false);
 
     Cycle access(const MemRequest& req) override;
+    /// For a shared cache reached out of time order (the approx L2): bound outstanding misses by
+    /// `mshrs` with an occupancy calendar instead of leaving them unlimited.
+    void limit_out_of_order_misses();
 
     const MemStats& stats() const { return m_stats; }
     nlohmann::json stats_json() const;
@@ -54,6 +58,8 @@ private:
     uint64_t m_set_mask;
     std::vector<Line> m_lines;  ///< sets x ways
     std::vector<Cycle> m_mshr_free;
+    std::unique_ptr<OccupancyCalendar> m_mshr_occupancy;  ///< out-of-order MSHR bound (approx L2)
+    double m_expected_miss = 0;                           ///< running mean of miss durations
     std::vector<BandwidthCalendar> m_banks;
     std::vector<SlotCalendar> m_exact_banks;  ///< detailed level only
     uint64_t m_use_clock = 0;

@@ -72,9 +72,10 @@ void Top::build_memory() {
     // L2's MSHRs (its units synchronise every cycle, so the shared L2 sees requests in time order).
     const bool detailed = c.fidelity == "detailed";
     m_dram = std::make_unique<Dram>("dram", c.dram, detailed);
-    // At approx the L2 is reached out of time order within a quantum, so its MSHRs are not
-    // modelled (docs/model.md); the private L1s model theirs exactly.
+    // At approx the L2 is reached out of time order within a quantum: its MSHRs bound outstanding
+    // misses through an occupancy calendar (docs/model.md); the private L1s model theirs exactly.
     m_l2 = std::make_unique<Cache>("l2", c.l2, detailed, 0, detailed);
+    if (!detailed) m_l2->limit_out_of_order_misses();
     m_l2->next(*m_dram);
     for (uint32_t u = 0; u < c.traversal.units; ++u) {
         m_l1.push_back(std::make_unique<Cache>(("l1_" + std::to_string(u)).c_str(), c.l1, true, c.interconnect_latency,

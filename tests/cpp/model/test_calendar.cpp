@@ -77,5 +77,32 @@ TEST(BandwidthCalendar, RejectsZeroCapacityOrWindow) {
     EXPECT_THROW(BandwidthCalendar(4, 0), Error);
 }
 
+TEST(OccupancyCalendar, CapsOutstandingRequestsAtItsSlots) {
+    // 4 slots, 16-cycle windows: 4 requests of 100 cycles fit at cycle 0; a fifth waits until
+    // the first windows free up (after the others end), whatever order they are asked in.
+    OccupancyCalendar mshrs(4, 16);
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_EQ(mshrs.earliest(0, 100), 0u) << i;
+        mshrs.occupy(0, 100);
+    }
+    Cycle fifth = mshrs.earliest(0, 100);
+    EXPECT_GE(fifth, 96u);  // the window holding cycle 96..111 is the first with room
+    EXPECT_LE(fifth, 112u);
+    // An earlier-stamped request arriving later is not blocked by requests in its future.
+    OccupancyCalendar late(1, 16);
+    late.occupy(1000, 1100);
+    EXPECT_EQ(late.earliest(0, 100), 0u);
+    // Average concurrency: 1,000 back-to-back requests of 64 cycles on 8 slots take about
+    // 1000 * 64 / 8 cycles.
+    OccupancyCalendar pool(8, 16);
+    Cycle last = 0;
+    for (int i = 0; i < 1000; ++i) {
+        Cycle s = pool.earliest(0, 64);
+        pool.occupy(s, s + 64);
+        last = std::max(last, s + 64);
+    }
+    EXPECT_NEAR(double(last), 1000.0 * 64 / 8, 1000.0 * 64 / 8 * 0.05);
+}
+
 }  // namespace
 }  // namespace rtsim
