@@ -30,6 +30,24 @@ private:
     Cycle m_busy = 0;
 };
 
+/// Usage per window of cycles over a sliding horizon: a ring indexed by window number, shared by
+/// the calendars below. An entry still holding an older window is reused (reset to zero).
+class WindowRing {
+public:
+    explicit WindowRing(uint32_t horizon_windows);
+    /// Usage counter of window w, or nullptr when its entry holds a later window (w lies more
+    /// than a horizon behind the newest request; each calendar decides what that means).
+    uint64_t* used(uint64_t w);
+
+private:
+    struct Entry {
+        uint64_t window = ~0ull;
+        uint64_t used = 0;
+    };
+    uint64_t m_mask;
+    std::vector<Entry> m_entries;
+};
+
 /// Bounded concurrency (MSHRs) for requests in any time order: each window of cycles can hold
 /// `slots` x window occupancy-cycles. A request asks for the earliest start at or after its time
 /// where adding [start, start + expected) keeps every window within that budget, then records
@@ -43,15 +61,9 @@ public:
     void occupy(Cycle start, Cycle end);
 
 private:
-    struct Slot {
-        uint64_t window = ~0ull;
-        uint64_t used = 0;  ///< occupancy-cycles in this window
-    };
-    Slot& slot(uint64_t window);
-    uint64_t m_capacity;
+    uint64_t m_capacity;  ///< occupancy-cycles per window
     uint32_t m_window;
-    uint64_t m_mask;
-    std::vector<Slot> m_slots;
+    WindowRing m_ring;
 };
 
 class BandwidthCalendar {
@@ -69,14 +81,9 @@ public:
     uint64_t total_reserved() const { return m_total; }
 
 private:
-    struct Slot {
-        uint64_t window = ~0ull;
-        uint64_t used = 0;
-    };
     uint64_t m_capacity;
     uint32_t m_window;
-    uint64_t m_mask;
-    std::vector<Slot> m_slots;
+    WindowRing m_ring;
     uint64_t m_total = 0;
 };
 
@@ -95,14 +102,9 @@ public:
     uint32_t slot_cycles() const { return m_slot; }
 
 private:
-    struct Slot {
-        uint64_t slot = ~0ull;
-        uint64_t used = 0;
-    };
     uint64_t m_capacity;
     uint32_t m_slot;
-    uint64_t m_mask;
-    std::vector<Slot> m_slots;
+    WindowRing m_ring;
 };
 
 }  // namespace rtsim
