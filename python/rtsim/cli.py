@@ -54,6 +54,8 @@ class TraceJob:
     camera: tuple[tuple[float, float, float], tuple[float, float, float], float] | None = None
     threads: int = 0
     hairball_triangles: int = 200_000
+    accel: str = "bvh2"
+    builder: str = "binned"
 
 
 def parse_workload(text: str) -> list[str]:
@@ -111,6 +113,8 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             threads=job.threads,
             hairball_triangles=job.hairball_triangles,
             progress=progress,
+            accel=job.accel,
+            builder=job.builder,
         )
     trace = open_trace(job.out_dir)
     heatmaps = write_heatmaps(trace, size=(job.width, job.height))
@@ -137,6 +141,8 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         camera=args.camera,
         threads=args.threads,
         hairball_triangles=args.hairball_triangles,
+        accel=args.accel,
+        builder=args.builder,
     )
     run_trace(job, console)
     return 0
@@ -226,6 +232,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--threads", type=positive_int, default=0, metavar="N", help="0: all cores")
     p.add_argument("--hairball-triangles", type=positive_int, default=200_000, metavar="N")
+    kinds = _core.accel_kinds()
+    p.add_argument(
+        "--accel",
+        default="bvh2",
+        choices=[k["name"] for k in kinds],
+        help="acceleration structure (default: bvh2): "
+        + "; ".join(f"{k['name']}: {k['description']}" for k in kinds),
+    )
+    p.add_argument(
+        "--builder",
+        default="binned",
+        metavar="NAME",
+        help="tree builder (default: binned, binned SAH); the structures take: "
+        + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in kinds),
+    )
     p.set_defaults(func=cmd_trace)
 
     p = sub.add_parser("scene", help="write a built-in scene as glTF")

@@ -48,7 +48,8 @@ class PipelineConfig:
     width: int = _f(
         1,
         "tests",
-        "Tests per issue (a node has 2 child boxes: width 2 tests a node in one issue)",
+        "Tests per issue (a node's child boxes take ceil(children / width) issues; "
+        "width 2 tests a binary node in one issue)",
         1,
         64,
     )

@@ -15,7 +15,7 @@
 #include "python/src/bindings.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_reader.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/tracer/tracer.h"
 
 namespace py = pybind11;
@@ -158,8 +158,10 @@ py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
                           const std::vector<std::string>& workload, uint32_t width,
                           uint32_t height, uint32_t bounces, uint64_t seed,
                           const py::object& camera, unsigned threads, uint32_t hairball_triangles,
-                          const py::object& progress) {
+                          const py::object& progress, const std::string& accel, const std::string& builder) {
     TraceOptions opt;
+    opt.accel.kind = accel;
+    opt.accel.builder = builder;
     opt.scene = scene_name(scene);
     opt.out_dir = out_dir.string();
     opt.workload.clear();
@@ -222,8 +224,24 @@ void bind_trace(py::module_& m) {
           py::arg("height") = 240u, py::arg("bounces") = 1u, py::arg("seed") = 1u,
           py::arg("camera") = py::none(), py::arg("threads") = 0u,
           py::arg("hairball_triangles") = 200000u, py::arg("progress") = py::none(),
+          py::arg("accel") = "bvh2", py::arg("builder") = "binned",
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
-          "returns the manifest. progress(done, total, stage) is called now and then.");
+          "returns the manifest. progress(done, total, stage) is called now and then.\n"
+          "accel and builder choose the acceleration structure (accel_kinds()).");
+    m.def(
+        "accel_kinds",
+        [] {
+            py::list out;
+            for (const AccelKindInfo& k : accel_kinds()) {
+                py::dict d;
+                d["name"] = k.name;
+                d["description"] = k.description;
+                d["builders"] = k.builders;
+                out.append(d);
+            }
+            return out;
+        },
+        "The acceleration structures this build knows: name, description, builders.");
     m.def("trace_sections", &trace_sections, py::arg("path"),
           "Validates a trace file's header and section table; returns its sections.");
     m.def(

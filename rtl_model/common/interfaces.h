@@ -7,16 +7,12 @@
 
 #include <systemc>
 
+#include "traces/common/data_kind.h"
 #include "traces/common/ray.h"
 
 namespace rtsim {
 
 using Cycle = uint64_t;
-
-/// What a memory access carries, for per-kind byte and hit-rate accounting.
-enum class DataKind : uint8_t { node = 0, triangle = 1, ray = 2, hit = 3, stack = 4, ray_buffer = 5 };
-constexpr int kDataKindCount = 6;
-const char* data_kind_name(DataKind kind);
 
 struct MemRequest {
     uint64_t addr = 0;

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "traces/bvh/builder.h"
+#include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_writer.h"
 #include "traces/raygen/auto_framing.h"
@@ -27,7 +27,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 /// The camera the user gave, else the scene's first camera, else automatic framing.
-Camera choose_camera(const TraceOptions& o, const Scene& scene, const HwBvh& bvh, std::string* source) {
+Camera choose_camera(const TraceOptions& o, const Scene& scene, const Accel& accel, std::string* source) {
     if (o.camera) {
         *source = "command line";
         return look_at(o.camera->eye, o.camera->target, o.camera->yfov_degrees);
@@ -36,7 +36,7 @@ Camera choose_camera(const TraceOptions& o, const Scene& scene, const HwBvh& bvh
         *source = "glTF camera '" + scene.cameras[0].name + "'";
         return scene.cameras[0];
     }
-    return auto_frame(scene, bvh, float(o.width) / float(o.height), source);
+    return auto_frame(scene, accel, float(o.width) / float(o.height), source);
 }
 
 std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint32_t h) {
@@ -98,6 +98,7 @@ void validate(const TraceOptions& o) {
     if (o.camera)
         require(o.camera->yfov_degrees > 0.0f && o.camera->yfov_degrees < 180.0f,
                 "camera field of view must be in (0, 180) degrees");
+    validate_accel_options(o.accel);
 }
 
 }  // namespace
@@ -117,17 +118,16 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     double load_ms = ms_since(t_start);
     require(scene.triangle_count() > 0, path + ": the scene has no triangles");
 
-    report(0, 1, "bvh");
-    HwBvh bvh = build_bvh(scene, o.bvh);
+    report(0, 1, "accel");
+    const std::unique_ptr<Accel> accel = load_accel(build_accel(scene, o.accel), path + ": built " + o.accel.kind);
     WorkloadPlan plan = plan_workload(scene, o.workload);
     std::string camera_source;
-    Camera camera = choose_camera(o, scene, bvh, &camera_source);
+    Camera camera = choose_camera(o, scene, *accel, &camera_source);
     PinholeCamera pinhole = make_camera(camera, o.width, o.height);
 
     auto t_trace = std::chrono::steady_clock::now();
     TraceWriter writer((fs::path(o.out_dir) / "trace.rtt").string());
-    writer.append(SectionKind::bvh_nodes, bvh.nodes);
-    writer.append(SectionKind::triangles, bvh.triangles);
+    write_accel_image(writer, accel->image());
     uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
     PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
     SpawnContext ctx{&scene, &plan, o.bounces, o.seed};
@@ -136,7 +136,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height);
     for (uint32_t depth = 0; !wave.empty(); ++depth) {
         std::string stage = depth == 0 ? "primary" : "depth " + std::to_string(depth);
-        WavefrontResult res = trace_wavefront(bvh, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
+        WavefrontResult res = trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
         counts.add_rejected(res.rejected);
         write_wavefront(writer, plan, wave, res, &counts);
         render.add(scene, wave, res.hits);
@@ -155,7 +155,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
         {"rtsim_version", RTSIM_VERSION},
         {"git", RTSIM_GIT_HASH},
         {"scene", scene_json(scene, name, procedural)},
-        {"bvh", bvh_json(bvh, o.bvh)},
+        {"accel", accel_json(accel->image())},
         {"camera", camera_json(camera, camera_source)},
         {"workload",
          {{"requested", requested},
@@ -165,7 +165,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
           {"effects", effects_json(plan)}}},
         {"counts", counts.to_json()},
         {"files", {{"trace", "trace.rtt"}, {"render", "render.png"}}},
-        {"timing_ms", {{"load", load_ms}, {"bvh", bvh.stats.build_ms}, {"trace", trace_ms}, {"total", ms_since(t_start)}}},
+        {"timing_ms", {{"load", load_ms}, {"accel", accel->image().build_ms}, {"trace", trace_ms}, {"total", ms_since(t_start)}}},
     };
     std::ofstream((fs::path(o.out_dir) / "manifest.json").string()) << manifest.dump(2) << "\n";
     return manifest;
