@@ -1,4 +1,4 @@
-"""The simulator's config tree as typed dataclasses (DESIGN rule 5).
+"""The simulator's config tree as typed dataclasses (docs/architecture.md, rule 5).
 
 Mirrors ``sim/config/config.h`` exactly: the same sections, field names and defaults, with the
 unit, range and doc of each field in its metadata. ``tests/python/test_config_py.py`` compares

@@ -2,7 +2,7 @@
 // The interfaces the model's blocks talk through (SystemC interface method calls, bound with
 // sc_port). Time is carried as cycle counts in the requests: a traversal unit runs ahead of
 // SystemC time by at most a quantum (TLM-2.0 style temporal decoupling) and every block returns
-// when its answer is ready, so no block needs a clock process (DESIGN rule 7).
+// when its answer is ready, so no block needs a clock process (docs/architecture.md, rule 7).
 #include <cstdint>
 
 #include <systemc>

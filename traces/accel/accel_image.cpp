@@ -80,6 +80,12 @@ AccelImage AccelImage::from_descriptor(const json& d, const std::string& source)
                 where + ": '" + key + "' is missing or not " + what);
         return obj.at(key);
     };
+    auto count_of = [&](const json& obj, const char* key, const std::string& at) -> uint64_t {
+        require(obj.contains(key) && obj.at(key).is_number_integer() &&
+                    (obj.at(key).is_number_unsigned() || obj.at(key).get<int64_t>() >= 0),
+                where + ": '" + at + "." + key + "' is missing or not a non-negative integer");
+        return obj.at(key).get<uint64_t>();
+    };
     AccelImage image;
     image.kind = need(d, "kind", &json::is_string, "a string").get<std::string>();
     image.params = need(d, "params", &json::is_object, "an object");
@@ -101,19 +107,17 @@ AccelImage AccelImage::from_descriptor(const json& d, const std::string& source)
         const std::string kind = need(r, "kind", &json::is_string, "a string").get<std::string>();
         DataKind dk;
         require(parse_data_kind(kind.c_str(), &dk), where + ": '" + at + ".kind' = '" + kind + "' is not a data kind");
-        const json& rb = need(r, "record_bytes", &json::is_number_unsigned, "a non-negative integer");
-        const json& count = need(r, "count", &json::is_number_unsigned, "a non-negative integer");
-        const json& base = need(r, "base", &json::is_number_unsigned, "a non-negative integer");
-        require(rb.get<uint64_t>() >= 1 && rb.get<uint64_t>() <= 4096,
-                where + ": '" + at + ".record_bytes' must be in [1, 4096]");
-        require(count.get<uint64_t>() <= (1ull << 40), where + ": '" + at + ".count' is larger than 2^40");
+        const uint64_t rb = count_of(r, "record_bytes", at), count = count_of(r, "count", at),
+                       base = count_of(r, "base", at);
+        require(rb >= 1 && rb <= 4096, where + ": '" + at + ".record_bytes' must be in [1, 4096]");
+        require(count <= (1ull << 40), where + ": '" + at + ".count' is larger than 2^40");
         require(!image.has_region(name), where + ": region '" + name + "' listed twice");
         Region region;
         region.name = name;
         region.kind = dk;
-        region.record_bytes = rb.get<uint32_t>();
-        region.count = count.get<uint64_t>();
-        region.base = base.get<uint64_t>();
+        region.record_bytes = uint32_t(rb);
+        region.count = count;
+        region.base = base;
         image.regions.push_back(std::move(region));  // bytes are allocated by the reader
     }
     // The addresses must be the ones place_regions() gives: the model relies on the layout.

@@ -1,6 +1,6 @@
 #pragma once
 // Hardware layout of the BVH: the one memory image the reference tracer and the SystemC model
-// both read (DESIGN rule 3). Documented byte by byte in docs/bvh_layout.md.
+// both read (docs/architecture.md, rule 3). Documented byte by byte in docs/bvh_layout.md.
 //
 // A binary BVH whose nodes hold the boxes of their two children, so one 64-byte fetch (one
 // cache line) feeds one issue of a 2-wide ray-box pipeline (as in Aila & Laine 2009's layout).
