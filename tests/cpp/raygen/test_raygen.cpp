@@ -135,6 +135,8 @@ TEST(RayGen, PlanFollowsTheScene) {
     WorkloadPlan only_primary = plan_workload(cornell, {RayKind::primary});
     EXPECT_FALSE(only_primary.wants(RayKind::shadow));
     for (const Effect& e : only_primary.effects) {
-        if (e.name == "shadow") EXPECT_NE(e.why.find("not requested"), std::string::npos);
+        if (e.name == "shadow") {
+            EXPECT_NE(e.why.find("not requested"), std::string::npos);
+        }
     }
 }
