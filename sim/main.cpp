@@ -38,13 +38,14 @@ int sc_main(int argc, char** argv) {
     CLI::App app{"rtsim-sim: replays a ray trace on the SystemC accelerator model"};
     std::string trace, config_path, out_dir;
     std::vector<std::string> sets;
-    bool timeline = false, progress = false, dump_defaults = false, dump_schema = false;
+    bool timeline = false, progress = false, dump_defaults = false, dump_schema = false, no_verdict = false;
     app.add_option("trace", trace, "Trace folder (from rtsim trace) or .rtt file");
     app.add_option("--config", config_path, "Config JSON (defaults for missing keys)");
     app.add_option("--set", sets, "Override a config key: key.path=value (repeatable)");
     app.add_option("-o,--out", out_dir, "Run folder for stats.json, config.resolved.json, provenance.json");
     app.add_flag("--timeline", timeline, "Also write timeline.json (Chrome/Perfetto trace events)");
     app.add_flag("--progress", progress, "Print JSON progress lines on stderr");
+    app.add_flag("--no-verdict", no_verdict, "Skip the bottleneck verdict (its analytic estimates on a sample of the trace)");
     app.add_flag("--dump-defaults", dump_defaults, "Print the default config as JSON and exit");
     app.add_flag("--dump-schema", dump_schema, "Print every config field with default, unit, range, doc");
     CLI11_PARSE(app, argc, argv);
@@ -62,6 +63,7 @@ int sc_main(int argc, char** argv) {
         o.out_dir = out_dir;
         o.timeline = timeline;
         o.progress = progress;
+        o.verdict = !no_verdict;
         for (int i = 0; i < argc; ++i) o.command_line += (i ? " " : "") + std::string(argv[i]);
         rtsim::SimOutcome r = rtsim::run_simulation(o);
         const auto& s = r.stats["summary"];

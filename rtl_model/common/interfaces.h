@@ -14,12 +14,24 @@ namespace rtsim {
 
 using Cycle = uint64_t;
 
+/// The memory level that served a read (its data came from there).
+enum class ServedBy : uint8_t { l1 = 0, l2 = 1, dram = 2 };
+constexpr int kServedByCount = 3;
+
+/// Where a read's time went, filled by the levels it passes (for the issuer's cycle accounting,
+/// docs/stats.md): which level served it and how long it waited for an MSHR at each cache.
+struct AccessInfo {
+    ServedBy level = ServedBy::l1;
+    Cycle mshr_wait[2] = {0, 0};  ///< cycles waited for a free MSHR at the L1 [0] and the L2 [1]
+};
+
 struct MemRequest {
     uint64_t addr = 0;
     uint32_t bytes = 0;
     bool write = false;
     DataKind kind = DataKind::node;
-    Cycle time = 0;  ///< cycle the request is issued
+    Cycle time = 0;              ///< cycle the request is issued
+    AccessInfo* info = nullptr;  ///< optional: filled with where a read's time went
 };
 
 /// Contract: returns the cycle the data is available (reads) or accepted (writes), >= req.time.

@@ -4,16 +4,16 @@
 
 namespace rtsim {
 
-Dispatch::Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream)
-    : sc_core::sc_module(name), m_config(config), m_stream(stream), m_queues(std::max(1u, units)) {}
+RayDealer::RayDealer(const DispatchConfig& config, uint32_t units, RayStream& stream)
+    : m_config(config), m_stream(stream), m_queues(std::max(1u, units)) {}
 
-bool Dispatch::next_ray(uint32_t unit, RayJob* job) {
+bool RayDealer::next_ray(uint32_t unit, RayJob* job) {
     bool ok = m_config.policy == DispatchPolicy::on_demand ? next_on_demand(job) : next_interleaved(unit, job);
     m_dispatched += ok;
     return ok;
 }
 
-bool Dispatch::next_on_demand(RayJob* job) {
+bool RayDealer::next_on_demand(RayJob* job) {
     if (m_next == m_buffer.size()) {
         m_buffer.clear();
         m_next = 0;
@@ -24,7 +24,7 @@ bool Dispatch::next_on_demand(RayJob* job) {
     return true;
 }
 
-bool Dispatch::deal_chunk() {
+bool RayDealer::deal_chunk() {
     // Deal the next chunk to the units in turn, block_rays at a time.
     std::vector<RayJob> chunk;
     if (m_stream_done || m_stream.read_chunk(m_config.chunk_rays, &chunk) == 0) {
@@ -40,7 +40,7 @@ bool Dispatch::deal_chunk() {
     return true;
 }
 
-bool Dispatch::next_interleaved(uint32_t unit, RayJob* job) {
+bool RayDealer::next_interleaved(uint32_t unit, RayJob* job) {
     if (unit == kAnyUnit) unit = m_any_unit++ % m_queues.size();
     unit %= m_queues.size();
     if (m_queues[unit].empty()) deal_chunk();
@@ -59,7 +59,7 @@ bool Dispatch::next_interleaved(uint32_t unit, RayJob* job) {
     return true;
 }
 
-nlohmann::json Dispatch::stats_json() const {
+nlohmann::json RayDealer::stats_json() const {
     return {{"rays", m_dispatched},
             {"chunks", m_chunks},
             {"chunk_rays", m_config.chunk_rays},

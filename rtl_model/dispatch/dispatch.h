@@ -29,9 +29,12 @@ public:
     virtual uint64_t total_rays() const = 0;
 };
 
-class Dispatch : public sc_core::sc_module, public RaySourceIf {
+/// The dealing policy itself, plain C++: the Dispatch block wraps it for the SystemC model, and
+/// the analytic level (which has no SystemC time, and may run after a simulation) uses it
+/// directly, so both give rays to the same units.
+class RayDealer : public RaySourceIf {
 public:
-    Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream);
+    RayDealer(const DispatchConfig& config, uint32_t units, RayStream& stream);
 
     bool next_ray(uint32_t unit, RayJob* job) override;
     uint64_t total_rays() const override { return m_stream.total_rays(); }
@@ -52,6 +55,12 @@ private:
     uint32_t m_any_unit = 0;                    ///< rotor for kAnyUnit requests
     bool m_stream_done = false;
     uint64_t m_dispatched = 0, m_chunks = 0, m_steals = 0;
+};
+
+class Dispatch : public sc_core::sc_module, public RayDealer {
+public:
+    Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream)
+        : sc_core::sc_module(name), RayDealer(config, units, stream) {}
 };
 
 }  // namespace rtsim

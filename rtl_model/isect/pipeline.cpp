@@ -27,6 +27,7 @@ Cycle Pipeline::issue(Cycle time, uint32_t tests) {
         for (uint32_t i = 1; i < issues; ++i) last = slot(last);
     }
     m_wait_cycles += first - time;
+    m_issue_use.add(first, issues);
     return last + m_config.latency;
 }
 

@@ -16,6 +16,7 @@
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/common/usage_series.h"
 #include "rtl_model/isect/pipeline_config.h"
 
 namespace rtsim {
@@ -30,6 +31,9 @@ public:
     uint64_t issues() const { return m_issues; }
     uint64_t tests() const { return m_tests; }
     uint32_t pipelines() const { return m_shared ? m_config.shared_count : 1; }
+    /// Issues over time (capacity: pipelines() / initiation_interval per cycle).
+    const UsageSeries& issue_use() const { return m_issue_use; }
+    double issue_capacity() const { return double(pipelines()) / m_config.initiation_interval; }
     nlohmann::json stats_json(Cycle total_cycles) const;
 
 private:
@@ -39,6 +43,7 @@ private:
     std::unique_ptr<BandwidthCalendar> m_pool;
     std::unique_ptr<SlotCalendar> m_exact_pool;  ///< shared pool at the detailed level
     uint64_t m_issues = 0, m_tests = 0, m_wait_cycles = 0;
+    UsageSeries m_issue_use;
 };
 
 }  // namespace rtsim

@@ -13,9 +13,10 @@ uint32_t log2_exact(uint64_t x) {
 }  // namespace
 
 Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency,
-             bool exact)
+             bool exact, ServedBy level)
     : sc_core::sc_module(name),
       m_config(config),
+      m_level(level),
       m_mshrs_enabled(mshrs_enabled),
       m_next_latency(next_latency),
       m_line_shift(log2_exact(config.line_bytes)) {
@@ -36,7 +37,19 @@ Cycle Cache::access(const MemRequest& req) {
     uint64_t first = req.addr >> m_line_shift;
     uint64_t last = (req.addr + (req.bytes ? req.bytes : 1) - 1) >> m_line_shift;
     Cycle done = req.time;
-    for (uint64_t line = first; line <= last; ++line) done = std::max(done, access_line(line, req));
+    if (!req.info) {
+        for (uint64_t line = first; line <= last; ++line) done = std::max(done, access_line(line, req, nullptr));
+        return done;
+    }
+    // The read's time is that of its slowest line: report where that line's time went.
+    for (uint64_t line = first; line <= last; ++line) {
+        AccessInfo line_info;
+        const Cycle ready = access_line(line, req, &line_info);
+        if (line == first || ready > done) {
+            done = std::max(done, ready);
+            *req.info = line_info;
+        }
+    }
     return done;
 }
 
@@ -46,12 +59,14 @@ Cycle Cache::bank_start(uint64_t line, Cycle time) {
     return m_banks[line % m_banks.size()].reserve(time, 1);
 }
 
-Cycle Cache::access_line(uint64_t line, const MemRequest& req) {
+Cycle Cache::access_line(uint64_t line, const MemRequest& req, AccessInfo* info) {
     const uint64_t line_lo = line << m_line_shift, line_hi = line_lo + m_config.line_bytes;
     const uint64_t lo = std::max(req.addr, line_lo), hi = std::min(req.addr + req.bytes, line_hi);
     const uint32_t bytes = uint32_t(hi > lo ? hi - lo : 0);
     MemCounters& c = m_stats[req.kind];
-    Cycle tag_done = bank_start(line, req.time) + m_config.latency;
+    const Cycle bank = bank_start(line, req.time);
+    m_bank_use.add(bank, 1);
+    Cycle tag_done = bank + m_config.latency;
 
     if (req.write) {
         // Write-through, no-write-allocate, posted.
@@ -61,6 +76,7 @@ Cycle Cache::access_line(uint64_t line, const MemRequest& req) {
         down.addr = lo;
         down.bytes = bytes;
         down.time = tag_done + m_next_latency;
+        down.info = nullptr;
         next->access(down);
         return tag_done;
     }
@@ -72,15 +88,17 @@ Cycle Cache::access_line(uint64_t line, const MemRequest& req) {
         set[w].last_use = ++m_use_clock;
         if (set[w].ready > tag_done) {
             ++c.merged;
+            if (info) info->level = set[w].filled_from;  // waits for a fill in flight
             return set[w].ready;
         }
         ++c.read_hits;
+        if (info) info->level = m_level;
         return tag_done;
     }
-    return miss(line, req, tag_done);
+    return miss(line, req, tag_done, info);
 }
 
-Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done) {
+Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessInfo* info) {
     Cycle issue = tag_done;
     size_t mshr = 0;
     if (m_mshrs_enabled) {
@@ -96,8 +114,16 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done) {
         m_mshr_stall_cycles += start - issue;
         issue = start;
     }
-    MemRequest down{line << m_line_shift, m_config.line_bytes, false, req.kind, issue + m_next_latency};
+    if (info) info->mshr_wait[size_t(m_level)] += issue - tag_done;
+    AccessInfo below;
+    MemRequest down{line << m_line_shift, m_config.line_bytes, false, req.kind, issue + m_next_latency, &below};
     Cycle fill = next->access(down) + m_next_latency;
+    if (info) {
+        info->level = below.level;
+        for (int k = 0; k < 2; ++k) info->mshr_wait[k] += below.mshr_wait[k];
+    }
+    m_mshr_busy_cycles += fill - issue;
+    m_mshr_use.add_interval(issue, fill);
     if (m_mshrs_enabled) m_mshr_free[mshr] = fill;
     if (m_mshr_occupancy) {
         m_mshr_occupancy->occupy(issue, fill);
@@ -112,6 +138,7 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done) {
     if (victim->tag != ~0ull) ++m_evictions;
     victim->tag = line;
     victim->ready = fill;
+    victim->filled_from = below.level;
     victim->last_use = ++m_use_clock;
     return fill;
 }
@@ -121,10 +148,21 @@ void Cache::limit_out_of_order_misses() {
     m_expected_miss = double(2 * m_next_latency + m_config.latency + 100);  // first guess, then learnt
 }
 
-nlohmann::json Cache::stats_json() const {
+nlohmann::json Cache::stats_json(Cycle total_cycles, bool series) const {
     nlohmann::json j = m_stats.to_json();
     j["evictions"] = m_evictions;
     j["mshr_stall_cycles"] = m_mshr_stall_cycles;
+    j["mshr_busy_cycles"] = m_mshr_busy_cycles;
+    const double cycles = double(std::max<Cycle>(total_cycles, 1));
+    uint64_t accesses = 0;
+    for (uint64_t b : m_bank_use.buckets()) accesses += b;
+    j["bank_utilization"] = double(accesses) / cycles / bank_capacity();
+    j["mshr_occupancy"] = double(m_mshr_busy_cycles) / cycles;  // mean outstanding misses
+    j["mshr_utilization"] = double(m_mshr_busy_cycles) / cycles / m_config.mshrs;
+    if (series) {
+        j["bank_utilization_over_time"] = m_bank_use.to_json(bank_capacity());
+        j["mshr_utilization_over_time"] = m_mshr_use.to_json(double(m_config.mshrs));
+    }
     j["config"] = {{"size_kib", m_config.size_kib}, {"ways", m_config.ways}, {"line_bytes", m_config.line_bytes},
                    {"latency", m_config.latency},   {"mshrs", (m_mshrs_enabled || m_mshr_occupancy) ? m_config.mshrs : 0},
                    {"banks", m_config.banks}};

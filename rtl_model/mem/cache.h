@@ -20,6 +20,7 @@
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/common/usage_series.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/mem/cache_config.h"
 
@@ -29,9 +30,10 @@ class Cache : public sc_core::sc_module, public MemIf {
 public:
     sc_core::sc_port<MemIf> next;
 
-    /// extra_latency: cycles added to every request forwarded to `next` and back (interconnect).
+    /// next_latency: cycles added to every request forwarded to `next` and back (interconnect).
+    /// level: which level this cache is (what AccessInfo reports for reads it serves).
     Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency,
-          bool exact = false);
+          bool exact = false, ServedBy level = ServedBy::l1);
 
     Cycle access(const MemRequest& req) override;
     /// For a shared cache reached out of time order (the approx L2): bound outstanding misses by
@@ -39,19 +41,29 @@ public:
     void limit_out_of_order_misses();
 
     const MemStats& stats() const { return m_stats; }
-    nlohmann::json stats_json() const;
+    /// MSHR-cycles held by misses (sum over misses of issue to fill): Little's law demand.
+    uint64_t mshr_busy_cycles() const { return m_mshr_busy_cycles; }
+    /// Stats; utilisation of banks and MSHRs over `total_cycles` (and over time, with `series`).
+    nlohmann::json stats_json(Cycle total_cycles, bool series = false) const;
+    const UsageSeries& bank_use() const { return m_bank_use; }
+    const UsageSeries& mshr_use() const { return m_mshr_use; }
+    /// Line accesses the banks can serve per cycle, and MSHRs: the capacities of the two series.
+    double bank_capacity() const { return double(m_config.banks) / m_config.bank_cycles; }
+    uint32_t mshrs() const { return m_config.mshrs; }
 
 private:
     struct Line {
         uint64_t tag = ~0ull;
         Cycle ready = 0;     ///< cycle the fill completes
         uint64_t last_use = 0;
+        ServedBy filled_from = ServedBy::l1;  ///< where its fill came from (for merged reads)
     };
-    Cycle access_line(uint64_t line_addr, const MemRequest& req);
-    Cycle miss(uint64_t line_addr, const MemRequest& req, Cycle tag_done);
+    Cycle access_line(uint64_t line_addr, const MemRequest& req, AccessInfo* info);
+    Cycle miss(uint64_t line_addr, const MemRequest& req, Cycle tag_done, AccessInfo* info);
     Cycle bank_start(uint64_t line_addr, Cycle time);
 
     CacheConfig m_config;
+    ServedBy m_level;
     bool m_mshrs_enabled;
     Cycle m_next_latency;
     uint32_t m_line_shift;
@@ -65,7 +77,10 @@ private:
     uint64_t m_use_clock = 0;
     MemStats m_stats;
     uint64_t m_evictions = 0;
-    uint64_t m_mshr_stall_cycles = 0;
+    uint64_t m_mshr_stall_cycles = 0;  ///< request-cycles waited for an MSHR (summed over misses)
+    uint64_t m_mshr_busy_cycles = 0;   ///< MSHR-cycles held by misses
+    UsageSeries m_bank_use;            ///< line accesses over time
+    UsageSeries m_mshr_use;            ///< MSHR-cycles held over time
 };
 
 }  // namespace rtsim

@@ -43,9 +43,8 @@ Cycle Dram::access(const MemRequest& req) {
         ready = start + m_config.latency + transfer;
     }
     m_queue_cycles += start - req.time;
-    size_t bucket = size_t(start / bucket_cycles());
-    if (bucket >= m_timeline.size()) m_timeline.resize(bucket + 1, 0);
-    m_timeline[bucket] += req.bytes;
+    if (req.info) req.info->level = ServedBy::dram;
+    m_bytes_use.add(start, req.bytes);
     return ready;
 }
 
@@ -66,12 +65,13 @@ nlohmann::json Dram::stats_json(Cycle total_cycles, double clock_ghz) const {
     j["bandwidth_utilization"] = peak > 0 ? achieved / peak : 0.0;
     j["avg_queue_cycles"] = (t.reads + t.writes) ? double(m_queue_cycles) / double(t.reads + t.writes) : 0.0;
     // Bandwidth over time, resampled to at most kTimelinePoints points.
-    size_t n = m_timeline.size(), group = std::max<size_t>(1, (n + kTimelinePoints - 1) / kTimelinePoints);
+    const std::vector<uint64_t>& buckets = m_bytes_use.buckets();
+    size_t n = buckets.size(), group = std::max<size_t>(1, (n + kTimelinePoints - 1) / kTimelinePoints);
     nlohmann::json series = nlohmann::json::array();
     for (size_t i = 0; i < n; i += group) {
         uint64_t bytes = 0;
         size_t end = std::min(n, i + group);
-        for (size_t k = i; k < end; ++k) bytes += m_timeline[k];
+        for (size_t k = i; k < end; ++k) bytes += buckets[k];
         double cycles = double((end - i) * bucket_cycles());
         series.push_back({{"cycle", i * bucket_cycles()}, {"gbps", double(bytes) / cycles * clock_ghz}});
     }

@@ -12,6 +12,7 @@
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/common/usage_series.h"
 #include "rtl_model/mem/dram_banks.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/mem/dram_config.h"
@@ -26,8 +27,11 @@ public:
 
     const MemStats& stats() const { return m_stats; }
     /// Bytes moved per bucket of `bucket_cycles()` cycles, from cycle 0.
-    const std::vector<uint64_t>& bytes_over_time() const { return m_timeline; }
-    static constexpr Cycle bucket_cycles() { return 1024; }
+    const std::vector<uint64_t>& bytes_over_time() const { return m_bytes_use.buckets(); }
+    const UsageSeries& bytes_use() const { return m_bytes_use; }
+    static constexpr Cycle bucket_cycles() { return UsageSeries::kBucketCycles; }
+    /// Peak bytes per cycle over all channels.
+    double peak_bytes_per_cycle() const { return double(m_config.bytes_per_cycle) * m_config.channels; }
     uint64_t queue_cycles() const { return m_queue_cycles; }
     nlohmann::json stats_json(Cycle total_cycles, double clock_ghz) const;
     /// The bank model (detailed only), else null.
@@ -38,7 +42,7 @@ private:
     std::vector<BandwidthCalendar> m_channels;
     std::unique_ptr<DramBanks> m_banks;
     MemStats m_stats;
-    std::vector<uint64_t> m_timeline;
+    UsageSeries m_bytes_use;  ///< bytes moved over time
     uint64_t m_queue_cycles = 0;
 };
 

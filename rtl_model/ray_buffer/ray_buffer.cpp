@@ -18,6 +18,7 @@ RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, 
                                                 : m_capacity + uint64_t(units) * ray_contexts),
       m_queues(partition.treelets.size()),
       m_unit_treelet(units, -1),
+      m_admit_slots(config.admit_outstanding, 0),
       m_sram(16ull * config.bytes_per_cycle, 16) {}
 
 Cycle RayBuffer::sram(Cycle time) {
@@ -67,11 +68,19 @@ void RayBuffer::admit(Cycle time) {
         s.start = time;
         const uint32_t first = s.stepper->plan().locality;
         const uint32_t treelet = first == kNoLocality ? m_partition.root_group : m_partition.group_of[first];
-        Cycle fetched = mem->access({m_map.ray(job.id), sizeof(RayRecord), false, DataKind::ray, time});
+        const Cycle fetched = fetch_ray_record(job.id, time);
         push(treelet, std::move(s), fetched, time);
         ++m_admitted;
         ++m_in_machine;
     }
+}
+
+Cycle RayBuffer::fetch_ray_record(uint64_t ray_id, Cycle time) {
+    auto slot = std::min_element(m_admit_slots.begin(), m_admit_slots.end());
+    const Cycle issue = std::max({time, *slot, m_admit_next});
+    m_admit_next = issue + 1;
+    *slot = mem->access({m_map.ray(ray_id), sizeof(RayRecord), false, DataKind::ray, issue});
+    return *slot;
 }
 
 void RayBuffer::unindex(uint32_t t) {

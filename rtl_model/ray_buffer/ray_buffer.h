@@ -59,6 +59,10 @@ private:
         uint64_t slot;     ///< overflow slot
     };
     void admit(Cycle time);
+    /// Reads a new ray's record through the admission engine: one read issued per cycle, at
+    /// most admit_outstanding in flight (a burst of thousands of reads at one cycle would
+    /// otherwise swamp the L2's MSHRs). Returns the cycle the record arrives.
+    Cycle fetch_ray_record(uint64_t ray_id, Cycle time);
     void unindex(uint32_t treelet);
     void index(uint32_t treelet);
     void push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time);
@@ -74,6 +78,8 @@ private:
     uint64_t m_max_in_flight;
     std::vector<std::deque<Waiting>> m_queues;
     std::vector<int64_t> m_unit_treelet;
+    std::vector<Cycle> m_admit_slots;  ///< completion cycle of each admission read slot
+    Cycle m_admit_next = 0;            ///< earliest cycle the next admission read can issue
     BandwidthCalendar m_sram;
     std::vector<uint64_t> m_free_slots;
     uint64_t m_next_slot = 0;

@@ -20,6 +20,7 @@ struct TreeletConfig {
     uint32_t bytes_per_cycle = 512;   ///< ray buffer SRAM bandwidth (banked: 8 units x 64 B)
     uint32_t idle_poll_cycles = 32;   ///< how often an idle unit looks for work again
     uint32_t max_rays_in_flight = 0;  ///< rays admitted at once (0: what the SRAM and contexts hold)
+    uint32_t admit_outstanding = 16;  ///< ray-record reads in flight while admitting rays
 
     template <class V>
     void visit(V& v) {
@@ -32,6 +33,7 @@ struct TreeletConfig {
         v.field("bytes_per_cycle", bytes_per_cycle, "B/cycle", "Ray buffer SRAM bandwidth", 1, 4096);
         v.field("idle_poll_cycles", idle_poll_cycles, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000);
         v.field("max_rays_in_flight", max_rays_in_flight, "rays", "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to DRAM (0: SRAM capacity plus the ray contexts, never overflows)", 0, 1u << 30);
+        v.field("admit_outstanding", admit_outstanding, "reads", "Ray-record reads the ray buffer keeps in flight while admitting new rays (a streaming engine, one read issued per cycle)", 1, 4096);
     }
 };
 

@@ -72,7 +72,7 @@ void Top::build_memory() {
     m_dram = std::make_unique<Dram>("dram", c.dram, detailed);
     // At approx the L2 is reached out of time order within a quantum: its MSHRs bound outstanding
     // misses through an occupancy calendar (docs/model.md); the private L1s model theirs exactly.
-    m_l2 = std::make_unique<Cache>("l2", c.l2, detailed, 0, detailed);
+    m_l2 = std::make_unique<Cache>("l2", c.l2, detailed, 0, detailed, ServedBy::l2);
     if (!detailed) m_l2->limit_out_of_order_misses();
     m_l2->next(*m_dram);
     for (uint32_t u = 0; u < c.traversal.units; ++u) {
@@ -155,9 +155,60 @@ nlohmann::json Top::stats_json() const {
         for (const auto& p : m_pipes[size_t(k)]) j[op_kind_name(OpKind(k))][p->basename()] = p->stats_json(total);
     if (m_ideal) j["ideal_memory"] = m_ideal->stats_json();
     if (m_ray_buffer) j["ray_buffer"] = m_ray_buffer->stats_json();
-    for (const auto& l1 : m_l1) j["l1"][l1->basename()] = l1->stats_json();
-    if (m_l2) j["l2"] = m_l2->stats_json();
+    for (const auto& l1 : m_l1) j["l1"][l1->basename()] = l1->stats_json(total);
+    if (m_l2) j["l2"] = m_l2->stats_json(total, true);
     if (m_dram) j["dram"] = m_dram->stats_json(total, m_config.clock_ghz);
+    j["cycle_accounting"] = cycle_accounting_json(total);
+    j["utilization"] = utilization_json(total);
+    return j;
+}
+
+nlohmann::json Top::cycle_accounting_json(Cycle total) const {
+    CycleAccount all;
+    for (const auto& u : m_units) all += u->cycle_account(total);
+    const double context_cycles = double(all.total());
+    const nlohmann::json by_use = all.to_json();
+    nlohmann::json fractions = nlohmann::json::object();
+    for (auto it = by_use.begin(); it != by_use.end(); ++it)
+        fractions[it.key()] = context_cycles > 0 ? it.value().get<double>() / context_cycles : 0.0;
+    return {{"context_cycles", all.total()}, {"by_use", by_use}, {"fractions", fractions}};
+}
+
+nlohmann::json Top::utilization_json(Cycle total) const {
+    // Every shared resource as one total over the run and over time (docs/stats.md).
+    nlohmann::json j = nlohmann::json::object();
+    const double cycles = double(std::max<Cycle>(total, 1));
+    auto add = [&](const std::string& name, const UsageSeries& use, double capacity) {
+        j[name] = {{"mean", capacity > 0 ? double(use.total()) / cycles / capacity : 0.0},
+                   {"over_time", use.to_json(capacity)}};
+    };
+    for (int k = 0; k < kOpKindCount; ++k) {
+        if (m_pipes[size_t(k)].empty()) continue;
+        UsageSeries use;
+        double capacity = 0;
+        for (const auto& p : m_pipes[size_t(k)]) {
+            use += p->issue_use();
+            capacity += p->issue_capacity();
+        }
+        add(std::string("pipe_") + op_kind_name(OpKind(k)), use, capacity);
+    }
+    if (!m_l1.empty()) {
+        UsageSeries banks, mshrs;
+        double bank_capacity = 0, mshr_capacity = 0;
+        for (const auto& l1 : m_l1) {
+            banks += l1->bank_use();
+            mshrs += l1->mshr_use();
+            bank_capacity += l1->bank_capacity();
+            mshr_capacity += l1->mshrs();
+        }
+        add("l1_banks", banks, bank_capacity);
+        add("l1_mshrs", mshrs, mshr_capacity);
+    }
+    if (m_l2) {
+        add("l2_banks", m_l2->bank_use(), m_l2->bank_capacity());
+        add("l2_mshrs", m_l2->mshr_use(), m_l2->mshrs());
+    }
+    if (m_dram) add("dram_bandwidth", m_dram->bytes_use(), m_dram->peak_bytes_per_cycle());
     return j;
 }
 

@@ -46,6 +46,8 @@ public:
 
 private:
     using PipelineSet = std::vector<std::unique_ptr<Pipeline>>;
+    nlohmann::json cycle_accounting_json(Cycle total) const;
+    nlohmann::json utilization_json(Cycle total) const;
     void build_memory();
     void build_pipelines(const Accel& accel);
     void build_ray_buffer(const Accel& accel, const MemoryMap& map);

@@ -63,7 +63,22 @@ void TraversalUnit::fill_idle_contexts(Cycle t) {
     m_next_fill = t + m_ctx.idle_poll_cycles;
 }
 
+void TraversalUnit::account(uint32_t c, CycleUse use, Cycle until) {
+    Context& ctx = m_contexts[c];
+    if (until <= ctx.accounted) return;
+    m_account.add(use, until - ctx.accounted);
+    ctx.accounted = until;
+}
+
+void TraversalUnit::account_read(uint32_t c, Cycle ready, const AccessInfo& info) {
+    Context& ctx = m_contexts[c];
+    if (ready <= ctx.accounted) return;
+    account_memory(m_account, ctx.accounted, ready, info);
+    ctx.accounted = ready;
+}
+
 void TraversalUnit::activate(uint32_t c, Cycle t) {
+    account(c, CycleUse::starved, t);  // idle until now, while rays were still to come
     m_contexts[c].active = true;
     if (m_active++ == 0) m_busy_since = t;
 }
@@ -85,7 +100,11 @@ bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
     ctx.ray.local_stack = ctx.ray.spilled = 0;
     activate(c, t);
     // The ray record is read from memory before traversal starts.
-    Cycle ready = mem->access({m_map.ray(job.id), sizeof(RayRecord), false, DataKind::ray, t + m_ctx.dispatch_latency});
+    const Cycle fetch = t + m_ctx.dispatch_latency;
+    account(c, CycleUse::dispatch, fetch);
+    AccessInfo info;
+    const Cycle ready = mem->access({m_map.ray(job.id), sizeof(RayRecord), false, DataKind::ray, fetch, &info});
+    account_read(c, ready, info);
     ctx.phase = Phase::fetch_ray;
     schedule(c, ready);
     return true;
@@ -102,6 +121,7 @@ bool TraversalUnit::take_parked_ray(uint32_t c, Cycle t) {
     if (!ray_is_valid(s.ray()) && s.work().steps == 0) ++m_rejected;
     ++m_takes;
     activate(c, t);
+    account(c, CycleUse::ray_buffer, ready);
     ctx.phase = Phase::step;
     schedule(c, ready);
     return true;
@@ -116,6 +136,7 @@ void TraversalUnit::park_ray(uint32_t c, uint32_t treelet, Cycle t) {
 
 void TraversalUnit::advance(uint32_t c, Cycle t) {
     ++m_steps;
+    account(c, CycleUse::issue, t);  // ready since its event, waiting for the scheduler
     if (m_contexts[c].phase == Phase::ops) run_ops(c, t);
     else step(c, t);
 }
@@ -129,10 +150,14 @@ void TraversalUnit::step(uint32_t c, Cycle t) {
         if (target != ctx.treelet) return park_ray(c, target, t);  // leaves its treelet
     }
     Cycle ready = t;
+    AccessInfo slowest, info;
     for (int i = 0; i < plan.fetch_count; ++i) {
         const Fetch& f = plan.fetch[i];
-        ready = std::max(ready, mem->access({f.addr, f.bytes, false, f.kind, t}));
+        const Cycle done = mem->access({f.addr, f.bytes, false, f.kind, t, &info});
+        if (done > ready || i == 0) slowest = info;
+        ready = std::max(ready, done);
     }
+    account_read(c, ready, slowest);
     ctx.phase = Phase::ops;
     schedule(c, ready);
 }
@@ -149,11 +174,18 @@ void TraversalUnit::run_ops(uint32_t c, Cycle t) {
     const int before = stepper.stack_size();
     const StepOutcome outcome = stepper.execute();
     Cycle ready = t;
-    for (int i = 0; i < op_count; ++i) ready = pipes[size_t(ops[i].kind)]->issue(ready, ops[i].count);
-    for (int i = 0; i < outcome.op_count; ++i)
+    for (int i = 0; i < op_count; ++i) {
+        ready = pipes[size_t(ops[i].kind)]->issue(ready, ops[i].count);
+        account(c, pipe_use(ops[i].kind), ready);
+    }
+    for (int i = 0; i < outcome.op_count; ++i) {
         ready = pipes[size_t(outcome.op[i].kind)]->issue(ready, outcome.op[i].count);
+        account(c, pipe_use(outcome.op[i].kind), ready);
+    }
+    ready = stack_traffic(c, before, t, ready);
+    account(c, CycleUse::stack, ready);  // spilled entries read back after the operations
     ctx.phase = Phase::step;
-    schedule(c, stack_traffic(c, before, t, ready));
+    schedule(c, ready);
 }
 
 Cycle TraversalUnit::stack_traffic(uint32_t c, int before, Cycle t, Cycle ready) {
@@ -188,6 +220,13 @@ void TraversalUnit::finish_ray(uint32_t c, Cycle t) {
     start_ray(c, t);
 }
 
+CycleAccount TraversalUnit::cycle_account(Cycle total_cycles) const {
+    CycleAccount a = m_account;
+    for (const Context& ctx : m_contexts)
+        if (total_cycles > ctx.accounted) a.add(CycleUse::tail, total_cycles - ctx.accounted);
+    return a;
+}
+
 nlohmann::json TraversalUnit::stats_json(Cycle total_cycles) const {
     nlohmann::json j = {{"rays", m_rays},
                         {"steps", m_steps},
@@ -197,7 +236,8 @@ nlohmann::json TraversalUnit::stats_json(Cycle total_cycles) const {
                         {"stack_spill_reads", m_spill_reads},
                         {"rejected_rays", m_rejected},
                         {"quantum_syncs", m_syncs},
-                        {"finish_cycle", m_finish}};
+                        {"finish_cycle", m_finish},
+                        {"cycle_accounting", cycle_account(total_cycles).to_json()}};
     if (m_treelet_mode) {
         j["rays_taken"] = m_takes;
         j["rays_parked"] = m_parks;

@@ -27,6 +27,7 @@
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/common/ray_state.h"
+#include "rtl_model/traversal/cycle_accounting.h"
 #include "rtl_model/traversal/traversal_config.h"
 
 namespace rtsim {
@@ -53,6 +54,8 @@ public:
 
     Cycle finish_cycle() const { return m_finish; }
     uint64_t rays_done() const { return m_rays; }
+    /// Context-cycles by use up to `total_cycles` (contexts idle at the end count as tail).
+    CycleAccount cycle_account(Cycle total_cycles) const;
     nlohmann::json stats_json(Cycle total_cycles) const;
 
 private:
@@ -62,6 +65,7 @@ private:
         Phase phase = Phase::step;
         uint32_t treelet = 0;      ///< treelet the ray is traversing (treelet mode)
         bool active = false;
+        Cycle accounted = 0;       ///< its cycles up to here are in m_account
     };
     struct Event {
         Cycle time;
@@ -83,6 +87,10 @@ private:
     void finish_ray(uint32_t c, Cycle t);
     Cycle stack_traffic(uint32_t c, int before, Cycle t, Cycle ready);
     void schedule(uint32_t c, Cycle t) { m_events.push(Event{t, c}); }
+    /// Context c's cycles from its last accounted cycle to `until` went to `use`.
+    void account(uint32_t c, CycleUse use, Cycle until);
+    /// Context c waited from its last accounted cycle to `ready` for a read (split by `info`).
+    void account_read(uint32_t c, Cycle ready, const AccessInfo& info);
 
     const TraversalConfig& m_config;
     UnitContext m_ctx;
@@ -100,6 +108,7 @@ private:
     bool m_treelet_mode = false;
     Cycle m_next_fill = 0;
     uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
+    CycleAccount m_account;
 };
 
 }  // namespace rtsim

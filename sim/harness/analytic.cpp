@@ -69,7 +69,7 @@ private:
     std::unique_ptr<FunctionalCache> m_l2;
     MemStats m_dram, m_ideal;
     uint32_t m_line_bytes = 64;
-    std::unique_ptr<Dispatch> m_dispatch;  ///< the model's dispatch block: same ray-to-unit policy
+    std::unique_ptr<RayDealer> m_dispatch;  ///< the model's dispatch policy: same ray-to-unit assignment
     uint64_t m_dispatched = 0;
     double m_latency_sum = 0;
     Cycle m_latency_max = 0;
@@ -77,7 +77,7 @@ private:
 };
 
 void AnalyticModel::run(RayStream& rays) {
-    m_dispatch = std::make_unique<Dispatch>("analytic_dispatch", m_c.dispatch, m_c.traversal.units, rays);
+    m_dispatch = std::make_unique<RayDealer>(m_c.dispatch, m_c.traversal.units, rays);
     const uint32_t units = m_c.traversal.units, contexts = m_c.traversal.ray_contexts;
     // The context whose unloaded clock is earliest takes the next step (ties: context-major,
     // then unit, so the first rays spread over the units); a context that finishes a ray takes

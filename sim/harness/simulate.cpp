@@ -9,10 +9,12 @@
 #include "rtl_model/top/top.h"
 #include "sim/harness/analytic.h"
 #include "sim/harness/hit_checker.h"
+#include "sim/harness/roofline.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
 #include "sim/harness/timeline.h"
 #include "sim/harness/trace_stream.h"
+#include "sim/harness/verdict.h"
 #include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
 
@@ -184,6 +186,13 @@ SimOutcome run_simulation(const SimOptions& o) {
         apply_sampling_to_summary(out.stats["summary"], o.config, sampled->plan, sampled->estimator);
         out.stats["sampling"] = sampled->estimator.to_json(o.config, cycles, wall);
     }
+    out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);
+    json verdict = nullptr;
+    if (o.verdict && o.config.fidelity != Fidelity::functional && total > 0)
+        verdict = judge(VerdictContext{o.config, model, *accel, map, reader});
+    out.stats["verdict"] = verdict;
+    out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
+    out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
     write_json(fs::path(o.out_dir) / "stats.json", out.stats);
     write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
     out.exit_code = (checker.hit_mismatches() || checker.work_mismatches()) ? 3 : 0;

@@ -126,7 +126,7 @@ TEST(Cache, HandWorkedSequence) {
     EXPECT_EQ(total.reads, 11u);
     EXPECT_EQ(total.writes, 2u);
 
-    const nlohmann::json j = b.cache.stats_json();
+    const nlohmann::json j = b.cache.stats_json(1000);
     EXPECT_EQ(j["evictions"], 4);  // B, A, C, B
     EXPECT_EQ(j["mshr_stall_cycles"], 21 + 6 + 22);
     EXPECT_EQ(j["reads"], 11);
@@ -141,8 +141,8 @@ TEST(Cache, WithoutMshrsMissesNeverWait) {
     EXPECT_EQ(b.cache.access({A, 64, false, DataKind::node, 0}), 28u);
     EXPECT_EQ(b.cache.access({B, 64, false, DataKind::node, 0}), 28u);
     EXPECT_EQ(b.cache.access({D, 64, false, DataKind::node, 0}), 28u);
-    EXPECT_EQ(b.cache.stats_json()["mshr_stall_cycles"], 0);
-    EXPECT_EQ(b.cache.stats_json()["config"]["mshrs"], 0);
+    EXPECT_EQ(b.cache.stats_json(1000)["mshr_stall_cycles"], 0);
+    EXPECT_EQ(b.cache.stats_json(1000)["config"]["mshrs"], 0);
 }
 
 TEST(Cache, EachBankServesOneAccessPerBankCycles) {
@@ -161,6 +161,51 @@ TEST(Cache, EachBankServesOneAccessPerBankCycles) {
     // Bank 1 is not slowed by bank 0's queue.
     EXPECT_EQ(b.cache.access({D, 64, false, DataKind::node, 1000}), 1004u);
     EXPECT_EQ(b.cache.stats()[DataKind::node].read_hits, 201u);
+}
+
+}  // namespace
+}  // namespace rtsim
+
+namespace rtsim {
+namespace {
+/// A DRAM stand-in: fixed latency, reports that it served the read.
+class FakeDram : public sc_core::sc_module, public MemIf {
+public:
+    explicit FakeDram(sc_core::sc_module_name name) : sc_core::sc_module(name) {}
+    Cycle access(const MemRequest& req) override {
+        if (req.info) req.info->level = ServedBy::dram;
+        return req.time + 100;
+    }
+};
+
+TEST(Cache, AccessInfoSaysWhereAReadsTimeWent) {
+    test::TestKernel kernel;
+    FakeDram dram("dram");
+    CacheConfig one_mshr = tiny_config();
+    one_mshr.mshrs = 1;
+    Cache l2("l2", tiny_config(), true, 0, false, ServedBy::l2);
+    Cache l1("l1", one_mshr, true, 2, false, ServedBy::l1);
+    l1.next(l2);
+    l2.next(dram);
+    kernel.elaborate();
+    auto read = [&](uint64_t addr, Cycle time, AccessInfo* info) {
+        return l1.access({addr, 8, false, DataKind::node, time, info});
+    };
+    AccessInfo a, b, c, d;
+    const Cycle first = read(0, 0, &a);  // misses both: DRAM
+    EXPECT_EQ(a.level, ServedBy::dram);
+    EXPECT_EQ(a.mshr_wait[0] + a.mshr_wait[1], 0u);
+    read(kLine * 4, 1, &b);  // another line while the L1's only MSHR is busy: waits for it
+    EXPECT_EQ(b.level, ServedBy::dram);
+    EXPECT_GT(b.mshr_wait[0], 0u);
+    EXPECT_EQ(read(0, first + 10, &c), first + 10 + 4);  // now an L1 hit
+    EXPECT_EQ(c.level, ServedBy::l1);
+    read(0, 2, &d);  // the first line again, still being filled: waits for the DRAM fill
+    EXPECT_EQ(d.level, ServedBy::dram);
+    const nlohmann::json j = l1.stats_json(first + 100, true);
+    EXPECT_GT(j["mshr_busy_cycles"].get<uint64_t>(), 0u);
+    EXPECT_GT(j["mshr_utilization"].get<double>(), 0.0);
+    EXPECT_TRUE(j["mshr_utilization_over_time"].is_array());
 }
 
 }  // namespace

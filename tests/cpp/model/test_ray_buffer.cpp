@@ -121,6 +121,31 @@ TEST(RayBuffer, AdmitsUpToCapacityAndOverflowsParkedRays) {
     EXPECT_EQ(s["overflow_writes"].get<uint64_t>(), overflow_writes);
 }
 
+TEST(RayBuffer, AdmissionReadsAreStreamedNotBurst) {
+    // Admitting a whole buffer of rays at one cycle: their ray-record reads leave one per cycle
+    // with at most admit_outstanding in flight (a burst would swamp the L2's MSHRs).
+    test::TestKernel kernel;
+    TreeletConfig c = config_with(64, "largest", 1);  // 64 KiB: 546 rays
+    c.admit_outstanding = 4;
+    Bench b(c, 300, 4, "admission");
+    RayState ray;
+    uint32_t treelet = 0;
+    Cycle ready = 0;
+    ASSERT_TRUE(b.buffer.take(0, 1000, &ray, &treelet, &ready));
+    std::vector<Cycle> issued;
+    for (const MemRequest& r : b.memory.requests)
+        if (r.kind == DataKind::ray) issued.push_back(r.time);
+    ASSERT_EQ(issued.size(), 300u);  // every ray of the trace fits: all admitted
+    EXPECT_EQ(issued.front(), 1000u);
+    for (size_t i = 1; i < issued.size(); ++i) {
+        EXPECT_GE(issued[i], issued[i - 1] + 1) << i;  // one per cycle
+        if (i >= 4) {
+            EXPECT_GE(issued[i], issued[i - 4] + 100) << i;  // the 5th waits for the 1st (latency 100)
+        }
+    }
+    EXPECT_GE(ready, 1000u + 100u);
+}
+
 TEST(RayBuffer, EveryRayIsHandedOutExactlyOnceUnderEveryPolicy) {
     for (const char* policy : {"largest", "oldest", "round_robin"}) {
         for (uint32_t kib : {1u, 64u}) {
