@@ -15,7 +15,8 @@ TraversalUnit::TraversalUnit(sc_core::sc_module_name name, const TraversalConfig
       m_map(map),
       m_steppers(steppers),
       m_index(index),
-      m_contexts(config.ray_contexts) {
+      m_contexts(config.ray_contexts),
+      m_events(config.ray_contexts) {
     SC_THREAD(run);
 }
 
@@ -36,14 +37,15 @@ void TraversalUnit::run() {
             fill_idle_contexts(now);
             continue;
         }
-        Event e = m_events.top();
+        const uint32_t c = m_events.top();
+        const Cycle ready = m_events.top_time();
         m_events.pop();
         // The scheduler takes one step per issue_cycles.
-        Cycle t = std::max(e.time, m_sched_free);
+        Cycle t = std::max(ready, m_sched_free);
         m_sched_free = t + m_config.issue_cycles;
         now = t;
         sync(t);
-        advance(e.context, t);
+        advance(c, t);
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
     }
 }

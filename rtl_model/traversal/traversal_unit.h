@@ -18,7 +18,6 @@
 // is parked in that treelet's queue and the context takes the next ray. Traversal order, hits and
 // work counts do not change: the stepper is the same, the ray only waits in between.
 #include <cstdint>
-#include <queue>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -27,6 +26,7 @@
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/common/ray_state.h"
+#include "rtl_model/traversal/context_queue.h"
 #include "rtl_model/traversal/cycle_accounting.h"
 #include "rtl_model/traversal/traversal_config.h"
 
@@ -67,11 +67,6 @@ private:
         bool active = false;
         Cycle accounted = 0;       ///< its cycles up to here are in m_account
     };
-    struct Event {
-        Cycle time;
-        uint32_t context;
-        bool operator>(const Event& o) const { return time > o.time || (time == o.time && context > o.context); }
-    };
 
     void run();
     void sync(Cycle t);
@@ -86,7 +81,7 @@ private:
     void run_ops(uint32_t c, Cycle t);
     void finish_ray(uint32_t c, Cycle t);
     Cycle stack_traffic(uint32_t c, int before, Cycle t, Cycle ready);
-    void schedule(uint32_t c, Cycle t) { m_events.push(Event{t, c}); }
+    void schedule(uint32_t c, Cycle t) { m_events.schedule(c, t); }
     /// Context c's cycles from its last accounted cycle to `until` went to `use`.
     void account(uint32_t c, CycleUse use, Cycle until);
     /// Context c waited from its last accounted cycle to `ready` for a read (split by `info`).
@@ -98,7 +93,7 @@ private:
     StepperPool& m_steppers;
     uint32_t m_index;
     std::vector<Context> m_contexts;
-    std::priority_queue<Event, std::vector<Event>, std::greater<Event>> m_events;
+    ContextQueue m_events;  ///< each context's next phase, earliest first
     Cycle m_sched_free = 0;
     Cycle m_synced = 0;
     Cycle m_finish = 0;

@@ -15,12 +15,13 @@ uint32_t bits(float f) {
 }  // namespace
 
 std::string compare_with_reference(const RayResult& r, const HitRecord& h, const WorkRecord& w, bool* hit_differs) {
-    std::ostringstream out;
     *hit_differs = r.hit.prim != h.prim || (h.prim >= 0 && bits(r.hit.t) != bits(h.t));
-    if (*hit_differs)
-        out << "hit: model prim " << r.hit.prim << " t " << r.hit.t << ", reference prim " << h.prim << " t " << h.t;
     const WorkCounts& m = r.work;
     const WorkCounts ref = work_from_record(w);
+    if (!*hit_differs && m == ref) return std::string();  // every ray comes here: no text unless needed
+    std::ostringstream out;
+    if (*hit_differs)
+        out << "hit: model prim " << r.hit.prim << " t " << r.hit.t << ", reference prim " << h.prim << " t " << h.t;
     if (m != ref) {
         if (*hit_differs) out << "; ";
         auto counts = [&out](const WorkCounts& c) {

@@ -38,12 +38,15 @@ ReferenceWindow::ReferenceWindow(TraceReader& reader, uint64_t chunk_rays)
 }
 
 ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {
+    // Called for every ray: messages are built only when a check fails.
     const uint64_t index = id / m_chunk;
-    require(id < m_total, "ray " + std::to_string(id) + " is beyond the trace (" + std::to_string(m_total) + " rays)");
+    if (id >= m_total)
+        throw Error("ray " + std::to_string(id) + " is beyond the trace (" + std::to_string(m_total) + " rays)");
     if (!m_chunks.empty() && index >= m_chunks.front().index && index < m_chunks.front().index + m_chunks.size())
         return m_chunks[index - m_chunks.front().index];
-    require(index >= m_loaded_end, "ray " + std::to_string(id) + " finished after all rays of its chunk were checked "
-                                   "(a ray was duplicated in the model)");
+    if (index < m_loaded_end)
+        throw Error("ray " + std::to_string(id) +
+                    " finished after all rays of its chunk were checked (a ray was duplicated in the model)");
     // Load consecutive chunks up to the one needed. Always from the first chunk never loaded, even
     // when every resident chunk has retired: rays of the chunks in between may still be in flight.
     uint64_t next = m_loaded_end;
@@ -61,7 +64,8 @@ ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {
 
 void ReferenceWindow::checked(uint64_t id) {
     Chunk& c = chunk_for(id);
-    require(!c.done[id % m_chunk], "ray " + std::to_string(id) + " finished twice (a ray was duplicated in the model)");
+    if (c.done[id % m_chunk])
+        throw Error("ray " + std::to_string(id) + " finished twice (a ray was duplicated in the model)");
     c.done[id % m_chunk] = true;
     --c.remaining;
     while (!m_chunks.empty() && m_chunks.front().remaining == 0) m_chunks.pop_front();

@@ -49,7 +49,7 @@ AccelImage read_accel_image(TraceReader& reader) {
         require(s.record_bytes == r.record_bytes && s.record_count == r.count,
                 where + ": holds " + std::to_string(s.record_count) + " records of " + std::to_string(s.record_bytes) +
                     " bytes, the descriptor says " + std::to_string(r.count) + " of " + std::to_string(r.record_bytes));
-        r.bytes.resize(r.count * r.record_bytes);
+        r.bytes.resize(r.count * r.record_bytes, false);  // every byte is read next
         reader.read(kind, 0, r.count, r.bytes.data());
     }
     return image;

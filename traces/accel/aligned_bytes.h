@@ -25,8 +25,9 @@ public:
     AlignedBytes(AlignedBytes&&) noexcept = default;
     AlignedBytes& operator=(AlignedBytes&&) noexcept = default;
 
-    /// Zero-filled storage of `size` bytes (contents are not kept).
-    void resize(size_t size) {
+    /// Storage of `size` bytes (contents are not kept), zero-filled unless the caller is about to
+    /// overwrite every byte (zero = false: a region read from a trace).
+    void resize(size_t size, bool zero = true) {
         m_size = size;
         if (size == 0) {
             m_data.reset();
@@ -35,7 +36,8 @@ public:
         const size_t rounded = (size + kAlign - 1) / kAlign * kAlign;
         auto* p = static_cast<uint8_t*>(std::aligned_alloc(kAlign, rounded));
         if (!p) throw std::bad_alloc();
-        std::memset(p, 0, rounded);
+        if (zero) std::memset(p, 0, rounded);
+        else std::memset(p + size, 0, rounded - size);  // only the padding past the end
         m_data.reset(p);
     }
     size_t size() const { return m_size; }
