@@ -220,6 +220,85 @@ class TreeletConfig:
 
 
 @dataclass
+class EnergyConfig:
+    """The first-order energy and area model's technology (docs/energy_area.md): 45 nm reference
+    figures (Horowitz, ISSCC 2014) scaled to node_nm (Stillmaker & Baas 2017)."""
+
+    node_nm: float = _f(
+        7.0,
+        "nm",
+        "Technology node; 45 nm reference figures are scaled to it (Stillmaker & Baas 2017)",
+        7,
+        130,
+    )
+    vdd: float = _f(
+        0.0,
+        "V",
+        "Supply voltage for the energy scaling (0: the node's nominal voltage, "
+        "docs/energy_area.md)",
+        0,
+        2,
+    )
+    dram_kind: str = _choice(
+        "gddr6",
+        ("gddr6", "lpddr5", "hbm2", "ddr4"),
+        "DRAM kind: picks the energy per bit moved (docs/energy_area.md)",
+    )
+    dram_pj_per_bit: float = _f(
+        0.0,
+        "pJ/bit",
+        "DRAM energy per bit read or written, overriding the kind's figure (0: the kind's)",
+        0,
+        1000,
+    )
+    fp_add_pj: float = _f(0.9, "pJ", "32-bit floating-point add (or subtract) at 45 nm", 0, 1000)
+    fp_mul_pj: float = _f(3.7, "pJ", "32-bit floating-point multiply at 45 nm", 0, 1000)
+    cmp_pj: float = _f(
+        0.1, "pJ", "Compare, min or max of two floats at 45 nm (a 32-bit integer add)", 0, 1000
+    )
+    fp_add_um2: float = _f(4184.0, "um^2", "32-bit floating-point adder area at 45 nm", 0, 1e7)
+    fp_mul_um2: float = _f(
+        7700.0, "um^2", "32-bit floating-point multiplier area at 45 nm", 0, 1e7
+    )
+    cmp_um2: float = _f(
+        137.0, "um^2", "Comparator area at 45 nm (a 32-bit integer adder)", 0, 1e7
+    )
+    datapath_overhead: float = _f(
+        1.5,
+        "x",
+        "Pipeline registers, operand muxes and control, as a multiple of the arithmetic's "
+        "energy and area",
+        1,
+        100,
+    )
+    sram_pj_64b: float = _f(
+        10.0,
+        "pJ",
+        "64-bit read of an 8 KiB SRAM at 45 nm (wider accesses scale per bit)",
+        0,
+        10000,
+    )
+    sram_size_exponent: float = _f(
+        0.5, "", "SRAM access energy grows as (size / 8 KiB) to this power", 0, 2
+    )
+    sram_mm2_per_mib: float = _f(5.8, "mm^2/MiB", "SRAM area per MiB of data at 45 nm", 0, 1000)
+    sram_tag_overhead: float = _f(
+        0.08,
+        "fraction",
+        "Cache tag and state bits as a fraction of data bits (area and access energy)",
+        0,
+        1,
+    )
+    leakage_mw_per_mm2: float = _f(
+        50.0,
+        "mW/mm^2",
+        "Static (leakage) power per mm^2 of SRAM and datapath at the configured node",
+        0,
+        10000,
+    )
+
+
+@dataclass
 class SimConfig:
     """The whole simulator config: the root of the tree rtsim-sim reads with --config."""
 
@@ -255,6 +334,7 @@ class SimConfig:
     dram: DramConfig = field(default_factory=DramConfig)
     treelets: TreeletConfig = field(default_factory=TreeletConfig)
     sampling: SamplingConfig = field(default_factory=SamplingConfig)
+    energy: EnergyConfig = field(default_factory=EnergyConfig)
 
     sections: ClassVar[tuple[str, ...]] = (
         "dispatch",
@@ -267,6 +347,7 @@ class SimConfig:
         "dram",
         "treelets",
         "sampling",
+        "energy",
     )
 
     def to_dict(self) -> dict[str, Any]:

@@ -8,6 +8,7 @@
 
 #include "rtl_model/top/top.h"
 #include "sim/harness/analytic.h"
+#include "sim/harness/energy_area.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
@@ -184,6 +185,9 @@ SimOutcome run_simulation(const SimOptions& o) {
         apply_sampling_to_summary(out.stats["summary"], o.config, sampled->plan, sampled->estimator);
         out.stats["sampling"] = sampled->estimator.to_json(o.config, cycles, wall);
     }
+    // Energy and area from the run's counts and config (docs/energy_area.md); the timed model
+    // never sees them.
+    add_energy_area(out.stats, o.config, checker.work_totals(), checker.checked());
     write_json(fs::path(o.out_dir) / "stats.json", out.stats);
     write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
     out.exit_code = (checker.hit_mismatches() || checker.work_mismatches()) ? 3 : 0;
