@@ -499,6 +499,72 @@ PRESETS: dict[str, dict[str, Any]] = {
     "detailed": {"fidelity": "detailed"},
 }
 
+# Presets from published machines (docs/presets.md gives each number's source and what has no
+# counterpart here). RT units of NVIDIA Turing as Vulkan-Sim models them (Saed et al., MICRO 2022:
+# configs/tested-cfgs/SM75_RTX2060/gpgpusim.config): one RT unit per SM with 4 warps of rays
+# (128) in flight, 64 MSHRs, the SM's 64 KiB L1 (128-byte lines, 4 banks, 20 cycles), a banked
+# L2 (160 cycles), GDDR6 channels of 16 bits at 14 Gbps (28 GB/s each). Chip totals from NVIDIA's
+# Turing architecture whitepaper (2018): SMs, clocks, L2 size, memory bus.
+_TURING_RT_UNIT: dict[str, Any] = {
+    "traversal": {"ray_contexts": 128},
+    "l1": {"size_kib": 64, "ways": 16, "line_bytes": 128, "latency": 20, "mshrs": 64, "banks": 4},
+    "l2": {"ways": 16, "line_bytes": 128, "latency": 160, "mshrs": 1024},
+    "dram": {"latency": 100, "interleave_bytes": 256},
+    "energy": {"node_nm": 12.0, "dram_kind": "gddr6"},
+}
+
+
+def _merge(base: dict[str, Any], patch: dict[str, Any]) -> dict[str, Any]:
+    out = copy.deepcopy(base)
+    for key, value in patch.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+PRESETS.update(
+    {
+        # RTX 2060 (TU106): 30 SMs at 1365 MHz base, 3 MB L2 (24 ways keeps the sets a power of
+        # two), 192-bit GDDR6 at 14 Gbps = 336 GB/s: 12 channels of 20 B/cycle = 328 GB/s.
+        "rtx2060": _merge(
+            _TURING_RT_UNIT,
+            {
+                "clock_ghz": 1.365,
+                "traversal": {"units": 30},
+                "l2": {"size_kib": 3072, "ways": 24, "banks": 24},
+                "dram": {"channels": 12, "bytes_per_cycle": 20},
+            },
+        ),
+        # RTX 2080 (TU104): 46 SMs at 1515 MHz base, 4 MB L2, 256-bit GDDR6 at 14 Gbps = 448 GB/s:
+        # 16 channels of 18 B/cycle = 436 GB/s.
+        "rtx2080": _merge(
+            _TURING_RT_UNIT,
+            {
+                "clock_ghz": 1.515,
+                "traversal": {"units": 46},
+                "l2": {"size_kib": 4096, "banks": 32},
+                "dram": {"channels": 16, "bytes_per_cycle": 18},
+            },
+        ),
+        # STRaTA (Kopta et al., HPG 2013): TRaX thread multiprocessors with treelet ray streams in
+        # on-chip SRAM. Numbers from Arches' STRaTA "modern config" (src/arches/strata.hpp): 2 GHz,
+        # 128 TMs with one RT core of 256 rays each, 128 KiB 4-way L1 per TM (8 banks, 30 cycles,
+        # 256 MSHRs), 512 KiB 8-way L2 (32 banks, 200 cycles, 256 MSHRs), a 4 MiB ray stream
+        # buffer (latency L1 + L2), 16 DRAM channels (GDDR5 under Ramulator; 16 B/cycle assumed).
+        "strata": {
+            "clock_ghz": 2.0,
+            "traversal": {"units": 128, "ray_contexts": 256},
+            "l1": {"size_kib": 128, "ways": 4, "latency": 30, "mshrs": 256, "banks": 8},
+            "l2": {"size_kib": 512, "ways": 8, "latency": 200, "mshrs": 256, "banks": 32},
+            "treelets": {"enabled": True, "buffer_kib": 4096, "latency": 230},
+            "dram": {"channels": 16, "bytes_per_cycle": 16},
+            "energy": {"node_nm": 7.0, "dram_kind": "gddr6"},
+        },
+    }
+)
+
 MODIFIERS: dict[str, dict[str, Any]] = {
     "tu4": {"traversal": {"units": 4}},
     "tu16": {"traversal": {"units": 16}},
