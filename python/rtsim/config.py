@@ -257,12 +257,8 @@ class EnergyConfig:
         0.1, "pJ", "Compare, min or max of two floats at 45 nm (a 32-bit integer add)", 0, 1000
     )
     fp_add_um2: float = _f(4184.0, "um^2", "32-bit floating-point adder area at 45 nm", 0, 1e7)
-    fp_mul_um2: float = _f(
-        7700.0, "um^2", "32-bit floating-point multiplier area at 45 nm", 0, 1e7
-    )
-    cmp_um2: float = _f(
-        137.0, "um^2", "Comparator area at 45 nm (a 32-bit integer adder)", 0, 1e7
-    )
+    fp_mul_um2: float = _f(7700.0, "um^2", "32-bit floating-point multiplier area at 45 nm", 0, 1e7)
+    cmp_um2: float = _f(137.0, "um^2", "Comparator area at 45 nm (a 32-bit integer adder)", 0, 1e7)
     datapath_overhead: float = _f(
         1.5,
         "x",
