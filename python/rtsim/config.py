@@ -325,8 +325,9 @@ class SimConfig:
     box: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 2, "private", 4))
     triangle: PipelineConfig = field(default_factory=lambda: PipelineConfig(20, 1, 1, "private", 4))
     anyhit: PipelineConfig = field(default_factory=lambda: PipelineConfig(10, 1, 1, "private", 4))
-    l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 8, 1, 1))
-    l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 32, 8, 1))
+    # MSHRs: docs/presets.md, "How the defaults were chosen".
+    l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 16, 1, 1))
+    l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 64, 8, 1))
     dram: DramConfig = field(default_factory=DramConfig)
     treelets: TreeletConfig = field(default_factory=TreeletConfig)
     sampling: SamplingConfig = field(default_factory=SamplingConfig)

@@ -38,8 +38,10 @@ struct SimConfig {
     PipelineConfig box{8, 1, 2, Sharing::per_unit, 4};
     PipelineConfig triangle{20, 1, 1, Sharing::per_unit, 4};
     PipelineConfig anyhit{10, 1, 1, Sharing::per_unit, 4};
-    CacheConfig l1{16, 4, 64, 4, 8, 1, 1};
-    CacheConfig l2{1024, 16, 64, 20, 32, 8, 1};
+    // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
+    // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
+    CacheConfig l1{16, 4, 64, 4, 16, 1, 1};
+    CacheConfig l2{1024, 16, 64, 20, 64, 8, 1};
     DramConfig dram;
     TreeletConfig treelets;
     SamplingConfig sampling;
