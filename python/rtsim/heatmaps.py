@@ -64,9 +64,9 @@ def panels(work: PixelWork) -> list[tuple[np.ndarray, str]]:
     """The panels worth drawing: primary rays and all rays, but not an empty primary panel (no
     primary rays) and not the same picture twice (only primary rays)."""
     if work.primary_rays == 0:
-        return [(work.all_rays, "all rays (no primary rays in this trace)")]
+        return [(work.all_rays, "all rays (no primary rays)")]
     if work.other_rays == 0:
-        return [(work.primary, "primary rays (the only rays in this trace)")]
+        return [(work.primary, "primary rays (the only kind)")]
     return [(work.primary, "primary rays"), (work.all_rays, "all rays")]
 
 
@@ -84,7 +84,7 @@ def _draw(work: PixelWork, label: str, scene: str, path: Path) -> None:
     from matplotlib.figure import Figure
 
     shown = panels(work)
-    fig = Figure(figsize=(5.6 * len(shown), 4.4), layout="constrained")
+    fig = Figure(figsize=(6.2 if len(shown) == 1 else 11.0, 4.4), layout="constrained")
     axes = fig.subplots(1, len(shown), squeeze=False)[0]
     for ax, (data, which) in zip(axes, shown, strict=True):
         # Each panel on its own scale: primary work is a fraction of the total.

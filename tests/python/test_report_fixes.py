@@ -69,10 +69,10 @@ def test_marginal_plot_splits_categorical_keys() -> None:
     assert fig is not None
     ax = fig.axes[0]  # rays/s against l1.size_kib
     lines = lines_of(ax)
-    assert set(lines) == {"hairball / diffuse · no treelets", "hairball / diffuse · treelets"}
+    assert set(lines) == {"diffuse · no treelets", "diffuse · treelets"}
     # Each line is one machine: treelets off ~11-14, on ~41-44 (a mixed median would be ~25).
-    assert max(lines["hairball / diffuse · no treelets"]) < 15
-    assert min(lines["hairball / diffuse · treelets"]) > 40
+    assert max(lines["diffuse · no treelets"]) < 15
+    assert min(lines["diffuse · treelets"]) > 40
 
 
 def test_treelets_off_label_has_no_buffer_size() -> None:
@@ -170,10 +170,10 @@ def test_heatmap_scale_clips_outliers() -> None:
 def test_heatmap_panels_follow_the_rays_present() -> None:
     z = np.zeros((2, 2))
     assert [t for _, t in heatmaps.panels(work(z, z + 1, 0, 4))] == [
-        "all rays (no primary rays in this trace)"
+        "all rays (no primary rays)"
     ]
     assert [t for _, t in heatmaps.panels(work(z + 1, z + 1, 4, 0))] == [
-        "primary rays (the only rays in this trace)"
+        "primary rays (the only kind)"
     ]
     assert len(heatmaps.panels(work(z + 1, z + 2, 4, 4))) == 2
 

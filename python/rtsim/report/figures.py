@@ -197,6 +197,7 @@ def _versus_key(
     key: str,
     groups: list[Group],
     metric: Callable[[RunRecord], float | None],
+    name: Callable[[Group], str] = lambda g: g.title,
 ) -> None:
     """metric against one swept key: a line per group and category (the other categorical keys)
     through the median over the other numeric keys, a band from min to max."""
@@ -217,7 +218,7 @@ def _versus_key(
             if not vs:
                 continue
             x = [xs[v] for v in vs]
-            label = g.title + (f" · {cat}" if cat else "")
+            label = name(g) + (f" · {cat}" if cat else "")
             ax.plot(
                 x,
                 [statistics.median(by_value[v]) for v in vs],
@@ -279,7 +280,9 @@ def rays_per_second(data: SweepData) -> Figure | None:
     for row, scene in enumerate(scenes):
         for col, key in enumerate(keys):
             ax = axes[row][col]
-            _versus_key(ax, data, key, [g for g in groups if g.scene == scene], mrays)
+            # A row per scene: the lines are named by workload (and category) alone.
+            row_groups = [g for g in groups if g.scene == scene]
+            _versus_key(ax, data, key, row_groups, mrays, lambda g: g.workload)
             ax.set_ylabel("simulated Mrays/s")
             ax.set_ylim(bottom=0)
             ax.set_title(f"{scene}: rays/s against {key}", fontsize=11)
@@ -413,7 +416,7 @@ def speedup(data: SweepData) -> Figure | None:
         ax.grid(axis="y", visible=False)
         ax.tick_params(axis="y", labelsize=8)
     fig.suptitle("Speed-up over the baseline configuration (grey; blue faster, red slower)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
     return fig
 
 
