@@ -278,6 +278,16 @@ def markdown_table(rows: list[Row]) -> str:
 
 
 def plot(rows: list[Row], path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    fig = accuracy_figure(rows)
+    # bbox_inches="tight": whatever the panel count, nothing outside the axes is cut off.
+    fig.savefig(path, dpi=72, bbox_inches="tight")
+    plt.close(fig)
+
+
+def accuracy_figure(rows: list[Row]) -> Any:
+    """Wall time against |error| per scene and workload, one colour per level."""
     import matplotlib
     import matplotlib.ticker
 
@@ -359,11 +369,15 @@ def plot(rows: list[Row], path: Path) -> None:
         plt.Line2D([], [], color=c, marker="o", ls="", label=lvl) for lvl, c in colors.items()
     ]
     handles += [plt.Line2D([], [], color="black", marker="^", ls="", label="sampled (% of rays)")]
-    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
+    # One legend row under two panels; under one panel the five entries need two rows.
+    ncol = len(handles) if cols > 1 else 3
+    legend = fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=9, frameon=False)
     fig.suptitle("Fidelity levels and sampling: wall time against error in cycles", fontsize=12)
-    fig.tight_layout(rect=(0, 0.05, 1, 0.97))
-    fig.savefig(path, dpi=72)
-    plt.close(fig)
+    # Leave the legend's own height at the bottom (measured, so it fits at any size).
+    fig.canvas.draw()
+    height = legend.get_window_extent().height / fig.bbox.height
+    fig.tight_layout(rect=(0, height + 0.01, 1, 0.97))
+    return fig
 
 
 def parse_fractions(text: str) -> list[float]:

@@ -220,6 +220,81 @@ class TreeletConfig:
 
 
 @dataclass
+class EnergyConfig:
+    """The first-order energy and area model's technology (docs/energy_area.md): 45 nm reference
+    figures (Horowitz, ISSCC 2014) scaled to node_nm (Stillmaker & Baas 2017)."""
+
+    node_nm: float = _f(
+        7.0,
+        "nm",
+        "Technology node; 45 nm reference figures are scaled to it (Stillmaker & Baas 2017)",
+        7,
+        130,
+    )
+    vdd: float = _f(
+        0.0,
+        "V",
+        "Supply voltage for the energy scaling (0: the node's nominal voltage, "
+        "docs/energy_area.md)",
+        0,
+        2,
+    )
+    dram_kind: str = _choice(
+        "gddr6",
+        ("gddr6", "lpddr5", "hbm2", "ddr4"),
+        "DRAM kind: picks the energy per bit moved (docs/energy_area.md)",
+    )
+    dram_pj_per_bit: float = _f(
+        0.0,
+        "pJ/bit",
+        "DRAM energy per bit read or written, overriding the kind's figure (0: the kind's)",
+        0,
+        1000,
+    )
+    fp_add_pj: float = _f(0.9, "pJ", "32-bit floating-point add (or subtract) at 45 nm", 0, 1000)
+    fp_mul_pj: float = _f(3.7, "pJ", "32-bit floating-point multiply at 45 nm", 0, 1000)
+    cmp_pj: float = _f(
+        0.1, "pJ", "Compare, min or max of two floats at 45 nm (a 32-bit integer add)", 0, 1000
+    )
+    fp_add_um2: float = _f(4184.0, "um^2", "32-bit floating-point adder area at 45 nm", 0, 1e7)
+    fp_mul_um2: float = _f(7700.0, "um^2", "32-bit floating-point multiplier area at 45 nm", 0, 1e7)
+    cmp_um2: float = _f(137.0, "um^2", "Comparator area at 45 nm (a 32-bit integer adder)", 0, 1e7)
+    datapath_overhead: float = _f(
+        1.5,
+        "x",
+        "Pipeline registers, operand muxes and control, as a multiple of the arithmetic's "
+        "energy and area",
+        1,
+        100,
+    )
+    sram_pj_64b: float = _f(
+        10.0,
+        "pJ",
+        "64-bit read of an 8 KiB SRAM at 45 nm (wider accesses scale per bit)",
+        0,
+        10000,
+    )
+    sram_size_exponent: float = _f(
+        0.5, "", "SRAM access energy grows as (size / 8 KiB) to this power", 0, 2
+    )
+    sram_mm2_per_mib: float = _f(5.8, "mm^2/MiB", "SRAM area per MiB of data at 45 nm", 0, 1000)
+    sram_tag_overhead: float = _f(
+        0.08,
+        "fraction",
+        "Cache tag and state bits as a fraction of data bits (area and access energy)",
+        0,
+        1,
+    )
+    leakage_mw_per_mm2: float = _f(
+        50.0,
+        "mW/mm^2",
+        "Static (leakage) power per mm^2 of SRAM and datapath at the configured node",
+        0,
+        10000,
+    )
+
+
+@dataclass
 class SimConfig:
     """The whole simulator config: the root of the tree rtsim-sim reads with --config."""
 
@@ -250,11 +325,13 @@ class SimConfig:
     box: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 2, "private", 4))
     triangle: PipelineConfig = field(default_factory=lambda: PipelineConfig(20, 1, 1, "private", 4))
     anyhit: PipelineConfig = field(default_factory=lambda: PipelineConfig(10, 1, 1, "private", 4))
-    l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 8, 1, 1))
-    l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 32, 8, 1))
+    # MSHRs: docs/presets.md, "How the defaults were chosen".
+    l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 16, 1, 1))
+    l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 64, 8, 1))
     dram: DramConfig = field(default_factory=DramConfig)
     treelets: TreeletConfig = field(default_factory=TreeletConfig)
     sampling: SamplingConfig = field(default_factory=SamplingConfig)
+    energy: EnergyConfig = field(default_factory=EnergyConfig)
 
     sections: ClassVar[tuple[str, ...]] = (
         "dispatch",
@@ -267,6 +344,7 @@ class SimConfig:
         "dram",
         "treelets",
         "sampling",
+        "energy",
     )
 
     def to_dict(self) -> dict[str, Any]:
@@ -417,6 +495,72 @@ PRESETS: dict[str, dict[str, Any]] = {
     "analytic": {"fidelity": "analytic"},
     "detailed": {"fidelity": "detailed"},
 }
+
+# Presets from published machines (docs/presets.md gives each number's source and what has no
+# counterpart here). RT units of NVIDIA Turing as Vulkan-Sim models them (Saed et al., MICRO 2022:
+# configs/tested-cfgs/SM75_RTX2060/gpgpusim.config): one RT unit per SM with 4 warps of rays
+# (128) in flight, 64 MSHRs, the SM's 64 KiB L1 (128-byte lines, 4 banks, 20 cycles), a banked
+# L2 (160 cycles), GDDR6 channels of 16 bits at 14 Gbps (28 GB/s each). Chip totals from NVIDIA's
+# Turing architecture whitepaper (2018): SMs, clocks, L2 size, memory bus.
+_TURING_RT_UNIT: dict[str, Any] = {
+    "traversal": {"ray_contexts": 128},
+    "l1": {"size_kib": 64, "ways": 16, "line_bytes": 128, "latency": 20, "mshrs": 64, "banks": 4},
+    "l2": {"ways": 16, "line_bytes": 128, "latency": 160, "mshrs": 1024},
+    "dram": {"latency": 100, "interleave_bytes": 256},
+    "energy": {"node_nm": 12.0, "dram_kind": "gddr6"},
+}
+
+
+def _merge(base: dict[str, Any], patch: dict[str, Any]) -> dict[str, Any]:
+    out = copy.deepcopy(base)
+    for key, value in patch.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+PRESETS.update(
+    {
+        # RTX 2060 (TU106): 30 SMs at 1365 MHz base, 3 MB L2 (24 ways keeps the sets a power of
+        # two), 192-bit GDDR6 at 14 Gbps = 336 GB/s: 12 channels of 20 B/cycle = 328 GB/s.
+        "rtx2060": _merge(
+            _TURING_RT_UNIT,
+            {
+                "clock_ghz": 1.365,
+                "traversal": {"units": 30},
+                "l2": {"size_kib": 3072, "ways": 24, "banks": 24},
+                "dram": {"channels": 12, "bytes_per_cycle": 20},
+            },
+        ),
+        # RTX 2080 (TU104): 46 SMs at 1515 MHz base, 4 MB L2, 256-bit GDDR6 at 14 Gbps = 448 GB/s:
+        # 16 channels of 18 B/cycle = 436 GB/s.
+        "rtx2080": _merge(
+            _TURING_RT_UNIT,
+            {
+                "clock_ghz": 1.515,
+                "traversal": {"units": 46},
+                "l2": {"size_kib": 4096, "banks": 32},
+                "dram": {"channels": 16, "bytes_per_cycle": 18},
+            },
+        ),
+        # STRaTA (Kopta et al., HPG 2013): TRaX thread multiprocessors with treelet ray streams in
+        # on-chip SRAM. Numbers from Arches' STRaTA "modern config" (src/arches/strata.hpp): 2 GHz,
+        # 128 TMs with one RT core of 256 rays each, 128 KiB 4-way L1 per TM (8 banks, 30 cycles,
+        # 256 MSHRs), 512 KiB 8-way L2 (32 banks, 200 cycles, 256 MSHRs), a 4 MiB ray stream
+        # buffer (latency L1 + L2), 16 DRAM channels (GDDR5 under Ramulator; 16 B/cycle assumed).
+        "strata": {
+            "clock_ghz": 2.0,
+            "traversal": {"units": 128, "ray_contexts": 256},
+            "l1": {"size_kib": 128, "ways": 4, "latency": 30, "mshrs": 256, "banks": 8},
+            "l2": {"size_kib": 512, "ways": 8, "latency": 200, "mshrs": 256, "banks": 32},
+            "treelets": {"enabled": True, "buffer_kib": 4096, "latency": 230},
+            "dram": {"channels": 16, "bytes_per_cycle": 16},
+            "energy": {"node_nm": 7.0, "dram_kind": "gddr6"},
+        },
+    }
+)
 
 MODIFIERS: dict[str, dict[str, Any]] = {
     "tu4": {"traversal": {"units": 4}},

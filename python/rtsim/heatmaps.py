@@ -1,8 +1,11 @@
 """Heatmaps of traversal work per pixel, drawn from a trace folder.
 
 Each figure has two panels: the work of primary rays alone, and the work of every ray that
-descends from the pixel (shadow, reflection, diffuse, ... rays carry their pixel). The trace is
-read in chunks of its memory maps, so memory stays bounded whatever the ray count.
+descends from the pixel (shadow, reflection, diffuse, ... rays carry their pixel). A trace
+without primary rays has only the second panel, and one with only primary rays only the first
+(the two would be the same). The colour scale ends at the 99.5th percentile of the pixels, so a
+few very costly pixels do not turn the rest black; pixels above it show the top colour. The trace
+is read in chunks of its memory maps, so memory stays bounded whatever the ray count.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from rtsim.trace_file import Trace
 
 CHUNK_RAYS = 1 << 20
 PRIMARY = 0
+CLIP_PERCENTILE = 99.5
 
 
 @dataclass(frozen=True)
@@ -26,12 +30,15 @@ class PixelWork:
     counter: str
     primary: np.ndarray
     all_rays: np.ndarray
+    primary_rays: int = 0  # rays of kind primary inside the image
+    other_rays: int = 0  # rays of any other kind inside the image
 
 
 def pixel_work(trace: Trace, width: int, height: int, counters: tuple[str, ...]) -> list[PixelWork]:
     """Sums each work counter per pixel with np.bincount, chunk by chunk."""
     pixels = width * height
     sums = {c: (np.zeros(pixels), np.zeros(pixels)) for c in counters}
+    n_primary = n_other = 0
     rays, work = trace.rays, trace.work
     if len(rays) != len(work):
         raise ValueError(f"{trace.path}: {len(rays)} rays but {len(work)} work records")
@@ -41,31 +48,58 @@ def pixel_work(trace: Trace, width: int, height: int, counters: tuple[str, ...])
         pixel = np.asarray(r["pixel"], dtype=np.int64)
         inside = pixel < pixels
         primary = inside & (np.asarray(r["kind"]) == PRIMARY)
+        n_primary += int(primary.sum())
+        n_other += int(inside.sum()) - int(primary.sum())
         for c in counters:
             values = np.asarray(w[c], dtype=np.float64)
             sums[c][0][:] += np.bincount(pixel[primary], values[primary], minlength=pixels)
             sums[c][1][:] += np.bincount(pixel[inside], values[inside], minlength=pixels)
     return [
-        PixelWork(c, p.reshape(height, width), a.reshape(height, width))
+        PixelWork(c, p.reshape(height, width), a.reshape(height, width), n_primary, n_other)
         for c, (p, a) in sums.items()
     ]
+
+
+def panels(work: PixelWork) -> list[tuple[np.ndarray, str]]:
+    """The panels worth drawing: primary rays and all rays, but not an empty primary panel (no
+    primary rays) and not the same picture twice (only primary rays)."""
+    if work.primary_rays == 0:
+        return [(work.all_rays, "all rays (no primary rays)")]
+    if work.other_rays == 0:
+        return [(work.primary, "primary rays (the only kind)")]
+    return [(work.primary, "primary rays"), (work.all_rays, "all rays")]
+
+
+def color_limit(data: np.ndarray) -> float:
+    """Top of the colour scale: the CLIP_PERCENTILE-th percentile of the pixels with work, so a
+    handful of extreme pixels (a ray grazing many thin triangles) cannot darken the image."""
+    values = data[data > 0]
+    if values.size == 0:
+        return 1.0
+    return max(float(np.percentile(values, CLIP_PERCENTILE)), 1.0)
 
 
 def _draw(work: PixelWork, label: str, scene: str, path: Path) -> None:
     # The object-oriented API: no pyplot global state, safe without a display.
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(11, 4.4), layout="constrained")
-    axes = fig.subplots(1, 2)
-    for ax, data, which in zip(
-        axes, (work.primary, work.all_rays), ("primary rays", "all rays"), strict=True
-    ):
+    shown = panels(work)
+    fig = Figure(figsize=(6.2 if len(shown) == 1 else 11.0, 4.4), layout="constrained")
+    axes = fig.subplots(1, len(shown), squeeze=False)[0]
+    for ax, (data, which) in zip(axes, shown, strict=True):
         # Each panel on its own scale: primary work is a fraction of the total.
-        vmax = max(float(data.max(initial=0.0)), 1.0)
+        vmax = color_limit(data)
         image = ax.imshow(data, cmap="inferno", vmin=0.0, vmax=vmax, interpolation="nearest")
         ax.set_title(f"{which}: mean {data.mean():.1f}, max {data.max(initial=0.0):.0f}")
         ax.set_axis_off()
-        fig.colorbar(image, ax=ax, shrink=0.85, label=f"{label} per pixel")
+        clipped = float(data.max(initial=0.0)) > vmax
+        fig.colorbar(
+            image,
+            ax=ax,
+            shrink=0.85,
+            extend="max" if clipped else "neither",
+            label=f"{label} per pixel" + (f" (clipped at p{CLIP_PERCENTILE:g})" if clipped else ""),
+        )
     fig.suptitle(f"{scene}: {label} per pixel")
     fig.savefig(path, dpi=110)
 

@@ -106,6 +106,28 @@ def utilisation_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def energy_table(stats: dict[str, Any]) -> Table:
+    """Energy per ray by block, efficiency, power and area (docs/energy_area.md)."""
+    s = stats.get("summary", {}) or {}
+    e = stats.get("energy", {}) or {}
+    table = _two_column(
+        f"energy and area (first-order model at {fmt_float(e.get('node_nm'), 0)} nm, "
+        f"{e.get('dram_kind', '?')}; docs/energy_area.md)"
+    )
+    table.add_row("energy / ray (nJ)", fmt_float(s.get("energy_per_ray_nj"), 2))
+    per_ray = e.get("per_ray_nj", {}) or {}
+    parts = sorted(
+        ((k, v) for k, v in per_ray.items() if k != "total" and _is_num(v) and v > 0),
+        key=lambda kv: -kv[1],
+    )
+    if parts:
+        table.add_row("  by block (nJ)", ", ".join(f"{k} {v:.3g}" for k, v in parts))
+    table.add_row("Mrays / J", fmt_float(s.get("mrays_per_joule"), 1))
+    table.add_row("power (W)", fmt_float(s.get("power_w"), 3))
+    table.add_row("area (mm^2)", fmt_float(s.get("area_mm2"), 3))
+    return table
+
+
 def latency_table(stats: dict[str, Any]) -> Table:
     lat = stats.get("latency", {}) or {}
     table = Table(title="ray latency (cycles)", title_justify="left")
@@ -143,6 +165,8 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         console.print(utilisation_table(stats))
         console.print(latency_table(stats))
         console.print(instantiated_table(stats))
+    if stats.get("energy"):
+        console.print(energy_table(stats))
     if stats.get("effects"):
         console.print(effects_table({"effects": stats["effects"]}))
 

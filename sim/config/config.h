@@ -18,6 +18,7 @@
 #include "rtl_model/mem/dram_config.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
 #include "rtl_model/traversal/traversal_config.h"
+#include "sim/harness/energy_config.h"
 #include "sim/harness/sampling_config.h"
 #include "traces/accel/step_plan.h"
 
@@ -37,11 +38,14 @@ struct SimConfig {
     PipelineConfig box{8, 1, 2, Sharing::per_unit, 4};
     PipelineConfig triangle{20, 1, 1, Sharing::per_unit, 4};
     PipelineConfig anyhit{10, 1, 1, Sharing::per_unit, 4};
-    CacheConfig l1{16, 4, 64, 4, 8, 1, 1};
-    CacheConfig l2{1024, 16, 64, 20, 32, 8, 1};
+    // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
+    // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
+    CacheConfig l1{16, 4, 64, 4, 16, 1, 1};
+    CacheConfig l2{1024, 16, 64, 20, 64, 8, 1};
     DramConfig dram;
     TreeletConfig treelets;
     SamplingConfig sampling;
+    EnergyConfig energy;  ///< the energy and area model's technology (sim/harness/energy_area.h)
 
     /// The pipeline operations of `kind` go to. Adding an operation kind adds a PipelineConfig
     /// member, its visit() line and a case here (docs/accel.md, "Adding a structure").
@@ -65,6 +69,7 @@ struct SimConfig {
         v.section("dram", dram);
         v.section("treelets", treelets);
         v.section("sampling", sampling);
+        v.section("energy", energy);
     }
 };
 

@@ -49,6 +49,7 @@ void HitChecker::ray_done(const RayResult& r) {
     }
     m_reference.checked(r.id);
     m_latency.add(r.end - r.start);
+    m_work.add(r.work);
     if (on_ray) on_ray(r);
     ++m_checked;
     if (m_progress && (m_checked % 4096 == 0 || m_checked == m_total)) m_progress(m_checked, m_total);

@@ -16,6 +16,23 @@
 
 namespace rtsim {
 
+/// Work summed over the rays checked (64-bit: a frame's box tests overflow 32 bits). The energy
+/// model (sim/harness/energy_area.h) prices these operations at every fidelity level.
+struct WorkTotals {
+    uint64_t steps = 0, box_tests = 0, tri_tests = 0, anyhit_calls = 0, transforms = 0, cell_steps = 0,
+             plane_tests = 0, refs = 0;
+    void add(const WorkCounts& w) {
+        steps += w.steps;
+        box_tests += w.box_tests;
+        tri_tests += w.tri_tests;
+        anyhit_calls += w.anyhit_calls;
+        transforms += w.transforms;
+        cell_steps += w.cell_steps;
+        plane_tests += w.plane_tests;
+        refs += w.refs;
+    }
+};
+
 class HitChecker : public sc_core::sc_module, public RaySinkIf {
 public:
     using Progress = std::function<void(uint64_t done, uint64_t total)>;
@@ -27,6 +44,8 @@ public:
     uint64_t hit_mismatches() const { return m_hit_mismatches; }
     uint64_t work_mismatches() const { return m_work_mismatches; }
     const LatencyHistogram& latency() const { return m_latency; }
+    /// The model's work over every ray checked (equal to the reference's when there are no mismatches).
+    const WorkTotals& work_totals() const { return m_work; }
     nlohmann::json to_json() const;
     /// Optional per-ray hook (the timeline records ray residency through it).
     std::function<void(const RayResult&)> on_ray;
@@ -38,6 +57,7 @@ private:
     uint64_t m_checked = 0, m_hit_mismatches = 0, m_work_mismatches = 0;
     nlohmann::json m_examples = nlohmann::json::array();
     LatencyHistogram m_latency;
+    WorkTotals m_work;
 };
 
 /// Compares one result with the reference; returns "" when equal, else a description.

@@ -8,6 +8,7 @@
 
 #include "rtl_model/top/top.h"
 #include "sim/harness/analytic.h"
+#include "sim/harness/energy_area.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/roofline.h"
 #include "sim/harness/sampling.h"
@@ -186,6 +187,9 @@ SimOutcome run_simulation(const SimOptions& o) {
         apply_sampling_to_summary(out.stats["summary"], o.config, sampled->plan, sampled->estimator);
         out.stats["sampling"] = sampled->estimator.to_json(o.config, cycles, wall);
     }
+    // Energy and area from the run's counts and config (docs/energy_area.md); the timed model
+    // never sees them.
+    add_energy_area(out.stats, o.config, checker.work_totals(), checker.checked());
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);
     json verdict = nullptr;
     if (o.verdict && o.config.fidelity != Fidelity::functional && total > 0)

@@ -114,7 +114,7 @@ def test_detailed_reports_row_buffer_outcomes(hairball: Path, sim: Sim, tmp_path
         assert outcomes == d["reads"] + d["writes"] > 0
         assert sum(b["accesses"] for b in d["by_bank"]) == outcomes
         assert d["page_policy"] == policy
-        assert stats["model"]["l2"]["config"]["mshrs"] == 32  # modelled at detailed
+        assert stats["model"]["l2"]["config"]["mshrs"] == 64  # modelled at detailed
     # Close page never finds a row open.
     assert runs["close"]["model"]["dram"]["row_hits"] == 0
     assert runs["close"]["model"]["dram"]["row_conflicts"] == 0

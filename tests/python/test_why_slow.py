@@ -123,7 +123,9 @@ def test_treelet_admission_does_not_swamp_the_l2_mshrs(
         sim, trace, tmp_path / "big", "treelets.enabled=true", "treelets.buffer_kib=8192"
     )
     l2, cycles = stats["model"]["l2"], stats["summary"]["cycles"]
-    units, l1_mshrs, admit = 8, 8, 16  # defaults
+    config = json.loads((tmp_path / "big" / "config.resolved.json").read_text())
+    units, l1_mshrs = config["traversal"]["units"], config["l1"]["mshrs"]
+    admit = config["treelets"]["admit_outstanding"]
     # At most every L1's MSHRs plus the admission engine wait at the L2 at once.
     assert l2["mshr_stall_cycles"] <= (units * l1_mshrs + admit) * cycles
     assert l2["by_kind"]["ray"]["reads"] > 0  # ray records are read through the L2 in treelet mode

@@ -1,13 +1,16 @@
 """A sweep's results as the report needs them: runs grouped by scene and workload, labels for
-config points, SRAM sizes and Pareto fronts."""
+config points, SRAM sizes, area and energy, the baseline point and Pareto fronts."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from rtsim.config import ConfigError, field_info
+import yaml
+
+from rtsim.config import ConfigError, field_info, flatten
 from rtsim.sweep.results import sram_bytes
 from rtsim.sweep.store import RunRecord, open_store
 
@@ -26,6 +29,24 @@ SHORT_KEYS: dict[str, tuple[str, str]] = {
 }
 # On/off keys: a word when on, nothing when off.
 FLAG_KEYS: dict[str, str] = {"treelets.enabled": "treelets", "ideal_memory": "ideal mem"}
+# Keys that do nothing unless a switch is on: (key prefix, switch). A treelets-off run is not
+# labelled with a ray-buffer size.
+INACTIVE_UNLESS: tuple[tuple[str, str], ...] = (("treelets.", "treelets.enabled"),)
+
+
+def key_active(key: str, config: dict[str, Any]) -> bool:
+    """False for a key whose switch is off in this run's config (treelets.buffer_kib without
+    treelets.enabled)."""
+    flat = flatten(config) if config else {}
+    for prefix, switch in INACTIVE_UNLESS:
+        if key.startswith(prefix) and key != switch and flat.get(switch) is False:
+            return False
+    return True
+
+
+def is_categorical(values: list[Any]) -> bool:
+    """Switches and named choices (treelets on/off, a preset name), not numbers."""
+    return bool(values) and all(isinstance(v, (bool, str)) for v in values)
 
 
 def short_label(key: str, value: Any) -> str:
@@ -70,9 +91,34 @@ class SweepData:
     keys: list[str]  # swept keys, in spec order
     runs: list[RunRecord]
 
+    # The spec's baseline point (swept key -> value) the report's speed-ups are measured against.
+    baseline: dict[str, Any] = field(default_factory=dict)
+
     def label(self, rec: RunRecord) -> str:
-        text = " · ".join(short_label(k, rec.params[k]) for k in self.keys if k in rec.params)
+        text = " · ".join(
+            short_label(k, rec.params[k])
+            for k in self.keys
+            if k in rec.params and key_active(k, rec.config)
+        )
         return text or rec.preset
+
+    def values(self, key: str) -> list[Any]:
+        """The distinct values of a swept key over the runs, in first-seen order."""
+        return list(dict.fromkeys(r.params[key] for r in self.runs if key in r.params))
+
+    def categorical_keys(self) -> list[str]:
+        return [k for k in self.keys if is_categorical(self.values(k))]
+
+    def baseline_run(self, runs: list[RunRecord]) -> RunRecord | None:
+        """The run among `runs` at the baseline point (inactive keys ignored), if there is one."""
+        for r in runs:
+            if all(
+                r.params.get(k) == v or not key_active(k, r.config)
+                for k, v in self.baseline.items()
+                if k in r.params
+            ):
+                return r
+        return None
 
     def groups(self) -> list[Group]:
         out: dict[tuple[str, str], Group] = {}
@@ -86,6 +132,29 @@ class SweepData:
         return None
 
 
+def spec_baseline(spec_text: str, runs: list[RunRecord], keys: list[str]) -> dict[str, Any]:
+    """The spec's `baseline` over the first value of each grid key; without a spec (or for keys
+    it does not list), each key's first value in the runs."""
+    try:
+        doc = yaml.safe_load(spec_text) if spec_text else {}
+    except yaml.YAMLError:
+        doc = {}
+    doc = doc if isinstance(doc, dict) else {}
+    grid = doc.get("grid") if isinstance(doc.get("grid"), dict) else {}
+    named = doc.get("baseline") if isinstance(doc.get("baseline"), dict) else {}
+    out: dict[str, Any] = {}
+    for k in keys:
+        if k in named:
+            out[k] = named[k]
+        elif isinstance(grid.get(k), list) and grid[k]:
+            out[k] = grid[k][0]
+        else:
+            first = next((r.params[k] for r in runs if k in r.params), None)
+            if first is not None:
+                out[k] = first
+    return out
+
+
 def load(sweep: Path) -> SweepData:
     with open_store(sweep, readonly=True) as store:
         meta = store.meta()
@@ -93,7 +162,8 @@ def load(sweep: Path) -> SweepData:
     keys = [k for k in meta.get("swept_keys", "").split(",") if k]
     for r in runs:
         keys += [k for k in r.params if k not in keys]
-    return SweepData(Path(sweep), meta, keys, runs)
+    baseline = spec_baseline(meta.get("spec", ""), runs, keys)
+    return SweepData(Path(sweep), meta, keys, runs, baseline)
 
 
 def mrays(rec: RunRecord) -> float:
@@ -104,10 +174,45 @@ def sram_kib(rec: RunRecord) -> float:
     return sram_bytes(rec.config) / 1024
 
 
-def pareto_front(runs: list[RunRecord]) -> list[RunRecord]:
-    """Runs no other run beats on both axes (less or equal SRAM and more rays/s), by SRAM."""
+def area_mm2(rec: RunRecord) -> float | None:
+    """Chip area of the run's config (the energy and area model, docs/energy_area.md)."""
+    v = rec.summary.get("area_mm2")
+    return float(v) if isinstance(v, (int, float)) else None
+
+
+def energy_nj(rec: RunRecord) -> float | None:
+    """Energy per ray in nJ (null at the functional level)."""
+    v = rec.summary.get("energy_per_ray_nj")
+    return float(v) if isinstance(v, (int, float)) else None
+
+
+@dataclass(frozen=True)
+class Cost:
+    """An x axis for a Pareto front: what a configuration costs."""
+
+    name: str
+    axis: str
+    unit: str
+    of: Callable[[RunRecord], float | None]
+
+
+COSTS: dict[str, Cost] = {
+    "sram": Cost(
+        "on-chip SRAM", "on-chip SRAM: L1s + L2 + stacks + ray buffer (KiB)", "KiB", sram_kib
+    ),
+    "area": Cost("area", "chip area: SRAM + pipelines (mm², docs/energy_area.md)", "mm²", area_mm2),
+    "energy": Cost("energy", "energy per ray (nJ, docs/energy_area.md)", "nJ/ray", energy_nj),
+}
+
+
+def pareto_front(
+    runs: list[RunRecord], cost: Callable[[RunRecord], float | None] = sram_kib
+) -> list[RunRecord]:
+    """Runs no other run beats on both axes (less or equal cost and more rays/s), by cost. Runs
+    without the cost (an older store, the functional level) are left out."""
     best: list[RunRecord] = []
-    for r in sorted(runs, key=lambda r: (sram_kib(r), -mrays(r))):
+    priced = [r for r in runs if cost(r) is not None]
+    for r in sorted(priced, key=lambda r: (cost(r), -mrays(r))):
         if not best or mrays(r) > mrays(best[-1]):
             best.append(r)
     return best

@@ -16,12 +16,14 @@ import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 from rtsim.report.data import (
+    COSTS,
     Group,
     SweepData,
     axis_label,
+    key_active,
     mrays,
     pareto_front,
-    sram_kib,
+    short_label,
 )
 from rtsim.sweep.results import DATA_KINDS, bytes_per_ray_by_kind
 from rtsim.sweep.store import RunRecord
@@ -172,49 +174,98 @@ def _numeric(values: list[Any]) -> bool:
     return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
 
 
+LINE_STYLES = ("-", "--", ":", "-.")
+
+
+def _categories(data: SweepData, key: str, runs: list[RunRecord]) -> dict[str, list[RunRecord]]:
+    """Runs split by the categorical swept keys other than `key` (treelets on/off, a preset):
+    a marginal plot over such runs would mix two machines in one line. Keys a run leaves inactive
+    (a ray-buffer size with treelets off) do not split it."""
+    cats = [k for k in data.categorical_keys() if k != key]
+    out: dict[str, list[RunRecord]] = {}
+    for r in runs:
+        name = " · ".join(
+            short_label(k, r.params[k]) for k in cats if k in r.params and key_active(k, r.config)
+        )
+        out.setdefault(name, []).append(r)
+    return out
+
+
 def _versus_key(
     ax: Any,
     data: SweepData,
     key: str,
     groups: list[Group],
     metric: Callable[[RunRecord], float | None],
+    name: Callable[[Group], str] = lambda g: g.title,
 ) -> None:
-    """metric against one swept key: a line per group through the median over the other keys,
-    a band from min to max, and every run as a faint dot."""
+    """metric against one swept key: a line per group and category (the other categorical keys)
+    through the median over the other numeric keys, a band from min to max."""
     values = sorted({r.params[key] for g in groups for r in g.ok if key in r.params}, key=str)
     numeric = _numeric(values)
     if numeric:
         values = sorted(values)
     xs = {v: (v if numeric else i) for i, v in enumerate(values)}
     for g, color in zip(groups, _line_colors(len(groups)), strict=True):
-        by_value: dict[Any, list[float]] = {}
-        for r in g.ok:
-            m = metric(r)
-            if key in r.params and m is not None:
-                by_value.setdefault(r.params[key], []).append(m)
-        vs = [v for v in values if v in by_value]
-        if not vs:
-            continue
-        x = [xs[v] for v in vs]
-        style = "o" if numeric and len(values) > 8 else "o-"  # sampled keys: points, no line
-        ax.plot(x, [statistics.median(by_value[v]) for v in vs], style, color=color, label=g.title)
-        ax.fill_between(
-            x,
-            [min(by_value[v]) for v in vs],
-            [max(by_value[v]) for v in vs],
-            color=color,
-            alpha=0.12,
-            lw=0,
-        )
+        cats = _categories(data, key, g.ok)
+        for (cat, runs), ls in zip(cats.items(), LINE_STYLES * 4, strict=False):
+            by_value: dict[Any, list[float]] = {}
+            for r in runs:
+                m = metric(r)
+                if key in r.params and m is not None:
+                    by_value.setdefault(r.params[key], []).append(m)
+            vs = [v for v in values if v in by_value]
+            if not vs:
+                continue
+            x = [xs[v] for v in vs]
+            label = name(g) + (f" · {cat}" if cat else "")
+            ax.plot(
+                x,
+                [statistics.median(by_value[v]) for v in vs],
+                marker="o",
+                ls="" if numeric and len(values) > 8 else ls,  # sampled keys: points only
+                color=color,
+                label=label,
+            )
+            ax.fill_between(
+                x,
+                [min(by_value[v]) for v in vs],
+                [max(by_value[v]) for v in vs],
+                color=color,
+                alpha=0.10,
+                lw=0,
+            )
+    _key_axis(ax, values, numeric, xs)
+    ax.set_xlabel(axis_label(key))
+
+
+def _powers_of_two(values: list[Any]) -> bool:
+    return all(
+        isinstance(v, int) and not isinstance(v, bool) and v > 0 and v & (v - 1) == 0
+        for v in values
+    )
+
+
+def _key_axis(ax: Any, values: list[Any], numeric: bool, xs: dict[Any, Any]) -> None:
+    """Swept values as ticks; a log-2 axis for wide numeric ranges, labelled with the plain
+    values (16, 32, 64), never 2^4."""
     if numeric and len(values) > 1 and min(values) > 0 and max(values) / min(values) >= 4:
         ax.set_xscale("log", base=2)
     if not numeric or len(values) <= 8:
-        ax.set_xticks([xs[v] for v in values], [f"{v:.3g}" if isinstance(v, float) else str(v)
-                                                for v in values])  # fmt: skip
+        ax.set_xticks([xs[v] for v in values], [_tick(v) for v in values])
+    elif ax.get_xscale() == "log" and _powers_of_two(values):
+        ax.xaxis.set_major_locator(matplotlib.ticker.LogLocator(base=2))
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     else:  # sampled keys: every run has its own value
         ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:.3g}"))
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.minorticks_off()
-    ax.set_xlabel(axis_label(key))
+
+
+def _tick(v: Any) -> str:
+    if isinstance(v, bool):
+        return "on" if v else "off"
+    return f"{v:.3g}" if isinstance(v, float) else str(v)
 
 
 def rays_per_second(data: SweepData) -> Figure | None:
@@ -229,7 +280,9 @@ def rays_per_second(data: SweepData) -> Figure | None:
     for row, scene in enumerate(scenes):
         for col, key in enumerate(keys):
             ax = axes[row][col]
-            _versus_key(ax, data, key, [g for g in groups if g.scene == scene], mrays)
+            # A row per scene: the lines are named by workload (and category) alone.
+            row_groups = [g for g in groups if g.scene == scene]
+            _versus_key(ax, data, key, row_groups, mrays, lambda g: g.workload)
             ax.set_ylabel("simulated Mrays/s")
             ax.set_ylim(bottom=0)
             ax.set_title(f"{scene}: rays/s against {key}", fontsize=11)
@@ -249,7 +302,7 @@ def _fig_legend(fig: Figure, ax: Any) -> None:
         names,
         loc="upper center",
         bbox_to_anchor=(0.5, 0.97),
-        ncol=len(names),
+        ncol=min(len(names), 4),
         frameon=False,
     )
 
@@ -278,25 +331,32 @@ def hit_rates(data: SweepData) -> Figure | None:
     return fig
 
 
-def pareto(data: SweepData) -> tuple[Figure | None, dict[str, list[RunRecord]]]:
-    groups = [g for g in data.groups() if g.ok]
+def pareto(
+    data: SweepData, cost_name: str = "sram"
+) -> tuple[Figure | None, dict[str, list[RunRecord]]]:
+    """Rays/s against a cost (COSTS: on-chip SRAM, chip area, energy per ray) with the Pareto
+    front per scene and workload."""
+    cost = COSTS[cost_name]
+    groups = [g for g in data.groups() if any(cost.of(r) is not None for r in g.ok)]
     if not groups:
         return None, {}
     fig, axes = _panels(len(groups), 7.0, 4.6)
     fronts: dict[str, list[RunRecord]] = {}
     for ax, g in zip(axes, groups, strict=True):
+        runs = [r for r in g.ok if cost.of(r) is not None]
+        xs = [float(cost.of(r) or 0) for r in runs]
         ax.scatter(
-            [sram_kib(r) for r in g.ok],
-            [mrays(r) for r in g.ok],
+            xs,
+            [mrays(r) for r in runs],
             s=22,
             color="#A0A0A0",
             label="every configuration",
             zorder=2,
         )
-        front = pareto_front(g.ok)
+        front = pareto_front(runs, cost.of)
         fronts[g.title] = front
         ax.plot(
-            [sram_kib(r) for r in front],
+            [cost.of(r) for r in front],
             [mrays(r) for r in front],
             "o-",
             color="#C44E52",
@@ -307,30 +367,66 @@ def pareto(data: SweepData) -> tuple[Figure | None, dict[str, list[RunRecord]]]:
         for i, r in enumerate(front):
             ax.annotate(
                 f"{i + 1}",
-                (sram_kib(r), mrays(r)),
+                (float(cost.of(r) or 0), mrays(r)),
                 textcoords="offset points",
                 xytext=(-4, 7),
                 fontsize=10,
                 fontweight="bold",
                 color="#C44E52",
             )
-        _sram_axis(ax, [sram_kib(r) for r in g.ok])
-        ax.set_xlabel("on-chip SRAM: L1s + L2 + stacks + ray buffer (KiB)")
+        _cost_axis(ax, xs, cost.unit)
+        ax.set_xlabel(cost.axis)
         ax.set_ylabel("simulated Mrays/s")
-        ax.set_ylim(bottom=0, top=max(mrays(r) for r in g.ok) * 1.15)
+        ax.set_ylim(bottom=0, top=max(mrays(r) for r in runs) * 1.15)
         ax.set_title(f"{g.title}  (numbers: table below)")
         ax.legend(loc="lower right", fontsize=9)
-    fig.suptitle("Performance against on-chip SRAM: the Pareto front")
+    fig.suptitle(f"Performance against {cost.name}: the Pareto front (up and left is better)")
     fig.tight_layout()
     return fig, fronts
 
 
-def _sram_axis(ax: Any, kib: list[float]) -> None:
-    """Log scale for wide ranges, plain numbers (KiB) as tick labels either way."""
-    lo, hi = min(kib), max(kib)
+def speedup(data: SweepData) -> Figure | None:
+    """Each configuration's rays/s over the baseline configuration's, per scene and workload."""
+    panels = []
+    for g in data.groups():
+        base = data.baseline_run(g.ok)
+        if base is None or mrays(base) <= 0 or len(g.ok) < 2:
+            continue
+        bars = sorted(((data.label(r), mrays(r) / mrays(base), r is base) for r in g.ok),
+                      key=lambda b: b[1])  # fmt: skip
+        if len(bars) > MAX_BARS:  # the slowest and fastest, and the baseline
+            keep = bars[: MAX_BARS // 2] + bars[-MAX_BARS // 2 :]
+            bars = sorted({*keep, *(b for b in bars if b[2])}, key=lambda b: b[1])
+        panels.append((g, base, bars))
+    if not panels:
+        return None
+    rows = max(len(b) for _, _, b in panels)
+    fig, axes = _panels(len(panels), 7.0, 0.32 * rows + 1.6)
+    for ax, (g, base, bars) in zip(axes, panels, strict=True):
+        colors = ["#8C8C8C" if is_base else ("#4C72B0" if x >= 1 else "#C44E52")
+                  for _, x, is_base in bars]  # fmt: skip
+        ax.barh([b[0] for b in bars], [b[1] for b in bars], color=colors)
+        ax.axvline(1.0, color="black", lw=1)
+        for y, (_, x, _) in enumerate(bars):
+            ax.annotate(f"{x:.2f}x", (x, y), xytext=(3, 0), textcoords="offset points",
+                        va="center", fontsize=8)  # fmt: skip
+        ax.set_xlim(0, max(b[1] for b in bars) * 1.18)
+        ax.set_xlabel(f"speed-up over the baseline ({mrays(base):.1f} Mrays/s)")
+        ax.set_title(f"{g.title}", fontsize=11)
+        ax.grid(axis="y", visible=False)
+        ax.tick_params(axis="y", labelsize=8)
+    fig.suptitle("Speed-up over the baseline configuration (grey; blue faster, red slower)")
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    return fig
+
+
+def _cost_axis(ax: Any, xs: list[float], unit: str) -> None:
+    """Log-2 scale for wide ranges (SRAM in KiB: ticks 256, 512, 1,024), plain numbers."""
+    lo, hi = min(xs), max(xs)
     if lo > 0 and hi / lo >= 8:
         ax.set_xscale("log", base=2)
-    ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:,.0f}"))
+    fmt = "{:,.0f}" if unit == "KiB" else "{:.3g}"
+    ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: fmt.format(v)))
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     pad = (hi - lo) * 0.06 or hi * 0.05
     if ax.get_xscale() == "linear":

@@ -1,8 +1,9 @@
 """The self-contained HTML report of a sweep: figures as embedded PNG, tables as HTML.
 
-Sections: overview, design space (rays/s against each key, the Pareto front of rays/s against
-on-chip SRAM with the best configurations named), bandwidth (DRAM bytes per ray by data kind,
-bandwidth over time, cache hit rates), validation (hit mismatches per run, effects per scene).
+Sections: overview, design space (rays/s against each key, speed-up over the baseline, the
+Pareto fronts of rays/s against on-chip SRAM, chip area and energy per ray with the best
+configurations named), bandwidth (DRAM bytes per ray by data kind, bandwidth over time, cache hit
+rates), validation (hit mismatches per run, effects per scene).
 """
 
 from __future__ import annotations
@@ -18,7 +19,16 @@ import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 from rtsim.report import figures
-from rtsim.report.data import SweepData, load, mrays, sram_kib
+from rtsim.report.data import (
+    COSTS,
+    SweepData,
+    area_mm2,
+    energy_nj,
+    load,
+    mrays,
+    short_label,
+    sram_kib,
+)
 from rtsim.sweep.store import RunRecord
 
 CSS = """
@@ -114,7 +124,11 @@ def _scenes(data: SweepData) -> str:
     return f"<div class='thumbs'>{''.join(items)}</div>" if items else ""
 
 
-def _front_table(data: SweepData, fronts: dict[str, list[RunRecord]]) -> str:
+def _num(x: float | None, fmt: str) -> str:
+    return "-" if x is None else format(x, fmt)
+
+
+def _front_table(data: SweepData, fronts: dict[str, list[RunRecord]], cost: str) -> str:
     rows = []
     for title, front in fronts.items():
         best = max(front, key=mrays)
@@ -126,15 +140,49 @@ def _front_table(data: SweepData, fronts: dict[str, list[RunRecord]]) -> str:
                     str(i + 1),
                     name,
                     f"{sram_kib(r):,.0f}",
+                    _num(area_mm2(r), ".2f"),
+                    _num(energy_nj(r), ".2f"),
                     f"{mrays(r):.1f}",
                     f"{r.summary.get('dram_bytes_per_ray', 0):.0f}",
                 ]
             )
-    return _table(
-        ["scene / workload", "#", "configuration", "SRAM (KiB)", "Mrays/s", "DRAM B/ray"],
-        rows,
-        {1, 3, 4, 5},
+    header = ["scene / workload", "#", "configuration", "SRAM (KiB)", "area (mm²)", "nJ/ray"]
+    return f"<p class='muted'>front against {escape(COSTS[cost].name)}</p>" + _table(
+        [*header, "Mrays/s", "DRAM B/ray"], rows, {1, 3, 4, 5, 6, 7}
     )
+
+
+def _baseline_text(data: SweepData) -> str:
+    if not data.baseline:
+        return "the first configuration"
+    return escape(" · ".join(short_label(k, v) for k, v in data.baseline.items()))
+
+
+def _pareto_section(data: SweepData) -> list[str]:
+    """A Pareto front of rays/s against each cost (SRAM, area, energy) with its table."""
+    captions = {
+        "sram": "On-chip SRAM = L1 size x traversal units + L2 + traversal stacks (units x ray "
+        "contexts x stack entries x entry bytes), plus the ray buffer when treelet scheduling is "
+        "on.",
+        "area": "Chip area from the first-order model of docs/energy_area.md: SRAM (L1s, L2, ray "
+        "buffer, stacks, ray contexts) plus the box, triangle and any-hit pipelines, at the "
+        "configured technology node (energy.node_nm).",
+        "energy": "Energy per ray from the first-order model of docs/energy_area.md: pipelines, "
+        "traversal state, L1s, L2, ray buffer, DRAM (by kind) and leakage.",
+    }
+    out = []
+    for cost in ("sram", "area", "energy"):
+        fig, fronts = figures.pareto(data, cost)
+        out.append(
+            _figure(
+                fig,
+                f"Pareto front of rays/s against {COSTS[cost].name}",
+                captions[cost] + " Front points are numbered; the table names them.",
+            )
+        )
+        if fronts:
+            out.append(_front_table(data, fronts, cost))
+    return out
 
 
 def _validation(data: SweepData) -> str:
@@ -264,7 +312,6 @@ def _failures(data: SweepData) -> str:
 
 
 def render_report(data: SweepData) -> str:
-    pareto_fig, fronts = figures.pareto(data)
     name = escape(data.meta.get("name", data.path.name))
     when = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     parts = [
@@ -276,17 +323,18 @@ def render_report(data: SweepData) -> str:
             figures.rays_per_second(data),
             "rays per second against each swept key",
             "Simulated rays per second (Mrays/s at the configured clock) against each swept "
-            "key, one line per scene and workload.",
+            "key, one line per scene and workload, and per value of the other categorical keys "
+            "(e.g. treelets on and off are separate lines, never one median).",
         ),
         _figure(
-            pareto_fig,
-            "Pareto front of rays/s against on-chip SRAM",
-            "On-chip SRAM = L1 size x traversal units + L2 + traversal stacks (units x ray "
-            "contexts x stack entries x entry bytes), plus the ray buffer when treelet scheduling "
-            "is on. Front points are numbered; the table names them.",
+            figures.speedup(data),
+            "speed-up over the baseline configuration",
+            f"Simulated rays/s of each configuration over the baseline ({_baseline_text(data)}; "
+            "a spec names it with <code>baseline:</code>, docs/sweeps.md), per scene and "
+            "workload.",
         ),
-        "<h3>The best configurations (Pareto front, by SRAM)</h3>",
-        _front_table(data, fronts) if fronts else "",
+        "<h3>Pareto fronts: rays/s against SRAM, area and energy</h3>",
+        *_pareto_section(data),
         "<h2>Bandwidth</h2>",
         _figure(
             figures.bytes_per_ray(data),

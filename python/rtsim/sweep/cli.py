@@ -14,10 +14,10 @@ from pathlib import Path
 from rich.console import Console
 from rich.table import Table
 
-from rtsim.sweep.results import tidy_rows, to_csv
+from rtsim.sweep.results import key_value, tidy_rows, to_csv
 from rtsim.sweep.runner import SweepOptions, SweepOutcome, run_sweep
 from rtsim.sweep.spec import SpecError, load_spec
-from rtsim.sweep.store import open_store
+from rtsim.sweep.store import RunRecord, open_store
 
 
 def print_outcome(outcome: SweepOutcome, out: Path, console: Console) -> None:
@@ -72,7 +72,7 @@ def cmd_results(args: argparse.Namespace, console: Console) -> int:
         table.add_row(
             r.scene,
             r.workload,
-            *(str(r.params.get(k, "")) for k in keys),
+            *(_key_cell(r, k) for k in keys),
             r.status if r.status == "ok" else f"[red]{r.status}[/]",
             f"{s['mrays_per_second']:.1f}" if s.get("mrays_per_second") is not None else "-",
             f"{s['dram_bytes_per_ray']:.0f}" if s.get("dram_bytes_per_ray") is not None else "-",
@@ -80,6 +80,14 @@ def cmd_results(args: argparse.Namespace, console: Console) -> int:
         )
     console.print(table)
     return 0
+
+
+def _key_cell(rec: RunRecord, key: str) -> str:
+    """The run's value of a swept key; dimmed when the run's spec did not sweep it (a store
+    mixing two specs), so no column is ever blank."""
+    value, swept = key_value(rec, key)
+    text = "-" if value is None else str(value)
+    return text if swept else f"[dim]{text}[/]"
 
 
 def cmd_report(args: argparse.Namespace, console: Console) -> int:

@@ -40,6 +40,17 @@ def bytes_per_ray_by_kind(rec: RunRecord) -> dict[str, float]:
     return {k: (v.get("read_bytes", 0) + v.get("write_bytes", 0)) / rays for k, v in kinds.items()}
 
 
+def key_value(rec: RunRecord, key: str) -> tuple[Any, bool]:
+    """A run's value of a swept key and whether the run swept it. A store can mix specs that
+    swept different keys: a run that did not sweep a key still ran with some value of it (its
+    resolved config, or its preset for the special key `preset`), never a blank."""
+    if key in rec.params:
+        return rec.params[key], True
+    if key == "preset":
+        return rec.preset, False
+    return flatten(rec.config or {}).get(key), False
+
+
 def tidy_row(rec: RunRecord) -> dict[str, Any]:
     row: dict[str, Any] = {c: getattr(rec, c) for c in ID_COLUMNS}
     config = flatten(rec.config)

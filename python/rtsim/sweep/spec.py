@@ -23,7 +23,7 @@ from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
 SAMPLING_METHODS = ("random", "latin_hypercube")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
-TOP_KEYS = ("name", "scenes", "workloads", "config", "grid", "sampling", "timeout")
+TOP_KEYS = ("name", "scenes", "workloads", "config", "grid", "sampling", "timeout", "baseline")
 
 
 class SpecError(ValueError):
@@ -118,6 +118,9 @@ class SweepSpec:
     sampling: SamplingSpec | None = None
     timeout: float | None = None
     text: str = ""
+    # The configuration the report's speed-ups are measured against: a value per swept grid key
+    # (keys left out take their first grid value). Empty: the first value of every grid key.
+    baseline: dict[str, Any] = field(default_factory=dict)
 
     @property
     def swept_keys(self) -> list[str]:
@@ -285,6 +288,18 @@ class _Reader:
             out[str(key)] = list(values)
         return out
 
+    def baseline(self, doc: LineDict, grid: dict[str, list[Any]]) -> dict[str, Any]:
+        """The report's baseline point: each key swept by the grid, each value one of its grid's."""
+        b = self.mapping(doc, "baseline", "baseline")
+        for key, value in b.items():
+            path = f"baseline.{key}"
+            if key not in grid:
+                known = ", ".join(grid) or "(no grid)"
+                raise self.fail(b, key, path, f"not a grid key (grid keys: {known})")
+            if value not in grid[key]:
+                raise self.fail(b, key, path, f"{value!r} is not one of the grid's {grid[key]}")
+        return {str(k): v for k, v in b.items()}
+
     def sampling(self, doc: LineDict) -> SamplingSpec:
         s = self.mapping(doc, "sampling", "sampling", ("method", "n", "seed", "ranges"))
         method = s.get("method", "latin_hypercube")
@@ -379,6 +394,8 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
             )
     if "timeout" in doc:
         spec.timeout = float(rd.number(doc, "timeout", "timeout", False, 0))
+    if "baseline" in doc:
+        spec.baseline = rd.baseline(doc, spec.grid)
     return spec
 
 

@@ -15,6 +15,8 @@ TEST(Verdict, EachResourceHasItsKnobDoubled) {
         const char* key;
         uint64_t from, to;
     };
+    c.l1.mshrs = 8;
+    c.l2.mshrs = 32;
     const Case cases[] = {{"l1_mshrs", "l1.mshrs", 8, 16},      {"l2_mshrs", "l2.mshrs", 32, 64},
                           {"dram", "dram.channels", 2, 4},      {"l2_banks", "l2.banks", 8, 16},
                           {"latency", "traversal.ray_contexts", 16, 32},
