@@ -209,6 +209,14 @@ class TreeletConfig:
     idle_poll_cycles: int = _f(
         32, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000
     )
+    admit_outstanding: int = _f(
+        16,
+        "reads",
+        "Ray-record reads the ray buffer keeps in flight while admitting new rays (a streaming "
+        "engine, one read issued per cycle)",
+        1,
+        4096,
+    )
     max_rays_in_flight: int = _f(
         0,
         "rays",

@@ -1,5 +1,6 @@
 """`rtsim simulate` and `rtsim config`: run the `rtsim-sim` executable (one simulation per process,
-docs/architecture.md, rule 4), drive a progress bar from its JSON progress lines and print the run's summary.
+docs/architecture.md, rule 4), drive a progress bar from its JSON progress lines and print the
+run's summary.
 
 rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline]
 rtsim config --defaults | --schema

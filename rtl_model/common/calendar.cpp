@@ -57,8 +57,20 @@ BandwidthCalendar::BandwidthCalendar(uint64_t capacity, uint32_t window_cycles, 
 }
 
 Cycle BandwidthCalendar::reserve(Cycle time, uint64_t amount) {
-    if (amount > m_capacity) amount = m_capacity;  // one request never needs more than a window
     m_total += amount;
+    // A request larger than a window (a 64-byte line on a 1 B/cycle channel) takes consecutive
+    // windows' worth of capacity; clamping it to one window would let the resource exceed its peak.
+    Cycle first = reserve_chunk(time, amount < m_capacity ? amount : m_capacity);
+    Cycle at = first;
+    for (uint64_t left = amount > m_capacity ? amount - m_capacity : 0; left > 0;) {
+        uint64_t chunk = left < m_capacity ? left : m_capacity;
+        at = reserve_chunk(at, chunk);
+        left -= chunk;
+    }
+    return first;
+}
+
+Cycle BandwidthCalendar::reserve_chunk(Cycle time, uint64_t amount) {
     for (uint64_t w = time / m_window;; ++w) {
         uint64_t* used = m_ring.used(w);
         if (!used || *used + amount > m_capacity) continue;  // a later window in the entry: full

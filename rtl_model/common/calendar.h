@@ -72,8 +72,9 @@ public:
     /// remembered (rounded up to a power of two).
     BandwidthCalendar(uint64_t capacity_per_window, uint32_t window_cycles, uint32_t horizon_windows = 1u << 14);
 
-    /// Reserves `amount` units (<= capacity) at or after `time`; returns the cycle service starts
-    /// (within the window, in proportion to what the window already serves).
+    /// Reserves `amount` units at or after `time`; returns the cycle service starts (within the
+    /// window, in proportion to what the window already serves). More than a window's capacity
+    /// spills into the following windows.
     Cycle reserve(Cycle time, uint64_t amount);
 
     uint64_t capacity_per_window() const { return m_capacity; }
@@ -81,6 +82,8 @@ public:
     uint64_t total_reserved() const { return m_total; }
 
 private:
+    Cycle reserve_chunk(Cycle time, uint64_t amount);  ///< amount <= capacity
+
     uint64_t m_capacity;
     uint32_t m_window;
     WindowRing m_ring;

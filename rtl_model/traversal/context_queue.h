@@ -33,16 +33,28 @@ public:
         for (uint32_t n = (m_leaves + c) >> 1; n >= 1; n >>= 1) m_winner[n] = better(m_winner[2 * n], m_winner[2 * n + 1]);
     }
     bool empty() const { return m_time[m_winner[1]] == kNever; }
-    /// The context that goes next and its time; pop() removes its event.
+    /// The context that goes next and its time.
     uint32_t top() const { return m_winner[1]; }
     Cycle top_time() const { return m_time[m_winner[1]]; }
-    void pop() { schedule(m_winner[1], kNever); }
+    /// Takes the top context's event without updating the tree yet: the caller usually gives the
+    /// context its next event at once (schedule() then updates its path once, not twice) and
+    /// calls finish_pop() after. Nodes left stale meanwhile all lie on the popped context's path,
+    /// which schedule() or finish_pop() recomputes; top() is not read in between.
+    uint32_t begin_pop() {
+        m_popped = m_winner[1];
+        m_time[m_popped] = kNever;
+        return m_popped;
+    }
+    void finish_pop() {
+        if (m_time[m_popped] == kNever) schedule(m_popped, kNever);
+    }
 
 private:
     uint32_t better(uint32_t a, uint32_t b) const {
         return m_time[b] < m_time[a] || (m_time[b] == m_time[a] && b < a) ? b : a;
     }
     uint32_t m_leaves = 1;
+    uint32_t m_popped = 0;
     std::vector<Cycle> m_time;        ///< per context (padded to a power of two): next event, or kNever
     std::vector<uint32_t> m_winner;   ///< tree nodes 1..2L-1: the earliest context below each
 };

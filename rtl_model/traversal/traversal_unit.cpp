@@ -37,15 +37,15 @@ void TraversalUnit::run() {
             fill_idle_contexts(now);
             continue;
         }
-        const uint32_t c = m_events.top();
         const Cycle ready = m_events.top_time();
-        m_events.pop();
+        const uint32_t c = m_events.begin_pop();
         // The scheduler takes one step per issue_cycles.
         Cycle t = std::max(ready, m_sched_free);
         m_sched_free = t + m_config.issue_cycles;
         now = t;
         sync(t);
         advance(c, t);
+        m_events.finish_pop();
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
     }
 }

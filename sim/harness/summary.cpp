@@ -8,6 +8,8 @@
 #include <string>
 #include <ctime>
 
+#include "traces/common/build_info.h"
+
 namespace rtsim {
 
 using nlohmann::json;
@@ -100,8 +102,8 @@ json provenance(const std::string& command_line, const std::string& trace, const
     gethostname(host, sizeof(host) - 1);
     char when[64];
     std::strftime(when, sizeof(when), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&started));
-    return {{"rtsim_version", RTSIM_VERSION},
-            {"git", RTSIM_GIT_HASH},
+    return {{"rtsim_version", rtsim_version()},
+            {"git", rtsim_git_hash()},
             {"command_line", command_line},
             {"host", host},
             {"started_utc", when},

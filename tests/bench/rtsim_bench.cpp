@@ -23,6 +23,7 @@
 #include "embree_oracle.h"
 #include "oracle_rays.h"
 #include "traces/bvh/builder.h"
+#include "traces/common/build_info.h"
 
 namespace rtsim::bench {
 namespace {
@@ -174,8 +175,8 @@ int run(const Args& args) {
     j["triangles"] = scene.triangle_count();
     j["resolution"] = {args.width, args.height};
     j["repeat"] = args.repeat;
-    j["rtsim_version"] = RTSIM_VERSION;
-    j["git"] = RTSIM_GIT_HASH;
+    j["rtsim_version"] = rtsim_version();
+    j["git"] = rtsim_git_hash();
     j["embree_version"] = RTC_VERSION_STRING;
     j["hardware_threads"] = std::thread::hardware_concurrency();
     j["camera"] = sets.camera_why;

@@ -169,9 +169,7 @@ def test_heatmap_scale_clips_outliers() -> None:
 
 def test_heatmap_panels_follow_the_rays_present() -> None:
     z = np.zeros((2, 2))
-    assert [t for _, t in heatmaps.panels(work(z, z + 1, 0, 4))] == [
-        "all rays (no primary rays)"
-    ]
+    assert [t for _, t in heatmaps.panels(work(z, z + 1, 0, 4))] == ["all rays (no primary rays)"]
     assert [t for _, t in heatmaps.panels(work(z + 1, z + 1, 4, 0))] == [
         "primary rays (the only kind)"
     ]

@@ -30,16 +30,23 @@ ACCOUNTING_CONFIGS = {
     "detailed": ["fidelity=detailed"],
     "treelets": ["treelets.enabled=true", "treelets.treelet_kib=4"],
     "ideal_memory": ["ideal_memory=true"],
-    "shared_spilling": ["box.sharing=shared", "triangle.sharing=shared", "traversal.stack_entries=1"],
+    "shared_spilling": [
+        "box.sharing=shared",
+        "triangle.sharing=shared",
+        "traversal.stack_entries=1",
+    ],
 }
 
 
 @pytest.mark.parametrize("name", list(ACCOUNTING_CONFIGS))
 def test_cycle_accounting_sums_to_every_context_cycle(
     name: str, hairball: Path, sim: Sim, tmp_path: Path  # noqa: F811
-) -> None:
+) -> None:  # fmt: skip
     stats = run_stats(sim, hairball, tmp_path / name, *ACCOUNTING_CONFIGS[name])
-    model, config = stats["model"], json.loads((tmp_path / name / "config.resolved.json").read_text())
+    model, config = (
+        stats["model"],
+        json.loads((tmp_path / name / "config.resolved.json").read_text()),
+    )
     cycles = stats["summary"]["cycles"]
     contexts = config["traversal"]["ray_contexts"]
     # Every unit's uses add up to its contexts x the run's cycles, exactly.
@@ -75,7 +82,9 @@ def test_verdict_names_the_starved_resource(hairball: Path, sim: Sim, tmp_path: 
     assert "l2.mshrs 2 -> 4" in v["text"] and "estimated by the analytic level" in v["text"]
     assert starved["summary"]["bottleneck"] == "l2_mshrs"
     # A narrow DRAM: bandwidth binds.
-    narrow = run_stats(sim, hairball, tmp_path / "dram", "dram.bytes_per_cycle=1", "dram.channels=1")
+    narrow = run_stats(
+        sim, hairball, tmp_path / "dram", "dram.bytes_per_cycle=1", "dram.channels=1"
+    )
     assert narrow["verdict"]["binding"] == "dram", narrow["verdict"]["text"]
     assert narrow["model"]["utilization"]["dram_bandwidth"]["mean"] > 0.7
     # The analytic level states its own binding bound too.
@@ -113,7 +122,7 @@ def test_roofline_ceilings_bound_the_run(hairball: Path, sim: Sim, tmp_path: Pat
 
 def test_treelet_admission_does_not_swamp_the_l2_mshrs(
     trace_of: Any, sim: Sim, tmp_path: Path  # noqa: F811
-) -> None:
+) -> None:  # fmt: skip
     """A big ray buffer admits thousands of rays at once; their ray-record reads go through an
     admission engine with a bounded number in flight, so the L2's MSHR stall counter measures
     traversal misses, not one burst (it used to read billions of request-cycles, nearly the same

@@ -14,6 +14,7 @@
 #include "traces/tracer/manifest.h"
 #include "traces/tracer/preview_render.h"
 #include "traces/tracer/wavefront.h"
+#include "traces/common/build_info.h"
 
 namespace rtsim {
 
@@ -152,8 +153,8 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     json manifest = {
         {"format", "rtsim-trace"},
         {"trace_version", kTraceVersion},
-        {"rtsim_version", RTSIM_VERSION},
-        {"git", RTSIM_GIT_HASH},
+        {"rtsim_version", rtsim_version()},
+        {"git", rtsim_git_hash()},
         {"scene", scene_json(scene, name, procedural)},
         {"accel", accel_json(accel->image())},
         {"camera", camera_json(camera, camera_source)},

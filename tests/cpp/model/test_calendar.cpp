@@ -65,11 +65,13 @@ TEST(BandwidthCalendar, SaturatesAtCapacity) {
     for (Cycle t = 0; t < 1000; ++t) EXPECT_EQ(light.reserve(t, 1), t);
 }
 
-TEST(BandwidthCalendar, OversizedRequestTakesOneWholeWindow) {
+TEST(BandwidthCalendar, OversizedRequestSpillsIntoFollowingWindows) {
+    // 100 units at 16 per 8-cycle window: windows 0-5 full, window 6 holds 4. The resource never
+    // serves more than its capacity, however large one request is.
     BandwidthCalendar cal(16, 8);
-    EXPECT_EQ(cal.reserve(0, 100), 0u);  // clamped to the capacity: one window
-    EXPECT_EQ(cal.reserve(0, 1), 8u);
-    EXPECT_EQ(cal.total_reserved(), 17u);
+    EXPECT_EQ(cal.reserve(0, 100), 0u);
+    EXPECT_EQ(cal.reserve(0, 1), 6u * 8 + 4 * 8 / 16);
+    EXPECT_EQ(cal.total_reserved(), 101u);
 }
 
 TEST(BandwidthCalendar, RejectsZeroCapacityOrWindow) {
