@@ -59,6 +59,20 @@ inline bool same_hit(const Hit& a, const Hit& b) {
            float_bits(a.u) == float_bits(b.u) && float_bits(a.v) == float_bits(b.v);
 }
 
+/// The SSE2 fused loop of an fp32 kind in distance order (Accel::trace runs the best the CPU has:
+/// AVX for 8-wide nodes where present), or nothing for other kinds.
+inline Hit trace_sse2(const Accel& accel, const Ray& r, TraversalMode mode, WorkCounts* work, bool* ran) {
+    *ran = true;
+    if (auto* a = dynamic_cast<const WideAccel<Fp32Codec<4>>*>(&accel))
+        return trace_wide_fused<4>(a->view(), r, mode, work, WideSimd::sse2);
+    if (auto* a = dynamic_cast<const WideAccel<Fp32Codec<6>>*>(&accel))
+        return trace_wide_fused<6>(a->view(), r, mode, work, WideSimd::sse2);
+    auto* a = dynamic_cast<const WideAccel<Fp32Codec<8>>*>(&accel);
+    if (a && a->view().order == ChildOrder::distance) return trace_wide_fused<8>(a->view(), r, mode, work, WideSimd::sse2);
+    *ran = false;
+    return Hit{};
+}
+
 inline const Region& triangles_of(const Accel& a) { return a.image().region("triangles"); }
 
 }  // namespace rtsim::test

@@ -152,8 +152,8 @@ TEST(WideImage, LayoutInvariantsOfEveryKind) {
     }
 }
 
-/// Traces `rays` random rays through `accel` with its fused loop and its stepper (hits, work and
-/// plans checked) and against the binary BVH. Returns the closest hits.
+/// Traces `rays` random rays through `accel` with its fused loops (best and SSE2) and its stepper
+/// (hits, work and plans checked) and against the binary BVH. Returns the closest hits.
 int compare_with_bvh2(const Accel& accel, const Accel& bvh2, const Aabb& bounds, uint64_t seed, int rays) {
     Rng rng(seed);
     const Region& tris = test::triangles_of(accel);
@@ -182,6 +182,12 @@ int compare_with_bvh2(const Accel& accel, const Accel& bvh2, const Aabb& bounds,
             EXPECT_EQ(stepper->work().steps, node_plans);
             EXPECT_EQ(stepper->work().box_tests, boxes);
             EXPECT_TRUE(test::same_hit(fused, stepper->hit())) << accel.kind() << " ray " << i;
+            bool ran = false;
+            WorkCounts sse_work;
+            const Hit sse = test::trace_sse2(accel, r, mode, &sse_work, &ran);
+            if (ran) {
+                EXPECT_TRUE(test::same_hit(sse, stepper->hit()) && sse_work == stepper->work()) << accel.kind() << " SSE2";
+            }
             EXPECT_TRUE(fused_work == stepper->work()) << accel.kind() << " ray " << i << " steps " << fused_work.steps
                                                        << " vs " << stepper->work().steps;
             if (mode == TraversalMode::closest_hit) {
@@ -198,6 +204,7 @@ int compare_with_bvh2(const Accel& accel, const Accel& bvh2, const Aabb& bounds,
 }
 
 TEST(WideTrace, RandomSoupsEqualBvh2AndStepper) {
+    std::printf("[ fused ] 8-wide node test: %s\n", wide_simd_has_avx() ? "AVX (and SSE2 checked too)" : "SSE2");
     for (uint64_t seed = 1; seed <= 4; ++seed) {
         const Scene scene = test::random_soup(seed, 200 + int(seed) * 700);
         const auto bvh2 = test::build_kind(scene, "bvh2", uint32_t(seed));

@@ -24,6 +24,12 @@ Hit trace(const Accel& accel, const Ray& r, TraversalMode mode) {
     const Hit stepped = trace_with_stepper(*s, r, mode, &step_work);
     EXPECT_TRUE(test::same_hit(fused, stepped) && fused_work == step_work)
         << accel.kind() << ": fused steps " << fused_work.steps << ", stepper " << step_work.steps;
+    bool ran = false;
+    WorkCounts sse_work;
+    const Hit sse = test::trace_sse2(accel, r, mode, &sse_work, &ran);
+    if (ran) {
+        EXPECT_TRUE(test::same_hit(sse, stepped) && sse_work == step_work) << accel.kind() << " SSE2";
+    }
     return fused;
 }
 

@@ -80,7 +80,7 @@ constexpr uint8_t meta_interior(int slot) { return uint8_t(0x20 | (24 + slot)); 
 constexpr uint8_t meta_leaf(uint32_t count, uint32_t offset) { return uint8_t(((1u << count) - 1) << 5 | offset); }
 /// Decoding: empty, interior (low 5 bits >= 24), else a leaf of popcount(meta >> 5) triangles.
 constexpr bool meta_is_interior(uint8_t m) { return (m >> 5) == 1 && (m & 31) >= 24; }
-inline uint32_t meta_leaf_count(uint8_t m) { return uint32_t(__builtin_popcount(uint32_t(m) >> 5)); }
+constexpr uint32_t meta_leaf_count(uint8_t m) { return (m >> 5 & 1u) + (m >> 6 & 1u) + (m >> 7 & 1u); }
 constexpr uint32_t meta_leaf_offset(uint8_t m) { return m & 31u; }
 
 }  // namespace rtsim

@@ -19,10 +19,18 @@
 
 namespace rtsim {
 
-/// The fused reference loop of the fp32 layouts (wide_trace.cpp): SSE, the same per-lane
-/// arithmetic, order and work as WideStepper<Fp32Codec<N>> in distance order. N = 4, 6, 8.
+/// Instruction set of the fused loops: the best the CPU has (AVX for 8-wide nodes when present),
+/// or the SSE2 baseline (tests run both).
+enum class WideSimd : uint8_t { best = 0, sse2 = 1 };
+/// True when the fused 8-wide loop runs its AVX node test on this CPU.
+bool wide_simd_has_avx();
+
+/// The fused reference loop of the fp32 layouts (wide_trace.cpp): SIMD node tests with the same
+/// per-lane arithmetic, and the same order and work as WideStepper<Fp32Codec<N>> in distance
+/// order. N = 4, 6, 8. Needs view.valid (WideAccel sets it); without it, drives the stepper.
 template <int N>
-Hit trace_wide_fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work);
+Hit trace_wide_fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work,
+                     WideSimd simd = WideSimd::best);
 
 /// Reads "order" from image params; throws rtsim::Error naming `source` if it is not a known order.
 ChildOrder child_order_param(const AccelImage& image, const std::string& source);
@@ -46,7 +54,7 @@ uint32_t validate_wide(const WideView& v, const std::string& source, const std::
         if (i > 0 && !seen[i]) fail("node " + std::to_string(i) + " is not reachable from the root");
         Codec::check(node, i, fail);
         Codec::decode(node, d);
-        const uint32_t k = uint32_t(__builtin_popcount(d.valid));
+        const uint32_t k = detail::popcount8(d.valid);
         if (k == 0) fail("node " + std::to_string(i) + " has no children");
         const uint32_t pushes = need[i] + k - 1;
         if (pushes > kWideStackLimit) fail("a ray can need more than " + std::to_string(kWideStackLimit) + " stack entries");
@@ -125,6 +133,11 @@ public:
         m_view.triangle_base = tris.base;
         m_view.order = child_order_param(m_image, source);
         m_view.max_stack = validate_wide<Codec>(m_view, source, m_image.kind);
+        m_valid.resize(m_view.node_count);
+        for (uint64_t i = 0; i < m_view.node_count; ++i)
+            m_valid[i] = uint8_t(Codec::valid_mask(
+                *reinterpret_cast<const typename Codec::Node*>(m_view.nodes + i * Codec::kBytes)));
+        m_view.valid = m_valid.data();
     }
 
     std::unique_ptr<Stepper> make_stepper() const override { return std::make_unique<WideStepper<Codec>>(m_view); }
@@ -149,6 +162,7 @@ public:
 
 private:
     WideView m_view;
+    std::vector<uint8_t> m_valid;
 };
 
 }  // namespace rtsim

@@ -70,6 +70,14 @@ struct Fp32Codec {
 
 namespace detail {
 
+/// Set bits of a slot mask (at most 8 bits) without a library call: SSE2 builds have no POPCNT
+/// instruction, and __builtin_popcount becomes a call to libgcc in the hot loop.
+inline uint32_t popcount8(uint32_t m) {
+    m = m - ((m >> 1) & 0x55u);
+    m = (m & 0x33u) + ((m >> 2) & 0x33u);
+    return (m + (m >> 4)) & 0x0Fu;
+}
+
 /// Bit a set where the ray's direction is negative on axis a (the sign of 1/d; -0 counts).
 inline uint32_t ray_octant(const RayBoxPre& pre) {
     return uint32_t(std::signbit(pre.inv_dir4[0])) | uint32_t(std::signbit(pre.inv_dir4[1])) << 1 |
@@ -93,7 +101,7 @@ inline uint32_t wide_box_tests(const RayBoxPre& pre, const DecodedNode& n, float
 /// The hit slots in visit order; returns how many. out[0] is visited next; out[n-1] .. out[1]
 /// are pushed in that order, so they pop nearest first. Slots arrive in increasing order and
 /// the insertion is stable, so equal keys keep the lower slot first.
-inline int order_children(uint32_t mask, const float tnear[kMaxWideWidth], ChildOrder order,
+__attribute__((always_inline)) inline int order_children(uint32_t mask, const float tnear[kMaxWideWidth], ChildOrder order,
                           uint32_t octant, uint8_t out[kMaxWideWidth]) {
     int n = 0;
     for (uint32_t m = mask; m; m &= m - 1) {

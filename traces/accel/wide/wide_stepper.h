@@ -32,6 +32,9 @@ struct WideView {
     uint64_t triangle_base = 0;  ///< address of triangle 0
     ChildOrder order = ChildOrder::distance;
     uint32_t max_stack = 1;  ///< deepest stack a ray can need (from validation)
+    /// Host-side copy of each node's slot mask, derived from the image when it is loaded (not
+    /// part of the image): the fused loops read one byte instead of decoding it per node.
+    const uint8_t* valid = nullptr;
 };
 
 template <class Codec>
@@ -74,7 +77,7 @@ private:
         if (m_count == 0) {
             m_plan.reset(m_ref);
             m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * Codec::kBytes, Codec::kBytes, DataKind::node);
-            m_plan.add_op(OpKind::box, uint32_t(__builtin_popcount(Codec::valid_mask(node(m_ref)))));
+            m_plan.add_op(OpKind::box, detail::popcount8(Codec::valid_mask(node(m_ref))));
         } else {
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
             m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
@@ -87,7 +90,7 @@ private:
         DecodedNode d;
         Codec::decode(n, d);
         m_work.steps += 1;
-        m_work.box_tests += uint32_t(__builtin_popcount(d.valid));
+        m_work.box_tests += detail::popcount8(d.valid);
         float tnear[kMaxWideWidth];
         const uint32_t mask = detail::wide_box_tests(m_box, d, m_ray.tmin, m_cull_t, tnear);
         uint8_t order[kMaxWideWidth];
