@@ -294,7 +294,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--accel",
         default=None,
         metavar="KIND,...",
-        help="structures to benchmark, the first one is 'rtsim' in the summary (default: bvh8,bvh2)",
+        help="structures to benchmark; the first is 'rtsim' in the summary (default: bvh8,bvh2)",
     )
     p.set_defaults(func=cmd_bench)
     return parser
