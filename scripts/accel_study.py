@@ -155,14 +155,18 @@ def markdown(scene: str, result: dict[str, Any]) -> str:
     b = result["build"]
     lines = [f"### {scene} ({b['triangles']:,} triangles)", ""]
     bvh2 = b["structures"].get("bvh2", {}).get("footprint_bytes")
+    bvh2_nodes = b["structures"].get("bvh2", {}).get("node_region_bytes")
     lines += [
-        "| structure | build ms | footprint MB | vs bvh2 | nodes | node B | SAH | SAH greedy |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|",
+        "| structure | build ms | footprint MB | vs bvh2 | node region MB | vs bvh2 | nodes "
+        "| node B | SAH | SAH greedy |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for kind, s in b["structures"].items():
         ratio = f"{s['footprint_bytes'] / bvh2:.2f}" if bvh2 else "-"
+        node_ratio = f"{s['node_region_bytes'] / bvh2_nodes:.2f}" if bvh2_nodes else "-"
         lines.append(
             f"| {kind} | {fmt(s['build_ms_cpu'])} | {s['footprint_bytes'] / 1e6:.2f} | {ratio} "
+            f"| {s['node_region_bytes'] / 1e6:.2f} | {node_ratio} "
             f"| {s['nodes']:,} | {s['node_bytes']} | {s['sah_cost']:.2f} "
             f"| {fmt(s.get('sah_cost_greedy'), 2)} |"
         )
@@ -208,6 +212,7 @@ def main() -> int:
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--no-model", action="store_true", help="skip the rtsim-sim runs")
     p.add_argument("--keep-traces", action="store_true", help="keep the trace files")
+    p.add_argument("--render", action="store_true", help="only rewrite the tables from OUT's JSON")
     args = p.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     results: dict[str, Any] = {}
@@ -217,6 +222,12 @@ def main() -> int:
         f"Command: `python scripts/accel_study.py {' '.join(sys.argv[1:])}`",
         "",
     ]
+    if args.render:
+        results = json.loads((args.out / "accel_study.json").read_text())
+        md += [markdown(scene, result) for scene, result in results.items()]
+        (args.out / "accel_study.md").write_text("\n".join(md))
+        print("\n".join(md))
+        return 0
     for scene in args.scenes.split(","):
         print(f"accel_study: {scene}", file=sys.stderr)
         results[scene] = study_scene(scene, args, args.out)

@@ -7,6 +7,7 @@
 // distances, the visit order, the hits and every work count equal the stepper's. test_wide checks
 // both instruction sets against the stepper ray by ray.
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "traces/accel/wide/wide_accel.h"
@@ -153,8 +154,12 @@ inline uint32_t node_test(const Lanes& l, const WideNode<N>& node, float* tnear)
 }  // namespace avx
 #pragma GCC pop_options
 
+/// AVX when the CPU has it, unless RTSIM_SIMD=sse2 asks for the baseline (benchmarks compare).
 bool cpu_has_avx() {
-    static const bool has = __builtin_cpu_supports("avx");
+    static const bool has = [] {
+        const char* env = std::getenv("RTSIM_SIMD");
+        return __builtin_cpu_supports("avx") && !(env && std::strcmp(env, "sse2") == 0);
+    }();
     return has;
 }
 #endif
