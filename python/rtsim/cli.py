@@ -203,6 +203,8 @@ def cmd_bench(args: argparse.Namespace, console: Console) -> int:
         cmd += ["--resolution", f"{args.resolution[0]}x{args.resolution[1]}"]
     if args.hairball_triangles:
         cmd += ["--hairball-triangles", str(args.hairball_triangles)]
+    if args.accel:
+        cmd += ["--accel", args.accel]
     return subprocess.run(cmd, check=False).returncode
 
 
@@ -288,6 +290,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--repeat", type=positive_int, default=5, metavar="N", help="runs per figure")
     p.add_argument("--resolution", type=parse_resolution, default=None, metavar="WxH")
     p.add_argument("--hairball-triangles", type=positive_int, default=None, metavar="N")
+    p.add_argument(
+        "--accel",
+        default=None,
+        metavar="KIND,...",
+        help="structures to benchmark; the first is 'rtsim' in the summary (default: bvh8,bvh2)",
+    )
     p.set_defaults(func=cmd_bench)
     return parser
 

@@ -57,6 +57,44 @@ NODE_DTYPE = np.dtype(
         ("child_count", "<u4", (2,)),
     ]
 )
+
+
+def wide_node_dtype(width: int) -> np.dtype:
+    """fp32 wide node WideNode<N> (32 N bytes): bounds[axis][0 = min, 1 = max][slot], child
+    references, child counts (0 interior, 0xFFFFFFFF empty, else leaf size; docs/accel.md)."""
+    return np.dtype(
+        [
+            ("bounds", "<f4", (3, 2, width)),
+            ("child_ref", "<u4", (width,)),
+            ("child_count", "<u4", (width,)),
+        ]
+    )
+
+
+#: CwNode8 (80 bytes): compressed 8-wide node (Ylitie et al. 2017; docs/accel.md).
+CWNODE8_DTYPE = np.dtype(
+    [
+        ("p", "<f4", (3,)),
+        ("e", "u1", (3,)),
+        ("imask", "u1"),
+        ("base_node", "<u4"),
+        ("base_tri", "<u4"),
+        ("meta", "u1", (8,)),
+        ("qlo", "u1", (3, 8)),
+        ("qhi", "u1", (3, 8)),
+    ]
+)
+#: CwNode6 (64 bytes): compressed 6-wide node; bases = base_node | base_tri << 28 (56 bits, LE).
+CWNODE6_DTYPE = np.dtype(
+    [
+        ("p", "<f4", (3,)),
+        ("e", "u1", (3,)),
+        ("meta", "u1", (6,)),
+        ("bases", "u1", (7,)),
+        ("qlo", "u1", (3, 6)),
+        ("qhi", "u1", (3, 6)),
+    ]
+)
 #: HwTriangle (48 bytes).
 TRIANGLE_DTYPE = np.dtype(
     [
@@ -81,6 +119,13 @@ SECTION_DTYPES: dict[str, np.dtype] = {
 REGION_DTYPES: dict[tuple[str, str], np.dtype] = {
     ("*", "triangles"): TRIANGLE_DTYPE,
     ("bvh2", "nodes"): NODE_DTYPE,
+    ("bvh4", "nodes"): wide_node_dtype(4),
+    ("bvh6", "nodes"): wide_node_dtype(6),
+    ("bvh8", "nodes"): wide_node_dtype(8),
+    ("bvh8_octant", "nodes"): wide_node_dtype(8),
+    ("cwbvh6", "nodes"): CWNODE6_DTYPE,
+    ("cwbvh8", "nodes"): CWNODE8_DTYPE,
+    ("cwbvh8_octant", "nodes"): CWNODE8_DTYPE,
 }
 
 #: RayKind values stored in RayRecord.kind.

@@ -6,6 +6,8 @@
 
 #include "traces/accel/accel.h"
 #include "traces/accel/bvh2/bvh2.h"
+#include "traces/accel/cwbvh/cwbvh.h"
+#include "traces/accel/wide/wide.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/builder.h"
 #include "traces/common/error.h"
@@ -34,6 +36,21 @@ AccelImage build_bvh2(const Scene& scene, const AccelOptions& o) {
     return bvh2_image(flatten_bvh(tree, scene, o.build), o.build, o.builder);
 }
 
+/// A wide BVH kind: the binary tree collapsed to `width` (wide.h), stored fp32 or compressed.
+Entry wide_entry(const std::string& name, const std::string& description, int width, bool compressed,
+                 ChildOrder order) {
+    BuildFn build = [=](const Scene& scene, const AccelOptions& o) {
+        const WideBuildTree wide = make_wide_tree(build_tree(scene, o), scene, width, o.build, order);
+        AccelImage image = compressed ? cwbvh_image(wide, scene, name, order) : wide_image(wide, scene, name, order);
+        image.stats = wide_stats(wide, o.build, o.builder, image.region("nodes").record_bytes, order);
+        return image;
+    };
+    LoadFn load = [=](AccelImage image, const std::string& source) {
+        return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
+    };
+    return {{name, description, {"binned"}}, build, load};
+}
+
 const std::vector<Entry>& registry() {
     static const std::vector<Entry> entries = {
         {{"bvh2", "binary BVH, 64-byte nodes holding both child boxes (docs/bvh_layout.md)", {"binned"}},
@@ -41,6 +58,18 @@ const std::vector<Entry>& registry() {
          [](AccelImage image, const std::string& source) {
              return std::make_unique<Bvh2Accel>(std::move(image), source);
          }},
+        wide_entry("bvh4", "4-wide BVH, 128-byte fp32 nodes, SAH-optimal collapse of the binary tree (docs/accel.md)", 4,
+                   false, ChildOrder::distance),
+        wide_entry("bvh6", "6-wide BVH, 192-byte fp32 nodes, SAH-optimal collapse", 6, false, ChildOrder::distance),
+        wide_entry("bvh8", "8-wide BVH, 256-byte fp32 nodes, SAH-optimal collapse", 8, false, ChildOrder::distance),
+        wide_entry("cwbvh6", "6-wide compressed BVH, 64-byte nodes with 8-bit quantised boxes (Intel Xe BVH6-like)", 6,
+                   true, ChildOrder::distance),
+        wide_entry("cwbvh8", "8-wide compressed BVH, 80-byte nodes with 8-bit quantised boxes (Ylitie et al. 2017)", 8,
+                   true, ChildOrder::distance),
+        wide_entry("bvh8_octant", "bvh8 with children in octant slots, visited in a fixed per-octant order (no sort)",
+                   8, false, ChildOrder::octant),
+        wide_entry("cwbvh8_octant", "cwbvh8 with children in octant slots, visited in a fixed per-octant order", 8,
+                   true, ChildOrder::octant),
     };
     return entries;
 }

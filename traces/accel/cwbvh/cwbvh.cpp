@@ -1,0 +1,90 @@
+// Building and loading the compressed wide BVHs (cwbvh.h).
+#include "traces/accel/cwbvh/cwbvh.h"
+
+#include <type_traits>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+namespace {
+
+void set_bases(CwNode8& n, uint32_t node, uint32_t tri) {
+    n.base_node = node;
+    n.base_tri = tri;
+}
+void set_bases(CwNode6& n, uint32_t node, uint32_t tri) { n.set_bases(node, tri); }
+
+/// One compressed node from build node b: frame, bases, meta, outward-quantised child boxes.
+template <class Node, int W>
+void write_node(const WideBuildTree& tree, const WideOrder& o, uint32_t b, Node& out) {
+    const WideBuildNode& n = tree.nodes[b];
+    out = Node{};
+    const QuantFrame f = make_quant_frame(n.box);
+    for (int a = 0; a < 3; ++a) {
+        out.p[a] = f.p[a];
+        out.e[a] = f.e[a];
+    }
+    // Children in slot order: interior ones are stored consecutively from the first, leaves'
+    // triangles consecutively from the first leaf's (wide_order).
+    int child_at[W];
+    std::fill(child_at, child_at + W, -1);
+    for (uint32_t k = 0; k < n.count; ++k) child_at[n.slot[k]] = int(k);
+    uint32_t base_node = 0, base_tri = 0;
+    bool have_node = false, have_tri = false;
+    for (int s = 0; s < W; ++s) {
+        if (child_at[s] < 0) continue;
+        const WideBuildChild& c = n.child[child_at[s]];
+        if (!c.is_leaf() && !have_node) base_node = o.index[c.node], have_node = true;
+        if (c.is_leaf() && !have_tri) base_tri = o.leaf_first[size_t(b) * kMaxWideWidth + uint32_t(child_at[s])], have_tri = true;
+    }
+    set_bases(out, base_node, base_tri);
+    for (int s = 0; s < W; ++s) {
+        if (child_at[s] < 0) continue;
+        const WideBuildChild& c = n.child[child_at[s]];
+        if (c.is_leaf()) {
+            require(c.count <= kWideLeafMax, "cwbvh: leaf of " + std::to_string(c.count) + " triangles (at most 3)");
+            const uint32_t offset = o.leaf_first[size_t(b) * kMaxWideWidth + uint32_t(child_at[s])] - base_tri;
+            out.meta[s] = meta_leaf(c.count, offset);
+        } else {
+            out.meta[s] = meta_interior(s);
+            if constexpr (std::is_same_v<Node, CwNode8>) out.imask |= uint8_t(1u << s);
+        }
+        for (int a = 0; a < 3; ++a) {
+            out.qlo[a][s] = quantize_lo(f, a, c.box.lo[a]);
+            out.qhi[a][s] = quantize_hi(f, a, c.box.hi[a]);
+        }
+    }
+}
+
+}  // namespace
+
+AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std::string& kind, ChildOrder order) {
+    require(tree.width == 8 || tree.width == 6, "cwbvh: no compressed layout of width " + std::to_string(tree.width));
+    const WideOrder o = wide_order(tree);
+    if (tree.width == 6)
+        require(o.stored.size() < CwNode6::kIndexLimit && o.prims.size() < CwNode6::kIndexLimit,
+                "cwbvh6: more than 2^28 nodes or triangles (the node's 28-bit bases cannot address them)");
+    AccelImage image;
+    image.kind = kind;
+    image.bounds = tree.nodes[0].box;
+    image.params = {{"order", child_order_name(order)}};
+    const uint32_t bytes = tree.width == 8 ? sizeof(CwNode8) : sizeof(CwNode6);
+    Region& nodes = image.add_region("nodes", DataKind::node, bytes, o.stored.size());
+    for (size_t i = 0; i < o.stored.size(); ++i) {
+        if (tree.width == 8) write_node<CwNode8, 8>(tree, o, o.stored[i], nodes.records<CwNode8>()[i]);
+        else write_node<CwNode6, 6>(tree, o, o.stored[i], nodes.records<CwNode6>()[i]);
+    }
+    Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), o.prims.size());
+    HwTriangle* t = tris.records<HwTriangle>();
+    for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
+    image.place_regions();
+    return image;
+}
+
+std::unique_ptr<Accel> load_cwbvh(AccelImage image, int width, const std::string& source) {
+    if (width == 8) return std::make_unique<WideAccel<Cw8Codec>>(std::move(image), source);
+    if (width == 6) return std::make_unique<WideAccel<Cw6Codec>>(std::move(image), source);
+    throw Error(source + ": no compressed layout of width " + std::to_string(width));
+}
+
+}  // namespace rtsim

@@ -1,0 +1,118 @@
+// Building the fp32 wide images (wide.h): wide tree, node and triangle order (WideOrder), records.
+#include <algorithm>
+
+#include "traces/accel/wide/wide.h"
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+const char* child_order_name(ChildOrder order) { return order == ChildOrder::octant ? "octant" : "distance"; }
+
+ChildOrder child_order_param(const AccelImage& image, const std::string& source) {
+    const auto it = image.params.find("order");
+    if (it == image.params.end()) return ChildOrder::distance;
+    if (it->is_string() && *it == "distance") return ChildOrder::distance;
+    if (it->is_string() && *it == "octant") return ChildOrder::octant;
+    throw Error(source + ": " + image.kind + ": params.order must be \"distance\" or \"octant\"");
+}
+
+WideBuildTree make_wide_tree(const BuildTree& tree, const Scene& scene, int width, const BuildConfig& config,
+                             ChildOrder order, Collapse method) {
+    CollapseConfig c;
+    c.width = width;
+    c.leaf_max = std::max(1u, std::min(kWideLeafMax, config.max_leaf_size));
+    c.method = method;
+    c.traversal_cost = config.traversal_cost;
+    c.intersection_cost = config.intersection_cost;
+    WideBuildTree wide = collapse_tree(split_large_leaves(tree, scene.triangles, c.leaf_max), c);
+    if (order == ChildOrder::octant) assign_octant_slots(wide);
+    return wide;
+}
+
+namespace {
+
+template <int N>
+void write_fp32_nodes(const WideBuildTree& tree, const WideOrder& order, WideNode<N>* out) {
+    for (size_t i = 0; i < order.stored.size(); ++i) {
+        const uint32_t b = order.stored[i];
+        const WideBuildNode& n = tree.nodes[b];
+        WideNode<N>& w = out[i];
+        for (int s = 0; s < N; ++s) {  // every slot empty until a child takes it
+            for (int a = 0; a < 3; ++a) {
+                w.lo(s, a) = std::numeric_limits<float>::infinity();
+                w.hi(s, a) = -std::numeric_limits<float>::infinity();
+            }
+            w.child_ref[s] = 0;
+            w.child_count[s] = kEmptyChild;
+        }
+        for (uint32_t k = 0; k < n.count; ++k) {
+            const WideBuildChild& c = n.child[k];
+            const int s = n.slot[k];
+            for (int a = 0; a < 3; ++a) {
+                w.lo(s, a) = c.box.lo[a];
+                w.hi(s, a) = c.box.hi[a];
+            }
+            w.child_ref[s] = c.is_leaf() ? order.leaf_first[size_t(b) * kMaxWideWidth + k] : order.index[c.node];
+            w.child_count[s] = c.count;
+        }
+    }
+}
+
+}  // namespace
+
+AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::string& kind, ChildOrder order) {
+    const WideOrder o = wide_order(tree);
+    AccelImage image;
+    image.kind = kind;
+    image.bounds = tree.nodes[0].box;
+    image.params = {{"order", child_order_name(order)}};
+    const uint32_t bytes = uint32_t(32 * tree.width);
+    Region& nodes = image.add_region("nodes", DataKind::node, bytes, o.stored.size());
+    switch (tree.width) {
+        case 4: write_fp32_nodes<4>(tree, o, nodes.records<WideNode<4>>()); break;
+        case 6: write_fp32_nodes<6>(tree, o, nodes.records<WideNode<6>>()); break;
+        case 8: write_fp32_nodes<8>(tree, o, nodes.records<WideNode<8>>()); break;
+        default: throw Error("wide_image: no fp32 layout of width " + std::to_string(tree.width));
+    }
+    Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), o.prims.size());
+    HwTriangle* t = tris.records<HwTriangle>();
+    for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
+    image.place_regions();
+    return image;
+}
+
+nlohmann::json wide_stats(const WideBuildTree& tree, const BuildConfig& c, const std::string& builder,
+                          uint32_t node_bytes, ChildOrder order) {
+    const WideShape s = wide_shape(tree);
+    return {{"builder", builder},
+            {"config",
+             {{"bins", c.bins},
+              {"traversal_cost", c.traversal_cost},
+              {"intersection_cost", c.intersection_cost},
+              {"max_leaf_size", c.max_leaf_size},
+              {"max_depth", c.max_depth}}},
+            {"width", tree.width},
+            {"node_bytes", node_bytes},
+            {"triangle_bytes", sizeof(HwTriangle)},
+            {"nodes", tree.nodes.size()},
+            {"leaves", s.leaves},
+            {"max_depth", s.max_depth},
+            {"avg_leaf_size", s.avg_leaf_size},
+            {"max_leaf_size", s.max_leaf_size},
+            {"avg_children", s.avg_children},
+            {"triangle_refs", tree.prims.size()},
+            {"collapse", "dp"},
+            {"order", child_order_name(order)},
+            {"sah_cost", wide_sah_cost(tree, c.traversal_cost, c.intersection_cost)}};
+}
+
+std::unique_ptr<Accel> load_wide_fp32(AccelImage image, int width, const std::string& source) {
+    switch (width) {
+        case 4: return std::make_unique<WideAccel<Fp32Codec<4>>>(std::move(image), source);
+        case 6: return std::make_unique<WideAccel<Fp32Codec<6>>>(std::move(image), source);
+        case 8: return std::make_unique<WideAccel<Fp32Codec<8>>>(std::move(image), source);
+        default: throw Error(source + ": no fp32 wide layout of width " + std::to_string(width));
+    }
+}
+
+}  // namespace rtsim

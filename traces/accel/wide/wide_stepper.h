@@ -1,0 +1,149 @@
+#pragma once
+// The stepper of every wide BVH layout, fp32 or compressed (docs/accel.md, "Wide BVHs"), on a
+// Codec that says where a node's children are and decodes its boxes to floats (wide_kernel.h).
+//
+// Steps: a node step fetches the node's bytes (several lines when it spans them: 128, 192, 256
+// bytes fp32; 64 or 80 compressed) and runs one box test per child (empty slots are neither
+// tested nor counted); its locality key is the node. The children hit are ordered
+// (wide_kernel.h): the first is visited next, the others pushed farthest first. A leaf step
+// fetches the leaf's triangles (contiguous) and runs one triangle test each, plus an alpha test
+// for each MASK triangle hit. Popped entries entered beyond the best hit are dropped unfetched.
+// Hit rules, cull distance and any-hit termination are every structure's (leaf_kernel.h).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "traces/accel/stepper.h"
+#include "traces/accel/wide/wide_kernel.h"
+#include "traces/common/error.h"
+#include "traces/common/hw_triangle.h"
+#include "traces/isect/leaf_kernel.h"
+#include "traces/isect/ray_triangle.h"
+
+namespace rtsim {
+
+/// Where a wide BVH's data lives: arrays, their addresses, and how it is traversed.
+struct WideView {
+    const uint8_t* nodes = nullptr;  ///< node records of Codec::kBytes each
+    const HwTriangle* triangles = nullptr;
+    uint64_t node_count = 0;
+    uint64_t triangle_count = 0;
+    uint64_t node_base = 0;      ///< address of node 0
+    uint64_t triangle_base = 0;  ///< address of triangle 0
+    ChildOrder order = ChildOrder::distance;
+    uint32_t max_stack = 1;  ///< deepest stack a ray can need (from validation)
+    /// Host-side copy of each node's slot mask, derived from the image when it is loaded (not
+    /// part of the image): the fused loops read one byte instead of decoding it per node.
+    const uint8_t* valid = nullptr;
+};
+
+template <class Codec>
+class WideStepper final : public Stepper {
+public:
+    explicit WideStepper(const WideView& view) : m_view(view), m_stack(std::max<uint32_t>(1, view.max_stack)) {}
+
+    void begin(const Ray& ray, TraversalMode mode) override {
+        m_ray = ray;
+        m_mode = mode;
+        m_hit = Hit{};
+        m_work = WorkCounts{};
+        m_stack_size = 0;
+        if (!ray_is_valid(ray) || m_view.node_count == 0) return finish();
+        m_box = ray_box_precompute(ray);
+        m_tri = ray_triangle_precompute(ray);
+        m_octant = detail::ray_octant(m_box);
+        m_hit.t = ray.tmax;  // while traversing: the best distance so far
+        m_cull_t = detail::cull_distance(ray.tmax);
+        m_ref = 0;
+        m_count = 0;
+        plan_next();
+    }
+
+    StepOutcome execute() override {
+        StepOutcome out;
+        if (m_plan.done) return out;
+        if (m_count == 0) visit_node(node(m_ref));
+        else out.add_op(OpKind::anyhit, visit_leaf());
+        return out;
+    }
+
+private:
+    using Node = typename Codec::Node;
+    const Node& node(uint32_t i) const {
+        return *reinterpret_cast<const Node*>(m_view.nodes + uint64_t(i) * Codec::kBytes);
+    }
+
+    void plan_next() {
+        if (m_count == 0) {
+            m_plan.reset(m_ref);
+            m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * Codec::kBytes, Codec::kBytes, DataKind::node);
+            m_plan.add_op(OpKind::box, detail::popcount8(Codec::valid_mask(node(m_ref))));
+        } else {
+            m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
+            m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
+                             uint32_t(sizeof(HwTriangle) * m_count), DataKind::triangle);
+            m_plan.add_op(OpKind::triangle, m_count);
+        }
+    }
+
+    void visit_node(const Node& n) {
+        DecodedNode d;
+        Codec::decode(n, d);
+        m_work.steps += 1;
+        m_work.box_tests += detail::popcount8(d.valid);
+        float tnear[kMaxWideWidth];
+        const uint32_t mask = detail::wide_box_tests(m_box, d, m_ray.tmin, m_cull_t, tnear);
+        uint8_t order[kMaxWideWidth];
+        const int hits = detail::order_children(mask, tnear, m_view.order, m_octant, order);
+        if (hits == 0) return pop_next();
+        for (int i = hits - 1; i >= 1; --i) {
+            if (uint32_t(m_stack_size) >= m_stack.size())
+                throw Error("wide BVH: traversal stack overflow (" + std::to_string(m_stack.size()) + " entries)");
+            m_stack[size_t(m_stack_size++)] = {d.ref[order[i]], d.count[order[i]], tnear[order[i]]};
+        }
+        m_ref = d.ref[order[0]];
+        m_count = d.count[order[0]];
+        plan_next();
+    }
+
+    uint32_t visit_leaf() {
+        m_work.tri_tests += m_count;
+        const uint32_t alpha_before = m_work.anyhit_calls;
+        const HwTriangle* tris = m_view.triangles + m_ref;
+        const bool done = m_mode == TraversalMode::any_hit
+                              ? detail::leaf_step<true>(m_tri, m_ray.tmin, m_ray.tmax, tris, m_count, m_hit,
+                                                        m_cull_t, m_work.anyhit_calls)
+                              : detail::leaf_step<false>(m_tri, m_ray.tmin, m_ray.tmax, tris, m_count, m_hit,
+                                                         m_cull_t, m_work.anyhit_calls);
+        if (done) finish();
+        else pop_next();
+        return m_work.anyhit_calls - alpha_before;
+    }
+
+    void pop_next() {
+        while (m_stack_size > 0) {
+            const WideStackEntry& e = m_stack[size_t(--m_stack_size)];
+            if (e.tnear > m_cull_t) continue;
+            m_ref = e.ref;
+            m_count = e.count;
+            return plan_next();
+        }
+        finish();
+    }
+
+    void finish() {
+        if (m_hit.prim < 0) m_hit = Hit{};
+        m_plan.finish();
+    }
+
+    WideView m_view;
+    RayBoxPre m_box;
+    RayTrianglePre m_tri;
+    uint32_t m_octant = 0;
+    float m_cull_t = 0.0f;
+    uint32_t m_ref = 0;    ///< node index, or first triangle of a leaf
+    uint32_t m_count = 0;  ///< 0: m_ref is a node; else the leaf's triangle count
+    std::vector<WideStackEntry> m_stack;
+};
+
+}  // namespace rtsim
