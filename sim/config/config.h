@@ -37,6 +37,7 @@ struct SimConfig {
     PipelineConfig box{8, 1, 2, Sharing::per_unit, 4};
     PipelineConfig triangle{20, 1, 1, Sharing::per_unit, 4};
     PipelineConfig anyhit{10, 1, 1, Sharing::per_unit, 4};
+    PipelineConfig cell{4, 1, 1, Sharing::per_unit, 4};
     CacheConfig l1{16, 4, 64, 4, 8, 1, 1};
     CacheConfig l2{1024, 16, 64, 20, 32, 8, 1};
     DramConfig dram;
@@ -60,6 +61,7 @@ struct SimConfig {
         v.section("box", box);
         v.section("triangle", triangle);
         v.section("anyhit", anyhit);
+        v.section("cell", cell);
         v.section("l1", l1);
         v.section("l2", l2);
         v.section("dram", dram);
