@@ -243,8 +243,8 @@ class SimConfig:
     ideal_memory: bool = _flag(
         False, "Every access hits in L1 at L1 latency: the upper bound on performance"
     )
-    # Sections: the box, triangle, any-hit and grid-cell pipelines and the two cache levels share a struct
-    # with per-section defaults, as in config.h.
+    # Sections: the box, triangle, any-hit and cell pipelines and the two cache levels share a
+    # struct with per-section defaults, as in config.h.
     dispatch: DispatchConfig = field(default_factory=DispatchConfig)
     traversal: TraversalConfig = field(default_factory=TraversalConfig)
     box: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 2, "private", 4))
