@@ -61,7 +61,7 @@ private:
     void process(Item& item);
     Candidate object_split(const std::vector<Ref>& refs);
     Candidate spatial_split(const std::vector<Ref>& refs, const Aabb& box, uint64_t budget);
-    void bin_spatial(const std::vector<Ref>& refs, int axis, const std::vector<float>& planes);
+    void bin_spatial(const std::vector<Ref>& refs, const std::vector<float>* planes, const bool* usable);
     bool apply_object(const Item& item, const Candidate& c, std::vector<Ref>* l, std::vector<Ref>* r) const;
     bool apply_spatial(const Item& item, Candidate c, std::vector<Ref>* l, std::vector<Ref>* r);
     void apply_median(Item& item, std::vector<Ref>* l, std::vector<Ref>* r);

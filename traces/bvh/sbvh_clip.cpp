@@ -73,9 +73,32 @@ void ClippedTriangle::clip(const Polygon& in, int axis, double position, double 
     }
 }
 
-Aabb ClippedTriangle::conservative_box(const Polygon& p, int axis, float lo, float hi) const {
-    double bl[3] = {kInf, kInf, kInf}, bh[3] = {-kInf, -kInf, -kInf};
-    const Polygon* src = &p;
+struct ClippedTriangle::DBox {
+    double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+    void grow(const double* p) {
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+    }
+    bool empty() const { return lo[0] > hi[0]; }
+};
+
+void ClippedTriangle::grow_crossings(int axis, double s, DBox* a, DBox* b) const {
+    // Where the polygon's edges cross the plane (strictly: an end on the plane is a vertex).
+    for (int i = 0; i < m_poly.n; ++i) {
+        const double* p = m_poly.v[i];
+        const double* q = m_poly.v[(i + 1) % m_poly.n];
+        if (!((p[axis] < s && q[axis] > s) || (p[axis] > s && q[axis] < s))) continue;
+        const double t = (s - p[axis]) / (q[axis] - p[axis]);
+        double x[3];
+        for (int k = 0; k < 3; ++k) x[k] = p[k] + t * (q[k] - p[k]);
+        x[axis] = s;
+        a->grow(x);
+        if (b) b->grow(x);
+    }
+}
+
+Aabb ClippedTriangle::conservative_box(const DBox& piece, int axis, float lo, float hi) const {
+    const DBox* src = &piece;
+    DBox whole;
     if (m_poly.n == 0) {
         // The triangle's part in the reference box vanished in double (a sliver on the box's
         // boundary): the reference box itself, cut to the slab, stands for it.
@@ -84,50 +107,54 @@ Aabb ClippedTriangle::conservative_box(const Polygon& p, int axis, float lo, flo
         box.hi[axis] = std::min(box.hi[axis], hi);
         return box.empty() ? Aabb{} : box;
     }
-    if (p.n == 0) {
+    if (piece.empty()) {
         // Empty in double, but the exact piece may still be a sliver within the clipping error
         // of the slab: then the whole polygon's box (cut to the slab below) stands for it.
-        double pl = kInf, ph = -kInf;
-        for (int i = 0; i < m_poly.n; ++i) {
-            pl = std::min(pl, m_poly.v[i][axis]);
-            ph = std::max(ph, m_poly.v[i][axis]);
-        }
-        if (pl - m_margin > double(hi) || ph + m_margin < double(lo)) return Aabb{};
-        src = &m_poly;
+        for (int i = 0; i < m_poly.n; ++i) whole.grow(m_poly.v[i]);
+        if (whole.lo[axis] - m_margin > double(hi) || whole.hi[axis] + m_margin < double(lo)) return Aabb{};
+        src = &whole;
     }
-    for (int i = 0; i < src->n; ++i)
-        for (int a = 0; a < 3; ++a) {
-            bl[a] = std::min(bl[a], src->v[i][a]);
-            bh[a] = std::max(bh[a], src->v[i][a]);
-        }
     Aabb box;
     for (int a = 0; a < 3; ++a) {
-        box.lo[a] = std::max(round_down(bl[a] - m_margin), m_box.lo[a]);
-        box.hi[a] = std::min(round_up(bh[a] + m_margin), m_box.hi[a]);
+        box.lo[a] = std::max(round_down(src->lo[a] - m_margin), m_box.lo[a]);
+        box.hi[a] = std::min(round_up(src->hi[a] + m_margin), m_box.hi[a]);
     }
     box.lo[axis] = std::max(box.lo[axis], lo);
     box.hi[axis] = std::min(box.hi[axis], hi);
     return box.empty() ? Aabb{} : box;
 }
 
+// A convex polygon's part in a slab is the hull of its vertices in the slab and its edges'
+// crossings of the slab's two planes, so each piece's box comes from those points: one pass
+// over the edges per plane, no polygon is copied. Binning only prices candidate splits, so the
+// boxes are rounded to nearest here; the references a split makes come from split().
 void ClippedTriangle::chop(int axis, const float* planes, uint32_t count, Aabb* out) const {
-    Polygon rest, piece, next;
-    clip(m_poly, axis, double(planes[0]), 1.0, &rest);
+    DBox at_low;  // crossings of the current slab's low plane
+    grow_crossings(axis, double(planes[0]), &at_low, nullptr);
     for (uint32_t k = 0; k < count; ++k) {
-        const double s = double(planes[k + 1]);
-        clip(rest, axis, s, -1.0, &piece);
-        clip(rest, axis, s, 1.0, &next);
-        out[k] = conservative_box(piece, axis, planes[k], planes[k + 1]);
-        rest = next;
+        const double lo = double(planes[k]), hi = double(planes[k + 1]);
+        DBox piece = at_low, at_high;
+        for (int i = 0; i < m_poly.n; ++i)
+            if (m_poly.v[i][axis] >= lo && m_poly.v[i][axis] <= hi) piece.grow(m_poly.v[i]);
+        grow_crossings(axis, hi, &piece, &at_high);
+        // An estimate for pricing splits only: nearest rounding, no margin (split() is exact).
+        out[k] = Aabb{};
+        if (!piece.empty())
+            for (int a = 0; a < 3; ++a) out[k].lo[a] = float(piece.lo[a]), out[k].hi[a] = float(piece.hi[a]);
+        at_low = at_high;
     }
 }
 
 void ClippedTriangle::split(int axis, float position, Aabb* left, Aabb* right) const {
-    Polygon part;
-    clip(m_poly, axis, double(position), -1.0, &part);
-    *left = conservative_box(part, axis, -std::numeric_limits<float>::infinity(), position);
-    clip(m_poly, axis, double(position), 1.0, &part);
-    *right = conservative_box(part, axis, position, std::numeric_limits<float>::infinity());
+    const double s = double(position);
+    DBox l, r;
+    for (int i = 0; i < m_poly.n; ++i) {
+        if (m_poly.v[i][axis] <= s) l.grow(m_poly.v[i]);
+        if (m_poly.v[i][axis] >= s) r.grow(m_poly.v[i]);
+    }
+    grow_crossings(axis, s, &l, &r);
+    *left = conservative_box(l, axis, -std::numeric_limits<float>::infinity(), position);
+    *right = conservative_box(r, axis, position, std::numeric_limits<float>::infinity());
 }
 
 }  // namespace rtsim

@@ -18,12 +18,13 @@ class ClippedTriangle {
 public:
     ClippedTriangle(const Triangle& tri, const Aabb& box);
 
-    /// Boxes of the polygon's pieces between consecutive planes of `axis`:
-    /// out[k] is the part in [planes[k], planes[k + 1]] for k in 0..count-1 (planes ascending).
-    /// Pieces the triangle does not reach are empty boxes. Conservative: each contains the exact
-    /// piece and lies in the reference box and its slab.
+    /// Boxes of the polygon's pieces between consecutive planes of `axis`, for binning:
+    /// out[k] is the part in [planes[k], planes[k + 1]] for k in 0..count-1 (planes ascending),
+    /// rounded to nearest (an estimate to price splits with, not a bound); pieces the triangle
+    /// does not reach are empty boxes.
     void chop(int axis, const float* planes, uint32_t count, Aabb* out) const;
-    /// The parts on either side of plane `position` of `axis` (each conservative, maybe empty).
+    /// The parts on either side of plane `position` of `axis`: conservative (each contains the
+    /// exact part and lies in the reference box and its half-space), maybe empty.
     void split(int axis, float position, Aabb* left, Aabb* right) const;
     bool empty() const { return m_poly.n == 0; }
     /// Area of the triangle's part in the box (in double; 0 when it vanished there).
@@ -31,15 +32,18 @@ public:
 
 private:
     static constexpr int kMaxVertices = 16;
+    struct DBox;  ///< a box in double
     struct Polygon {
         double v[kMaxVertices][3];
         int n = 0;
     };
     /// Keeps the part with sign * (p[axis] - position) >= 0; the new vertices lie on the plane.
     static void clip(const Polygon& in, int axis, double position, double sign, Polygon* out);
-    /// The polygon's box rounded outward by the clipping error bound, then intersected with the
-    /// reference box and the slab [lo, hi] of `axis`.
-    Aabb conservative_box(const Polygon& p, int axis, float lo, float hi) const;
+    /// Grows `a` (and `b`, if given) by the points where the polygon's edges cross plane s.
+    void grow_crossings(int axis, double s, DBox* a, DBox* b) const;
+    /// A piece's box (in double) rounded outward by the clipping error bound, then intersected
+    /// with the reference box and the slab [lo, hi] of `axis`.
+    Aabb conservative_box(const DBox& piece, int axis, float lo, float hi) const;
 
     Polygon m_poly;
     Aabb m_box;         ///< the reference's box

@@ -2,6 +2,7 @@
 // "Spatial splits in bounding volume hierarchies", sections 4.3 (binning with triangle clipping)
 // and 4.4 (reference unsplitting).
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 #include "traces/bvh/sbvh_builder_impl.h"
@@ -41,71 +42,86 @@ struct SpatialBins {
 
 }  // namespace
 
-// Spatial-split binning (section 4.3): a reference inside one bin grows it whole; one spanning
-// several is clipped into each, grows each with its piece's box, and counts as entering its
-// first non-empty bin and leaving its last ("chopped binning").
-void SbvhBuilder::bin_spatial(const std::vector<Ref>& refs, int axis, const std::vector<float>& planes) {
-    const uint32_t nb = uint32_t(planes.size() - 1);
-    const SpatialBins bins{planes.data(), nb, planes[0], float(nb) / (planes[nb] - planes[0])};
-    m_sbox.assign(nb, Aabb{});
-    m_entry.assign(nb, 0);
-    m_exit.assign(nb, 0);
+// Spatial-split binning (section 4.3), all three axes in one pass: a reference inside one bin
+// grows it whole; one spanning several is clipped into each (its triangle clipped to its box
+// once, then chopped along each axis it spans), grows each with its piece's box, and counts as
+// entering its first non-empty bin and leaving its last ("chopped binning").
+void SbvhBuilder::bin_spatial(const std::vector<Ref>& refs, const std::vector<float>* planes, const bool* usable) {
+    const uint32_t nb = m_s.spatial_bins;
+    SpatialBins bins[3];
+    for (int a = 0; a < 3; ++a)
+        if (usable[a]) bins[a] = {planes[a].data(), nb, planes[a][0], float(nb) / (planes[a][nb] - planes[a][0])};
+    m_sbox.assign(3 * size_t(nb), Aabb{});
+    m_entry.assign(3 * size_t(nb), 0);
+    m_exit.assign(3 * size_t(nb), 0);
     m_pieces.resize(nb);
     for (const Ref& r : refs) {
-        const uint32_t b0 = bins.first(r.box.lo[axis]), b1 = bins.last(r.box.hi[axis], b0);
-        uint32_t in = b0, out = b1;
-        if (b0 == b1) {
-            m_sbox[b0].grow(r.box);
-        } else {
-            ClippedTriangle(m_tris[r.prim], r.box).chop(axis, &planes[b0], b1 - b0 + 1, m_pieces.data());
-            in = b1, out = b0;
-            for (uint32_t b = b0; b <= b1; ++b) {
-                if (m_pieces[b - b0].empty()) continue;
-                m_sbox[b].grow(m_pieces[b - b0]);
-                in = std::min(in, b), out = std::max(out, b);
+        std::optional<ClippedTriangle> clipped;  // made once, for the first axis that needs it
+        for (int a = 0; a < 3; ++a) {
+            if (!usable[a]) continue;
+            Aabb* sbox = &m_sbox[a * size_t(nb)];
+            const uint32_t b0 = bins[a].first(r.box.lo[a]), b1 = bins[a].last(r.box.hi[a], b0);
+            uint32_t in = b0, out = b1;
+            if (b0 == b1) {
+                sbox[b0].grow(r.box);
+            } else {
+                if (!clipped) clipped.emplace(m_tris[r.prim], r.box);
+                clipped->chop(a, &planes[a][b0], b1 - b0 + 1, m_pieces.data());
+                in = b1, out = b0;
+                for (uint32_t b = b0; b <= b1; ++b) {
+                    if (m_pieces[b - b0].empty()) continue;
+                    sbox[b].grow(m_pieces[b - b0]);
+                    in = std::min(in, b), out = std::max(out, b);
+                }
+                if (in > out) in = b0, out = b0, sbox[b0].grow(r.box);  // nothing left: keep it whole
             }
-            if (in > out) in = b0, out = b0, m_sbox[b0].grow(r.box);  // nothing left: keep it whole
+            ++m_entry[a * size_t(nb) + in];
+            ++m_exit[a * size_t(nb) + out];
         }
-        ++m_entry[in];
-        ++m_exit[out];
     }
 }
 
 Candidate SbvhBuilder::spatial_split(const std::vector<Ref>& refs, const Aabb& box, uint64_t budget) {
     const uint32_t nb = m_s.spatial_bins;
     const uint64_t n = refs.size();
-    std::vector<float> planes(nb + 1);
+    std::vector<float> planes[3];
+    bool usable[3];
+    for (int a = 0; a < 3; ++a) {
+        planes[a].resize(nb + 1);
+        const float width = (box.hi[a] - box.lo[a]) / float(nb);
+        for (uint32_t k = 0; k < nb; ++k) planes[a][k] = box.lo[a] + float(k) * width;
+        planes[a][nb] = box.hi[a];
+        usable[a] = width > 0.0f;  // and no room for bins at this scale if planes coincide:
+        for (uint32_t k = 0; k < nb && usable[a]; ++k) usable[a] = planes[a][k] < planes[a][k + 1];
+    }
+    bin_spatial(refs, planes, usable);
     m_rbox.resize(nb);
     m_rcount.resize(nb);
     Candidate best;
     for (int a = 0; a < 3; ++a) {
-        const float width = (box.hi[a] - box.lo[a]) / float(nb);
-        bool increasing = width > 0.0f;
-        for (uint32_t k = 0; k < nb; ++k) planes[k] = box.lo[a] + float(k) * width;
-        planes[nb] = box.hi[a];
-        for (uint32_t k = 0; k < nb && increasing; ++k) increasing = planes[k] < planes[k + 1];
-        if (!increasing) continue;  // no room for bins at this scale
-        bin_spatial(refs, a, planes);
+        if (!usable[a]) continue;
+        const Aabb* sbox = &m_sbox[a * size_t(nb)];
+        const uint32_t *entry = &m_entry[a * size_t(nb)], *exit = &m_exit[a * size_t(nb)];
         Aabb acc;
         uint32_t count = 0;
         for (uint32_t b = nb - 1; b > 0; --b) {
-            acc.grow(m_sbox[b]);
-            count += m_exit[b];
+            acc.grow(sbox[b]);
+            count += exit[b];
             m_rbox[b] = acc;
             m_rcount[b] = count;
         }
         acc = Aabb{};
         count = 0;
         for (uint32_t b = 1; b < nb; ++b) {
-            acc.grow(m_sbox[b - 1]);
-            count += m_entry[b - 1];
+            acc.grow(sbox[b - 1]);
+            count += entry[b - 1];
             const uint64_t nl = count, nr = m_rcount[b];
             // Both sides smaller than the node (progress) and the duplicates within budget.
             if (nl == 0 || nr == 0 || nl >= n || nr >= n || nl + nr - n > budget) continue;
             const float cost = acc.half_area() * float(nl) + m_rbox[b].half_area() * float(nr);
             if (cost < best.cost)
                 best = Candidate{Candidate::spatial, a, cost, acc, m_rbox[b], uint32_t(nl), uint32_t(nr), 0, 0, 0,
-                                 planes[b]};
+                                 planes[a][b]};
         }
     }
     return best;
