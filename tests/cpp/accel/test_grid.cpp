@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <set>
 
 #include "accel_test_util.h"
@@ -14,6 +15,8 @@
 #include "traces/common/error.h"
 #include "traces/isect/ray_box_kernel.h"
 #include "traces/isect/leaf_kernel.h"
+#include "traces/raygen/auto_framing.h"
+#include "traces/raygen/camera.h"
 
 namespace rtsim {
 namespace {
@@ -214,6 +217,49 @@ TEST(GridTrace, WorkIsWhatThePlansAskedForAndTraceEqualsTheStepper) {
     EXPECT_EQ(g->max_stack_entries(), 0u);
     const std::vector<OpKind> ops = g->op_kinds();
     EXPECT_NE(std::find(ops.begin(), ops.end(), OpKind::cell), ops.end());
+}
+
+}  // namespace
+}  // namespace rtsim
+
+// The density heuristic on Sponza (disabled: needs the shared scenes and a few minutes); run with
+//   test_accel --gtest_also_run_disabled_tests --gtest_filter='*DensityOnSponza'
+// Prints, per lambda, the grid's size and the mean work of 160x120 primary rays (docs/accel.md).
+namespace rtsim {
+namespace {
+
+TEST(GridBenchmark, DISABLED_DensityOnSponza) {
+    const std::string path = std::string(RTSIM_SCENES_DIR) + "/sponza/Sponza.gltf";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not found";
+    const Scene scene = load_gltf(path);
+    const std::unique_ptr<Accel> bvh = bvh2_of(scene);
+    std::string why;
+    const Camera cam = scene.cameras.empty() ? auto_frame(scene, *bvh, 4.0f / 3.0f, &why) : scene.cameras[0];
+    const PinholeCamera pinhole = make_camera(cam, 160, 120);
+    std::vector<Ray> rays;
+    for (uint32_t y = 0; y < 120; ++y)
+        for (uint32_t x = 0; x < 160; ++x) rays.push_back(primary_ray(pinhole, x, y, 160, 120));
+    for (float density : {0.5f, 1.0f, 2.0f, 4.0f, 8.0f, 16.0f}) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::unique_ptr<Accel> g = grid_of(scene, density);
+        const double build = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        double cells = 0, refs = 0, tris = 0;
+        int diffs = 0;
+        for (const Ray& r : rays) {
+            WorkCounts w;
+            const Hit h = g->trace(r, TraversalMode::closest_hit, &w);
+            diffs += !test::same_hit(h, bvh->trace(r, TraversalMode::closest_hit), TraversalMode::closest_hit);
+            cells += w.cell_steps, refs += w.refs, tris += w.tri_tests;
+        }
+        const double n = double(rays.size());
+        const GridView& v = view_of(*g);
+        std::printf("lambda %5.1f: %4u x %4u x %4u = %8llu cells, %9llu refs, %6.1f MiB, build %6.0f ms | per ray: "
+                    "%6.1f cell steps, %7.1f refs, %7.1f tri tests, %d diffs\n",
+                    density, v.geometry.res[0], v.geometry.res[1], v.geometry.res[2],
+                    (unsigned long long)v.cell_count, (unsigned long long)v.ref_count,
+                    double(g->image().footprint_bytes()) / 1048576.0, build, cells / n, refs / n, tris / n, diffs);
+        EXPECT_EQ(diffs, 0);
+    }
 }
 
 }  // namespace

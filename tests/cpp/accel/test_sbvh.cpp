@@ -102,6 +102,13 @@ TEST(SbvhImage, DuplicatesAreValidRecordsAndStatsReachTheManifest) {
     bvh.triangles.assign(v.triangles, v.triangles + v.triangle_count);
     bvh.bounds = sbvh->image().bounds;
     EXPECT_NO_THROW(check_bvh_invariants(bvh, scene, true));
+    // Brute force over the image's records (duplicates included) equals brute force over the scene.
+    const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+    const std::vector<Ray> rays = test::random_rays(scene, tris, 5, 300);
+    const test::Tracer over_records = [&](const Ray& r, TraversalMode m) {
+        return trace_ray_brute_force(v.triangles, v.triangle_count, r, m);
+    };
+    EXPECT_EQ(test::compare_rays(over_records, test::brute_force(tris), rays, "records").diffs, 0);
 }
 
 TEST(SbvhImage, LowerSahCostOnProceduralScenes) {
