@@ -70,6 +70,29 @@ GridGeometry make_geometry(const Aabb& bounds, uint64_t n, const GridConfig& c) 
     return g;
 }
 
+/// What the manifest records about a grid build.
+nlohmann::json build_stats(const GridGeometry& g, const GridConfig& config, const GridCell* cells, uint64_t total,
+                           size_t n) {
+    uint32_t max_list = 0;
+    uint64_t empty = 0;
+    for (uint64_t c = 0; c < g.cell_count(); ++c) {
+        max_list = std::max(max_list, cells[c].ref_count);
+        empty += cells[c].ref_count == 0;
+    }
+    return {{"builder", "uniform"},
+            {"config",
+             {{"density", config.density}, {"max_resolution", config.max_resolution}, {"max_cells", config.max_cells}}},
+            {"resolution", {g.res[0], g.res[1], g.res[2]}},
+            {"cells", g.cell_count()},
+            {"references", total},
+            {"references_per_triangle", n ? double(total) / double(n) : 0.0},
+            {"references_per_cell", double(total) / double(g.cell_count())},
+            {"max_references_per_cell", max_list},
+            {"empty_cell_fraction", double(empty) / double(g.cell_count())},
+            {"cell_bytes", sizeof(GridCell)},
+            {"triangle_bytes", sizeof(HwTriangle)}};
+}
+
 }  // namespace
 
 AccelImage grid_image(const Scene& scene, const GridConfig& config) {
@@ -113,12 +136,7 @@ AccelImage grid_image(const Scene& scene, const GridConfig& config) {
     GridCell* cells = image.add_region("cells", DataKind::cell, sizeof(GridCell), g.cell_count()).records<GridCell>();
     uint32_t* refs = image.add_region("prim_refs", DataKind::prim_ref, kGridRefBytes, total).records<uint32_t>();
     HwTriangle* tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), n).records<HwTriangle>();
-    uint32_t max_list = 0, empty = 0;
-    for (uint64_t c = 0; c < g.cell_count(); ++c) {
-        cells[c] = GridCell{uint32_t(count[c]), uint32_t(count[c + 1] - count[c])};
-        max_list = std::max(max_list, cells[c].ref_count);
-        empty += cells[c].ref_count == 0;
-    }
+    for (uint64_t c = 0; c < g.cell_count(); ++c) cells[c] = GridCell{uint32_t(count[c]), uint32_t(count[c + 1] - count[c])};
     for (size_t i = 0; i < n; ++i) {
         tris[i] = make_hw_triangle(scene, uint32_t(i));
         const uint32_t* r = &range[6 * i];
@@ -127,18 +145,7 @@ AccelImage grid_image(const Scene& scene, const GridConfig& config) {
                 for (uint32_t x = r[0]; x <= r[1]; ++x) refs[count[g.cell_index(x, y, z)]++] = uint32_t(i);
     }
     image.place_regions();
-    image.stats = {{"builder", "uniform"},
-                   {"config", {{"density", config.density}, {"max_resolution", config.max_resolution},
-                               {"max_cells", config.max_cells}}},
-                   {"resolution", {g.res[0], g.res[1], g.res[2]}},
-                   {"cells", g.cell_count()},
-                   {"references", total},
-                   {"references_per_triangle", n ? double(total) / double(n) : 0.0},
-                   {"references_per_cell", double(total) / double(g.cell_count())},
-                   {"max_references_per_cell", max_list},
-                   {"empty_cell_fraction", double(empty) / double(g.cell_count())},
-                   {"cell_bytes", sizeof(GridCell)},
-                   {"triangle_bytes", sizeof(HwTriangle)}};
+    image.stats = build_stats(g, config, cells, total, n);
     return image;
 }
 
