@@ -24,7 +24,9 @@ REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "config.md"
 
 # Sections in the order of the hardware (dispatch to DRAM); unknown sections follow alphabetically.
-SECTION_ORDER = ("dispatch", "traversal", "box", "triangle", "anyhit", "l1", "l2", "dram", "energy")
+SECTION_ORDER = (
+    "dispatch", "traversal", "box", "triangle", "anyhit", "cell", "l1", "l2", "dram", "energy"
+)
 
 SECTION_NOTES = {
     "dispatch": "Hands rays from the trace to free ray contexts (`rtl_model/dispatch`).",
@@ -32,6 +34,8 @@ SECTION_NOTES = {
     "box": "The ray-box pipelines: one test per child box, a whole node is 2 tests.",
     "triangle": "The ray-triangle pipelines: one test per leaf triangle.",
     "anyhit": "The alpha-test stage; built only when the BVH has alpha-MASK triangles.",
+    "cell": "The grid's cell-step (3D-DDA) pipeline: one operation per cell visited; built only "
+    "for structures that issue cell steps (`grid`, docs/accel.md).",
     "l1": "The private per-unit L1 caches (MSHRs modelled exactly).",
     "l2": "The shared banked L2 (MSHRs: occupancy bound at approx, exact at detailed).",
     "dram": "DRAM channels: bandwidth calendars plus a fixed latency.",

@@ -55,7 +55,7 @@ class TraceJob:
     threads: int = 0
     hairball_triangles: int = 200_000
     accel: str = "bvh2"
-    builder: str = "binned"
+    builder: str = ""  # empty: the structure's default builder (its first)
 
 
 def parse_workload(text: str) -> list[str]:
@@ -244,9 +244,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--builder",
-        default="binned",
+        default="",
         metavar="NAME",
-        help="tree builder (default: binned, binned SAH); the structures take: "
+        help="builder (default: the structure's first); the structures take: "
         + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in kinds),
     )
     p.set_defaults(func=cmd_trace)

@@ -107,6 +107,9 @@ TRIANGLE_DTYPE = np.dtype(
     ]
 )
 
+#: grid GridCell (8 bytes): the cell's list in prim_refs (docs/accel.md, "grid").
+CELL_DTYPE = np.dtype([("first_ref", "<u4"), ("ref_count", "<u4")])
+
 #: Section name (as the C++ section_name() spells it, lower-cased) -> record dtype.
 SECTION_DTYPES: dict[str, np.dtype] = {
     "rays": RAY_DTYPE,
@@ -126,6 +129,8 @@ REGION_DTYPES: dict[tuple[str, str], np.dtype] = {
     ("cwbvh6", "nodes"): CWNODE6_DTYPE,
     ("cwbvh8", "nodes"): CWNODE8_DTYPE,
     ("cwbvh8_octant", "nodes"): CWNODE8_DTYPE,
+    ("grid", "cells"): CELL_DTYPE,
+    ("grid", "prim_refs"): np.dtype("<u4"),
 }
 
 #: RayKind values stored in RayRecord.kind.
@@ -180,7 +185,7 @@ class Trace:
 
     def region(self, name: str) -> np.ndarray:
         """Records of an image region: a structured array where the layout is known (bvh2
-        nodes, triangles), else a (count, record_bytes) array of bytes."""
+        nodes, grid cells and prim_refs, triangles), else a (count, record_bytes) array of bytes."""
         regions = self.accel["regions"]
         for index, info in enumerate(regions):
             if info.get("name") != name:

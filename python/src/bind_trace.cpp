@@ -224,7 +224,7 @@ void bind_trace(py::module_& m) {
           py::arg("height") = 240u, py::arg("bounces") = 1u, py::arg("seed") = 1u,
           py::arg("camera") = py::none(), py::arg("threads") = 0u,
           py::arg("hairball_triangles") = 200000u, py::arg("progress") = py::none(),
-          py::arg("accel") = "bvh2", py::arg("builder") = "binned",
+          py::arg("accel") = "bvh2", py::arg("builder") = "",
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
           "returns the manifest. progress(done, total, stage) is called now and then.\n"
           "accel and builder choose the acceleration structure (accel_kinds()).");

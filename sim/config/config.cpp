@@ -184,6 +184,7 @@ const PipelineConfig& SimConfig::pipeline(OpKind kind) const {
         case OpKind::box: return box;
         case OpKind::triangle: return triangle;
         case OpKind::anyhit: return anyhit;
+        case OpKind::cell: return cell;
         default: break;
     }
     throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");

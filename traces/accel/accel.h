@@ -52,7 +52,7 @@ protected:
 /// How to build a structure: which kind, which builder for its tree, and the builder's config.
 struct AccelOptions {
     std::string kind = "bvh2";        ///< accel_kinds() name
-    std::string builder = "binned";   ///< "binned" (binned SAH); kinds list the builders they take
+    std::string builder;              ///< empty: the kind's default (its first); accel_kinds() lists each kind's builders
     BuildConfig build;
 };
 

@@ -7,9 +7,11 @@
 #include "traces/accel/accel.h"
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/accel/cwbvh/cwbvh.h"
+#include "traces/accel/grid/grid.h"
 #include "traces/accel/wide/wide.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/builder.h"
+#include "traces/bvh/sbvh_builder.h"
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
 
@@ -26,34 +28,56 @@ struct Entry {
     LoadFn load;
 };
 
-/// The binary build tree of the chosen builder (the tree every BVH kind starts from).
-BuildTree build_tree(const Scene& scene, const AccelOptions& o) {
-    return build_binned_sah(scene.triangles, o.build);
+/// The binary build tree of the chosen builder (the tree every BVH kind starts from): "binned"
+/// (binned SAH) or "sbvh" (spatial splits; prim_ids may repeat a primitive). What the builder
+/// reports beyond the tree's own statistics goes to `stats`.
+BuildTree build_tree(const Scene& scene, const AccelOptions& o, nlohmann::json* stats) {
+    if (o.builder != "sbvh") return build_binned_sah(scene.triangles, o.build);
+    const SbvhConfig c;
+    SbvhStats s;
+    BuildTree tree = build_sbvh(scene.triangles, o.build, c, &s);
+    (*stats)["sbvh"] = {{"config",
+                         {{"alpha", c.alpha},
+                          {"spatial_bins", c.spatial_bins},
+                          {"reference_budget", c.reference_budget},
+                          {"unsplit", c.unsplit}}},
+                        {"references", s.references},
+                        {"duplication", double(s.references) / double(scene.triangles.size())},
+                        {"object_splits", s.object_splits},
+                        {"spatial_splits", s.spatial_splits},
+                        {"median_splits", s.median_splits},
+                        {"unsplit_references", s.unsplit}};
+    return tree;
 }
 
 AccelImage build_bvh2(const Scene& scene, const AccelOptions& o) {
-    const BuildTree tree = build_tree(scene, o);
-    return bvh2_image(flatten_bvh(tree, scene, o.build), o.build, o.builder);
+    nlohmann::json extra = nlohmann::json::object();
+    const BuildTree tree = build_tree(scene, o, &extra);
+    AccelImage image = bvh2_image(flatten_bvh(tree, scene, o.build), o.build, o.builder);
+    image.stats.update(extra);
+    return image;
 }
 
 /// A wide BVH kind: the binary tree collapsed to `width` (wide.h), stored fp32 or compressed.
 Entry wide_entry(const std::string& name, const std::string& description, int width, bool compressed,
                  ChildOrder order) {
     BuildFn build = [=](const Scene& scene, const AccelOptions& o) {
-        const WideBuildTree wide = make_wide_tree(build_tree(scene, o), scene, width, o.build, order);
+        nlohmann::json extra = nlohmann::json::object();
+        const WideBuildTree wide = make_wide_tree(build_tree(scene, o, &extra), scene, width, o.build, order);
         AccelImage image = compressed ? cwbvh_image(wide, scene, name, order) : wide_image(wide, scene, name, order);
         image.stats = wide_stats(wide, o.build, o.builder, image.region("nodes").record_bytes, order);
+        image.stats.update(extra);
         return image;
     };
     LoadFn load = [=](AccelImage image, const std::string& source) {
         return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
     };
-    return {{name, description, {"binned"}}, build, load};
+    return {{name, description, {"binned", "sbvh"}}, build, load};
 }
 
 const std::vector<Entry>& registry() {
     static const std::vector<Entry> entries = {
-        {{"bvh2", "binary BVH, 64-byte nodes holding both child boxes (docs/bvh_layout.md)", {"binned"}},
+        {{"bvh2", "binary BVH, 64-byte nodes holding both child boxes (docs/bvh_layout.md)", {"binned", "sbvh"}},
          build_bvh2,
          [](AccelImage image, const std::string& source) {
              return std::make_unique<Bvh2Accel>(std::move(image), source);
@@ -70,6 +94,12 @@ const std::vector<Entry>& registry() {
                    8, false, ChildOrder::octant),
         wide_entry("cwbvh8_octant", "cwbvh8 with children in octant slots, visited in a fixed per-octant order", 8,
                    true, ChildOrder::octant),
+        {{"grid", "uniform grid, cells of lambda x N by density, 3D-DDA traversal, no stack (docs/accel.md)",
+          {"uniform"}},
+         [](const Scene& scene, const AccelOptions&) { return grid_image(scene); },
+         [](AccelImage image, const std::string& source) {
+             return std::make_unique<GridAccel>(std::move(image), source);
+         }},
     };
     return entries;
 }
@@ -101,14 +131,16 @@ void validate_accel_options(const AccelOptions& o) {
     const Entry* e = find(o.kind);
     require(e != nullptr, "accel: unknown structure '" + o.kind + "' (known: " + known_kinds() + ")");
     const auto& b = e->info.builders;
-    if (std::find(b.begin(), b.end(), o.builder) != b.end()) return;
+    if (o.builder.empty() || std::find(b.begin(), b.end(), o.builder) != b.end()) return;
     std::string list;
     for (const std::string& name : b) list += (list.empty() ? "" : ", ") + name;
     throw Error("accel: structure '" + o.kind + "' has no builder '" + o.builder + "' (it takes: " + list + ")");
 }
 
-AccelImage build_accel(const Scene& scene, const AccelOptions& o) {
-    validate_accel_options(o);
+AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
+    validate_accel_options(options);
+    AccelOptions o = options;
+    if (o.builder.empty()) o.builder = find(o.kind)->info.builders.front();  // the kind's default
     require(!scene.triangles.empty(), "scene has no triangles");
     require(scene.tri_material.size() == scene.triangles.size() && scene.tri_instance.size() == scene.triangles.size(),
             "build_accel: scene is not flattened (call Scene::flatten())");

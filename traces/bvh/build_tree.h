@@ -19,7 +19,10 @@ struct BuildNode {
 };
 
 /// Node 0 is the root; children are allocated in adjacent pairs. Leaves own disjoint ranges of
-/// prim_ids, a permutation of 0..N-1, laid out left subtree before right subtree.
+/// prim_ids, laid out left subtree before right subtree. The binned builder's prim_ids are a
+/// permutation of 0..N-1; the SBVH builder's (sbvh_builder.h) hold every primitive at least once
+/// and may repeat one in several leaves (spatial splits): a converter must give each entry its
+/// own triangle record (flatten_bvh does) and never assume prim_ids.size() == N.
 struct BuildTree {
     std::vector<BuildNode> nodes;
     std::vector<uint32_t> prim_ids;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "traces/bvh/builder.h"
+#include "traces/bvh/sbvh_clip.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -31,7 +32,9 @@ bool same_vertex(const float* hw, const Vec3& v) {
 struct Checker {
     const HwBvh& bvh;
     const Scene& scene;
+    bool spatial_splits;
     std::vector<uint8_t> node_seen, tri_seen, prim_seen;
+    std::vector<double> covered;  ///< spatial splits: area of each primitive inside its leaf boxes
     struct Item {
         uint32_t node;
         Aabb parent;
@@ -67,13 +70,21 @@ void Checker::check_leaf(uint32_t node, int slot, const Aabb& box, uint32_t dept
         const HwTriangle& t = bvh.triangles[j];
         if (tri_seen[j]) fail(node, slot, triangle_name(j, t.prim) + " referenced twice");
         tri_seen[j] = 1;
-        if (!inside(box, t.v0) || !inside(box, t.v1) || !inside(box, t.v2))
-            fail(node, slot, triangle_name(j, t.prim) + " outside the leaf box");
         if (t.prim >= scene.triangles.size())
             fail(node, slot, triangle_name(j, t.prim) + ": no such primitive in the scene");
-        if (prim_seen[t.prim]) fail(node, slot, triangle_name(j, t.prim) + ": primitive stored twice");
-        prim_seen[t.prim] = 1;
         const Triangle& s = scene.triangles[t.prim];
+        if (spatial_splits) {
+            Aabb tri_box;
+            tri_box.grow(s.v0), tri_box.grow(s.v1), tri_box.grow(s.v2);
+            const Aabb common{glm::max(tri_box.lo, box.lo), glm::min(tri_box.hi, box.hi)};
+            if (common.empty()) fail(node, slot, triangle_name(j, t.prim) + " does not overlap the leaf box");
+            covered[t.prim] += ClippedTriangle(s, box).area();
+        } else {
+            if (!inside(box, t.v0) || !inside(box, t.v1) || !inside(box, t.v2))
+                fail(node, slot, triangle_name(j, t.prim) + " outside the leaf box");
+            if (prim_seen[t.prim]) fail(node, slot, triangle_name(j, t.prim) + ": primitive stored twice");
+        }
+        prim_seen[t.prim] = 1;
         if (!same_vertex(t.v0, s.v0) || !same_vertex(t.v1, s.v1) || !same_vertex(t.v2, s.v2) ||
             t.inst != scene.tri_instance[t.prim])
             fail(node, slot, triangle_name(j, t.prim) + " differs from the scene's primitive");
@@ -104,9 +115,10 @@ void Checker::check_slot(uint32_t node, int slot, const Aabb& parent, uint32_t d
 
 void Checker::run() {
     if (bvh.nodes.empty()) throw Error("BVH has no nodes");
-    if (bvh.triangles.size() != scene.triangles.size())
+    if (spatial_splits ? bvh.triangles.size() < scene.triangles.size() : bvh.triangles.size() != scene.triangles.size())
         throw Error("BVH holds " + std::to_string(bvh.triangles.size()) + " triangles, the scene " +
                     std::to_string(scene.triangles.size()));
+    covered.assign(spatial_splits ? scene.triangles.size() : 0, 0.0);
     node_seen.assign(bvh.nodes.size(), 0);
     tri_seen.assign(bvh.triangles.size(), 0);
     prim_seen.assign(scene.triangles.size(), 0);
@@ -124,12 +136,23 @@ void Checker::run() {
         if (!node_seen[i]) throw Error("BVH node " + std::to_string(i) + " unreachable from the root");
     for (size_t j = 0; j < tri_seen.size(); ++j)
         if (!tri_seen[j]) throw Error("BVH triangle " + std::to_string(j) + " referenced by no leaf");
+    for (size_t p = 0; p < prim_seen.size(); ++p)
+        if (!prim_seen[p]) throw Error("BVH primitive " + std::to_string(p) + " is in no triangle record");
+    // Spatial splits: the leaf boxes of a primitive's records cover all of it (to rounding).
+    for (size_t p = 0; p < covered.size(); ++p) {
+        const Triangle& s = scene.triangles[p];
+        const double whole = ClippedTriangle(s, Aabb{glm::min(glm::min(s.v0, s.v1), s.v2),
+                                                     glm::max(glm::max(s.v0, s.v1), s.v2)}).area();
+        if (covered[p] < whole * (1.0 - 1e-6))
+            throw Error("BVH primitive " + std::to_string(p) + ": its leaf boxes cover " + std::to_string(covered[p]) +
+                        " of its area " + std::to_string(whole));
+    }
 }
 
 }  // namespace
 
-void check_bvh_invariants(const HwBvh& bvh, const Scene& scene) {
-    Checker{bvh, scene, {}, {}, {}, {}}.run();
+void check_bvh_invariants(const HwBvh& bvh, const Scene& scene, bool spatial_splits) {
+    Checker{bvh, scene, spatial_splits, {}, {}, {}, {}, {}}.run();
 }
 
 // SAH cost (Goldsmith & Salmon 1987; MacDonald & Booth 1990): every node costs traversal_cost

@@ -1,0 +1,70 @@
+// The uniform grid's Accel: validation when loaded, steppers, the reference loop (grid.h).
+#include <string>
+
+#include "traces/accel/grid/grid.h"
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+void validate_grid(const GridView& v, const std::string& source) {
+    // Messages are built only on failure: this pass runs over every cell of every trace opened.
+    auto fail = [&](const std::string& what) { throw Error(source + ": grid: " + what); };
+    const GridGeometry& g = v.geometry;
+    if (v.cell_count != g.cell_count())
+        fail("resolution " + std::to_string(g.res[0]) + " x " + std::to_string(g.res[1]) + " x " +
+             std::to_string(g.res[2]) + " needs " + std::to_string(g.cell_count()) + " cells, region 'cells' holds " +
+             std::to_string(v.cell_count));
+    if (v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) fail("more than 2^32 references or triangles");
+    for (uint64_t c = 0; c < v.cell_count; ++c) {
+        const GridCell& cell = v.cells[c];
+        if (uint64_t(cell.first_ref) + cell.ref_count > v.ref_count)
+            fail("cell " + std::to_string(c) + " lists prim_refs " + std::to_string(cell.first_ref) + ".." +
+                 std::to_string(uint64_t(cell.first_ref) + cell.ref_count - 1) + " of " + std::to_string(v.ref_count));
+    }
+    for (uint64_t r = 0; r < v.ref_count; ++r)
+        if (v.refs[r] >= v.triangle_count)
+            fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.refs[r]) + " of " +
+                 std::to_string(v.triangle_count));
+}
+
+GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
+    const Region& cells = m_image.region("cells");
+    const Region& refs = m_image.region("prim_refs");
+    const Region& tris = m_image.region("triangles");
+    require(cells.record_bytes == sizeof(GridCell) && refs.record_bytes == kGridRefBytes &&
+                tris.record_bytes == sizeof(HwTriangle),
+            source + ": grid regions must hold 8-byte cells, 4-byte references and 48-byte triangles");
+    require(cells.kind == DataKind::cell && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
+            source + ": grid regions must be of data kinds cell, prim_ref and triangle");
+    m_view.geometry = GridGeometry::from_json(m_image.params, source);
+    m_view.cells = cells.records<GridCell>();
+    m_view.refs = refs.records<uint32_t>();
+    m_view.triangles = tris.records<HwTriangle>();
+    m_view.cell_count = cells.count;
+    m_view.ref_count = refs.count;
+    m_view.triangle_count = tris.count;
+    m_view.cell_base = cells.base;
+    m_view.ref_base = refs.base;
+    m_view.triangle_base = tris.base;
+    validate_grid(m_view, source);
+}
+
+std::unique_ptr<Stepper> GridAccel::make_stepper() const { return std::make_unique<GridStepper>(m_view); }
+
+Hit GridAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
+    GridStepper stepper(m_view);
+    stepper.begin(ray, mode);
+    while (!stepper.done()) stepper.execute();
+    if (work) *work = stepper.work();
+    return stepper.hit();
+}
+
+LocalityPartition GridAccel::partition(uint64_t budget_bytes) const { return grid_partition(m_view, budget_bytes); }
+
+std::vector<OpKind> GridAccel::op_kinds() const {
+    std::vector<OpKind> kinds{OpKind::box, OpKind::cell, OpKind::triangle};
+    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
+    return kinds;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,122 @@
+// The uniform grid's stepper (grid_stepper.h): the order of visits and the work counted here are
+// the definition the SystemC model matches (docs/accel.md, "grid").
+#include "traces/accel/grid/grid_stepper.h"
+
+#include <algorithm>
+
+#include "traces/isect/leaf_kernel.h"
+#include "traces/isect/ray_box_kernel.h"
+
+namespace rtsim {
+
+void GridStepper::begin(const Ray& ray, TraversalMode mode) {
+    m_ray = ray;
+    m_mode = mode;
+    m_hit = Hit{};
+    m_work = WorkCounts{};
+    m_stack_size = 0;
+    if (!ray_is_valid(ray) || m_view.cell_count == 0) {
+        finish();
+        return;
+    }
+    m_box = ray_box_precompute(ray);
+    m_tri = ray_triangle_precompute(ray);
+    // While traversing, m_hit.t is the current best distance (the shrinking tmax).
+    m_hit.t = ray.tmax;
+    m_cull_t = detail::cull_distance(ray.tmax);
+    m_phase = Phase::clip;
+    m_plan.reset(kNoLocality);
+    m_plan.add_op(OpKind::box, 1);
+}
+
+StepOutcome GridStepper::execute() {
+    StepOutcome out;
+    if (m_plan.done) return out;
+    switch (m_phase) {
+        case Phase::clip:
+            clip();
+            break;
+        case Phase::cell: {
+            m_work.steps += 1;
+            m_work.cell_steps += 1;
+            const GridCell& c = m_view.cells[m_cell];
+            if (c.ref_count == 0) {
+                next_cell();
+                break;
+            }
+            m_first = c.first_ref;
+            m_count = c.ref_count;
+            m_tested = 0;
+            m_phase = Phase::refs;
+            m_plan.reset(kNoLocality);  // the list belongs to its cell's brick
+            m_plan.add_fetch(m_view.ref_base + uint64_t(m_first) * kGridRefBytes, m_count * kGridRefBytes,
+                             DataKind::prim_ref);
+            break;
+        }
+        case Phase::refs:
+            m_work.refs += m_count;
+            m_phase = Phase::triangles;
+            plan_triangles();
+            break;
+        case Phase::triangles:
+            out.add_op(OpKind::anyhit, test_triangles());
+            break;
+    }
+    return out;
+}
+
+void GridStepper::clip() {
+    m_work.box_tests += 1;
+    const Aabb b = m_view.geometry.bounds();
+    const float lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+    float t0;
+    if (!detail::box_kernel(m_box, lo, hi, m_ray.tmin, m_cull_t, &t0)) return finish();
+    m_dda.begin(m_view.geometry, m_box, t0);
+    next_cell();
+}
+
+void GridStepper::next_cell() {
+    if (!m_dda.next(m_cull_t, &m_cell)) return finish();
+    m_phase = Phase::cell;
+    m_plan.reset(m_cell);
+    m_plan.add_fetch(m_view.cell_base + uint64_t(m_cell) * sizeof(GridCell), sizeof(GridCell), DataKind::cell);
+    m_plan.add_op(OpKind::cell, 1);
+}
+
+void GridStepper::plan_triangles() {
+    const uint32_t n = std::min(kBatch, m_count - m_tested);
+    m_plan.reset(kNoLocality);
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t tri = m_view.refs[m_first + m_tested + i];
+        m_plan.add_fetch(m_view.triangle_base + uint64_t(tri) * sizeof(HwTriangle), sizeof(HwTriangle),
+                         DataKind::triangle);
+    }
+    m_plan.add_op(OpKind::triangle, n);
+}
+
+uint32_t GridStepper::test_triangles() {
+    const uint32_t n = std::min(kBatch, m_count - m_tested), alpha_before = m_work.anyhit_calls;
+    m_work.tri_tests += n;
+    const uint32_t* refs = m_view.refs + m_first + m_tested;
+    bool done = false;
+    for (uint32_t i = 0; i < n && !done; ++i) {
+        const HwTriangle& tri = m_view.triangles[refs[i]];
+        done = m_mode == TraversalMode::any_hit
+                   ? detail::triangle_step<true>(m_tri, m_ray.tmin, m_ray.tmax, tri, m_hit, m_cull_t, m_work.anyhit_calls)
+                   : (detail::triangle_step<false>(m_tri, m_ray.tmin, m_ray.tmax, tri, m_hit, m_cull_t,
+                                                   m_work.anyhit_calls),
+                      false);
+    }
+    m_tested += n;
+    if (done) finish();
+    else if (m_tested < m_count) plan_triangles();
+    else next_cell();
+    return m_work.anyhit_calls - alpha_before;
+}
+
+void GridStepper::finish() {
+    if (m_hit.prim < 0) m_hit = Hit{};
+    m_plan.finish();
+}
+
+}  // namespace rtsim
