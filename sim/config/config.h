@@ -18,6 +18,7 @@
 #include "rtl_model/mem/dram_config.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
 #include "rtl_model/traversal/traversal_config.h"
+#include "sim/harness/analytic_config.h"
 #include "sim/harness/sampling_config.h"
 #include "traces/accel/step_plan.h"
 
@@ -42,6 +43,7 @@ struct SimConfig {
     DramConfig dram;
     TreeletConfig treelets;
     SamplingConfig sampling;
+    AnalyticConfig analytic;  ///< the analytic level (sim/harness/analytic_config.h)
 
     /// The pipeline operations of `kind` go to. Adding an operation kind adds a PipelineConfig
     /// member, its visit() line and a case here (docs/accel.md, "Adding a structure").
@@ -65,6 +67,7 @@ struct SimConfig {
         v.section("dram", dram);
         v.section("treelets", treelets);
         v.section("sampling", sampling);
+        v.section("analytic", analytic);
     }
 };
 

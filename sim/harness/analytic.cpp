@@ -115,7 +115,7 @@ AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const 
     std::vector<RayJob> jobs;
     while (rays.read_chunk(65536, &jobs)) {
     }
-    const std::string key = analysis_key(config, AnalyticSampleParams{}, stream_fingerprint(jobs, accel)).dump();
+    const std::string key = analysis_key(config, config.analytic, stream_fingerprint(jobs, accel)).dump();
     auto& cache = memo();
     auto it = cache.find(key);
     if (it != cache.end()) {
@@ -131,7 +131,8 @@ AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const 
     VectorStream stream(jobs);
     profiler.run_cluster(stream, 0, ~0ull, recording);
     profiler.finish();
-    // The stream is its own sample: its work totals are the stepped rays'.
+    // The stream is its own sample: its work totals are the stepped rays'; nothing ran before it.
+    p.whole_trace = true;
     p.rays = uint64_t(p.sample_rays);
     p.work = p.sample_work;
     for (const RayResult& r : recording.results) {
@@ -145,7 +146,7 @@ AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const 
     return out;
 }
 
-SamplePlan analysis_plan(uint64_t rays, const AnalyticSampleParams& s, const SimConfig& config) {
+SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig& config) {
     SamplePlan plan;
     plan.trace_rays = rays;
     const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.ray_contexts;
@@ -167,7 +168,7 @@ SamplePlan analysis_plan(uint64_t rays, const AnalyticSampleParams& s, const Sim
 }
 
 AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map, TraceReader& reader,
-                              RaySinkIf& sink, const AnalyticSampleParams& sample) {
+                              RaySinkIf& sink, const AnalyticConfig& sample) {
     const auto t0 = std::chrono::steady_clock::now();
     AnalyticProfile p;
     p.accel_kind = accel.kind();
@@ -186,6 +187,7 @@ AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const
         profiler.run_cluster(stream, measure_first, measure_end, sink);
     }
     profiler.finish();
+    p.whole_trace = whole;
     p.analysis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return p;
 }

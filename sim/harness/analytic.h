@@ -51,12 +51,12 @@ AnalyticOutcome run_analytic_exact(const SimConfig& config, const Accel& accel, 
 /// The per-trace analysis of a whole trace: work counts of every ray, the sampled clusters
 /// (every stepped ray checked through `sink`).
 AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map, TraceReader& reader,
-                              RaySinkIf& sink, const AnalyticSampleParams& sample);
+                              RaySinkIf& sink, const AnalyticConfig& sample);
 
 /// Which rays the analysis of a trace of `rays` rays steps: clusters of (warm-up, measured) in
 /// trace order (sim/harness/sampling.h's plan type; measured = the cluster's rest).
 struct SamplePlan;
-SamplePlan analysis_plan(uint64_t rays, const AnalyticSampleParams& sample, const SimConfig& config);
+SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& sample, const SimConfig& config);
 
 /// rtsim-sim at fidelity = analytic: the analysis from the cache beside the trace (or computed
 /// and cached), the estimate, stats.json, config.resolved.json, provenance.json.

@@ -61,7 +61,7 @@ std::string trace_identity(const TraceReader& reader) {
     return f.hex();
 }
 
-json analysis_key(const SimConfig& c, const AnalyticSampleParams& s, const std::string& identity) {
+json analysis_key(const SimConfig& c, const AnalyticConfig& s, const std::string& identity) {
     return {{"version", kAnalysisVersion},
             {"trace", identity},
             {"units", c.traversal.units},

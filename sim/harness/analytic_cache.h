@@ -28,7 +28,7 @@ namespace rtsim {
 std::string trace_identity(const TraceReader& reader);
 
 /// The analysis key for a trace identity, config and sample.
-nlohmann::json analysis_key(const SimConfig& config, const AnalyticSampleParams& sample, const std::string& identity);
+nlohmann::json analysis_key(const SimConfig& config, const AnalyticConfig& sample, const std::string& identity);
 
 /// Where the analysis for `key` of the trace at `rtt` lives ("" when caching is off).
 std::string analysis_path(const std::string& rtt, const nlohmann::json& key);

@@ -19,6 +19,7 @@ public:
         : m_unit(p.unit_events, p.unit_censored),
           m_global(p.global_events, p.global_censored),
           m_c(c),
+          m_cold(p.whole_trace),
           m_m1(2 * DistanceBins::kBins, -1.0),
           m_m2(2 * DistanceBins::kBins, -1.0) {}
     /// P(L1 miss) and P(L1 miss and L2 miss) of an access in a joint cell.
@@ -27,22 +28,23 @@ public:
         int ub, gb;
         bool uc, gc;
         JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
-        const double p1 = lookup(m_m1, m_unit, ub, uc, m_c.l1);
-        return {p1, p1 * lookup(m_m2, m_global, gb, gc, m_c.l2)};
+        const double p1 = lookup(m_m1, m_unit, ub, uc, m_c.l1, m_cold);
+        return {p1, p1 * lookup(m_m2, m_global, gb, gc, m_c.l2, m_cold)};
     }
 
 private:
     static double lookup(std::vector<double>& table, const ReuseCurve& curve, int b, bool censored,
-                         const CacheConfig& cache) {
+                         const CacheConfig& cache, bool cold) {
         double& m = table[size_t(2 * b + censored)];
         if (m < 0) {
             const double lines = double(cache.size_kib) * 1024.0 / cache.line_bytes;
-            m = bin_miss_probability(curve, b, censored, lines, cache.ways);
+            m = bin_miss_probability(curve, b, censored, lines, cache.ways, cold);
         }
         return m;
     }
     ReuseCurve m_unit, m_global;
     const SimConfig& m_c;
+    bool m_cold;  ///< censored accesses are compulsory misses (whole-trace analysis)
     mutable std::vector<double> m_m1, m_m2;
 };
 

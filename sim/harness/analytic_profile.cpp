@@ -87,6 +87,7 @@ json AnalyticProfile::to_json() const {
             {"longest_ray_steps", longest_ray_steps},
             {"longest_ray_tests", longest_ray_tests},
             {"sample_rays", sample_rays},
+            {"whole_trace", whole_trace},
             {"sample_work", array_json(sample_work)},
             {"sample_plan_steps", sample_plan_steps},
             {"plan_steps_per", {plan_steps_per[0], plan_steps_per[1]}},
@@ -120,6 +121,7 @@ AnalyticProfile AnalyticProfile::from_json(const json& j) {
     p.longest_ray_steps = j.at("longest_ray_steps");
     p.longest_ray_tests = j.at("longest_ray_tests");
     p.sample_rays = j.at("sample_rays");
+    p.whole_trace = j.at("whole_trace");
     array_from(j.at("sample_work"), &p.sample_work);
     p.sample_plan_steps = j.at("sample_plan_steps");
     p.plan_steps_per[0] = j.at("plan_steps_per").at(0);

@@ -26,14 +26,6 @@
 
 namespace rtsim {
 
-/// How the sample is drawn (part of the analysis key).
-struct AnalyticSampleParams {
-    uint64_t whole_trace_rays = 32768;  ///< traces up to this many rays are stepped whole
-    uint32_t clusters = 8;              ///< else: clusters spread evenly over the trace ...
-    uint32_t warmup_rays = 3072;        ///< ... each with this many warm-up rays (history only) ...
-    uint32_t measured_rays = 1024;      ///< ... then this many measured rays
-};
-
 /// Work fields of WorkRecord, in order.
 constexpr int kWorkFields = 8;
 const char* work_field_name(int field);
@@ -65,6 +57,7 @@ struct AnalyticProfile {
 
     // The sample's measured rays.
     double sample_rays = 0;
+    bool whole_trace = false;  ///< the sample is the whole trace from its first ray: no history before it
     std::array<double, kWorkFields> sample_work{};
     double sample_plan_steps = 0;           ///< steps the stepper planned (node and leaf steps)
     double plan_steps_per[2] = {0, 0};      ///< regression: plan steps = a (steps + cell_steps) + b tri_tests

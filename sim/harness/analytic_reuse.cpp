@@ -82,7 +82,9 @@ double lru_hit_probability(double sd, double lines, uint32_t ways) {
     return std::min(1.0, sum);
 }
 
-double bin_miss_probability(const ReuseCurve& curve, int b, bool censored, double lines, uint32_t ways) {
+double bin_miss_probability(const ReuseCurve& curve, int b, bool censored, double lines, uint32_t ways,
+                            bool censored_is_cold) {
+    if (censored && censored_is_cold) return 1.0;
     constexpr int kPoints = 4;
     const double lo = DistanceBins::low(b), hi = DistanceBins::high(b);
     double miss = 0;

@@ -59,8 +59,10 @@ double lru_hit_probability(double sd, double lines, uint32_t ways);
 
 /// Miss probability of an access in bin b of a stream whose curve is `curve`, for a cache of
 /// `lines` x `ways`, averaged over the bin (log-uniform within it). Censored: the distance is
-/// only known to exceed the bin's low edge.
-double bin_miss_probability(const ReuseCurve& curve, int b, bool censored, double lines, uint32_t ways);
+/// only known to exceed the bin's low edge; `censored_is_cold` when the window started at the
+/// beginning of the trace (nothing before it: a censored access is a compulsory miss).
+double bin_miss_probability(const ReuseCurve& curve, int b, bool censored, double lines, uint32_t ways,
+                            bool censored_is_cold = false);
 
 /// Open-addressing hash map uint64 -> uint64 (last access position of a line), cleared per
 /// cluster; the analysis's hot loop does one lookup per access and stream.

@@ -4,6 +4,7 @@
 // analysis needs neither the structure's image nor a pass over the rays, so a run costs little
 // more than reading its config and writing its stats.
 #include <chrono>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "sim/harness/roofline.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
+#include "sim/harness/trace_stream.h"
 #include "sim/harness/verdict.h"
 #include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
@@ -71,7 +73,7 @@ json workload_json(TraceReader& reader) {
 /// Computes the analysis of the trace (the structure's image loaded, the sample stepped and
 /// checked through `checker`).
 AnalyticProfile build_analysis(const SimConfig& c, TraceReader& reader, const std::string& rtt, HitChecker& checker,
-                               const SamplePlan& plan, const AnalyticSampleParams& sample) {
+                               const SamplePlan& plan, const AnalyticConfig& sample) {
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
     const uint64_t total = reader.section(SectionKind::rays).record_count;
     const MemoryMap map(accel->image().end_address(), total, uint64_t(c.traversal.units) * c.traversal.ray_contexts,
@@ -95,6 +97,68 @@ json analytic_summary(const SimOptions& o, const AnalyticProfile& p, const Analy
     return s;
 }
 
+/// What a run adds to stats.json beyond the common keys; written by write_outputs.
+struct RunStats {
+    json summary, validation, latency, workload, instantiated, model;
+    bool bad = false;  ///< a hit or work mismatch
+};
+
+SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json& manifest, std::time_t started,
+                         RunStats r, const std::function<json(const json& model)>& verdict_of) {
+    SimOutcome out;
+    out.stats = {{"schema", "rtsim-stats/1"},
+                 {"fidelity", kFidelityChoices.name(o.config.fidelity)},
+                 {"summary", r.summary},
+                 {"validation", r.validation},
+                 {"latency", r.latency},
+                 {"workload", r.workload},
+                 {"instantiated", r.instantiated},
+                 {"effects", manifest.value("workload", json::object()).value("effects", json::array())},
+                 {"model", r.model},
+                 {"provenance", provenance(o.command_line, rtt, manifest, started)}};
+    out.stats["summary"]["sampled"] = false;
+    out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], r.model);
+    const json verdict = o.verdict && out.stats["summary"].value("rays", 0) > 0 ? verdict_of(r.model) : json(nullptr);
+    out.stats["verdict"] = verdict;
+    out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
+    out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
+    write_json(fs::path(o.out_dir) / "stats.json", out.stats);
+    write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
+    out.exit_code = r.bad ? 3 : 0;
+    return out;
+}
+
+/// analytic.caches = functional: every ray stepped through functional caches (the analytic level
+/// before issue 16; analytic_exact.cpp), every ray checked.
+SimOutcome run_functional_caches(const SimOptions& o, TraceReader& reader, const std::string& rtt,
+                                 const json& manifest, std::time_t started,
+                                 std::chrono::steady_clock::time_point t0) {
+    const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
+    RunStats r;
+    r.workload = workload_json(reader);
+    reader.verify_all();
+    const uint64_t total = r.workload["rays"];
+    const TraversalConfig& tc = o.config.traversal;
+    const MemoryMap map(accel->image().end_address(), total, uint64_t(tc.units) * tc.ray_contexts,
+                        accel->max_stack_entries(), tc.stack_entry_bytes);
+    ReferenceWindow reference(reader, o.config.dispatch.chunk_rays);
+    HitChecker checker("checker", reference, total);
+    TraceRayStream stream(reader);
+    AnalyticOutcome a = run_analytic_exact(o.config, *accel, map, stream, checker);
+    require(checker.checked() == total, "analytic run ended with " + std::to_string(checker.checked()) + " of " +
+                                            std::to_string(total) + " rays finished");
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.summary = summarize(o.config, a.cycles, total, a.model, checker, wall);
+    r.validation = checker.to_json();
+    r.latency = checker.latency().to_json();
+    r.instantiated = std::move(a.instantiated);
+    r.model = std::move(a.model);
+    r.bad = checker.hit_mismatches() || checker.work_mismatches();
+    return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
+        return judge(VerdictContext{o.config, model, accel.get(), &map, &reader});
+    });
+}
+
 }  // namespace
 
 SimOutcome run_analytic_simulation(const SimOptions& o) {
@@ -106,8 +170,10 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     const json manifest = read_manifest(rtt);
     fs::create_directories(o.out_dir);
     write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(o.config));
+    if (o.config.analytic.caches == AnalyticCaches::functional)
+        return run_functional_caches(o, reader, rtt, manifest, started, t0);
 
-    const AnalyticSampleParams sample;
+    const AnalyticConfig& sample = o.config.analytic;
     const json key = analysis_key(o.config, sample, trace_identity(reader));
     const std::string path = analysis_path(rtt, key);
     const SamplePlan plan = analysis_plan(reader.section(SectionKind::rays).record_count, sample, o.config);
@@ -127,6 +193,7 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     }
     const AnalyticProfile& p = *profile;
     AnalyticEstimate e = estimate_analytic(o.config, p);
+    e.model["analytic"]["caches"] = "statistical";
     e.model["analytic"]["analysis"] = {{"file", path.empty() ? json(nullptr) : json(path)},
                                        {"reused", reused},
                                        {"seconds", p.analysis_seconds},
@@ -134,42 +201,27 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
                                        {"sample_rays", p.sample_rays},
                                        {"key", key}};
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    json validation = p.validation;
-    validation["scope"] = "the analysis's sampled rays are checked bit for bit (hit and work); every other ray's "
-                          "work record is read (CRC checked) as the work counted";
-
-    SimOutcome out;
-    out.stats = {{"schema", "rtsim-stats/1"},
-                 {"fidelity", kFidelityChoices.name(o.config.fidelity)},
-                 {"summary", analytic_summary(o, p, e, checker, wall)},
-                 {"validation", validation},
-                 {"latency", {{"rays", p.rays}, {"mean_cycles", e.mean_latency}, {"estimated", "unloaded mean"}}},
-                 {"workload", p.workload},
-                 {"instantiated", e.instantiated},
-                 {"effects", manifest.value("workload", json::object()).value("effects", json::array())},
-                 {"model", e.model},
-                 {"provenance", provenance(o.command_line, rtt, manifest, started)}};
-    out.stats["summary"]["sampled"] = false;
-    out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], e.model);
-    json verdict = nullptr;
-    if (o.verdict && p.rays > 0) {
+    RunStats r;
+    r.summary = analytic_summary(o, p, e, checker, wall);
+    r.validation = p.validation;
+    r.validation["scope"] = "the analysis's sampled rays are checked bit for bit (hit and work); every other "
+                            "ray's work record is read (CRC checked) as the work counted";
+    r.latency = {{"rays", p.rays}, {"mean_cycles", e.mean_latency}, {"estimated", "unloaded mean"}};
+    r.workload = p.workload;
+    r.instantiated = std::move(e.instantiated);
+    r.model = std::move(e.model);
+    r.bad = p.validation.value("hit_mismatches", 0) || p.validation.value("work_mismatches", 0);
+    return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
         // The verdict's analytic estimates come from this run's own analysis (no second pass).
-        VerdictContext v{o.config, e.model, nullptr, nullptr, nullptr};
+        VerdictContext v{o.config, model, nullptr, nullptr, nullptr};
         v.estimate = [&p](const SimConfig& c) {
-            const AnalyticEstimate r = estimate_analytic(c, p);
-            return std::make_pair(r.form.cycles, r.form.binding);
+            const AnalyticEstimate x = estimate_analytic(c, p);
+            return std::make_pair(x.form.cycles, x.form.binding);
         };
-        v.estimate_method = "the analytic level's per-trace analysis";
-        verdict = judge(v);
-    }
-    out.stats["verdict"] = verdict;
-    out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
-    out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
-    write_json(fs::path(o.out_dir) / "stats.json", out.stats);
-    write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
-    const bool bad = p.validation.value("hit_mismatches", 0) || p.validation.value("work_mismatches", 0);
-    out.exit_code = bad ? 3 : 0;
-    return out;
+        v.estimate_method = "the analytic level's per-trace analysis (" + std::to_string(p.stepped_rays) +
+                            " stepped rays)";
+        return judge(v);
+    });
 }
 
 }  // namespace rtsim
