@@ -1,6 +1,7 @@
 """`rtsim accuracy`: what each fidelity level and sample size costs in accuracy and saves in time.
 
 rtsim accuracy SCENE... [-o DIR] [--resolution WxH] [--fractions 0.01,0.05,0.1] [--repeat 3]
+rtsim accuracy --spec SPEC.yaml [-o DIR] [--levels analytic,approx,detailed]   (accuracy_grid.py)
 
 Per scene and workload (coherent primary rays, incoherent diffuse rays) it traces once, then runs
 every level the installed rtsim-sim accepts (functional, analytic, approx, detailed) on that trace
@@ -393,6 +394,15 @@ def parse_fractions(text: str) -> list[float]:
 
 
 def cmd_accuracy(args: argparse.Namespace, console: Console) -> int:
+    if args.spec:
+        from rtsim.accuracy_grid import markdown, run_grid, summarize_grid
+
+        grid = run_grid(Path(args.spec), Path(args.output), args.levels.split(","), console)
+        print(markdown(summarize_grid(grid)))
+        console.print(f"wrote {Path(args.output) / 'grid.csv'}, grid.md, grid.json, grid.png")
+        return 3 if any(r.hit_mismatches for r in grid) else 0
+    if not args.scenes:
+        raise ValueError("name at least one SCENE, or a sweep spec with --spec")
     unknown = [w for w in args.workloads.split(",") if w not in WORKLOADS]
     if unknown:
         raise ValueError(f"unknown workload(s) {unknown}; choose from {', '.join(WORKLOADS)}")
@@ -419,7 +429,20 @@ def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None: 
         help="wall time against error of each fidelity level and sample size (table and plot)",
         description=__doc__.split("\n\n")[1] if __doc__ else None,
     )
-    p.add_argument("scenes", nargs="+", metavar="SCENE", help="built-in or shared scene, or glTF")
+    p.add_argument("scenes", nargs="*", metavar="SCENE", help="built-in or shared scene, or glTF")
+    p.add_argument(
+        "--spec",
+        metavar="SPEC.yaml",
+        help="a sweep spec (e.g. python/rtsim/specs/demo.yaml): each level's error, rank "
+        "agreement and speed-up across its grid instead (grid.md, grid.csv, grid.png)",
+    )
+    p.add_argument(
+        "--levels",
+        default="analytic,analytic_functional,approx,detailed",
+        metavar="L,L",
+        help="with --spec: levels to run (analytic_functional: the analytic level with "
+        "functional caches, for hit-rate errors)",
+    )
     p.add_argument("-o", "--output", default="out/accuracy", metavar="DIR")
     p.add_argument("--resolution", type=parse_resolution, default=(256, 192), metavar="WxH")
     p.add_argument(

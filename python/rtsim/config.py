@@ -179,6 +179,37 @@ class SamplingConfig:
 
 
 @dataclass
+class AnalyticConfig:
+    """The analytic level (docs/fidelity.md): its cache model and how its per-trace analysis
+    samples the trace (sim/harness/analytic_config.h)."""
+
+    caches: str = _choice(
+        "statistical",
+        ("statistical", "functional"),
+        "statistical: reuse distances of a sample of rays (StatStack) scaled by the trace's work "
+        "counts; functional: every ray through functional caches (exact, slow)",
+    )
+    whole_trace_rays: int = _f(
+        32768,
+        "rays",
+        "Traces up to this many rays are analysed whole (statistical caches)",
+        0,
+        1 << 30,
+    )
+    clusters: int = _f(
+        8, "clusters", "Clusters of consecutive rays the analysis steps in larger traces", 1, 4096
+    )
+    warmup_rays: int = _f(
+        3072,
+        "rays",
+        "Warm-up rays per cluster: their accesses only build reuse history",
+        0,
+        1 << 24,
+    )
+    measured_rays: int = _f(1024, "rays", "Measured rays per cluster", 1, 1 << 24)
+
+
+@dataclass
 class TreeletConfig:
     """Treelet scheduling with ray buffers (docs/treelets.md; Aila & Karras 2010, STRaTA)."""
 
@@ -341,6 +372,7 @@ class SimConfig:
     treelets: TreeletConfig = field(default_factory=TreeletConfig)
     sampling: SamplingConfig = field(default_factory=SamplingConfig)
     energy: EnergyConfig = field(default_factory=EnergyConfig)
+    analytic: AnalyticConfig = field(default_factory=AnalyticConfig)
 
     sections: ClassVar[tuple[str, ...]] = (
         "dispatch",
@@ -355,6 +387,7 @@ class SimConfig:
         "treelets",
         "sampling",
         "energy",
+        "analytic",
     )
 
     def to_dict(self) -> dict[str, Any]:

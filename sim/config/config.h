@@ -18,6 +18,7 @@
 #include "rtl_model/mem/dram_config.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
 #include "rtl_model/traversal/traversal_config.h"
+#include "sim/harness/analytic_config.h"
 #include "sim/harness/energy_config.h"
 #include "sim/harness/sampling_config.h"
 #include "traces/accel/step_plan.h"
@@ -47,6 +48,7 @@ struct SimConfig {
     TreeletConfig treelets;
     SamplingConfig sampling;
     EnergyConfig energy;  ///< the energy and area model's technology (sim/harness/energy_area.h)
+    AnalyticConfig analytic;  ///< the analytic level (sim/harness/analytic_config.h)
 
     /// The pipeline operations of `kind` go to. Adding an operation kind adds a PipelineConfig
     /// member, its visit() line and a case here (docs/accel.md, "Adding a structure").
@@ -72,6 +74,7 @@ struct SimConfig {
         v.section("treelets", treelets);
         v.section("sampling", sampling);
         v.section("energy", energy);
+        v.section("analytic", analytic);
     }
 };
 

@@ -1,16 +1,17 @@
 #include "sim/harness/analytic.h"
 
 #include <algorithm>
-#include <cmath>
-#include <deque>
-#include <memory>
-#include <queue>
+#include <chrono>
+#include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
-#include "rtl_model/dispatch/dispatch.h"
-#include "rtl_model/mem/functional_cache.h"
-#include "rtl_model/traversal/stack_spill.h"
+#include "sim/harness/analytic_cache.h"
+#include "sim/harness/analytic_estimate.h"
+#include "sim/harness/analytic_sample.h"
+#include "sim/harness/sampling.h"
+#include "sim/harness/trace_stream.h"
 
 namespace rtsim {
 
@@ -18,391 +19,92 @@ using nlohmann::json;
 
 namespace {
 
-/// Per-unit counts (the analytic counterpart of a traversal unit and its pipelines).
-struct UnitCounts {
-    uint64_t rays = 0, steps = 0, spill_writes = 0, spill_reads = 0, rejected = 0;
-    uint64_t issues[kOpKindCount] = {}, tests[kOpKindCount] = {};  ///< per operation kind
-};
-
-class AnalyticModel {
-public:
-    AnalyticModel(const SimConfig& config, const Accel& accel, const MemoryMap& map, RaySinkIf& sink)
-        : m_c(config), m_map(map), m_sink(sink), m_ops(accel.op_kinds()), m_units(config.traversal.units),
-          m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts) {
-        for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper();
-        if (!config.ideal_memory) {
-            for (uint32_t u = 0; u < config.traversal.units; ++u) m_l1.emplace_back(config.l1);
-            m_l2 = std::make_unique<FunctionalCache>(config.l2);
+/// Sums every ray's work record (one streaming pass; each chunk's CRC is checked as it is read).
+void work_totals(TraceReader& reader, AnalyticProfile* p) {
+    const uint64_t n = reader.section(SectionKind::work).record_count;
+    std::vector<WorkRecord> buf(65536);
+    p->rays = n;
+    p->work.fill(0.0);
+    for (uint64_t first = 0; first < n; first += buf.size()) {
+        const uint64_t count = std::min<uint64_t>(buf.size(), n - first);
+        reader.read(SectionKind::work, first, count, buf.data());
+        uint64_t sums[kWorkFields] = {};
+        for (uint64_t i = 0; i < count; ++i) {
+            const WorkRecord& w = buf[i];
+            sums[0] += w.steps, sums[1] += w.box_tests, sums[2] += w.tri_tests, sums[3] += w.anyhit_calls;
+            sums[4] += w.transforms, sums[5] += w.cell_steps, sums[6] += w.plane_tests, sums[7] += w.refs;
+            const double steps = double(w.steps) + w.cell_steps;
+            if (steps > p->longest_ray_steps) p->longest_ray_steps = steps, p->longest_ray_tests = w.tri_tests;
         }
-        m_line_bytes = config.l1.line_bytes;
+        for (int f = 0; f < kWorkFields; ++f) p->work[size_t(f)] += double(sums[f]);
     }
+}
 
-    void run(RayStream& rays);
-    AnalyticOutcome outcome(const Accel& accel) const;
+/// A vector of rays as a stream.
+class VectorStream : public RayStream {
+public:
+    explicit VectorStream(const std::vector<RayJob>& jobs) : m_jobs(jobs) {}
+    size_t read_chunk(size_t max, std::vector<RayJob>* out) override {
+        const size_t n = std::min(max, m_jobs.size() - m_next);
+        out->insert(out->end(), m_jobs.begin() + long(m_next), m_jobs.begin() + long(m_next + n));
+        m_next += n;
+        return n;
+    }
+    uint64_t total_rays() const override { return m_jobs.size(); }
 
 private:
-    struct Context {
-        std::unique_ptr<Stepper> stepper;
-        uint64_t id = 0;
-        Cycle clock = 0;    ///< this context's unloaded clock
-        Cycle start = 0;    ///< clock the ray started at
-        uint32_t local_stack = 0, spilled = 0;
-        bool active = false;
-    };
-    bool start_ray(uint32_t unit, uint32_t slot);
-    void step(uint32_t unit, uint32_t slot);
-    Cycle read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind, Cycle now);
-    void write(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind);
-    Cycle stack_traffic(uint32_t unit, uint32_t slot, int before, Cycle now);
-    Cycle pipe(uint32_t unit, const Op& op);
-    bool uses(OpKind kind) const { return std::find(m_ops.begin(), m_ops.end(), kind) != m_ops.end(); }
-    json bounds_json(double* cycles, std::string* binding) const;
-    double queueing_cycles(const json& bounds) const;
-
-    const SimConfig& m_c;
-    const MemoryMap& m_map;
-    RaySinkIf& m_sink;
-    std::vector<OpKind> m_ops;  ///< operation kinds the structure issues
-    std::vector<UnitCounts> m_units;
-    std::vector<Context> m_contexts;  ///< unit-major: unit * ray_contexts + context
-    std::vector<FunctionalCache> m_l1;
-    std::unique_ptr<FunctionalCache> m_l2;
-    MemStats m_dram, m_ideal;
-    uint32_t m_line_bytes = 64;
-    std::unique_ptr<RayDealer> m_dispatch;  ///< the model's dispatch policy: same ray-to-unit assignment
-    uint64_t m_dispatched = 0;
-    double m_latency_sum = 0;
-    Cycle m_latency_max = 0;
-    double m_l1_hold = 0, m_l2_hold = 0;  ///< cycles L1 / L2 misses hold an MSHR, summed
+    const std::vector<RayJob>& m_jobs;
+    size_t m_next = 0;
 };
 
-void AnalyticModel::run(RayStream& rays) {
-    m_dispatch = std::make_unique<RayDealer>(m_c.dispatch, m_c.traversal.units, rays);
-    const uint32_t units = m_c.traversal.units, contexts = m_c.traversal.ray_contexts;
-    // The context whose unloaded clock is earliest takes the next step (ties: context-major,
-    // then unit, so the first rays spread over the units); a context that finishes a ray takes
-    // the next one at once. The clocks order the accesses and detect fills in flight only.
-    using Entry = std::pair<Cycle, uint32_t>;  // clock, c * units + u
-    std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> ready;
-    for (uint32_t c = 0; c < contexts; ++c)
-        for (uint32_t u = 0; u < units; ++u)
-            if (start_ray(u, c)) ready.push({m_contexts[size_t(u) * contexts + c].clock, c * units + u});
-    while (!ready.empty()) {
-        const uint32_t key = ready.top().second;
-        ready.pop();
-        const uint32_t u = key % units, c = key / units;
-        step(u, c);
-        const Context& ctx = m_contexts[size_t(u) * contexts + c];
-        if (ctx.active) ready.push({ctx.clock, key});
+/// Keeps the results of the rays it forwards (for replay) and the longest ray's work.
+class RecordingSink : public RaySinkIf {
+public:
+    explicit RecordingSink(RaySinkIf& next) : m_next(next) {}
+    void ray_done(const RayResult& r) override {
+        results.push_back(r);
+        m_next.ray_done(r);
     }
+    std::vector<RayResult> results;
+
+private:
+    RaySinkIf& m_next;
+};
+
+struct Memo {
+    AnalyticProfile profile;
+    std::vector<RayResult> results;
+};
+
+/// Analyses of ray streams already stepped in this process (the verdict evaluates several
+/// configurations on the same sample), by key; a handful at most.
+std::map<std::string, Memo>& memo() {
+    static std::map<std::string, Memo> m;
+    return m;
 }
 
-bool AnalyticModel::start_ray(uint32_t unit, uint32_t slot) {
-    RayJob job;
-    if (!m_dispatch->next_ray(unit, &job)) return false;
-    ++m_dispatched;
-    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
-    ctx.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
-    if (!ray_is_valid(job.ray)) ++m_units[unit].rejected;
-    ctx.id = job.id;
-    ctx.local_stack = ctx.spilled = 0;
-    ctx.active = true;
-    ++m_units[unit].steps;  // the ray-fetch step
-    ctx.start = ctx.clock;
-    const Cycle fetch = ctx.clock + m_c.dispatch.latency;
-    ctx.clock = fetch + read(unit, m_map.ray(job.id), sizeof(RayRecord), DataKind::ray, fetch);
-    return true;
-}
-
-void AnalyticModel::step(uint32_t unit, uint32_t slot) {
-    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
-    UnitCounts& uc = m_units[unit];
-    Stepper& stepper = *ctx.stepper;
-    const StepPlan& plan = stepper.plan();
-    if (plan.done) {
-        write(unit, m_map.hit(ctx.id), sizeof(HitRecord), DataKind::hit);  // posted
-        const Cycle latency = ctx.clock - ctx.start;
-        m_sink.ray_done(RayResult{ctx.id, stepper.hit(), stepper.work(), 0, latency, unit, slot});
-        ++uc.rays;
-        m_latency_sum += double(latency);
-        m_latency_max = std::max(m_latency_max, latency);
-        ctx.active = false;
-        start_ray(unit, slot);
-        return;
-    }
-    // The step as the traversal unit takes it: its fetches, then its operations in order, then
-    // those its results call for (alpha tests); two scheduler steps (fetch, operations).
-    uc.steps += 2;
-    Cycle fetched = 0;
-    for (int i = 0; i < plan.fetch_count; ++i)
-        fetched = std::max(fetched, read(unit, plan.fetch[i].addr, plan.fetch[i].bytes, plan.fetch[i].kind, ctx.clock));
-    ctx.clock += fetched;
-    Op ops[StepPlan::kMaxOps];
-    const int op_count = plan.op_count;
-    std::copy(plan.op, plan.op + op_count, ops);
-    const int before = stepper.stack_size();
-    const StepOutcome outcome = stepper.execute();
-    Cycle ready = 0;
-    for (int i = 0; i < op_count; ++i) ready += pipe(unit, ops[i]);
-    for (int i = 0; i < outcome.op_count; ++i) ready += pipe(unit, outcome.op[i]);
-    ctx.clock += std::max(ready, stack_traffic(unit, slot, before, ctx.clock));
-}
-
-/// Issues an operation into its pipeline; returns its unloaded latency.
-Cycle AnalyticModel::pipe(uint32_t unit, const Op& op) {
-    const PipelineConfig& pc = m_c.pipeline(op.kind);
-    const uint32_t issues = (op.count + pc.width - 1) / pc.width;
-    m_units[unit].issues[size_t(op.kind)] += issues;
-    m_units[unit].tests[size_t(op.kind)] += op.count;
-    return issues ? Cycle(issues - 1) * pc.initiation_interval + pc.latency : 0;
-}
-
-/// One read through L1, L2 and DRAM at cycle `now` (line by line, as Cache does); returns the
-/// unloaded latency of its slowest line, including the wait for a fill in flight (a merge).
-Cycle AnalyticModel::read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind, Cycle now) {
-    if (m_c.ideal_memory) {
-        MemCounters& c = m_ideal[kind];
-        ++c.reads;
-        ++c.read_hits;
-        c.read_bytes += bytes;
-        return m_c.l1.latency;
-    }
-    const uint32_t shift = m_l1[unit].line_shift();
-    const Cycle ic = m_c.interconnect_latency;
-    const Cycle dram = m_c.dram.latency + (m_line_bytes + m_c.dram.bytes_per_cycle - 1) / m_c.dram.bytes_per_cycle;
-    Cycle done = now;
-    for (uint64_t line = addr >> shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> shift; ++line) {
-        const uint64_t lo = std::max(addr, line << shift), hi = std::min(addr + bytes, (line + 1) << shift);
-        const uint32_t part = uint32_t(hi > lo ? hi - lo : 0);
-        const Cycle l1_tag = now + m_c.l1.latency;
-        Cycle ready = 0, *fill = nullptr;
-        if (m_l1[unit].read(line, part, kind, l1_tag, &ready, &fill)) {
-            done = std::max(done, std::max(l1_tag, ready));
-            continue;
-        }
-        // L1 miss: to the L2 over the interconnect; its fill comes back the same way.
-        const Cycle l2_tag = l1_tag + ic + m_c.l2.latency;
-        Cycle l2_ready = 0, *l2_fill = nullptr, l2_done;
-        if (m_l2->read(line, m_line_bytes, kind, l2_tag, &l2_ready, &l2_fill)) {
-            l2_done = std::max(l2_tag, l2_ready);
-        } else {
-            l2_done = *l2_fill = l2_tag + dram;
-            m_l2_hold += double(dram);
-            MemCounters& d = m_dram[kind];
-            ++d.reads;
-            ++d.read_hits;
-            d.read_bytes += m_line_bytes;
-        }
-        *fill = l2_done + ic;
-        m_l1_hold += double(*fill - l1_tag);
-        done = std::max(done, *fill);
-    }
-    return done - now;
-}
-
-/// A posted write: write-through, no-write-allocate at every level, one request per line piece.
-void AnalyticModel::write(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind) {
-    if (m_c.ideal_memory) {
-        ++m_ideal[kind].writes;
-        m_ideal[kind].write_bytes += bytes;
-        return;
-    }
-    const uint32_t shift = m_l1[unit].line_shift();
-    for (uint64_t line = addr >> shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> shift; ++line) {
-        const uint64_t lo = std::max(addr, line << shift), hi = std::min(addr + bytes, (line + 1) << shift);
-        const uint32_t part = uint32_t(hi > lo ? hi - lo : 0);
-        m_l1[unit].write(part, kind);
-        m_l2->write(part, kind);
-        ++m_dram[kind].writes;
-        m_dram[kind].write_bytes += part;
-    }
-}
-
-/// Stack spills (posted writes) and refills (reads the ray waits for), as the traversal unit
-/// maps the stepper's stack onto stack_entries on-chip entries; returns the refill latency.
-Cycle AnalyticModel::stack_traffic(uint32_t unit, uint32_t slot, int before, Cycle now) {
-    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
-    const uint32_t bytes = m_c.traversal.stack_entry_bytes;
-    const uint64_t owner = uint64_t(unit) * m_c.traversal.ray_contexts + slot;
-    Cycle refill = 0;
-    map_stack_change(
-        ctx.local_stack, ctx.spilled, before, ctx.stepper->stack_size(), m_c.traversal.stack_entries,
-        [&](uint32_t s) {
-            write(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack);
-            ++m_units[unit].spill_writes;
-        },
-        [&](uint32_t s) {
-            ++m_units[unit].spill_reads;
-            refill = std::max(refill, read(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack, now));
-        });
-    return refill;
-}
-
-/// The roofline: each bound in cycles; `cycles` gets the largest, `binding` its name.
-json AnalyticModel::bounds_json(double* cycles, std::string* binding) const {
-    const TraversalConfig& t = m_c.traversal;
-    uint64_t issues[kOpKindCount] = {}, steps = 0;
-    for (const UnitCounts& u : m_units) {
-        for (int k = 0; k < kOpKindCount; ++k) issues[k] += u.issues[k];
-        steps += u.steps;
-    }
-    json b = json::object();
-    for (OpKind kind : m_ops) {
-        const PipelineConfig& pc = m_c.pipeline(kind);
-        const double pipelines = pc.shared() ? pc.shared_count : t.units;
-        b[op_kind_name(kind)] = double(issues[size_t(kind)]) * pc.initiation_interval / pipelines;
-    }
-    if (!m_c.ideal_memory) {
-        MemCounters d = m_dram.total(), l2 = m_l2->stats().total();
-        uint64_t l1_accesses = 0;
-        for (const FunctionalCache& l1 : m_l1) l1_accesses += l1.stats().total().reads + l1.stats().total().writes;
-        b["dram"] = double(d.read_bytes + d.write_bytes) / (double(m_c.dram.channels) * m_c.dram.bytes_per_cycle);
-        b["l2_banks"] = double(l2.reads + l2.writes) * m_c.l2.bank_cycles / m_c.l2.banks;
-        b["l1_banks"] = double(l1_accesses) * m_c.l1.bank_cycles / (double(m_c.l1.banks) * t.units);
-        // Little's law on the MSHRs: each miss holds one for its unloaded miss latency.
-        b["l1_mshrs"] = m_l1_hold / (double(m_c.l1.mshrs) * t.units);
-        b["l2_mshrs"] = m_l2_hold / double(m_c.l2.mshrs);
-    }
-    b["scheduler"] = double(steps) * t.issue_cycles / t.units;
-    b["latency"] = std::max(m_latency_sum / (double(t.units) * t.ray_contexts), double(m_latency_max));
-    *cycles = 0;
-    for (auto& [name, value] : b.items())
-        if (value.get<double>() > *cycles) {
-            *cycles = value.get<double>();
-            *binding = name;
-        }
-    return b;
-}
-
-/// Mean value analysis (Reiser & Lavenberg 1980) of the ray contexts as a closed queueing
-/// network: each unit's `ray_contexts` rays circulate through the resources behind the bounds
-/// (each a queue whose demand per ray is its bound's share) and a pure delay (the rest of the
-/// unloaded latency). Units are symmetric classes: a private resource queues one unit's rays, a
-/// shared one (DRAM, L2, shared pipelines) all units' rays. An m-server resource (MSHRs) is a
-/// queue of demand D/m plus a delay (Seidmann et al. 1987). The throughput it gives is never
-/// above any bound, and it adds the queueing the roofline leaves out when several resources are
-/// loaded at once. Returns the cycles for all rays.
-double AnalyticModel::queueing_cycles(const json& bounds) const {
-    const double rays = double(m_dispatched), units = m_c.traversal.units;
-    if (rays == 0) return 0;
-    struct Station {
-        double demand;  ///< cycles per ray of one class (unit)
-        bool shared;
+std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& accel) {
+    uint64_t h = 1469598103934665603ull;
+    auto add = [&](const void* data, size_t n) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
     };
-    std::vector<std::pair<std::string, bool>> kinds;  // station, shared by all units
-    for (OpKind kind : m_ops) kinds.push_back({op_kind_name(kind), m_c.pipeline(kind).shared()});
-    for (const char* name : {"scheduler", "l1_banks", "l1_mshrs"}) kinds.push_back({name, false});
-    for (const char* name : {"dram", "l2_banks", "l2_mshrs"}) kinds.push_back({name, true});
-    std::vector<Station> stations;
-    double think = m_latency_sum / rays;  // unloaded latency per ray
-    for (const auto& [name, shared] : kinds) {
-        if (!bounds.contains(name)) continue;
-        const double bound = bounds[name].get<double>();
-        const double demand = shared ? bound / rays : bound * units / rays;
-        stations.push_back({demand, shared});
-        // The MSHR queues' demand D/m is part of the unloaded latency already.
-        if (name.find("mshrs") != std::string::npos) think -= demand;
+    const void* a = &accel;
+    add(&a, sizeof a);
+    for (const RayJob& j : jobs) {
+        add(&j.id, sizeof j.id);
+        add(&j.ray, sizeof j.ray);
+        add(&j.any_hit, sizeof j.any_hit);
     }
-    think = std::max(think, 0.0);
-    std::vector<double> queue(stations.size(), 0.0);
-    double x = 0;
-    for (uint32_t n = 1; n <= m_c.traversal.ray_contexts; ++n) {
-        double residence = think;
-        std::vector<double> r(stations.size());
-        for (size_t k = 0; k < stations.size(); ++k) {
-            r[k] = stations[k].demand * (1.0 + (stations[k].shared ? units : 1.0) * queue[k]);
-            residence += r[k];
-        }
-        x = double(n) / residence;  // rays per cycle of one unit
-        for (size_t k = 0; k < stations.size(); ++k) queue[k] = x * r[k];
-    }
-    return x > 0 ? rays / (units * x) : 0.0;
+    return std::to_string(h) + ":" + std::to_string(jobs.size());
 }
 
-AnalyticOutcome AnalyticModel::outcome(const Accel& accel) const {
+AnalyticOutcome outcome_of(const SimConfig& config, const AnalyticProfile& profile) {
+    AnalyticEstimate e = estimate_analytic(config, profile);
     AnalyticOutcome out;
-    double bound = 0;
-    std::string binding = "latency";
-    json bounds = bounds_json(&bound, &binding);
-    const double queueing = queueing_cycles(bounds);
-    out.cycles = Cycle(std::ceil(std::max(bound, queueing)));
-    const double total = double(out.cycles);
-    json& m = out.model;
-    m["dispatch"] = m_dispatch->stats_json();
-    for (size_t u = 0; u < m_units.size(); ++u) {
-        const UnitCounts& uc = m_units[u];
-        // Time-dependent counters do not exist at this level: null.
-        m["units"]["tu" + std::to_string(u)] = {
-            {"rays", uc.rays},          {"steps", uc.steps},      {"busy_cycles", nullptr},
-            {"busy_fraction", nullptr}, {"stack_spill_writes", uc.spill_writes},
-            {"stack_spill_reads", uc.spill_reads}, {"rejected_rays", uc.rejected},
-            {"quantum_syncs", nullptr}, {"finish_cycle", nullptr}};
-    }
-    for (OpKind kind : m_ops) {
-        const size_t p = size_t(kind);
-        const std::string name = op_kind_name(kind);
-        const PipelineConfig& pc = m_c.pipeline(kind);
-        auto block = [&](uint64_t issues, uint64_t tests, uint32_t pipelines) {
-            const double capacity = total * pipelines / pc.initiation_interval;
-            return json{{"issues", issues},     {"tests", tests}, {"pipelines", pipelines},
-                        {"utilization", capacity > 0 ? double(issues) / capacity : 0.0}, {"avg_wait_cycles", nullptr}};
-        };
-        if (pc.shared()) {
-            uint64_t issues = 0, tests = 0;
-            for (const UnitCounts& uc : m_units) issues += uc.issues[p], tests += uc.tests[p];
-            m[name][name + "_pool"] = block(issues, tests, pc.shared_count);
-        } else {
-            for (size_t u = 0; u < m_units.size(); ++u)
-                m[name][name + "_" + std::to_string(u)] = block(m_units[u].issues[p], m_units[u].tests[p], 1);
-        }
-    }
-    if (m_c.ideal_memory) {
-        m["ideal_memory"] = m_ideal.to_json();
-    } else {
-        for (size_t u = 0; u < m_l1.size(); ++u) m["l1"]["l1_" + std::to_string(u)] = m_l1[u].stats_json();
-        m["l2"] = m_l2->stats_json();
-        json d = m_dram.to_json();
-        auto drop_cache_fields = [](json& c) {
-            for (const char* k : {"read_hits", "merged", "hit_rate"}) c.erase(k);
-        };
-        drop_cache_fields(d);
-        for (auto& [kind, c] : d["by_kind"].items()) drop_cache_fields(c);
-        const MemCounters t = m_dram.total();
-        const double seconds = total / (m_c.clock_ghz * 1e9);
-        const double peak = double(m_c.dram.bytes_per_cycle) * m_c.dram.channels * m_c.clock_ghz;
-        const double achieved = seconds > 0 ? double(t.read_bytes + t.write_bytes) / seconds / 1e9 : 0.0;
-        d["bandwidth_gbps"] = achieved;
-        d["peak_bandwidth_gbps"] = peak;
-        d["bandwidth_utilization"] = peak > 0 ? achieved / peak : 0.0;
-        d["avg_queue_cycles"] = nullptr;
-        d["bandwidth_over_time"] = json::array();
-        m["dram"] = d;
-    }
-    const double rays = double(m_dispatched);
-    m["analytic"] = {{"bounds", bounds},
-                     {"binding", binding},
-                     {"roofline_cycles", bound},
-                     {"queueing_cycles", queueing},
-                     {"cycles", out.cycles},
-                     {"unloaded_latency_mean_cycles", rays > 0 ? m_latency_sum / rays : 0.0},
-                     {"unloaded_latency_max_cycles", m_latency_max},
-                     {"assignment", "rays to contexts in trace order as contexts free up; contexts of all units "
-                                    "step in round robin"}};
-    const TraversalConfig& tc = m_c.traversal;
-    out.instantiated = json::array(
-        {{{"block", "traversal"}, {"instantiated", true},
-          {"why", std::to_string(tc.units) + " units x " + std::to_string(tc.ray_contexts) +
-                      " ray contexts (analytic: counted, not timed)"}},
-         {{"block", "memory"}, {"instantiated", !m_c.ideal_memory},
-          {"why", m_c.ideal_memory ? "ideal_memory: every access hits at L1 latency, no L2/DRAM"
-                                   : "functional L1 per unit and shared L2 (tags only), DRAM bytes"}},
-        });
-    for (int k = 0; k < kOpKindCount; ++k)
-        out.instantiated.push_back({{"block", op_kind_name(OpKind(k))},
-                                    {"instantiated", uses(OpKind(k))},
-                                    {"why", std::string("the ") + accel.kind() + " structure issues " +
-                                                (uses(OpKind(k)) ? "" : "no ") + op_kind_name(OpKind(k)) +
-                                                " operations (analytic: counted, not timed)"}});
+    out.cycles = Cycle(e.form.cycles);
+    out.model = std::move(e.model);
+    out.instantiated = std::move(e.instantiated);
     return out;
 }
 
@@ -410,9 +112,84 @@ AnalyticOutcome AnalyticModel::outcome(const Accel& accel) const {
 
 AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
                              RaySinkIf& sink) {
-    AnalyticModel model(config, accel, map, sink);
-    model.run(rays);
-    return model.outcome(accel);
+    std::vector<RayJob> jobs;
+    while (rays.read_chunk(65536, &jobs)) {
+    }
+    const std::string key = analysis_key(config, config.analytic, stream_fingerprint(jobs, accel)).dump();
+    auto& cache = memo();
+    auto it = cache.find(key);
+    if (it != cache.end()) {
+        for (const RayResult& r : it->second.results) sink.ray_done(r);
+        return outcome_of(config, it->second.profile);
+    }
+    Memo m;
+    AnalyticProfile& p = m.profile;
+    p.accel_kind = accel.kind();
+    p.op_kinds = accel.op_kinds();
+    RecordingSink recording(sink);
+    SampleProfiler profiler(config, accel, map, p);
+    VectorStream stream(jobs);
+    profiler.run_cluster(stream, 0, ~0ull, recording);
+    profiler.finish();
+    // The stream is its own sample: its work totals are the stepped rays'; nothing ran before it.
+    p.whole_trace = true;
+    p.rays = uint64_t(p.sample_rays);
+    p.work = p.sample_work;
+    for (const RayResult& r : recording.results) {
+        const double steps = double(r.work.steps) + r.work.cell_steps;
+        if (steps > p.longest_ray_steps) p.longest_ray_steps = steps, p.longest_ray_tests = r.work.tri_tests;
+    }
+    m.results = std::move(recording.results);
+    if (cache.size() >= 8) cache.erase(cache.begin());
+    const AnalyticOutcome out = outcome_of(config, p);
+    cache.emplace(key, std::move(m));
+    return out;
+}
+
+SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig& config) {
+    SamplePlan plan;
+    plan.trace_rays = rays;
+    const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.ray_contexts;
+    const uint64_t length = uint64_t(s.warmup_rays) + s.measured_rays + tail;
+    const uint64_t clusters = std::min<uint64_t>(s.clusters, length ? rays / length : 0);
+    if (rays <= s.whole_trace_rays || clusters == 0) {
+        plan.clusters.push_back({0, rays, 0, 0, rays});
+    } else {
+        // One cluster in the middle of each of K equal strata (deterministic).
+        for (uint64_t k = 0; k < clusters; ++k) {
+            const uint64_t first = rays * k / clusters, end = rays * (k + 1) / clusters;
+            const uint64_t start = first + (end - first - length) / 2;
+            plan.clusters.push_back({first, end - first, start, s.warmup_rays, s.measured_rays + tail});
+        }
+        plan.warmup_rays = s.warmup_rays;
+    }
+    for (const auto& c : plan.clusters) plan.simulated_rays += c.warmup + c.measured;
+    return plan;
+}
+
+AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map, TraceReader& reader,
+                              RaySinkIf& sink, const AnalyticConfig& sample) {
+    const auto t0 = std::chrono::steady_clock::now();
+    AnalyticProfile p;
+    p.accel_kind = accel.kind();
+    p.op_kinds = accel.op_kinds();
+    work_totals(reader, &p);
+    const SamplePlan plan = analysis_plan(p.rays, sample, config);
+    const bool whole = plan.clusters.size() == 1 && plan.clusters[0].warmup == 0;
+    SampleProfiler profiler(config, accel, map, p);
+    std::vector<RayRecord> buffer;
+    for (const SamplePlan::Cluster& c : plan.clusters) {
+        std::vector<RayJob> jobs;
+        read_ray_jobs(reader, c.first, size_t(c.warmup + c.measured), &buffer, &jobs);
+        VectorStream stream(jobs);
+        const uint64_t measure_first = c.first + c.warmup;
+        const uint64_t measure_end = whole ? c.end() : measure_first + sample.measured_rays;
+        profiler.run_cluster(stream, measure_first, measure_end, sink);
+    }
+    profiler.finish();
+    p.whole_trace = whole;
+    p.analysis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return p;
 }
 
 }  // namespace rtsim

@@ -1,26 +1,20 @@
 #pragma once
-// The analytic fidelity level: counts, a functional cache simulation and a closed-form
-// (roofline) model of time. No SystemC time passes.
+// The analytic fidelity level (docs/fidelity.md, "The analytic level"): first-order answers from
+// a per-trace analysis and a closed form, no SystemC time, no traversal of every ray.
 //
-// Every ray is traced with the structure's stepper (the one the model's units drive), and every
-// access its plans make (ray record, each step's fetches, stack spills and refills, hit record) goes through functional L1s (tags only, one per unit) and the shared L2 to
-// DRAM. Rays go to ray contexts in trace order as contexts free up; the contexts of all units take
-// one traversal step each in turn (unit 0 context 0, unit 1 context 0, ..., then context 1), so
-// each L1 sees its unit's rays interleaved and the L2 sees all units interleaved, as in the timed
-// model, but with no timing feedback on the order. The cycles are the largest of:
+//   1. analysis (once per trace and key, cached beside the trace: analytic_cache.h): the trace's
+//      work counts summed over every ray (one streaming pass over WORK), and clusters of rays
+//      stepped in the machine's interleaving, recording reuse distances per data kind in each
+//      unit's stream and in all units' stream (analytic_sample.h, analytic_profile.h);
+//   2. per configuration: hit rates of the L1s and the L2 for their sizes and ways from the
+//      reuse distances (StatStack, analytic_reuse.h), traffic and unloaded latencies scaled by
+//      the work counts (analytic_estimate.h), then the roofline and mean value analysis
+//      (analytic_closed_form.h).
 //
-//   box / triangle / ...: issues x initiation_interval / pipelines      (pipeline throughput,
-//                                                                       per operation kind used)
-//   dram:      DRAM bytes / (channels x bytes_per_cycle)                 (bandwidth)
-//   l2_banks:  L2 line accesses x bank_cycles / banks                    (L2 bank throughput)
-//   l1_banks:  L1 line accesses x bank_cycles / (banks x units)          (L1 bank throughput)
-//   scheduler: traversal steps x issue_cycles / units                    (decision logic)
-//   latency:   sum over rays of the unloaded ray latency / (units x ray_contexts), and at least
-//              the longest ray: latency hidden by the ray contexts (Little's law)
-//
-// The unloaded latency of a ray adds, per phase, the access latency of where its data was found
-// (L1 hit, L2 hit, DRAM), the pipeline latency and the scheduler cycles. Each bound and the one
-// that binds are reported under model.analytic (docs/stats.md).
+// Hit checking at this level: every ray the analysis steps (its sample, warm-up included) is
+// checked against the reference hit and work bit for bit; every other ray's work record is read
+// (its chunk's CRC verified) and used as the work the model counts. The functional level checks
+// every ray in full.
 #include <cstdint>
 
 #include <nlohmann/json.hpp>
@@ -29,7 +23,10 @@
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/dispatch/dispatch.h"
 #include "sim/config/config.h"
+#include "sim/harness/analytic_profile.h"
+#include "sim/harness/simulate.h"
 #include "traces/accel/accel.h"
+#include "traces/format/trace_reader.h"
 
 namespace rtsim {
 
@@ -39,9 +36,30 @@ struct AnalyticOutcome {
     nlohmann::json instantiated;  ///< [{block, instantiated, why}]
 };
 
-/// Runs the analytic level over every ray of `rays`, reporting each finished ray to `sink`
-/// (start 0, end = its unloaded latency).
+/// The analytic level over the rays of `rays` (all of them stepped and measured: the stream is
+/// its own sample, e.g. the verdict's 8192 rays), each finished ray reported to `sink` (start
+/// and end 0). The analysis of a stream is kept in memory for the process, so evaluating several
+/// configurations with the same key on the same rays steps them once.
 AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
                              RaySinkIf& sink);
+
+/// The exact variant (before issue 16): every ray stepped, every access through functional
+/// caches on unloaded clocks (analytic_exact.cpp); for tests and comparisons.
+AnalyticOutcome run_analytic_exact(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                                   RayStream& rays, RaySinkIf& sink);
+
+/// The per-trace analysis of a whole trace: work counts of every ray, the sampled clusters
+/// (every stepped ray checked through `sink`).
+AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map, TraceReader& reader,
+                              RaySinkIf& sink, const AnalyticConfig& sample);
+
+/// Which rays the analysis of a trace of `rays` rays steps: clusters of (warm-up, measured) in
+/// trace order (sim/harness/sampling.h's plan type; measured = the cluster's rest).
+struct SamplePlan;
+SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& sample, const SimConfig& config);
+
+/// rtsim-sim at fidelity = analytic: the analysis from the cache beside the trace (or computed
+/// and cached), the estimate, stats.json, config.resolved.json, provenance.json.
+SimOutcome run_analytic_simulation(const SimOptions& options);
 
 }  // namespace rtsim

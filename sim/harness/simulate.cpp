@@ -90,6 +90,8 @@ void write_json(const fs::path& path, const json& j) {
 }  // namespace
 
 SimOutcome run_simulation(const SimOptions& o) {
+    // The analytic level works from a per-trace analysis and a closed form (sim/harness/analytic.h).
+    if (o.config.fidelity == Fidelity::analytic) return run_analytic_simulation(o);
     auto t0 = std::chrono::steady_clock::now();
     const std::time_t started = std::time(nullptr);
     validate(o.config);
@@ -131,14 +133,6 @@ SimOutcome run_simulation(const SimOptions& o) {
     if (o.config.fidelity == Fidelity::detailed) timed_config.quantum_cycles = 1;
     if (o.config.fidelity == Fidelity::functional) {
         run_functional(*accel, reader, checker);
-    } else if (o.config.fidelity == Fidelity::analytic) {
-        // Counts, functional caches and a closed form (sim/harness/analytic.h); no SystemC time.
-        // (validate() refuses sampling here: it needs a timed SystemC level.)
-        TraceRayStream stream(reader);
-        AnalyticOutcome a = run_analytic(o.config, *accel, map, stream, checker);
-        cycles = a.cycles;
-        model = std::move(a.model);
-        instantiated = std::move(a.instantiated);
     } else {
         TraceRayStream stream(reader);
         Top top("top", timed_config, *accel, map, sampled ? static_cast<RayStream&>(sampled->stream) : stream, checker,
@@ -193,7 +187,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);
     json verdict = nullptr;
     if (o.verdict && o.config.fidelity != Fidelity::functional && total > 0)
-        verdict = judge(VerdictContext{o.config, model, *accel, map, reader});
+        verdict = judge(VerdictContext{o.config, model, accel.get(), &map, &reader});
     out.stats["verdict"] = verdict;
     out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
     out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];

@@ -127,9 +127,10 @@ public:
 
 /// The analytic level on the sample: its cycles and its binding bound.
 std::pair<double, std::string> analytic_on_sample(const VerdictContext& c, const SimConfig& config) {
-    SampleStream stream(c.reader, c.sample_rays);
+    if (c.estimate) return c.estimate(config);
+    SampleStream stream(*c.reader, c.sample_rays);
     DiscardSink sink;
-    const AnalyticOutcome a = run_analytic(config, c.accel, c.map, stream, sink);
+    const AnalyticOutcome a = run_analytic(config, *c.accel, *c.map, stream, sink);
     return {double(a.cycles), a.model["analytic"].value("binding", "")};
 }
 
@@ -268,8 +269,10 @@ json judge(const VerdictContext& c) {
               {"candidates", tried},
               {"analytic_binding", analytic_binding},
               {"estimate",
-               {{"method", "analytic level on " + std::to_string(SampleStream(c.reader, c.sample_rays).total_rays()) +
-                               " sampled rays" + (c.config.treelets.enabled ? " (treelets off)" : "")},
+               {{"method", c.estimate ? c.estimate_method
+                                      : "analytic level on " +
+                                            std::to_string(SampleStream(*c.reader, c.sample_rays).total_rays()) +
+                                            " sampled rays" + (c.config.treelets.enabled ? " (treelets off)" : "")},
                 {"base_cycles", base_cycles},
                 {"wall_seconds",
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}}}};

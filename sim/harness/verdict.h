@@ -15,7 +15,9 @@
 //      First order: the analytic level has its own error (docs/fidelity.md); an estimate of
 //      direction and size, not a promise.
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -39,10 +41,14 @@ Relaxation relaxation_for(const std::string& resource, const SimConfig& config);
 struct VerdictContext {
     const SimConfig& config;
     const nlohmann::json& model;  ///< the run's model stats (cycle accounting, utilisation, ...)
-    const Accel& accel;
-    const MemoryMap& map;
-    TraceReader& reader;
+    const Accel* accel;           ///< the structure, its memory map and the trace: the sample
+    const MemoryMap* map;         ///< the analytic estimates run on (unless `estimate` is set)
+    TraceReader* reader;
     uint64_t sample_rays = 8192;  ///< rays the analytic estimates run on (evenly spread blocks)
+    /// When set, the analytic estimates (cycles, binding bound) come from it instead: the
+    /// analytic level passes its own per-trace analysis, so it needs no second pass over rays.
+    std::function<std::pair<double, std::string>(const SimConfig&)> estimate = {};
+    std::string estimate_method = {};  ///< how `estimate` estimates, for the verdict's text
 };
 
 /// {binding, label, evidence, relax, estimate, analytic_binding, text}; null for the functional level.

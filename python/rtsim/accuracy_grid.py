@@ -1,0 +1,272 @@
+"""`rtsim accuracy --spec SPEC.yaml`: each fidelity level's error and speed across a design grid.
+
+Traces every scene and workload of a sweep spec once, runs every configuration of its grid at
+each level (one rtsim-sim process per run, --no-verdict), and reports per trace and level the
+error in cycles against `detailed` (median and max of |error|), the rank agreement of the
+configurations (Kendall's tau-b over the points both levels ran), whether the level picks the
+same best design, and the wall time of the whole grid against detailed's (the sweep speed-up:
+at the analytic level the first run per trace and key builds the per-trace analysis, the others
+reuse it). The pseudo-level `analytic_functional` is the analytic level with functional caches
+(analytic.caches=functional): the analytic level's hit rates are compared with it per cache
+level. Writes DIR/grid.csv, DIR/grid.json, DIR/grid.md and DIR/grid.png; docs/fidelity.md
+explains.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import statistics
+import subprocess
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+
+from rtsim.simulate import find_sim
+from rtsim.sweep.spec import RunPlan, load_spec
+from rtsim.sweep.tasks import TraceTask, make_trace
+
+REFERENCE = "detailed"
+PSEUDO = {"analytic_functional": ("analytic", ["analytic.caches=functional"])}
+
+
+@dataclass
+class GridRow:
+    """One run: a configuration of the grid at one level on one trace."""
+
+    trace: str
+    point: str  # the swept values, "key=value ..."
+    level: str
+    status: str = "ok"
+    wall_seconds: float | None = None
+    cycles: float | None = None
+    error: float | None = None  # against the reference level's cycles at the same point
+    l1_hit_rate: float | None = None
+    l2_hit_rate: float | None = None
+    dram_bytes: float | None = None
+    analysis_reused: bool | None = None
+    hit_mismatches: int | None = None
+
+
+def kendall_tau(x: list[float], y: list[float]) -> float | None:
+    """Kendall's tau-b of two rankings (ties count as neither concordant nor discordant)."""
+    n = len(x)
+    if n < 2:
+        return None
+    conc = disc = tx = ty = 0
+    for i in range(n):
+        for j in range(i + 1, n):
+            dx, dy = x[i] - x[j], y[i] - y[j]
+            if dx == 0 and dy == 0:
+                continue
+            if dx == 0:
+                tx += 1
+            elif dy == 0:
+                ty += 1
+            elif (dx > 0) == (dy > 0):
+                conc += 1
+            else:
+                disc += 1
+    denom = ((conc + disc + tx) * (conc + disc + ty)) ** 0.5
+    return (conc - disc) / denom if denom else None
+
+
+def point_label(run: RunPlan) -> str:
+    return " ".join(f"{k}={v}" for k, v in run.params.items())
+
+
+def run_level(exe: Path, trace: Path, run: RunPlan, level: str, folder: Path) -> GridRow:
+    row = GridRow(trace.name, point_label(run), level)
+    fidelity, extra = PSEUDO.get(level, (level, []))
+    folder.mkdir(parents=True, exist_ok=True)
+    config = run.config.to_dict()
+    (folder / "config.json").write_text(json.dumps(config))
+    cmd = [str(exe), str(trace), "--config", str(folder / "config.json"), "-o", str(folder)]
+    cmd += ["--no-verdict", "--set", f"fidelity={fidelity}"]
+    for s in extra:
+        cmd += ["--set", s]
+    (folder / "stats.json").unlink(missing_ok=True)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    row.wall_seconds = time.perf_counter() - t0
+    stats_path = folder / "stats.json"
+    if proc.returncode not in (0, 3) or not stats_path.is_file():
+        lines = proc.stderr.strip().splitlines()
+        row.status = (lines[-1] if lines else f"exit {proc.returncode}").replace("rtsim-sim: error: ", "")
+        row.wall_seconds = None
+        return row
+    stats = json.loads(stats_path.read_text())
+    s = stats["summary"]
+    row.cycles, row.hit_mismatches = s.get("cycles"), s.get("hit_mismatches")
+    row.l1_hit_rate, row.l2_hit_rate, row.dram_bytes = s.get("l1_hit_rate"), s.get("l2_hit_rate"), s.get("dram_bytes")
+    analysis = stats.get("model", {}).get("analytic", {}).get("analysis")
+    row.analysis_reused = analysis.get("reused") if analysis else None
+    return row
+
+
+def trace_of(run: RunPlan, out: Path) -> Path:
+    from rtsim.sweep.runner import _resolved
+
+    plan, w = run.trace, run.trace.workload
+    task = TraceTask(
+        trace_dir=str(out / "traces" / plan.folder_name),
+        scene=_resolved(plan.scene.source),
+        rays=list(w.rays),
+        width=w.width,
+        height=w.height,
+        bounces=w.bounces,
+        seed=w.seed,
+        hairball_triangles=plan.scene.hairball_triangles,
+    )
+    result = make_trace(task)
+    if not result.get("ok"):
+        raise RuntimeError(f"tracing {plan.folder_name} failed: {result.get('error')}")
+    return Path(task.trace_dir)
+
+
+def run_grid(spec_path: Path, out: Path, levels: list[str], console: Console) -> list[GridRow]:
+    exe = find_sim()
+    spec = load_spec(spec_path)
+    rows: list[GridRow] = []
+    runs = spec.runs()
+    console.print(f"grid {spec.name}: {len(runs)} runs x levels {', '.join(levels)}")
+    for run in runs:
+        trace = trace_of(run, out.resolve())
+        for level in levels:
+            folder = out / "runs" / trace.name / run.run_id[:12] / level
+            row = run_level(exe, trace, run, level, folder)
+            rows.append(row)
+            what = f"{row.wall_seconds:7.2f} s  cycles {row.cycles}" if row.status == "ok" else row.status
+            console.print(f"  {trace.name:<28} {level:<20} {row.point:<60} {what}", highlight=False)
+    compare(rows)
+    write_grid(rows, out)
+    return rows
+
+
+def compare(rows: list[GridRow]) -> None:
+    ref = {(r.trace, r.point): r for r in rows if r.level == REFERENCE and r.cycles}
+    for r in rows:
+        base = ref.get((r.trace, r.point))
+        if base and r.cycles and base.cycles:
+            r.error = (r.cycles - base.cycles) / base.cycles
+
+
+def summarize_grid(rows: list[GridRow]) -> list[dict[str, Any]]:
+    """Per trace and level: error spread, Kendall tau, best design, wall times, hit-rate errors."""
+    out = []
+    traces = sorted({r.trace for r in rows})
+    levels = list(dict.fromkeys(r.level for r in rows))
+    for trace in traces:
+        ref = {r.point: r for r in rows if r.trace == trace and r.level == REFERENCE and r.cycles}
+        exact = {r.point: r for r in rows if r.trace == trace and r.level == "analytic_functional"}
+        for level in levels:
+            mine = [r for r in rows if r.trace == trace and r.level == level and r.cycles]
+            both = [r for r in mine if r.point in ref]
+            errors = [abs(r.error) for r in both if r.error is not None]
+            tau = kendall_tau([ref[r.point].cycles for r in both], [r.cycles for r in both])  # type: ignore[misc]
+            best = min(both, key=lambda r: r.cycles).point if both else None  # type: ignore[arg-type,return-value]
+            best_ref = min((ref[r.point] for r in both), key=lambda r: r.cycles).point if both else None  # type: ignore[arg-type,return-value]
+            wall = sum(r.wall_seconds or 0 for r in both)
+            ref_wall = sum(ref[r.point].wall_seconds or 0 for r in both)
+            row: dict[str, Any] = {
+                "trace": trace,
+                "level": level,
+                "points": len(both),
+                "skipped": len([r for r in rows if r.trace == trace and r.level == level and r.status != "ok"]),
+                "median_abs_error": statistics.median(errors) if errors else None,
+                "max_abs_error": max(errors) if errors else None,
+                "kendall_tau": tau,
+                "same_best": best == best_ref if both else None,
+                "wall_seconds": wall,
+                "speedup": ref_wall / wall if wall > 0 else None,
+            }
+            if level == "analytic" and exact:
+                for key in ("l1_hit_rate", "l2_hit_rate"):
+                    diffs = [
+                        abs((r.__dict__[key] or 0) - (exact[r.point].__dict__[key] or 0))
+                        for r in mine
+                        if r.point in exact and exact[r.point].cycles
+                    ]
+                    row[f"{key}_error_max"] = max(diffs) if diffs else None
+                    row[f"{key}_error_median"] = statistics.median(diffs) if diffs else None
+            out.append(row)
+    return out
+
+
+def fmt(x: float | None, pct: bool = False, digits: int = 1) -> str:
+    if x is None:
+        return ""
+    return f"{100 * x:.{digits}f}%" if pct else f"{x:.{digits}f}"
+
+
+def markdown(summary: list[dict[str, Any]]) -> str:
+    lines = [
+        "| trace | level | configs | median abs error | max abs error | Kendall tau | same best "
+        "| grid wall (s) | speed-up vs detailed | L1 hit-rate error (median / max) | L2 hit-rate error |",
+        "|" + "---|" * 11,
+    ]
+    for s in summary:
+        hr = ""
+        if s.get("l1_hit_rate_error_max") is not None:
+            hr = f"{fmt(s['l1_hit_rate_error_median'], True, 2)} / {fmt(s['l1_hit_rate_error_max'], True, 2)}"
+        hr2 = ""
+        if s.get("l2_hit_rate_error_max") is not None:
+            hr2 = f"{fmt(s['l2_hit_rate_error_median'], True, 2)} / {fmt(s['l2_hit_rate_error_max'], True, 2)}"
+        skipped = f" (+{s['skipped']} n/a)" if s["skipped"] else ""
+        lines.append(
+            f"| {s['trace']} | {s['level']} | {s['points']}{skipped} | {fmt(s['median_abs_error'], True)} "
+            f"| {fmt(s['max_abs_error'], True)} | {fmt(s['kendall_tau'], digits=2)} "
+            f"| {'' if s['same_best'] is None else ('yes' if s['same_best'] else 'no')} "
+            f"| {fmt(s['wall_seconds'], digits=2)} | {fmt(s['speedup'])}x | {hr} | {hr2} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def write_grid(rows: list[GridRow], out: Path) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    summary = summarize_grid(rows)
+    (out / "grid.json").write_text(json.dumps({"runs": [asdict(r) for r in rows], "summary": summary}, indent=2))
+    with (out / "grid.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(asdict(rows[0]))) if rows else None
+        if w:
+            w.writeheader()
+            for r in rows:
+                w.writerow(asdict(r))
+    (out / "grid.md").write_text(markdown(summary))
+    plot_grid(rows, out / "grid.png")
+
+
+def plot_grid(rows: list[GridRow], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ref = {(r.trace, r.point): r.cycles for r in rows if r.level == REFERENCE and r.cycles}
+    levels = [lvl for lvl in dict.fromkeys(r.level for r in rows) if lvl != REFERENCE]
+    fig, ax = plt.subplots(figsize=(6.4, 5.2))
+    colors = {"analytic": "#2ca02c", "approx": "#1f77b4", "analytic_functional": "#9467bd"}
+    lo, hi = float("inf"), 0.0
+    for level in levels:
+        pts = [(ref[(r.trace, r.point)], r.cycles) for r in rows if r.level == level and r.cycles and (r.trace, r.point) in ref]
+        if not pts:
+            continue
+        xs, ys = zip(*pts, strict=True)
+        ax.scatter(xs, ys, s=22, label=level, color=colors.get(level), alpha=0.8)
+        lo, hi = min(lo, *xs, *ys), max(hi, *xs, *ys)
+    if hi > 0:
+        for f, style in ((1.0, "-"), (1.15, ":"), (1 / 1.15, ":")):
+            ax.plot([lo, hi], [lo * f, hi * f], color="#999999", ls=style, lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("detailed cycles")
+    ax.set_ylabel("level's cycles (dotted: +-15%)")
+    ax.set_title("Each configuration of the grid: level against detailed", fontsize=11)
+    ax.legend(fontsize=9)
+    ax.grid(True, which="both", alpha=0.25)
+    fig.tight_layout()
+    fig.savefig(path, dpi=72)
+    plt.close(fig)

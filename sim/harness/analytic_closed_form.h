@@ -1,0 +1,63 @@
+#pragma once
+// The analytic level's closed form of time (docs/fidelity.md, "The analytic level"): a roofline
+// of the machine's resources and mean value analysis of the ray contexts as a closed queueing
+// network, from demands alone (counts, bytes, hold times, unloaded latencies). Both the exact
+// functional-cache model and the statistical one feed it, and so does the verdict through them.
+//
+// The roofline's bounds, in cycles (the largest binds):
+//   box / triangle / ...: issues x initiation_interval / pipelines      (per operation kind used)
+//   dram:      DRAM bytes / (channels x bytes_per_cycle)
+//   l2_banks:  L2 line accesses x bank_cycles / banks
+//   l1_banks:  L1 line accesses x bank_cycles / (banks x units)
+//   l1_mshrs / l2_mshrs: miss hold time / MSHRs (Little's law: each miss holds one for its
+//              unloaded miss latency)
+//   scheduler: scheduler steps x issue_cycles / units
+//   latency:   sum of the rays' unloaded latencies / (units x ray_contexts), at least the
+//              longest ray (latency hidden by the ray contexts, Little's law)
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sim/config/config.h"
+#include "traces/accel/step_plan.h"
+
+namespace rtsim {
+
+/// What the closed form needs: whole-run totals.
+struct AnalyticDemands {
+    double rays = 0;
+    double issues[kOpKindCount] = {};  ///< pipeline issues per operation kind
+    double scheduler_steps = 0;        ///< one per ray (its fetch) and two per planned step
+    double l1_accesses = 0, l2_accesses = 0, dram_bytes = 0;  ///< line accesses (reads + writes)
+    double l1_hold = 0, l2_hold = 0;   ///< cycles misses hold an L1 / L2 MSHR, summed
+    double latency_sum = 0;            ///< sum of the rays' unloaded latencies
+    double latency_max = 0;            ///< the longest ray's
+};
+
+struct ClosedForm {
+    nlohmann::json bounds;  ///< {name: cycles}
+    std::string binding;    ///< the largest bound
+    double roofline = 0;    ///< its cycles
+    double queueing = 0;    ///< the MVA estimate
+    double cycles = 0;      ///< max(roofline, queueing), rounded up
+};
+
+/// The roofline and the MVA estimate of a run with these demands (ideal_memory: no cache or
+/// DRAM bounds).
+ClosedForm closed_form(const SimConfig& config, const std::vector<OpKind>& ops, const AnalyticDemands& d);
+
+/// model.analytic (docs/stats.md) for a closed form.
+nlohmann::json closed_form_json(const ClosedForm& f, const AnalyticDemands& d);
+
+/// The pipeline blocks of stats.json (model.box, model.triangle, ...) from per-unit issues and
+/// tests, with utilisation over `cycles`.
+nlohmann::json pipelines_json(const SimConfig& config, const std::vector<OpKind>& ops,
+                              const std::vector<std::vector<double>>& unit_issues,
+                              const std::vector<std::vector<double>>& unit_tests, double cycles);
+
+/// The instantiated blocks of an analytic run.
+nlohmann::json analytic_instantiated(const SimConfig& config, const std::string& accel_kind,
+                                     const std::vector<OpKind>& ops, const std::string& memory_why);
+
+}  // namespace rtsim
