@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from rtsim._core import RtsimError, trace_sections, verify_trace
+from rtsim.kinds import RAY_KINDS as RAY_KINDS  # RayKind values stored in RayRecord.kind
 
 TRACE_FILE = "trace.rtt"
 MANIFEST_FILE = "manifest.json"
@@ -81,9 +82,6 @@ _FOURCC_NAMES = {
     0x45444F4E: "bvh_nodes",
     0x53495254: "triangles",
 }
-
-#: RayKind values stored in RayRecord.kind.
-RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
 
 
 @dataclass(frozen=True)
