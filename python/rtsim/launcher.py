@@ -181,6 +181,9 @@ def run_sim(
                 if on_message is not None and line.strip():
                     on_message(line.rstrip("\n"))
             returncode = proc.wait()
+        except BaseException:
+            proc.kill()  # e.g. KeyboardInterrupt in a notebook: do not wait for the run to end
+            raise
         finally:
             if timer is not None:
                 timer.cancel()
