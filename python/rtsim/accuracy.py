@@ -15,10 +15,8 @@ DIR/accuracy.json and DIR/accuracy.png (wall time against |error|). docs/fidelit
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
-import statistics
 import subprocess
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -104,6 +102,8 @@ def run_once(
 
 
 def measure(exe: Path, trace: Path, run: Path, sets: list[str], repeat: int, row: Row) -> Row:
+    import statistics  # here, not at the top: `rtsim --help` imports this module
+
     walls = []
     for _ in range(repeat):
         wall, code, stats, message = run_once(exe, trace, run, sets)
@@ -211,6 +211,8 @@ def fmt_speed(x: float | None) -> str:
 
 
 def write_outputs(rows: list[Row], out: Path) -> None:
+    import csv
+
     out.mkdir(parents=True, exist_ok=True)
     (out / "accuracy.json").write_text(json.dumps([asdict(r) for r in rows], indent=2))
     columns = [
@@ -395,7 +397,10 @@ def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any, formatter
         "accuracy",
         formatter_class=formatter,
         help="wall time against error of each fidelity level and sample size (table and plot)",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description="Per scene and workload (coherent primary, incoherent diffuse rays): "
+        "traces once, runs every fidelity level and each timed level on samples of a few "
+        "fractions, and writes DIR/accuracy.csv, .md, .json and .png: the wall time against the "
+        "error in cycles of each (docs/fidelity.md).",
     )
     p.add_argument("scenes", nargs="+", metavar="SCENE", help="built-in or shared scene, or glTF")
     p.add_argument(

@@ -43,9 +43,19 @@ WORKLOAD_DEFAULT = (
 )
 
 
-class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+class HelpFormatter(argparse.HelpFormatter):
     """Ends each option's help with its default, unless the help already says it (an option
-    whose default is None must say in words what happens without it)."""
+    whose default is None must say in words what happens without it). Descriptions and epilogs
+    are wrapped paragraph by paragraph; a paragraph with indented lines is kept as written."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        paragraphs = text.strip("\n").split("\n\n")
+        return "\n\n".join(
+            "\n".join(indent + line for line in para.splitlines())
+            if any(line.startswith(" ") for line in para.splitlines())
+            else super(HelpFormatter, self)._fill_text(para, width, indent)
+            for para in paragraphs
+        )
 
     def _get_help_string(self, action: argparse.Action) -> str | None:
         text = action.help or ""
@@ -393,7 +403,9 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rtsim",
-        description=__doc__.split("\n\n")[0].strip(),
+        description="rtsim: a simulator of ray-tracing hardware. Trace a glTF scene with the "
+        "reference tracer, replay the trace on the SystemC accelerator model (every hit checked), "
+        "sweep accelerator configurations and report on them.",
         formatter_class=HelpFormatter,
         epilog="`rtsim COMMAND --help` describes each command's options and their defaults.",
     )

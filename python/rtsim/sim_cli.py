@@ -32,11 +32,12 @@ def simulate_epilog() -> str:
     levels = "\n".join(f"  {name:<11} {text}" for name, text in FIDELITY_LEVELS.items())
     return (
         "fidelity levels (--set fidelity=LEVEL; docs/fidelity.md):\n"
-        f"{levels}\n"
-        "sampling: --set sampling.fraction=0.05 simulates a stratified 5% sample and reports the\n"
-        "  estimate with a 95% interval.\n"
-        "every config key with its default, unit, range and meaning: rtsim config --schema\n"
-        "  (or docs/config.md). From Python: rtsim.simulate(TRACE, l1__size_kib=32)."
+        f"{levels}\n\n"
+        "Sampling: --set sampling.fraction=0.05 simulates a stratified 5% sample and reports the "
+        "estimate with a 95% interval.\n\n"
+        "Every config key with its default, unit, range and meaning (or docs/config.md):\n"
+        "  rtsim config --schema\n"
+        "From Python: rtsim.simulate(TRACE, l1__size_kib=32) (docs/python.md)."
     )
 
 
