@@ -45,18 +45,23 @@ def run_and_report(job: SimJob, console: Any, show_progress: bool = True) -> int
     """Runs one simulation with a progress bar and prints its summary; returns the exit code."""
     from rich.console import Console
 
-    from rtsim.progress import TraceProgress
     from rtsim.sim_summary import print_mismatches, print_sim_summary
 
     err_console = Console(stderr=True)
-    job.progress = True
-    with TraceProgress(console=err_console, disable=not show_progress) as bar:
-        result = run_sim(
-            job,
-            on_progress=lambda done, total: bar(done, total, "simulate"),
-            on_message=lambda line: err_console.print(line, markup=False, highlight=False),
-            stdout=None,
-        )
+
+    def echo(line: str) -> None:
+        err_console.print(line, markup=False, highlight=False)
+
+    job.progress = show_progress
+    if show_progress:
+        from rtsim.progress import TraceProgress
+
+        with TraceProgress(console=err_console) as bar:
+            result = run_sim(
+                job, on_progress=lambda d, n: bar(d, n, "simulate"), on_message=echo, stdout=None
+            )
+    else:
+        result = run_sim(job, on_message=echo, stdout=None)
     if result.returncode == EXIT_BAD_INPUT:
         return EXIT_BAD_INPUT  # rtsim-sim's message (naming the file or field) was echoed
     if result.returncode not in (EXIT_OK, EXIT_MISMATCH) or result.stats is None:

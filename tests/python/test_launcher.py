@@ -56,9 +56,9 @@ def test_every_caller_goes_through_the_launcher(
 
     job = launcher.SimJob(trace=trace, out_dir=tmp_path / "cli", sets=["fidelity=functional"])
     with (tmp_path / "summary.txt").open("w") as summary:
-        assert sim_cli.run_and_report(job, Console(file=summary), show_progress=False) == 0
+        assert sim_cli.run_and_report(job, Console(file=summary)) == 0
     assert "rays" in (tmp_path / "summary.txt").read_text()
-    assert len(started) == 2 and "--progress" in started[-1]
+    assert len(started) == 2 and "--progress" in started[-1]  # drives the progress bar
 
     task = tasks.SimTask("id", str(trace), str(tmp_path / "sweep"), {"fidelity": "functional"})
     assert tasks.run_sim(task)["status"] == "ok"
