@@ -4,8 +4,8 @@
     python scripts/gen_config_doc.py            # regenerate docs/config.md
     python scripts/gen_config_doc.py --check    # exit 1 if docs/config.md is out of date
 
-The schema is the one config tree of sim/config/config.h (DESIGN rule 5), so this page cannot
-drift from the code: tests/python/test_config_doc.py fails when it does.
+The schema is the one config tree of sim/config/config.h (docs/architecture.md, rule 5), so this
+page cannot drift from the code: tests/python/test_config_doc.py fails when it does.
 """
 
 from __future__ import annotations

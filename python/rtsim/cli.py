@@ -20,10 +20,10 @@ import os
 import shutil
 import subprocess
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from rtsim import __version__
 from rtsim.accuracy import add_parser as add_accuracy_parser
@@ -71,6 +71,40 @@ class HelpFormatter(argparse.HelpFormatter):
         return f"{text} (default: %(default)s)"
 
 
+class LazyHelpStore(argparse.Action):
+    """Stores the value like the default action; its help is computed only when help is shown,
+    because it needs the C++ extension, which `rtsim --version` or `rtsim simulate` must not
+    load."""
+
+    def __init__(self, *args: Any, help_text: Callable[[], str], **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._help_text = help_text
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        setattr(namespace, self.dest, values)
+
+    @property
+    def help(self) -> str:  # type: ignore[override]
+        return self._help_text()
+
+    @help.setter
+    def help(self, value: str | None) -> None:
+        pass
+
+
+def accel_kinds() -> list[dict[str, Any]]:
+    """The acceleration structures of this build (name, description, builders)."""
+    from rtsim import _core
+
+    return list(_core.accel_kinds())
+
+
 @dataclass
 class TraceJob:
     """Everything `rtsim trace` needs; the CLI arguments, parsed and checked."""
@@ -85,6 +119,8 @@ class TraceJob:
     camera: tuple[tuple[float, float, float], tuple[float, float, float], float] | None = None
     threads: int = 0
     hairball_triangles: int = 200_000
+    accel: str = "bvh2"
+    builder: str = "binned"
 
 
 def parse_workload(text: str) -> list[str]:
@@ -150,6 +186,8 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             threads=job.threads,
             hairball_triangles=job.hairball_triangles,
             progress=progress,
+            accel=job.accel,
+            builder=job.builder,
         )
     trace = open_trace(job.out_dir)
     heatmaps = write_heatmaps(trace, size=(job.width, job.height))
@@ -176,6 +214,8 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         camera=args.camera,
         threads=args.threads,
         hairball_triangles=args.hairball_triangles,
+        accel=args.accel,
+        builder=args.builder,
     )
     run_trace(job, console)
     return 0
@@ -301,6 +341,26 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         default=200_000,
         metavar="N",
         help="triangles of the built-in hairball scene",
+    )
+    p.add_argument(
+        "--accel",
+        action=LazyHelpStore,
+        default="bvh2",
+        metavar="KIND",
+        help_text=lambda: (
+            "acceleration structure (default: bvh2): "
+            + "; ".join(f"{k['name']}: {k['description']}" for k in accel_kinds())
+        ),
+    )
+    p.add_argument(
+        "--builder",
+        action=LazyHelpStore,
+        default="binned",
+        metavar="NAME",
+        help_text=lambda: (
+            "tree builder (default: binned, binned SAH); the structures take: "
+            + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in accel_kinds())
+        ),
     )
     p.set_defaults(func=cmd_trace)
 

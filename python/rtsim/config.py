@@ -1,4 +1,4 @@
-"""The simulator's config tree as typed dataclasses (DESIGN rule 5).
+"""The simulator's config tree as typed dataclasses (docs/architecture.md, rule 5).
 
 Mirrors ``sim/config/config.h`` exactly: the same sections, field names and defaults, with the
 unit, range and doc of each field in its metadata. ``tests/python/test_config_py.py`` compares
@@ -48,7 +48,8 @@ class PipelineConfig:
     width: int = _f(
         1,
         "tests",
-        "Tests per issue (a node has 2 child boxes: width 2 tests a node in one issue)",
+        "Tests per issue (a node's child boxes take ceil(children / width) issues; "
+        "width 2 tests a binary node in one issue)",
         1,
         64,
     )

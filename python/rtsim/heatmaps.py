@@ -82,8 +82,8 @@ def write_heatmaps(
     width, height = size
     out = Path(out_dir) if out_dir is not None else trace.folder
     out.mkdir(parents=True, exist_ok=True)
-    nodes, tris = pixel_work(trace, width, height, ("nodes", "tri_tests"))
+    steps, tris = pixel_work(trace, width, height, ("steps", "tri_tests"))
     paths = [out / "heatmap_nodes.png", out / "heatmap_tris.png"]
-    _draw(nodes, "BVH nodes visited", trace.scene_name, paths[0])
+    _draw(steps, "traversal steps (nodes or cells visited)", trace.scene_name, paths[0])
     _draw(tris, "triangle tests", trace.scene_name, paths[1])
     return paths

@@ -1,6 +1,6 @@
 """Starts rtsim-sim: the one place a simulation process is launched, for `rtsim simulate`,
-`rtsim.simulate()`, sweeps and `rtsim accuracy` (DESIGN rule 4: one simulation per process,
-because SystemC elaborates once per process).
+`rtsim.simulate()`, sweeps and `rtsim accuracy` (docs/architecture.md, rule 4: one simulation
+per process, because SystemC elaborates once per process).
 
 rtsim-sim reads a trace and a config, writes RUN/stats.json, RUN/config.resolved.json and
 RUN/provenance.json, and exits 0 (ok), 2 (bad input: its message names the file or field) or 3

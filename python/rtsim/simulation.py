@@ -1,5 +1,5 @@
 """`rtsim.simulate()`: one simulation from Python, through the same launcher as the command line
-and sweeps (rtsim/launcher.py: one rtsim-sim process per simulation, DESIGN rule 4).
+and sweeps (rtsim/launcher.py: one rtsim-sim process per simulation, docs/architecture.md, rule 4).
 
 Config overrides are keyword arguments whose double underscores stand for the dots of a config
 key (``l1__size_kib=32`` is ``l1.size_kib``; top-level keys as they are: ``fidelity="analytic"``),

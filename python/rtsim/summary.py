@@ -23,7 +23,7 @@ def _num(value: Any, digits: int = 2) -> str:
 
 def ray_table(manifest: dict[str, Any]) -> Table:
     table = Table(title="rays", title_justify="left")
-    for column in ("kind", "traced", "hits", "hit rate", "nodes/ray", "tris/ray"):
+    for column in ("kind", "traced", "hits", "hit rate", "steps/ray", "tris/ray"):
         table.add_column(column, justify="left" if column == "kind" else "right")
     by_kind = find(manifest, "counts.by_kind", "by_kind", default={}) or {}
     if isinstance(by_kind, dict):
@@ -37,23 +37,25 @@ def ray_table(manifest: dict[str, Any]) -> Table:
                 _num(stats.get("traced", stats.get("rays"))),
                 _num(stats.get("hits")),
                 f"{hit_rate:.1%}" if isinstance(hit_rate, (int, float)) else "-",
-                _num(stats.get("nodes_per_ray"), 1),
+                _num(stats.get("steps_per_ray"), 1),
                 _num(stats.get("tri_tests_per_ray"), 1),
             )
     return table
 
 
 def scene_table(manifest: dict[str, Any]) -> Table:
-    table = Table(title="scene and BVH", title_justify="left", show_header=False)
+    table = Table(title="scene and acceleration structure", title_justify="left", show_header=False)
     table.add_column("what")
     table.add_column("value", justify="right")
     rows = [
         ("scene", find(manifest, "scene.name")),
         ("triangles", find(manifest, "scene.triangles")),
         ("instances", find(manifest, "scene.instances")),
-        ("BVH nodes", find(manifest, "bvh.nodes")),
-        ("BVH leaves", find(manifest, "bvh.leaves")),
-        ("SAH cost", find(manifest, "bvh.sah_cost")),
+        ("structure", find(manifest, "accel.kind")),
+        ("nodes", find(manifest, "accel.nodes")),
+        ("leaves", find(manifest, "accel.leaves")),
+        ("SAH cost", find(manifest, "accel.sah_cost")),
+        ("footprint (bytes)", find(manifest, "accel.footprint_bytes")),
         ("rays written", find(manifest, "counts.rays")),
         ("rays rejected", find(manifest, "counts.rejected")),
         ("trace time (ms)", find(manifest, "timing_ms.trace")),

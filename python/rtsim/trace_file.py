@@ -36,17 +36,20 @@ RAY_DTYPE = np.dtype(
 )
 #: HitRecord (20 bytes).
 HIT_DTYPE = np.dtype([("prim", "<i4"), ("inst", "<i4"), ("t", "<f4"), ("u", "<f4"), ("v", "<f4")])
-#: WorkRecord (20 bytes).
+#: WorkRecord (32 bytes): the neutral work counts of every acceleration structure.
 WORK_DTYPE = np.dtype(
     [
-        ("nodes", "<u4"),
+        ("steps", "<u4"),
         ("box_tests", "<u4"),
         ("tri_tests", "<u4"),
         ("anyhit_calls", "<u4"),
         ("transforms", "<u4"),
+        ("cell_steps", "<u4"),
+        ("plane_tests", "<u4"),
+        ("refs", "<u4"),
     ]
 )
-#: HwNode (64 bytes): two child boxes, child references and leaf sizes.
+#: bvh2 HwNode (64 bytes): two child boxes, child references and leaf sizes.
 #: bounds[axis][0 = min, 1 = max][child] (docs/bvh_layout.md).
 NODE_DTYPE = np.dtype(
     [
@@ -72,15 +75,13 @@ SECTION_DTYPES: dict[str, np.dtype] = {
     "rays": RAY_DTYPE,
     "hits": HIT_DTYPE,
     "work": WORK_DTYPE,
-    "bvh_nodes": NODE_DTYPE,
-    "triangles": TRIANGLE_DTYPE,
+    "accl": np.dtype("u1"),
 }
-_FOURCC_NAMES = {
-    0x53594152: "rays",
-    0x53544948: "hits",
-    0x4B524F57: "work",
-    0x45444F4E: "bvh_nodes",
-    0x53495254: "triangles",
+#: Layouts of image regions this package knows, by (structure kind, region name); ("*", name)
+#: for every kind. Other regions are read as raw records (docs/accel.md documents them).
+REGION_DTYPES: dict[tuple[str, str], np.dtype] = {
+    ("*", "triangles"): TRIANGLE_DTYPE,
+    ("bvh2", "nodes"): NODE_DTYPE,
 }
 
 
@@ -119,6 +120,40 @@ class Trace:
         return name in self.sections
 
     @cached_property
+    def accel(self) -> dict[str, Any]:
+        """The acceleration structure's descriptor: kind, params, stats, bounds, regions."""
+        raw = bytes(self._map("accl"))
+        try:
+            data = json.loads(raw.decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as err:
+            raise RtsimError(f"{self.path}: section ACCL is not JSON ({err})") from err
+        if not isinstance(data, dict) or not isinstance(data.get("regions"), list):
+            raise RtsimError(f"{self.path}: section ACCL is not a structure descriptor")
+        return data
+
+    def region(self, name: str) -> np.ndarray:
+        """Records of an image region: a structured array where the layout is known (bvh2
+        nodes, triangles), else a (count, record_bytes) array of bytes."""
+        regions = self.accel["regions"]
+        for index, info in enumerate(regions):
+            if info.get("name") != name:
+                continue
+            kind = str(self.accel.get("kind", ""))
+            dtype = REGION_DTYPES.get((kind, name), REGION_DTYPES.get(("*", name)))
+            record_bytes = int(info["record_bytes"])
+            count = int(info["count"])
+            if dtype is None or dtype.itemsize != record_bytes:
+                dtype = np.dtype(("u1", (record_bytes,)))
+            section = self.sections.get(f"rg{index:02d}")
+            if count == 0 or section is None:
+                return np.zeros(0, dtype=dtype)
+            return np.memmap(
+                self.path, dtype=dtype, mode="r", offset=section.offset, shape=(count,)
+            )
+        names = ", ".join(str(r.get("name")) for r in regions)
+        raise RtsimError(f"{self.path}: the structure has no region '{name}' (has: {names})")
+
+    @cached_property
     def rays(self) -> np.ndarray:
         return self._map("rays")
 
@@ -132,11 +167,15 @@ class Trace:
 
     @cached_property
     def nodes(self) -> np.ndarray | None:
-        return self._map("bvh_nodes") if self.has("bvh_nodes") else None
+        """The structure's node region, if it has one."""
+        return self.region("nodes") if self._has_region("nodes") else None
 
     @cached_property
     def triangles(self) -> np.ndarray | None:
-        return self._map("triangles") if self.has("triangles") else None
+        return self.region("triangles") if self._has_region("triangles") else None
+
+    def _has_region(self, name: str) -> bool:
+        return self.has("accl") and any(r.get("name") == name for r in self.accel["regions"])
 
     @property
     def ray_count(self) -> int:
@@ -159,9 +198,6 @@ class Trace:
 
 
 def _section_name(info: dict[str, Any]) -> str:
-    fourcc = info.get("fourcc")
-    if isinstance(fourcc, int) and fourcc in _FOURCC_NAMES:
-        return _FOURCC_NAMES[fourcc]
     return str(info.get("kind", "")).lower()
 
 

@@ -57,11 +57,14 @@ def trace_scene(
     threads: int = 0,
     hairball_triangles: int = 200_000,
     progress: Callable[[int, int, str], None] | None = None,
+    accel: str = "bvh2",
+    builder: str = "binned",
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. workload: ray kinds ("primary,diffuse" or a list);
     None (the default) traces every kind the scene calls for (manifest["workload"]["effects"]
-    says which and why). camera: (eye, target, vertical field of view in degrees)."""
+    says which and why). camera: (eye, target, vertical field of view in degrees). accel and
+    builder choose the acceleration structure (rtsim._core.accel_kinds(), docs/accel.md)."""
     from rtsim import _core
 
     kinds = (
@@ -81,6 +84,8 @@ def trace_scene(
         threads=threads,
         hairball_triangles=hairball_triangles,
         progress=progress,
+        accel=accel,
+        builder=builder,
     )
 
 
@@ -118,6 +123,8 @@ def write_trace(
     kind: str | Sequence[str] | Any = "primary",
     any_hit: bool | Sequence[bool] | Any | None = None,
     threads: int = 0,
+    accel: str = "bvh2",
+    builder: str = "binned",
 ) -> dict[str, Any]:
     """Traces your rays with the reference tracer and writes a trace folder (OUT/trace.rtt and
     manifest.json, exactly as trace_scene writes one) that rtsim.simulate replays.
@@ -125,8 +132,9 @@ def write_trace(
     origins, directions: (N, 3) arrays; tmin, tmax: scalars or (N,) arrays. kind: the ray kind
     of every ray ("primary", "shadow", "reflection", "diffuse", "refraction") or one per ray.
     any_hit: None makes shadow rays any-hit (occlusion) rays and the others closest-hit, as the
-    tracer does; or a bool for every ray, or one per ray. Returns the manifest; rays are written
-    in order, each with its index as `pixel`."""
+    tracer does; or a bool for every ray, or one per ray. accel and builder choose the
+    acceleration structure, built as trace_scene builds it. Returns the manifest; rays are
+    written in order, each with its index as `pixel`."""
     import numpy as np
 
     from rtsim import _core
@@ -141,5 +149,15 @@ def write_trace(
         if flags.ndim == 0:
             flags = np.full(n, bool(flags))
     return _core.write_trace(
-        loaded, origins, directions, tmin, tmax, kinds, flags, os.fspath(out), threads=threads
+        loaded,
+        origins,
+        directions,
+        tmin,
+        tmax,
+        kinds,
+        flags,
+        os.fspath(out),
+        threads=threads,
+        accel=accel,
+        builder=builder,
     )

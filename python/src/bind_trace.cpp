@@ -16,7 +16,8 @@
 #include "python/src/ray_args.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_reader.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/accel.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/scene/procedural.h"
 #include "traces/tracer/ray_trace.h"
 #include "traces/tracer/tracer.h"
@@ -118,8 +119,10 @@ py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
                           const std::optional<std::vector<std::string>>& workload, uint32_t width,
                           uint32_t height, uint32_t bounces, uint64_t seed,
                           const py::object& camera, unsigned threads, uint32_t hairball_triangles,
-                          const py::object& progress) {
+                          const py::object& progress, const std::string& accel, const std::string& builder) {
     TraceOptions opt;
+    opt.accel.kind = accel;
+    opt.accel.builder = builder;
     opt.scene = scene_name(scene);
     opt.out_dir = out_dir.string();
     if (workload) {  // None: every kind the scene calls for
@@ -156,7 +159,8 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
                           const py::object& tmin, const py::object& tmax,
                           const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& kinds,
                           const py::array_t<bool, py::array::c_style | py::array::forcecast>& any_hit,
-                          const fs::path& out_dir, unsigned threads, const py::object& progress) {
+                          const fs::path& out_dir, unsigned threads, const py::object& progress,
+                          const std::string& accel, const std::string& builder) {
     const std::vector<Ray> rays = rays_from_arrays(origins, directions, tmin, tmax);
     const auto n = static_cast<py::ssize_t>(rays.size());
     if (kinds.ndim() != 1 || kinds.shape(0) != n)
@@ -174,15 +178,22 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
         pending[i].pixel = uint32_t(i);
         pending[i].any_hit = any_hit.data()[i];
     }
-    const HwBvh& bvh = scene.bvh();
+    AccelOptions accel_options;
+    accel_options.kind = accel;
+    accel_options.builder = builder;
+    validate_accel_options(accel_options);
     RayTraceOptions opt;
     opt.out_dir = out_dir.string();
     opt.threads = threads;
     const ProgressFn fn = make_progress(progress);
+    const SceneLabel label = label_of(scene.scene());
     std::string manifest;
     {
+        // The structure is built exactly as trace_scene builds it (traces/accel/accel.h).
         py::gil_scoped_release release;
-        manifest = write_ray_trace(scene.scene(), label_of(scene.scene()), bvh, BuildConfig{}, pending, opt, fn)
+        const std::unique_ptr<Accel> built =
+            load_accel(build_accel(scene.scene(), accel_options), label.name + ": built " + accel);
+        manifest = write_ray_trace(scene.scene(), label, *built, pending, opt, fn)
                        .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     }
     return py::module_::import("json").attr("loads")(manifest);
@@ -215,7 +226,8 @@ py::list trace_sections(const fs::path& path) {
 
 void bind_trace(py::module_& m) {
     // The one mapping of the C++ WorkCounts fields to Python names (trace_rays' `work` field).
-    PYBIND11_NUMPY_DTYPE(WorkCounts, nodes, box_tests, tri_tests, anyhit_calls, transforms);
+    PYBIND11_NUMPY_DTYPE(WorkCounts, steps, box_tests, tri_tests, anyhit_calls, transforms,
+                         cell_steps, plane_tests, refs);
     PYBIND11_NUMPY_DTYPE(PyHit, prim, inst, t, u, v, valid, work);
 
     m.def("trace_rays", &trace_rays, py::arg("scene"), py::arg("origins"), py::arg("directions"),
@@ -230,16 +242,33 @@ void bind_trace(py::module_& m) {
           py::arg("height") = 240u, py::arg("bounces") = 1u, py::arg("seed") = 1u,
           py::arg("camera") = py::none(), py::arg("threads") = 0u,
           py::arg("hairball_triangles") = 200000u, py::arg("progress") = py::none(),
+          py::arg("accel") = "bvh2", py::arg("builder") = "binned",
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
           "returns the manifest. workload: ray kinds (None: every kind the scene calls for).\n"
-          "progress(done, total, stage) is called now and then.");
+          "progress(done, total, stage) is called now and then. accel and builder choose the\n"
+          "acceleration structure (accel_kinds()).");
     m.def("write_trace", &write_trace_py, py::arg("scene"), py::arg("origins"),
           py::arg("directions"), py::arg("tmin"), py::arg("tmax"), py::arg("kinds"),
           py::arg("any_hit"), py::arg("out_dir"), py::arg("threads") = 0u,
-          py::arg("progress") = py::none(),
+          py::arg("progress") = py::none(), py::arg("accel") = "bvh2",
+          py::arg("builder") = "binned",
           "Traces the given rays (kinds: RayKind per ray, any_hit: flag per ray) and writes\n"
           "OUT/trace.rtt and manifest.json exactly as trace_scene writes a workload; returns\n"
           "the manifest. Use rtsim.write_trace, which takes kind names and scene names.");
+    m.def(
+        "accel_kinds",
+        [] {
+            py::list out;
+            for (const AccelKindInfo& k : accel_kinds()) {
+                py::dict d;
+                d["name"] = k.name;
+                d["description"] = k.description;
+                d["builders"] = k.builders;
+                out.append(d);
+            }
+            return out;
+        },
+        "The acceleration structures this build knows: name, description, builders.");
     m.def("trace_sections", &trace_sections, py::arg("path"),
           "Validates a trace file's header and section table; returns its sections.");
     m.def(

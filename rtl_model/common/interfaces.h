@@ -2,21 +2,17 @@
 // The interfaces the model's blocks talk through (SystemC interface method calls, bound with
 // sc_port). Time is carried as cycle counts in the requests: a traversal unit runs ahead of
 // SystemC time by at most a quantum (TLM-2.0 style temporal decoupling) and every block returns
-// when its answer is ready, so no block needs a clock process (DESIGN rule 7).
+// when its answer is ready, so no block needs a clock process (docs/architecture.md, rule 7).
 #include <cstdint>
 
 #include <systemc>
 
+#include "traces/common/data_kind.h"
 #include "traces/common/ray.h"
 
 namespace rtsim {
 
 using Cycle = uint64_t;
-
-/// What a memory access carries, for per-kind byte and hit-rate accounting.
-enum class DataKind : uint8_t { node = 0, triangle = 1, ray = 2, hit = 3, stack = 4, ray_buffer = 5 };
-constexpr int kDataKindCount = 6;
-const char* data_kind_name(DataKind kind);
 
 struct MemRequest {
     uint64_t addr = 0;

@@ -1,19 +1,41 @@
 #pragma once
-// Everything a ray in flight carries between a traversal unit and the ray buffer: the stepper
-// (ray, hit so far, traversal stack, work counts) and the model's bookkeeping of its stack.
+// Everything a ray in flight carries between a traversal unit and the ray buffer: its stepper
+// (ray, hit so far, traversal stack, work counts; any structure behind the seam) and the model's
+// bookkeeping of its stack. Moving a ray moves a pointer, not its state.
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 #include "rtl_model/common/interfaces.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/accel.h"
 
 namespace rtsim {
 
 struct RayState {
-    Traversal trav;
+    std::unique_ptr<Stepper> stepper;
     uint64_t ray_id = 0;
     Cycle start = 0;           ///< cycle the ray entered the machine (latency is measured from it)
     uint32_t local_stack = 0;  ///< stack entries held on chip
     uint32_t spilled = 0;      ///< stack entries spilled to memory
+};
+
+/// Steppers for rays in flight, reused: a free list over the structure's make_stepper().
+class StepperPool {
+public:
+    explicit StepperPool(const Accel& accel) : m_accel(accel) {}
+    std::unique_ptr<Stepper> acquire() {
+        if (m_free.empty()) return m_accel.make_stepper();
+        std::unique_ptr<Stepper> s = std::move(m_free.back());
+        m_free.pop_back();
+        return s;
+    }
+    void release(std::unique_ptr<Stepper> s) {
+        if (s) m_free.push_back(std::move(s));
+    }
+
+private:
+    const Accel& m_accel;
+    std::vector<std::unique_ptr<Stepper>> m_free;
 };
 
 /// Bytes of ray-buffer SRAM one waiting ray occupies: origin, direction, tmin, tmax (32), hit so
@@ -31,12 +53,13 @@ public:
     /// is empty. False when no ray can be run now. *ready: cycle the ray's state is in the unit.
     virtual bool take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) = 0;
     /// A ray leaves its treelet for `treelet`; returns the cycle its state is written.
-    virtual Cycle park(uint32_t treelet, const RayState& ray, Cycle time) = 0;
+    virtual Cycle park(uint32_t treelet, RayState&& ray, Cycle time) = 0;
     /// A ray finished (its hit was written).
     virtual void finished(Cycle time) = 0;
     /// No ray is left anywhere: not in dispatch, not in queues, not in flight.
     virtual bool done() const = 0;
-    virtual uint32_t treelet_of(uint32_t node) const = 0;
+    /// Treelet of a step's locality key (StepPlan::locality; never kNoLocality).
+    virtual uint32_t treelet_of(uint32_t locality) const = 0;
 };
 
 }  // namespace rtsim

@@ -8,7 +8,7 @@ Dispatch::Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, u
     : sc_core::sc_module(name), m_config(config), m_stream(stream), m_queues(std::max(1u, units)) {}
 
 bool Dispatch::next_ray(uint32_t unit, RayJob* job) {
-    bool ok = m_config.policy == "on_demand" ? next_on_demand(job) : next_interleaved(unit, job);
+    bool ok = m_config.policy == DispatchPolicy::on_demand ? next_on_demand(job) : next_interleaved(unit, job);
     m_dispatched += ok;
     return ok;
 }
@@ -63,7 +63,7 @@ nlohmann::json Dispatch::stats_json() const {
     return {{"rays", m_dispatched},
             {"chunks", m_chunks},
             {"chunk_rays", m_config.chunk_rays},
-            {"policy", m_config.policy},
+            {"policy", kDispatchPolicyChoices.name(m_config.policy)},
             {"steals", m_steals}};
 }
 

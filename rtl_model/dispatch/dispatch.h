@@ -16,7 +16,7 @@
 #include <systemc>
 
 #include "rtl_model/common/interfaces.h"
-#include "sim/config/config.h"
+#include "rtl_model/dispatch/dispatch_config.h"
 
 namespace rtsim {
 

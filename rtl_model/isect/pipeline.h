@@ -16,7 +16,7 @@
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
-#include "sim/config/config.h"
+#include "rtl_model/isect/pipeline_config.h"
 
 namespace rtsim {
 

@@ -21,7 +21,7 @@
 
 #include "rtl_model/common/calendar.h"
 #include "rtl_model/mem/mem_stats.h"
-#include "sim/config/config.h"
+#include "rtl_model/mem/cache_config.h"
 
 namespace rtsim {
 

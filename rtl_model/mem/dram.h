@@ -14,7 +14,7 @@
 #include "rtl_model/common/calendar.h"
 #include "rtl_model/mem/dram_banks.h"
 #include "rtl_model/mem/mem_stats.h"
-#include "sim/config/config.h"
+#include "rtl_model/mem/dram_config.h"
 
 namespace rtsim {
 

@@ -5,7 +5,7 @@
 namespace rtsim {
 
 DramBanks::DramBanks(const DramConfig& config)
-    : m_config(config), m_close_page(config.page_policy == "close"), m_banks(size_t(config.channels) * config.banks) {
+    : m_config(config), m_close_page(config.page_policy == PagePolicy::close), m_banks(size_t(config.channels) * config.banks) {
     for (uint32_t c = 0; c < config.channels; ++c) m_buses.emplace_back(config.bytes_per_cycle, 1);
 }
 
@@ -95,7 +95,7 @@ nlohmann::json DramBanks::stats_json() const {
             {"row_misses", m_totals[1]},
             {"row_conflicts", m_totals[2]},
             {"row_hit_rate", all ? double(m_totals[0]) / double(all) : 0.0},
-            {"page_policy", m_config.page_policy},
+            {"page_policy", kPagePolicyChoices.name(m_config.page_policy)},
             {"banks_per_channel", m_config.banks},
             {"row_bytes", m_config.row_bytes},
             {"by_bank", by_bank}};

@@ -29,7 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rtl_model/common/calendar.h"
-#include "sim/config/config.h"
+#include "rtl_model/mem/dram_config.h"
 
 namespace rtsim {
 

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rtl_model/mem/mem_stats.h"
-#include "sim/config/config.h"
+#include "rtl_model/mem/cache_config.h"
 
 namespace rtsim {
 

@@ -1,6 +1,6 @@
 #pragma once
 // Access counters of one memory level, per data kind. Kept in plain arrays in the hot path and
-// turned into JSON once at the end (DESIGN rule 6).
+// turned into JSON once at the end (docs/architecture.md, rule 6).
 #include <cstdint>
 
 #include <nlohmann/json.hpp>

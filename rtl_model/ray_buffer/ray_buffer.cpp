@@ -2,31 +2,32 @@
 
 #include <algorithm>
 
-#include "rtl_model/top/memory_image.h"
-
 namespace rtsim {
 
-RayBuffer::RayBuffer(sc_core::sc_module_name name, const SimConfig& config, const TreeletPartition& partition)
+RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const LocalityPartition& partition,
+                     const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts,
+                     uint32_t state_bytes)
     : sc_core::sc_module(name),
       m_config(config),
       m_partition(partition),
-      m_state_bytes(ray_state_bytes(config.traversal.stack_entries, config.traversal.stack_entry_bytes)),
-      m_capacity(std::max<uint64_t>(1, uint64_t(config.treelets.buffer_kib) * 1024 / m_state_bytes)),
-      m_max_in_flight(config.treelets.max_rays_in_flight
-                          ? config.treelets.max_rays_in_flight
-                          : m_capacity + uint64_t(config.traversal.units) * config.traversal.ray_contexts),
+      m_map(map),
+      m_steppers(steppers),
+      m_state_bytes(state_bytes),
+      m_capacity(std::max<uint64_t>(1, uint64_t(config.buffer_kib) * 1024 / m_state_bytes)),
+      m_max_in_flight(config.max_rays_in_flight ? config.max_rays_in_flight
+                                                : m_capacity + uint64_t(units) * ray_contexts),
       m_queues(partition.treelets.size()),
-      m_unit_treelet(config.traversal.units, -1),
-      m_sram(16ull * config.treelets.bytes_per_cycle, 16) {}
+      m_unit_treelet(units, -1),
+      m_sram(16ull * config.bytes_per_cycle, 16) {}
 
 Cycle RayBuffer::sram(Cycle time) {
     // One ray state moved through the SRAM port: bandwidth, then latency.
     Cycle start = m_sram.reserve(time, m_state_bytes);
-    return start + m_config.treelets.latency + (m_state_bytes + m_config.treelets.bytes_per_cycle - 1) / m_config.treelets.bytes_per_cycle;
+    return start + m_config.latency + (m_state_bytes + m_config.bytes_per_cycle - 1) / m_config.bytes_per_cycle;
 }
 
-void RayBuffer::push(uint32_t treelet, const RayState& ray, Cycle ready, Cycle time) {
-    Waiting w{ray, ready, false, 0};
+void RayBuffer::push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time) {
+    Waiting w{std::move(ray), ready, false, 0};
     if (m_occupancy < m_capacity) {
         ++m_occupancy;
         m_max_occupancy = std::max(m_max_occupancy, m_occupancy);
@@ -40,7 +41,7 @@ void RayBuffer::push(uint32_t treelet, const RayState& ray, Cycle ready, Cycle t
         } else {
             w.slot = m_next_slot++;
         }
-        mem->access({MemoryMap::ray_buffer(w.slot, m_state_bytes), m_state_bytes, true, DataKind::ray_buffer, time});
+        mem->access({m_map.ray_buffer(w.slot, m_state_bytes), m_state_bytes, true, DataKind::ray_buffer, time});
         ++m_overflows;
     }
     unindex(treelet);
@@ -49,22 +50,25 @@ void RayBuffer::push(uint32_t treelet, const RayState& ray, Cycle ready, Cycle t
 }
 
 void RayBuffer::admit(Cycle time) {
-    // New rays enter the root treelet's queue while the machine holds fewer than the limit.
-    const uint32_t root = m_partition.node_treelet[0];
+    // New rays enter the queue of their first step's treelet (the root treelet for a tree)
+    // while the machine holds fewer than the limit.
     RayJob job;
     // By default (no explicit limit) admission also waits for SRAM room, so it never overflows.
-    const bool may_overflow = m_config.treelets.max_rays_in_flight != 0;
+    const bool may_overflow = m_config.max_rays_in_flight != 0;
     while (!m_dispatch_empty && m_in_machine < m_max_in_flight && (may_overflow || m_occupancy < m_capacity)) {
         if (!rays->next_ray(RaySourceIf::kAnyUnit, &job)) {
             m_dispatch_empty = true;
             break;
         }
         RayState s;
-        s.trav.begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+        s.stepper = m_steppers.acquire();
+        s.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
         s.ray_id = job.id;
         s.start = time;
-        Cycle fetched = mem->access({MemoryMap::ray(job.id), sizeof(RayRecord), false, DataKind::ray, time});
-        push(root, s, fetched, time);
+        const uint32_t first = s.stepper->plan().locality;
+        const uint32_t treelet = first == kNoLocality ? m_partition.root_group : m_partition.group_of[first];
+        Cycle fetched = mem->access({m_map.ray(job.id), sizeof(RayRecord), false, DataKind::ray, time});
+        push(treelet, std::move(s), fetched, time);
         ++m_admitted;
         ++m_in_machine;
     }
@@ -81,9 +85,8 @@ void RayBuffer::unindex(uint32_t t) {
 void RayBuffer::index(uint32_t t) {
     const auto& q = m_queues[t];
     if (q.empty()) return;
-    const std::string& policy = m_config.treelets.policy;
-    if (policy == "largest") m_by_size.insert({q.size(), t});
-    else if (policy == "oldest") m_by_age.insert({q.front().ready, t});
+    if (m_config.policy == TreeletPolicy::largest) m_by_size.insert({q.size(), t});
+    else if (m_config.policy == TreeletPolicy::oldest) m_by_age.insert({q.front().ready, t});
     else m_nonempty.insert(t);
 }
 
@@ -93,17 +96,17 @@ int64_t RayBuffer::pick(uint32_t) {
     // tried and idles the machine: only running rays refill the queues (docs/treelets.md). With
     // `largest` the threshold therefore changes nothing: the largest queue is the choice either way.
     constexpr int kLook = 64;
-    const uint64_t threshold = m_config.treelets.threshold;
-    const std::string& policy = m_config.treelets.policy;
+    const uint64_t threshold = m_config.threshold;
+    const TreeletPolicy policy = m_config.policy;
     int64_t first = -1, chosen = -1;
     auto consider = [&](uint32_t t) {
         if (first < 0) first = t;
         if (m_queues[t].size() >= threshold) chosen = t;
         return chosen >= 0;
     };
-    if (policy == "largest") {
+    if (policy == TreeletPolicy::largest) {
         if (!m_by_size.empty()) consider(m_by_size.begin()->second);  // the largest decides
-    } else if (policy == "oldest") {
+    } else if (policy == TreeletPolicy::oldest) {
         int k = 0;
         for (auto it = m_by_age.begin(); it != m_by_age.end() && k < kLook; ++it, ++k)
             if (consider(it->second)) break;
@@ -119,7 +122,7 @@ int64_t RayBuffer::pick(uint32_t) {
         chosen = first;
         ++m_drain_picks;
     }
-    if (policy == "round_robin") m_round_robin = uint32_t(chosen);
+    if (policy == TreeletPolicy::round_robin) m_round_robin = uint32_t(chosen);
     ++m_picks;
     m_picked_queue_rays += m_queues[chosen].size();
     return chosen;
@@ -136,7 +139,7 @@ bool RayBuffer::take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet
     *ray = std::move(w.state);
     *treelet = uint32_t(current);
     if (w.overflowed) {
-        *ready = mem->access({MemoryMap::ray_buffer(w.slot, m_state_bytes), m_state_bytes, false, DataKind::ray_buffer,
+        *ready = mem->access({m_map.ray_buffer(w.slot, m_state_bytes), m_state_bytes, false, DataKind::ray_buffer,
                               std::max(time, w.ready)});
         m_free_slots.push_back(w.slot);
         ++m_overflow_reads;
@@ -151,9 +154,9 @@ bool RayBuffer::take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet
     return true;
 }
 
-Cycle RayBuffer::park(uint32_t treelet, const RayState& ray, Cycle time) {
+Cycle RayBuffer::park(uint32_t treelet, RayState&& ray, Cycle time) {
     ++m_parked;
-    push(treelet, ray, time, time);
+    push(treelet, std::move(ray), time, time);
     return m_queues[treelet].back().ready;
 }
 

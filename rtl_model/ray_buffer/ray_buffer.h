@@ -2,7 +2,7 @@
 // The treelet ray buffer (Aila & Karras 2010; in hardware, STRaTA by Kopta et al. 2013): an SRAM
 // of `buffer_kib` holding the state of rays waiting for a treelet, one FIFO queue per treelet.
 //
-// - New rays are admitted from dispatch into the root treelet's queue while fewer than
+// - New rays are admitted from dispatch into the queue of their first step's treelet while fewer than
 //   max_rays_in_flight rays are in the machine (default: what the SRAM and the ray contexts hold,
 //   so nothing overflows); their ray record is read from memory on the way in. Admitting more
 //   makes longer queues (more rays share each treelet load) at the price of overflow traffic.
@@ -25,9 +25,10 @@
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/common/memory_map.h"
 #include "rtl_model/common/ray_state.h"
-#include "sim/config/config.h"
-#include "traces/bvh/treelets.h"
+#include "rtl_model/ray_buffer/ray_buffer_config.h"
+#include "traces/accel/locality.h"
 
 namespace rtsim {
 
@@ -36,13 +37,15 @@ public:
     sc_core::sc_port<RaySourceIf> rays;  ///< dispatch
     sc_core::sc_port<MemIf> mem;          ///< ray records in, overflow out (the L2)
 
-    RayBuffer(sc_core::sc_module_name name, const SimConfig& config, const TreeletPartition& partition);
+    /// units x ray_contexts: the rays the traversal units hold; state_bytes: ray_state_bytes().
+    RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const LocalityPartition& partition,
+              const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts, uint32_t state_bytes);
 
     bool take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) override;
-    Cycle park(uint32_t treelet, const RayState& ray, Cycle time) override;
+    Cycle park(uint32_t treelet, RayState&& ray, Cycle time) override;
     void finished(Cycle time) override;
     bool done() const override { return m_dispatch_empty && m_in_machine == 0; }
-    uint32_t treelet_of(uint32_t node) const override { return m_partition.node_treelet[node]; }
+    uint32_t treelet_of(uint32_t locality) const override { return m_partition.group_of[locality]; }
 
     uint64_t capacity_rays() const { return m_capacity; }
     uint64_t max_occupancy() const { return m_max_occupancy; }
@@ -58,12 +61,14 @@ private:
     void admit(Cycle time);
     void unindex(uint32_t treelet);
     void index(uint32_t treelet);
-    void push(uint32_t treelet, const RayState& ray, Cycle ready, Cycle time);
+    void push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time);
     int64_t pick(uint32_t unit);
     Cycle sram(Cycle time);
 
-    const SimConfig& m_config;
-    const TreeletPartition& m_partition;
+    const TreeletConfig& m_config;
+    const LocalityPartition& m_partition;
+    const MemoryMap& m_map;
+    StepperPool& m_steppers;
     uint32_t m_state_bytes;
     uint64_t m_capacity;
     uint64_t m_max_in_flight;

@@ -4,10 +4,6 @@
 
 namespace rtsim {
 
-bool MemoryImage::has_anyhit_triangles() const {
-    return std::any_of(triangles.begin(), triangles.end(), [](const HwTriangle& t) { return t.flags & kTriAnyHit; });
-}
-
 /// Memory where every access hits at the L1 latency: the performance upper bound.
 class IdealMemory : public sc_core::sc_module, public MemIf {
 public:
@@ -26,36 +22,38 @@ private:
     MemStats m_stats;
 };
 
-Top::Top(sc_core::sc_module_name name, const SimConfig& config, const MemoryImage& image, RayStream& rays,
-         RaySinkIf& sink, const WorkloadFeatures& features)
-    : sc_core::sc_module(name), m_config(config) {
+Top::Top(sc_core::sc_module_name name, const SimConfig& config, const Accel& accel, const MemoryMap& map,
+         RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features)
+    : sc_core::sc_module(name),
+      m_config(config),
+      m_unit_context{config.quantum_cycles, config.dispatch.latency, config.treelets.idle_poll_cycles},
+      m_steppers(accel) {
     m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, config.traversal.units, rays);
     build_memory();
-    build_pipelines(features);
-    build_ray_buffer(image);
+    build_pipelines(accel);
+    build_ray_buffer(accel, map);
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
-        auto unit = std::make_unique<TraversalUnit>(("tu" + std::to_string(u)).c_str(), config, image, u);
+        auto unit = std::make_unique<TraversalUnit>(("tu" + std::to_string(u)).c_str(), config.traversal,
+                                                    m_unit_context, map, m_steppers, u);
         unit->rays(*m_dispatch);
         unit->sink(sink);
         if (m_ideal) unit->mem(*m_ideal);
         else unit->mem(*m_l1[u]);
-        size_t b = m_box.size() == 1 ? 0 : u, t = m_tri.size() == 1 ? 0 : u, a = m_anyhit.size() == 1 ? 0 : u;
-        unit->box(*m_box[b]);
-        unit->triangle(*m_tri[t]);
-        if (!m_anyhit.empty()) unit->anyhit(*m_anyhit[a]);
+        for (int k = 0; k < kOpKindCount; ++k) {
+            const PipelineSet& set = m_pipes[size_t(k)];
+            if (!set.empty()) unit->pipes[size_t(k)](*set[set.size() == 1 ? 0 : u]);
+        }
         if (m_ray_buffer) unit->ray_buffer(*m_ray_buffer);
         m_units.push_back(std::move(unit));
     }
     m_instantiated.push_back({{"block", "traversal"}, {"instantiated", true},
                               {"why", std::to_string(config.traversal.units) + " units x " +
-                                          std::to_string(config.traversal.ray_contexts) + " ray contexts"}});
+                                          std::to_string(config.traversal.ray_contexts) + " ray contexts, " +
+                                          accel.kind() + " structure"}});
     m_instantiated.push_back({{"block", "occlusion_early_exit"}, {"instantiated", features.occlusion_rays > 0},
                               {"why", features.occlusion_rays ? std::to_string(features.occlusion_rays) +
                                                                     " any-hit (shadow) rays stop at their first hit"
                                                               : "no any-hit (shadow) rays in the trace"}});
-    m_instantiated.push_back({{"block", "instance_transform"}, {"instantiated", false},
-                              {"why", features.instancing ? "two-level BVHs are not modelled yet"
-                                                          : "single-level BVH: the trace has no instance transforms"}});
 }
 
 Top::~Top() = default;
@@ -70,7 +68,7 @@ void Top::build_memory() {
     }
     // The detailed level adds DRAM banks and row buffers, exact per-cycle cache banks and the
     // L2's MSHRs (its units synchronise every cycle, so the shared L2 sees requests in time order).
-    const bool detailed = c.fidelity == "detailed";
+    const bool detailed = c.fidelity == Fidelity::detailed;
     m_dram = std::make_unique<Dram>("dram", c.dram, detailed);
     // At approx the L2 is reached out of time order within a quantum: its MSHRs bound outstanding
     // misses through an occupancy calendar (docs/model.md); the private L1s model theirs exactly.
@@ -86,40 +84,52 @@ void Top::build_memory() {
                               {"why", "per-unit L1, shared " + std::to_string(c.l2.banks) + "-bank L2, " +
                                           std::to_string(c.dram.channels) + " DRAM channels" +
                                           (detailed ? " of " + std::to_string(c.dram.banks) + " banks (" +
-                                                          c.dram.page_policy + " page), L2 MSHRs"
+                                                          kPagePolicyChoices.name(c.dram.page_policy) + " page), L2 MSHRs"
                                                     : std::string())}});
 }
 
-std::unique_ptr<Pipeline> Top::make_pipeline(const std::string& name, const PipelineConfig& c) {
-    return std::make_unique<Pipeline>(name.c_str(), c, c.sharing == "shared", m_config.fidelity == "detailed");
-}
-
-void Top::build_pipelines(const WorkloadFeatures& features) {
-    auto build = [&](const char* base, const PipelineConfig& c, std::vector<std::unique_ptr<Pipeline>>* out) {
-        if (c.sharing == "shared") {
-            out->push_back(make_pipeline(std::string(base) + "_pool", c));
-        } else {
-            for (uint32_t u = 0; u < m_config.traversal.units; ++u)
-                out->push_back(make_pipeline(std::string(base) + "_" + std::to_string(u), c));
+void Top::build_pipelines(const Accel& accel) {
+    // A pipeline for each operation kind the structure issues; the others are not built.
+    const std::vector<OpKind> used = accel.op_kinds();
+    const bool exact = m_config.fidelity == Fidelity::detailed;
+    for (int k = 0; k < kOpKindCount; ++k) {
+        const OpKind kind = OpKind(k);
+        const char* base = op_kind_name(kind);
+        const bool needed = std::find(used.begin(), used.end(), kind) != used.end();
+        if (needed) {
+            const PipelineConfig& c = m_config.pipeline(kind);
+            if (c.shared()) {
+                m_pipes[size_t(k)].push_back(std::make_unique<Pipeline>((std::string(base) + "_pool").c_str(), c, true, exact));
+            } else {
+                for (uint32_t u = 0; u < m_config.traversal.units; ++u)
+                    m_pipes[size_t(k)].push_back(
+                        std::make_unique<Pipeline>((std::string(base) + "_" + std::to_string(u)).c_str(), c, false, exact));
+            }
         }
-    };
-    build("box", m_config.box, &m_box);
-    build("triangle", m_config.triangle, &m_tri);
-    if (features.anyhit_triangles) build("anyhit", m_config.anyhit, &m_anyhit);
-    m_instantiated.push_back({{"block", "anyhit"}, {"instantiated", features.anyhit_triangles},
-                              {"why", features.anyhit_triangles ? "the BVH has alpha-MASK triangles: alpha test stage"
-                                                                : "no alpha-MASK triangle in the BVH"}});
+        std::string why;
+        if (kind == OpKind::anyhit)
+            why = needed ? "the structure has alpha-MASK triangles: alpha test stage" : "no alpha-MASK triangle in the structure";
+        else if (kind == OpKind::transform)
+            why = needed ? "two-level structure: instance transforms" : "single-level structure: no instance transforms";
+        else
+            why = std::string("the ") + accel.kind() + " structure " + (needed ? "issues" : "issues no") + " " + base +
+                  " operations";
+        m_instantiated.push_back({{"block", kind == OpKind::transform ? "instance_transform" : base},
+                                  {"instantiated", needed}, {"why", why}});
+    }
 }
 
-void Top::build_ray_buffer(const MemoryImage& image) {
+void Top::build_ray_buffer(const Accel& accel, const MemoryMap& map) {
     const TreeletConfig& t = m_config.treelets;
     if (!t.enabled) {
         m_instantiated.push_back({{"block", "ray_buffer"}, {"instantiated", false},
                                   {"why", "treelets.enabled is false: rays go from dispatch straight to the units"}});
         return;
     }
-    m_partition = partition_treelets(image.nodes, t.treelet_kib * 1024);
-    m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", m_config, m_partition);
+    m_partition = accel.partition(uint64_t(t.treelet_kib) * 1024);
+    const TraversalConfig& tc = m_config.traversal;
+    m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", t, m_partition, map, m_steppers, tc.units, tc.ray_contexts,
+                                               ray_state_bytes(tc.stack_entries, tc.stack_entry_bytes));
     m_ray_buffer->rays(*m_dispatch);
     if (m_ideal) m_ray_buffer->mem(*m_ideal);
     else m_ray_buffer->mem(*m_l2);
@@ -127,7 +137,7 @@ void Top::build_ray_buffer(const MemoryImage& image) {
                               {"why", std::to_string(m_partition.treelets.size()) + " treelets of at most " +
                                           std::to_string(t.treelet_kib) + " KiB, " + std::to_string(t.buffer_kib) +
                                           " KiB ray buffer (" + std::to_string(m_ray_buffer->capacity_rays()) +
-                                          " rays), policy " + t.policy}});
+                                          " rays), policy " + kTreeletPolicyChoices.name(t.policy)}});
 }
 
 Cycle Top::total_cycles() const {
@@ -141,12 +151,8 @@ nlohmann::json Top::stats_json() const {
     nlohmann::json j;
     j["dispatch"] = m_dispatch->stats_json();
     for (const auto& u : m_units) j["units"][u->basename()] = u->stats_json(total);
-    auto pipes = [&](const char* key, const std::vector<std::unique_ptr<Pipeline>>& v) {
-        for (const auto& p : v) j[key][p->basename()] = p->stats_json(total);
-    };
-    pipes("box", m_box);
-    pipes("triangle", m_tri);
-    pipes("anyhit", m_anyhit);
+    for (int k = 0; k < kOpKindCount; ++k)
+        for (const auto& p : m_pipes[size_t(k)]) j[op_kind_name(OpKind(k))][p->basename()] = p->stats_json(total);
     if (m_ideal) j["ideal_memory"] = m_ideal->stats_json();
     if (m_ray_buffer) j["ray_buffer"] = m_ray_buffer->stats_json();
     for (const auto& l1 : m_l1) j["l1"][l1->basename()] = l1->stats_json();

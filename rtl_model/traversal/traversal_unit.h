@@ -1,11 +1,12 @@
 #pragma once
 // A MIMD traversal unit (in the spirit of TRaX/STRaTA, Kopta et al. 2013): `ray_contexts` rays in
-// flight, each stepping the reference traversal stepper (traces/isect/traversal.h) on its own —
-// no lock-step. Each step is split into phases so that the unit's requests to its private L1 and
-// pipelines come in time order:
+// flight, each stepping its own stepper (traces/accel/stepper.h) on its own, no lock-step. The
+// unit knows no acceleration structure: each step's plan says what to fetch and which operations
+// to run (docs/architecture.md, the acceleration-structure seam). A step takes two phases so the
+// unit's requests to its private L1 and pipelines come in time order:
 //
-//   fetch ray -> [fetch node (64 B) -> box pipeline -> decide]* / [fetch leaf triangles ->
-//   triangle pipeline -> (alpha any-hit stage) -> decide]* -> write hit
+//   fetch ray -> [step: issue the plan's fetches -> ops: run the plan's operations on their
+//   pipelines (box, triangle, ...), then any the results call for (alpha tests)]* -> write hit
 //
 // A scheduler picks the context whose next phase is ready earliest (one step per issue_cycles).
 // The on-chip stack holds `stack_entries` entries per ray; pushes beyond spill to memory (posted
@@ -13,7 +14,7 @@
 // The unit runs ahead of SystemC time by at most quantum_cycles, then waits (temporal decoupling).
 //
 // With treelet scheduling (ray_buffer bound), contexts take rays from the ray buffer queue of the
-// unit's current treelet instead of from dispatch; a ray whose next node lies in another treelet
+// unit's current treelet instead of from dispatch; a ray whose next step lies in another treelet
 // is parked in that treelet's queue and the context takes the next ray. Traversal order, hits and
 // work counts do not change: the stepper is the same, the ray only waits in between.
 #include <cstdint>
@@ -24,32 +25,38 @@
 #include <systemc>
 
 #include "rtl_model/common/interfaces.h"
+#include "rtl_model/common/memory_map.h"
 #include "rtl_model/common/ray_state.h"
-#include "rtl_model/top/memory_image.h"
-#include "sim/config/config.h"
-#include "traces/isect/traversal.h"
+#include "rtl_model/traversal/traversal_config.h"
 
 namespace rtsim {
+
+/// What a unit needs from beyond its own config, set by the top level from the config tree.
+struct UnitContext {
+    uint32_t quantum_cycles = 256;    ///< how far the unit may run ahead of SystemC time
+    uint32_t dispatch_latency = 2;    ///< cycles to receive a ray from dispatch
+    uint32_t idle_poll_cycles = 32;   ///< treelet mode: how often an idle unit looks for rays
+};
 
 class TraversalUnit : public sc_core::sc_module {
 public:
     sc_core::sc_port<RaySourceIf> rays;
     sc_core::sc_port<MemIf> mem;
-    sc_core::sc_port<PipeIf> box;
-    sc_core::sc_port<PipeIf> triangle;
-    sc_core::sc_port<PipeIf, 1, sc_core::SC_ZERO_OR_MORE_BOUND> anyhit;  ///< only with MASK triangles
+    /// One port per operation kind; bound for the kinds the structure issues (Top::build_pipelines).
+    sc_core::sc_vector<sc_core::sc_port<PipeIf, 1, sc_core::SC_ZERO_OR_MORE_BOUND>> pipes;
     sc_core::sc_port<RaySinkIf> sink;
     sc_core::sc_port<RayBufferIf, 1, sc_core::SC_ZERO_OR_MORE_BOUND> ray_buffer;  ///< treelet mode
 
     SC_HAS_PROCESS(TraversalUnit);
-    TraversalUnit(sc_core::sc_module_name name, const SimConfig& config, const MemoryImage& image, uint32_t index);
+    TraversalUnit(sc_core::sc_module_name name, const TraversalConfig& config, const UnitContext& context,
+                  const MemoryMap& map, StepperPool& steppers, uint32_t index);
 
     Cycle finish_cycle() const { return m_finish; }
     uint64_t rays_done() const { return m_rays; }
     nlohmann::json stats_json(Cycle total_cycles) const;
 
 private:
-    enum class Phase : uint8_t { fetch_ray, step, boxes, triangles };
+    enum class Phase : uint8_t { fetch_ray, step, ops };
     struct Context {
         RayState ray;              ///< stepper, ray id, start cycle, stack bookkeeping
         Phase phase = Phase::step;
@@ -69,14 +76,18 @@ private:
     void park_ray(uint32_t c, uint32_t treelet, Cycle t);
     void fill_idle_contexts(Cycle t);
     void activate(uint32_t c, Cycle t);
+    void deactivate(uint32_t c, Cycle t);
     void advance(uint32_t c, Cycle t);
     void step(uint32_t c, Cycle t);
+    void run_ops(uint32_t c, Cycle t);
     void finish_ray(uint32_t c, Cycle t);
     Cycle stack_traffic(uint32_t c, int before, Cycle t, Cycle ready);
     void schedule(uint32_t c, Cycle t) { m_events.push(Event{t, c}); }
 
-    const SimConfig& m_config;
-    const MemoryImage& m_image;
+    const TraversalConfig& m_config;
+    UnitContext m_ctx;
+    const MemoryMap& m_map;
+    StepperPool& m_steppers;
     uint32_t m_index;
     std::vector<Context> m_contexts;
     std::priority_queue<Event, std::vector<Event>, std::greater<Event>> m_events;

@@ -45,11 +45,16 @@ public:
             value = j->get<T>();
         }
     }
-    void choice(const char* name, std::string& value, std::initializer_list<const char*>, const char*) {
+    template <class E, size_t N>
+    void choice(const char* name, E& value, const Choices<E, N>& choices, const char*) {
         const json* j = take(name);
         if (!j) return;
         require(j->is_string(), "config: '" + join_path(m_prefix, name) + "' must be a string");
-        value = j->get<std::string>();
+        const std::string text = j->get<std::string>();
+        if (choices.parse(text.c_str(), &value)) return;
+        std::string list;
+        for (const char* o : choices.names) list += (list.empty() ? "" : ", ") + std::string(o);
+        throw Error("config: '" + join_path(m_prefix, name) + "' = '" + text + "' is not one of: " + list);
     }
     void flag(const char* name, bool& value, const char*) {
         const json* j = take(name);
@@ -93,7 +98,8 @@ public:
     explicit JsonWriter(json& out) : m_out(out) { m_out = json::object(); }
     template <class T>
     void field(const char* name, T& value, const char*, const char*, double, double) { m_out[name] = value; }
-    void choice(const char* name, std::string& value, std::initializer_list<const char*>, const char*) { m_out[name] = value; }
+    template <class E, size_t N>
+    void choice(const char* name, E& value, const Choices<E, N>& choices, const char*) { m_out[name] = choices.name(value); }
     void flag(const char* name, bool& value, const char*) { m_out[name] = value; }
     template <class S>
     void section(const char* name, S& s) {
@@ -113,8 +119,10 @@ public:
         m_out[name] = {{"type", std::is_integral_v<T> ? "int" : "float"}, {"default", value}, {"unit", unit},
                        {"min", lo}, {"max", hi}, {"doc", doc}};
     }
-    void choice(const char* name, std::string& value, std::initializer_list<const char*> options, const char* doc) {
-        m_out[name] = {{"type", "choice"}, {"default", value}, {"choices", std::vector<std::string>(options.begin(), options.end())}, {"doc", doc}};
+    template <class E, size_t N>
+    void choice(const char* name, E& value, const Choices<E, N>& choices, const char* doc) {
+        m_out[name] = {{"type", "choice"}, {"default", choices.name(value)},
+                       {"choices", std::vector<std::string>(choices.names.begin(), choices.names.end())}, {"doc", doc}};
     }
     void flag(const char* name, bool& value, const char* doc) {
         m_out[name] = {{"type", "bool"}, {"default", value}, {"doc", doc}};
@@ -141,12 +149,10 @@ public:
                 "config: '" + join_path(m_prefix, name) + "' = " + format_number(d) + " is out of range [" +
                     format_number(lo) + ", " + format_number(hi) + "] " + unit);
     }
-    void choice(const char* name, std::string& value, std::initializer_list<const char*> options, const char*) {
-        for (const char* o : options)
-            if (value == o) return;
-        std::string list;
-        for (const char* o : options) list += (list.empty() ? "" : ", ") + std::string(o);
-        throw Error("config: '" + join_path(m_prefix, name) + "' = '" + value + "' is not one of: " + list);
+    /// Choices are validated when read (JsonReader::choice); an enum in range is always valid.
+    template <class E, size_t N>
+    void choice(const char* name, E& value, const Choices<E, N>&, const char*) {
+        require(static_cast<size_t>(value) < N, "config: '" + join_path(m_prefix, name) + "' holds an invalid value");
     }
     void flag(const char*, bool&, const char*) {}
     template <class S>
@@ -172,6 +178,16 @@ void validate_cache(const CacheConfig& c, const char* name) {
 }
 
 }  // namespace
+
+const PipelineConfig& SimConfig::pipeline(OpKind kind) const {
+    switch (kind) {
+        case OpKind::box: return box;
+        case OpKind::triangle: return triangle;
+        case OpKind::anyhit: return anyhit;
+        default: break;
+    }
+    throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");
+}
 
 SimConfig config_from_json(const json& j, const SimConfig& base) {
     SimConfig c = base;
@@ -234,17 +250,17 @@ void validate(const SimConfig& config) {
             "config: 'dram.interleave_bytes' must be a power of two and at least the line size");
     require(power_of_two(config.dram.row_bytes) && power_of_two(config.dram.banks),
             "config: 'dram.row_bytes' and 'dram.banks' must be powers of two (address bit fields)");
-    require(config.fidelity != "detailed" || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
+    require(config.fidelity != Fidelity::detailed || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
             "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas at fidelity detailed (it is the "
             "latency of an access to a closed bank)");
-    require(!config.treelets.enabled || config.fidelity != "analytic",
+    require(!config.treelets.enabled || config.fidelity != Fidelity::analytic,
             "config: 'treelets.enabled' is not supported at fidelity 'analytic' (its closed form models plain "
             "dispatch); use approx or detailed");
     require(config.sampling.fraction == 0 || config.sampling.count == 0,
             "config: set 'sampling.fraction' or 'sampling.count', not both");
-    require(!config.sampling.enabled() || config.fidelity == "approx" || config.fidelity == "detailed",
+    require(!config.sampling.enabled() || config.fidelity == Fidelity::approx || config.fidelity == Fidelity::detailed,
             "config: sampling ('sampling.fraction' or 'sampling.count') needs a timed SystemC level: fidelity approx "
-            "or detailed, not '" + config.fidelity + "'");
+            "or detailed, not '" + std::string(kFidelityChoices.name(config.fidelity)) + "'");
 }
 
 }  // namespace rtsim

@@ -10,7 +10,7 @@
 
 #include "rtl_model/dispatch/dispatch.h"
 #include "rtl_model/mem/functional_cache.h"
-#include "traces/isect/traversal.h"
+#include "rtl_model/traversal/stack_spill.h"
 
 namespace rtsim {
 
@@ -21,15 +21,15 @@ namespace {
 /// Per-unit counts (the analytic counterpart of a traversal unit and its pipelines).
 struct UnitCounts {
     uint64_t rays = 0, steps = 0, spill_writes = 0, spill_reads = 0, rejected = 0;
-    uint64_t issues[3] = {}, tests[3] = {};  ///< box, triangle, anyhit
+    uint64_t issues[kOpKindCount] = {}, tests[kOpKindCount] = {};  ///< per operation kind
 };
-enum Pipe { kBox = 0, kTriangle = 1, kAnyhit = 2 };
 
 class AnalyticModel {
 public:
-    AnalyticModel(const SimConfig& config, const MemoryImage& image, RaySinkIf& sink)
-        : m_c(config), m_image(image), m_sink(sink), m_units(config.traversal.units),
+    AnalyticModel(const SimConfig& config, const Accel& accel, const MemoryMap& map, RaySinkIf& sink)
+        : m_c(config), m_map(map), m_sink(sink), m_ops(accel.op_kinds()), m_units(config.traversal.units),
           m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts) {
+        for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper();
         if (!config.ideal_memory) {
             for (uint32_t u = 0; u < config.traversal.units; ++u) m_l1.emplace_back(config.l1);
             m_l2 = std::make_unique<FunctionalCache>(config.l2);
@@ -38,11 +38,11 @@ public:
     }
 
     void run(RayStream& rays);
-    AnalyticOutcome outcome(bool anyhit_triangles) const;
+    AnalyticOutcome outcome(const Accel& accel) const;
 
 private:
     struct Context {
-        Traversal trav;
+        std::unique_ptr<Stepper> stepper;
         uint64_t id = 0;
         Cycle clock = 0;    ///< this context's unloaded clock
         Cycle start = 0;    ///< clock the ray started at
@@ -54,13 +54,15 @@ private:
     Cycle read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind, Cycle now);
     void write(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind);
     Cycle stack_traffic(uint32_t unit, uint32_t slot, int before, Cycle now);
-    Cycle pipe(uint32_t unit, Pipe p, const PipelineConfig& pc, uint32_t tests);
+    Cycle pipe(uint32_t unit, const Op& op);
+    bool uses(OpKind kind) const { return std::find(m_ops.begin(), m_ops.end(), kind) != m_ops.end(); }
     json bounds_json(double* cycles, std::string* binding) const;
     double queueing_cycles(const json& bounds) const;
 
     const SimConfig& m_c;
-    const MemoryImage& m_image;
+    const MemoryMap& m_map;
     RaySinkIf& m_sink;
+    std::vector<OpKind> m_ops;  ///< operation kinds the structure issues
     std::vector<UnitCounts> m_units;
     std::vector<Context> m_contexts;  ///< unit-major: unit * ray_contexts + context
     std::vector<FunctionalCache> m_l1;
@@ -100,7 +102,7 @@ bool AnalyticModel::start_ray(uint32_t unit, uint32_t slot) {
     if (!m_dispatch->next_ray(unit, &job)) return false;
     ++m_dispatched;
     Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
-    ctx.trav.begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+    ctx.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_units[unit].rejected;
     ctx.id = job.id;
     ctx.local_stack = ctx.spilled = 0;
@@ -108,56 +110,50 @@ bool AnalyticModel::start_ray(uint32_t unit, uint32_t slot) {
     ++m_units[unit].steps;  // the ray-fetch step
     ctx.start = ctx.clock;
     const Cycle fetch = ctx.clock + m_c.dispatch.latency;
-    ctx.clock = fetch + read(unit, MemoryMap::ray(job.id), sizeof(RayRecord), DataKind::ray, fetch);
+    ctx.clock = fetch + read(unit, m_map.ray(job.id), sizeof(RayRecord), DataKind::ray, fetch);
     return true;
 }
 
 void AnalyticModel::step(uint32_t unit, uint32_t slot) {
     Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
     UnitCounts& uc = m_units[unit];
-    switch (ctx.trav.step()) {
-        case Traversal::Step::node: {
-            uc.steps += 2;  // fetch-and-decide, then the box phase
-            ctx.clock += read(unit, MemoryMap::node(ctx.trav.node_index()), sizeof(HwNode), DataKind::node, ctx.clock);
-            Cycle ready = pipe(unit, kBox, m_c.box, 2);
-            const int before = ctx.trav.stack_size();
-            ctx.trav.visit_node(m_image.nodes[ctx.trav.node_index()]);
-            ctx.clock += std::max(ready, stack_traffic(unit, slot, before, ctx.clock));
-            return;
-        }
-        case Traversal::Step::leaf: {
-            uc.steps += 2;
-            const uint32_t first = ctx.trav.leaf_first(), count = ctx.trav.leaf_count();
-            ctx.clock += read(unit, MemoryMap::triangle(first), uint32_t(sizeof(HwTriangle) * count), DataKind::triangle,
-                              ctx.clock);
-            Cycle ready = pipe(unit, kTriangle, m_c.triangle, count);
-            const uint32_t alpha_before = ctx.trav.work().anyhit_calls;
-            const int before = ctx.trav.stack_size();
-            ctx.trav.visit_leaf(&m_image.triangles[first]);
-            const uint32_t alpha = ctx.trav.work().anyhit_calls - alpha_before;
-            if (alpha) ready += pipe(unit, kAnyhit, m_c.anyhit, alpha);
-            ctx.clock += std::max(ready, stack_traffic(unit, slot, before, ctx.clock));
-            return;
-        }
-        case Traversal::Step::done: {
-            write(unit, MemoryMap::hit(ctx.id), sizeof(HitRecord), DataKind::hit);  // posted
-            const Cycle latency = ctx.clock - ctx.start;
-            m_sink.ray_done(RayResult{ctx.id, ctx.trav.hit(), ctx.trav.work(), 0, latency, unit, slot});
-            ++uc.rays;
-            m_latency_sum += double(latency);
-            m_latency_max = std::max(m_latency_max, latency);
-            ctx.active = false;
-            start_ray(unit, slot);
-            return;
-        }
+    Stepper& stepper = *ctx.stepper;
+    const StepPlan& plan = stepper.plan();
+    if (plan.done) {
+        write(unit, m_map.hit(ctx.id), sizeof(HitRecord), DataKind::hit);  // posted
+        const Cycle latency = ctx.clock - ctx.start;
+        m_sink.ray_done(RayResult{ctx.id, stepper.hit(), stepper.work(), 0, latency, unit, slot});
+        ++uc.rays;
+        m_latency_sum += double(latency);
+        m_latency_max = std::max(m_latency_max, latency);
+        ctx.active = false;
+        start_ray(unit, slot);
+        return;
     }
+    // The step as the traversal unit takes it: its fetches, then its operations in order, then
+    // those its results call for (alpha tests); two scheduler steps (fetch, operations).
+    uc.steps += 2;
+    Cycle fetched = 0;
+    for (int i = 0; i < plan.fetch_count; ++i)
+        fetched = std::max(fetched, read(unit, plan.fetch[i].addr, plan.fetch[i].bytes, plan.fetch[i].kind, ctx.clock));
+    ctx.clock += fetched;
+    Op ops[StepPlan::kMaxOps];
+    const int op_count = plan.op_count;
+    std::copy(plan.op, plan.op + op_count, ops);
+    const int before = stepper.stack_size();
+    const StepOutcome outcome = stepper.execute();
+    Cycle ready = 0;
+    for (int i = 0; i < op_count; ++i) ready += pipe(unit, ops[i]);
+    for (int i = 0; i < outcome.op_count; ++i) ready += pipe(unit, outcome.op[i]);
+    ctx.clock += std::max(ready, stack_traffic(unit, slot, before, ctx.clock));
 }
 
-/// Issues `tests` into a pipeline; returns its unloaded latency.
-Cycle AnalyticModel::pipe(uint32_t unit, Pipe p, const PipelineConfig& pc, uint32_t tests) {
-    const uint32_t issues = (tests + pc.width - 1) / pc.width;
-    m_units[unit].issues[p] += issues;
-    m_units[unit].tests[p] += tests;
+/// Issues an operation into its pipeline; returns its unloaded latency.
+Cycle AnalyticModel::pipe(uint32_t unit, const Op& op) {
+    const PipelineConfig& pc = m_c.pipeline(op.kind);
+    const uint32_t issues = (op.count + pc.width - 1) / pc.width;
+    m_units[unit].issues[size_t(op.kind)] += issues;
+    m_units[unit].tests[size_t(op.kind)] += op.count;
     return issues ? Cycle(issues - 1) * pc.initiation_interval + pc.latency : 0;
 }
 
@@ -226,45 +222,35 @@ void AnalyticModel::write(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind
 /// maps the stepper's stack onto stack_entries on-chip entries; returns the refill latency.
 Cycle AnalyticModel::stack_traffic(uint32_t unit, uint32_t slot, int before, Cycle now) {
     Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
-    const int after = ctx.trav.stack_size();
-    const uint32_t cap = m_c.traversal.stack_entries, bytes = m_c.traversal.stack_entry_bytes;
-    const uint64_t context = uint64_t(unit) * m_c.traversal.ray_contexts + slot;
+    const uint32_t bytes = m_c.traversal.stack_entry_bytes;
+    const uint64_t owner = uint64_t(unit) * m_c.traversal.ray_contexts + slot;
     Cycle refill = 0;
-    for (int i = before; i < after; ++i) {
-        if (ctx.local_stack < cap) {
-            ++ctx.local_stack;
-            continue;
-        }
-        write(unit, MemoryMap::stack(context, ctx.spilled, bytes), bytes, DataKind::stack);
-        ++ctx.spilled;
-        ++m_units[unit].spill_writes;
-    }
-    for (int i = after; i < before; ++i) {
-        if (ctx.local_stack > 0) {
-            --ctx.local_stack;
-            continue;
-        }
-        --ctx.spilled;
-        ++m_units[unit].spill_reads;
-        refill = std::max(refill, read(unit, MemoryMap::stack(context, ctx.spilled, bytes), bytes, DataKind::stack, now));
-    }
+    map_stack_change(
+        ctx.local_stack, ctx.spilled, before, ctx.stepper->stack_size(), m_c.traversal.stack_entries,
+        [&](uint32_t s) {
+            write(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack);
+            ++m_units[unit].spill_writes;
+        },
+        [&](uint32_t s) {
+            ++m_units[unit].spill_reads;
+            refill = std::max(refill, read(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack, now));
+        });
     return refill;
 }
 
 /// The roofline: each bound in cycles; `cycles` gets the largest, `binding` its name.
 json AnalyticModel::bounds_json(double* cycles, std::string* binding) const {
     const TraversalConfig& t = m_c.traversal;
-    uint64_t issues[3] = {}, steps = 0;
+    uint64_t issues[kOpKindCount] = {}, steps = 0;
     for (const UnitCounts& u : m_units) {
-        for (int p = 0; p < 3; ++p) issues[p] += u.issues[p];
+        for (int k = 0; k < kOpKindCount; ++k) issues[k] += u.issues[k];
         steps += u.steps;
     }
     json b = json::object();
-    const PipelineConfig* pcs[3] = {&m_c.box, &m_c.triangle, &m_c.anyhit};
-    const char* names[3] = {"box", "triangle", "anyhit"};
-    for (int p = 0; p < 3; ++p) {
-        const double pipelines = pcs[p]->sharing == "shared" ? pcs[p]->shared_count : t.units;
-        b[names[p]] = double(issues[p]) * pcs[p]->initiation_interval / pipelines;
+    for (OpKind kind : m_ops) {
+        const PipelineConfig& pc = m_c.pipeline(kind);
+        const double pipelines = pc.shared() ? pc.shared_count : t.units;
+        b[op_kind_name(kind)] = double(issues[size_t(kind)]) * pc.initiation_interval / pipelines;
     }
     if (!m_c.ideal_memory) {
         MemCounters d = m_dram.total(), l2 = m_l2->stats().total();
@@ -303,11 +289,10 @@ double AnalyticModel::queueing_cycles(const json& bounds) const {
         double demand;  ///< cycles per ray of one class (unit)
         bool shared;
     };
-    auto pool = [](const PipelineConfig& p) { return p.sharing == "shared"; };
-    const std::pair<const char*, bool> kinds[] = {
-        {"box", pool(m_c.box)}, {"triangle", pool(m_c.triangle)}, {"anyhit", pool(m_c.anyhit)},
-        {"scheduler", false},   {"l1_banks", false},            {"l1_mshrs", false},
-        {"dram", true},         {"l2_banks", true},              {"l2_mshrs", true}};
+    std::vector<std::pair<std::string, bool>> kinds;  // station, shared by all units
+    for (OpKind kind : m_ops) kinds.push_back({op_kind_name(kind), m_c.pipeline(kind).shared()});
+    for (const char* name : {"scheduler", "l1_banks", "l1_mshrs"}) kinds.push_back({name, false});
+    for (const char* name : {"dram", "l2_banks", "l2_mshrs"}) kinds.push_back({name, true});
     std::vector<Station> stations;
     double think = m_latency_sum / rays;  // unloaded latency per ray
     for (const auto& [name, shared] : kinds) {
@@ -316,7 +301,7 @@ double AnalyticModel::queueing_cycles(const json& bounds) const {
         const double demand = shared ? bound / rays : bound * units / rays;
         stations.push_back({demand, shared});
         // The MSHR queues' demand D/m is part of the unloaded latency already.
-        if (std::string(name).find("mshrs") != std::string::npos) think -= demand;
+        if (name.find("mshrs") != std::string::npos) think -= demand;
     }
     think = std::max(think, 0.0);
     std::vector<double> queue(stations.size(), 0.0);
@@ -334,7 +319,7 @@ double AnalyticModel::queueing_cycles(const json& bounds) const {
     return x > 0 ? rays / (units * x) : 0.0;
 }
 
-AnalyticOutcome AnalyticModel::outcome(bool anyhit_triangles) const {
+AnalyticOutcome AnalyticModel::outcome(const Accel& accel) const {
     AnalyticOutcome out;
     double bound = 0;
     std::string binding = "latency";
@@ -353,24 +338,22 @@ AnalyticOutcome AnalyticModel::outcome(bool anyhit_triangles) const {
             {"stack_spill_reads", uc.spill_reads}, {"rejected_rays", uc.rejected},
             {"quantum_syncs", nullptr}, {"finish_cycle", nullptr}};
     }
-    const PipelineConfig* pcs[3] = {&m_c.box, &m_c.triangle, &m_c.anyhit};
-    const char* names[3] = {"box", "triangle", "anyhit"};
-    for (int p = 0; p < 3; ++p) {
-        if (p == kAnyhit && !anyhit_triangles) continue;
-        const bool shared = pcs[p]->sharing == "shared";
+    for (OpKind kind : m_ops) {
+        const size_t p = size_t(kind);
+        const std::string name = op_kind_name(kind);
+        const PipelineConfig& pc = m_c.pipeline(kind);
         auto block = [&](uint64_t issues, uint64_t tests, uint32_t pipelines) {
-            const double capacity = total * pipelines / pcs[p]->initiation_interval;
+            const double capacity = total * pipelines / pc.initiation_interval;
             return json{{"issues", issues},     {"tests", tests}, {"pipelines", pipelines},
                         {"utilization", capacity > 0 ? double(issues) / capacity : 0.0}, {"avg_wait_cycles", nullptr}};
         };
-        if (shared) {
+        if (pc.shared()) {
             uint64_t issues = 0, tests = 0;
             for (const UnitCounts& uc : m_units) issues += uc.issues[p], tests += uc.tests[p];
-            m[names[p]][std::string(names[p]) + "_pool"] = block(issues, tests, pcs[p]->shared_count);
+            m[name][name + "_pool"] = block(issues, tests, pc.shared_count);
         } else {
             for (size_t u = 0; u < m_units.size(); ++u)
-                m[names[p]][std::string(names[p]) + "_" + std::to_string(u)] =
-                    block(m_units[u].issues[p], m_units[u].tests[p], 1);
+                m[name][name + "_" + std::to_string(u)] = block(m_units[u].issues[p], m_units[u].tests[p], 1);
         }
     }
     if (m_c.ideal_memory) {
@@ -413,19 +396,23 @@ AnalyticOutcome AnalyticModel::outcome(bool anyhit_triangles) const {
          {{"block", "memory"}, {"instantiated", !m_c.ideal_memory},
           {"why", m_c.ideal_memory ? "ideal_memory: every access hits at L1 latency, no L2/DRAM"
                                    : "functional L1 per unit and shared L2 (tags only), DRAM bytes"}},
-         {{"block", "anyhit"}, {"instantiated", anyhit_triangles},
-          {"why", anyhit_triangles ? "the BVH has alpha-MASK triangles: alpha test stage"
-                                   : "no alpha-MASK triangle in the BVH"}}});
+        });
+    for (int k = 0; k < kOpKindCount; ++k)
+        out.instantiated.push_back({{"block", op_kind_name(OpKind(k))},
+                                    {"instantiated", uses(OpKind(k))},
+                                    {"why", std::string("the ") + accel.kind() + " structure issues " +
+                                                (uses(OpKind(k)) ? "" : "no ") + op_kind_name(OpKind(k)) +
+                                                " operations (analytic: counted, not timed)"}});
     return out;
 }
 
 }  // namespace
 
-AnalyticOutcome run_analytic(const SimConfig& config, const MemoryImage& image, RayStream& rays, RaySinkIf& sink,
-                             bool anyhit_triangles) {
-    AnalyticModel model(config, image, sink);
+AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
+                             RaySinkIf& sink) {
+    AnalyticModel model(config, accel, map, sink);
     model.run(rays);
-    return model.outcome(anyhit_triangles);
+    return model.outcome(accel);
 }
 
 }  // namespace rtsim

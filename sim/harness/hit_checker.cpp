@@ -20,10 +20,17 @@ std::string compare_with_reference(const RayResult& r, const HitRecord& h, const
     if (*hit_differs)
         out << "hit: model prim " << r.hit.prim << " t " << r.hit.t << ", reference prim " << h.prim << " t " << h.t;
     const WorkCounts& m = r.work;
-    if (m.nodes != w.nodes || m.box_tests != w.box_tests || m.tri_tests != w.tri_tests || m.anyhit_calls != w.anyhit_calls) {
+    const WorkCounts ref = work_from_record(w);
+    if (m != ref) {
         if (*hit_differs) out << "; ";
-        out << "work: model nodes/box/tri/alpha " << m.nodes << "/" << m.box_tests << "/" << m.tri_tests << "/"
-            << m.anyhit_calls << ", reference " << w.nodes << "/" << w.box_tests << "/" << w.tri_tests << "/" << w.anyhit_calls;
+        auto counts = [&out](const WorkCounts& c) {
+            out << c.steps << "/" << c.box_tests << "/" << c.tri_tests << "/" << c.anyhit_calls << "/" << c.transforms
+                << "/" << c.cell_steps << "/" << c.plane_tests << "/" << c.refs;
+        };
+        out << "work (steps/box/tri/alpha/transforms/cells/planes/refs): model ";
+        counts(m);
+        out << ", reference ";
+        counts(ref);
     }
     return out.str();
 }

@@ -1,7 +1,7 @@
 #pragma once
-// The hit checker (DESIGN rule 2): every ray the model finishes is compared with the trace's
-// reference hit (primitive id and the bits of t) and reference work (nodes, box and triangle
-// tests, alpha tests). Mismatches are counted, the first ones listed, and make rtsim-sim exit
+// The hit checker (docs/architecture.md, rule 2): every ray the model finishes is compared with the
+// trace's reference hit (primitive id and the bits of t) and reference work (every WorkCounts
+// field: steps, box, triangle, alpha and plane tests, transforms, cell steps, references). Mismatches are counted, the first ones listed, and make rtsim-sim exit
 // non-zero. It also keeps the per-ray latency histogram and reports progress.
 #include <cstdint>
 #include <functional>

@@ -13,8 +13,8 @@
 #include "sim/harness/summary.h"
 #include "sim/harness/timeline.h"
 #include "sim/harness/trace_stream.h"
+#include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
-#include "traces/isect/traversal.h"
 
 namespace rtsim {
 
@@ -63,17 +63,14 @@ void report_progress(uint64_t done, uint64_t total) {
 }
 
 /// Functional level: the reference traversal in a loop, no time. Counts and the hit check only.
-json run_functional(const MemoryImage& image, TraceReader& reader, ReferenceWindow& ref, HitChecker& checker) {
-    HwBvh bvh;
-    bvh.nodes = image.nodes;
-    bvh.triangles = image.triangles;
+json run_functional(const Accel& accel, TraceReader& reader, HitChecker& checker) {
     TraceRayStream stream(reader);
     std::vector<RayJob> jobs;
     while (stream.read_chunk(65536, &jobs)) {
         for (const RayJob& job : jobs) {
             RayResult r;
             r.id = job.id;
-            r.hit = trace_ray(bvh, job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
+            r.hit = accel.trace(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
             checker.ray_done(r);
         }
         jobs.clear();
@@ -96,12 +93,9 @@ SimOutcome run_simulation(const SimOptions& o) {
     const std::string rtt = trace_file(o.trace);
     TraceReader reader(rtt);
     json manifest = read_manifest(rtt);
-    MemoryImage image;
-    image.nodes = reader.read_all<HwNode>(SectionKind::bvh_nodes);
-    image.triangles = reader.read_all<HwTriangle>(SectionKind::triangles);
-    require(!image.nodes.empty(), rtt + ": the trace has no BVH nodes (section NODE)");
+    // The acceleration structure, whichever it is, validated structurally (load_accel).
+    const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
     WorkloadFeatures features;
-    features.anyhit_triangles = image.has_anyhit_triangles();
     json workload = scan_workload(reader, &features);
     // Check every chunk's CRC now (one streaming pass): the reference window reads HITS and WORK
     // during sc_start, where a corrupt chunk would surface as a SystemC report (exit 1) instead
@@ -112,6 +106,11 @@ SimOutcome run_simulation(const SimOptions& o) {
     std::unique_ptr<SampledRun> sampled;
     if (o.config.sampling.enabled()) sampled = std::make_unique<SampledRun>(reader, o.config, total);
     const uint64_t simulated = sampled ? sampled->plan.simulated_rays : total;
+    // Spill areas belong to contexts, or to rays in treelet mode (they move between units).
+    const TraversalConfig& tc = o.config.traversal;
+    const MemoryMap map(accel->image().end_address(), total,
+                        o.config.treelets.enabled ? total : uint64_t(tc.units) * tc.ray_contexts,
+                        accel->max_stack_entries(), tc.stack_entry_bytes);
 
     fs::create_directories(o.out_dir);
     write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(o.config));
@@ -126,20 +125,21 @@ SimOutcome run_simulation(const SimOptions& o) {
     // Detailed: units synchronise every cycle (quantum 1), so shared blocks see requests in time
     // order (docs/model.md, "The detailed level"); the resolved config keeps the user's value.
     SimConfig timed_config = o.config;
-    if (o.config.fidelity == "detailed") timed_config.quantum_cycles = 1;
-    if (o.config.fidelity == "functional") {
-        run_functional(image, reader, reference, checker);
-    } else if (o.config.fidelity == "analytic") {
+    if (o.config.fidelity == Fidelity::detailed) timed_config.quantum_cycles = 1;
+    if (o.config.fidelity == Fidelity::functional) {
+        run_functional(*accel, reader, checker);
+    } else if (o.config.fidelity == Fidelity::analytic) {
         // Counts, functional caches and a closed form (sim/harness/analytic.h); no SystemC time.
         // (validate() refuses sampling here: it needs a timed SystemC level.)
         TraceRayStream stream(reader);
-        AnalyticOutcome a = run_analytic(o.config, image, stream, checker, features.anyhit_triangles);
+        AnalyticOutcome a = run_analytic(o.config, *accel, map, stream, checker);
         cycles = a.cycles;
         model = std::move(a.model);
         instantiated = std::move(a.instantiated);
     } else {
         TraceRayStream stream(reader);
-        Top top("top", timed_config, image, sampled ? static_cast<RayStream&>(sampled->stream) : stream, checker, features);
+        Top top("top", timed_config, *accel, map, sampled ? static_cast<RayStream&>(sampled->stream) : stream, checker,
+                features);
         std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
         if (o.timeline) {
             kind_reader = std::make_unique<TraceReader>(rtt);
@@ -170,7 +170,7 @@ SimOutcome run_simulation(const SimOptions& o) {
 
     SimOutcome out;
     out.stats = {{"schema", "rtsim-stats/1"},
-                 {"fidelity", o.config.fidelity},
+                 {"fidelity", kFidelityChoices.name(o.config.fidelity)},
                  {"summary", summarize(o.config, cycles, total, model, checker, wall)},
                  {"validation", checker.to_json()},
                  {"latency", checker.latency().to_json()},

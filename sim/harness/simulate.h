@@ -1,6 +1,6 @@
 #pragma once
 // One simulation: a trace and a config in, RUN/stats.json, RUN/config.resolved.json and
-// RUN/provenance.json out (DESIGN rule 5). SystemC elaborates once per process, so this runs at
+// RUN/provenance.json out (docs/architecture.md, rule 5). SystemC elaborates once per process, so this runs at
 // most once per process (rtsim-sim); Python runs many processes.
 #include <cstdint>
 #include <string>

@@ -53,13 +53,13 @@ double peak_memory_mib() {
 json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& model, const HitChecker& checker,
                double wall) {
     json s = {{"rays", rays},
-              {"fidelity", c.fidelity},
+              {"fidelity", kFidelityChoices.name(c.fidelity)},
               {"hit_mismatches", checker.hit_mismatches()},
               {"work_mismatches", checker.work_mismatches()},
               {"wall_seconds", wall},
               {"peak_memory_mib", peak_memory_mib()},
               {"simulated_rays_per_wall_second", wall > 0 ? double(rays) / wall : 0.0}};
-    if (c.fidelity == "functional") {
+    if (c.fidelity == Fidelity::functional) {
         // Every level reports the same keys; what the functional level cannot know is null.
         for (const char* k : {"cycles", "seconds", "rays_per_second", "mrays_per_second", "avg_ray_latency_cycles",
                               "unit_busy_fraction", "box_utilization", "triangle_utilization", "l1_hit_rate",

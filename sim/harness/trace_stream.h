@@ -1,6 +1,6 @@
 #pragma once
 // Streams a trace into the model and the checker in chunks, so memory stays bounded however long
-// the trace is (DESIGN rule 8).
+// the trace is (docs/architecture.md, rule 8).
 #include <cstdint>
 #include <deque>
 #include <string>

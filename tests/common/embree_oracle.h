@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "traces/common/ray.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/scene/scene.h"
 
 namespace rtsim::oracle {

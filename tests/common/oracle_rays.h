@@ -10,7 +10,7 @@
 
 #include "traces/bvh/hw_layout.h"
 #include "traces/common/ray.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
 #include "traces/raygen/secondary.h"
@@ -53,7 +53,8 @@ inline Vec3 oracle_light(const Scene& scene) {
 inline RaySets make_ray_sets(const Scene& scene, const HwBvh& bvh, uint32_t width, uint32_t height,
                              uint64_t seed = 1) {
     RaySets sets;
-    const Camera cam = auto_frame(scene, bvh, float(width) / float(height), &sets.camera_why);
+    const Bvh2Accel accel(bvh2_image(bvh, BuildConfig{}, "binned"), "oracle rays");
+    const Camera cam = auto_frame(scene, accel, float(width) / float(height), &sets.camera_why);
     const PinholeCamera pin = make_camera(cam, width, height);
     const WorkloadPlan plan = plan_workload(scene, {RayKind::diffuse});
     const SpawnContext ctx{&scene, &plan, 1, seed};

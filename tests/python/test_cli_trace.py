@@ -51,7 +51,7 @@ def test_open_trace(cornell_trace: Path) -> None:
     assert primary.sum() > 0 and (trace.rays["depth"][primary] == 0).all()
     assert (trace.rays["pixel"] < TRACE_WIDTH * TRACE_HEIGHT).all()
     assert len(np.unique(trace.rays["kind"])) > 1  # secondary rays were traced
-    assert (trace.work["nodes"] > 0).any()
+    assert (trace.work["steps"] > 0).any()
     assert trace.nodes is not None and len(trace.nodes) > 0
     assert trace.triangles is not None
     assert trace.scene_name == "cornell"
@@ -88,11 +88,11 @@ def test_trace_hits_match_trace_rays(cornell_trace: Path, cornell: rtsim.Scene) 
 
 def test_heatmap_sums(cornell_trace: Path) -> None:
     trace = rtsim.open_trace(cornell_trace)
-    nodes, tris = pixel_work(trace, TRACE_WIDTH, TRACE_HEIGHT, ("nodes", "tri_tests"))
+    nodes, tris = pixel_work(trace, TRACE_WIDTH, TRACE_HEIGHT, ("steps", "tri_tests"))
     primary = trace.rays["kind"] == 0
     assert nodes.primary.shape == (TRACE_HEIGHT, TRACE_WIDTH)
-    assert nodes.primary.sum() == trace.work["nodes"][primary].sum()
-    assert nodes.all_rays.sum() == trace.work["nodes"].astype(np.int64).sum()
+    assert nodes.primary.sum() == trace.work["steps"][primary].sum()
+    assert nodes.all_rays.sum() == trace.work["steps"].astype(np.int64).sum()
     assert tris.all_rays.sum() >= tris.primary.sum() > 0
 
 

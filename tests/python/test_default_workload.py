@@ -1,4 +1,4 @@
-"""The workload a scene calls for is the default (DESIGN rule 10) of `rtsim trace`,
+"""The workload a scene calls for is the default (docs/architecture.md, rule 10) of `rtsim trace`,
 rtsim.trace_scene and sweeps; an explicit list narrows it."""
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ from rtsim.trace_file import HIT_DTYPE, NODE_DTYPE, RAY_DTYPE, TRIANGLE_DTYPE, W
 def test_record_sizes() -> None:
     assert RAY_DTYPE.itemsize == 40
     assert HIT_DTYPE.itemsize == 20
-    assert WORK_DTYPE.itemsize == 20
+    assert WORK_DTYPE.itemsize == 32
     assert NODE_DTYPE.itemsize == 64
     assert TRIANGLE_DTYPE.itemsize == 48
 

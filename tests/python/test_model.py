@@ -320,7 +320,7 @@ def doctor(trace: Path, out: Path, section: str, record: int, field: str, value:
 def test_wrong_reference_is_detected(cornell_small: Path, sim: Sim, tmp_path: Path) -> None:
     trace = rtsim.open_trace(cornell_small)
     hit_ray = int(np.flatnonzero(trace.hits["prim"] >= 0)[0])
-    work_ray = int(np.flatnonzero(trace.work["nodes"] > 0)[-1])
+    work_ray = int(np.flatnonzero(trace.work["steps"] > 0)[-1])
     assert hit_ray != work_ray
     t = trace.hits["t"][hit_ray]
     step1 = tmp_path / "one.rtt"
@@ -333,8 +333,8 @@ def test_wrong_reference_is_detected(cornell_small: Path, sim: Sim, tmp_path: Pa
         np.nextafter(t, np.float32(np.inf)),
     )
     doctored = tmp_path / "doctored.rtt"
-    nodes = int(trace.work["nodes"][work_ray])
-    doctor(step1, doctored, "work", work_ray, "nodes", nodes + 1)
+    nodes = int(trace.work["steps"][work_ray])
+    doctor(step1, doctored, "work", work_ray, "steps", nodes + 1)
     rtsim.verify_trace(doctored)  # the file itself is sound: only the reference is wrong
 
     result = sim(doctored, tmp_path / "run")
@@ -345,7 +345,7 @@ def test_wrong_reference_is_detected(cornell_small: Path, sim: Sim, tmp_path: Pa
     listed = {m["ray"]: m["difference"] for m in validation["first_mismatches"]}
     assert set(listed) == {hit_ray, work_ray}
     assert listed[hit_ray].startswith("hit:")
-    assert "work:" in listed[work_ray] and f"reference {nodes + 1}/" in listed[work_ray]
+    assert listed[work_ray].startswith("work") and f"reference {nodes + 1}/" in listed[work_ray]
     # The functional level checks the same way.
     result = sim(doctored, tmp_path / "functional", "fidelity=functional")
     assert result.returncode == 3

@@ -31,8 +31,8 @@ def test_same_rays_give_the_same_trace_file(primary: Path, tmp_path: Path) -> No
     assert manifest["workload"]["requested"] == "given"
     effects = {e["name"]: e for e in manifest["workload"]["effects"]}
     assert effects["primary"]["simulated"] and not effects["shadow"]["simulated"]
-    assert manifest["bvh"] == rtsim.open_trace(primary).manifest["bvh"] | {
-        "build_ms": manifest["bvh"]["build_ms"]
+    assert manifest["accel"] == rtsim.open_trace(primary).manifest["accel"] | {
+        "build_ms": manifest["accel"]["build_ms"]
     }
 
 
@@ -68,7 +68,7 @@ def test_trace_rays_returns_the_traces_work(primary: Path) -> None:
     assert set(work.dtype.names) == set(trace.work.dtype.names)  # the C++ WorkCounts fields
     for name in work.dtype.names:
         assert np.array_equal(work[name], trace.work[name]), name
-    assert work["nodes"].sum() > 0 and np.array_equal(hits["prim"], trace.hits["prim"])
+    assert work["steps"].sum() > 0 and np.array_equal(hits["prim"], trace.hits["prim"])
 
 
 def test_bad_rays_raise_naming_the_argument(tmp_path: Path) -> None:

@@ -121,7 +121,7 @@ private:
     BuildTree m_tree;
 };
 
-// Per-primitive boxes, rejecting non-finite vertices (DESIGN rule 11); returns the centroid bounds.
+// Per-primitive boxes, rejecting non-finite vertices (docs/architecture.md, rule 11); returns the centroid bounds.
 Box BinnedSahBuilder::make_refs() {
     m_refs.resize(m_triangles.size());
     Box centroids;

@@ -34,6 +34,10 @@ BuildTree build_binned_sah(const std::vector<Triangle>& triangles, const BuildCo
 /// triangles in leaf order) and fills the stats other than build_ms.
 HwBvh flatten_bvh(const BuildTree& tree, const Scene& scene, const BuildConfig& config);
 
+/// The hardware triangle record of scene primitive `prim` (vertices, ids, alpha and material
+/// flags). Throws rtsim::Error if its material index does not fit the layout.
+HwTriangle make_hw_triangle(const Scene& scene, uint32_t prim);
+
 /// Levels of object-median splits needed below a node of `count` primitives before every leaf
 /// holds at most max_leaf_size: ceil(log2(ceil(count / max_leaf_size))).
 uint32_t median_levels_needed(uint32_t count, uint32_t max_leaf_size);

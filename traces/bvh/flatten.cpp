@@ -27,6 +27,17 @@ void set_empty_slot(HwNode& node, int slot) {
     node.child_count[slot] = kEmptyChild;
 }
 
+/// A build node whose HwNode is still to be written, and the parent slot that will point to it.
+struct Pending {
+    uint32_t build;
+    uint32_t parent;  // HwNode index, or kNoParent for the root
+    uint32_t slot;
+    uint32_t depth;
+};
+constexpr uint32_t kNoParent = std::numeric_limits<uint32_t>::max();
+
+}  // namespace
+
 HwTriangle make_hw_triangle(const Scene& scene, uint32_t prim) {
     const Triangle& t = scene.triangles[prim];
     HwTriangle hw{};
@@ -49,17 +60,6 @@ HwTriangle make_hw_triangle(const Scene& scene, uint32_t prim) {
                (coverage8 << kTriCoverageShift) | (material << kTriMaterialShift);
     return hw;
 }
-
-/// A build node whose HwNode is still to be written, and the parent slot that will point to it.
-struct Pending {
-    uint32_t build;
-    uint32_t parent;  // HwNode index, or kNoParent for the root
-    uint32_t slot;
-    uint32_t depth;
-};
-constexpr uint32_t kNoParent = std::numeric_limits<uint32_t>::max();
-
-}  // namespace
 
 HwBvh flatten_bvh(const BuildTree& tree, const Scene& scene, const BuildConfig& config) {
     HwBvh out;

@@ -1,6 +1,6 @@
 #pragma once
 // Hardware layout of the BVH: the one memory image the reference tracer and the SystemC model
-// both read (DESIGN rule 3). Documented byte by byte in docs/bvh_layout.md.
+// both read (docs/architecture.md, rule 3). Documented byte by byte in docs/bvh_layout.md.
 //
 // A binary BVH whose nodes hold the boxes of their two children, so one 64-byte fetch (one
 // cache line) feeds one issue of a 2-wide ray-box pipeline (as in Aila & Laine 2009's layout).
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "traces/common/aabb.h"
+#include "traces/common/hw_triangle.h"
 
 namespace rtsim {
 
@@ -27,21 +28,6 @@ struct alignas(64) HwNode {     // 64 bytes, 64-byte aligned in memory (one line
     float& hi(int child, int axis) { return bounds[axis][1][child]; }
 };
 static_assert(sizeof(HwNode) == 64, "HwNode must be one 64-byte line");
-
-/// HwTriangle::flags bits.
-constexpr uint32_t kTriAnyHit = 1u << 0;         ///< alpha-MASK: call the any-hit (alpha) test
-constexpr uint32_t kTriCoverageShift = 8;        ///< bits 8..15: alpha coverage x 255
-constexpr uint32_t kTriMaterialShift = 16;       ///< bits 16..31: material index
-
-struct HwTriangle {             // 48 bytes
-    float v0[3];                //  0
-    float v1[3];                // 12
-    float v2[3];                // 24
-    uint32_t prim;              // 36: stable primitive id (scene order, see scene.h)
-    uint32_t inst;              // 40: instance id
-    uint32_t flags;             // 44: kTriAnyHit | coverage << 8 | material << 16
-};
-static_assert(sizeof(HwTriangle) == 48, "HwTriangle must be 48 bytes");
 
 /// Statistics of a built BVH (written to the trace manifest).
 struct BvhStats {

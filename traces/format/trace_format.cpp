@@ -1,18 +1,31 @@
 // Section names and sizes, and conversions between the tracer's types and the trace records.
 #include "traces/format/trace_format.h"
 
-#include "traces/bvh/hw_layout.h"
-
 namespace rtsim {
 
-const char* section_name(SectionKind kind) {
+SectionKind region_section(uint32_t index) {
+    const uint32_t tens = '0' + index / 10 % 10, ones = '0' + index % 10;
+    return static_cast<SectionKind>(uint32_t('R') | uint32_t('G') << 8 | tens << 16 | ones << 24);
+}
+
+bool is_region_section(SectionKind kind, uint32_t* index) {
+    const auto v = static_cast<uint32_t>(kind);
+    const uint32_t tens = (v >> 16) & 0xFF, ones = v >> 24;
+    if ((v & 0xFFFF) != (uint32_t('R') | uint32_t('G') << 8) || tens < '0' || tens > '9' || ones < '0' || ones > '9')
+        return false;
+    if (index) *index = (tens - '0') * 10 + (ones - '0');
+    return true;
+}
+
+std::string section_name(SectionKind kind) {
     switch (kind) {
     case SectionKind::rays: return "RAYS";
     case SectionKind::hits: return "HITS";
     case SectionKind::work: return "WORK";
-    case SectionKind::bvh_nodes: return "NODE";
-    case SectionKind::triangles: return "TRIS";
+    case SectionKind::accel: return "ACCL";
     }
+    uint32_t index;
+    if (is_region_section(kind, &index)) return "RG" + std::to_string(index / 10) + std::to_string(index % 10);
     return "unknown";
 }
 
@@ -21,8 +34,7 @@ uint32_t section_record_bytes(SectionKind kind) {
     case SectionKind::rays: return sizeof(RayRecord);
     case SectionKind::hits: return sizeof(HitRecord);
     case SectionKind::work: return sizeof(WorkRecord);
-    case SectionKind::bvh_nodes: return sizeof(HwNode);
-    case SectionKind::triangles: return sizeof(HwTriangle);
+    case SectionKind::accel: return 1;
     }
     return 0;
 }
@@ -64,16 +76,20 @@ Hit hit_from_record(const HitRecord& h) {
 }
 
 WorkRecord to_record(const WorkCounts& w) {
-    return WorkRecord{w.nodes, w.box_tests, w.tri_tests, w.anyhit_calls, w.transforms};
+    return WorkRecord{w.steps,      w.box_tests,  w.tri_tests,   w.anyhit_calls,
+                      w.transforms, w.cell_steps, w.plane_tests, w.refs};
 }
 
 WorkCounts work_from_record(const WorkRecord& w) {
     WorkCounts c;
-    c.nodes = w.nodes;
+    c.steps = w.steps;
     c.box_tests = w.box_tests;
     c.tri_tests = w.tri_tests;
     c.anyhit_calls = w.anyhit_calls;
     c.transforms = w.transforms;
+    c.cell_steps = w.cell_steps;
+    c.plane_tests = w.plane_tests;
+    c.refs = w.refs;
     return c;
 }
 

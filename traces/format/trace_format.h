@@ -14,20 +14,27 @@
 namespace rtsim {
 
 constexpr char kTraceMagic[8] = {'R', 'T', 'S', 'I', 'M', 'T', 'R', 'C'};
-constexpr uint32_t kTraceVersion = 2;  // 2: HwNode boxes in the per-axis bounds layout
+constexpr uint32_t kTraceVersion = 3;  // 3: acceleration-structure image (ACCL + regions), 32-byte WORK
 
 /// Section kinds (fourcc, little-endian). Never renumber; add new kinds instead.
 enum class SectionKind : uint32_t {
     rays = 0x53594152,       // 'RAYS': RayRecord
     hits = 0x53544948,       // 'HITS': HitRecord
     work = 0x4B524F57,       // 'WORK': WorkRecord
-    bvh_nodes = 0x45444F4E,  // 'NODE': HwNode (64 B)
-    triangles = 0x53495254,  // 'TRIS': HwTriangle (48 B)
+    accel = 0x4C434341,      // 'ACCL': the acceleration structure's descriptor, JSON text (1-byte records)
+    // 'RG00'..'RG99': region i of the acceleration-structure image (record size: its descriptor)
 };
-/// "RAYS", "HITS", ...; "unknown" for a kind this build does not know.
-const char* section_name(SectionKind kind);
-/// Record size a kind must have (RAYS 40, HITS 20, WORK 20, NODE 64, TRIS 48); 0 if unknown.
+/// The section holding region `index` (0..99) of the acceleration-structure image.
+SectionKind region_section(uint32_t index);
+/// True for a region section ('RG00'..'RG99'); *index gets its region index.
+bool is_region_section(SectionKind kind, uint32_t* index = nullptr);
+/// "RAYS", "HITS", ..., "RG03"; "unknown" for a kind this build does not know.
+std::string section_name(SectionKind kind);
+/// Record size a kind must have (RAYS 40, HITS 20, WORK 32, ACCL 1); 0 if it varies (regions)
+/// or the kind is unknown.
 uint32_t section_record_bytes(SectionKind kind);
+/// Regions an image may have (the region sections' two digits).
+constexpr uint32_t kMaxRegionSections = 100;
 
 #pragma pack(push, 1)
 /// One ray of the trace (40 bytes).
@@ -49,18 +56,21 @@ struct HitRecord {
     float u;              // 12
     float v;              // 16
 };
-/// Work the reference traversal did for the ray at the same index (20 bytes).
+/// Work the reference traversal did for the ray at the same index (32 bytes; WorkCounts).
 struct WorkRecord {
-    uint32_t nodes;        //  0
+    uint32_t steps;        //  0: steps that fetched a node or a cell
     uint32_t box_tests;    //  4
     uint32_t tri_tests;    //  8
     uint32_t anyhit_calls; // 12
     uint32_t transforms;   // 16
+    uint32_t cell_steps;   // 20
+    uint32_t plane_tests;  // 24
+    uint32_t refs;         // 28
 };
 #pragma pack(pop)
 static_assert(sizeof(RayRecord) == 40, "RayRecord layout");
 static_assert(sizeof(HitRecord) == 20, "HitRecord layout");
-static_assert(sizeof(WorkRecord) == 20, "WorkRecord layout");
+static_assert(sizeof(WorkRecord) == 32, "WorkRecord layout");
 
 constexpr uint8_t kRayFlagAnyHit = 1u << 0;
 

@@ -1,6 +1,6 @@
 #pragma once
 // The ray/box arithmetic itself, inline so the traversal's hot loop can inline it; ray_box.cpp
-// exposes the same code as the public functions of ray_box.h (one arithmetic, DESIGN rule 1).
+// exposes the same code as the public functions of ray_box.h (one arithmetic, docs/architecture.md, rule 1).
 //
 // Robust slab test of Ize 2013, "Robust BVH Ray Traversal" (JCGT 2(2)):
 //   near/far slab distances (plane - origin) * inv_dir, the plane picked by the sign bit of

@@ -1,6 +1,6 @@
 #pragma once
 // The ray/triangle arithmetic itself, inline so the traversal's hot loop can inline it;
-// ray_triangle.cpp exposes the same code as intersect_triangle() (one arithmetic, DESIGN rule 1).
+// ray_triangle.cpp exposes the same code as intersect_triangle() (one arithmetic, docs/architecture.md, rule 1).
 // Woop, Benthin & Wald 2013, "Watertight Ray/Triangle Intersection", JCGT 2(1), Listing 1,
 // without backface culling. Conventions are in docs/intersection.md; the comments below name
 // the paper's steps.

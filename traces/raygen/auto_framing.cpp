@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "traces/isect/traversal.h"
+#include "traces/accel/accel.h"
 #include "traces/raygen/camera.h"
 
 namespace rtsim {
@@ -28,11 +28,11 @@ std::vector<Vec3> sphere_directions(int n) {
 
 /// Fraction of probe rays from p that hit the front face of some geometry. A room seen from
 /// inside shows its front faces; a closed object probed from its centre shows back faces.
-float enclosure(const Scene& scene, const HwBvh& bvh, const Vec3& p) {
+float enclosure(const Scene& scene, const Accel& accel, const Vec3& p) {
     std::vector<Vec3> dirs = sphere_directions(128);
     int front = 0;
     for (const Vec3& d : dirs) {
-        Hit h = trace_ray(bvh, Ray{p, 0.0f, d, INFINITY}, TraversalMode::closest_hit);
+        Hit h = accel.trace(Ray{p, 0.0f, d, INFINITY}, TraversalMode::closest_hit);
         if (!h.valid()) continue;
         const Triangle& t = scene.triangles[h.prim];
         front += glm::dot(glm::cross(t.v1 - t.v0, t.v2 - t.v0), d) < 0.0f;
@@ -42,14 +42,14 @@ float enclosure(const Scene& scene, const HwBvh& bvh, const Vec3& p) {
 
 /// How good a view from eye along forward is: median free distance over a cone of probes,
 /// zero if the eye sits inside a solid (probes hit back faces).
-float view_score(const Scene& scene, const HwBvh& bvh, const Vec3& eye, const Vec3& target) {
+float view_score(const Scene& scene, const Accel& accel, const Vec3& eye, const Vec3& target) {
     PinholeCamera cam = make_camera(look_at(eye, target, kFovDegrees), 16, 9);
     std::vector<float> dist;
     int back_faces = 0;
     for (uint32_t y = 0; y < 9; ++y)
         for (uint32_t x = 0; x < 16; ++x) {
             Ray r = primary_ray(cam, x, y, 16, 9);
-            Hit h = trace_ray(bvh, r, TraversalMode::closest_hit);
+            Hit h = accel.trace(r, TraversalMode::closest_hit);
             if (!h.valid()) {
                 dist.push_back(1e30f);
                 continue;
@@ -63,7 +63,7 @@ float view_score(const Scene& scene, const HwBvh& bvh, const Vec3& eye, const Ve
     return dist[dist.size() / 2];
 }
 
-Camera frame_interior(const Scene& scene, const HwBvh& bvh, std::ostringstream& why) {
+Camera frame_interior(const Scene& scene, const Accel& accel, std::ostringstream& why) {
     const Aabb& b = scene.bounds;
     Vec3 e = b.extent();
     int axis = e.x >= e.z ? 0 : 2;  // longest horizontal axis (glTF: +Y up)
@@ -78,7 +78,7 @@ Camera frame_interior(const Scene& scene, const HwBvh& bvh, std::ostringstream& 
             Vec3 target = eye;
             target[axis] = b.hi[axis];
             target.y = b.lo.y + 0.35f * e.y;
-            float score = view_score(scene, bvh, eye, target);
+            float score = view_score(scene, accel, eye, target);
             if (score > best_score) {
                 best_score = score;
                 best = look_at(eye, target, kFovDegrees);
@@ -111,14 +111,14 @@ Camera frame_object(const Aabb& b, float aspect) {
 
 }  // namespace
 
-Camera auto_frame(const Scene& scene, const HwBvh& bvh, float aspect, std::string* why) {
+Camera auto_frame(const Scene& scene, const Accel& accel, float aspect, std::string* why) {
     std::ostringstream reason;
     reason << "automatic framing: ";
     const Aabb& b = scene.bounds;
-    float enclosed = enclosure(scene, bvh, b.center());
+    float enclosed = enclosure(scene, accel, b.center());
     Camera cam;
     if (enclosed >= 0.6f) {
-        cam = frame_interior(scene, bvh, reason);
+        cam = frame_interior(scene, accel, reason);
     } else {
         cam = frame_object(b, aspect);
         reason << "object seen from outside";

@@ -1,5 +1,5 @@
 #pragma once
-// Which ray kinds and model features a scene calls for (DESIGN rule 10). The plan records, for
+// Which ray kinds and model features a scene calls for (docs/architecture.md, rule 10). The plan records, for
 // every effect, whether it is simulated and why, in words a user can check against the scene.
 #include <array>
 #include <string>

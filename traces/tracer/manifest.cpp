@@ -33,24 +33,17 @@ json scene_json(const Scene& scene, const std::string& name, bool procedural) {
             {"warnings", scene.warnings}};
 }
 
-json bvh_json(const HwBvh& bvh, const BuildConfig& c) {
-    const BvhStats& s = bvh.stats;
-    return {{"builder", "binned_sah"},
-            {"config",
-             {{"bins", c.bins},
-              {"traversal_cost", c.traversal_cost},
-              {"intersection_cost", c.intersection_cost},
-              {"max_leaf_size", c.max_leaf_size},
-              {"max_depth", c.max_depth}}},
-            {"layout", {{"node_bytes", sizeof(HwNode)}, {"triangle_bytes", sizeof(HwTriangle)}, {"arity", 2}}},
-            {"nodes", s.nodes},
-            {"leaves", s.leaves},
-            {"max_depth", s.max_depth},
-            {"avg_leaf_size", s.avg_leaf_size},
-            {"max_leaf_size", s.max_leaf_size},
-            {"sah_cost", s.sah_cost},
-            {"build_ms", s.build_ms},
-            {"bytes", bvh.nodes.size() * sizeof(HwNode) + bvh.triangles.size() * sizeof(HwTriangle)}};
+json accel_json(const AccelImage& image) {
+    json j = image.stats;
+    j["kind"] = image.kind;
+    j["footprint_bytes"] = image.footprint_bytes();
+    j["build_ms"] = image.build_ms;
+    json regions = json::array();
+    for (const Region& r : image.regions)
+        regions.push_back({{"name", r.name}, {"kind", data_kind_name(r.kind)}, {"record_bytes", r.record_bytes},
+                           {"count", r.count}, {"bytes", r.size_bytes()}});
+    j["regions"] = regions;
+    return j;
 }
 
 json camera_json(const Camera& c, const std::string& source) {
@@ -72,7 +65,7 @@ void RayCounts::add(RayKind kind, uint16_t depth, const Hit& hit, const WorkCoun
     ++k.rays;
     k.hits += hit.valid();
     k.written += written;
-    k.nodes += w.nodes;
+    k.steps += w.steps;
     k.box_tests += w.box_tests;
     k.tri_tests += w.tri_tests;
     k.anyhit_calls += w.anyhit_calls;
@@ -91,7 +84,7 @@ json RayCounts::to_json() const {
                                             {"hits", k.hits},
                                             {"hit_rate", k.hits / n},
                                             {"max_depth", k.max_depth},
-                                            {"nodes_per_ray", k.nodes / n},
+                                            {"steps_per_ray", k.steps / n},
                                             {"box_tests_per_ray", k.box_tests / n},
                                             {"tri_tests_per_ray", k.tri_tests / n},
                                             {"anyhit_calls_per_ray", k.anyhit_calls / n}};

@@ -2,15 +2,15 @@
 // Pieces of the trace manifest (manifest.json), documented in docs/trace_format.md.
 #include <nlohmann/json.hpp>
 
-#include "traces/bvh/config.h"
-#include "traces/bvh/hw_layout.h"
+#include "traces/accel/accel_image.h"
 #include "traces/raygen/workload.h"
 #include "traces/scene/scene.h"
 
 namespace rtsim {
 
 nlohmann::json scene_json(const Scene& scene, const std::string& name, bool procedural);
-nlohmann::json bvh_json(const HwBvh& bvh, const BuildConfig& config);
+/// The structure's kind, build statistics, footprint and regions (manifest "accel").
+nlohmann::json accel_json(const AccelImage& image);
 nlohmann::json camera_json(const Camera& camera, const std::string& source);
 nlohmann::json effects_json(const WorkloadPlan& plan);
 
@@ -24,7 +24,7 @@ public:
 
 private:
     struct KindStats {
-        uint64_t rays = 0, hits = 0, written = 0, nodes = 0, box_tests = 0, tri_tests = 0, anyhit_calls = 0;
+        uint64_t rays = 0, hits = 0, written = 0, steps = 0, box_tests = 0, tri_tests = 0, anyhit_calls = 0;
         uint16_t max_depth = 0;
     };
     KindStats m_kinds[kRayKindCount];

@@ -34,15 +34,15 @@ WorkloadPlan given_rays_plan(const Scene& scene, const std::vector<PendingRay>& 
 
 }  // namespace
 
-json write_ray_trace(const Scene& scene, const SceneLabel& label, const HwBvh& bvh, const BuildConfig& config,
+json write_ray_trace(const Scene& scene, const SceneLabel& label, const Accel& accel,
                      const std::vector<PendingRay>& rays, const RayTraceOptions& o, const ProgressFn& progress) {
     require(!o.out_dir.empty(), "no output folder given");
     require(!rays.empty(), "no rays given: a trace needs at least one ray");
     const auto t_start = std::chrono::steady_clock::now();
     const WorkloadPlan plan = given_rays_plan(scene, rays);
 
-    TraceFolderWriter folder(o.out_dir, bvh);
-    WavefrontResult res = trace_wavefront(bvh, rays, o.threads, [&](uint64_t done) {
+    TraceFolderWriter folder(o.out_dir, accel.image());
+    WavefrontResult res = trace_wavefront(accel, rays, o.threads, [&](uint64_t done) {
         if (progress) progress(done, rays.size(), "trace");
     });
     folder.add_wavefront(plan, rays, res);
@@ -51,7 +51,7 @@ json write_ray_trace(const Scene& scene, const SceneLabel& label, const HwBvh& b
                    {{"requested", "given"},
                     {"source", "rays given by the caller (rtsim.write_trace)"},
                     {"effects", effects_json(plan)}}}};
-    return folder.finish(scene, label, bvh, config, 0.0, t_start, std::move(extra));
+    return folder.finish(scene, label, accel.image(), 0.0, t_start, std::move(extra));
 }
 
 }  // namespace rtsim

@@ -7,8 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "traces/bvh/config.h"
-#include "traces/bvh/hw_layout.h"
+#include "traces/accel/accel.h"
 #include "traces/raygen/secondary.h"
 #include "traces/scene/scene.h"
 #include "traces/tracer/trace_folder.h"
@@ -21,12 +20,12 @@ struct RayTraceOptions {
     unsigned threads = 0;  ///< 0: all hardware threads. Output does not depend on it.
 };
 
-/// Traces `rays` in order (each with its kind, pixel, depth and any-hit flag) through `bvh`, the
-/// BVH built from `scene` with `config`, and writes OUT/trace.rtt and OUT/manifest.json. Every
-/// ray is written, whatever the scene calls for: the manifest's workload says they were given
-/// by the caller, per kind. Throws rtsim::Error if there are no rays.
-nlohmann::json write_ray_trace(const Scene& scene, const SceneLabel& label, const HwBvh& bvh,
-                               const BuildConfig& config, const std::vector<PendingRay>& rays,
-                               const RayTraceOptions& options, const ProgressFn& progress = {});
+/// Traces `rays` in order (each with its kind, pixel, depth and any-hit flag) through `accel`,
+/// a structure built over `scene`, and writes OUT/trace.rtt and OUT/manifest.json. Every ray is
+/// written, whatever the scene calls for: the manifest's workload says they were given by the
+/// caller, per kind. Throws rtsim::Error if there are no rays.
+nlohmann::json write_ray_trace(const Scene& scene, const SceneLabel& label, const Accel& accel,
+                               const std::vector<PendingRay>& rays, const RayTraceOptions& options,
+                               const ProgressFn& progress = {});
 
 }  // namespace rtsim

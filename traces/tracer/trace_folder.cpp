@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -23,12 +24,11 @@ std::string created(const std::string& out_dir) {
 
 }  // namespace
 
-TraceFolderWriter::TraceFolderWriter(const std::string& out_dir, const HwBvh& bvh)
+TraceFolderWriter::TraceFolderWriter(const std::string& out_dir, const AccelImage& image)
     : m_out_dir(created(out_dir)),
       m_writer((fs::path(out_dir) / "trace.rtt").string()),
       m_start(std::chrono::steady_clock::now()) {
-    m_writer.append(SectionKind::bvh_nodes, bvh.nodes);
-    m_writer.append(SectionKind::triangles, bvh.triangles);
+    write_accel_image(m_writer, image);
 }
 
 void TraceFolderWriter::add_wavefront(const WorkloadPlan& plan, const std::vector<PendingRay>& rays,
@@ -51,9 +51,8 @@ void TraceFolderWriter::add_wavefront(const WorkloadPlan& plan, const std::vecto
     m_writer.append(SectionKind::work, work_rec);
 }
 
-json TraceFolderWriter::finish(const Scene& scene, const SceneLabel& label, const HwBvh& bvh,
-                               const BuildConfig& config, double load_ms,
-                               std::chrono::steady_clock::time_point started, json extra) {
+json TraceFolderWriter::finish(const Scene& scene, const SceneLabel& label, const AccelImage& image,
+                               double load_ms, std::chrono::steady_clock::time_point started, json extra) {
     m_writer.close();
     const double trace_ms = ms_since(m_start);
     json files = {{"trace", "trace.rtt"}};
@@ -67,11 +66,11 @@ json TraceFolderWriter::finish(const Scene& scene, const SceneLabel& label, cons
         {"rtsim_version", RTSIM_VERSION},
         {"git", RTSIM_GIT_HASH},
         {"scene", scene_json(scene, label.name, label.procedural)},
-        {"bvh", bvh_json(bvh, config)},
+        {"accel", accel_json(image)},
         {"counts", m_counts.to_json()},
         {"files", files},
         {"timing_ms",
-         {{"load", load_ms}, {"bvh", bvh.stats.build_ms}, {"trace", trace_ms}, {"total", ms_since(started)}}},
+         {{"load", load_ms}, {"accel", image.build_ms}, {"trace", trace_ms}, {"total", ms_since(started)}}},
     };
     manifest.update(extra);
     const std::string path = (fs::path(m_out_dir) / "manifest.json").string();

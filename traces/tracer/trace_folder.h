@@ -2,8 +2,10 @@
 // The write side of a trace folder, shared by every producer of traces (trace_scene for a
 // scene's workload, write_ray_trace for rays a user brings), so a change to the trace format
 // or to the manifest's common keys lands here once:
-//   OUT/trace.rtt      the BVH image, then each traced wavefront's rays, reference hits and work
-//   OUT/manifest.json  format and versions, scene, BVH, counts, files, timing + the producer's keys
+//   OUT/trace.rtt      the acceleration-structure image, then each traced wavefront's rays,
+//                      reference hits and work
+//   OUT/manifest.json  format and versions, scene, structure, counts, files, timing + the
+//                      producer's keys
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -11,8 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "traces/bvh/config.h"
-#include "traces/bvh/hw_layout.h"
+#include "traces/accel/accel_image.h"
 #include "traces/format/trace_writer.h"
 #include "traces/raygen/workload.h"
 #include "traces/scene/scene.h"
@@ -29,8 +30,8 @@ struct SceneLabel {
 
 class TraceFolderWriter {
 public:
-    /// Creates OUT and starts OUT/trace.rtt with the BVH image (nodes, then triangles).
-    TraceFolderWriter(const std::string& out_dir, const HwBvh& bvh);
+    /// Creates OUT and starts OUT/trace.rtt with the structure's image (traces/accel/accel_io.h).
+    TraceFolderWriter(const std::string& out_dir, const AccelImage& image);
 
     /// Appends the rays of a traced wavefront that the plan wants, in order, with their hits and
     /// work; every ray is counted in the manifest's per-kind statistics (written or not).
@@ -41,9 +42,9 @@ public:
     /// "camera", "workload", ...; `files` entries in extra are added to the common ones).
     /// Timing: `load_ms` is the producer's scene loading, `started` when the producer began.
     /// Returns the manifest.
-    nlohmann::json finish(const Scene& scene, const SceneLabel& label, const HwBvh& bvh,
-                          const BuildConfig& config, double load_ms,
-                          std::chrono::steady_clock::time_point started, nlohmann::json extra);
+    nlohmann::json finish(const Scene& scene, const SceneLabel& label, const AccelImage& image,
+                          double load_ms, std::chrono::steady_clock::time_point started,
+                          nlohmann::json extra);
 
     const std::string& out_dir() const { return m_out_dir; }
 

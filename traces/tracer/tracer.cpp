@@ -4,7 +4,6 @@
 #include <chrono>
 #include <filesystem>
 
-#include "traces/bvh/builder.h"
 #include "traces/common/error.h"
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
@@ -25,7 +24,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 /// The camera the user gave, else the scene's first camera, else automatic framing.
-Camera choose_camera(const TraceOptions& o, const Scene& scene, const HwBvh& bvh, std::string* source) {
+Camera choose_camera(const TraceOptions& o, const Scene& scene, const Accel& accel, std::string* source) {
     if (o.camera) {
         *source = "command line";
         return look_at(o.camera->eye, o.camera->target, o.camera->yfov_degrees);
@@ -34,7 +33,7 @@ Camera choose_camera(const TraceOptions& o, const Scene& scene, const HwBvh& bvh
         *source = "glTF camera '" + scene.cameras[0].name + "'";
         return scene.cameras[0];
     }
-    return auto_frame(scene, bvh, float(o.width) / float(o.height), source);
+    return auto_frame(scene, accel, float(o.width) / float(o.height), source);
 }
 
 std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint32_t h) {
@@ -76,6 +75,7 @@ void validate(const TraceOptions& o) {
     if (o.camera)
         require(o.camera->yfov_degrees > 0.0f && o.camera->yfov_degrees < 180.0f,
                 "camera field of view must be in (0, 180) degrees");
+    validate_accel_options(o.accel);
 }
 
 }  // namespace
@@ -95,14 +95,14 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     double load_ms = ms_since(t_start);
     require(scene.triangle_count() > 0, path + ": the scene has no triangles");
 
-    report(0, 1, "bvh");
-    HwBvh bvh = build_bvh(scene, o.bvh);
+    report(0, 1, "accel");
+    const std::unique_ptr<Accel> accel = load_accel(build_accel(scene, o.accel), path + ": built " + o.accel.kind);
     WorkloadPlan plan = plan_workload(scene, o.workload);
     std::string camera_source;
-    Camera camera = choose_camera(o, scene, bvh, &camera_source);
+    Camera camera = choose_camera(o, scene, *accel, &camera_source);
     PinholeCamera pinhole = make_camera(camera, o.width, o.height);
 
-    TraceFolderWriter folder(o.out_dir, bvh);
+    TraceFolderWriter folder(o.out_dir, accel->image());
     uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
     PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
     SpawnContext ctx{&scene, &plan, o.bounces, o.seed};
@@ -110,7 +110,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height);
     for (uint32_t depth = 0; !wave.empty(); ++depth) {
         std::string stage = depth == 0 ? "primary" : "depth " + std::to_string(depth);
-        WavefrontResult res = trace_wavefront(bvh, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
+        WavefrontResult res = trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
         folder.add_wavefront(plan, wave, res);
         render.add(scene, wave, res.hits);
         wave = next_wavefront(ctx, wave, res.hits);
@@ -133,7 +133,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     };
     SceneLabel label{procedural ? o.scene : fs::path(path).stem().string(), procedural};
     render.write_png((fs::path(o.out_dir) / "render.png").string());
-    return folder.finish(scene, label, bvh, o.bvh, load_ms, t_start, std::move(extra));
+    return folder.finish(scene, label, accel->image(), load_ms, t_start, std::move(extra));
 }
 
 }  // namespace rtsim

@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "traces/bvh/config.h"
+#include "traces/accel/accel.h"
 #include "traces/common/ray.h"
 #include "traces/scene/procedural.h"
 
@@ -36,7 +36,7 @@ struct TraceOptions {
     uint32_t bounces = 1;  ///< diffuse bounce depth (and reflection/refraction depth)
     uint64_t seed = 1;
     std::optional<CameraOverride> camera;
-    BuildConfig bvh;
+    AccelOptions accel;  ///< which acceleration structure and builder (docs/accel.md)
     ProceduralOptions procedural;
     unsigned threads = 0;  ///< 0: all hardware threads. Output does not depend on it.
 };

@@ -5,7 +5,7 @@
 #include <functional>
 #include <vector>
 
-#include "traces/bvh/hw_layout.h"
+#include "traces/accel/accel.h"
 #include "traces/raygen/secondary.h"
 
 namespace rtsim {
@@ -17,7 +17,7 @@ struct WavefrontResult {
 };
 
 /// progress(done) is called from the calling thread only.
-WavefrontResult trace_wavefront(const HwBvh& bvh, const std::vector<PendingRay>& rays, unsigned threads,
+WavefrontResult trace_wavefront(const Accel& accel, const std::vector<PendingRay>& rays, unsigned threads,
                                 const std::function<void(uint64_t)>& progress);
 
 }  // namespace rtsim

@@ -1,8 +1,8 @@
 """What a Dask worker runs: make one trace (`rtsim trace` as a subprocess) or one simulation
-(`rtsim-sim` through rtsim/launcher.py, DESIGN rule 4). Both never raise: every failure, crash
-or timeout comes back as a dict with status "failed" and the tail of the process's stderr, so the
-client records it and the sweep goes on. Paths are absolute: with --scheduler the workers must
-see the sweep folder at the same path (a shared file system).
+(`rtsim-sim` through rtsim/launcher.py; docs/architecture.md, rule 4). Both never raise: every
+failure, crash or timeout comes back as a dict with status "failed" and the tail of the process's
+stderr, so the client records it and the sweep goes on. Paths are absolute: with --scheduler the
+workers must see the sweep folder at the same path (a shared file system).
 """
 
 from __future__ import annotations

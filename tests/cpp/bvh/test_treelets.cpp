@@ -1,12 +1,13 @@
-// Treelet partitioning (Aila & Karras 2010): every node in exactly one treelet, budgets kept,
-// deterministic, fewer treelets for bigger budgets, broken partitions caught.
+// Treelet partitioning of tree structures (Aila & Karras 2010; traces/accel/locality.h) on the
+// binary BVH: every node in exactly one treelet, budgets kept, deterministic, fewer treelets for
+// bigger budgets, broken partitions caught.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
 #include "bvh_test_scenes.h"
 #include "traces/bvh/builder.h"
-#include "traces/bvh/treelets.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/common/error.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
@@ -19,6 +20,14 @@ HwBvh random_bvh(size_t triangles, uint64_t seed) {
     return build_bvh(test::make_scene(test::random_triangles(triangles, seed)));
 }
 
+LocalityTree tree_of(const HwBvh& bvh) { return bvh2_locality_tree(bvh.nodes.data(), bvh.nodes.size()); }
+
+LocalityPartition partition_treelets(const HwBvh& bvh, uint64_t budget) {
+    return partition_tree(tree_of(bvh), budget);
+}
+
+void check_treelet_partition(const HwBvh& bvh, const LocalityPartition& p) { check_tree_partition(tree_of(bvh), p); }
+
 }  // namespace
 
 TEST(Treelets, PartitionInvariantsOverBudgetsAndScenes) {
@@ -26,8 +35,8 @@ TEST(Treelets, PartitionInvariantsOverBudgetsAndScenes) {
         HwBvh bvh = random_bvh(n, 11 + n);
         for (uint32_t budget : {64u, 256u, 1024u, 16384u, 1u << 20}) {
             SCOPED_TRACE(std::to_string(n) + " triangles, budget " + std::to_string(budget));
-            TreeletPartition p = partition_treelets(bvh.nodes, budget);
-            EXPECT_NO_THROW(check_treelet_partition(bvh.nodes, p));
+            LocalityPartition p = partition_treelets(bvh, budget);
+            EXPECT_NO_THROW(check_treelet_partition(bvh, p));
             uint64_t bytes = 0, nodes = 0;
             for (const TreeletInfo& t : p.treelets) {
                 EXPECT_GT(t.nodes, 0u);
@@ -36,10 +45,10 @@ TEST(Treelets, PartitionInvariantsOverBudgetsAndScenes) {
                 nodes += t.nodes;
             }
             EXPECT_EQ(nodes, bvh.nodes.size());  // every node exactly once
-            uint64_t all = 0;
-            for (const HwNode& node : bvh.nodes) all += node_footprint(node);
-            EXPECT_EQ(bytes, all);
-            EXPECT_EQ(p.node_treelet[0], 0u);  // the root's treelet comes first
+            // Every node and triangle byte is in some treelet, once.
+            EXPECT_EQ(bytes, bvh.nodes.size() * sizeof(HwNode) + bvh.triangles.size() * sizeof(HwTriangle));
+            EXPECT_EQ(p.group_of[0], 0u);  // the root's treelet comes first
+            EXPECT_EQ(p.root_group, 0u);
         }
     }
 }
@@ -51,9 +60,9 @@ TEST(Treelets, ProceduralScenesAndDeterminism) {
     for (const std::string& name : procedural_scene_names()) {
         SCOPED_TRACE(name);
         HwBvh bvh = build_bvh(load_gltf(write_procedural_scene(name, dir, options)));
-        TreeletPartition a = partition_treelets(bvh.nodes, 8192), b = partition_treelets(bvh.nodes, 8192);
-        EXPECT_EQ(a.node_treelet, b.node_treelet);
-        check_treelet_partition(bvh.nodes, a);
+        LocalityPartition a = partition_treelets(bvh, 8192), b = partition_treelets(bvh, 8192);
+        EXPECT_EQ(a.group_of, b.group_of);
+        check_treelet_partition(bvh, a);
     }
 }
 
@@ -61,7 +70,7 @@ TEST(Treelets, BiggerBudgetsMakeFewerFullerTreelets) {
     HwBvh bvh = random_bvh(100000, 5);
     size_t previous = SIZE_MAX;
     for (uint32_t kib : {4u, 16u, 64u, 256u}) {
-        TreeletPartition p = partition_treelets(bvh.nodes, kib * 1024);
+        LocalityPartition p = partition_treelets(bvh, kib * 1024);
         EXPECT_LT(p.treelets.size(), previous) << kib;
         previous = p.treelets.size();
         // Packing keeps treelets reasonably full: on average at least half the budget.
@@ -73,16 +82,16 @@ TEST(Treelets, BiggerBudgetsMakeFewerFullerTreelets) {
 
 TEST(Treelets, BrokenPartitionsAreCaught) {
     HwBvh bvh = random_bvh(5000, 9);
-    TreeletPartition p = partition_treelets(bvh.nodes, 2048);
+    LocalityPartition p = partition_treelets(bvh, 2048);
     ASSERT_GT(p.treelets.size(), 3u);
-    TreeletPartition unassigned = p;
-    unassigned.node_treelet[10] = 0xFFFFFFFFu;
-    EXPECT_THROW(check_treelet_partition(bvh.nodes, unassigned), Error);
-    TreeletPartition moved = p;
-    moved.node_treelet[bvh.nodes.size() - 1] = (moved.node_treelet.back() + 1) % uint32_t(p.treelets.size());
-    EXPECT_THROW(check_treelet_partition(bvh.nodes, moved), Error);
-    TreeletPartition over = p;
+    LocalityPartition unassigned = p;
+    unassigned.group_of[10] = 0xFFFFFFFFu;
+    EXPECT_THROW(check_treelet_partition(bvh, unassigned), Error);
+    LocalityPartition moved = p;
+    moved.group_of[bvh.nodes.size() - 1] = (moved.group_of.back() + 1) % uint32_t(p.treelets.size());
+    EXPECT_THROW(check_treelet_partition(bvh, moved), Error);
+    LocalityPartition over = p;
     over.budget_bytes = 64;
-    EXPECT_THROW(check_treelet_partition(bvh.nodes, over), Error);
-    EXPECT_THROW(partition_treelets(bvh.nodes, 32), Error);
+    EXPECT_THROW(check_treelet_partition(bvh, over), Error);
+    EXPECT_THROW(load_accel(bvh2_image(bvh, BuildConfig{}, "binned"))->partition(32), Error);
 }

@@ -28,7 +28,7 @@
 #include "embree_oracle.h"
 #include "traces/bvh/hw_layout.h"
 #include "traces/isect/ray_triangle.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 
 namespace rtsim::oracle {
 

@@ -76,7 +76,7 @@ inline HitRecord hit_at(uint64_t i) {
     return HitRecord{int32_t(i % 11) - 1, int32_t(i / 3), float(i) * 0.25f, 0.125f, float(i % 8) / 8.0f};
 }
 inline WorkRecord work_at(uint64_t i) {
-    return WorkRecord{uint32_t(i), uint32_t(2 * i), uint32_t(i % 17), uint32_t(i % 2), 0};
+    return WorkRecord{uint32_t(i), uint32_t(2 * i), uint32_t(i % 17), uint32_t(i % 2), 0, uint32_t(i % 5), 0, uint32_t(i % 3)};
 }
 
 }  // namespace rtsim::test

@@ -154,7 +154,8 @@ TEST_F(CorruptionTest, WrongVersionAndForeignFilesAreRefused) {
     tl::FileHeader h = m_header;
     h.version = kTraceVersion + 1;
     tl::encode_header(h, b.data());
-    EXPECT_EQ(open_error(b), m_bad + ": trace version 3 is not supported by this build (reads version 2)");
+    EXPECT_EQ(open_error(b), m_bad + ": trace version " + std::to_string(kTraceVersion + 1) +
+                                  " is not supported by this build (reads version " + std::to_string(kTraceVersion) + ")");
 
     const std::string text = "This is a text file, long enough to fill a whole trace header, honestly.\n";
     EXPECT_EQ(open_error(std::vector<uint8_t>(text.begin(), text.end())),

@@ -74,7 +74,7 @@ TEST(TraceLarge, MillionsOfRecordsStreamWithBoundedMemory) {
     }
     const double read_s = seconds_since(t1);
     EXPECT_EQ(mismatches, 0u);
-    EXPECT_EQ(work[(kRays - 1) % kPiece].nodes, kRays - 1);
+    EXPECT_EQ(work[(kRays - 1) % kPiece].steps, kRays - 1);
 
     const double rss_growth = peak_rss_mib() - rss0;
     std::printf("[ trace    ] %.0f MiB: write %.0f MiB/s (incl. close+fsync), read+verify %.0f MiB/s, "

@@ -30,11 +30,14 @@ TEST(TraceRecords, OffsetsMatchTheDocumentedLayout) {
     EXPECT_EQ(offsetof(HitRecord, t), 8u);
     EXPECT_EQ(offsetof(HitRecord, u), 12u);
     EXPECT_EQ(offsetof(HitRecord, v), 16u);
-    EXPECT_EQ(offsetof(WorkRecord, nodes), 0u);
+    EXPECT_EQ(offsetof(WorkRecord, steps), 0u);
     EXPECT_EQ(offsetof(WorkRecord, box_tests), 4u);
     EXPECT_EQ(offsetof(WorkRecord, tri_tests), 8u);
     EXPECT_EQ(offsetof(WorkRecord, anyhit_calls), 12u);
     EXPECT_EQ(offsetof(WorkRecord, transforms), 16u);
+    EXPECT_EQ(offsetof(WorkRecord, cell_steps), 20u);
+    EXPECT_EQ(offsetof(WorkRecord, plane_tests), 24u);
+    EXPECT_EQ(offsetof(WorkRecord, refs), 28u);
     EXPECT_EQ(offsetof(HwNode, bounds), 0u);
     EXPECT_EQ(sizeof(HwNode::bounds), 48u);
     EXPECT_EQ(offsetof(HwNode, child_ref), 48u);
@@ -45,14 +48,21 @@ TEST(TraceRecords, OffsetsMatchTheDocumentedLayout) {
 }
 
 TEST(TraceRecords, SectionNamesAndSizes) {
-    EXPECT_STREQ(section_name(SectionKind::rays), "RAYS");
-    EXPECT_STREQ(section_name(SectionKind::triangles), "TRIS");
-    EXPECT_STREQ(section_name(SectionKind(0x12345678)), "unknown");
+    EXPECT_EQ(section_name(SectionKind::rays), "RAYS");
+    EXPECT_EQ(section_name(SectionKind::accel), "ACCL");
+    EXPECT_EQ(section_name(region_section(7)), "RG07");
+    EXPECT_EQ(section_name(region_section(42)), "RG42");
+    EXPECT_EQ(section_name(SectionKind(0x12345678)), "unknown");
     // The fourcc value spells the name in file byte order.
-    const auto kind = static_cast<uint32_t>(SectionKind::bvh_nodes);
-    EXPECT_EQ(std::memcmp(&kind, "NODE", 4), 0);
+    const auto kind = static_cast<uint32_t>(region_section(13));
+    EXPECT_EQ(std::memcmp(&kind, "RG13", 4), 0);
+    uint32_t index = 0;
+    EXPECT_TRUE(is_region_section(region_section(13), &index));
+    EXPECT_EQ(index, 13u);
+    EXPECT_FALSE(is_region_section(SectionKind::rays));
     EXPECT_EQ(section_record_bytes(SectionKind::rays), 40u);
-    EXPECT_EQ(section_record_bytes(SectionKind::bvh_nodes), 64u);
+    EXPECT_EQ(section_record_bytes(SectionKind::work), 32u);
+    EXPECT_EQ(section_record_bytes(region_section(0)), 0u);  // regions: size from the descriptor
     EXPECT_EQ(section_record_bytes(SectionKind(0x12345678)), 0u);
 }
 
@@ -81,13 +91,17 @@ TEST(TraceRecords, ConversionsRoundTrip) {
     EXPECT_EQ(hb.t, 2.5f);
     EXPECT_EQ(hb.u, 0.25f);
     EXPECT_EQ(hb.v, 0.5f);
-    const WorkCounts w{10, 20, 30, 4, 5};
+    const WorkCounts w{10, 20, 30, 4, 5, 6, 7, 8};
     const WorkCounts wb = work_from_record(to_record(w));
-    EXPECT_EQ(wb.nodes, 10u);
+    EXPECT_EQ(wb.steps, 10u);
     EXPECT_EQ(wb.box_tests, 20u);
     EXPECT_EQ(wb.tri_tests, 30u);
     EXPECT_EQ(wb.anyhit_calls, 4u);
     EXPECT_EQ(wb.transforms, 5u);
+    EXPECT_EQ(wb.cell_steps, 6u);
+    EXPECT_EQ(wb.plane_tests, 7u);
+    EXPECT_EQ(wb.refs, 8u);
+    EXPECT_EQ(wb, w);
 }
 
 /// Byte-exact equality of two record vectors.
@@ -125,14 +139,14 @@ TEST(TraceRoundTrip, InterleavedAppendsOfAllKindsAcrossManyChunks) {
                 node.child_ref[0] = uint32_t(step);
                 node.lo(1, 2) = float(step);
                 nodes.push_back(node);
-                writer.append(SectionKind::bvh_nodes, std::vector<HwNode>{node});
+                writer.append(region_section(0), std::vector<HwNode>{node});
             }
             writer.append(SectionKind::hits, h);
             HwTriangle tri{};
             tri.prim = uint32_t(step);
             tri.v2[1] = -float(step);
             tris.push_back(tri);
-            writer.append(SectionKind::triangles, &tri, 1, sizeof tri);
+            writer.append(region_section(1), &tri, 1, sizeof tri);
             writer.append(SectionKind::work, w);
             rays.insert(rays.end(), r.begin(), r.end());
             hits.insert(hits.end(), h.begin(), h.end());
@@ -146,7 +160,7 @@ TEST(TraceRoundTrip, InterleavedAppendsOfAllKindsAcrossManyChunks) {
     EXPECT_EQ(reader.version(), kTraceVersion);
     ASSERT_EQ(reader.sections().size(), 5u);
     EXPECT_EQ(reader.sections()[0].kind, SectionKind::rays);  // order of first append
-    EXPECT_EQ(reader.sections()[1].kind, SectionKind::bvh_nodes);
+    EXPECT_EQ(reader.sections()[1].kind, region_section(0));
     const std::vector<uint8_t> file = test::read_bytes(path);
     for (const SectionInfo& s : reader.sections()) {
         EXPECT_EQ(s.offset % 64, 0u);
@@ -158,8 +172,8 @@ TEST(TraceRoundTrip, InterleavedAppendsOfAllKindsAcrossManyChunks) {
     EXPECT_TRUE(same_bytes(reader.read_all<RayRecord>(SectionKind::rays), rays));
     EXPECT_TRUE(same_bytes(reader.read_all<HitRecord>(SectionKind::hits), hits));
     EXPECT_TRUE(same_bytes(reader.read_all<WorkRecord>(SectionKind::work), work));
-    EXPECT_TRUE(same_bytes(reader.read_all<HwNode>(SectionKind::bvh_nodes), nodes));
-    EXPECT_TRUE(same_bytes(reader.read_all<HwTriangle>(SectionKind::triangles), tris));
+    EXPECT_TRUE(same_bytes(reader.read_all<HwNode>(region_section(0)), nodes));
+    EXPECT_TRUE(same_bytes(reader.read_all<HwTriangle>(region_section(1)), tris));
     // The payload is the records verbatim at the section's offset (what np.memmap relies on).
     const SectionInfo& rs = reader.section(SectionKind::rays);
     EXPECT_EQ(std::memcmp(file.data() + rs.offset, rays.data(), rs.bytes), 0);

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "isect_test_util.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
 
@@ -52,11 +52,10 @@ Ray random_ray(Rng& rng, const HwBvh& bvh, const Aabb& bounds) {
         test::float_bits(a.v) != test::float_bits(b.v))
         return ::testing::AssertionFailure() << "hit: fused prim " << a.prim << " t " << a.t
                                              << ", stepper prim " << b.prim << " t " << b.t;
-    if (wa.nodes != wb.nodes || wa.box_tests != wb.box_tests || wa.tri_tests != wb.tri_tests ||
-        wa.anyhit_calls != wb.anyhit_calls || wa.transforms != wb.transforms)
+    if (wa != wb)
         return ::testing::AssertionFailure()
-               << "work: fused nodes " << wa.nodes << " tris " << wa.tri_tests << " anyhit "
-               << wa.anyhit_calls << ", stepper nodes " << wb.nodes << " tris " << wb.tri_tests
+               << "work: fused steps " << wa.steps << " tris " << wa.tri_tests << " anyhit "
+               << wa.anyhit_calls << ", stepper steps " << wb.steps << " tris " << wb.tri_tests
                << " anyhit " << wb.anyhit_calls;
     return ::testing::AssertionSuccess();
 }

@@ -7,7 +7,7 @@
 
 #include "isect_test_util.h"
 #include "traces/common/error.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 
 namespace rtsim {
 namespace {
@@ -60,13 +60,14 @@ TEST(Traversal, InvalidRaysAreDoneAtOnceWithZeroWork) {
                        make_ray(Vec3(0), Vec3(0, 0, 1), 0.0f, nan), make_ray(Vec3(0), Vec3(nan, 0, 1))};
     for (const Ray& r : bad) {
         EXPECT_FALSE(ray_is_valid(r));
-        Traversal tr;
+        Bvh2Stepper tr(bvh2_view(bvh));
         tr.begin(r, TraversalMode::closest_hit);
-        EXPECT_EQ(tr.step(), Traversal::Step::done);
+        EXPECT_TRUE(tr.done());
+        EXPECT_EQ(tr.plan().fetch_count, 0);
         WorkCounts w;
         const Hit h = trace_ray(bvh, r, TraversalMode::closest_hit, &w);
         EXPECT_FALSE(h.valid());
-        EXPECT_EQ(w.nodes + w.box_tests + w.tri_tests + w.anyhit_calls, 0u);
+        EXPECT_EQ(w, WorkCounts{});
         EXPECT_FALSE(trace_ray_brute_force(bvh, r, TraversalMode::closest_hit).valid());
     }
 }
@@ -74,22 +75,37 @@ TEST(Traversal, InvalidRaysAreDoneAtOnceWithZeroWork) {
 TEST(Traversal, StepsAndWorkOnAHandMadeTree) {
     const HwBvh bvh = two_leaf_bvh();
     // Through both leaves' boxes: x = 0 lies on both boxes' shared face.
-    Traversal tr;
+    Bvh2View view = bvh2_view(bvh);
+    view.node_base = 0x1000;
+    view.triangle_base = 0x8000;
+    Bvh2Stepper tr(view);
     tr.begin(make_ray(Vec3(0, 0, 0), Vec3(0, 0, 1)), TraversalMode::closest_hit);
-    ASSERT_EQ(tr.step(), Traversal::Step::node);
-    EXPECT_EQ(tr.node_index(), 0u);
-    tr.visit_node(bvh.nodes[0]);
+    // The root: one 64-byte node fetch at its address, two box tests, locality key node 0.
+    ASSERT_FALSE(tr.done());
+    ASSERT_EQ(tr.plan().fetch_count, 1);
+    EXPECT_EQ(tr.plan().fetch[0].addr, 0x1000u);
+    EXPECT_EQ(tr.plan().fetch[0].bytes, 64u);
+    EXPECT_EQ(tr.plan().fetch[0].kind, DataKind::node);
+    ASSERT_EQ(tr.plan().op_count, 1);
+    EXPECT_EQ(tr.plan().op[0].kind, OpKind::box);
+    EXPECT_EQ(tr.plan().op[0].count, 2u);
+    EXPECT_EQ(tr.plan().locality, 0u);
+    EXPECT_EQ(tr.execute().op_count, 0);
     // Leaf 1 (entry 3) is nearer than leaf 0 (entry 5): it goes first, leaf 0 is pushed.
-    ASSERT_EQ(tr.step(), Traversal::Step::leaf);
-    EXPECT_EQ(tr.leaf_first(), 2u);
-    EXPECT_EQ(tr.leaf_count(), 1u);
+    ASSERT_FALSE(tr.done());
+    EXPECT_EQ(tr.plan().fetch[0].addr, 0x8000u + 2 * 48);
+    EXPECT_EQ(tr.plan().fetch[0].bytes, 48u);
+    EXPECT_EQ(tr.plan().fetch[0].kind, DataKind::triangle);
+    EXPECT_EQ(tr.plan().op[0].kind, OpKind::triangle);
+    EXPECT_EQ(tr.plan().op[0].count, 1u);
+    EXPECT_EQ(tr.plan().locality, kNoLocality);  // a leaf stays in its node's treelet
     EXPECT_EQ(tr.stack_size(), 1);
-    tr.visit_leaf(&bvh.triangles[2]);
+    tr.execute();
     // Triangle 2 hit at t = 3 (on its edge x = 0): leaf 0 (tnear 5) is skipped, no fetch.
-    ASSERT_EQ(tr.step(), Traversal::Step::done);
+    ASSERT_TRUE(tr.done());
     EXPECT_EQ(tr.hit().prim, 2);
     EXPECT_EQ(tr.hit().t, 3.0f);
-    EXPECT_EQ(tr.work().nodes, 1u);
+    EXPECT_EQ(tr.work().steps, 1u);
     EXPECT_EQ(tr.work().box_tests, 2u);
     EXPECT_EQ(tr.work().tri_tests, 1u);
 
@@ -98,11 +114,11 @@ TEST(Traversal, StepsAndWorkOnAHandMadeTree) {
     const Hit h = trace_ray(bvh, make_ray(Vec3(-1, 0, 0), Vec3(0, 0, 1)), TraversalMode::closest_hit, &w);
     EXPECT_EQ(h.prim, 0);
     EXPECT_EQ(h.t, 5.0f);
-    EXPECT_EQ(w.nodes, 1u);
+    EXPECT_EQ(w.steps, 1u);
     EXPECT_EQ(w.tri_tests, 2u);
     // A miss of both boxes: one node visit, no triangle test.
     EXPECT_FALSE(trace_ray(bvh, make_ray(Vec3(5, 0, 0), Vec3(0, 0, 1)), TraversalMode::closest_hit, &w).valid());
-    EXPECT_EQ(w.nodes, 1u);
+    EXPECT_EQ(w.steps, 1u);
     EXPECT_EQ(w.tri_tests, 0u);
     // tmax before leaf 0's box: leaf 0 is never entered.
     EXPECT_FALSE(trace_ray(bvh, make_ray(Vec3(-1, 0, 0), Vec3(0, 0, 1), 0.0f, 4.9f), TraversalMode::closest_hit, &w).valid());
@@ -120,9 +136,9 @@ TEST(Traversal, EmptySlotAndEmptyScene) {
     WorkCounts w;
     EXPECT_EQ(trace_ray(bvh, make_ray(Vec3(0), Vec3(0, 0, 1)), TraversalMode::closest_hit, &w).prim, 0);
     EXPECT_EQ(w.tri_tests, 1u);
-    EXPECT_EQ(w.nodes, 1u);
+    EXPECT_EQ(w.steps, 1u);
     EXPECT_FALSE(trace_ray(HwBvh{}, make_ray(Vec3(0), Vec3(0, 0, 1)), TraversalMode::closest_hit, &w).valid());
-    EXPECT_EQ(w.nodes, 0u);
+    EXPECT_EQ(w.steps, 0u);
 }
 
 TEST(Traversal, CoincidentTrianglesGiveTheSmallerPrim) {

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "isect_test_util.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 
 namespace rtsim {
 namespace {
@@ -109,22 +109,19 @@ TEST(TraversalVsBruteForce, SteppingByHandEqualsTraceRay) {
     for (int i = 0; i < 5000; ++i) {
         const Ray r = random_ray(rng);
         for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
-            Traversal tr;
+            Bvh2Stepper tr(bvh2_view(bvh));
             tr.begin(r, mode);
             int max_stack = 0;
-            while (tr.step() != Traversal::Step::done) {
-                if (tr.step() == Traversal::Step::node)
-                    tr.visit_node(bvh.nodes.at(tr.node_index()));
-                else
-                    tr.visit_leaf(&bvh.triangles.at(tr.leaf_first()));
+            while (!tr.done()) {
+                tr.execute();
                 max_stack = std::max(max_stack, tr.stack_size());
             }
             WorkCounts w;
             const Hit h = trace_ray(bvh, r, mode, &w);
             ASSERT_EQ(h.prim, tr.hit().prim);
             ASSERT_EQ(test::float_bits(h.t), test::float_bits(tr.hit().t));
-            ASSERT_EQ(w.nodes, tr.work().nodes);
-            ASSERT_EQ(w.box_tests, 2 * w.nodes);
+            ASSERT_EQ(w.steps, tr.work().steps);
+            ASSERT_EQ(w.box_tests, 2 * w.steps);
             ASSERT_EQ(w.tri_tests, tr.work().tri_tests);
             ASSERT_EQ(w.anyhit_calls, tr.work().anyhit_calls);
             ASSERT_LE(max_stack, int(bvh.stats.max_depth) + 1);

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "isect_test_util.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 
 namespace rtsim {
 namespace {

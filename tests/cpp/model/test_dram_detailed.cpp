@@ -23,7 +23,7 @@ DramConfig small(const char* policy = "open") {
     c.interleave_bytes = 256;
     c.banks = 2;
     c.row_bytes = 1024;
-    c.page_policy = policy;
+    EXPECT_TRUE(kPagePolicyChoices.parse(policy, &c.page_policy));
     c.t_rcd = 10;
     c.t_rp = 8;
     c.t_cas = 6;

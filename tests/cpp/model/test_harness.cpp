@@ -77,7 +77,7 @@ public:
         for (uint64_t i = 0; i < n; ++i) {
             rays[i] = RayRecord{};
             hits[i] = HitRecord{int32_t(i), -1, float(i), 0.0f, 0.0f};
-            work[i] = WorkRecord{uint32_t(i), uint32_t(2 * i), 0, 0, 0};
+            work[i] = WorkRecord{uint32_t(i), uint32_t(2 * i), 0, 0, 0, 0, 0, 0};
         }
         TraceWriter w(m_path, 64);
         w.append(SectionKind::rays, rays);
@@ -151,7 +151,7 @@ TEST(HitChecker, ComparesPrimitiveTheBitsOfTAndWork) {
     r.hit.t = 2.5f;
     r.work = WorkCounts{3, 6, 4, 0, 0};
     HitRecord ref{5, -1, 2.5f, 0.1f, 0.2f};
-    WorkRecord work{3, 6, 4, 0, 0};
+    WorkRecord work{3, 6, 4, 0, 0, 0, 0, 0};
     bool hit_differs = true;
     EXPECT_EQ(compare_with_reference(r, ref, work, &hit_differs), "");
     EXPECT_FALSE(hit_differs);

@@ -17,7 +17,7 @@ PipelineConfig config(uint32_t latency, uint32_t ii, uint32_t width, uint32_t sh
     c.latency = latency;
     c.initiation_interval = ii;
     c.width = width;
-    c.sharing = "private";
+    c.sharing = Sharing::per_unit;
     c.shared_count = shared_count;
     return c;
 }

@@ -7,6 +7,8 @@
 
 #include "model_test_util.h"
 #include "rtl_model/ray_buffer/ray_buffer.h"
+#include "traces/accel/bvh2/bvh2.h"
+#include "traces/bvh/builder.h"
 
 using namespace rtsim;
 
@@ -29,42 +31,60 @@ private:
 };
 
 /// A partition of `treelets` treelets, one node each (node i in treelet i; node 0 is the root).
-TreeletPartition partition_of(uint32_t treelets) {
-    TreeletPartition p;
+LocalityPartition partition_of(uint32_t treelets) {
+    LocalityPartition p;
     p.budget_bytes = 64;
     for (uint32_t i = 0; i < treelets; ++i) {
-        p.node_treelet.push_back(i);
+        p.group_of.push_back(i);
         p.treelets.push_back(TreeletInfo{i, 1, 64, i ? 1u : 0u});
     }
     return p;
 }
 
+/// A one-triangle binary BVH: its steppers start every ray at node 0 (treelet 0).
+std::unique_ptr<Accel> tiny_accel() {
+    Scene scene;
+    scene.triangles.push_back(Triangle{Vec3(0, 0, 5), Vec3(1, 0, 5), Vec3(0, 1, 5)});
+    scene.materials.emplace_back();
+    scene.tri_material.push_back(0);
+    scene.tri_instance.push_back(0);
+    return load_accel(bvh2_image(build_bvh(scene), BuildConfig{}, "binned"));
+}
+
+constexpr uint32_t kUnits = 2, kContexts = 16;
+
 struct Bench {
-    Bench(const SimConfig& c, uint64_t rays, uint32_t treelets, const std::string& tag)
+    Bench(const TreeletConfig& c, uint64_t rays, uint32_t treelets, const std::string& tag)
         : config(c),
           partition(partition_of(treelets)),
+          accel(tiny_accel()),
+          map(accel->image().end_address(), rays, rays, 64, 8),
+          steppers(*accel),
           dispatch(("dispatch_" + tag).c_str(), rays),
           memory(("memory_" + tag).c_str(), 100),
-          buffer(("ray_buffer_" + tag).c_str(), config, partition) {
+          buffer(("ray_buffer_" + tag).c_str(), config, partition, map, steppers, kUnits, kContexts,
+                 ray_state_bytes(8, 8)) {
         buffer.rays(dispatch);
         buffer.mem(memory);
         kernel_elaborate();
     }
     void kernel_elaborate() { sc_core::sc_get_curr_simcontext()->elaborate(); }
-    SimConfig config;  ///< the buffer keeps a reference, as to Top's config
-    TreeletPartition partition;
+    TreeletConfig config;  ///< the buffer keeps a reference, as to Top's config
+    LocalityPartition partition;
+    std::unique_ptr<Accel> accel;
+    MemoryMap map;
+    StepperPool steppers;
     FakeDispatch dispatch;
     test::FakeMemory memory;
     RayBuffer buffer;
 };
 
-SimConfig config_with(uint32_t buffer_kib, const std::string& policy, uint32_t threshold) {
-    SimConfig c;
-    c.traversal.units = 2;
-    c.treelets.enabled = true;
-    c.treelets.buffer_kib = buffer_kib;
-    c.treelets.policy = policy;
-    c.treelets.threshold = threshold;
+TreeletConfig config_with(uint32_t buffer_kib, const std::string& policy, uint32_t threshold) {
+    TreeletConfig c;
+    c.enabled = true;
+    c.buffer_kib = buffer_kib;
+    EXPECT_TRUE(kTreeletPolicyChoices.parse(policy.c_str(), &c.policy));
+    c.threshold = threshold;
     return c;
 }
 
@@ -72,7 +92,7 @@ SimConfig config_with(uint32_t buffer_kib, const std::string& policy, uint32_t t
 
 TEST(RayBuffer, AdmitsUpToCapacityAndOverflowsParkedRays) {
     test::TestKernel kernel;
-    SimConfig c = config_with(1, "largest", 1);  // 1 KiB: 8 rays of 120 bytes
+    TreeletConfig c = config_with(1, "largest", 1);  // 1 KiB: 8 rays of 120 bytes
     Bench b(c, 100, 4, "overflow");
     ASSERT_EQ(b.buffer.capacity_rays(), 1024u / 120u);
     const uint64_t capacity = b.buffer.capacity_rays();
@@ -92,7 +112,7 @@ TEST(RayBuffer, AdmitsUpToCapacityAndOverflowsParkedRays) {
     ASSERT_TRUE(b.buffer.take(0, 20, &ray, &treelet, &ready));
     EXPECT_EQ(ray.ray_id, capacity);
     // Parking the held rays: one fits, the others overflow to memory as ray_buffer writes.
-    for (RayState& r : held) b.buffer.park(2, r, 30);
+    for (RayState& r : held) b.buffer.park(2, std::move(r), 30);
     size_t overflow_writes = 0;
     for (const MemRequest& r : b.memory.requests) overflow_writes += r.write && r.kind == DataKind::ray_buffer;
     EXPECT_EQ(overflow_writes, capacity - 1);
@@ -117,7 +137,7 @@ TEST(RayBuffer, EveryRayIsHandedOutExactlyOnceUnderEveryPolicy) {
                 if (!b.buffer.take(guard % 2, now, &ray, &treelet, &ready)) continue;
                 ++takes[ray.ray_id];
                 if (treelet == 0) {
-                    b.buffer.park(1 + ray.ray_id % 5, ray, now + 1);
+                    b.buffer.park(1 + ray.ray_id % 5, std::move(ray), now + 1);
                 } else {
                     EXPECT_TRUE(finished.insert(ray.ray_id).second) << "ray " << ray.ray_id << " finished twice";
                     b.buffer.finished(now + 1);
@@ -143,7 +163,7 @@ TEST(RayBuffer, LargestPolicyRunsTheLongestQueue) {
         rays.push_back(std::move(ray));
     }
     // 2 rays to treelet 1, 5 to treelet 2, 3 to treelet 3.
-    for (int i = 0; i < 10; ++i) b.buffer.park(i < 2 ? 1 : i < 7 ? 2 : 3, rays[i], 5);
+    for (int i = 0; i < 10; ++i) b.buffer.park(i < 2 ? 1 : i < 7 ? 2 : 3, std::move(rays[i]), 5);
     ASSERT_TRUE(b.buffer.take(1, 10, &ray, &treelet, &ready));
     EXPECT_EQ(treelet, 2u);
     EXPECT_GE(ready, 10u);  // state read from the SRAM after it was written

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "traces/bvh/builder.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/raygen/camera.h"
 #include "traces/raygen/secondary.h"
 #include "traces/raygen/surface.h"
@@ -134,8 +134,11 @@ TEST(RayGen, PlanFollowsTheScene) {
     EXPECT_FALSE(plan.emissive_prims.empty());
     WorkloadPlan only_primary = plan_workload(cornell, {RayKind::primary});
     EXPECT_FALSE(only_primary.wants(RayKind::shadow));
-    for (const Effect& e : only_primary.effects)
-        if (e.name == "shadow") EXPECT_NE(e.why.find("not requested"), std::string::npos);
+    for (const Effect& e : only_primary.effects) {
+        if (e.name == "shadow") {
+            EXPECT_NE(e.why.find("not requested"), std::string::npos);
+        }
+    }
 }
 
 TEST(RayGen, EmptyRequestIsWhatTheSceneCallsFor) {

@@ -10,7 +10,8 @@
 #include "traces/bvh/builder.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_reader.h"
-#include "traces/isect/traversal.h"
+#include "traces/accel/accel_io.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/raygen/workload.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/tracer/ray_trace.h"
@@ -51,9 +52,7 @@ TraceOptions small_options(const std::string& scene, const fs::path& out) {
 /// bit-identical to the recorded reference.
 void expect_trace_self_consistent(const fs::path& trace) {
     TraceReader reader(trace.string());
-    HwBvh bvh;
-    bvh.nodes = reader.read_all<HwNode>(SectionKind::bvh_nodes);
-    bvh.triangles = reader.read_all<HwTriangle>(SectionKind::triangles);
+    const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), trace.string());
     auto rays = reader.read_all<RayRecord>(SectionKind::rays);
     auto hits = reader.read_all<HitRecord>(SectionKind::hits);
     auto work = reader.read_all<WorkRecord>(SectionKind::work);
@@ -62,11 +61,10 @@ void expect_trace_self_consistent(const fs::path& trace) {
     for (size_t i = 0; i < rays.size(); ++i) {
         WorkCounts w;
         TraversalMode mode = (rays[i].flags & kRayFlagAnyHit) ? TraversalMode::any_hit : TraversalMode::closest_hit;
-        Hit h = trace_ray(bvh, ray_from_record(rays[i]), mode, &w);
+        Hit h = accel->trace(ray_from_record(rays[i]), mode, &w);
         ASSERT_EQ(h.prim, hits[i].prim) << "ray " << i;
         ASSERT_EQ(std::memcmp(&h.t, &hits[i].t, 4), 0) << "ray " << i;
-        ASSERT_EQ(w.nodes, work[i].nodes) << "ray " << i;
-        ASSERT_EQ(w.tri_tests, work[i].tri_tests) << "ray " << i;
+        ASSERT_EQ(w, work_from_record(work[i])) << "ray " << i;
     }
 }
 
@@ -196,10 +194,10 @@ TEST(Tracer, GivenRaysWriteTheSameTrace) {
         rays.push_back(p);
     }
     Scene scene = load_gltf((a / "scene" / "cornell.gltf").string());
-    HwBvh bvh = build_bvh(scene, o.bvh);
+    const std::unique_ptr<Accel> accel = load_accel(build_accel(scene, o.accel));
     RayTraceOptions ro;
     ro.out_dir = b.string();
-    nlohmann::json m = write_ray_trace(scene, {"cornell", true}, bvh, o.bvh, rays, ro);
+    nlohmann::json m = write_ray_trace(scene, {"cornell", true}, *accel, rays, ro);
     std::ifstream fa(a / "trace.rtt", std::ios::binary), fb(b / "trace.rtt", std::ios::binary);
     std::string sa((std::istreambuf_iterator<char>(fa)), {}), sb((std::istreambuf_iterator<char>(fb)), {});
     EXPECT_GT(sa.size(), 1000u);
@@ -207,7 +205,7 @@ TEST(Tracer, GivenRaysWriteTheSameTrace) {
     EXPECT_EQ(m["counts"]["rays"].get<uint64_t>(), rays.size());
     EXPECT_EQ(m["workload"]["requested"], "given");
     EXPECT_TRUE(fs::is_regular_file(b / "manifest.json"));
-    EXPECT_THROW(write_ray_trace(scene, {"cornell", true}, bvh, o.bvh, {}, ro), Error);
+    EXPECT_THROW(write_ray_trace(scene, {"cornell", true}, *accel, {}, ro), Error);
     fs::remove_all(a);
     fs::remove_all(b);
 }

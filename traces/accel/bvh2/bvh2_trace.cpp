@@ -1,10 +1,9 @@
-// trace_ray: the Traversal stepper's node and leaf steps (traversal_kernel.h) fused into one
-// loop, specialised per mode, with the per-ray state in registers and local counters. It visits
-// the same nodes in the same order and keeps the same hits and work counts as driving the
-// stepper (trace_ray_stepper); test_trace_ray_equivalence checks that ray by ray.
-#include "traces/isect/traversal.h"
-
-#include "traces/isect/traversal_kernel.h"
+// The binary BVH's fused reference loop: the stepper's node and leaf steps (bvh2_kernel.h)
+// fused into one loop, specialised per mode, with the per-ray state in registers and local
+// counters. It visits the same nodes in the same order and keeps the same hits and work counts
+// as driving the stepper; test_trace_ray_equivalence checks that ray by ray.
+#include "traces/accel/bvh2/bvh2.h"
+#include "traces/accel/bvh2/bvh2_kernel.h"
 
 // Hides a value from the optimiser so it keeps a branch rather than a conditional move.
 #if defined(__GNUC__)
@@ -17,14 +16,14 @@ namespace rtsim {
 namespace {
 
 template <bool kAnyHit>
-Hit trace_fused(const HwBvh& bvh, const Ray& ray, WorkCounts* work) {
+Hit trace_fused(const Bvh2View& bvh, const Ray& ray, WorkCounts* work) {
     // An empty scene has no root, and an invalid ray is never traversed: a miss, no work.
-    if (bvh.nodes.empty() || !ray_is_valid(ray)) {
+    if (bvh.node_count == 0 || !ray_is_valid(ray)) {
         if (work) *work = WorkCounts{};
         return Hit{};
     }
-    const HwNode* const nodes = bvh.nodes.data();
-    const HwTriangle* const tris = bvh.triangles.data();
+    const HwNode* const nodes = bvh.nodes;
+    const HwTriangle* const tris = bvh.triangles;
     const RayBoxPre box = ray_box_precompute(ray);
     const RayTrianglePre tri = ray_triangle_precompute(ray);
     const float tmin = ray.tmin, tmax = ray.tmax;
@@ -103,7 +102,7 @@ Hit trace_fused(const HwBvh& bvh, const Ray& ray, WorkCounts* work) {
 done:
     if (work) {
         *work = WorkCounts{};
-        work->nodes = node_visits;
+        work->steps = node_visits;
         work->box_tests = 2 * node_visits;
         work->tri_tests = tri_tests;
         work->anyhit_calls = anyhit_calls;
@@ -114,30 +113,9 @@ done:
 
 }  // namespace
 
-Hit trace_ray(const HwBvh& bvh, const Ray& ray, TraversalMode mode, WorkCounts* work) {
+Hit trace_bvh2(const Bvh2View& bvh, const Ray& ray, TraversalMode mode, WorkCounts* work) {
     return mode == TraversalMode::any_hit ? trace_fused<true>(bvh, ray, work)
                                           : trace_fused<false>(bvh, ray, work);
-}
-
-Hit trace_ray_stepper(const HwBvh& bvh, const Ray& ray, TraversalMode mode, WorkCounts* work) {
-    // An empty scene has no root: every ray misses without work.
-    if (bvh.nodes.empty()) {
-        if (work) *work = WorkCounts{};
-        return Hit{};
-    }
-    Traversal tr;
-    tr.begin(ray, mode);
-    for (;;) {
-        const Traversal::Step step = tr.step();
-        if (step == Traversal::Step::node)
-            tr.visit_node(bvh.nodes[tr.node_index()]);
-        else if (step == Traversal::Step::leaf)
-            tr.visit_leaf(bvh.triangles.data() + tr.leaf_first());
-        else
-            break;
-    }
-    if (work) *work = tr.work();
-    return tr.hit();
 }
 
 }  // namespace rtsim

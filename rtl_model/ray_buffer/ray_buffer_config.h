@@ -1,0 +1,38 @@
+#pragma once
+// Configuration of treelet scheduling with ray buffers (Aila & Karras 2010; STRaTA, Kopta et
+// al. 2013; docs/treelets.md).
+#include <cstdint>
+
+#include "rtl_model/common/choice.h"
+
+namespace rtsim {
+
+enum class TreeletPolicy : uint8_t { largest = 0, oldest = 1, round_robin = 2 };
+inline constexpr Choices<TreeletPolicy, 3> kTreeletPolicyChoices{{"largest", "oldest", "round_robin"}};
+
+struct TreeletConfig {
+    bool enabled = false;             ///< queue rays per treelet in the ray buffer
+    uint32_t treelet_kib = 16;        ///< byte budget per treelet (nodes + leaf triangles)
+    uint32_t buffer_kib = 512;        ///< ray buffer SRAM capacity
+    TreeletPolicy policy = TreeletPolicy::largest;  ///< which queue a free unit runs next
+    uint32_t threshold = 64;          ///< rays a queue needs before it is worth running
+    uint32_t latency = 4;             ///< ray buffer SRAM access latency
+    uint32_t bytes_per_cycle = 512;   ///< ray buffer SRAM bandwidth (banked: 8 units x 64 B)
+    uint32_t idle_poll_cycles = 32;   ///< how often an idle unit looks for work again
+    uint32_t max_rays_in_flight = 0;  ///< rays admitted at once (0: what the SRAM and contexts hold)
+
+    template <class V>
+    void visit(V& v) {
+        v.flag("enabled", enabled, "Treelet scheduling: rays queue per treelet in the ray buffer SRAM");
+        v.field("treelet_kib", treelet_kib, "KiB", "Byte budget per treelet (nodes and their leaf triangles)", 1, 1u << 20);
+        v.field("buffer_kib", buffer_kib, "KiB", "Ray buffer SRAM capacity; rays beyond it overflow to DRAM", 1, 1u << 22);
+        v.choice("policy", policy, kTreeletPolicyChoices, "Queue a free unit runs next: largest queue, oldest waiting ray, or round robin");
+        v.field("threshold", threshold, "rays", "Queues of at least this many rays are preferred (oldest, round_robin); shorter ones run only when no queue is that long. No effect with largest", 1, 1u << 20);
+        v.field("latency", latency, "cycles", "Ray buffer SRAM access latency", 1, 1000);
+        v.field("bytes_per_cycle", bytes_per_cycle, "B/cycle", "Ray buffer SRAM bandwidth", 1, 4096);
+        v.field("idle_poll_cycles", idle_poll_cycles, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000);
+        v.field("max_rays_in_flight", max_rays_in_flight, "rays", "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to DRAM (0: SRAM capacity plus the ray contexts, never overflows)", 0, 1u << 30);
+    }
+};
+
+}  // namespace rtsim

@@ -1,0 +1,41 @@
+#include "traces/accel/accel.h"
+
+#include "traces/common/hw_triangle.h"
+
+namespace rtsim {
+
+const char* op_kind_name(OpKind kind) {
+    switch (kind) {
+        case OpKind::box: return "box";
+        case OpKind::triangle: return "triangle";
+        case OpKind::anyhit: return "anyhit";
+        case OpKind::transform: return "transform";
+        case OpKind::cell: return "cell";
+        case OpKind::plane: return "plane";
+    }
+    return "unknown";
+}
+
+Hit trace_with_stepper(Stepper& stepper, const Ray& ray, TraversalMode mode, WorkCounts* work) {
+    stepper.begin(ray, mode);
+    while (!stepper.done()) stepper.execute();
+    if (work) *work = stepper.work();
+    return stepper.hit();
+}
+
+Hit Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
+    std::unique_ptr<Stepper> s = make_stepper();
+    return trace_with_stepper(*s, ray, mode, work);
+}
+
+bool Accel::has_anyhit_triangles() const {
+    for (const Region& r : m_image.regions) {
+        if (r.kind != DataKind::triangle) continue;
+        const HwTriangle* t = r.records<HwTriangle>();
+        for (uint64_t i = 0; i < r.count; ++i)
+            if (t[i].flags & kTriAnyHit) return true;
+    }
+    return false;
+}
+
+}  // namespace rtsim

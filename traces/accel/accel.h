@@ -1,0 +1,78 @@
+#pragma once
+// One seam for every acceleration structure (docs/accel.md, docs/architecture.md):
+//
+//   builder:  Scene -> AccelImage     (regions of documented layouts at addresses; in the trace)
+//   Accel:    AccelImage -> steppers, the fused reference loop, the locality partition
+//
+// The reference tracer, the model's traversal units, the analytic level and the ray buffer see
+// structures only through Accel and Stepper. Structures register by name in registry.cpp;
+// adding one touches its own folder and one line there.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "traces/accel/accel_image.h"
+#include "traces/accel/locality.h"
+#include "traces/accel/stepper.h"
+#include "traces/bvh/config.h"
+
+namespace rtsim {
+
+struct Scene;
+
+/// Contract: an Accel owns a validated image. make_stepper() steppers and trace() agree on every
+/// ray (hits bit for bit, work counts exactly); both read only the image.
+class Accel {
+public:
+    explicit Accel(AccelImage image) : m_image(std::move(image)) {}
+    virtual ~Accel() = default;
+    Accel(const Accel&) = delete;
+    Accel& operator=(const Accel&) = delete;
+
+    const AccelImage& image() const { return m_image; }
+    const std::string& kind() const { return m_image.kind; }
+
+    virtual std::unique_ptr<Stepper> make_stepper() const = 0;
+    /// The reference loop: the stepper's steps, fused for speed where a kind provides one
+    /// (the default drives a stepper).
+    virtual Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const;
+    /// Treelets (or cell blocks) of at most `budget_bytes`, keyed by StepPlan::locality.
+    virtual LocalityPartition partition(uint64_t budget_bytes) const = 0;
+    /// Operation kinds the steppers issue (the model instantiates a pipeline for each).
+    virtual std::vector<OpKind> op_kinds() const = 0;
+    /// Deepest traversal stack a ray can need (sizes the model's stack spill area).
+    virtual uint32_t max_stack_entries() const = 0;
+    /// True when some triangle is alpha-MASKed (the any-hit stage is then needed).
+    bool has_anyhit_triangles() const;
+
+protected:
+    AccelImage m_image;
+};
+
+/// How to build a structure: which kind, which builder for its tree, and the builder's config.
+struct AccelOptions {
+    std::string kind = "bvh2";        ///< accel_kinds() name
+    std::string builder = "binned";   ///< "binned" (binned SAH); kinds list the builders they take
+    BuildConfig build;
+};
+
+struct AccelKindInfo {
+    std::string name;
+    std::string description;
+    std::vector<std::string> builders;  ///< builders this kind accepts (first: default)
+};
+
+/// Every registered structure, in a stable order.
+const std::vector<AccelKindInfo>& accel_kinds();
+/// Throws rtsim::Error listing the known kinds and builders if the options name none.
+void validate_accel_options(const AccelOptions& options);
+/// Builds the image of a structure over a flattened scene; build_ms is the wall time it took.
+AccelImage build_accel(const Scene& scene, const AccelOptions& options);
+/// Wraps an image (e.g. read from a trace) in its kind's Accel, validating it structurally;
+/// throws rtsim::Error naming `source` and the first problem.
+std::unique_ptr<Accel> load_accel(AccelImage image, const std::string& source = "accel image");
+
+/// Drives a stepper over a ray to the end: the definition every fused loop is tested against.
+Hit trace_with_stepper(Stepper& stepper, const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr);
+
+}  // namespace rtsim

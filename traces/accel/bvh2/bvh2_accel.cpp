@@ -1,0 +1,162 @@
+// The binary BVH's image, Accel and locality tree (bvh2.h).
+#include <string>
+#include <vector>
+
+#include "traces/accel/bvh2/bvh2.h"
+#include "traces/bvh/builder.h"
+#include "traces/common/error.h"
+#include "traces/isect/brute_force.h"
+
+namespace rtsim {
+
+Bvh2View bvh2_view(const HwBvh& bvh) {
+    Bvh2View v;
+    v.nodes = bvh.nodes.data();
+    v.triangles = bvh.triangles.data();
+    v.node_count = bvh.nodes.size();
+    v.triangle_count = bvh.triangles.size();
+    return v;
+}
+
+Hit trace_ray_stepper(const HwBvh& bvh, const Ray& ray, TraversalMode mode, WorkCounts* work) {
+    Bvh2Stepper stepper(bvh2_view(bvh));
+    return trace_with_stepper(stepper, ray, mode, work);
+}
+
+Hit trace_ray_brute_force(const HwBvh& bvh, const Ray& ray, TraversalMode mode) {
+    return trace_ray_brute_force(bvh.triangles.data(), bvh.triangles.size(), ray, mode);
+}
+
+AccelImage bvh2_image(const HwBvh& bvh, const BuildConfig& c, const std::string& builder) {
+    AccelImage image;
+    image.kind = "bvh2";
+    image.bounds = bvh.bounds;
+    Region& nodes = image.add_region("nodes", DataKind::node, sizeof(HwNode), bvh.nodes.size());
+    std::copy(bvh.nodes.begin(), bvh.nodes.end(), nodes.records<HwNode>());
+    Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), bvh.triangles.size());
+    std::copy(bvh.triangles.begin(), bvh.triangles.end(), tris.records<HwTriangle>());
+    image.place_regions();
+    const BvhStats& s = bvh.stats;
+    image.stats = {{"builder", builder},
+                   {"config",
+                    {{"bins", c.bins},
+                     {"traversal_cost", c.traversal_cost},
+                     {"intersection_cost", c.intersection_cost},
+                     {"max_leaf_size", c.max_leaf_size},
+                     {"max_depth", c.max_depth}}},
+                   {"width", 2},
+                   {"node_bytes", sizeof(HwNode)},
+                   {"triangle_bytes", sizeof(HwTriangle)},
+                   {"nodes", s.nodes},
+                   {"leaves", s.leaves},
+                   {"max_depth", s.max_depth},
+                   {"avg_leaf_size", s.avg_leaf_size},
+                   {"max_leaf_size", s.max_leaf_size},
+                   {"sah_cost", s.sah_cost}};
+    return image;
+}
+
+LocalityTree bvh2_locality_tree(const HwNode* nodes, uint64_t count) {
+    LocalityTree t;
+    std::vector<float> area(count, 0.0f);
+    if (count) area[0] = std::numeric_limits<float>::infinity();
+    for (uint64_t i = 0; i < count; ++i)
+        for (int c = 0; c < 2; ++c)
+            if (nodes[i].child_count[c] == 0) {
+                const HwNode& n = nodes[i];
+                const float ex = n.hi(c, 0) - n.lo(c, 0), ey = n.hi(c, 1) - n.lo(c, 1), ez = n.hi(c, 2) - n.lo(c, 2);
+                area[n.child_ref[c]] = ex * ey + ey * ez + ez * ex;
+            }
+    for (uint64_t i = 0; i < count; ++i) {
+        uint64_t bytes = sizeof(HwNode);
+        for (int c = 0; c < 2; ++c)
+            if (nodes[i].child_count[c] != 0 && nodes[i].child_count[c] != kEmptyChild)
+                bytes += uint64_t(nodes[i].child_count[c]) * sizeof(HwTriangle);
+        t.add_node(bytes, area[i]);
+        for (int c = 0; c < 2; ++c)
+            if (nodes[i].child_count[c] == 0) t.add_child(nodes[i].child_ref[c]);
+    }
+    t.finish();
+    return t;
+}
+
+namespace {
+/// Largest leaf an image may hold (the builders make leaves of at most max_leaf_size <= 64).
+constexpr uint32_t kMaxLeafTriangles = 1u << 16;
+}  // namespace
+
+void validate_bvh2(const Bvh2View& v, const std::string& source) {
+    if (v.node_count == 0) return;  // an empty scene: every ray misses
+    // Messages are built only on failure: this pass runs over every node of every trace opened.
+    auto fail = [&](const std::string& what) { throw Error(source + ": binary BVH: " + what); };
+    auto child = [](uint64_t i, int c) { return "node " + std::to_string(i) + " child " + std::to_string(c); };
+    if (v.node_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) fail("more than 2^32 nodes or triangles");
+    // Depth-first layout: a child always comes after its parent, so following children can
+    // never cycle, and depth can be checked in one forward pass.
+    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0), covered(v.triangle_count, 0);
+    seen[0] = 1;
+    for (uint64_t i = 0; i < v.node_count; ++i) {
+        const HwNode& n = v.nodes[i];
+        if (!seen[i]) fail("node " + std::to_string(i) + " is not reachable from the root");
+        for (int c = 0; c < 2; ++c) {
+            const uint32_t ref = n.child_ref[c], count = n.child_count[c];
+            if (count == kEmptyChild) continue;
+            if (count == 0) {
+                if (ref <= i || ref >= v.node_count)
+                    fail(child(i, c) + " points to node " + std::to_string(ref) +
+                         (ref < v.node_count ? " (not after its parent)" : " (out of range)"));
+                if (seen[ref]) fail("node " + std::to_string(ref) + " has two parents");
+                seen[ref] = 1;
+                if (depth[i] + 1 >= kTraversalStackSize)
+                    fail("deeper than the traversal stack (" + std::to_string(kTraversalStackSize) + ")");
+                depth[ref] = uint8_t(depth[i] + 1);
+                continue;
+            }
+            if (count > kMaxLeafTriangles)
+                fail(child(i, c) + " is a leaf of " + std::to_string(count) + " triangles (at most " +
+                     std::to_string(kMaxLeafTriangles) + ")");
+            if (uint64_t(ref) + count > v.triangle_count)
+                fail(child(i, c) + " references triangles " + std::to_string(ref) + ".." +
+                     std::to_string(uint64_t(ref) + count - 1) + " of " + std::to_string(v.triangle_count));
+            for (uint64_t k = ref; k < uint64_t(ref) + count; ++k) {
+                if (covered[k]) fail("triangle " + std::to_string(k) + " is in two leaves");
+                covered[k] = 1;
+            }
+        }
+    }
+    for (uint64_t k = 0; k < v.triangle_count; ++k)
+        if (!covered[k]) fail("triangle " + std::to_string(k) + " is in no leaf (unreachable)");
+}
+
+Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
+    const Region& nodes = m_image.region("nodes");
+    const Region& tris = m_image.region("triangles");
+    require(nodes.record_bytes == sizeof(HwNode) && tris.record_bytes == sizeof(HwTriangle),
+            source + ": bvh2 regions must hold 64-byte nodes and 48-byte triangles");
+    m_view.nodes = nodes.records<HwNode>();
+    m_view.node_count = nodes.count;
+    m_view.node_base = nodes.base;
+    m_view.triangles = tris.records<HwTriangle>();
+    m_view.triangle_count = tris.count;
+    m_view.triangle_base = tris.base;
+    validate_bvh2(m_view, source);
+}
+
+std::unique_ptr<Stepper> Bvh2Accel::make_stepper() const { return std::make_unique<Bvh2Stepper>(m_view); }
+
+Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
+    return trace_bvh2(m_view, ray, mode, work);
+}
+
+LocalityPartition Bvh2Accel::partition(uint64_t budget_bytes) const {
+    require(budget_bytes >= sizeof(HwNode), "treelet budget must be at least one node (64 bytes)");
+    return partition_tree(bvh2_locality_tree(m_view.nodes, m_view.node_count), budget_bytes);
+}
+
+std::vector<OpKind> Bvh2Accel::op_kinds() const {
+    std::vector<OpKind> kinds{OpKind::box, OpKind::triangle};
+    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
+    return kinds;
+}
+
+}  // namespace rtsim

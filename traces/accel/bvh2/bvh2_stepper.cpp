@@ -1,0 +1,120 @@
+// The binary BVH stepper (bvh2_stepper.h). The order of visits and the work counted here are the
+// definition the SystemC model matches (docs/intersection.md); bvh2_trace.cpp fuses the same
+// steps into one loop.
+#include "traces/accel/bvh2/bvh2_stepper.h"
+
+#include <string>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+using detail::cull_distance;
+
+namespace detail {
+
+void throw_stack_overflow() {
+    throw Error("traversal stack overflow (" + std::to_string(kTraversalStackSize) +
+                " entries): BVH deeper than the builder's max_depth allows");
+}
+
+}  // namespace detail
+
+void Bvh2Stepper::begin(const Ray& ray, TraversalMode mode) {
+    m_ray = ray;
+    m_mode = mode;
+    m_hit = Hit{};
+    m_work = WorkCounts{};
+    m_stack_size = 0;
+    if (!ray_is_valid(ray) || m_view.node_count == 0) {
+        finish();
+        return;
+    }
+    m_box = ray_box_precompute(ray);
+    m_tri = ray_triangle_precompute(ray);
+    // While traversing, m_hit.t is the current best distance (the shrinking tmax).
+    m_hit.t = ray.tmax;
+    m_cull_t = cull_distance(ray.tmax);
+    m_ref = 0;
+    m_count = 0;
+    plan_next();
+}
+
+void Bvh2Stepper::plan_next() {
+    if (m_count == 0) {
+        m_plan.reset(m_ref);
+        m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+        m_plan.add_op(OpKind::box, 2);
+    } else {
+        m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
+        m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
+                         uint32_t(sizeof(HwTriangle) * m_count), DataKind::triangle);
+        m_plan.add_op(OpKind::triangle, m_count);
+    }
+}
+
+StepOutcome Bvh2Stepper::execute() {
+    StepOutcome out;
+    if (m_plan.done) return out;
+    if (m_count == 0) {
+        visit_node(m_view.nodes[m_ref]);
+    } else {
+        out.add_op(OpKind::anyhit, visit_leaf(m_view.triangles + m_ref));
+    }
+    return out;
+}
+
+void Bvh2Stepper::visit_node(const HwNode& node) {
+    m_work.steps += 1;
+    m_work.box_tests += 2;
+    float tnear[2];
+    const unsigned mask = detail::node_step(m_box, node, m_ray.tmin, m_cull_t, tnear);
+    if (mask == 0) {
+        pop_next();
+        return;
+    }
+    const unsigned next = detail::next_slot(mask, tnear);
+    // Nearer child next (child 0 on equal entry distances); push the farther one.
+    if (mask == 3) {
+        const unsigned far = next ^ 1u;
+        if (m_stack_size >= kTraversalStackSize) detail::throw_stack_overflow();
+        m_stack[m_stack_size++] = {node.child_ref[far], node.child_count[far], tnear[far]};
+    }
+    m_ref = node.child_ref[next];
+    m_count = node.child_count[next];
+    plan_next();
+}
+
+uint32_t Bvh2Stepper::visit_leaf(const HwTriangle* triangles) {
+    m_work.tri_tests += m_count;
+    const uint32_t alpha_before = m_work.anyhit_calls;
+    const bool done =
+        m_mode == TraversalMode::any_hit
+            ? detail::leaf_step<true>(m_tri, m_ray.tmin, m_ray.tmax, triangles, m_count, m_hit, m_cull_t,
+                                      m_work.anyhit_calls)
+            : detail::leaf_step<false>(m_tri, m_ray.tmin, m_ray.tmax, triangles, m_count, m_hit, m_cull_t,
+                                       m_work.anyhit_calls);
+    if (done) finish();
+    else pop_next();
+    return m_work.anyhit_calls - alpha_before;
+}
+
+void Bvh2Stepper::pop_next() {
+    // Entries entered beyond the (widened) best hit are dropped without a fetch.
+    while (m_stack_size > 0) {
+        const StackEntry& e = m_stack[--m_stack_size];
+        if (e.tnear > m_cull_t) continue;
+        m_ref = e.ref;
+        m_count = e.count;
+        plan_next();
+        return;
+    }
+    finish();
+}
+
+void Bvh2Stepper::finish() {
+    if (m_hit.prim < 0) m_hit = Hit{};
+    m_plan.finish();
+}
+
+}  // namespace rtsim

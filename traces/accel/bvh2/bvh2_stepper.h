@@ -1,0 +1,59 @@
+#pragma once
+// The binary BVH's stepper (docs/intersection.md): closest hit with front-to-back child order.
+// Both child boxes of a node are tested, the nearer hit child is visited next, the farther
+// pushed with its entry distance; popped entries farther than the current hit are skipped
+// without a fetch. Any-hit stops at the first accepted hit. Ties in t are broken towards the
+// smaller primitive id so the result is order-independent.
+//
+// Steps: a node step fetches one 64-byte HwNode and runs 2 box tests (locality key: the node);
+// a leaf step fetches its HwTriangles (contiguous) and runs one triangle test each, plus an
+// alpha test for each MASK triangle hit (reported by execute()).
+#include <cstdint>
+
+#include "traces/accel/bvh2/bvh2_kernel.h"
+#include "traces/accel/stepper.h"
+#include "traces/bvh/hw_layout.h"
+#include "traces/isect/ray_box.h"
+#include "traces/isect/ray_triangle.h"
+
+namespace rtsim {
+
+/// Where a binary BVH's data lives: arrays and their addresses in the memory image.
+struct Bvh2View {
+    const HwNode* nodes = nullptr;
+    const HwTriangle* triangles = nullptr;
+    uint64_t node_count = 0;
+    uint64_t triangle_count = 0;
+    uint64_t node_base = 0;      ///< address of node 0
+    uint64_t triangle_base = 0;  ///< address of triangle 0
+};
+
+class Bvh2Stepper final : public Stepper {
+public:
+    explicit Bvh2Stepper(const Bvh2View& view) : m_view(view) {}
+
+    void begin(const Ray& ray, TraversalMode mode) override;
+    StepOutcome execute() override;
+
+private:
+    struct StackEntry {
+        uint32_t ref;
+        uint32_t count;
+        float tnear;
+    };
+    void visit_node(const HwNode& node);
+    uint32_t visit_leaf(const HwTriangle* triangles);
+    void pop_next();
+    void plan_next();
+    void finish();  ///< the plan is done; a ray without a hit reports Hit{} (t = +inf)
+
+    Bvh2View m_view;
+    RayBoxPre m_box;
+    RayTrianglePre m_tri;
+    float m_cull_t = 0.0f;  ///< boxes entered beyond this are culled: best t widened
+    uint32_t m_ref = 0;     ///< node index, or first triangle of a leaf
+    uint32_t m_count = 0;   ///< 0: m_ref is a node; else the leaf's triangle count
+    StackEntry m_stack[kTraversalStackSize];
+};
+
+}  // namespace rtsim

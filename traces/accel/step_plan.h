@@ -1,0 +1,80 @@
+#pragma once
+// The seam between an acceleration structure and whatever times it (docs/architecture.md, "The
+// acceleration-structure seam"): a StepPlan is plain data saying what a ray's next traversal step
+// fetches (addresses in the one memory image, bytes, data kind) and which operations it runs on
+// the fetched data (box tests, triangle tests, ...). The model's traversal units and the analytic
+// level consume plans only; neither knows which structure produced them.
+#include <cstdint>
+
+#include "traces/common/data_kind.h"
+
+namespace rtsim {
+
+/// Operation kinds; the model sends each to the pipeline configured for its kind. A structure
+/// that needs a new kind adds one here and one pipeline config (docs/accel.md). Append only.
+enum class OpKind : uint8_t {
+    box = 0,        ///< ray/box test
+    triangle = 1,   ///< ray/triangle test
+    anyhit = 2,     ///< alpha (any-hit) evaluation of a MASK triangle
+    transform = 3,  ///< ray transform into an instance's object space
+    cell = 4,       ///< 3D-DDA step to the next grid cell
+    plane = 5,      ///< ray/split-plane test
+};
+constexpr int kOpKindCount = 6;
+const char* op_kind_name(OpKind kind);
+
+/// One read the step needs before its operations can run.
+struct Fetch {
+    uint64_t addr = 0;
+    uint32_t bytes = 0;
+    DataKind kind = DataKind::node;
+};
+
+/// `count` operations of one kind (a pipeline of width w takes ceil(count / w) issues).
+struct Op {
+    OpKind kind = OpKind::box;
+    uint32_t count = 0;
+};
+
+/// Locality key of a step that stays where the ray is (e.g. a BVH leaf: its triangles belong to
+/// the treelet of the node that references them).
+constexpr uint32_t kNoLocality = 0xFFFFFFFFu;
+
+/// What one ray's next step fetches and runs. The fetches are independent (issued together);
+/// the operations run in order once all fetched data has arrived.
+struct StepPlan {
+    static constexpr int kMaxFetches = 8;
+    static constexpr int kMaxOps = 4;
+
+    bool done = true;                 ///< the ray has finished: hit() and work() are final
+    uint32_t locality = kNoLocality;  ///< the step's node or cell, for treelet partitions
+    uint8_t fetch_count = 0;
+    uint8_t op_count = 0;
+    Fetch fetch[kMaxFetches];
+    Op op[kMaxOps];
+
+    void reset(uint32_t locality_key) {
+        done = false;
+        locality = locality_key;
+        fetch_count = op_count = 0;
+    }
+    void finish() {
+        done = true;
+        locality = kNoLocality;
+        fetch_count = op_count = 0;
+    }
+    void add_fetch(uint64_t addr, uint32_t bytes, DataKind kind) { fetch[fetch_count++] = Fetch{addr, bytes, kind}; }
+    void add_op(OpKind kind, uint32_t count) { op[op_count++] = Op{kind, count}; }
+};
+
+/// Operations a step's results called for beyond its plan (alpha tests of the triangles hit).
+struct StepOutcome {
+    static constexpr int kMaxOps = 2;
+    uint8_t op_count = 0;
+    Op op[kMaxOps];
+    void add_op(OpKind kind, uint32_t count) {
+        if (count) op[op_count++] = Op{kind, count};
+    }
+};
+
+}  // namespace rtsim

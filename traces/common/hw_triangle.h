@@ -1,0 +1,23 @@
+#pragma once
+// The hardware triangle record every acceleration structure's leaves reference (48 bytes,
+// docs/bvh_layout.md): the one triangle layout the reference tracer and the model both read.
+#include <cstdint>
+
+namespace rtsim {
+
+/// HwTriangle::flags bits.
+constexpr uint32_t kTriAnyHit = 1u << 0;         ///< alpha-MASK: call the any-hit (alpha) test
+constexpr uint32_t kTriCoverageShift = 8;        ///< bits 8..15: alpha coverage x 255
+constexpr uint32_t kTriMaterialShift = 16;       ///< bits 16..31: material index
+
+struct HwTriangle {             // 48 bytes
+    float v0[3];                //  0
+    float v1[3];                // 12
+    float v2[3];                // 24
+    uint32_t prim;              // 36: stable primitive id (scene order, see scene.h)
+    uint32_t inst;              // 40: instance id
+    uint32_t flags;             // 44: kTriAnyHit | coverage << 8 | material << 16
+};
+static_assert(sizeof(HwTriangle) == 48, "HwTriangle must be 48 bytes");
+
+}  // namespace rtsim
