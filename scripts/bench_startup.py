@@ -1,8 +1,9 @@
 #!/usr/bin/env python
 """Measures what Python start-up adds to a short simulation: `rtsim --version`, `import rtsim`,
 and `rtsim simulate` against `rtsim-sim` alone on the same small trace (cornell, 64x48 primary
-rays). Each command runs --repeat times, interleaved round-robin so machine load hits every
-command alike; prints the median and min of each and asserts nothing.
+rays), with a bare `python -c pass` as the interpreter's own floor. Each command runs --repeat
+times, interleaved round-robin so machine load hits every command alike; prints the median and
+min of each and asserts nothing (docs/benchmarks.md).
 
     python scripts/bench_startup.py [--repeat 15] [--before DIR] [--json FILE]
 
@@ -34,9 +35,18 @@ def timed(cmd: list[str], env: dict[str, str]) -> float:
     return wall
 
 
+def load_average() -> str:
+    """1, 5 and 15 minute load averages (Linux), to judge how busy the machine was."""
+    try:
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+    except OSError:
+        return "unknown"
+
+
 def commands(trace: Path, runs: Path, sim: str) -> dict[str, list[str]]:
     py = [sys.executable, "-m", "rtsim"]
     return {
+        "python -c pass": [sys.executable, "-c", "pass"],  # the interpreter's own start-up
         "rtsim --version": [*py, "--version"],
         "import rtsim": [sys.executable, "-c", "import rtsim"],
         "rtsim-sim TRACE": [sim, str(trace), "-o", str(runs / "sim")],
@@ -88,13 +98,15 @@ def main() -> int:
         plan = []
         for name, env in variants.items():
             for label, cmd in commands(trace, Path(tmp) / name, sim).items():
-                if label.startswith("rtsim-sim") and name != "current":
-                    continue  # the executable is the same for both variants
+                if label.startswith(("rtsim-sim", "python -c")) and name != "current":
+                    continue  # the same for both variants
                 plan.append((name, label, cmd, env))
         times: dict[tuple[str, str], list[float]] = {(n, lbl): [] for n, lbl, _, _ in plan}
+        print(f"load average before: {load_average()}")
         for _ in range(args.repeat):
             for name, label, cmd, env in plan:
                 times[(name, label)].append(timed(cmd, env))
+    print(f"load average after:  {load_average()}")
     rows = []
     for (name, label), walls in times.items():
         rows.append(

@@ -22,6 +22,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rtsim.cli_help import HelpFormatter
 from rtsim.launcher import SimJob, find_sim, run_sim
 from rtsim.scenes import resolve_scene
 
@@ -392,10 +393,10 @@ def cmd_accuracy(args: argparse.Namespace, console: Console) -> int:
     return 3 if bad else 0
 
 
-def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any, formatter: type) -> None:  # type: ignore[type-arg]
+def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None:  # type: ignore[type-arg]
     p = sub.add_parser(
         "accuracy",
-        formatter_class=formatter,
+        formatter_class=HelpFormatter,
         help="wall time against error of each fidelity level and sample size (table and plot)",
         description="Per scene and workload (coherent primary, incoherent diffuse rays): "
         "traces once, runs every fidelity level and each timed level on samples of a few "

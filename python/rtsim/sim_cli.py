@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from rtsim.cli_help import HelpFormatter
 from rtsim.launcher import EXIT_BAD_INPUT, EXIT_MISMATCH, EXIT_OK, SimJob, find_sim, run_sim
 
 #: One line per fidelity level for `rtsim simulate --help` (docs/fidelity.md has the details;
@@ -99,11 +100,11 @@ def cmd_config(args: argparse.Namespace, console: Any) -> int:
     return 0
 
 
-def add_parsers(sub: argparse._SubParsersAction, formatter: type) -> None:  # type: ignore[type-arg]
+def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Registers `simulate` and `config` on the `rtsim` subcommand parser."""
     p = sub.add_parser(
         "simulate",
-        formatter_class=formatter,
+        formatter_class=HelpFormatter,
         help="replay a trace on the SystemC accelerator model (rtsim-sim) and summarise the run",
         description="Replays TRACE on the accelerator model (one rtsim-sim process), checks every "
         "hit against the reference and writes RUN/stats.json, RUN/config.resolved.json and "
@@ -135,7 +136,7 @@ def add_parsers(sub: argparse._SubParsersAction, formatter: type) -> None:  # ty
 
     p = sub.add_parser(
         "config",
-        formatter_class=formatter,
+        formatter_class=HelpFormatter,
         help="print the simulator's default config or its schema",
         description="Prints the simulator's config tree as JSON: its defaults, or every field "
         "with its default, unit, range and meaning.",

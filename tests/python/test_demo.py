@@ -33,14 +33,18 @@ def test_demo_prints_its_wall_time(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     assert match and int(match.group(1)) < 600, out.getvalue()
 
 
-def test_readme_demo_time_matches_the_measurements() -> None:
+def test_readme_demo_figures_match_the_measurements() -> None:
+    """README states the demo's CPU time as a range; every run recorded in docs/benchmarks.md
+    falls in it (the CPU time hardly depends on load; the wall time does, so it is recorded)."""
     readme = " ".join((REPO / "README.md").read_text().split())
-    stated = re.search(r"(\d+) to (\d+) s on 2 cores", readme)
-    assert stated, "the README states the demo's wall time as a range on 2 cores"
+    stated = re.search(r"(\d+) to (\d+) CPU-seconds", readme)
+    assert stated, "the README states the demo's CPU time as a range"
     low, high = int(stated.group(1)), int(stated.group(2))
+    assert "prints its wall time" in readme
     bench = (REPO / "docs" / "benchmarks.md").read_text()
     section = bench[bench.index("## The demo") :]
-    rows = re.findall(r"^\| demo run \d+ \|[^|]*\| ([\d.]+) \|", section, re.M)
-    measured = [float(s) for s in rows]
-    assert len(measured) >= 3, "docs/benchmarks.md records at least three demo runs"
-    assert all(low <= s <= high for s in measured), (low, high, measured)
+    runs = re.findall(r"^\| demo run \d+ \|[^|]*\|[^|]*\| ([\d.]+) \| ([\d.]+) \|$", section, re.M)
+    assert len(runs) >= 3, "docs/benchmarks.md records at least three demo runs"
+    for wall, cpu in runs:
+        assert low <= float(cpu) <= high, (low, high, cpu)
+        assert float(wall) > float(cpu) / 2  # 2 workers cannot beat the CPU time halved

@@ -12,6 +12,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from rtsim.cli_help import HelpFormatter
+
 # Only the parsers are built at import time (every `rtsim` command builds them): the sweep
 # machinery (Dask, numpy, yaml, rich) is imported by the commands that use it.
 if TYPE_CHECKING:
@@ -99,11 +101,11 @@ def cmd_report(args: argparse.Namespace, console: Console) -> int:
     return 0
 
 
-def add_parsers(sub: argparse._SubParsersAction, formatter: type) -> None:  # type: ignore[type-arg]
+def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Registers `sweep`, `results` and `report` on the `rtsim` subcommand parser."""
     p = sub.add_parser(
         "sweep",
-        formatter_class=formatter,
+        formatter_class=HelpFormatter,
         help="run a design-space sweep (scenes x workloads x configs) on Dask",
         description="Runs every scene x workload x config point of SPEC (docs/sweeps.md), one "
         "rtsim-sim process per run, into SWEEP/results.sqlite. Re-running resumes: finished runs "
@@ -137,7 +139,7 @@ def add_parsers(sub: argparse._SubParsersAction, formatter: type) -> None:  # ty
 
     p = sub.add_parser(
         "results",
-        formatter_class=formatter,
+        formatter_class=HelpFormatter,
         help="a sweep's results: a summary table, or --csv",
         description="Prints a summary table of a sweep's runs, or writes the tidy table (one "
         "row per run: config keys and summary stats) as CSV.",
@@ -156,7 +158,7 @@ def add_parsers(sub: argparse._SubParsersAction, formatter: type) -> None:  # ty
 
     p = sub.add_parser(
         "report",
-        formatter_class=formatter,
+        formatter_class=HelpFormatter,
         help="write a sweep's HTML report (figures embedded)",
         description="Writes one self-contained HTML page from a sweep's results store.",
     )
