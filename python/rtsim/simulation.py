@@ -19,7 +19,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from rtsim.config import ConfigError, SimConfig, apply_patch, compose, unflatten
+from rtsim.config import ConfigError, SimConfig, apply_patch, compose
 from rtsim.errors import HitMismatchError, RtsimError
 from rtsim.launcher import EXIT_BAD_INPUT, EXIT_MISMATCH, EXIT_OK, SimJob, read_json, run_sim
 from rtsim.stats import Stats
@@ -40,7 +40,10 @@ def resolve_config(
         elif isinstance(config, SimConfig):
             base = config
         elif isinstance(config, Mapping):
-            base = apply_patch(SimConfig(), unflatten(copy.deepcopy(dict(config))))
+            # Nested sections first, then dotted keys over them: {"l1": {...}, "l1.ways": 8}.
+            nested = {k: v for k, v in config.items() if "." not in k}
+            dotted_keys = {k: v for k, v in config.items() if "." in k}
+            base = apply_patch(SimConfig(), copy.deepcopy(nested)).with_values(dotted_keys)
         elif isinstance(config, os.PathLike) or str(config).endswith(".json"):
             base = _config_file(Path(config))
         elif isinstance(config, str):

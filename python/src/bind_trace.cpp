@@ -14,10 +14,10 @@
 
 #include "python/src/bindings.h"
 #include "python/src/ray_args.h"
-#include "traces/common/error.h"
-#include "traces/format/trace_reader.h"
 #include "traces/accel/accel.h"
 #include "traces/accel/bvh2/bvh2.h"
+#include "traces/common/error.h"
+#include "traces/format/trace_reader.h"
 #include "traces/scene/procedural.h"
 #include "traces/tracer/ray_trace.h"
 #include "traces/tracer/tracer.h"
@@ -36,7 +36,7 @@ struct PyHit {
     float u;
     float v;
     bool valid;  ///< false: the ray was rejected as invalid (NaN, zero direction, tmin > tmax)
-    WorkCounts work;  ///< the reference traversal's work (fields: bind_work_dtype)
+    WorkCounts work;  ///< the reference traversal's work (numpy fields: bind_trace below)
 };
 
 py::array trace_rays(PyScene& scene, const py::object& origins, const py::object& directions,

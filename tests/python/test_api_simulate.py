@@ -66,6 +66,17 @@ def test_both_override_conventions_reach_the_model(trace: Path) -> None:
     assert typed.config["l2"]["size_kib"] == 512
 
 
+def test_config_conventions_compose() -> None:
+    """Nested sections, dotted keys and keyword overrides, later ones winning (no run needed)."""
+    from rtsim.simulation import resolve_config
+
+    config = resolve_config({"l1.size_kib": 32, "l1": {"ways": 8, "size_kib": 8}}, {"l1__ways": 2})
+    assert (config.l1.size_kib, config.l1.ways) == (32, 2)
+    assert resolve_config("base+tu16", {"fidelity": "analytic"}).traversal.units == 16
+    with pytest.raises(rtsim.RtsimError, match="expected a SimConfig"):
+        resolve_config(42)  # type: ignore[arg-type]
+
+
 def test_temporary_run_folder_is_removed(trace: Path) -> None:
     stats = rtsim.simulate(trace)
     assert stats.run_dir is None
