@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 import rtsim
-from rtsim.simulate import find_sim
+from rtsim.launcher import find_sim
 
 REPO = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- accel-study:begin -->", "<!-- accel-study:end -->"

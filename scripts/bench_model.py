@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 
 import rtsim
+from rtsim.launcher import find_sim
 from rtsim.scenes import resolve_scene
-from rtsim.simulate import find_sim
 
 
 def make_trace(scene: str, out: Path, width: int, height: int) -> None:

@@ -23,7 +23,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from rtsim.simulate import find_sim
+from rtsim.launcher import find_sim
 
 REPO = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- treelet-study:begin -->", "<!-- treelet-study:end -->"

@@ -1,40 +1,93 @@
 """rtsim: a cycle-approximate simulator of ray-tracing accelerators.
 
-The C++ reference tracer is reached through the extension module ``rtsim._core``; this package
-adds trace-file access (numpy memory maps), plots and the ``rtsim`` command line.
-
 >>> import rtsim
->>> scene = rtsim.load_scene("cornell")
->>> hits = rtsim.trace_rays(scene, origins, directions, 0.0, float("inf"))
+>>> scene = rtsim.load_scene("cornell")            # a built-in or shared scene name, or a path
+>>> hits = rtsim.trace_rays(scene, origins, directions)
+>>> rtsim.trace_scene("cornell", "out/cornell")     # the workload the scene calls for
+>>> stats = rtsim.simulate("out/cornell", l1__size_kib=32)
+>>> stats.mrays_per_second, stats.dram_bytes_per_ray
+
+Names are imported on first use (PEP 562), so ``import rtsim`` and the command line stay fast:
+the C++ extension ``rtsim._core`` (and numpy with it) loads only when a tracer function is used.
 """
 
 from __future__ import annotations
 
-from rtsim._core import (
-    RtsimError,
-    Scene,
-    load_scene,
-    procedural_scene_names,
-    trace_rays,
-    trace_scene,
-    trace_sections,
-    verify_trace,
-    write_procedural_scene,
-)
-from rtsim._core import __version__ as __version__
-from rtsim.trace_file import Trace, open_trace
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from rtsim.errors import HitMismatchError, RtsimError
+
+try:
+    from rtsim._version import __version__
+except ImportError:  # not built by scikit-build-core (e.g. a source checkout on sys.path)
+    from importlib.metadata import version as _version
+
+    __version__ = _version("rtsim")
+
+#: Public name -> the module that defines it (imported on first access).
+_LAZY = {
+    "Scene": "rtsim._core",
+    "procedural_scene_names": "rtsim._core",
+    "trace_rays": "rtsim._core",
+    "trace_sections": "rtsim._core",
+    "verify_trace": "rtsim._core",
+    "write_procedural_scene": "rtsim._core",
+    "load_scene": "rtsim.tracing",
+    "trace_scene": "rtsim.tracing",
+    "write_trace": "rtsim.tracing",
+    "Trace": "rtsim.trace_file",
+    "open_trace": "rtsim.trace_file",
+    "simulate": "rtsim.simulation",
+    "Stats": "rtsim.stats",
+    "SimConfig": "rtsim.config",
+}
+
+if TYPE_CHECKING:
+    from rtsim._core import (
+        Scene,
+        procedural_scene_names,
+        trace_rays,
+        trace_sections,
+        verify_trace,
+        write_procedural_scene,
+    )
+    from rtsim.config import SimConfig
+    from rtsim.simulation import simulate
+    from rtsim.stats import Stats
+    from rtsim.trace_file import Trace, open_trace
+    from rtsim.tracing import load_scene, trace_scene, write_trace
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'rtsim' has no attribute '{name}'")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY])
+
 
 __all__ = [
+    "HitMismatchError",
     "RtsimError",
     "Scene",
+    "SimConfig",
+    "Stats",
     "Trace",
     "__version__",
     "load_scene",
     "open_trace",
     "procedural_scene_names",
+    "simulate",
     "trace_rays",
     "trace_scene",
     "trace_sections",
     "verify_trace",
     "write_procedural_scene",
+    "write_trace",
 ]

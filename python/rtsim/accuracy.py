@@ -16,20 +16,19 @@ DIR/accuracy.json and DIR/accuracy.png (wall time against |error|). docs/fidelit
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
-import statistics
 import subprocess
-import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from rich.console import Console
-
+from rtsim.cli_help import HelpFormatter
+from rtsim.launcher import SimJob, find_sim, run_sim
 from rtsim.scenes import resolve_scene
-from rtsim.simulate import find_sim
+
+if TYPE_CHECKING:
+    from rich.console import Console
 
 LEVEL_ORDER = ("functional", "analytic", "approx", "detailed")
 SAMPLED_LEVELS = ("approx", "detailed")  # sampling needs the SystemC model (sim/config validate)
@@ -99,21 +98,14 @@ def run_once(
     exe: Path, trace: Path, run: Path, sets: list[str]
 ) -> tuple[float, int, dict[str, Any] | None, str]:
     """One rtsim-sim process: (wall seconds, exit code, stats or None, last stderr line)."""
-    cmd = [str(exe), str(trace), "-o", str(run)]
-    for s in sets:
-        cmd += ["--set", s]
-    stats_path = run / "stats.json"
-    if stats_path.is_file():
-        stats_path.unlink()
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    wall = time.perf_counter() - t0
-    stats = json.loads(stats_path.read_text()) if stats_path.is_file() else None
-    lines = proc.stderr.strip().splitlines()
-    return wall, proc.returncode, stats, lines[-1] if lines else ""
+    result = run_sim(SimJob(trace=trace, out_dir=run, sets=list(sets)), exe=exe)
+    messages = result.messages
+    return result.wall_seconds, result.returncode, result.stats, messages[-1] if messages else ""
 
 
 def measure(exe: Path, trace: Path, run: Path, sets: list[str], repeat: int, row: Row) -> Row:
+    import statistics  # here, not at the top: `rtsim --help` imports this module
+
     walls = []
     for _ in range(repeat):
         wall, code, stats, message = run_once(exe, trace, run, sets)
@@ -221,6 +213,8 @@ def fmt_speed(x: float | None) -> str:
 
 
 def write_outputs(rows: list[Row], out: Path) -> None:
+    import csv
+
     out.mkdir(parents=True, exist_ok=True)
     (out / "accuracy.json").write_text(json.dumps([asdict(r) for r in rows], indent=2))
     columns = [
@@ -426,8 +420,12 @@ def cmd_accuracy(args: argparse.Namespace, console: Console) -> int:
 def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None:  # type: ignore[type-arg]
     p = sub.add_parser(
         "accuracy",
+        formatter_class=HelpFormatter,
         help="wall time against error of each fidelity level and sample size (table and plot)",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description="Per scene and workload (coherent primary, incoherent diffuse rays): "
+        "traces once, runs every fidelity level and each timed level on samples of a few "
+        "fractions, and writes DIR/accuracy.csv, .md, .json and .png: the wall time against the "
+        "error in cycles of each (docs/fidelity.md).",
     )
     p.add_argument("scenes", nargs="*", metavar="SCENE", help="built-in or shared scene, or glTF")
     p.add_argument(
@@ -443,12 +441,20 @@ def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None: 
         help="with --spec: levels to run (analytic_functional: the analytic level with "
         "functional caches, for hit-rate errors)",
     )
-    p.add_argument("-o", "--output", default="out/accuracy", metavar="DIR")
-    p.add_argument("--resolution", type=parse_resolution, default=(256, 192), metavar="WxH")
+    p.add_argument(
+        "-o", "--output", default="out/accuracy", metavar="DIR", help="folder for traces, runs, tables"
+    )
+    p.add_argument(
+        "--resolution",
+        type=parse_resolution,
+        default=(256, 192),
+        metavar="WxH",
+        help="image size of each traced workload",
+    )
     p.add_argument(
         "--fractions",
         type=parse_fractions,
-        default=list(DEFAULT_FRACTIONS),
+        default=",".join(f"{f:g}" for f in DEFAULT_FRACTIONS),
         metavar="F,F,...",
         help="sample fractions for the timed levels",
     )
@@ -464,6 +470,6 @@ def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None: 
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help="config override for every run (repeatable)",
+        help="config override for every run (repeatable; default: none)",
     )
     p.set_defaults(func=cmd_accuracy)

@@ -25,7 +25,7 @@ from typing import Any
 
 from rich.console import Console
 
-from rtsim.simulate import find_sim
+from rtsim.launcher import find_sim
 from rtsim.sweep.spec import RunPlan, load_spec
 from rtsim.sweep.tasks import TraceTask, make_trace
 

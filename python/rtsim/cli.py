@@ -21,23 +21,34 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from rich.console import Console
-
-from rtsim import _core
-from rtsim._core import RtsimError
+from rtsim import __version__
 from rtsim.accuracy import add_parser as add_accuracy_parser
-from rtsim.heatmaps import write_heatmaps
-from rtsim.progress import TraceProgress
-from rtsim.scenes import list_scenes, resolve_scene, shared_scenes_dir
-from rtsim.simulate import add_parsers as add_simulate_parsers
-from rtsim.summary import print_summary
+from rtsim.cli_help import HelpFormatter, LazyHelpStore
+from rtsim.errors import RtsimError
+from rtsim.kinds import RAY_KINDS
+from rtsim.sim_cli import add_parsers as add_simulate_parsers
 from rtsim.sweep.cli import add_parsers as add_sweep_parsers
-from rtsim.trace_file import open_trace
 
-RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
+# Start-up matters (`rtsim simulate` runs once per simulation): modules above import only the
+# standard library; rich, numpy, the C++ extension and Dask are imported by the commands.
+if TYPE_CHECKING:
+    from rich.console import Console
+
+WORKLOAD_DEFAULT = (
+    "every kind the scene calls for: primary and diffuse always, shadow with lights, reflection "
+    "with metallic or smooth materials, refraction with transmissive ones"
+)
+
+
+def accel_kinds() -> list[dict[str, Any]]:
+    """The acceleration structures of this build (name, description, builders)."""
+    from rtsim import _core
+
+    return list(_core.accel_kinds())
 
 
 @dataclass
@@ -46,7 +57,7 @@ class TraceJob:
 
     scene: str
     out_dir: Path
-    workload: list[str] = field(default_factory=lambda: ["primary"])
+    workload: list[str] | None = None  # None: every kind the scene calls for
     width: int = 320
     height: int = 240
     bounces: int = 1
@@ -100,9 +111,17 @@ def positive_int(text: str) -> int:
 
 def run_trace(job: TraceJob, console: Console) -> dict:
     """Traces, draws the heatmaps and prints the summary; returns the manifest."""
+    from rich.console import Console
+
+    from rtsim.heatmaps import write_heatmaps
+    from rtsim.progress import TraceProgress
+    from rtsim.summary import print_summary
+    from rtsim.trace_file import open_trace
+    from rtsim.tracing import trace_scene
+
     with TraceProgress(console=Console(stderr=True)) as progress:
-        manifest = _core.trace_scene(
-            resolve_scene(job.scene),
+        manifest = trace_scene(
+            job.scene,
             job.out_dir,
             workload=job.workload,
             width=job.width,
@@ -149,6 +168,8 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
 
 
 def cmd_scene(args: argparse.Namespace, console: Console) -> int:
+    from rtsim import _core
+
     path = _core.write_procedural_scene(
         args.name, Path(args.output), hairball_triangles=args.hairball_triangles, seed=args.seed
     )
@@ -157,6 +178,8 @@ def cmd_scene(args: argparse.Namespace, console: Console) -> int:
 
 
 def cmd_scenes(args: argparse.Namespace, console: Console) -> int:
+    from rtsim.scenes import list_scenes, shared_scenes_dir
+
     for entry in list_scenes():
         where = f"  {entry.path}" if entry.path else ""
         console.print(f"{entry.name:<28} {entry.kind}{where}", highlight=False)
@@ -195,6 +218,8 @@ def cmd_bench(args: argparse.Namespace, console: Console) -> int:
         return 2
     cmd = [str(exe)]
     if args.scene:
+        from rtsim.scenes import resolve_scene
+
         cmd.append(resolve_scene(args.scene))
     cmd += ["--repeat", str(args.repeat)]
     if args.json:
@@ -208,23 +233,42 @@ def cmd_bench(args: argparse.Namespace, console: Console) -> int:
     return subprocess.run(cmd, check=False).returncode
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rtsim", description=__doc__.split("\n\n")[0].strip())
-    parser.add_argument("--version", action="version", version=f"rtsim {_core.__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
-    p = sub.add_parser("trace", help="trace a scene into a trace folder")
+def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    p = sub.add_parser(
+        "trace",
+        formatter_class=HelpFormatter,
+        help="trace a scene into a trace folder",
+        description="Traces SCENE with the reference tracer into OUT: trace.rtt (rays, reference "
+        "hits, per-ray work, the BVH image), manifest.json (scene, BVH, the effects traced and "
+        "why, counts), render.png and work heatmaps.",
+    )
     p.add_argument("scene", metavar="SCENE", help="glTF file, built-in or shared scene name")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="trace folder")
     p.add_argument(
         "--workload",
         type=parse_workload,
-        default=["primary"],
-        help="comma-separated ray kinds: " + ",".join(RAY_KINDS),
+        default=None,
+        metavar="KINDS",
+        help=f"comma-separated ray kinds ({','.join(RAY_KINDS)}) narrowing what is traced "
+        f"(default: {WORKLOAD_DEFAULT})",
     )
-    p.add_argument("--resolution", type=parse_resolution, default=(320, 240), metavar="WxH")
-    p.add_argument("--bounces", type=positive_int, default=1, metavar="N")
-    p.add_argument("--seed", type=positive_int, default=1, metavar="S")
+    p.add_argument(
+        "--resolution",
+        type=parse_resolution,
+        default="320x240",
+        metavar="WxH",
+        help="camera image size: one primary ray per pixel",
+    )
+    p.add_argument(
+        "--bounces",
+        type=positive_int,
+        default=1,
+        metavar="N",
+        help="depth of diffuse, reflection and refraction bounces",
+    )
+    p.add_argument(
+        "--seed", type=positive_int, default=1, metavar="S", help="seed of the random numbers"
+    )
     p.add_argument(
         "--camera",
         type=parse_camera,
@@ -232,52 +276,107 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="EYE,TARGET,FOV",
         help="ex,ey,ez,tx,ty,tz,fov_degrees (default: the scene's camera or a framing)",
     )
-    p.add_argument("--threads", type=positive_int, default=0, metavar="N", help="0: all cores")
-    p.add_argument("--hairball-triangles", type=positive_int, default=200_000, metavar="N")
-    kinds = _core.accel_kinds()
+    p.add_argument(
+        "--threads",
+        type=positive_int,
+        default=0,
+        metavar="N",
+        help="tracing threads, 0 for all cores (the trace is the same for any N)",
+    )
+    p.add_argument(
+        "--hairball-triangles",
+        type=positive_int,
+        default=200_000,
+        metavar="N",
+        help="triangles of the built-in hairball scene",
+    )
     p.add_argument(
         "--accel",
+        action=LazyHelpStore,
         default="bvh2",
-        choices=[k["name"] for k in kinds],
-        help="acceleration structure (default: bvh2): "
-        + "; ".join(f"{k['name']}: {k['description']}" for k in kinds),
+        metavar="KIND",
+        help_text=lambda: (
+            "acceleration structure (default: bvh2): "
+            + "; ".join(f"{k['name']}: {k['description']}" for k in accel_kinds())
+        ),
     )
     p.add_argument(
         "--builder",
+        action=LazyHelpStore,
         default="",
         metavar="NAME",
-        help="builder (default: the structure's first); the structures take: "
-        + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in kinds),
+        help_text=lambda: (
+            "builder (default: the structure's first); the structures take: "
+            + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in accel_kinds())
+        ),
     )
     p.set_defaults(func=cmd_trace)
 
-    p = sub.add_parser("scene", help="write a built-in scene as glTF")
-    p.add_argument("name", metavar="NAME")
-    p.add_argument("-o", "--output", required=True, metavar="DIR")
-    p.add_argument("--hairball-triangles", type=positive_int, default=200_000, metavar="N")
-    p.add_argument("--seed", type=positive_int, default=1, metavar="S")
+
+def add_scene_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    p = sub.add_parser(
+        "scene",
+        formatter_class=HelpFormatter,
+        help="write a built-in scene as glTF",
+        description="Writes the built-in scene NAME as DIR/NAME.gltf (see rtsim scenes).",
+    )
+    p.add_argument("name", metavar="NAME", help="built-in scene name (cornell, hairball, ...)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into")
+    p.add_argument(
+        "--hairball-triangles",
+        type=positive_int,
+        default=200_000,
+        metavar="N",
+        help="triangles of the hairball scene",
+    )
+    p.add_argument(
+        "--seed", type=positive_int, default=1, metavar="S", help="seed of the procedural scenes"
+    )
     p.set_defaults(func=cmd_scene)
 
-    p = sub.add_parser("scenes", help="list built-in and shared scenes")
+    p = sub.add_parser(
+        "scenes",
+        formatter_class=HelpFormatter,
+        help="list built-in and shared scenes",
+        description="Lists the built-in scenes and the glTF scenes of the shared folder "
+        "($RTSIM_SCENES, else ../shared/scenes), by the names SCENE arguments accept.",
+    )
     p.set_defaults(func=cmd_scenes)
 
+
+def add_demo_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     p = sub.add_parser(
         "demo",
+        formatter_class=HelpFormatter,
         help="run the main job: a small design-space sweep on two built-in scenes and its "
         "HTML report (OUT/report.html)",
+        description="Sweeps python/rtsim/specs/demo.yaml into OUT and writes OUT/report.html. "
+        "Running it again resumes: finished runs are kept.",
     )
     p.add_argument("-o", "--output", default="out/demo", metavar="OUT", help="sweep folder")
-    p.add_argument("--workers", type=int, default=0, metavar="N", help="default: one per core")
-    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT", help="a Dask cluster")
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=0,
+        metavar="N",
+        help="local Dask worker processes (default: one per core)",
+    )
+    p.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="tcp://HOST:PORT",
+        help="an existing Dask cluster (default: a local cluster)",
+    )
     p.set_defaults(func=cmd_demo)
 
-    add_simulate_parsers(sub)
-    add_accuracy_parser(sub, parse_resolution)
-    add_sweep_parsers(sub)
 
+def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     p = sub.add_parser(
         "bench",
+        formatter_class=HelpFormatter,
         help="benchmark the reference tracer against Embree (BVH build, rays/s, one thread)",
+        description="Runs rtsim-bench: BVH build time and closest-hit and any-hit rays/s of "
+        "rtsim and Embree on one thread (docs/benchmarks.md).",
     )
     p.add_argument(
         "scene",
@@ -286,10 +385,26 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="glTF file, built-in or shared scene name (default: the shared Sponza)",
     )
-    p.add_argument("--json", metavar="FILE", default=None, help="also write the figures as JSON")
-    p.add_argument("--repeat", type=positive_int, default=5, metavar="N", help="runs per figure")
-    p.add_argument("--resolution", type=parse_resolution, default=None, metavar="WxH")
-    p.add_argument("--hairball-triangles", type=positive_int, default=None, metavar="N")
+    p.add_argument(
+        "--json", metavar="FILE", default=None, help="also write the figures as JSON (default: no)"
+    )
+    p.add_argument(
+        "--repeat", type=positive_int, default=5, metavar="N", help="runs per figure (median)"
+    )
+    p.add_argument(
+        "--resolution",
+        type=parse_resolution,
+        default=None,
+        metavar="WxH",
+        help="primary ray image size (default: rtsim-bench's, 640x480)",
+    )
+    p.add_argument(
+        "--hairball-triangles",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="triangles of the hairball scene (default: rtsim-bench's)",
+    )
     p.add_argument(
         "--accel",
         default=None,
@@ -297,12 +412,34 @@ def build_parser() -> argparse.ArgumentParser:
         help="structures to benchmark; the first is 'rtsim' in the summary (default: bvh8,bvh2)",
     )
     p.set_defaults(func=cmd_bench)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="rtsim",
+        description="rtsim: a simulator of ray-tracing hardware. Trace a glTF scene with the "
+        "reference tracer, replay the trace on the SystemC accelerator model (every hit checked), "
+        "sweep accelerator configurations and report on them.",
+        formatter_class=HelpFormatter,
+        epilog="`rtsim COMMAND --help` describes each command's options and their defaults.",
+    )
+    parser.add_argument("--version", action="version", version=f"rtsim {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add_trace_parser(sub)
+    add_scene_parsers(sub)
+    add_demo_parser(sub)
+    add_simulate_parsers(sub)
+    add_accuracy_parser(sub, parse_resolution)
+    add_sweep_parsers(sub)
+    add_bench_parser(sub)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    from rich.console import Console
+
     console = Console()
     try:
         return int(args.func(args, console))

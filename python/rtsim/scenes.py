@@ -1,5 +1,8 @@
 """Where scenes come from: built-in procedural scenes and the shared glTF scene folder.
 
+``resolve_scene`` is the one resolver of scene names: the command line, ``rtsim.load_scene``,
+``rtsim.trace_scene``, ``rtsim.write_trace``, sweeps and ``rtsim accuracy`` all use it.
+
 The shared folder is ``$RTSIM_SCENES`` if set, else the first ``shared/scenes`` found beside
 the current directory or one of its parents (a clone of the repo sits next to ``shared/``), else
 ``../shared/scenes`` beside the source tree the package was built from.
@@ -11,7 +14,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from rtsim._core import default_scenes_dir, procedural_scene_names
+from rtsim.errors import UnknownSceneError
 
 SCENE_SUFFIXES = (".gltf", ".glb")
 
@@ -36,6 +39,8 @@ def shared_scenes_dir() -> Path | None:
         for candidate in (base / "shared" / "scenes", base / "scenes"):
             if candidate.is_dir() and any(_scene_files(candidate)):
                 return candidate
+    from rtsim._core import default_scenes_dir
+
     built_with = Path(default_scenes_dir).resolve()
     return built_with if built_with.is_dir() else None
 
@@ -58,14 +63,23 @@ def shared_scenes() -> list[SceneEntry]:
     return entries
 
 
+def procedural_scene_names() -> list[str]:
+    from rtsim._core import procedural_scene_names as names
+
+    return list(names())
+
+
 def list_scenes() -> list[SceneEntry]:
     built_in = [SceneEntry(name=n, kind="built-in") for n in procedural_scene_names()]
     return built_in + shared_scenes()
 
 
-def resolve_scene(text: str) -> str:
+def resolve_scene(name: str | os.PathLike[str]) -> str:
     """A path for an existing file; a built-in name as is; a shared scene's folder or file name
-    (case-insensitive) as its glTF path; anything else unchanged (the loader names it)."""
+    (case-insensitive) as its glTF path; a path that does not exist unchanged (the loader names
+    it). A bare name that is none of these raises UnknownSceneError (a ValueError and an
+    RtsimError) saying where it looked."""
+    text = os.fspath(name)
     if Path(text).is_file() or text in procedural_scene_names():
         return text
     wanted = text.lower()
@@ -80,5 +94,7 @@ def resolve_scene(text: str) -> str:
             f"shared scenes in {folder}" if folder else "no shared scene folder (set RTSIM_SCENES)"
         )
         names = ", ".join(procedural_scene_names())
-        raise ValueError(f"unknown scene '{text}': not a file, not built in ({names}), {where}")
+        raise UnknownSceneError(
+            f"unknown scene '{text}': not a file, not built in ({names}), {where}"
+        )
     return text

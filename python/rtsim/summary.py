@@ -7,8 +7,8 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from rtsim.kinds import RAY_KINDS
 from rtsim.manifest import find
-from rtsim.trace_file import RAY_KINDS
 
 
 def _num(value: Any, digits: int = 2) -> str:

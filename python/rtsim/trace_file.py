@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from rtsim._core import RtsimError, trace_sections, verify_trace
+from rtsim.kinds import RAY_KINDS as RAY_KINDS  # RayKind values stored in RayRecord.kind
 
 TRACE_FILE = "trace.rtt"
 MANIFEST_FILE = "manifest.json"
@@ -132,9 +133,6 @@ REGION_DTYPES: dict[tuple[str, str], np.dtype] = {
     ("grid", "cells"): CELL_DTYPE,
     ("grid", "prim_refs"): np.dtype("<u4"),
 }
-
-#: RayKind values stored in RayRecord.kind.
-RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
 
 
 @dataclass(frozen=True)

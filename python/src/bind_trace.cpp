@@ -13,9 +13,13 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "python/src/bindings.h"
+#include "python/src/ray_args.h"
+#include "traces/accel/accel.h"
+#include "traces/accel/bvh2/bvh2.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_reader.h"
-#include "traces/accel/bvh2/bvh2.h"
+#include "traces/scene/procedural.h"
+#include "traces/tracer/ray_trace.h"
 #include "traces/tracer/tracer.h"
 
 namespace py = pybind11;
@@ -32,66 +36,23 @@ struct PyHit {
     float u;
     float v;
     bool valid;  ///< false: the ray was rejected as invalid (NaN, zero direction, tmin > tmax)
+    WorkCounts work;  ///< the reference traversal's work (numpy fields: bind_trace below)
 };
-
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-
-/// (N, 3) float array or a ValueError naming the argument.
-FloatArray as_vectors(const py::handle& obj, const char* name) {
-    FloatArray a = FloatArray::ensure(obj);
-    if (!a) throw py::value_error(std::string(name) + ": expected an array of floats");
-    if (a.ndim() != 2 || a.shape(1) != 3) {
-        std::string shape = "(";
-        for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
-        throw py::value_error(std::string(name) + ": expected shape (N, 3), got " + shape +
-                              (a.ndim() == 1 ? ",)" : ")"));
-    }
-    return a;
-}
-
-/// A scalar (broadcast) or an (N,) array; returns the values and the stride (0 or 1).
-std::pair<FloatArray, py::ssize_t> as_limits(const py::handle& obj, py::ssize_t n, const char* name) {
-    FloatArray a = FloatArray::ensure(obj);
-    if (!a) throw py::value_error(std::string(name) + ": expected a float or an array of floats");
-    if (a.ndim() == 0) return {a, 0};
-    if (a.ndim() == 1 && a.shape(0) == n) return {a, 1};
-    if (a.ndim() == 1 && a.shape(0) == 1) return {a, 0};
-    throw py::value_error(std::string(name) + ": expected a scalar or shape (" + std::to_string(n) +
-                          ",), got an array with " + std::to_string(a.ndim()) + " dimensions and " +
-                          std::to_string(a.size()) + " elements");
-}
 
 py::array trace_rays(PyScene& scene, const py::object& origins, const py::object& directions,
                      const py::object& tmin, const py::object& tmax, bool any_hit) {
-    FloatArray o = as_vectors(origins, "origins");
-    FloatArray d = as_vectors(directions, "directions");
-    const py::ssize_t n = o.shape(0);
-    if (d.shape(0) != n) {
-        throw py::value_error("directions: expected " + std::to_string(n) +
-                              " rays (as many as origins), got " + std::to_string(d.shape(0)));
-    }
-    auto [lo, lo_step] = as_limits(tmin, n, "tmin");
-    auto [hi, hi_step] = as_limits(tmax, n, "tmax");
-
+    const std::vector<Ray> rays = rays_from_arrays(origins, directions, tmin, tmax);
     const HwBvh& bvh = scene.bvh();  // builds with the GIL held on entry
-    py::array_t<PyHit> out(n);
+    py::array_t<PyHit> out(static_cast<py::ssize_t>(rays.size()));
     PyHit* hits = out.mutable_data();
-    const float* po = o.data();
-    const float* pd = d.data();
-    const float* plo = lo.data();
-    const float* phi = hi.data();
     const TraversalMode mode = any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
     {
         py::gil_scoped_release release;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            Ray ray;
-            ray.origin = Vec3(po[3 * i], po[3 * i + 1], po[3 * i + 2]);
-            ray.direction = Vec3(pd[3 * i], pd[3 * i + 1], pd[3 * i + 2]);
-            ray.tmin = plo[i * lo_step];
-            ray.tmax = phi[i * hi_step];
-            const bool valid = ray_is_valid(ray);
-            const Hit h = valid ? trace_ray(bvh, ray, mode) : Hit{};
-            hits[i] = PyHit{h.prim, h.inst, h.t, h.u, h.v, valid};
+        for (size_t i = 0; i < rays.size(); ++i) {
+            const bool valid = ray_is_valid(rays[i]);
+            WorkCounts work;
+            const Hit h = valid ? trace_ray(bvh, rays[i], mode, &work) : Hit{};
+            hits[i] = PyHit{h.prim, h.inst, h.t, h.u, h.v, valid, work};
         }
     }
     return std::move(out);
@@ -155,7 +116,7 @@ std::string scene_name(const py::object& obj) {
 }
 
 py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
-                          const std::vector<std::string>& workload, uint32_t width,
+                          const std::optional<std::vector<std::string>>& workload, uint32_t width,
                           uint32_t height, uint32_t bounces, uint64_t seed,
                           const py::object& camera, unsigned threads, uint32_t hairball_triangles,
                           const py::object& progress, const std::string& accel, const std::string& builder) {
@@ -164,8 +125,10 @@ py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
     opt.accel.builder = builder;
     opt.scene = scene_name(scene);
     opt.out_dir = out_dir.string();
-    opt.workload.clear();
-    for (const std::string& kind : workload) opt.workload.push_back(parse_ray_kind(kind.c_str()));
+    if (workload) {  // None: every kind the scene calls for
+        if (workload->empty()) throw py::value_error("workload: empty list (None: what the scene calls for)");
+        for (const std::string& kind : *workload) opt.workload.push_back(parse_ray_kind(kind.c_str()));
+    }
     if (width == 0 || height == 0) throw py::value_error("width and height must be positive");
     opt.width = width;
     opt.height = height;
@@ -181,6 +144,57 @@ py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
     {
         py::gil_scoped_release release;
         manifest = trace_scene(opt, fn).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    }
+    return py::module_::import("json").attr("loads")(manifest);
+}
+
+/// How a Scene is named in a manifest: a procedural scene by its name, a file by its stem.
+SceneLabel label_of(const Scene& scene) {
+    const bool procedural = !fs::is_regular_file(scene.source) && is_procedural_scene(scene.source);
+    return {procedural ? scene.source : fs::path(scene.source).stem().string(), procedural};
+}
+
+/// write_trace: user rays (one kind and any-hit flag per ray) traced and written as a trace.
+py::object write_trace_py(PyScene& scene, const py::object& origins, const py::object& directions,
+                          const py::object& tmin, const py::object& tmax,
+                          const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& kinds,
+                          const py::array_t<bool, py::array::c_style | py::array::forcecast>& any_hit,
+                          const fs::path& out_dir, unsigned threads, const py::object& progress,
+                          const std::string& accel, const std::string& builder) {
+    const std::vector<Ray> rays = rays_from_arrays(origins, directions, tmin, tmax);
+    const auto n = static_cast<py::ssize_t>(rays.size());
+    if (kinds.ndim() != 1 || kinds.shape(0) != n)
+        throw py::value_error("kind: expected one ray kind per ray (" + std::to_string(n) + ")");
+    if (any_hit.ndim() != 1 || any_hit.shape(0) != n)
+        throw py::value_error("any_hit: expected one flag per ray (" + std::to_string(n) + ")");
+    std::vector<PendingRay> pending(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const uint8_t kind = kinds.data()[i];
+        if (kind >= kRayKindCount)
+            throw py::value_error("kind: ray " + std::to_string(i) + " has kind " + std::to_string(kind) +
+                                  " (0..4: primary, shadow, reflection, diffuse, refraction)");
+        pending[i].ray = rays[i];
+        pending[i].kind = RayKind(kind);
+        pending[i].pixel = uint32_t(i);
+        pending[i].any_hit = any_hit.data()[i];
+    }
+    AccelOptions accel_options;
+    accel_options.kind = accel;
+    accel_options.builder = builder;
+    validate_accel_options(accel_options);
+    RayTraceOptions opt;
+    opt.out_dir = out_dir.string();
+    opt.threads = threads;
+    const ProgressFn fn = make_progress(progress);
+    const SceneLabel label = label_of(scene.scene());
+    std::string manifest;
+    {
+        // The structure is built exactly as trace_scene builds it (traces/accel/accel.h).
+        py::gil_scoped_release release;
+        const std::unique_ptr<Accel> built =
+            load_accel(build_accel(scene.scene(), accel_options), label.name + ": built " + accel);
+        manifest = write_ray_trace(scene.scene(), label, *built, pending, opt, fn)
+                       .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     }
     return py::module_::import("json").attr("loads")(manifest);
 }
@@ -211,23 +225,36 @@ py::list trace_sections(const fs::path& path) {
 }  // namespace
 
 void bind_trace(py::module_& m) {
-    PYBIND11_NUMPY_DTYPE(PyHit, prim, inst, t, u, v, valid);
+    // The one mapping of the C++ WorkCounts fields to Python names (trace_rays' `work` field).
+    PYBIND11_NUMPY_DTYPE(WorkCounts, steps, box_tests, tri_tests, anyhit_calls, transforms,
+                         cell_steps, plane_tests, refs);
+    PYBIND11_NUMPY_DTYPE(PyHit, prim, inst, t, u, v, valid, work);
 
     m.def("trace_rays", &trace_rays, py::arg("scene"), py::arg("origins"), py::arg("directions"),
           py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
           py::arg("any_hit") = false,
           "Traces rays (origins and directions: (N, 3)) through the scene's reference BVH.\n"
-          "Returns a structured array with fields prim (-1: miss), inst, t, u, v and valid\n"
-          "(False for rays rejected as invalid: NaN, zero direction, tmin > tmax).");
+          "Returns a structured array with fields prim (-1: miss), inst, t, u, v, valid\n"
+          "(False for rays rejected as invalid: NaN, zero direction, tmin > tmax) and work,\n"
+          "the traversal's work counts (work.dtype.names: the C++ WorkCounts fields).");
     m.def("trace_scene", &trace_scene_py, py::arg("scene"), py::arg("out_dir"),
-          py::arg("workload") = std::vector<std::string>{"primary"}, py::arg("width") = 320u,
+          py::arg("workload") = py::none(), py::arg("width") = 320u,
           py::arg("height") = 240u, py::arg("bounces") = 1u, py::arg("seed") = 1u,
           py::arg("camera") = py::none(), py::arg("threads") = 0u,
           py::arg("hairball_triangles") = 200000u, py::arg("progress") = py::none(),
           py::arg("accel") = "bvh2", py::arg("builder") = "",
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
-          "returns the manifest. progress(done, total, stage) is called now and then.\n"
-          "accel and builder choose the acceleration structure (accel_kinds()).");
+          "returns the manifest. workload: ray kinds (None: every kind the scene calls for).\n"
+          "progress(done, total, stage) is called now and then. accel and builder choose the\n"
+          "acceleration structure (accel_kinds()).");
+    m.def("write_trace", &write_trace_py, py::arg("scene"), py::arg("origins"),
+          py::arg("directions"), py::arg("tmin"), py::arg("tmax"), py::arg("kinds"),
+          py::arg("any_hit"), py::arg("out_dir"), py::arg("threads") = 0u,
+          py::arg("progress") = py::none(), py::arg("accel") = "bvh2",
+          py::arg("builder") = "binned",
+          "Traces the given rays (kinds: RayKind per ray, any_hit: flag per ray) and writes\n"
+          "OUT/trace.rtt and manifest.json exactly as trace_scene writes a workload; returns\n"
+          "the manifest. Use rtsim.write_trace, which takes kind names and scene names.");
     m.def(
         "accel_kinds",
         [] {

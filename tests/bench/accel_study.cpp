@@ -19,6 +19,7 @@
 #include "oracle_rays.h"
 #include "traces/accel/accel.h"
 #include "traces/accel/wide/wide.h"
+#include "traces/common/build_info.h"
 #include "traces/bvh/build_tree.h"
 
 namespace rtsim::bench {
@@ -103,7 +104,7 @@ int run(const Args& args) {
     const std::string scratch = (std::filesystem::temp_directory_path() / "rtsim_accel_study").string();
     const Scene scene = oracle::load_named_scene(args.scene, scratch, args.procedural);
     json j = {{"scene", args.scene}, {"triangles", scene.triangle_count()}, {"repeat", args.repeat},
-              {"git", RTSIM_GIT_HASH}, {"structures", json::object()}};
+              {"git", rtsim_git_hash()}, {"structures", json::object()}};
     std::printf("%-14s %9s %9s %12s %9s %9s %10s\n", "structure", "build ms", "cpu ms", "footprint", "nodes", "SAH",
                 "SAH greedy");
     for (const std::string& kind : args.accel) {

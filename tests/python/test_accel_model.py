@@ -17,7 +17,7 @@ import pytest
 
 import rtsim
 from conftest import run_rtsim
-from rtsim.simulate import SimNotFoundError, find_sim
+from rtsim.launcher import SimNotFoundError, find_sim
 
 KINDS = ["bvh4", "bvh6", "bvh8", "cwbvh6", "cwbvh8", "bvh8_octant", "cwbvh8_octant"]
 NODE_BYTES = {"bvh4": 128, "bvh6": 192, "bvh8": 256, "cwbvh6": 64, "cwbvh8": 80}

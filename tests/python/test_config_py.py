@@ -20,7 +20,7 @@ from rtsim.config import (
     config_keys,
     field_info,
 )
-from rtsim.simulate import find_sim
+from rtsim.launcher import find_sim
 
 
 def sim_json(*args: str) -> Any:

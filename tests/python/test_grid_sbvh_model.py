@@ -15,7 +15,7 @@ import pytest
 
 import rtsim
 from conftest import run_rtsim
-from rtsim.simulate import SimNotFoundError, find_sim
+from rtsim.launcher import SimNotFoundError, find_sim
 
 STRUCTURES = {
     "grid": ["--accel", "grid"],

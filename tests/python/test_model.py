@@ -22,8 +22,8 @@ import pytest
 
 import rtsim
 from conftest import run_rtsim
-from rtsim.simulate import SimNotFoundError
-from rtsim.simulate import find_sim as sim_executable
+from rtsim.launcher import SimNotFoundError
+from rtsim.launcher import find_sim as sim_executable
 
 SIM_EXE = "rtsim-sim"
 RESOLUTION = "48x32"
@@ -66,7 +66,7 @@ NOISE = 1.02  # timing comparisons allow 2% (rays interleave differently when ti
 
 
 def find_sim() -> Path:
-    """The rtsim-sim the package would run (rtsim.simulate.find_sim), or fail the test."""
+    """The rtsim-sim the package would run (rtsim.launcher.find_sim), or fail the test."""
     try:
         return sim_executable()
     except SimNotFoundError as error:

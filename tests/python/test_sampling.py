@@ -20,7 +20,7 @@ from typing import Any
 import pytest
 
 from conftest import REPO, run_rtsim
-from rtsim.simulate import find_sim
+from rtsim.launcher import find_sim
 
 # Two units of four contexts: few rays in flight, so a small trace has many clusters.
 SMALL_MACHINE = ["traversal.units=2", "traversal.ray_contexts=4"]

@@ -13,7 +13,7 @@ import pytest
 
 import rtsim
 from conftest import REPO, rtsim_command, run_rtsim
-from rtsim.simulate import parse_progress
+from rtsim.launcher import parse_progress
 
 
 @pytest.fixture(scope="module")

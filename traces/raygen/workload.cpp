@@ -55,7 +55,10 @@ bool material_refracts(const Material& m) { return m.transmission > 0.0f; }
 
 WorkloadPlan plan_workload(const Scene& scene, const std::vector<RayKind>& requested) {
     WorkloadPlan plan;
-    auto asked = [&](RayKind k) { return std::find(requested.begin(), requested.end(), k) != requested.end(); };
+    const bool scene_default = requested.empty();  // every kind the scene calls for
+    auto asked = [&](RayKind k) {
+        return scene_default || std::find(requested.begin(), requested.end(), k) != requested.end();
+    };
     std::vector<bool> used = used_materials(scene);
     plan_emissive(scene, used, &plan);
 
@@ -77,7 +80,7 @@ WorkloadPlan plan_workload(const Scene& scene, const std::vector<RayKind>& reque
         if (!asked(kind)) {
             e.why = "not requested" + (called_for ? " (the scene has " + because + ")" : "");
         } else if (!called_for) {
-            e.why = "requested, but " + not_because;
+            e.why = scene_default ? not_because : "requested, but " + not_because;
         } else {
             e.simulated = true;
             e.why = because;

@@ -33,8 +33,11 @@ struct WorkloadPlan {
     bool wants(RayKind kind) const { return generate[size_t(kind)]; }
 };
 
-/// Derives the plan from the scene and the kinds the user asked for. Asked-for kinds the scene
-/// does not call for are dropped with the reason; kinds not asked for are listed as such.
+/// Derives the plan from the scene and the kinds the user asked for. An empty request is the
+/// default: every kind the scene calls for (primary and diffuse always; shadow, reflection and
+/// refraction when lights, metallic or smooth, transmissive materials are present). An explicit
+/// request narrows it: asked-for kinds the scene does not call for are dropped with the reason,
+/// kinds not asked for are listed as such.
 WorkloadPlan plan_workload(const Scene& scene, const std::vector<RayKind>& requested);
 
 /// A surface sends reflection rays when it is metallic or smooth.

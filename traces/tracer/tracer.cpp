@@ -3,16 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 
-#include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
-#include "traces/format/trace_writer.h"
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
 #include "traces/scene/gltf_loader.h"
-#include "traces/tracer/manifest.h"
 #include "traces/tracer/preview_render.h"
+#include "traces/tracer/trace_folder.h"
 #include "traces/tracer/wavefront.h"
 #include "traces/common/build_info.h"
 
@@ -50,26 +47,6 @@ std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint3
             r.pixel = y * w + x;
         }
     return rays;
-}
-
-/// Writes the rays of a traced wavefront that the workload asked for, in order.
-void write_wavefront(TraceWriter& writer, const WorkloadPlan& plan, const std::vector<PendingRay>& rays,
-                     const WavefrontResult& res, RayCounts* counts) {
-    std::vector<RayRecord> ray_rec;
-    std::vector<HitRecord> hit_rec;
-    std::vector<WorkRecord> work_rec;
-    for (size_t i = 0; i < rays.size(); ++i) {
-        const PendingRay& r = rays[i];
-        bool written = plan.wants(r.kind);
-        counts->add(r.kind, r.depth, res.hits[i], res.work[i], written);
-        if (!written) continue;
-        ray_rec.push_back(to_record(r.ray, r.kind, r.pixel, r.depth, r.any_hit));
-        hit_rec.push_back(to_record(res.hits[i]));
-        work_rec.push_back(to_record(res.work[i]));
-    }
-    writer.append(SectionKind::rays, ray_rec);
-    writer.append(SectionKind::hits, hit_rec);
-    writer.append(SectionKind::work, work_rec);
 }
 
 /// Next wavefront: secondaries of every path ray, grouped by kind (stable), so a trace lists
@@ -126,37 +103,26 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     Camera camera = choose_camera(o, scene, *accel, &camera_source);
     PinholeCamera pinhole = make_camera(camera, o.width, o.height);
 
-    auto t_trace = std::chrono::steady_clock::now();
-    TraceWriter writer((fs::path(o.out_dir) / "trace.rtt").string());
-    write_accel_image(writer, accel->image());
+    TraceFolderWriter folder(o.out_dir, accel->image());
     uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
     PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
     SpawnContext ctx{&scene, &plan, o.bounces, o.seed};
-    RayCounts counts;
 
     std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height);
     for (uint32_t depth = 0; !wave.empty(); ++depth) {
         std::string stage = depth == 0 ? "primary" : "depth " + std::to_string(depth);
         WavefrontResult res = trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
-        counts.add_rejected(res.rejected);
-        write_wavefront(writer, plan, wave, res, &counts);
+        folder.add_wavefront(plan, wave, res);
         render.add(scene, wave, res.hits);
         wave = next_wavefront(ctx, wave, res.hits);
     }
-    writer.close();
-    double trace_ms = ms_since(t_trace);
-    render.write_png((fs::path(o.out_dir) / "render.png").string());
 
-    std::string name = procedural ? o.scene : fs::path(path).stem().string();
-    json requested = json::array();
-    for (RayKind k : o.workload) requested.push_back(ray_kind_name(k));
-    json manifest = {
-        {"format", "rtsim-trace"},
-        {"trace_version", kTraceVersion},
-        {"rtsim_version", rtsim_version()},
-        {"git", rtsim_git_hash()},
-        {"scene", scene_json(scene, name, procedural)},
-        {"accel", accel_json(accel->image())},
+    json requested = "scene";  // the default: every kind the scene calls for
+    if (!o.workload.empty()) {
+        requested = json::array();
+        for (RayKind k : o.workload) requested.push_back(ray_kind_name(k));
+    }
+    json extra = {
         {"camera", camera_json(camera, camera_source)},
         {"workload",
          {{"requested", requested},
@@ -164,12 +130,11 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
           {"bounces", o.bounces},
           {"seed", o.seed},
           {"effects", effects_json(plan)}}},
-        {"counts", counts.to_json()},
-        {"files", {{"trace", "trace.rtt"}, {"render", "render.png"}}},
-        {"timing_ms", {{"load", load_ms}, {"accel", accel->image().build_ms}, {"trace", trace_ms}, {"total", ms_since(t_start)}}},
+        {"files", {{"render", "render.png"}}},
     };
-    std::ofstream((fs::path(o.out_dir) / "manifest.json").string()) << manifest.dump(2) << "\n";
-    return manifest;
+    SceneLabel label{procedural ? o.scene : fs::path(path).stem().string(), procedural};
+    render.write_png((fs::path(o.out_dir) / "render.png").string());
+    return folder.finish(scene, label, accel->image(), load_ms, t_start, std::move(extra));
 }
 
 }  // namespace rtsim

@@ -28,9 +28,9 @@ struct CameraOverride {
 struct TraceOptions {
     std::string scene;    ///< .gltf/.glb path, or a procedural scene name ("cornell", ...)
     std::string out_dir;  ///< created if missing
-    /// Ray kinds requested. Kinds the scene does not call for are skipped, and the manifest says
-    /// why. Empty means primary only.
-    std::vector<RayKind> workload{RayKind::primary};
+    /// Ray kinds requested. Empty (the default): every kind the scene calls for. A list narrows
+    /// it; listed kinds the scene does not call for are skipped, and the manifest says why.
+    std::vector<RayKind> workload;
     uint32_t width = 320;
     uint32_t height = 240;
     uint32_t bounces = 1;  ///< diffuse bounce depth (and reflection/refraction depth)

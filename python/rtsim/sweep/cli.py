@@ -10,14 +10,16 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from rich.console import Console
-from rich.table import Table
+from rtsim.cli_help import HelpFormatter
 
-from rtsim.sweep.results import key_value, tidy_rows, to_csv
-from rtsim.sweep.runner import SweepOptions, SweepOutcome, run_sweep
-from rtsim.sweep.spec import SpecError, load_spec
-from rtsim.sweep.store import RunRecord, open_store
+# Only the parsers are built at import time (every `rtsim` command builds them): the sweep
+# machinery (Dask, numpy, yaml, rich) is imported by the commands that use it.
+if TYPE_CHECKING:
+    from rich.console import Console
+
+    from rtsim.sweep.runner import SweepOutcome
 
 
 def print_outcome(outcome: SweepOutcome, out: Path, console: Console) -> None:
@@ -34,6 +36,9 @@ def print_outcome(outcome: SweepOutcome, out: Path, console: Console) -> None:
 
 
 def cmd_sweep(args: argparse.Namespace, console: Console) -> int:
+    from rtsim.sweep.runner import SweepOptions, run_sweep
+    from rtsim.sweep.spec import SpecError, load_spec
+
     try:
         spec = load_spec(Path(args.spec))
     except SpecError as err:
@@ -53,6 +58,11 @@ def cmd_sweep(args: argparse.Namespace, console: Console) -> int:
 
 
 def cmd_results(args: argparse.Namespace, console: Console) -> int:
+    from rich.table import Table
+
+    from rtsim.sweep.results import tidy_rows, to_csv
+    from rtsim.sweep.store import open_store
+
     with open_store(Path(args.sweep), readonly=True) as store:
         records = list(store.runs())
     if args.csv is not None:
@@ -103,12 +113,13 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
     """Registers `sweep`, `results` and `report` on the `rtsim` subcommand parser."""
     p = sub.add_parser(
         "sweep",
+        formatter_class=HelpFormatter,
         help="run a design-space sweep (scenes x workloads x configs) on Dask",
         description="Runs every scene x workload x config point of SPEC (docs/sweeps.md), one "
         "rtsim-sim process per run, into SWEEP/results.sqlite. Re-running resumes: finished runs "
         "are skipped. Exit 0 when every run is ok, 1 if any failed, 2 for a bad spec.",
     )
-    p.add_argument("spec", metavar="SPEC.yaml")
+    p.add_argument("spec", metavar="SPEC.yaml", help="the sweep spec (docs/sweeps.md)")
     p.add_argument("-o", "--output", required=True, metavar="SWEEP", help="sweep folder")
     p.add_argument(
         "--scheduler",
@@ -134,7 +145,13 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_sweep)
 
-    p = sub.add_parser("results", help="a sweep's results: a summary table, or --csv")
+    p = sub.add_parser(
+        "results",
+        formatter_class=HelpFormatter,
+        help="a sweep's results: a summary table, or --csv",
+        description="Prints a summary table of a sweep's runs, or writes the tidy table (one "
+        "row per run: config keys and summary stats) as CSV.",
+    )
     p.add_argument("sweep", metavar="SWEEP", help="sweep folder (holds results.sqlite)")
     p.add_argument(
         "--csv",
@@ -142,13 +159,23 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         const="-",
         default=None,
         metavar="FILE",
-        help="write the tidy table (one row per run) as CSV to FILE or stdout",
+        help="write the tidy table (one row per run) as CSV to FILE, or stdout if no FILE "
+        "(default: print the summary table instead)",
     )
     p.set_defaults(func=cmd_results)
 
-    p = sub.add_parser("report", help="write a sweep's HTML report (figures embedded)")
+    p = sub.add_parser(
+        "report",
+        formatter_class=HelpFormatter,
+        help="write a sweep's HTML report (figures embedded)",
+        description="Writes one self-contained HTML page from a sweep's results store.",
+    )
     p.add_argument("sweep", metavar="SWEEP", help="sweep folder (holds results.sqlite)")
     p.add_argument(
-        "-o", "--output", default=None, metavar="report.html", help="default: SWEEP/report.html"
+        "-o",
+        "--output",
+        default=None,
+        metavar="report.html",
+        help="the HTML file to write (default: SWEEP/report.html)",
     )
     p.set_defaults(func=cmd_report)

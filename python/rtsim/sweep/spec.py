@@ -17,10 +17,10 @@ import numpy as np
 import yaml
 
 from rtsim.config import ConfigError, SimConfig, apply_patch, compose, field_info, unflatten
+from rtsim.kinds import RAY_KINDS
 from rtsim.scenes import resolve_scene
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
-RAY_KINDS = ("primary", "shadow", "reflection", "diffuse", "refraction")
 SAMPLING_METHODS = ("random", "latin_hypercube")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
 TOP_KEYS = ("name", "scenes", "workloads", "config", "grid", "sampling", "timeout", "baseline")
@@ -53,7 +53,7 @@ class SceneSpec:
 @dataclass(frozen=True)
 class WorkloadSpec:
     label: str
-    rays: tuple[str, ...]
+    rays: tuple[str, ...]  # empty: every kind the scene calls for (the tracer's default)
     width: int
     height: int
     bounces: int = 1
@@ -61,7 +61,7 @@ class WorkloadSpec:
 
     def key(self) -> dict[str, Any]:
         return {
-            "rays": list(self.rays),
+            "rays": list(self.rays) or "scene",
             "width": self.width,
             "height": self.height,
             "bounces": self.bounces,
@@ -242,11 +242,12 @@ class _Reader:
         allowed = ("name", "rays", "resolution", "bounces", "seed")
         d = self.mapping(items, i, f"workloads[{i}]", allowed)
         path = f"workloads[{i}]"
-        rays = d.get("rays", ["primary"])
+        rays = d.get("rays", [])  # absent: what the scene calls for
+        explicit = "rays" in d
         if isinstance(rays, str):
             rays = [r.strip() for r in rays.split(",") if r.strip()]
         bad = [r for r in rays if r not in RAY_KINDS] if isinstance(rays, list) else [rays]
-        if bad or not rays:
+        if bad or (explicit and not rays):
             raise self.fail(
                 d,
                 "rays",
@@ -259,7 +260,7 @@ class _Reader:
             raise self.fail(d, "resolution", f"{path}.resolution", f"expected WxH, got {res!r}")
         bounces = self.number(d, "bounces", f"{path}.bounces", True) if "bounces" in d else 1
         seed = self.number(d, "seed", f"{path}.seed", True) if "seed" in d else 1
-        label = str(d.get("name") or "-".join(rays))
+        label = str(d.get("name") or "-".join(rays) or "scene")
         return WorkloadSpec(label, tuple(rays), int(w), int(h), bounces, seed)
 
     def config_value(self, parent: Any, key: Any, path: str, config_key: str, value: Any) -> None:

@@ -1,8 +1,8 @@
 """What a Dask worker runs: make one trace (`rtsim trace` as a subprocess) or one simulation
-(`rtsim-sim` as a subprocess, docs/architecture.md, rule 4). Both never raise: every failure,
-crash or timeout comes back as a dict with status "failed" and the tail of the process's stderr,
-so the client records it and the sweep goes on. Paths are absolute: with --scheduler the workers
-must see the sweep folder at the same path (a shared file system).
+(`rtsim-sim` through rtsim/launcher.py; docs/architecture.md, rule 4). Both never raise: every
+failure, crash or timeout comes back as a dict with status "failed" and the tail of the process's
+stderr, so the client records it and the sweep goes on. Paths are absolute: with --scheduler the
+workers must see the sweep folder at the same path (a shared file system).
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def stderr_tail(text: str, lines: int = ERROR_TAIL_LINES) -> str:
 class TraceTask:
     trace_dir: str
     scene: str
-    rays: list[str]
+    rays: list[str]  # empty: every kind the scene calls for
     width: int
     height: int
     bounces: int
@@ -45,6 +45,7 @@ class TraceTask:
     hairball_triangles: int
 
     def command(self, out: str) -> list[str]:
+        workload = ["--workload", ",".join(self.rays)] if self.rays else []
         return [
             sys.executable,
             "-m",
@@ -53,8 +54,7 @@ class TraceTask:
             self.scene,
             "-o",
             out,
-            "--workload",
-            ",".join(self.rays),
+            *workload,
             "--resolution",
             f"{self.width}x{self.height}",
             "--bounces",
@@ -135,34 +135,30 @@ def run_sim(task: SimTask, trace: dict[str, Any] | None = None) -> dict[str, Any
     if trace is not None and not trace.get("ok"):
         return done(_failed(f"no trace: {trace.get('error')}", exit_code=None))
     try:
-        from rtsim.simulate import find_sim
+        from rtsim.launcher import SimJob, find_sim
+        from rtsim.launcher import run_sim as launch
 
         exe = find_sim()
     except (ImportError, OSError) as err:
         return done(_failed(str(err), exit_code=None))
     run = Path(task.run_dir)
     run.mkdir(parents=True, exist_ok=True)
-    for stale in ("stats.json", "config.resolved.json", "provenance.json"):
-        (run / stale).unlink(missing_ok=True)
     (run / "config.json").write_text(json.dumps(task.config, indent=2, sort_keys=True) + "\n")
-    cmd = [str(exe), task.trace_dir, "--config", str(run / "config.json"), "-o", str(run)]
-    (run / "command.txt").write_text(" ".join(cmd) + "\n")
+    job = SimJob(trace=Path(task.trace_dir), out_dir=run, config=run / "config.json")
+    (run / "command.txt").write_text(" ".join(job.command(exe)) + "\n")
     try:
-        proc = subprocess.run(
-            cmd, capture_output=True, text=True, timeout=task.timeout, check=False, errors="replace"
-        )
-    except subprocess.TimeoutExpired as err:
-        tail = stderr_tail(err.stderr.decode(errors="replace") if err.stderr else "")
-        msg = f"timed out after {task.timeout:g} s" + (f": {tail}" if tail else "")
-        return done(_failed(msg, exit_code=None))
+        result = launch(job, exe=exe, timeout=task.timeout)
     except OSError as err:
         return done(_failed(f"cannot run {exe}: {err}", exit_code=None))
-    (run / "stderr.log").write_text(proc.stderr)
-    return done(_outcome(proc.returncode, proc.stderr, run))
+    if result.timed_out:
+        tail = stderr_tail(result.stderr)
+        msg = f"timed out after {task.timeout:g} s" + (f": {tail}" if tail else "")
+        return done(_failed(msg, exit_code=None))
+    (run / "stderr.log").write_text(result.stderr)
+    return done(_outcome(result.returncode, result.stderr, result.stats))
 
 
-def _outcome(code: int, stderr: str, run: Path) -> dict[str, Any]:
-    stats = _read_json(run / "stats.json")
+def _outcome(code: int, stderr: str, stats: dict[str, Any] | None) -> dict[str, Any]:
     if code not in (0, 3):
         what = f"killed by signal {-code}" if code < 0 else f"exit code {code}"
         return _failed(f"rtsim-sim {what}: {stderr_tail(stderr) or '(no message)'}", exit_code=code)
@@ -179,11 +175,3 @@ def _outcome(code: int, stderr: str, run: Path) -> dict[str, Any]:
         "stats": stats,
         "provenance": stats.get("provenance"),
     }
-
-
-def _read_json(path: Path) -> dict[str, Any] | None:
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError):
-        return None
-    return data if isinstance(data, dict) else None

@@ -140,3 +140,21 @@ TEST(RayGen, PlanFollowsTheScene) {
         }
     }
 }
+
+TEST(RayGen, EmptyRequestIsWhatTheSceneCallsFor) {
+    Scene cornell = procedural("cornell");
+    WorkloadPlan by_default = plan_workload(cornell, {});
+    WorkloadPlan everything = plan_workload(cornell, kAll);
+    for (int k = 0; k < kRayKindCount; ++k) EXPECT_EQ(by_default.wants(RayKind(k)), everything.wants(RayKind(k)));
+    EXPECT_TRUE(by_default.wants(RayKind::primary) && by_default.wants(RayKind::diffuse));
+    EXPECT_FALSE(by_default.wants(RayKind::refraction));
+    for (const Effect& e : by_default.effects) {
+        // Nobody asked: kinds the scene does not call for say why, not "requested, but".
+        if (e.name == "refraction") {
+            EXPECT_EQ(e.why, "no material has KHR_materials_transmission");
+        }
+        if (e.name == "shadow") {
+            EXPECT_TRUE(e.simulated);
+        }
+    }
+}

@@ -14,6 +14,7 @@
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/raygen/workload.h"
 #include "traces/scene/gltf_loader.h"
+#include "traces/tracer/ray_trace.h"
 #include "traces/tracer/tracer.h"
 
 namespace fs = std::filesystem;
@@ -175,4 +176,36 @@ TEST(Tracer, SharedSceneEffectsFollowTheScene) {
     bool alpha = false;
     for (const Effect& e : sp.effects) alpha |= e.name == "alpha_mask" && e.simulated;
     EXPECT_TRUE(alpha);
+}
+
+// write_ray_trace writes through the same TraceFolderWriter as trace_scene: the tracer's own
+// primary rays, given back as user rays, give a byte-identical trace.rtt.
+TEST(Tracer, GivenRaysWriteTheSameTrace) {
+    fs::path a = temp_dir("given_a"), b = temp_dir("given_b");
+    TraceOptions o = small_options("cornell", a);
+    o.workload = {RayKind::primary};
+    trace_scene(o);
+    TraceReader reader((a / "trace.rtt").string());
+    std::vector<PendingRay> rays;
+    for (const RayRecord& r : reader.read_all<RayRecord>(SectionKind::rays)) {
+        PendingRay p;
+        p.ray = ray_from_record(r);
+        p.pixel = r.pixel;
+        rays.push_back(p);
+    }
+    Scene scene = load_gltf((a / "scene" / "cornell.gltf").string());
+    const std::unique_ptr<Accel> accel = load_accel(build_accel(scene, o.accel));
+    RayTraceOptions ro;
+    ro.out_dir = b.string();
+    nlohmann::json m = write_ray_trace(scene, {"cornell", true}, *accel, rays, ro);
+    std::ifstream fa(a / "trace.rtt", std::ios::binary), fb(b / "trace.rtt", std::ios::binary);
+    std::string sa((std::istreambuf_iterator<char>(fa)), {}), sb((std::istreambuf_iterator<char>(fb)), {});
+    EXPECT_GT(sa.size(), 1000u);
+    EXPECT_EQ(sa, sb);
+    EXPECT_EQ(m["counts"]["rays"].get<uint64_t>(), rays.size());
+    EXPECT_EQ(m["workload"]["requested"], "given");
+    EXPECT_TRUE(fs::is_regular_file(b / "manifest.json"));
+    EXPECT_THROW(write_ray_trace(scene, {"cornell", true}, *accel, {}, ro), Error);
+    fs::remove_all(a);
+    fs::remove_all(b);
 }

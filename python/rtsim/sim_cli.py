@@ -1,0 +1,149 @@
+"""`rtsim simulate` and `rtsim config`: run rtsim-sim through the launcher (rtsim/launcher.py),
+drive a progress bar from its JSON progress lines and print the run's summary.
+
+rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline]
+rtsim config --defaults | --schema
+
+Kept light at import time (no numpy, no C++ extension): a short simulation should not wait for
+Python start-up. rich is imported when a run starts.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+from rtsim.cli_help import HelpFormatter
+from rtsim.launcher import EXIT_BAD_INPUT, EXIT_MISMATCH, EXIT_OK, SimJob, find_sim, run_sim
+
+#: One line per fidelity level for `rtsim simulate --help` (docs/fidelity.md has the details;
+#: tests check these are exactly the levels of the config tree).
+FIDELITY_LEVELS = {
+    "functional": "reference traversal, fetch and test counts, no time (fastest; hit check)",
+    "analytic": "counts + functional caches + a closed-form roofline of pipelines and DRAM",
+    "approx": "event-driven SystemC model of every block (the default)",
+    "detailed": "approx + per-cycle arbitration, L2 MSHRs, DRAM banks and row buffers",
+}
+
+
+def simulate_epilog() -> str:
+    levels = "\n".join(f"  {name:<11} {text}" for name, text in FIDELITY_LEVELS.items())
+    return (
+        "fidelity levels (--set fidelity=LEVEL; docs/fidelity.md):\n"
+        f"{levels}\n\n"
+        "Sampling: --set sampling.fraction=0.05 simulates a stratified 5% sample and reports the "
+        "estimate with a 95% interval.\n\n"
+        "Every config key with its default, unit, range and meaning (or docs/config.md):\n"
+        "  rtsim config --schema\n"
+        "From Python: rtsim.simulate(TRACE, l1__size_kib=32) (docs/python.md)."
+    )
+
+
+def run_and_report(job: SimJob, console: Any, show_progress: bool = True) -> int:
+    """Runs one simulation with a progress bar and prints its summary; returns the exit code."""
+    from rich.console import Console
+
+    from rtsim.sim_summary import print_mismatches, print_sim_summary
+
+    err_console = Console(stderr=True)
+
+    def echo(line: str) -> None:
+        err_console.print(line, markup=False, highlight=False)
+
+    job.progress = show_progress
+    if show_progress:
+        from rtsim.progress import TraceProgress
+
+        with TraceProgress(console=err_console) as bar:
+            result = run_sim(
+                job, on_progress=lambda d, n: bar(d, n, "simulate"), on_message=echo, stdout=None
+            )
+    else:
+        result = run_sim(job, on_message=echo, stdout=None)
+    if result.returncode == EXIT_BAD_INPUT:
+        return EXIT_BAD_INPUT  # rtsim-sim's message (naming the file or field) was echoed
+    if result.returncode not in (EXIT_OK, EXIT_MISMATCH) or result.stats is None:
+        print(
+            f"rtsim: error: {result.describe_failure()}; run folder {job.out_dir}", file=sys.stderr
+        )
+        return result.returncode if result.returncode > 0 else 1
+    print_sim_summary(result.stats, console)
+    console.print(f"run:      {job.out_dir}  (stats.json, config.resolved.json, provenance.json)")
+    if job.timeline and (job.out_dir / "timeline.json").is_file():
+        console.print(f"timeline: {job.out_dir / 'timeline.json'}  (open in ui.perfetto.dev)")
+    if result.returncode == EXIT_MISMATCH:
+        print_mismatches(result.stats, err_console)
+    return result.returncode
+
+
+def cmd_simulate(args: argparse.Namespace, console: Any) -> int:
+    job = SimJob(
+        trace=Path(args.trace),
+        out_dir=Path(args.output),
+        config=Path(args.config) if args.config else None,
+        sets=list(args.set or []),
+        timeline=args.timeline,
+    )
+    return run_and_report(job, console, show_progress=not args.no_progress)
+
+
+def cmd_config(args: argparse.Namespace, console: Any) -> int:
+    flag = "--dump-schema" if args.schema else "--dump-defaults"
+    result = subprocess.run([str(find_sim()), flag], capture_output=True, text=True, check=False)
+    if result.returncode != 0:
+        sys.stderr.write(result.stderr)
+        return result.returncode if result.returncode > 0 else 1
+    sys.stdout.write(result.stdout)
+    return 0
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Registers `simulate` and `config` on the `rtsim` subcommand parser."""
+    p = sub.add_parser(
+        "simulate",
+        formatter_class=HelpFormatter,
+        help="replay a trace on the SystemC accelerator model (rtsim-sim) and summarise the run",
+        description="Replays TRACE on the accelerator model (one rtsim-sim process), checks every "
+        "hit against the reference and writes RUN/stats.json, RUN/config.resolved.json and "
+        "RUN/provenance.json. Exit codes: 0 ok, 2 bad input, 3 simulated hits or work differ "
+        "from the reference.",
+        epilog=simulate_epilog(),
+    )
+    p.add_argument("trace", metavar="TRACE", help="trace folder (from rtsim trace) or .rtt file")
+    p.add_argument(
+        "--config",
+        metavar="CFG.json",
+        default=None,
+        help="config JSON over the defaults (default: the defaults, rtsim config --defaults)",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        default=[],
+        help="override one config key after --config, e.g. l1.size_kib=32 or fidelity=analytic "
+        "(repeatable; default: none)",
+    )
+    p.add_argument("-o", "--output", required=True, metavar="RUN", help="run folder")
+    p.add_argument(
+        "--timeline", action="store_true", help="also write RUN/timeline.json (Perfetto)"
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_simulate)
+
+    p = sub.add_parser(
+        "config",
+        formatter_class=HelpFormatter,
+        help="print the simulator's default config or its schema",
+        description="Prints the simulator's config tree as JSON: its defaults, or every field "
+        "with its default, unit, range and meaning.",
+    )
+    group = p.add_mutually_exclusive_group(required=True)
+    group.add_argument("--defaults", action="store_true", help="the default config as JSON")
+    group.add_argument(
+        "--schema", action="store_true", help="every field: default, unit, range, doc (JSON)"
+    )
+    p.set_defaults(func=cmd_config)

@@ -1,0 +1,84 @@
+#include "traces/tracer/trace_folder.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include "traces/accel/accel_io.h"
+#include "traces/common/build_info.h"
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string created(const std::string& out_dir) {
+    fs::create_directories(out_dir);
+    return out_dir;
+}
+
+}  // namespace
+
+TraceFolderWriter::TraceFolderWriter(const std::string& out_dir, const AccelImage& image)
+    : m_out_dir(created(out_dir)),
+      m_writer((fs::path(out_dir) / "trace.rtt").string()),
+      m_start(std::chrono::steady_clock::now()) {
+    write_accel_image(m_writer, image);
+}
+
+void TraceFolderWriter::add_wavefront(const WorkloadPlan& plan, const std::vector<PendingRay>& rays,
+                                      const WavefrontResult& res) {
+    std::vector<RayRecord> ray_rec;
+    std::vector<HitRecord> hit_rec;
+    std::vector<WorkRecord> work_rec;
+    m_counts.add_rejected(res.rejected);
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const PendingRay& r = rays[i];
+        const bool written = plan.wants(r.kind);
+        m_counts.add(r.kind, r.depth, res.hits[i], res.work[i], written);
+        if (!written) continue;
+        ray_rec.push_back(to_record(r.ray, r.kind, r.pixel, r.depth, r.any_hit));
+        hit_rec.push_back(to_record(res.hits[i]));
+        work_rec.push_back(to_record(res.work[i]));
+    }
+    m_writer.append(SectionKind::rays, ray_rec);
+    m_writer.append(SectionKind::hits, hit_rec);
+    m_writer.append(SectionKind::work, work_rec);
+}
+
+json TraceFolderWriter::finish(const Scene& scene, const SceneLabel& label, const AccelImage& image,
+                               double load_ms, std::chrono::steady_clock::time_point started, json extra) {
+    m_writer.close();
+    const double trace_ms = ms_since(m_start);
+    json files = {{"trace", "trace.rtt"}};
+    if (extra.contains("files")) {
+        files.update(extra["files"]);
+        extra.erase("files");
+    }
+    json manifest = {
+        {"format", "rtsim-trace"},
+        {"trace_version", kTraceVersion},
+        {"rtsim_version", rtsim_version()},
+        {"git", rtsim_git_hash()},
+        {"scene", scene_json(scene, label.name, label.procedural)},
+        {"accel", accel_json(image)},
+        {"counts", m_counts.to_json()},
+        {"files", files},
+        {"timing_ms",
+         {{"load", load_ms}, {"accel", image.build_ms}, {"trace", trace_ms}, {"total", ms_since(started)}}},
+    };
+    manifest.update(extra);
+    const std::string path = (fs::path(m_out_dir) / "manifest.json").string();
+    std::ofstream out(path);
+    out << manifest.dump(2) << "\n";
+    require(bool(out), path + ": cannot write the manifest");
+    return manifest;
+}
+
+}  // namespace rtsim
