@@ -13,6 +13,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "python/src/bindings.h"
+#include "traces/bvh/bvh_image_checks.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_reader.h"
 #include "traces/isect/traversal.h"
@@ -189,6 +190,10 @@ py::list trace_sections(const fs::path& path) {
         py::gil_scoped_release release;
         TraceReader reader(path.string());
         sections = reader.sections();
+        // The BVH image must be a tree the traversal can walk, not just bytes with valid CRCs.
+        if (reader.has(SectionKind::bvh_nodes) || reader.has(SectionKind::triangles))
+            validate_bvh_image(reader.read_all<HwNode>(SectionKind::bvh_nodes),
+                               reader.read_all<HwTriangle>(SectionKind::triangles), reader.path());
     }
     py::list out;
     for (const SectionInfo& s : sections) {
@@ -225,7 +230,7 @@ void bind_trace(py::module_& m) {
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
           "returns the manifest. progress(done, total, stage) is called now and then.");
     m.def("trace_sections", &trace_sections, py::arg("path"),
-          "Validates a trace file's header and section table; returns its sections.");
+          "Validates a trace file's header, section table and BVH image; returns its sections.");
     m.def(
         "verify_trace",
         [](const fs::path& path) {

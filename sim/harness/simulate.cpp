@@ -13,6 +13,7 @@
 #include "sim/harness/summary.h"
 #include "sim/harness/timeline.h"
 #include "sim/harness/trace_stream.h"
+#include "traces/bvh/bvh_image_checks.h"
 #include "traces/common/error.h"
 #include "traces/isect/traversal.h"
 
@@ -48,7 +49,10 @@ json scan_workload(TraceReader& reader, WorkloadFeatures* features) {
         uint64_t count = std::min<uint64_t>(buf.size(), n - first);
         reader.read(SectionKind::rays, first, count, buf.data());
         for (uint64_t i = 0; i < count; ++i) {
-            if (buf[i].kind < kRayKindCount) ++kinds[buf[i].kind];
+            require(buf[i].kind < kRayKindCount, reader.path() + ": ray " + std::to_string(first + i) +
+                                                     " has unknown ray kind " + std::to_string(buf[i].kind) +
+                                                     " (known kinds: 0.." + std::to_string(kRayKindCount - 1) + ")");
+            ++kinds[buf[i].kind];
             features->occlusion_rays += (buf[i].flags & kRayFlagAnyHit) != 0;
         }
     }
@@ -99,7 +103,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     MemoryImage image;
     image.nodes = reader.read_all<HwNode>(SectionKind::bvh_nodes);
     image.triangles = reader.read_all<HwTriangle>(SectionKind::triangles);
-    require(!image.nodes.empty(), rtt + ": the trace has no BVH nodes (section NODE)");
+    validate_bvh_image(image.nodes, image.triangles, rtt);  // CRCs prove bytes, not a tree
     WorkloadFeatures features;
     features.anyhit_triangles = image.has_anyhit_triangles();
     json workload = scan_workload(reader, &features);
