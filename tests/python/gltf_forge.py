@@ -66,7 +66,9 @@ def glb_bytes(doc: dict[str, Any] | bytes, binary: bytes | None, version: int = 
     return struct.pack("<III", GLB_MAGIC, version, 12 + len(out)) + out
 
 
-def write_glb(path: Path, doc: dict[str, Any] | bytes, binary: bytes | None, version: int = 2) -> Path:
+def write_glb(
+    path: Path, doc: dict[str, Any] | bytes, binary: bytes | None, version: int = 2
+) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_bytes(glb_bytes(doc, binary, version))
@@ -78,7 +80,9 @@ def png_bytes(width: int, height: int) -> bytes:
     import zlib
 
     def chunk(kind: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        return (
+            struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        )
 
     raw = zlib.compressobj(9)
     row = bytes(1 + width)

@@ -70,7 +70,15 @@ def write_trace(path: Path, sections: dict[str, bytes], version: int = VERSION) 
     for name, offset, nbytes, crc_offset in entries:
         rb = RECORD_BYTES[name]
         table += struct.pack(
-            "<IIQQQIIQ16x", FOURCC[name], rb, nbytes // rb, offset, nbytes, CHUNK_BYTES, 0, crc_offset
+            "<IIQQQIIQ16x",
+            FOURCC[name],
+            rb,
+            nbytes // rb,
+            offset,
+            nbytes,
+            CHUNK_BYTES,
+            0,
+            crc_offset,
         )
     table += struct.pack("<I", zlib.crc32(bytes(table)))
     body += table
@@ -93,14 +101,24 @@ def write_trace(path: Path, sections: dict[str, bytes], version: int = VERSION) 
 
 def nodes_view(payload: bytearray) -> np.ndarray:
     """The NODE payload as a writable (n,) array with child_ref and child_count fields."""
-    dtype = np.dtype([("bounds", "<f4", (12,)), ("child_ref", "<u4", (2,)), ("child_count", "<u4", (2,))])
+    dtype = np.dtype(
+        [("bounds", "<f4", (12,)), ("child_ref", "<u4", (2,)), ("child_count", "<u4", (2,))]
+    )
     return np.frombuffer(payload, dtype=dtype)
 
 
 def rays_view(payload: bytearray) -> np.ndarray:
     """The RAYS payload as a writable (n,) array (kind is a field)."""
     dtype = np.dtype(
-        [("origin", "<f4", (3,)), ("tmin", "<f4"), ("direction", "<f4", (3,)), ("tmax", "<f4"),
-         ("pixel", "<u4"), ("kind", "u1"), ("flags", "u1"), ("depth", "<u2")]
+        [
+            ("origin", "<f4", (3,)),
+            ("tmin", "<f4"),
+            ("direction", "<f4", (3,)),
+            ("tmax", "<f4"),
+            ("pixel", "<u4"),
+            ("kind", "u1"),
+            ("flags", "u1"),
+            ("depth", "<u2"),
+        ]
     )
     return np.frombuffer(payload, dtype=dtype)
