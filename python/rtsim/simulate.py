@@ -1,7 +1,7 @@
 """`rtsim simulate` and `rtsim config`: run the `rtsim-sim` executable (one simulation per process,
 DESIGN rule 4), drive a progress bar from its JSON progress lines and print the run's summary.
 
-rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline]
+rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline] [--timeout S]
 rtsim config --defaults | --schema
 """
 
@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import shutil
 import subprocess
 import sys
 import sysconfig
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -24,7 +26,7 @@ from rtsim.progress import TraceProgress
 from rtsim.sim_summary import print_mismatches, print_sim_summary
 
 SIM_EXE = "rtsim-sim"
-EXIT_OK, EXIT_BAD_INPUT, EXIT_MISMATCH = 0, 2, 3
+EXIT_OK, EXIT_BAD_INPUT, EXIT_MISMATCH, EXIT_TIMEOUT = 0, 2, 3, 4
 
 
 class SimNotFoundError(OSError):
@@ -66,6 +68,7 @@ class SimJob:
     config: Path | None = None
     sets: list[str] = field(default_factory=list)
     timeline: bool = False
+    timeout: float | None = None  # seconds; rtsim-sim is killed after this
 
     def command(self, exe: Path) -> list[str]:
         cmd = [str(exe), str(self.trace), "-o", str(self.out_dir), "--progress"]
@@ -85,6 +88,7 @@ class SimResult:
     returncode: int
     messages: list[str]
     stats: dict[str, Any] | None
+    timed_out: bool = False
 
 
 def parse_progress(line: str) -> tuple[int, int] | None:
@@ -126,6 +130,7 @@ def run_sim(job: SimJob, show_progress: bool = True, echo: bool = True) -> SimRe
         stale.unlink()
     messages: list[str] = []
     err_console = Console(stderr=True)
+    killed = threading.Event()
     with (
         subprocess.Popen(
             job.command(exe), stderr=subprocess.PIPE, text=True, bufsize=1, errors="replace"
@@ -133,6 +138,12 @@ def run_sim(job: SimJob, show_progress: bool = True, echo: bool = True) -> SimRe
         TraceProgress(console=err_console, disable=not show_progress) as bar,
     ):
         assert proc.stderr is not None
+        timer = None
+        if job.timeout is not None:
+            # Kill rtsim-sim when time is up; its stderr then closes and the loop below ends.
+            timer = threading.Timer(job.timeout, lambda: (killed.set(), proc.kill()))
+            timer.daemon = True
+            timer.start()
         for line in proc.stderr:
             progress = parse_progress(line)
             if progress is not None:
@@ -145,7 +156,9 @@ def run_sim(job: SimJob, show_progress: bool = True, echo: bool = True) -> SimRe
             if echo:
                 err_console.print(message, markup=False, highlight=False)
         returncode = proc.wait()
-    return SimResult(returncode, messages, read_stats(job.out_dir))
+        if timer is not None:
+            timer.cancel()
+    return SimResult(returncode, messages, read_stats(job.out_dir), timed_out=killed.is_set())
 
 
 def describe_failure(returncode: int) -> str:
@@ -157,6 +170,13 @@ def describe_failure(returncode: int) -> str:
 def simulate(job: SimJob, console: Console, show_progress: bool = True) -> int:
     """Runs one simulation and prints its summary; returns rtsim-sim's exit code."""
     result = run_sim(job, show_progress=show_progress)
+    if result.timed_out:
+        print(
+            f"rtsim: error: {SIM_EXE} timed out after {job.timeout:g} s and was killed "
+            f"(--timeout); run folder {job.out_dir} has no stats",
+            file=sys.stderr,
+        )
+        return EXIT_TIMEOUT
     if result.returncode == EXIT_BAD_INPUT:
         return EXIT_BAD_INPUT  # rtsim-sim's message (naming the file or field) was echoed
     if result.returncode not in (EXIT_OK, EXIT_MISMATCH) or result.stats is None:
@@ -172,6 +192,17 @@ def simulate(job: SimJob, console: Console, show_progress: bool = True) -> int:
     return result.returncode
 
 
+def positive_seconds(text: str) -> float:
+    """An argparse type: a finite number of seconds > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"expected a number of seconds > 0, got '{text}'")
+    return value
+
+
 def cmd_simulate(args: argparse.Namespace, console: Console) -> int:
     job = SimJob(
         trace=Path(args.trace),
@@ -179,6 +210,7 @@ def cmd_simulate(args: argparse.Namespace, console: Console) -> int:
         config=Path(args.config) if args.config else None,
         sets=list(args.set or []),
         timeline=args.timeline,
+        timeout=args.timeout,
     )
     return simulate(job, console, show_progress=not args.no_progress)
 
@@ -200,7 +232,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         help="replay a trace on the SystemC accelerator model (rtsim-sim) and summarise the run",
         description="Replays TRACE on the accelerator model and writes RUN/stats.json, "
         "RUN/config.resolved.json and RUN/provenance.json. Exit codes: 0 ok, 2 bad input, "
-        "3 simulated hits or work differ from the reference.",
+        "3 simulated hits or work differ from the reference, 4 timed out (--timeout).",
     )
     p.add_argument("trace", metavar="TRACE", help="trace folder (from rtsim trace) or .rtt file")
     p.add_argument("--config", metavar="CFG.json", default=None, help="config JSON over defaults")
@@ -214,6 +246,13 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
     p.add_argument("-o", "--output", required=True, metavar="RUN", help="run folder")
     p.add_argument(
         "--timeline", action="store_true", help="also write RUN/timeline.json (Perfetto)"
+    )
+    p.add_argument(
+        "--timeout",
+        type=positive_seconds,
+        default=None,
+        metavar="SECONDS",
+        help="kill rtsim-sim after this many seconds and exit with status 4 (default: no limit)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_simulate)

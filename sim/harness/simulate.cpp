@@ -9,6 +9,8 @@
 #include "rtl_model/top/top.h"
 #include "sim/harness/analytic.h"
 #include "sim/harness/hit_checker.h"
+#include "sim/harness/memory_estimate.h"
+#include "sim/harness/model_errors.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
 #include "sim/harness/timeline.h"
@@ -33,10 +35,25 @@ std::string trace_file(const std::string& path) {
 
 json read_manifest(const std::string& rtt) {
     fs::path m = fs::path(rtt).parent_path() / "manifest.json";
-    if (!fs::exists(m)) return json::object();
+    std::error_code ec;
+    if (!fs::exists(m, ec)) return json::object();
+    require(fs::is_regular_file(m, ec), m.string() + ": is not a file (expected the trace's manifest)");
     std::ifstream in(m);
-    json j = json::parse(in, nullptr, false);
+    require(bool(in), m.string() + ": cannot open");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    json j = json::parse(text, nullptr, false);
     require(!j.is_discarded(), m.string() + ": not valid JSON");
+    require(j.is_object(), m.string() + ": expected a JSON object (the trace manifest), found " + j.type_name());
+    // The keys the harness reads (provenance, effects) must have their documented types.
+    auto check = [&](const json& parent, const char* key, bool (json::*is)() const noexcept, const char* what,
+                     const std::string& path) {
+        const auto it = parent.find(key);
+        require(it == parent.end() || ((*it).*is)(), m.string() + ": '" + path + "' must be " + what);
+    };
+    check(j, "workload", &json::is_object, "an object", "workload");
+    check(j, "scene", &json::is_object, "an object", "scene");
+    check(j, "git", &json::is_string, "a string", "git");
+    if (j.contains("scene")) check(j["scene"], "name", &json::is_string, "a string", "scene.name");
     return j;
 }
 
@@ -68,6 +85,7 @@ void report_progress(uint64_t done, uint64_t total) {
 
 /// Functional level: the reference traversal in a loop, no time. Counts and the hit check only.
 json run_functional(const MemoryImage& image, TraceReader& reader, ReferenceWindow& ref, HitChecker& checker) {
+    const std::string& path = reader.path();
     HwBvh bvh;
     bvh.nodes = image.nodes;
     bvh.triangles = image.triangles;
@@ -77,7 +95,11 @@ json run_functional(const MemoryImage& image, TraceReader& reader, ReferenceWind
         for (const RayJob& job : jobs) {
             RayResult r;
             r.id = job.id;
-            r.hit = trace_ray(bvh, job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
+            try {
+                r.hit = trace_ray(bvh, job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
+            } catch (const Error& e) {
+                throw Error(path + ": ray " + std::to_string(job.id) + ": " + e.what());
+            }
             checker.ray_done(r);
         }
         jobs.clear();
@@ -104,6 +126,9 @@ SimOutcome run_simulation(const SimOptions& o) {
     image.nodes = reader.read_all<HwNode>(SectionKind::bvh_nodes);
     image.triangles = reader.read_all<HwTriangle>(SectionKind::triangles);
     validate_bvh_image(image.nodes, image.triangles, rtt);  // CRCs prove bytes, not a tree
+    check_sim_memory(o.config, image.nodes.size(), image.triangles.size(),
+                     "config (traversal.units=" + std::to_string(o.config.traversal.units) +
+                         ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     WorkloadFeatures features;
     features.anyhit_triangles = image.has_anyhit_triangles();
     json workload = scan_workload(reader, &features);
@@ -160,7 +185,14 @@ SimOutcome run_simulation(const SimOptions& o) {
                 sampled->estimator.ray_done(r);
                 if (hook) hook(r);
             };
-        sc_core::sc_start();
+        try {
+            sc_core::sc_start();
+        } catch (const sc_core::sc_report& e) {
+            // An rtsim::Error raised in a SystemC process (a traversal stack overflow, say): name
+            // the trace and the ray instead of SystemC's wrapper (exit 2, not a raw report).
+            const std::string ray = first_failing_ray(image, reader);
+            throw Error(rtt + ": " + (ray.empty() ? "simulation failed: " + unwrap_report(e.what()) : ray));
+        }
         cycles = top.total_cycles();
         model = top.stats_json();
         instantiated = top.instantiated();

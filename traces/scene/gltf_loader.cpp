@@ -141,7 +141,9 @@ std::vector<glm::dmat4> gpu_instances(const Source& src, const tinygltf::Value& 
     if (!have_count) src.fail(where + ": no TRANSLATION, ROTATION or SCALE attribute");
     *flat += uint64_t(count) * std::max<uint64_t>(mesh_triangles, 1);
     check_flat_size(src.file, *flat, where + " (" + std::to_string(count) + " instances of " +
-                                         std::to_string(mesh_triangles) + " triangles, with the nodes before it)");
+                                         std::to_string(mesh_triangles) +
+                                         " triangles, with the nodes before it; instances are flattened: "
+                                         "rtsim has no two-level BVH yet)");
     std::vector<glm::dmat4> out(count);
     for (size_t i = 0; i < count; ++i) {
         glm::dmat4 t(1.0), r(1.0), s(1.0);

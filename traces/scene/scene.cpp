@@ -27,8 +27,7 @@ void check_flat_size(const std::string& source, uint64_t triangles, const std::s
                   static_cast<unsigned long long>(triangles),
                   double(triangles) * double(kBytesPerFlatTriangle) / double(1ull << 30),
                   static_cast<unsigned long long>(limit), static_cast<unsigned long long>(kBytesPerFlatTriangle));
-    throw Error(source + ": " + what + text +
-                "; instances are flattened into one triangle list until rtsim has a two-level BVH");
+    throw Error(source + ": " + what + text);
 }
 
 namespace {
@@ -40,7 +39,8 @@ bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && 
 void Scene::flatten() {
     uint64_t total = 0;
     for (const Instance& inst : instances) total += meshes[inst.mesh].triangle_count();
-    check_flat_size(source, total, "the scene (" + std::to_string(instances.size()) + " instances)");
+    check_flat_size(source, total, "the scene (" + std::to_string(instances.size()) +
+                                       " instances, flattened into one triangle list: rtsim has no two-level BVH yet)");
     total = 0;
     for (Instance& inst : instances) {
         inst.prim_base = uint32_t(total);
