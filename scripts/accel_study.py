@@ -36,8 +36,8 @@ from typing import Any
 import numpy as np
 
 import rtsim
-from rtsim.scenes import resolve_scene
 from rtsim.launcher import find_sim
+from rtsim.scenes import resolve_scene
 
 DEFAULT_SCENES = "sponza,bunny,hairball,teapot_stadium,rotated_walls,cornell"
 DEFAULT_ACCEL = "bvh2,bvh4,bvh6,bvh8,cwbvh6,cwbvh8,bvh8_octant,cwbvh8_octant"

@@ -25,7 +25,16 @@ DOC = REPO / "docs" / "config.md"
 
 # Sections in the order of the hardware (dispatch to DRAM); unknown sections follow alphabetically.
 SECTION_ORDER = (
-    "dispatch", "traversal", "box", "triangle", "anyhit", "cell", "l1", "l2", "dram", "energy"
+    "dispatch",
+    "traversal",
+    "box",
+    "triangle",
+    "anyhit",
+    "cell",
+    "l1",
+    "l2",
+    "dram",
+    "energy",
 )
 
 SECTION_NOTES = {

@@ -3,6 +3,7 @@
 //   rtsim-sim --dump-defaults | --dump-schema
 // Exit codes: 0 ok, 2 bad input (message names the file or field), 3 hits differ from the reference.
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -17,9 +18,12 @@ namespace {
 rtsim::SimConfig load_config(const std::string& path, const std::vector<std::string>& sets) {
     rtsim::SimConfig config;
     if (!path.empty()) {
+        std::error_code ec;
+        rtsim::require(!std::filesystem::is_directory(path, ec), path + ": is a folder, not a config JSON file");
         std::ifstream in(path);
         rtsim::require(bool(in), path + ": cannot open config");
-        nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
         rtsim::require(!j.is_discarded(), path + ": not valid JSON");
         try {
             config = rtsim::config_from_json(j);

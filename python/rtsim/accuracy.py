@@ -442,7 +442,11 @@ def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None: 
         "functional caches, for hit-rate errors)",
     )
     p.add_argument(
-        "-o", "--output", default="out/accuracy", metavar="DIR", help="folder for traces, runs, tables"
+        "-o",
+        "--output",
+        default="out/accuracy",
+        metavar="DIR",
+        help="folder for traces, runs, tables",
     )
     p.add_argument(
         "--resolution",

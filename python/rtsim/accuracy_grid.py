@@ -95,13 +95,19 @@ def run_level(exe: Path, trace: Path, run: RunPlan, level: str, folder: Path) ->
     stats_path = folder / "stats.json"
     if proc.returncode not in (0, 3) or not stats_path.is_file():
         lines = proc.stderr.strip().splitlines()
-        row.status = (lines[-1] if lines else f"exit {proc.returncode}").replace("rtsim-sim: error: ", "")
+        row.status = (lines[-1] if lines else f"exit {proc.returncode}").replace(
+            "rtsim-sim: error: ", ""
+        )
         row.wall_seconds = None
         return row
     stats = json.loads(stats_path.read_text())
     s = stats["summary"]
     row.cycles, row.hit_mismatches = s.get("cycles"), s.get("hit_mismatches")
-    row.l1_hit_rate, row.l2_hit_rate, row.dram_bytes = s.get("l1_hit_rate"), s.get("l2_hit_rate"), s.get("dram_bytes")
+    row.l1_hit_rate, row.l2_hit_rate, row.dram_bytes = (
+        s.get("l1_hit_rate"),
+        s.get("l2_hit_rate"),
+        s.get("dram_bytes"),
+    )
     analysis = stats.get("model", {}).get("analytic", {}).get("analysis")
     row.analysis_reused = analysis.get("reused") if analysis else None
     return row
@@ -139,7 +145,11 @@ def run_grid(spec_path: Path, out: Path, levels: list[str], console: Console) ->
             folder = out / "runs" / trace.name / run.run_id[:12] / level
             row = run_level(exe, trace, run, level, folder)
             rows.append(row)
-            what = f"{row.wall_seconds:7.2f} s  cycles {row.cycles}" if row.status == "ok" else row.status
+            what = (
+                f"{row.wall_seconds:7.2f} s  cycles {row.cycles}"
+                if row.status == "ok"
+                else row.status
+            )
             console.print(f"  {trace.name:<28} {level:<20} {row.point:<60} {what}", highlight=False)
     compare(rows)
     write_grid(rows, out)
@@ -168,14 +178,18 @@ def summarize_grid(rows: list[GridRow]) -> list[dict[str, Any]]:
             errors = [abs(r.error) for r in both if r.error is not None]
             tau = kendall_tau([ref[r.point].cycles for r in both], [r.cycles for r in both])  # type: ignore[misc]
             best = min(both, key=lambda r: r.cycles).point if both else None  # type: ignore[arg-type,return-value]
-            best_ref = min((ref[r.point] for r in both), key=lambda r: r.cycles).point if both else None  # type: ignore[arg-type,return-value]
+            best_ref = (
+                min((ref[r.point] for r in both), key=lambda r: r.cycles).point if both else None
+            )  # type: ignore[arg-type,return-value]
             wall = sum(r.wall_seconds or 0 for r in both)
             ref_wall = sum(ref[r.point].wall_seconds or 0 for r in both)
             row: dict[str, Any] = {
                 "trace": trace,
                 "level": level,
                 "points": len(both),
-                "skipped": len([r for r in rows if r.trace == trace and r.level == level and r.status != "ok"]),
+                "skipped": len(
+                    [r for r in rows if r.trace == trace and r.level == level and r.status != "ok"]
+                ),
                 "median_abs_error": statistics.median(errors) if errors else None,
                 "max_abs_error": max(errors) if errors else None,
                 "kendall_tau": tau,
@@ -202,22 +216,28 @@ def fmt(x: float | None, pct: bool = False, digits: int = 1) -> str:
     return f"{100 * x:.{digits}f}%" if pct else f"{x:.{digits}f}"
 
 
+def _median_max(s: dict[str, Any], key: str) -> str:
+    return f"{fmt(s[key + '_median'], True, 2)} / {fmt(s[key + '_max'], True, 2)}"
+
+
 def markdown(summary: list[dict[str, Any]]) -> str:
     lines = [
         "| trace | level | configs | median abs error | max abs error | Kendall tau | same best "
-        "| grid wall (s) | speed-up vs detailed | L1 hit-rate error (median / max) | L2 hit-rate error |",
+        "| grid wall (s) | speed-up vs detailed | L1 hit-rate error (median / max) "
+        "| L2 hit-rate error |",
         "|" + "---|" * 11,
     ]
     for s in summary:
         hr = ""
         if s.get("l1_hit_rate_error_max") is not None:
-            hr = f"{fmt(s['l1_hit_rate_error_median'], True, 2)} / {fmt(s['l1_hit_rate_error_max'], True, 2)}"
+            hr = _median_max(s, "l1_hit_rate_error")
         hr2 = ""
         if s.get("l2_hit_rate_error_max") is not None:
-            hr2 = f"{fmt(s['l2_hit_rate_error_median'], True, 2)} / {fmt(s['l2_hit_rate_error_max'], True, 2)}"
+            hr2 = _median_max(s, "l2_hit_rate_error")
         skipped = f" (+{s['skipped']} n/a)" if s["skipped"] else ""
         lines.append(
-            f"| {s['trace']} | {s['level']} | {s['points']}{skipped} | {fmt(s['median_abs_error'], True)} "
+            f"| {s['trace']} | {s['level']} | {s['points']}{skipped} "
+            f"| {fmt(s['median_abs_error'], True)} "
             f"| {fmt(s['max_abs_error'], True)} | {fmt(s['kendall_tau'], digits=2)} "
             f"| {'' if s['same_best'] is None else ('yes' if s['same_best'] else 'no')} "
             f"| {fmt(s['wall_seconds'], digits=2)} | {fmt(s['speedup'])}x | {hr} | {hr2} |"
@@ -228,7 +248,9 @@ def markdown(summary: list[dict[str, Any]]) -> str:
 def write_grid(rows: list[GridRow], out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     summary = summarize_grid(rows)
-    (out / "grid.json").write_text(json.dumps({"runs": [asdict(r) for r in rows], "summary": summary}, indent=2))
+    (out / "grid.json").write_text(
+        json.dumps({"runs": [asdict(r) for r in rows], "summary": summary}, indent=2)
+    )
     with (out / "grid.csv").open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(asdict(rows[0]))) if rows else None
         if w:
@@ -251,7 +273,11 @@ def plot_grid(rows: list[GridRow], path: Path) -> None:
     colors = {"analytic": "#2ca02c", "approx": "#1f77b4", "analytic_functional": "#9467bd"}
     lo, hi = float("inf"), 0.0
     for level in levels:
-        pts = [(ref[(r.trace, r.point)], r.cycles) for r in rows if r.level == level and r.cycles and (r.trace, r.point) in ref]
+        pts = [
+            (ref[(r.trace, r.point)], r.cycles)
+            for r in rows
+            if r.level == level and r.cycles and (r.trace, r.point) in ref
+        ]
         if not pts:
             continue
         xs, ys = zip(*pts, strict=True)

@@ -16,11 +16,12 @@ rtsim report SWEEP [-o report.html]                                 its HTML rep
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import shutil
 import subprocess
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -80,10 +81,15 @@ def parse_workload(text: str) -> list[str]:
     return kinds
 
 
+MAX_PIXELS = 1 << 28  # the tracer's limit (traces/tracer/tracer.cpp)
+
+
 def parse_resolution(text: str) -> tuple[int, int]:
     w, sep, h = text.lower().partition("x")
     if not sep or not w.isdigit() or not h.isdigit() or int(w) == 0 or int(h) == 0:
         raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT like 320x240, got '{text}'")
+    if int(w) * int(h) > MAX_PIXELS:
+        raise argparse.ArgumentTypeError(f"{text}: more than {MAX_PIXELS} pixels")
     return int(w), int(h)
 
 
@@ -97,7 +103,15 @@ def parse_camera(text: str) -> tuple[tuple[float, float, float], tuple[float, fl
             "expected 7 numbers EX,EY,EZ,TX,TY,TZ,FOV (eye, target, field of view in degrees), "
             f"got '{text}'"
         )
+    if not all(math.isfinite(v) and abs(v) <= FLOAT_MAX for v in values):
+        raise argparse.ArgumentTypeError(
+            f"camera numbers must be finite single-precision, got '{text}'"
+        )
     ex, ey, ez, tx, ty, tz, fov = values
+    if (ex, ey, ez) == (tx, ty, tz):
+        raise argparse.ArgumentTypeError(
+            f"camera eye equals the target (no view direction): '{text}'"
+        )
     if not 0.0 < fov < 180.0:
         raise argparse.ArgumentTypeError(f"field of view must be in (0, 180) degrees, got {fov}")
     return (ex, ey, ez), (tx, ty, tz), fov
@@ -107,6 +121,24 @@ def positive_int(text: str) -> int:
     if not text.isdigit():
         raise argparse.ArgumentTypeError(f"expected a non-negative integer, got '{text}'")
     return int(text)
+
+
+def bounded_int(low: int, high: int) -> Callable[[str], int]:
+    """An argparse type: an integer in [low, high] (the C++ field's range), named in errors."""
+
+    def parse(text: str) -> int:
+        value = positive_int(text)
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text} is out of range ({low}..{high})")
+        return value
+
+    return parse
+
+
+FLOAT_MAX = 3.4028234663852886e38
+UINT32_MAX, UINT64_MAX = (1 << 32) - 1, (1 << 64) - 1
+seed_int = bounded_int(0, UINT64_MAX)
+hairball_int = bounded_int(1, UINT32_MAX)
 
 
 def run_trace(job: TraceJob, console: Console) -> dict:
@@ -261,13 +293,13 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
     )
     p.add_argument(
         "--bounces",
-        type=positive_int,
+        type=bounded_int(0, 64),
         default=1,
         metavar="N",
         help="depth of diffuse, reflection and refraction bounces",
     )
     p.add_argument(
-        "--seed", type=positive_int, default=1, metavar="S", help="seed of the random numbers"
+        "--seed", type=seed_int, default=1, metavar="S", help="seed of the random numbers"
     )
     p.add_argument(
         "--camera",
@@ -278,14 +310,14 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
     )
     p.add_argument(
         "--threads",
-        type=positive_int,
+        type=bounded_int(0, 4096),
         default=0,
         metavar="N",
         help="tracing threads, 0 for all cores (the trace is the same for any N)",
     )
     p.add_argument(
         "--hairball-triangles",
-        type=positive_int,
+        type=hairball_int,
         default=200_000,
         metavar="N",
         help="triangles of the built-in hairball scene",
@@ -324,13 +356,13 @@ def add_scene_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into")
     p.add_argument(
         "--hairball-triangles",
-        type=positive_int,
+        type=hairball_int,
         default=200_000,
         metavar="N",
         help="triangles of the hairball scene",
     )
     p.add_argument(
-        "--seed", type=positive_int, default=1, metavar="S", help="seed of the procedural scenes"
+        "--seed", type=seed_int, default=1, metavar="S", help="seed of the procedural scenes"
     )
     p.set_defaults(func=cmd_scene)
 
@@ -400,7 +432,7 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
     )
     p.add_argument(
         "--hairball-triangles",
-        type=positive_int,
+        type=hairball_int,
         default=None,
         metavar="N",
         help="triangles of the hairball scene (default: rtsim-bench's)",

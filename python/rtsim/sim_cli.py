@@ -1,7 +1,7 @@
 """`rtsim simulate` and `rtsim config`: run rtsim-sim through the launcher (rtsim/launcher.py),
 drive a progress bar from its JSON progress lines and print the run's summary.
 
-rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline]
+rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline] [--timeout S]
 rtsim config --defaults | --schema
 
 Kept light at import time (no numpy, no C++ extension): a short simulation should not wait for
@@ -11,6 +11,7 @@ Python start-up. rich is imported when a run starts.
 from __future__ import annotations
 
 import argparse
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -42,7 +43,23 @@ def simulate_epilog() -> str:
     )
 
 
-def run_and_report(job: SimJob, console: Any, show_progress: bool = True) -> int:
+EXIT_TIMEOUT = 4
+
+
+def positive_seconds(text: str) -> float:
+    """An argparse type: a finite number of seconds > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"expected a number of seconds > 0, got '{text}'")
+    return value
+
+
+def run_and_report(
+    job: SimJob, console: Any, show_progress: bool = True, timeout: float | None = None
+) -> int:
     """Runs one simulation with a progress bar and prints its summary; returns the exit code."""
     from rich.console import Console
 
@@ -59,10 +76,21 @@ def run_and_report(job: SimJob, console: Any, show_progress: bool = True) -> int
 
         with TraceProgress(console=err_console) as bar:
             result = run_sim(
-                job, on_progress=lambda d, n: bar(d, n, "simulate"), on_message=echo, stdout=None
+                job,
+                timeout=timeout,
+                on_progress=lambda d, n: bar(d, n, "simulate"),
+                on_message=echo,
+                stdout=None,
             )
     else:
-        result = run_sim(job, on_message=echo, stdout=None)
+        result = run_sim(job, timeout=timeout, on_message=echo, stdout=None)
+    if result.timed_out:
+        print(
+            f"rtsim: error: rtsim-sim timed out after {timeout:g} s and was killed (--timeout); "
+            f"run folder {job.out_dir} has no stats",
+            file=sys.stderr,
+        )
+        return EXIT_TIMEOUT
     if result.returncode == EXIT_BAD_INPUT:
         return EXIT_BAD_INPUT  # rtsim-sim's message (naming the file or field) was echoed
     if result.returncode not in (EXIT_OK, EXIT_MISMATCH) or result.stats is None:
@@ -87,7 +115,7 @@ def cmd_simulate(args: argparse.Namespace, console: Any) -> int:
         sets=list(args.set or []),
         timeline=args.timeline,
     )
-    return run_and_report(job, console, show_progress=not args.no_progress)
+    return run_and_report(job, console, show_progress=not args.no_progress, timeout=args.timeout)
 
 
 def cmd_config(args: argparse.Namespace, console: Any) -> int:
@@ -109,7 +137,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         description="Replays TRACE on the accelerator model (one rtsim-sim process), checks every "
         "hit against the reference and writes RUN/stats.json, RUN/config.resolved.json and "
         "RUN/provenance.json. Exit codes: 0 ok, 2 bad input, 3 simulated hits or work differ "
-        "from the reference.",
+        "from the reference, 4 timed out (--timeout).",
         epilog=simulate_epilog(),
     )
     p.add_argument("trace", metavar="TRACE", help="trace folder (from rtsim trace) or .rtt file")
@@ -130,6 +158,13 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
     p.add_argument("-o", "--output", required=True, metavar="RUN", help="run folder")
     p.add_argument(
         "--timeline", action="store_true", help="also write RUN/timeline.json (Perfetto)"
+    )
+    p.add_argument(
+        "--timeout",
+        type=positive_seconds,
+        default=None,
+        metavar="SECONDS",
+        help="kill rtsim-sim after this many seconds and exit with status 4 (default: no limit)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_simulate)

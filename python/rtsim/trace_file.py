@@ -262,7 +262,9 @@ def open_trace(path: str | Path) -> Trace:
     """Opens a trace folder (or its ``trace.rtt``); validates the header and section table.
 
     Raises RtsimError naming the file if it is missing, truncated, corrupted or of another
-    version, or if a section's record size differs from the dtype this package expects.
+    version, if a section's record size differs from the dtype this package expects, if its BVH
+    image is not a tree the traversal can walk (rtsim._core.trace_sections checks it), if a ray
+    has an unknown kind, or if manifest.json is not a JSON object.
     """
     file, folder = _resolve(path)
     if not file.is_file():
@@ -284,11 +286,38 @@ def open_trace(path: str | Path) -> Trace:
                 f"rtsim reads {dtype.itemsize}-byte records (trace written by another version?)"
             )
         sections[name] = section
-    manifest: dict[str, Any] = {}
-    manifest_path = folder / MANIFEST_FILE
-    if manifest_path.is_file():
-        try:
-            manifest = json.loads(manifest_path.read_text())
-        except json.JSONDecodeError as err:
-            raise RtsimError(f"{manifest_path}: not valid JSON ({err})") from err
-    return Trace(path=file, folder=folder, sections=sections, manifest=manifest)
+    trace = Trace(path=file, folder=folder, sections=sections, manifest=_read_manifest(folder))
+    _check_ray_kinds(trace)
+    return trace
+
+
+def _read_manifest(folder: Path) -> dict[str, Any]:
+    """The trace's manifest.json (a JSON object), {} if there is none."""
+    path = folder / MANIFEST_FILE
+    if not path.exists():
+        return {}
+    if not path.is_file():
+        raise RtsimError(f"{path}: is not a file (expected the trace's manifest)")
+    try:
+        manifest = json.loads(path.read_bytes())
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as err:
+        raise RtsimError(f"{path}: not valid JSON ({type(err).__name__}: {err})") from err
+    if not isinstance(manifest, dict):
+        raise RtsimError(
+            f"{path}: expected a JSON object (the trace manifest), found {type(manifest).__name__}"
+        )
+    return manifest
+
+
+def _check_ray_kinds(trace: Trace) -> None:
+    """Refuses a ray whose kind this rtsim does not know, naming the first one."""
+    if not trace.has("rays") or trace.ray_count == 0:
+        return
+    kinds = trace.rays["kind"]
+    bad = np.flatnonzero(kinds >= len(RAY_KINDS))
+    if bad.size:
+        first = int(bad[0])
+        raise RtsimError(
+            f"{trace.path}: ray {first} has unknown ray kind {int(kinds[first])} "
+            f"(known kinds: 0..{len(RAY_KINDS) - 1}); {bad.size} such rays"
+        )

@@ -15,6 +15,7 @@
 #include "python/src/bindings.h"
 #include "python/src/ray_args.h"
 #include "traces/accel/accel.h"
+#include "traces/accel/accel_io.h"
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_reader.h"
@@ -205,6 +206,9 @@ py::list trace_sections(const fs::path& path) {
         py::gil_scoped_release release;
         TraceReader reader(path.string());
         sections = reader.sections();
+        // The structure's image must be one its traversal can walk, not just bytes with valid
+        // CRCs: load_accel validates it structurally (docs/accel.md).
+        if (reader.has(SectionKind::accel)) load_accel(read_accel_image(reader), reader.path());
     }
     py::list out;
     for (const SectionInfo& s : sections) {
@@ -270,7 +274,7 @@ void bind_trace(py::module_& m) {
         },
         "The acceleration structures this build knows: name, description, builders.");
     m.def("trace_sections", &trace_sections, py::arg("path"),
-          "Validates a trace file's header and section table; returns its sections.");
+          "Validates a trace file's header, section table and BVH image; returns its sections.");
     m.def(
         "verify_trace",
         [](const fs::path& path) {

@@ -11,6 +11,8 @@
 #include "sim/harness/energy_area.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/roofline.h"
+#include "sim/harness/memory_estimate.h"
+#include "sim/harness/model_errors.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
 #include "sim/harness/timeline.h"
@@ -35,10 +37,25 @@ std::string trace_file(const std::string& path) {
 
 json read_manifest(const std::string& rtt) {
     fs::path m = fs::path(rtt).parent_path() / "manifest.json";
-    if (!fs::exists(m)) return json::object();
+    std::error_code ec;
+    if (!fs::exists(m, ec)) return json::object();
+    require(fs::is_regular_file(m, ec), m.string() + ": is not a file (expected the trace's manifest)");
     std::ifstream in(m);
-    json j = json::parse(in, nullptr, false);
+    require(bool(in), m.string() + ": cannot open");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    json j = json::parse(text, nullptr, false);
     require(!j.is_discarded(), m.string() + ": not valid JSON");
+    require(j.is_object(), m.string() + ": expected a JSON object (the trace manifest), found " + j.type_name());
+    // The keys the harness reads (provenance, effects) must have their documented types.
+    auto check = [&](const json& parent, const char* key, bool (json::*is)() const noexcept, const char* what,
+                     const std::string& path) {
+        const auto it = parent.find(key);
+        require(it == parent.end() || ((*it).*is)(), m.string() + ": '" + path + "' must be " + what);
+    };
+    check(j, "workload", &json::is_object, "an object", "workload");
+    check(j, "scene", &json::is_object, "an object", "scene");
+    check(j, "git", &json::is_string, "a string", "git");
+    if (j.contains("scene")) check(j["scene"], "name", &json::is_string, "a string", "scene.name");
     return j;
 }
 
@@ -51,7 +68,10 @@ json scan_workload(TraceReader& reader, WorkloadFeatures* features) {
         uint64_t count = std::min<uint64_t>(buf.size(), n - first);
         reader.read(SectionKind::rays, first, count, buf.data());
         for (uint64_t i = 0; i < count; ++i) {
-            if (buf[i].kind < kRayKindCount) ++kinds[buf[i].kind];
+            require(buf[i].kind < kRayKindCount, reader.path() + ": ray " + std::to_string(first + i) +
+                                                     " has unknown ray kind " + std::to_string(buf[i].kind) +
+                                                     " (known kinds: 0.." + std::to_string(kRayKindCount - 1) + ")");
+            ++kinds[buf[i].kind];
             features->occlusion_rays += (buf[i].flags & kRayFlagAnyHit) != 0;
         }
     }
@@ -67,13 +87,18 @@ void report_progress(uint64_t done, uint64_t total) {
 
 /// Functional level: the reference traversal in a loop, no time. Counts and the hit check only.
 json run_functional(const Accel& accel, TraceReader& reader, HitChecker& checker) {
+    const std::string& path = reader.path();
     TraceRayStream stream(reader);
     std::vector<RayJob> jobs;
     while (stream.read_chunk(65536, &jobs)) {
         for (const RayJob& job : jobs) {
             RayResult r;
             r.id = job.id;
-            r.hit = accel.trace(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
+            try {
+                r.hit = accel.trace(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
+            } catch (const Error& e) {
+                throw Error(path + ": ray " + std::to_string(job.id) + ": " + e.what());
+            }
             checker.ray_done(r);
         }
         jobs.clear();
@@ -100,6 +125,9 @@ SimOutcome run_simulation(const SimOptions& o) {
     json manifest = read_manifest(rtt);
     // The acceleration structure, whichever it is, validated structurally (load_accel).
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
+    check_sim_memory(o.config, accel->image().end_address(),
+                     "config (traversal.units=" + std::to_string(o.config.traversal.units) +
+                         ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     WorkloadFeatures features;
     json workload = scan_workload(reader, &features);
     // Check every chunk's CRC now (one streaming pass): the reference window reads HITS and WORK
@@ -153,7 +181,14 @@ SimOutcome run_simulation(const SimOptions& o) {
                 sampled->estimator.ray_done(r);
                 if (hook) hook(r);
             };
-        sc_core::sc_start();
+        try {
+            sc_core::sc_start();
+        } catch (const sc_core::sc_report& e) {
+            // An rtsim::Error raised in a SystemC process (a traversal stack overflow, say): name
+            // the trace and the ray instead of SystemC's wrapper (exit 2, not a raw report).
+            const std::string ray = first_failing_ray(*accel, reader);
+            throw Error(rtt + ": " + (ray.empty() ? "simulation failed: " + unwrap_report(e.what()) : ray));
+        }
         cycles = top.total_cycles();
         model = top.stats_json();
         instantiated = top.instantiated();

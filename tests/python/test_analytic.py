@@ -39,11 +39,15 @@ def analysis(stats: dict[str, Any]) -> dict[str, Any]:
 def own_trace(trace_of: Callable[[str, str], Path], tmp_path: Path) -> Path:
     """A private copy of the hairball trace (its analyses are written beside it)."""
     out = tmp_path / "trace"
-    shutil.copytree(trace_of("hairball", "hairball"), out, ignore=shutil.ignore_patterns("analytic"))
+    shutil.copytree(
+        trace_of("hairball", "hairball"), out, ignore=shutil.ignore_patterns("analytic")
+    )
     return out
 
 
-def test_second_configuration_reuses_the_analysis(own_trace: Path, sim: Sim, tmp_path: Path) -> None:
+def test_second_configuration_reuses_the_analysis(
+    own_trace: Path, sim: Sim, tmp_path: Path
+) -> None:
     first = run(sim, own_trace, tmp_path / "a")
     assert analysis(first)["reused"] is False
     assert Path(analysis(first)["file"]).parent == own_trace / "analytic"
@@ -78,21 +82,34 @@ def test_a_changed_trace_is_analysed_anew(
     )
 
 
-def test_sampled_rays_are_checked_and_the_scope_is_stated(own_trace: Path, sim: Sim, tmp_path: Path) -> None:
+def test_sampled_rays_are_checked_and_the_scope_is_stated(
+    own_trace: Path, sim: Sim, tmp_path: Path
+) -> None:
     # A sample smaller than the trace: 2 clusters of 64 + 64 rays (plus each cluster's tail).
-    sets = ["analytic.whole_trace_rays=100", "analytic.clusters=2", "analytic.warmup_rays=64",
-            "analytic.measured_rays=64", "traversal.units=2", "traversal.ray_contexts=4"]  # fmt: skip
+    sets = [
+        "analytic.whole_trace_rays=100", "analytic.clusters=2", "analytic.warmup_rays=64",
+        "analytic.measured_rays=64", "traversal.units=2", "traversal.ray_contexts=4",
+    ]  # fmt: skip
     stats = run(sim, own_trace, tmp_path / "a", *sets)
     v = stats["validation"]
-    assert v["rays_checked"] == v["rays_expected"] == analysis(stats)["stepped_rays"] == 2 * (64 + 64 + 8)
+    assert (
+        v["rays_checked"]
+        == v["rays_expected"]
+        == analysis(stats)["stepped_rays"]
+        == 2 * (64 + 64 + 8)
+    )
     assert v["rays_checked"] < stats["summary"]["rays"]
     assert stats["summary"]["hit_mismatches"] == stats["summary"]["work_mismatches"] == 0
     assert "sampled rays are checked" in v["scope"]
     assert analysis(stats)["sample_rays"] == 2 * 64
 
 
-def test_statistical_hit_rates_track_the_functional_caches(own_trace: Path, sim: Sim, tmp_path: Path) -> None:
-    for i, sets in enumerate([[], ["l1.size_kib=4", "l2.size_kib=64"], ["l1.ways=1", "l2.size_kib=256"]]):
+def test_statistical_hit_rates_track_the_functional_caches(
+    own_trace: Path, sim: Sim, tmp_path: Path
+) -> None:
+    for i, sets in enumerate(
+        [[], ["l1.size_kib=4", "l2.size_kib=64"], ["l1.ways=1", "l2.size_kib=256"]]
+    ):
         stat = run(sim, own_trace, tmp_path / f"s{i}", *sets)
         exact = run(sim, own_trace, tmp_path / f"f{i}", "analytic.caches=functional", *sets)
         assert exact["validation"]["rays_checked"] == exact["summary"]["rays"]  # every ray

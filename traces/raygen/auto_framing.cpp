@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "traces/accel/accel.h"
+#include "traces/common/error.h"
 #include "traces/raygen/camera.h"
 
 namespace rtsim {
@@ -13,6 +14,9 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 constexpr float kFovDegrees = 60.0f;
+
+/// Centre of a box without overflow (lo + hi may exceed the float range where hi - lo does not).
+Vec3 mid(const Aabb& b) { return b.lo + 0.5f * (b.hi - b.lo); }
 
 /// Directions spread evenly over the sphere (Fibonacci lattice).
 std::vector<Vec3> sphere_directions(int n) {
@@ -72,7 +76,7 @@ Camera frame_interior(const Scene& scene, const Accel& accel, std::ostringstream
     // Candidate eyes along the long axis at a few heights, looking towards the far end.
     for (float along : {0.1f, 0.2f, 0.3f}) {
         for (float height : {0.2f, 0.3f, 0.45f}) {
-            Vec3 eye = b.center();
+            Vec3 eye = mid(b);
             eye[axis] = b.lo[axis] + along * e[axis];
             eye.y = b.lo.y + height * e.y;
             Vec3 target = eye;
@@ -91,22 +95,39 @@ Camera frame_interior(const Scene& scene, const Accel& accel, std::ostringstream
 }
 
 /// Three-quarter view from outside, at the smallest distance where all 8 box corners project
-/// inside the image (with a 5% margin).
-Camera frame_object(const Aabb& b, float aspect) {
-    Vec3 dir = glm::normalize(Vec3(0.6f, 0.45f, 1.0f));
-    Camera probe = look_at(b.center() + dir, b.center(), kFovDegrees);
-    PinholeCamera cam = make_camera(probe, 4, 3);
-    float tan_y = cam.tan_half_fov, tan_x = cam.tan_half_fov * aspect;
-    float dist = 0.0f;
+/// inside the image (with a 5% margin). In double precision: the box may span or sit near the
+/// float range (1e20 wide, or 1e30 from the origin) where float sums lose the offset.
+Camera frame_object(const Scene& scene, float aspect) {
+    const Aabb& b = scene.bounds;
+    const glm::dvec3 lo(b.lo), hi(b.hi), center = (lo + hi) * 0.5;
+    const glm::dvec3 dir = glm::normalize(glm::dvec3(0.6, 0.45, 1.0));
+    // The orientation does not depend on where the box is: take it from a camera at the origin.
+    PinholeCamera cam = make_camera(look_at(Vec3(dir), Vec3(0.0f), kFovDegrees), 4, 3);
+    const glm::dvec3 fwd(cam.forward), right(cam.right), up(cam.up);
+    const double tan_y = cam.tan_half_fov, tan_x = double(cam.tan_half_fov) * aspect;
+    double dist = 0.0;
     for (int i = 0; i < 8; ++i) {
-        Vec3 corner((i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z);
-        Vec3 p = corner - b.center();
-        float depth = glm::dot(p, cam.forward);
-        dist = std::max(dist, std::abs(glm::dot(p, cam.right)) / tan_x - depth);
-        dist = std::max(dist, std::abs(glm::dot(p, cam.up)) / tan_y - depth);
+        glm::dvec3 corner((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+        glm::dvec3 p = corner - center;
+        double depth = glm::dot(p, fwd);
+        dist = std::max(dist, std::abs(glm::dot(p, right)) / tan_x - depth);
+        dist = std::max(dist, std::abs(glm::dot(p, up)) / tan_y - depth);
     }
-    dist = std::max(dist * 1.05f, 1e-6f * glm::length(b.extent()));
-    return look_at(b.center() + dir * dist, b.center(), kFovDegrees);
+    dist = std::max(dist * 1.05, 1e-6 * glm::length(hi - lo));
+    const glm::dvec3 eye = center + dir * dist;
+    const Vec3 eye_f(eye), center_f(center);
+    const bool representable = std::isfinite(eye_f.x) && std::isfinite(eye_f.y) && std::isfinite(eye_f.z) &&
+                               std::isfinite(center_f.x) && std::isfinite(center_f.y) &&
+                               std::isfinite(center_f.z) && eye_f != center_f;
+    if (!representable) {
+        std::ostringstream os;
+        os << scene.source << ": automatic framing failed: the scene's bounds [" << lo.x << ", " << lo.y << ", "
+           << lo.z << "] .. [" << hi.x << ", " << hi.y << ", " << hi.z << "] need an eye at distance " << dist
+           << " from their centre, which single-precision rays cannot represent; scale the scene or give a "
+              "camera (--camera)";
+        throw Error(os.str());
+    }
+    return look_at(eye_f, center_f, kFovDegrees);
 }
 
 }  // namespace
@@ -115,12 +136,22 @@ Camera auto_frame(const Scene& scene, const Accel& accel, float aspect, std::str
     std::ostringstream reason;
     reason << "automatic framing: ";
     const Aabb& b = scene.bounds;
+    const Vec3 e = b.extent();
+    if (b.empty() || !(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f) || !std::isfinite(e.x + e.y + e.z)) {
+        std::ostringstream os;
+        os << scene.source << ": automatic framing failed: the scene's bounds [" << b.lo.x << ", " << b.lo.y
+           << ", " << b.lo.z << "] .. [" << b.hi.x << ", " << b.hi.y << ", " << b.hi.z << "] "
+           << (b.empty() ? "are empty" : std::isfinite(e.x + e.y + e.z) ? "have zero extent (every triangle is one point)"
+                                                                        : "exceed the float range")
+           << "; give a camera (--camera)";
+        throw Error(os.str());
+    }
     float enclosed = enclosure(scene, accel, b.center());
     Camera cam;
     if (enclosed >= 0.6f) {
         cam = frame_interior(scene, accel, reason);
     } else {
-        cam = frame_object(b, aspect);
+        cam = frame_object(scene, aspect);
         reason << "object seen from outside";
     }
     cam.name = "auto";

@@ -56,6 +56,29 @@ Light read_light(const Source& src, int light_index, const glm::dmat4& world, in
 Camera read_camera(const Source& src, int camera_index, const glm::dmat4& world, int node,
                    Scene& scene);
 
+/// Deepest JSON nesting a glTF file may have. tinygltf recurses once per level; real files
+/// nest a handful of levels (extras and extensions included), so 512 leaves ample room.
+constexpr size_t kMaxJsonDepth = 512;
+
+/// Refuses JSON text nested deeper than kMaxJsonDepth (one linear scan, before any parsing).
+void check_json_depth(const std::string& file, const unsigned char* text, size_t size);
+/// Checks what tinygltf lets through (gltf_json_checks.cpp): byteOffset, byteStride, byteLength
+/// and count must be non-negative integers (byteLength >= 1); texture, image and sampler
+/// indices in range. Text that is not a JSON object is left for tinygltf to report.
+void check_raw_document(const std::string& file, const unsigned char* text, size_t size);
+
+/// The JSON chunk of a GLB file.
+struct GlbChunks {
+    const unsigned char* json = nullptr;
+    size_t json_bytes = 0;
+};
+/// Validates a GLB header (version 2, length, first chunk JSON) and returns its JSON chunk.
+GlbChunks check_glb(const std::string& file, const unsigned char* data, size_t size);
+
+/// The text with every byte that is not part of well-formed UTF-8 written as "\xNN", so an
+/// error message can always be shown (and decoded by Python).
+std::string valid_utf8(const std::string& text);
+
 /// Number `key` of a JSON object value, or `fallback` when absent or not a number.
 double value_number(const tinygltf::Value& object, const char* key, double fallback);
 /// A JSON number as an element index, -1 when it is not a non-negative integer that fits an int.

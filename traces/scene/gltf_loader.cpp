@@ -2,6 +2,9 @@
 // precision and turns meshes, EXT_mesh_gpu_instancing entries, lights and cameras into a Scene.
 #include "traces/scene/gltf_loader.h"
 
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 
@@ -14,6 +17,7 @@ namespace rtsim {
 
 namespace {
 
+namespace fs = std::filesystem;
 using gltf::element;
 using gltf::Source;
 
@@ -24,24 +28,61 @@ bool extension_supported(const std::string& name) {
     return kGeometry.count(name) || name.rfind("KHR_materials_", 0) == 0;
 }
 
+/// The whole file; a folder, an unreadable or a > 4 GiB file (tinygltf's limit) is refused.
+std::vector<unsigned char> read_file(const std::string& path) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw Error(path + ": is a folder, not a glTF file (.gltf or .glb)");
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in) throw Error(path + ": cannot open file");
+    const std::streamoff size = in.tellg();
+    if (size < 0) throw Error(path + ": cannot read file");
+    if (uint64_t(size) >= (uint64_t(1) << 32))
+        throw Error(path + ": " + std::to_string(size) + " bytes; glTF files of 4 GiB or more are not supported");
+    std::vector<unsigned char> bytes(static_cast<size_t>(size));
+    in.seekg(0);
+    if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) throw Error(path + ": cannot read file");
+    return bytes;
+}
+
+/// tinygltf image callback that keeps nothing: rtsim traces geometry only (alpha coverage comes
+/// from extras.textureAlphaCoverage), so images are never decoded (an 8000 x 8000 PNG would
+/// cost 256 MB per reference otherwise).
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                void*) {
+    return true;
+}
+
 /// Loads the model (binary if the file starts with the GLB magic) or throws naming the file.
+/// The raw bytes are checked first (gltf_json_checks.cpp): nesting depth, GLB header, negative
+/// offsets and out-of-range texture indices, which tinygltf would crash on or let through.
 void load_model(const std::string& path, tinygltf::Model& model, Scene& scene) {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) throw Error(path + ": cannot open file");
-    char magic[4] = {0, 0, 0, 0};
-    probe.read(magic, 4);
-    bool binary = probe.gcount() == 4 && std::string(magic, 4) == "glTF";
-    probe.close();
+    const std::vector<unsigned char> bytes = read_file(path);
+    const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    gltf::GlbChunks json{bytes.data(), bytes.size()};
+    if (binary) json = gltf::check_glb(path, bytes.data(), bytes.size());
+    gltf::check_json_depth(path, json.json, json.json_bytes);
+    gltf::check_raw_document(path, json.json, json.json_bytes);
 
     tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(&skip_image, nullptr);
+    const std::string base = fs::path(path).parent_path().string();
+    const auto size = static_cast<unsigned int>(bytes.size());
     std::string err, warn;
-    bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                     : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    bool ok = false;
+    try {
+        ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), size, base)
+                    : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
+                                                 size, base);
+    } catch (const std::bad_alloc&) {
+        throw Error(path + ": out of memory while parsing the file");
+    } catch (const std::exception& e) {  // tinygltf's .at() and JSON conversions
+        throw Error(path + ": malformed glTF (" + e.what() + ")");
+    }
     if (!ok || !err.empty()) {
         while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
         throw Error(path + ": " + (err.empty() ? std::string("tinygltf failed to load the file") : err));
     }
-    if (!warn.empty()) scene.warnings.push_back(warn);
+    if (!warn.empty()) scene.warnings.push_back(gltf::valid_utf8(warn));
     for (const std::string& ext : model.extensionsRequired)
         if (!extension_supported(ext)) throw Error(path + ": required extension " + ext + " is not supported");
 }
@@ -74,8 +115,10 @@ glm::dmat4 local_matrix(const Source& src, const tinygltf::Node& node, size_t in
 }
 
 /// Instance transforms of an EXT_mesh_gpu_instancing node: world x T_i x R_i x S_i.
+/// `flat` counts the scene's triangles so far (each instance counts at least one): the
+/// flattened size is checked before the instances are expanded.
 std::vector<glm::dmat4> gpu_instances(const Source& src, const tinygltf::Value& ext, size_t node,
-                                      const glm::dmat4& world) {
+                                      const glm::dmat4& world, uint64_t mesh_triangles, uint64_t* flat) {
     std::string where = element("node", node, src.model->nodes[node].name) + " EXT_mesh_gpu_instancing";
     const tinygltf::Value& attrs = ext.IsObject() ? ext.Get("attributes") : ext;
     if (!attrs.IsObject()) src.fail(where + ": no attributes object");
@@ -96,6 +139,11 @@ std::vector<glm::dmat4> gpu_instances(const Source& src, const tinygltf::Value& 
         have_count = present[a] = true;
     }
     if (!have_count) src.fail(where + ": no TRANSLATION, ROTATION or SCALE attribute");
+    *flat += uint64_t(count) * std::max<uint64_t>(mesh_triangles, 1);
+    check_flat_size(src.file, *flat, where + " (" + std::to_string(count) + " instances of " +
+                                         std::to_string(mesh_triangles) +
+                                         " triangles, with the nodes before it; instances are flattened: "
+                                         "rtsim has no two-level BVH yet)");
     std::vector<glm::dmat4> out(count);
     for (size_t i = 0; i < count; ++i) {
         glm::dmat4 t(1.0), r(1.0), s(1.0);
@@ -175,11 +223,14 @@ private:
         int& mesh = m_mesh_of[size_t(node.mesh)];
         if (mesh < 0) mesh = int(gltf::read_mesh(m_src, node.mesh, m_scene));
         auto inst = node.extensions.find("EXT_mesh_gpu_instancing");
+        const uint64_t triangles = m_scene.meshes[size_t(mesh)].triangle_count();
         if (inst == node.extensions.end()) {
+            m_flat += std::max<uint64_t>(triangles, 1);
+            check_flat_size(m_src.file, m_flat, element("node", index, node.name) + " (with the nodes before it)");
             m_scene.instances.push_back({uint32_t(mesh), world, 0, int32_t(index)});
             return;
         }
-        for (const glm::dmat4& m : gpu_instances(m_src, inst->second, index, world))
+        for (const glm::dmat4& m : gpu_instances(m_src, inst->second, index, world, triangles, &m_flat))
             m_scene.instances.push_back({uint32_t(mesh), m, 0, int32_t(index)});
     }
 
@@ -187,11 +238,10 @@ private:
     Scene& m_scene;
     std::vector<uint8_t> m_state;  ///< 0 unvisited, 1 on the current path, 2 done
     std::vector<int> m_mesh_of;    ///< glTF mesh index -> Scene::meshes index (-1 not read yet)
+    uint64_t m_flat = 0;           ///< triangles placed so far (at least one per instance)
 };
 
-}  // namespace
-
-Scene load_gltf(const std::string& path) {
+Scene load_gltf_checked(const std::string& path) {
     Scene scene;
     scene.source = path;
     tinygltf::Model model;
@@ -220,7 +270,22 @@ Scene load_gltf(const std::string& path) {
 
     if (scene.materials.empty()) scene.default_material();
     scene.flatten();
+    if (scene.triangles.empty())
+        throw Error(path + ": the scene has no triangles (no mesh with TRIANGLES, TRIANGLE_STRIP or "
+                           "TRIANGLE_FAN primitives in its default scene)");
     return scene;
+}
+
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+    try {
+        return load_gltf_checked(path);
+    } catch (const Error& e) {
+        // Names and tinygltf's messages may quote bytes that are not UTF-8 (a Python caller
+        // decodes the message): escape them rather than lose the message.
+        throw Error(gltf::valid_utf8(e.what()));
+    }
 }
 
 }  // namespace rtsim

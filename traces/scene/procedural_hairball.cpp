@@ -8,6 +8,7 @@
 #include "traces/common/error.h"
 #include "traces/common/rng.h"
 #include "traces/scene/procedural_shapes.h"
+#include "traces/scene/scene.h"
 
 namespace rtsim {
 
@@ -65,6 +66,7 @@ uint32_t add_strand(TriangleSoup& soup, Rng& rng, uint32_t budget) {
 std::string write_hairball(const std::string& dir, const ProceduralOptions& options) {
     uint32_t total = options.hairball_triangles;
     if (total == 0) throw Error("procedural scene 'hairball': hairball_triangles must be > 0");
+    check_flat_size("procedural scene 'hairball'", total, "hairball_triangles=" + std::to_string(total));
     TriangleSoup hair;
     uint64_t strands = (uint64_t(total) + 2 * kSegments - 1) / (2 * kSegments);
     hair.vertices.reserve(size_t(strands) * 2 * (kSegments + 1));

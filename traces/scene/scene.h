@@ -84,6 +84,16 @@ struct Triangle {
     Vec3 v0, v1, v2;
 };
 
+/// Peak memory of tracing, per flattened triangle (scene, BVH build, hardware image, writer),
+/// measured with /usr/bin/time on 2M-triangle hairballs (docs/validation.md).
+constexpr uint64_t kBytesPerFlatTriangle = 200;
+/// Most triangles a scene may flatten to: primitive ids are int32, and the estimate at
+/// kBytesPerFlatTriangle must fit this machine's physical memory.
+uint64_t max_flat_triangles();
+/// Throws rtsim::Error "<source>: <what> flattens to N triangles (about X GiB to trace); ..."
+/// when `triangles` exceeds max_flat_triangles(). Called before any flattening is allocated.
+void check_flat_size(const std::string& source, uint64_t triangles, const std::string& what);
+
 struct Scene {
     std::string source;  ///< file the scene was read from
     std::vector<Mesh> meshes;
@@ -100,7 +110,8 @@ struct Scene {
     Aabb bounds;
 
     /// Fills triangles/tri_material/tri_instance/bounds from meshes and instances. Vertices are
-    /// transformed in double precision and rounded once to float.
+    /// transformed in double precision and rounded once to float. Throws rtsim::Error naming
+    /// `source` if the result would not fit (check_flat_size) or a vertex is not finite.
     void flatten();
     size_t triangle_count() const { return triangles.size(); }
     /// True if some mesh is placed more than once (shared meshes or GPU instancing).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 
 #include "traces/common/error.h"
@@ -37,12 +38,15 @@ Camera choose_camera(const TraceOptions& o, const Scene& scene, const Accel& acc
     return auto_frame(scene, accel, float(o.width) / float(o.height), source);
 }
 
-std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint32_t h) {
+/// Every primary ray; an invalid one (NaN or infinite) is refused, never written silently.
+std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint32_t h, const std::string& source) {
     std::vector<PendingRay> rays(size_t(w) * h);
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {
             PendingRay& r = rays[size_t(y) * w + x];
             r.ray = primary_ray(cam, x, y, w, h);
+            require(ray_is_valid(r.ray), source + ": primary ray of pixel (" + std::to_string(x) + ", " +
+                                             std::to_string(y) + ") is not finite (camera eye, axes or field of view)");
             r.kind = RayKind::primary;
             r.pixel = y * w + x;
         }
@@ -67,15 +71,25 @@ std::string resolve_scene(const TraceOptions& o, bool* procedural) {
     return write_procedural_scene(o.scene, (fs::path(o.out_dir) / "scene").string(), o.procedural);
 }
 
+std::string vec_text(const Vec3& v) {
+    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
+}
+
 void validate(const TraceOptions& o) {
     require(!o.scene.empty(), "no scene given");
     require(!o.out_dir.empty(), "no output folder given");
     require(o.width > 0 && o.height > 0 && uint64_t(o.width) * o.height <= (1ull << 28),
             "resolution " + std::to_string(o.width) + "x" + std::to_string(o.height) + " is out of range");
     require(o.bounces <= 64, "bounces " + std::to_string(o.bounces) + " is out of range (0..64)");
-    if (o.camera)
-        require(o.camera->yfov_degrees > 0.0f && o.camera->yfov_degrees < 180.0f,
-                "camera field of view must be in (0, 180) degrees");
+    if (o.camera) {
+        const CameraOverride& c = *o.camera;
+        require(c.yfov_degrees > 0.0f && c.yfov_degrees < 180.0f, "camera field of view must be in (0, 180) degrees");
+        const bool finite = std::isfinite(c.eye.x) && std::isfinite(c.eye.y) && std::isfinite(c.eye.z) &&
+                            std::isfinite(c.target.x) && std::isfinite(c.target.y) && std::isfinite(c.target.z);
+        require(finite, "camera eye and target must be finite single-precision numbers (eye " + vec_text(c.eye) +
+                            ", target " + vec_text(c.target) + ")");
+        require(c.eye != c.target, "camera eye " + vec_text(c.eye) + " equals the target: no view direction");
+    }
     validate_accel_options(o.accel);
 }
 
@@ -102,13 +116,16 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     std::string camera_source;
     Camera camera = choose_camera(o, scene, *accel, &camera_source);
     PinholeCamera pinhole = make_camera(camera, o.width, o.height);
+    const std::string camera_where = path + ": camera from " + camera_source;
+    check_camera(pinhole, camera_where);
+    check_scene_reach(pinhole, scene.bounds, camera_where);
 
     TraceFolderWriter folder(o.out_dir, accel->image());
     uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
     PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
     SpawnContext ctx{&scene, &plan, o.bounces, o.seed};
 
-    std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height);
+    std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height, camera_where);
     for (uint32_t depth = 0; !wave.empty(); ++depth) {
         std::string stage = depth == 0 ? "primary" : "depth " + std::to_string(depth);
         WavefrontResult res = trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from rich.console import Console
 
     from rtsim.sweep.runner import SweepOutcome
+    from rtsim.sweep.store import RunRecord
 
 
 def print_outcome(outcome: SweepOutcome, out: Path, console: Console) -> None:
@@ -95,6 +96,8 @@ def cmd_results(args: argparse.Namespace, console: Console) -> int:
 def _key_cell(rec: RunRecord, key: str) -> str:
     """The run's value of a swept key; dimmed when the run's spec did not sweep it (a store
     mixing two specs), so no column is ever blank."""
+    from rtsim.sweep.results import key_value
+
     value, swept = key_value(rec, key)
     text = "-" if value is None else str(value)
     return text if swept else f"[dim]{text}[/]"

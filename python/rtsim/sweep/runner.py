@@ -24,6 +24,7 @@ from rich.progress import (
 )
 
 from rtsim import __version__
+from rtsim.sweep.lock import clean_stale_traces, sweep_lock
 from rtsim.sweep.spec import RunPlan, SweepSpec, TracePlan
 from rtsim.sweep.store import ResultsStore, RunRecord, open_store
 from rtsim.sweep.tasks import SimTask, TraceTask, make_trace, run_sim, utc_now
@@ -155,6 +156,14 @@ def run_sweep(spec: SweepSpec, opts: SweepOptions, console: Console) -> SweepOut
     """Runs every run of the spec not yet in the store (and failed ones with retry_failed)."""
     out = opts.out_dir.resolve()
     out.mkdir(parents=True, exist_ok=True)
+    with sweep_lock(out):
+        stale = clean_stale_traces(out)
+        if stale:
+            console.print(f"removed {len(stale)} unfinished trace folder(s) of an earlier sweep")
+        return _run_locked(spec, opts, out, console)
+
+
+def _run_locked(spec: SweepSpec, opts: SweepOptions, out: Path, console: Console) -> SweepOutcome:
     runs = spec.runs()
     timeout = opts.timeout if opts.timeout is not None else (spec.timeout or DEFAULT_TIMEOUT)
     with open_store(out) as store:

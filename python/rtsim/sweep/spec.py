@@ -9,6 +9,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,9 @@ from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 SAMPLING_METHODS = ("random", "latin_hypercube")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
 TOP_KEYS = ("name", "scenes", "workloads", "config", "grid", "sampling", "timeout", "baseline")
+#: Most runs one sweep may have (each is an rtsim-sim process and a row of the store); checked
+#: from the grid's and sample's sizes before any point is enumerated.
+MAX_RUNS = 100_000
 
 
 class SpecError(ValueError):
@@ -393,11 +397,30 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
                 f"sampling.ranges.{key}",
                 "already swept by the grid",
             )
+    _check_size(rd, doc, spec)
     if "timeout" in doc:
         spec.timeout = float(rd.number(doc, "timeout", "timeout", False, 0))
     if "baseline" in doc:
         spec.baseline = rd.baseline(doc, spec.grid)
     return spec
+
+
+def _check_size(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
+    """Refuses a sweep of more than MAX_RUNS runs before anything is enumerated."""
+    points = math.prod(len(v) for v in spec.grid.values())
+    points *= spec.sampling.n if spec.sampling else 1
+    runs = points * len(spec.scenes) * len(spec.workloads)
+    if runs <= MAX_RUNS:
+        return
+    key = "grid" if "grid" in doc else "sampling"
+    raise rd.fail(
+        doc,
+        key,
+        key,
+        f"{runs:,} runs ({len(spec.scenes)} scenes x {len(spec.workloads)} workloads x "
+        f"{points:,} config points) exceed the limit of {MAX_RUNS:,} runs per sweep "
+        "(docs/sweeps.md); split the sweep, or sample points (sampling.n) instead of a grid",
+    )
 
 
 def load_spec(path: Path) -> SweepSpec:

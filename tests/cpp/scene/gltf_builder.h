@@ -11,6 +11,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "traces/common/error.h"
+#include "traces/scene/gltf_loader.h"
+
 namespace rtsim::test {
 
 using nlohmann::json;
@@ -96,6 +99,48 @@ struct GltfBuilder {
         return path;
     }
 };
+
+/// Loads `path`, expecting an Error whose message contains the file name and every fragment;
+/// returns the message ("" if it loaded).
+inline std::string expect_error(const std::string& path, const std::vector<std::string>& fragments) {
+    std::string file = std::filesystem::path(path).filename().string();
+    try {
+        load_gltf(path);
+        ADD_FAILURE() << path << ": loaded without error";
+    } catch (const Error& e) {
+        std::string msg = e.what();
+        EXPECT_NE(msg.find(file), std::string::npos) << "message lacks the file name: " << msg;
+        for (const std::string& f : fragments)
+            EXPECT_NE(msg.find(f), std::string::npos) << "message lacks '" << f << "': " << msg;
+        return msg;
+    }
+    return "";
+}
+
+/// Writes a GLB container: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded,
+/// omitted when empty). `version` goes into the header as is.
+inline std::string write_glb(const std::string& path, const json& doc, std::vector<uint8_t> bin,
+                             uint32_t version = 2) {
+    std::string text = doc.dump();
+    while (text.size() % 4) text += ' ';
+    while (bin.size() % 4) bin.push_back(0);
+    std::string out;
+    auto u32 = [&out](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+    const uint32_t total = uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size()));
+    u32(0x46546C67u);
+    u32(version);
+    u32(total);
+    u32(uint32_t(text.size()));
+    u32(0x4E4F534Au);
+    out += text;
+    if (!bin.empty()) {
+        u32(uint32_t(bin.size()));
+        u32(0x004E4942u);
+        out.append(reinterpret_cast<const char*>(bin.data()), bin.size());
+    }
+    std::ofstream(path, std::ios::binary) << out;
+    return path;
+}
 
 /// A one-triangle mesh (0,0,0), (1,0,0), (0,1,0) named "tri" with u16 indices, node 0, scene 0.
 inline GltfBuilder one_triangle() {

@@ -13,19 +13,7 @@ namespace {
 using test::GltfBuilder;
 using test::json;
 
-/// Loads `path`, expecting an Error whose message contains the file name and every fragment.
-void expect_error(const std::string& path, const std::vector<std::string>& fragments) {
-    std::string file = std::filesystem::path(path).filename().string();
-    try {
-        load_gltf(path);
-        ADD_FAILURE() << path << ": loaded without error";
-    } catch (const Error& e) {
-        std::string msg = e.what();
-        EXPECT_NE(msg.find(file), std::string::npos) << "message lacks the file name: " << msg;
-        for (const std::string& f : fragments)
-            EXPECT_NE(msg.find(f), std::string::npos) << "message lacks '" << f << "': " << msg;
-    }
-}
+using test::expect_error;
 
 TEST(GltfErrors, MissingFile) {
     expect_error(test::test_dir() + "/no_such_scene.gltf", {"cannot open"});

@@ -1,4 +1,5 @@
 // The binary BVH's image, Accel and locality tree (bvh2.h).
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -86,9 +87,12 @@ constexpr uint32_t kMaxLeafTriangles = 1u << 16;
 }  // namespace
 
 void validate_bvh2(const Bvh2View& v, const std::string& source) {
-    if (v.node_count == 0) return;  // an empty scene: every ray misses
     // Messages are built only on failure: this pass runs over every node of every trace opened.
     auto fail = [&](const std::string& what) { throw Error(source + ": binary BVH: " + what); };
+    if (v.node_count == 0) {  // an empty scene: every ray misses
+        if (v.triangle_count) fail("no nodes but " + std::to_string(v.triangle_count) + " triangles");
+        return;
+    }
     auto child = [](uint64_t i, int c) { return "node " + std::to_string(i) + " child " + std::to_string(c); };
     if (v.node_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) fail("more than 2^32 nodes or triangles");
     // Depth-first layout: a child always comes after its parent, so following children can
@@ -100,7 +104,15 @@ void validate_bvh2(const Bvh2View& v, const std::string& source) {
         if (!seen[i]) fail("node " + std::to_string(i) + " is not reachable from the root");
         for (int c = 0; c < 2; ++c) {
             const uint32_t ref = n.child_ref[c], count = n.child_count[c];
-            if (count == kEmptyChild) continue;
+            if (count == kEmptyChild) {
+                // Only the builder's one-leaf root has an empty slot, with a box no ray enters.
+                if (i != 0 || c != 1) fail(child(i, c) + " is an empty child slot outside the root");
+                if (!(n.lo(c, 0) > n.hi(c, 0) && n.lo(c, 1) > n.hi(c, 1) && n.lo(c, 2) > n.hi(c, 2)))
+                    fail(child(i, c) + " is an empty slot with an enterable box");
+                continue;
+            }
+            for (int a = 0; a < 3; ++a)
+                if (std::isnan(n.lo(c, a)) || std::isnan(n.hi(c, a))) fail(child(i, c) + " has a NaN in its box");
             if (count == 0) {
                 if (ref <= i || ref >= v.node_count)
                     fail(child(i, c) + " points to node " + std::to_string(ref) +

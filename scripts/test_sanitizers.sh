@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# The sanitizer and fuzz step (docs/validation.md, "Bad input"): builds the asan preset (clang,
+# AddressSanitizer + UndefinedBehaviorSanitizer, the libFuzzer targets) in build/asan, then
+#   1. runs the C++ tests (ctest) under the sanitizers;
+#   2. runs every bad input of tests/python/bad_corpus.py (and the seeds) once through each
+#      fuzz target, and the bad traces through the sanitized rtsim-sim (each must exit 2);
+#   3. runs the bad-input pytest corpus against the sanitized rtsim-sim;
+#   4. fuzzes each target for FUZZ_SECONDS from the project's own seed corpus.
+# Needs scripts/setup.sh first (the rtsim package makes the corpus). Installs clang and the
+# libFuzzer runtime if missing. Env: FUZZ_SECONDS (default 45), PYTHON (default python),
+# SANITIZER_SCOPE: "full" (default: every step above) or "fuzz" (CI: builds only the three fuzz
+# targets and runs steps 2 and 4 for them, a few minutes on 2 cores instead of a whole ASan build).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+PYTHON="${PYTHON:-python}"
+FUZZ_SECONDS="${FUZZ_SECONDS:-45}"
+SANITIZER_SCOPE="${SANITIZER_SCOPE:-full}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  SUDO="sudo"
+fi
+missing=()
+for pkg in clang libclang-rt-14-dev; do
+  if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$pkg")
+  fi
+done
+if [ "${#missing[@]}" -gt 0 ]; then
+  echo "sanitizers: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+start=$(date +%s)
+echo "== sanitizers: building build/asan (clang, ASan + UBSan, fuzz targets)"
+cmake --preset asan >/dev/null
+if [ "$SANITIZER_SCOPE" = "fuzz" ]; then
+  cmake --build build/asan -j "${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)}" \
+    --target fuzz_gltf_loader fuzz_trace_reader fuzz_config
+else
+  cmake --build build/asan -j "${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)}"
+fi
+built=$(date +%s)
+
+# SystemC allocates kernels and processes it never frees (and the tests make one kernel per
+# test): leak checking is for the fuzzers, which do not use SystemC.
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=0:strict_string_checks=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+status=0
+if [ "$SANITIZER_SCOPE" != "fuzz" ]; then
+  echo "== sanitizers: C++ tests"
+  ctest --test-dir build/asan --output-on-failure -j2 || status=1
+fi
+
+work=build/asan/fuzz-work
+rm -rf "$work"
+mkdir -p "$work/artifacts"
+"$PYTHON" scripts/make_fuzz_corpus.py "$work/corpus"
+
+echo "== sanitizers: every bad input and seed once, through each fuzz target"
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1"
+for target in gltf_loader trace_reader config; do
+  short=${target%%_*}
+  exe="build/asan/tests/fuzz/fuzz_$target"
+  # With files as arguments libFuzzer runs each once and stops at the first crash.
+  "$exe" -timeout=20 -artifact_prefix="$work/artifacts/" \
+    "$work/corpus/$short"/bad/* "$work/corpus/$short"/seed/* </dev/null >"$work/$short-once.log" 2>&1 \
+    || { echo "sanitizers: an input crashed $exe (log: $work/$short-once.log)"; tail -30 "$work/$short-once.log"; status=1; }
+  echo "  fuzz_$target: $(grep -c "^Running: " "$work/$short-once.log") inputs, $(grep -c "^Executed " "$work/$short-once.log") ran clean"
+done
+
+if [ "$SANITIZER_SCOPE" != "fuzz" ]; then
+echo "== sanitizers: bad traces through the sanitized rtsim-sim (each must exit 2)"
+export ASAN_OPTIONS="detect_leaks=0"
+for trace in "$work"/corpus/sim/*; do
+  code=0
+  build/asan/sim/rtsim-sim "$trace" -o "$work/run" >"$work/sim.log" 2>&1 || code=$?
+  if [ "$code" -ne 2 ] || ! grep -q "$trace/trace.rtt" "$work/sim.log"; then
+    echo "sanitizers: rtsim-sim $trace exited $code:"; cat "$work/sim.log"; status=1
+  fi
+done
+echo "== sanitizers: bad-input pytest corpus against the sanitized rtsim-sim"
+RTSIM_SIM="$PWD/build/asan/sim/rtsim-sim" "$PYTHON" -m pytest tests/python/test_bad_inputs.py -q -k "trace or manifest or config" \
+  || status=1
+fi
+
+echo "== sanitizers: fuzzing each target for ${FUZZ_SECONDS} s"
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1"
+for target in gltf_loader trace_reader config; do
+  short=${target%%_*}
+  corpus="$work/live-$short"
+  mkdir -p "$corpus"
+  cp "$work/corpus/$short"/seed/* "$corpus/"
+  if ! "build/asan/tests/fuzz/fuzz_$target" "$corpus" -max_total_time="$FUZZ_SECONDS" -timeout=20 \
+      -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$work/artifacts/" </dev/null \
+      >"$work/fuzz-$target.log" 2>&1; then
+    echo "sanitizers: fuzz_$target found a crash, hang or leak (artifacts: $work/artifacts):"
+    grep -E "ERROR|SUMMARY|Test unit written|runtime error" "$work/fuzz-$target.log" | head -20
+    status=1
+  fi
+  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$work/fuzz-$target.log" | sed "s/^/  fuzz_$target: /"
+done
+
+end=$(date +%s)
+echo "sanitizers: build $((built - start)) s, checks $((end - built)) s"
+if [ "$status" -ne 0 ]; then
+  echo "sanitizers: FAILED" >&2
+else
+  echo "sanitizers: all passed"
+fi
+exit "$status"
