@@ -1,6 +1,6 @@
 // rtsim-sim: one simulation per process (SystemC elaborates once).
 //   rtsim-sim TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline] [--progress]
-//   rtsim-sim --dump-defaults | --dump-schema
+//   rtsim-sim --dump-defaults | --dump-schema | --dump-stats-schema
 // Exit codes: 0 ok, 2 bad input (message names the file or field), 3 hits differ from the reference.
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +11,7 @@
 #include <systemc>
 
 #include "sim/harness/simulate.h"
+#include "sim/harness/summary_schema.h"
 #include "traces/common/error.h"
 
 namespace {
@@ -42,7 +43,8 @@ int sc_main(int argc, char** argv) {
     CLI::App app{"rtsim-sim: replays a ray trace on the SystemC accelerator model"};
     std::string trace, config_path, out_dir;
     std::vector<std::string> sets;
-    bool timeline = false, progress = false, dump_defaults = false, dump_schema = false, no_verdict = false;
+    bool timeline = false, progress = false, dump_defaults = false, dump_schema = false, dump_stats_schema = false,
+         no_verdict = false;
     app.add_option("trace", trace, "Trace folder (from rtsim trace) or .rtt file");
     app.add_option("--config", config_path, "Config JSON (defaults for missing keys)");
     app.add_option("--set", sets, "Override a config key: key.path=value (repeatable)");
@@ -52,8 +54,13 @@ int sc_main(int argc, char** argv) {
     app.add_flag("--no-verdict", no_verdict, "Skip the bottleneck verdict (its analytic estimates on a sample of the trace)");
     app.add_flag("--dump-defaults", dump_defaults, "Print the default config as JSON and exit");
     app.add_flag("--dump-schema", dump_schema, "Print every config field with default, unit, range, doc");
+    app.add_flag("--dump-stats-schema", dump_stats_schema, "Print every stats.json summary key with unit and meaning");
     CLI11_PARSE(app, argc, argv);
     try {
+        if (dump_stats_schema) {
+            std::cout << rtsim::summary_schema_json().dump(2) << "\n";
+            return 0;
+        }
         if (dump_defaults || dump_schema) {
             std::cout << (dump_schema ? rtsim::config_schema() : rtsim::config_to_json(rtsim::SimConfig{})).dump(2) << "\n";
             return 0;

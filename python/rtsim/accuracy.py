@@ -432,14 +432,15 @@ def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None: 
         "--spec",
         metavar="SPEC.yaml",
         help="a sweep spec (e.g. python/rtsim/specs/demo.yaml): each level's error, rank "
-        "agreement and speed-up across its grid instead (grid.md, grid.csv, grid.png)",
+        "agreement and speed-up across its grid instead (grid.md, grid.csv, grid.png; default: "
+        "no spec, the scenes' default configuration)",
     )
     p.add_argument(
         "--levels",
         default="analytic,analytic_functional,approx,detailed",
         metavar="L,L",
         help="with --spec: levels to run (analytic_functional: the analytic level with "
-        "functional caches, for hit-rate errors)",
+        "functional caches, for hit-rate errors; default: all four)",
     )
     p.add_argument(
         "-o",

@@ -128,6 +128,41 @@ def energy_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def why_slow_table(stats: dict[str, Any]) -> Table:
+    """The verdict, where context time went, and the roofline (docs/stats.md, `verdict`,
+    `model.cycle_accounting`, `roofline`)."""
+    table = _two_column("why is it slow (docs/model.md)")
+    verdict = stats.get("verdict") or {}
+    if verdict:
+        table.add_row("bottleneck", str(verdict.get("label", verdict.get("binding", "-"))))
+        evidence = (verdict.get("evidence") or {}).get("text")
+        if evidence:
+            table.add_row("  evidence", str(evidence))
+        relax = verdict.get("relax") or {}
+        if relax and _is_num(relax.get("speedup")):
+            table.add_row(
+                "  try",
+                f"--set {relax.get('key')}={relax.get('to')} (now {relax.get('from')}): "
+                f"{relax['speedup']:.2f}x estimated",
+            )
+    fractions = _get(stats, "model.cycle_accounting.fractions") or {}
+    top = sorted(
+        ((k, v) for k, v in fractions.items() if _is_num(v) and v >= 0.01), key=lambda kv: -kv[1]
+    )[:5]
+    if top:
+        table.add_row("context time", ", ".join(f"{k} {v:.0%}" for k, v in top))
+    roof = stats.get("roofline") or {}
+    bound = roof.get("bound_rays_per_second")
+    achieved = roof.get("rays_per_second")
+    if _is_num(bound) and _is_num(achieved) and bound > 0:
+        table.add_row(
+            "roofline",
+            f"{achieved / 1e6:,.2f} of {bound / 1e6:,.2f} Mrays/s allowed by {roof.get('bound')} "
+            f"({achieved / bound:.0%})",
+        )
+    return table
+
+
 def latency_table(stats: dict[str, Any]) -> Table:
     lat = stats.get("latency", {}) or {}
     table = Table(title="ray latency (cycles)", title_justify="left")
@@ -163,6 +198,8 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
     console.print(performance_table(stats))
     if _get(stats, "summary.cycles") is not None:
         console.print(utilisation_table(stats))
+        if stats.get("verdict") or stats.get("roofline"):
+            console.print(why_slow_table(stats))
         console.print(latency_table(stats))
         console.print(instantiated_table(stats))
     if stats.get("energy"):

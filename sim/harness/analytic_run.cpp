@@ -12,10 +12,12 @@
 #include "sim/harness/analytic.h"
 #include "sim/harness/analytic_cache.h"
 #include "sim/harness/analytic_estimate.h"
+#include "sim/harness/energy_area.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/roofline.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
+#include "sim/harness/summary_schema.h"
 #include "sim/harness/trace_stream.h"
 #include "sim/harness/verdict.h"
 #include "traces/accel/accel_io.h"
@@ -100,8 +102,19 @@ json analytic_summary(const SimOptions& o, const AnalyticProfile& p, const Analy
 /// What a run adds to stats.json beyond the common keys; written by write_outputs.
 struct RunStats {
     json summary, validation, latency, workload, instantiated, model;
-    bool bad = false;  ///< a hit or work mismatch
+    WorkTotals work;    ///< the whole trace's work (for the energy model)
+    uint64_t rays = 0;  ///< rays that work covers
+    bool bad = false;   ///< a hit or work mismatch
 };
+
+/// The profile's whole-trace work sums as the energy model's totals.
+WorkTotals work_totals_of(const AnalyticProfile& p) {
+    auto n = [&p](int field) { return uint64_t(p.work[size_t(field)] + 0.5); };
+    WorkTotals w;
+    w.steps = n(0), w.box_tests = n(1), w.tri_tests = n(2), w.anyhit_calls = n(3);
+    w.transforms = n(4), w.cell_steps = n(5), w.plane_tests = n(6), w.refs = n(7);
+    return w;
+}
 
 SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json& manifest, std::time_t started,
                          RunStats r, const std::function<json(const json& model)>& verdict_of) {
@@ -117,11 +130,13 @@ SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json
                  {"model", r.model},
                  {"provenance", provenance(o.command_line, rtt, manifest, started)}};
     out.stats["summary"]["sampled"] = false;
+    add_energy_area(out.stats, o.config, r.work, r.rays);
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], r.model);
     const json verdict = o.verdict && out.stats["summary"].value("rays", 0) > 0 ? verdict_of(r.model) : json(nullptr);
     out.stats["verdict"] = verdict;
     out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
     out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
+    check_summary(out.stats["summary"], false);  // every key declared once (summary_schema.cpp)
     write_json(fs::path(o.out_dir) / "stats.json", out.stats);
     write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
     out.exit_code = r.bad ? 3 : 0;
@@ -154,6 +169,8 @@ SimOutcome run_functional_caches(const SimOptions& o, TraceReader& reader, const
     r.instantiated = std::move(a.instantiated);
     r.model = std::move(a.model);
     r.bad = checker.hit_mismatches() || checker.work_mismatches();
+    r.work = checker.work_totals();
+    r.rays = checker.checked();
     return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
         return judge(VerdictContext{o.config, model, accel.get(), &map, &reader});
     });
@@ -211,6 +228,8 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     r.instantiated = std::move(e.instantiated);
     r.model = std::move(e.model);
     r.bad = p.validation.value("hit_mismatches", 0) || p.validation.value("work_mismatches", 0);
+    r.work = work_totals_of(p);
+    r.rays = p.rays;
     return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
         // The verdict's analytic estimates come from this run's own analysis (no second pass).
         VerdictContext v{o.config, model, nullptr, nullptr, nullptr};

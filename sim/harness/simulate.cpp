@@ -15,6 +15,7 @@
 #include "sim/harness/model_errors.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
+#include "sim/harness/summary_schema.h"
 #include "sim/harness/timeline.h"
 #include "sim/harness/trace_stream.h"
 #include "sim/harness/verdict.h"
@@ -125,7 +126,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     json manifest = read_manifest(rtt);
     // The acceleration structure, whichever it is, validated structurally (load_accel).
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
-    check_sim_memory(o.config, accel->image().end_address(),
+    check_sim_memory(o.config, accel->image().footprint_bytes(),
                      "config (traversal.units=" + std::to_string(o.config.traversal.units) +
                          ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     WorkloadFeatures features;
@@ -226,6 +227,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     out.stats["verdict"] = verdict;
     out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
     out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
+    check_summary(out.stats["summary"], bool(sampled));  // every key declared once (summary_schema.cpp)
     write_json(fs::path(o.out_dir) / "stats.json", out.stats);
     write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
     out.exit_code = (checker.hit_mismatches() || checker.work_mismatches()) ? 3 : 0;

@@ -8,6 +8,7 @@
 #include <string>
 #include <ctime>
 
+#include "sim/harness/summary_schema.h"
 #include "traces/common/build_info.h"
 
 namespace rtsim {
@@ -62,12 +63,10 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
               {"peak_memory_mib", peak_memory_mib()},
               {"simulated_rays_per_wall_second", wall > 0 ? double(rays) / wall : 0.0}};
     if (c.fidelity == Fidelity::functional) {
-        // Every level reports the same keys; what the functional level cannot know is null.
-        for (const char* k : {"cycles", "seconds", "rays_per_second", "mrays_per_second", "avg_ray_latency_cycles",
-                              "unit_busy_fraction", "box_utilization", "triangle_utilization", "l1_hit_rate",
-                              "l2_hit_rate", "dram_bytes", "dram_bytes_per_ray", "dram_bandwidth_gbps",
-                              "dram_bandwidth_utilization"})
-            s[k] = nullptr;
+        // Every level reports the same keys; what the functional level cannot know is null
+        // (the keys summary_schema.cpp marks as timed; the energy and verdict steps add theirs).
+        for (const StatDecl& d : summary_schema())
+            if (d.timed) s[d.key] = nullptr;
         return s;
     }
     double seconds = double(cycles) / (c.clock_ghz * 1e9);

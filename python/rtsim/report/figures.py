@@ -431,3 +431,48 @@ def _cost_axis(ax: Any, xs: list[float], unit: str) -> None:
     pad = (hi - lo) * 0.06 or hi * 0.05
     if ax.get_xscale() == "linear":
         ax.set_xlim(lo - pad, hi + pad)
+
+
+CEILING_MARKERS = {"dram": "v", "box": "s", "triangle": "^", "scheduler": "D"}
+
+
+def roofline(data: SweepData) -> Figure | None:
+    """Per scene and workload: each configuration's achieved Mrays/s (bars, fastest first) and
+    the ceilings each resource alone allows (markers, stats `roofline.ceilings`): how far a
+    design is from its bound and which bound is next."""
+    groups = [g for g in data.groups() if any((r.stats or {}).get("roofline") for r in g.ok)]
+    if not groups:
+        return None
+    groups = groups[:4]
+    fig, axes = _panels(len(groups), 7.0, 4.2)
+    for ax, g in zip(axes, groups, strict=True):
+        runs = sorted(
+            (r for r in g.ok if (r.stats or {}).get("roofline")),
+            key=lambda r: -r.summary["rays_per_second"],
+        )[:MAX_BARS]
+        xs = list(range(len(runs)))
+        ax.bar(xs, [mrays(r) for r in runs], color="#4C72B0", alpha=0.75, label="achieved")
+        kinds = sorted({k for r in runs for k in (r.stats or {})["roofline"].get("ceilings", {})})
+        colors = dict(zip(kinds, _line_colors(len(kinds)), strict=True))
+        for kind in kinds:
+            pts = [
+                (x, r.stats["roofline"]["ceilings"][kind] / 1e6)
+                for x, r in zip(xs, runs, strict=True)
+                if kind in r.stats["roofline"].get("ceilings", {})
+            ]
+            ax.scatter(
+                [p[0] for p in pts],
+                [p[1] for p in pts],
+                marker=CEILING_MARKERS.get(kind, "o"),
+                color=colors[kind],
+                label=f"{kind} ceiling",
+                zorder=3,
+            )
+        ax.set_yscale("log")
+        ax.set_xticks(xs)
+        ax.set_xticklabels([data.label(r) for r in runs], rotation=60, ha="right", fontsize=8)
+        ax.set_ylabel("Mrays/s")
+        ax.set_title(g.title)
+        ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    return fig

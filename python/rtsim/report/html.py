@@ -295,6 +295,52 @@ def _effects(data: SweepData) -> str:
     )
 
 
+def _why_slow(data: SweepData) -> str:
+    """Per scene and workload: how many configurations each resource binds, and every run's
+    verdict (stats `verdict`: the bottleneck, its evidence, the knob to relax and its estimate)."""
+    out = []
+    for g in data.groups():
+        runs = [r for r in g.ok if (r.stats or {}).get("verdict")]
+        if not runs:
+            continue
+        counts: dict[str, int] = {}
+        for r in runs:
+            label = str(r.stats["verdict"].get("label", "?"))
+            counts[label] = counts.get(label, 0) + 1
+        tally = ", ".join(
+            f"{escape(k)}: {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])
+        )
+        rows = []
+        for r in sorted(runs, key=lambda r: -r.summary["rays_per_second"]):
+            v = r.stats["verdict"]
+            relax = v.get("relax") or {}
+            speedup = relax.get("speedup")
+            rows.append(
+                [
+                    escape(data.label(r)),
+                    f"{r.summary['rays_per_second'] / 1e6:,.2f}",
+                    escape(str(v.get("label", "-"))),
+                    escape(str((v.get("evidence") or {}).get("text", ""))),
+                    escape(f"{relax.get('key')} {relax.get('from')} -> {relax.get('to')}")
+                    if relax
+                    else "-",
+                    f"{speedup:.2f}x" if isinstance(speedup, (int, float)) else "-",
+                ]
+            )
+        table = _table(
+            ["configuration", "Mrays/s", "bottleneck", "evidence", "relax", "estimated"],
+            rows,
+            numeric={1, 5},
+        )
+        out.append(
+            f"<h3>{escape(g.title)}</h3><p>Binding resource over {len(runs)} configurations: "
+            f"{tally}.</p><details><summary>every run's verdict</summary>{table}</details>"
+        )
+    if not out:
+        return "<p class='muted'>No verdicts (functional runs, or runs with --no-verdict).</p>"
+    return "".join(out)
+
+
 def _failures(data: SweepData) -> str:
     bad = [r for r in data.runs if r.status != "ok"]
     if not bad:
@@ -335,6 +381,19 @@ def render_report(data: SweepData) -> str:
         ),
         "<h3>Pareto fronts: rays/s against SRAM, area and energy</h3>",
         *_pareto_section(data),
+        "<h2>Why is it slow</h2>",
+        "<p>Every timed run states its bottleneck with evidence from its cycle accounting and "
+        "utilisations, and the knob that relaxes it with the analytic level's estimate of the "
+        "gain (docs/model.md, docs/stats.md <code>verdict</code>).</p>",
+        _why_slow(data),
+        _figure(
+            figures.roofline(data),
+            "roofline: achieved rays per second against each resource's ceiling",
+            "Achieved Mrays/s per configuration (bars, fastest first) and the rays/s each "
+            "resource alone would allow (markers; stats <code>roofline.ceilings</code>): DRAM "
+            "bandwidth over DRAM bytes per ray, pipeline issue slots over issues per ray, the "
+            "scheduler's steps. A bar far below its lowest marker is latency- or queue-bound.",
+        ),
         "<h2>Bandwidth</h2>",
         _figure(
             figures.bytes_per_ray(data),
