@@ -433,46 +433,60 @@ def _cost_axis(ax: Any, xs: list[float], unit: str) -> None:
         ax.set_xlim(lo - pad, hi + pad)
 
 
-CEILING_MARKERS = {"dram": "v", "box": "s", "triangle": "^", "scheduler": "D"}
-
-
 def roofline(data: SweepData) -> Figure | None:
-    """Per scene and workload: each configuration's achieved Mrays/s (bars, fastest first) and
-    the ceilings each resource alone allows (markers, stats `roofline.ceilings`): how far a
-    design is from its bound and which bound is next."""
-    groups = [g for g in data.groups() if any((r.stats or {}).get("roofline") for r in g.ok)]
+    """The roofline per scene and workload: every run a point at (DRAM bytes per ray, Mrays/s);
+    the DRAM ceilings (peak bandwidth over bytes per ray: one line per distinct peak in the
+    sweep) and, above each point, the lowest ceiling of its pipelines and scheduler (stats
+    `roofline.ceilings`). A point on a line is bound by that resource; a point far below both is
+    latency- or queue-bound (the verdict says which)."""
+    groups = [g for g in data.groups() if any(_roof(r) for r in g.ok)][:4]
     if not groups:
         return None
-    groups = groups[:4]
-    fig, axes = _panels(len(groups), 7.0, 4.2)
+    fig, axes = _panels(len(groups), 6.5, 4.6)
     for ax, g in zip(axes, groups, strict=True):
-        runs = sorted(
-            (r for r in g.ok if (r.stats or {}).get("roofline")),
-            key=lambda r: -r.summary["rays_per_second"],
-        )[:MAX_BARS]
-        xs = list(range(len(runs)))
-        ax.bar(xs, [mrays(r) for r in runs], color="#4C72B0", alpha=0.75, label="achieved")
-        kinds = sorted({k for r in runs for k in (r.stats or {})["roofline"].get("ceilings", {})})
-        colors = dict(zip(kinds, _line_colors(len(kinds)), strict=True))
-        for kind in kinds:
-            pts = [
-                (x, r.stats["roofline"]["ceilings"][kind] / 1e6)
-                for x, r in zip(xs, runs, strict=True)
-                if kind in r.stats["roofline"].get("ceilings", {})
-            ]
-            ax.scatter(
-                [p[0] for p in pts],
-                [p[1] for p in pts],
-                marker=CEILING_MARKERS.get(kind, "o"),
-                color=colors[kind],
-                label=f"{kind} ceiling",
-                zorder=3,
+        runs = [r for r in g.ok if _roof(r) and _roof(r).get("dram_bytes_per_ray")]
+        if not runs:
+            ax.set_visible(False)
+            continue
+        xs = [float(_roof(r)["dram_bytes_per_ray"]) for r in runs]
+        lo, hi = min(xs) / 2, max(xs) * 2
+        peaks = sorted({float(_roof(r)["peak_dram_bytes_per_second"]) for r in runs})
+        grid = [lo * (hi / lo) ** (i / 50) for i in range(51)]
+        for peak, color in zip(peaks, _line_colors(len(peaks)), strict=True):
+            ax.plot(
+                grid,
+                [peak / x / 1e6 for x in grid],
+                color=color,
+                linestyle="--",
+                label=f"DRAM ceiling {peak / 1e9:g} GB/s",
             )
+        compute = [
+            min((v for k, v in _roof(r)["ceilings"].items() if k != "dram"), default=None)
+            for r in runs
+        ]
+        ax.scatter(
+            [x for x, c in zip(xs, compute, strict=True) if c],
+            [c / 1e6 for c in compute if c],
+            marker="_",
+            s=160,
+            color="#555555",
+            label="pipeline / scheduler ceiling",
+        )
+        ax.scatter(xs, [mrays(r) for r in runs], color="#C44E52", zorder=3, label="run")
+        ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xticks(xs)
-        ax.set_xticklabels([data.label(r) for r in runs], rotation=60, ha="right", fontsize=8)
+        ax.set_xlim(lo, hi)
+        plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:,.0f}" if v >= 1 else f"{v:g}")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(plain)
+            axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xlabel("DRAM bytes per ray")
         ax.set_ylabel("Mrays/s")
         ax.set_title(g.title)
-        ax.legend(loc="upper right", fontsize=8)
+        ax.legend(loc="lower left", fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def _roof(rec: RunRecord) -> dict[str, Any]:
+    return (rec.stats or {}).get("roofline") or {}

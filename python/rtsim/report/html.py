@@ -388,11 +388,12 @@ def render_report(data: SweepData) -> str:
         _why_slow(data),
         _figure(
             figures.roofline(data),
-            "roofline: achieved rays per second against each resource's ceiling",
-            "Achieved Mrays/s per configuration (bars, fastest first) and the rays/s each "
-            "resource alone would allow (markers; stats <code>roofline.ceilings</code>): DRAM "
-            "bandwidth over DRAM bytes per ray, pipeline issue slots over issues per ray, the "
-            "scheduler's steps. A bar far below its lowest marker is latency- or queue-bound.",
+            "roofline: rays per second against DRAM bytes per ray",
+            "Every run a point: simulated Mrays/s against DRAM bytes per ray. Dashed: the DRAM "
+            "ceiling of each peak bandwidth in the sweep (peak / bytes per ray); grey bars: each "
+            "run's lowest pipeline or scheduler ceiling (stats <code>roofline.ceilings</code>). "
+            "A point on a line is bound by it; a point far below both is latency- or queue-bound, "
+            "and its verdict above says by what.",
         ),
         "<h2>Bandwidth</h2>",
         _figure(
