@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 from rtsim.report import figures
+from rtsim.report.accel_section import accel_section
 from rtsim.report.data import (
     COSTS,
     SweepData,
@@ -335,6 +336,7 @@ def render_report(data: SweepData) -> str:
         ),
         "<h3>Pareto fronts: rays/s against SRAM, area and energy</h3>",
         *_pareto_section(data),
+        *accel_section(data, _table),
         "<h2>Bandwidth</h2>",
         _figure(
             figures.bytes_per_ray(data),
