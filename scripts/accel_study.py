@@ -5,9 +5,10 @@ Any registered kind and builder (`rtsim trace --help` lists them), written KIND 
 - build side, from `rtsim-accel-study` (one thread, median of --repeats builds): build time,
   footprint, structure bytes (every region but the triangle records), node bytes, SAH cost, and
   for the wide kinds the SAH cost of the greedy collapse of the same binary tree;
-- per ray kind, from the trace's per-ray work records (one trace per workload: `primary`, and
-  `diffuse`, whose trace holds its primary rays too; figures are over the rays of that kind):
-  steps (node or cell fetches), box tests, triangle tests (mean and p99), hit rate;
+- per ray kind, from the trace's per-ray work records (one trace per workload, `primary` and
+  `diffuse`; the diffuse trace holds the diffuse bounces only): steps (node or cell fetches), box
+  tests, triangle tests (mean and p99), hit rate, and the rays whose hit (primitive and bits of
+  t) differs from the binary BVH's trace of the same workload;
 - on the model at the default config (`rtsim-sim`, approx) on the whole trace of the workload:
   Mrays/s, DRAM bytes per ray, L1 and L2 hit rates; any hit or work mismatch stops the study;
 - derived: the extra work of each compressed kind over its fp32 twin (same tree: quantisation's
@@ -154,6 +155,22 @@ def study(args: argparse.Namespace) -> dict[str, Any]:
     return results
 
 
+def hit_differences(results: dict[str, Any], args: argparse.Namespace) -> None:
+    """Per structure and workload: rays whose hit differs from bvh2's (same rays, same order)."""
+    for scene in args.scenes:
+        rays = results[scene]["rays"]
+        if "bvh2" not in rays:
+            continue
+        for workload in args.workloads:
+            ref = np.asarray(rtsim.open_trace(trace(scene, "bvh2", workload, args)).hits)
+            for accel in args.accels:
+                hits = np.asarray(rtsim.open_trace(trace(scene, accel, workload, args)).hits)
+                differ = (hits["prim"] != ref["prim"]) | (
+                    hits["t"].view(np.uint32) != ref["t"].view(np.uint32)
+                )
+                rays[accel][workload]["hits_differ"] = int(differ.sum())
+
+
 def extra_work(rays: dict[str, Any], workload: str) -> dict[str, dict[str, float]]:
     """Per derived kind: percent more steps/box/triangle tests than its twin."""
     out = {}
@@ -200,9 +217,9 @@ def build_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
 
 def ray_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
     lines = [
-        "| scene | rays | structure | steps | box tests | tri tests | hit rate "
+        "| scene | rays | structure | steps | box tests | tri tests | hit rate | hits vs bvh2 "
         "| model Mrays/s | DRAM B/ray | L1 hit | L2 hit |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for scene in args.scenes:
         for workload in args.workloads:
@@ -212,6 +229,7 @@ def ray_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
                 cells = " | ".join(f"{w[f]['mean']:.1f} / {w[f]['p99']:.0f}" for f in WORK)
                 lines.append(
                     f"| {scene} | {workload} | {label(accel)} | {cells} | {w['hit_rate']:.1%} | "
+                    f"{fmt(r.get('hits_differ'))} | "
                     f"{fmt(m.get('mrays_per_second'), 2)} | {fmt(m.get('dram_bytes_per_ray'), 0)} "
                     f"| {fmt(m.get('l1_hit_rate'), 3)} | {fmt(m.get('l2_hit_rate'), 3)} |"
                 )
@@ -246,8 +264,8 @@ def tables(results: dict[str, Any], args: argparse.Namespace) -> str:
         "",
         "Per ray of each kind (mean / p99) from the reference traversal (for the grid a step is "
         "a cell step and every reference fetched is a triangle test); model at the default "
-        "config (approx) on the whole trace of that workload (the diffuse trace holds its "
-        "primary rays too).",
+        "config (approx) on the trace of that workload; *hits vs bvh2* counts the rays whose "
+        "hit (primitive and bits of t) differs from the binary BVH's.",
         "",
         *ray_table(results, args),
     ]
@@ -278,6 +296,7 @@ def main() -> int:
         results = json.loads((args.out / "study.json").read_text())
     else:
         results = study(args)
+        hit_differences(results, args)
         (args.out / "study.json").write_text(json.dumps(results, indent=2) + "\n")
     text = tables(results, args)
     (args.out / "study.md").write_text(text + "\n")

@@ -147,3 +147,18 @@ def test_no_axis_no_section(tmp_path: Path) -> None:
         store.record(rec)
     assert accel_section(load(tmp_path), _table) == []
     assert tidy_row(rec)["accel"] == "bvh2"
+
+
+def test_report_follows_the_spec_order(tmp_path: Path) -> None:
+    """The first structure of the spec's axis is the one speeds are measured against."""
+    records = [
+        _record(tmp_path, "bvh2", 2, 10.0, 2**20),
+        _record(tmp_path, "bvh8", 2, 15.0, 2**21),
+    ]
+    with open_store(tmp_path) as store:
+        store.set_meta({"swept_keys": "accel", "spec": "accel: [bvh8, bvh2]\n"})
+        for r in records:
+            store.record(r)
+    html = "".join(accel_section(load(tmp_path), _table))
+    assert html.index(">bvh8<") < html.index(">bvh2<")
+    assert "0.67x" in html  # bvh2 over bvh8

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from html import escape
 from typing import Any
 
+import yaml
+
 from rtsim.report.data import Group, SweepData, key_active, mrays
 from rtsim.sweep.spec import ACCEL_KEY
 from rtsim.sweep.store import RunRecord
@@ -74,9 +76,29 @@ def at_baseline(data: SweepData, runs: list[RunRecord]) -> RunRecord | None:
     return None
 
 
+def axis_order(data: SweepData) -> list[str]:
+    """The axis's labels in the spec's order (the first is what speeds are measured against);
+    labels only the runs know (a store mixing specs) follow in first-seen order."""
+    try:
+        doc = yaml.safe_load(data.meta.get("spec", "")) or {}
+    except yaml.YAMLError:
+        doc = {}
+    entries = doc.get("accel") if isinstance(doc, dict) else None
+    entries = entries if isinstance(entries, list) else [entries] if entries else []
+    labels = []
+    for e in entries:
+        if isinstance(e, dict):
+            kind, builder = e.get("kind"), e.get("builder")
+            labels.append(str(e.get("label") or (f"{kind}:{builder}" if builder else kind)))
+        else:
+            labels.append(str(e).strip())
+    seen = data.values(ACCEL_KEY)
+    return [x for x in labels if x in seen] + [x for x in seen if x not in labels]
+
+
 def accel_rows(data: SweepData, group: Group) -> list[AccelRow]:
     rows = []
-    for accel in data.values(ACCEL_KEY):
+    for accel in axis_order(data):
         runs = [r for r in group.runs if r.accel == accel and r.status != "failed"]
         run = at_baseline(data, runs)
         if run is not None:

@@ -190,8 +190,8 @@ def _run_locked(spec: SweepSpec, opts: SweepOptions, out: Path, console: Console
         console.print(
             f"[bold]rtsim sweep[/] {spec.name}: {len(runs)} runs "
             f"({len(spec.scenes)} scenes x {len(spec.workloads)} workloads x "
-            f"{len(spec.points())} configs), {outcome.skipped} already in {store.path.name}, "
-            f"{len(todo)} to run"
+            f"{len(spec.accels or [None])} structures x {len(spec.points())} configs), "
+            f"{outcome.skipped} already in {store.path.name}, {len(todo)} to run"
         )
         t0 = time.monotonic()
         if todo:
