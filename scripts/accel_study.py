@@ -108,7 +108,12 @@ def simulate(folder: Path, args: argparse.Namespace) -> dict[str, Any]:
     stats_file = out / "stats.json"
     if args.fresh or not stats_file.is_file():
         shutil.rmtree(out, ignore_errors=True)
-        subprocess.run([str(find_sim()), str(folder), "-o", str(out)], capture_output=True)
+        try:
+            cmd = [str(find_sim()), str(folder), "-o", str(out)]
+            subprocess.run(cmd, capture_output=True, timeout=args.sim_timeout)
+        except subprocess.TimeoutExpired:
+            print(f"accel_study: {out.name}: no model figures (over {args.sim_timeout} s)")
+            return {"timed_out": args.sim_timeout}
     if not stats_file.is_file():
         sys.exit(f"accel_study: rtsim-sim wrote no {stats_file}")
     s = json.loads(stats_file.read_text())["summary"]
@@ -187,6 +192,8 @@ def extra_work(rays: dict[str, Any], workload: str) -> dict[str, dict[str, float
 def fmt(x: Any, digits: int = 1) -> str:
     if x is None:
         return "-"
+    if isinstance(x, str):
+        return x
     return f"{x:,.{digits}f}" if isinstance(x, float) else f"{x:,}"
 
 
@@ -227,6 +234,8 @@ def ray_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
                 r = results[scene]["rays"][accel][workload]
                 w, m = r["work"], r.get("model") or {}
                 cells = " | ".join(f"{w[f]['mean']:.1f} / {w[f]['p99']:.0f}" for f in WORK)
+                if m.get("timed_out"):  # the model ran out of time: say so, not a blank
+                    m = {"mrays_per_second": f"> {m['timed_out']:g} s"}
                 lines.append(
                     f"| {scene} | {workload} | {label(accel)} | {cells} | {w['hit_rate']:.1%} | "
                     f"{fmt(r.get('hits_differ'))} | "
@@ -265,7 +274,13 @@ def tables(results: dict[str, Any], args: argparse.Namespace) -> str:
         "Per ray of each kind (mean / p99) from the reference traversal (for the grid a step is "
         "a cell step and every reference fetched is a triangle test); model at the default "
         "config (approx) on the trace of that workload; *hits vs bvh2* counts the rays whose "
-        "hit (primitive and bits of t) differs from the binary BVH's.",
+        "hit (primitive and bits of t) differs from the binary BVH's"
+        + (
+            f"; '> {args.sim_timeout:g} s': the simulation was stopped after that long "
+            "(--sim-timeout) and has no model figures."
+            if args.sim_timeout
+            else "."
+        ),
         "",
         *ray_table(results, args),
     ]
@@ -287,6 +302,9 @@ def main() -> int:
     p.add_argument("--hairball-triangles", type=int, default=200_000)
     p.add_argument("--jobs", type=int, default=2, help="traces and simulations at once")
     p.add_argument("--no-sim", action="store_true", help="reference figures only")
+    p.add_argument(
+        "--sim-timeout", type=float, default=None, help="seconds per simulation (then no figures)"
+    )
     p.add_argument("--fresh", action="store_true", help="redo cached builds, traces and runs")
     p.add_argument("--render", action="store_true", help="only rewrite tables from OUT/study.json")
     p.add_argument("--write-docs", action="store_true", help="write the tables into docs/accel.md")
