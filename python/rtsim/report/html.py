@@ -336,7 +336,6 @@ def render_report(data: SweepData) -> str:
         ),
         "<h3>Pareto fronts: rays/s against SRAM, area and energy</h3>",
         *_pareto_section(data),
-        *accel_section(data, _table),
         "<h2>Bandwidth</h2>",
         _figure(
             figures.bytes_per_ray(data),
@@ -355,6 +354,7 @@ def render_report(data: SweepData) -> str:
             "cache hit rates per level",
             "L1 (mean over the per-unit L1s) and L2 hit rates against each swept key.",
         ),
+        *accel_section(data, _table),
         "<h2>Validation</h2>",
         "<h3>Hit mismatches per run (must be zero)</h3>",
         _validation(data),
