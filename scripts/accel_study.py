@@ -1,25 +1,29 @@
 """Compares acceleration structures per scene and ray kind (docs/accel.md, "Comparison").
 
-For every scene and every structure (any registered kind: `rtsim trace --help` lists them):
+Any registered kind and builder (`rtsim trace --help` lists them), written KIND or KIND:BUILDER:
 
-- build side, from `rtsim-accel-study` (one thread, median of --repeat builds): build time,
-  footprint, nodes, SAH cost, and for the wide kinds the SAH cost of the greedy collapse;
-- per ray, from `rtsim trace --accel KIND` (primary and diffuse rays, shadow rays where the scene
-  has lights): steps (node fetches), box tests and triangle tests, mean and p99;
-- on the model at the default configuration (`rtsim-sim`): Mrays/s, DRAM bytes per ray, L1 and
-  L2 hit rates, and the hit and work mismatches (must be 0);
-- derived: each compressed kind's extra work over its fp32 twin of the same width (same tree:
-  the difference is quantisation's), and the octant order's extra work over front-to-back.
+- build side, from `rtsim-accel-study` (one thread, median of --repeats builds): build time,
+  footprint, structure bytes (every region but the triangle records), node bytes, SAH cost, and
+  for the wide kinds the SAH cost of the greedy collapse of the same binary tree;
+- per ray kind, from the trace's per-ray work records (one trace per workload, `primary` and
+  `diffuse`; the diffuse trace holds the diffuse bounces only): steps (node or cell fetches), box
+  tests, triangle tests (mean and p99), hit rate, and the rays whose hit (primitive and bits of
+  t) differs from the binary BVH's trace of the same workload;
+- on the model at the default config (`rtsim-sim`, approx) on the whole trace of the workload:
+  Mrays/s, DRAM bytes per ray, L1 and L2 hit rates; any hit or work mismatch stops the study;
+- derived: the extra work of each compressed kind over its fp32 twin (same tree: quantisation's
+  alone) and of the octant order over front-to-back.
 
-Writes OUT/accel_study.json and OUT/accel_study.md. Usage:
+Traces, runs and build figures are cached in OUT (--fresh redoes them). Writes OUT/study.json,
+OUT/study.md and, with --write-docs, the tables between the `accel-study` markers of
+docs/accel.md. Usage:
 
-    python scripts/accel_study.py --out out/accel_study \
-        [--scenes sponza,bunny,hairball,teapot_stadium,rotated_walls,cornell] \
-        [--accel bvh2,bvh4,bvh6,bvh8,cwbvh6,cwbvh8,bvh8_octant,cwbvh8_octant] \
-        [--resolution 256x192] [--repeat 3] [--no-model]
+    python scripts/accel_study.py [--out out/accel_study] [--resolution 128x96]
+        [--accels bvh2,bvh2:sbvh,bvh4,...,grid] [--scenes sponza,bunny,...] [--jobs 2]
+        [--no-sim] [--render] [--write-docs]
 
-Needs the rtsim package and `rtsim-accel-study` (installed next to `rtsim-bench`, or
-$RTSIM_ACCEL_STUDY).
+Needs the rtsim package, `rtsim-accel-study` (installed next to `rtsim-bench`, or
+$RTSIM_ACCEL_STUDY) and the shared scenes ($RTSIM_SCENES) for sponza and bunny.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ import os
 import shutil
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -39,9 +44,12 @@ import rtsim
 from rtsim.launcher import find_sim
 from rtsim.scenes import resolve_scene
 
+REPO = Path(__file__).resolve().parents[1]
+BEGIN, END = "<!-- accel-study:begin -->", "<!-- accel-study:end -->"
 DEFAULT_SCENES = "sponza,bunny,hairball,teapot_stadium,rotated_walls,cornell"
-DEFAULT_ACCEL = "bvh2,bvh4,bvh6,bvh8,cwbvh6,cwbvh8,bvh8_octant,cwbvh8_octant"
+DEFAULT_ACCELS = "bvh2,bvh2:sbvh,bvh4,bvh6,bvh8,cwbvh6,cwbvh8,bvh8_octant,cwbvh8_octant,grid"
 WORK = ("steps", "box_tests", "tri_tests")
+#: Same tree, one difference: quantisation (cw vs fp32) or the child order (octant vs distance).
 TWINS = {"cwbvh6": "bvh6", "cwbvh8": "bvh8", "bvh8_octant": "bvh8", "cwbvh8_octant": "cwbvh8"}
 
 
@@ -60,85 +68,123 @@ def find_study() -> Path:
 
 def run(cmd: list[str]) -> None:
     result = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    if result.returncode != 0:
-        sys.exit(f"accel_study: {' '.join(cmd)} failed:\n{result.stderr}")
+    if result.returncode not in (0,):
+        sys.exit(f"accel_study: {' '.join(cmd)} failed ({result.returncode}):\n{result.stderr}")
 
 
-def per_ray(trace_dir: Path) -> dict[str, dict[str, float]]:
-    """Mean and p99 of each work count, per ray kind present in the trace."""
-    trace = rtsim.open_trace(trace_dir)
-    kinds = np.asarray(trace.rays["kind"])
-    out: dict[str, dict[str, float]] = {}
-    for code, name in enumerate(rtsim.trace_file.RAY_KINDS):
-        mask = kinds == code
-        if not mask.any():
-            continue
-        figures: dict[str, float] = {"rays": int(mask.sum())}
-        for key in WORK:
-            values = np.asarray(trace.work[key])[mask].astype(np.float64)
-            figures[f"{key}_mean"] = float(values.mean())
-            figures[f"{key}_p99"] = float(np.percentile(values, 99))
-            figures[f"{key}_sum"] = float(values.sum())
-        out[name] = figures
+def label(accel: str) -> str:
+    return accel.replace(":", " ")
+
+
+def build_figures(scene: str, args: argparse.Namespace) -> dict[str, Any]:
+    """rtsim-accel-study on one scene for every structure (cached in OUT/build)."""
+    path = args.out / "build" / f"{scene}.json"
+    if args.fresh or not path.is_file():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        cmd = [str(find_study()), resolve_scene(scene), "--accel", ",".join(args.accels)]
+        cmd += ["--repeat", str(args.repeats), "--json", str(path)]
+        cmd += ["--hairball-triangles", str(args.hairball_triangles)]
+        run(cmd)
+    return dict(json.loads(path.read_text()))
+
+
+def trace(scene: str, accel: str, workload: str, args: argparse.Namespace) -> Path:
+    kind, _, builder = accel.partition(":")
+    name = f"{scene}-{kind}-{builder or 'default'}-{workload}-{args.resolution}"
+    folder = args.out / "traces" / name
+    if (folder / "manifest.json").is_file() and not args.fresh:
+        return folder
+    shutil.rmtree(folder, ignore_errors=True)
+    cmd = [sys.executable, "-m", "rtsim", "trace", resolve_scene(scene), "-o", str(folder)]
+    cmd += ["--workload", workload, "--resolution", args.resolution, "--accel", kind]
+    cmd += ["--hairball-triangles", str(args.hairball_triangles)]
+    cmd += ["--builder", builder] if builder else []
+    run(cmd)
+    return folder
+
+
+def simulate(folder: Path, args: argparse.Namespace) -> dict[str, Any]:
+    out = args.out / "runs" / folder.name
+    stats_file = out / "stats.json"
+    if args.fresh or not stats_file.is_file():
+        shutil.rmtree(out, ignore_errors=True)
+        try:
+            cmd = [str(find_sim()), str(folder), "-o", str(out)]
+            subprocess.run(cmd, capture_output=True, timeout=args.sim_timeout)
+        except subprocess.TimeoutExpired:
+            print(f"accel_study: {out.name}: no model figures (over {args.sim_timeout} s)")
+            return {"timed_out": args.sim_timeout}
+    if not stats_file.is_file():
+        sys.exit(f"accel_study: rtsim-sim wrote no {stats_file}")
+    s = json.loads(stats_file.read_text())["summary"]
+    if s["hit_mismatches"] or s["work_mismatches"]:
+        sys.exit(f"{out}: {s['hit_mismatches']} hit and {s['work_mismatches']} work mismatches")
+    keys = ("mrays_per_second", "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate", "rays")
+    return {k: s.get(k) for k in keys}
+
+
+def work_stats(folder: Path, ray_kind: str) -> dict[str, Any]:
+    """Mean, p99 and sum of each work count over the trace's rays of one kind, and hit rate."""
+    t = rtsim.open_trace(folder)
+    mask = np.asarray(t.rays["kind"]) == rtsim.trace_file.RAY_KINDS.index(ray_kind)
+    work, hits = np.asarray(t.work)[mask], np.asarray(t.hits)[mask]
+    out: dict[str, Any] = {"rays": int(mask.sum()), "hit_rate": float((hits["prim"] >= 0).mean())}
+    for f in WORK:
+        v = work[f].astype(np.float64)
+        out[f] = {
+            "mean": float(v.mean()),
+            "p99": float(np.percentile(v, 99)),
+            "sum": float(v.sum()),
+        }
     return out
 
 
-def model(trace_dir: Path, out: Path) -> dict[str, Any]:
-    run([str(find_sim()), str(trace_dir), "-o", str(out)])
-    s = json.loads((out / "stats.json").read_text())["summary"]
-    keys = ("mrays_per_second", "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate", "cycles")
-    figures = {k: s.get(k) for k in keys}
-    figures["mismatches"] = int(s["hit_mismatches"]) + int(s["work_mismatches"])
-    return figures
+def one(scene: str, accel: str, workload: str, args: argparse.Namespace) -> dict[str, Any]:
+    folder = trace(scene, accel, workload, args)
+    entry: dict[str, Any] = {"work": work_stats(folder, workload)}
+    if not args.no_sim:
+        entry["model"] = simulate(folder, args)
+    print(f"accel_study: {scene} {label(accel)} {workload} done", file=sys.stderr, flush=True)
+    return entry
 
 
-def study_scene(scene: str, args: argparse.Namespace, out: Path) -> dict[str, Any]:
-    path = resolve_scene(scene)
-    build_json = out / f"{scene}_build.json"
-    run(
-        [
-            str(find_study()),
-            path,
-            "--accel",
-            args.accel,
-            "--repeat",
-            str(args.repeat),
-            "--json",
-            str(build_json),
-        ]
-    )
-    result: dict[str, Any] = {"build": json.loads(build_json.read_text()), "structures": {}}
-    for kind in args.accel.split(","):
-        trace_dir = out / scene / kind
-        run(
-            [sys.executable, "-m", "rtsim", "trace", path, "-o", str(trace_dir), "--accel", kind,
-             "--workload", "primary,diffuse,shadow", "--resolution", args.resolution,
-             "--bounces", "1"]
-        )  # fmt: skip
-        entry: dict[str, Any] = {"rays": per_ray(trace_dir)}
-        if not args.no_model:
-            entry["model"] = model(trace_dir, out / scene / f"{kind}_run")
-        result["structures"][kind] = entry
-        if not args.keep_traces:
-            (trace_dir / "trace.rtt").unlink(missing_ok=True)
-    return result
+def study(args: argparse.Namespace) -> dict[str, Any]:
+    results: dict[str, Any] = {}
+    for scene in args.scenes:
+        results[scene] = {"build": build_figures(scene, args), "rays": {}}
+    jobs = [(s, a, w) for s in args.scenes for a in args.accels for w in args.workloads]
+    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        done = list(pool.map(lambda j: one(*j, args), jobs))
+    for (scene, accel, workload), entry in zip(jobs, done, strict=True):
+        results[scene]["rays"].setdefault(accel, {})[workload] = entry
+    return results
 
 
-def extra_work(result: dict[str, Any]) -> dict[str, dict[str, dict[str, float]]]:
-    """Per derived kind, per ray kind: percent more steps/box/triangle tests than its twin."""
-    out: dict[str, dict[str, dict[str, float]]] = {}
-    s = result["structures"]
-    for kind, twin in TWINS.items():
-        if kind not in s or twin not in s:
+def hit_differences(results: dict[str, Any], args: argparse.Namespace) -> None:
+    """Per structure and workload: rays whose hit differs from bvh2's (same rays, same order)."""
+    for scene in args.scenes:
+        rays = results[scene]["rays"]
+        if "bvh2" not in rays:
             continue
-        out[kind] = {}
-        for ray_kind, ours in s[kind]["rays"].items():
-            theirs = s[twin]["rays"][ray_kind]
-            out[kind][ray_kind] = {
-                key: 100.0 * (ours[f"{key}_sum"] / theirs[f"{key}_sum"] - 1.0)
-                if theirs[f"{key}_sum"]
-                else 0.0
-                for key in WORK
+        for workload in args.workloads:
+            ref = np.asarray(rtsim.open_trace(trace(scene, "bvh2", workload, args)).hits)
+            for accel in args.accels:
+                hits = np.asarray(rtsim.open_trace(trace(scene, accel, workload, args)).hits)
+                differ = (hits["prim"] != ref["prim"]) | (
+                    hits["t"].view(np.uint32) != ref["t"].view(np.uint32)
+                )
+                rays[accel][workload]["hits_differ"] = int(differ.sum())
+
+
+def extra_work(rays: dict[str, Any], workload: str) -> dict[str, dict[str, float]]:
+    """Per derived kind: percent more steps/box/triangle tests than its twin."""
+    out = {}
+    for kind, twin in TWINS.items():
+        if kind in rays and twin in rays:
+            ours, theirs = rays[kind][workload]["work"], rays[twin][workload]["work"]
+            out[kind] = {
+                f: 100.0 * (ours[f]["sum"] / theirs[f]["sum"] - 1.0) if theirs[f]["sum"] else 0.0
+                for f in WORK
             }
     return out
 
@@ -146,96 +192,138 @@ def extra_work(result: dict[str, Any]) -> dict[str, dict[str, dict[str, float]]]
 def fmt(x: Any, digits: int = 1) -> str:
     if x is None:
         return "-"
-    if isinstance(x, float):
-        return f"{x:,.{digits}f}"
-    return f"{x:,}"
+    if isinstance(x, str):
+        return x
+    return f"{x:,.{digits}f}" if isinstance(x, float) else f"{x:,}"
 
 
-def markdown(scene: str, result: dict[str, Any]) -> str:
-    b = result["build"]
-    lines = [f"### {scene} ({b['triangles']:,} triangles)", ""]
-    bvh2 = b["structures"].get("bvh2", {}).get("footprint_bytes")
-    bvh2_nodes = b["structures"].get("bvh2", {}).get("node_region_bytes")
-    lines += [
-        "| structure | build ms | footprint MB | vs bvh2 | node region MB | vs bvh2 | nodes "
-        "| node B | SAH | SAH greedy |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+def build_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
+    lines = [
+        "| scene | structure | build ms | footprint MiB | vs bvh2 | structure MiB | vs bvh2 "
+        "| node B | SAH cost | SAH greedy |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    for kind, s in b["structures"].items():
-        ratio = f"{s['footprint_bytes'] / bvh2:.2f}" if bvh2 else "-"
-        node_ratio = f"{s['node_region_bytes'] / bvh2_nodes:.2f}" if bvh2_nodes else "-"
-        lines.append(
-            f"| {kind} | {fmt(s['build_ms_cpu'])} | {s['footprint_bytes'] / 1e6:.2f} | {ratio} "
-            f"| {s['node_region_bytes'] / 1e6:.2f} | {node_ratio} "
-            f"| {s['nodes']:,} | {s['node_bytes']} | {s['sah_cost']:.2f} "
-            f"| {fmt(s.get('sah_cost_greedy'), 2)} |"
-        )
-    lines += [
-        "",
-        "| structure | rays | steps mean / p99 | box tests mean / p99 | tri tests mean / p99 "
-        "| model Mrays/s | DRAM B/ray | L1 hit | L2 hit |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
-    ]
-    for kind, s in result["structures"].items():
-        m = s.get("model", {})
-        first = True
-        for ray_kind, r in s["rays"].items():
-            work = " | ".join(f"{r[f'{k}_mean']:.1f} / {r[f'{k}_p99']:.0f}" for k in WORK)
-            model_cols = (
-                f"{fmt(m.get('mrays_per_second'), 1)} | {fmt(m.get('dram_bytes_per_ray'), 0)} | "
-                f"{fmt(m.get('l1_hit_rate'), 3)} | {fmt(m.get('l2_hit_rate'), 3)}"
-                if first and m
-                else " | | | "
+    for scene in args.scenes:
+        st = results[scene]["build"]["structures"]
+        ref = st.get("bvh2", {})
+        for accel in args.accels:
+            s = st[accel]
+
+            def ratio(key: str, s: dict[str, Any] = s, ref: dict[str, Any] = ref) -> str:
+                return f"{s[key] / ref[key]:.2f}" if ref.get(key) else "-"
+
+            lines.append(
+                f"| {scene} | {label(accel)} | {fmt(s['build_ms_cpu'], 0)} | "
+                f"{s['footprint_bytes'] / 2**20:.2f} | {ratio('footprint_bytes')} | "
+                f"{s['structure_bytes'] / 2**20:.2f} | {ratio('structure_bytes')} | "
+                f"{fmt(s.get('node_bytes', s.get('cell_bytes')))} | {fmt(s.get('sah_cost'), 1)} | "
+                f"{fmt(s.get('sah_cost_greedy'), 1)} |"
             )
-            lines.append(f"| {kind if first else ''} | {ray_kind} | {work} | {model_cols} |")
-            first = False
-    extra = extra_work(result)
+    return lines
+
+
+def ray_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
+    lines = [
+        "| scene | rays | structure | steps | box tests | tri tests | hit rate | hits vs bvh2 "
+        "| model Mrays/s | DRAM B/ray | L1 hit | L2 hit |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for scene in args.scenes:
+        for workload in args.workloads:
+            for accel in args.accels:
+                r = results[scene]["rays"][accel][workload]
+                w, m = r["work"], r.get("model") or {}
+                cells = " | ".join(f"{w[f]['mean']:.1f} / {w[f]['p99']:.0f}" for f in WORK)
+                if m.get("timed_out"):  # the model ran out of time: say so, not a blank
+                    m = {"mrays_per_second": f"> {m['timed_out']:g} s"}
+                lines.append(
+                    f"| {scene} | {workload} | {label(accel)} | {cells} | {w['hit_rate']:.1%} | "
+                    f"{fmt(r.get('hits_differ'))} | "
+                    f"{fmt(m.get('mrays_per_second'), 2)} | {fmt(m.get('dram_bytes_per_ray'), 0)} "
+                    f"| {fmt(m.get('l1_hit_rate'), 3)} | {fmt(m.get('l2_hit_rate'), 3)} |"
+                )
+    return lines
+
+
+def extra_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
+    lines = [
+        "| scene | rays | structure | vs | steps | box tests | tri tests |",
+        "|---|---|---|---|---:|---:|---:|",
+    ]
+    for scene in args.scenes:
+        for workload in args.workloads:
+            for kind, e in extra_work(results[scene]["rays"], workload).items():
+                cells = " | ".join(f"{e[f]:+.1f}%" for f in WORK)
+                lines.append(f"| {scene} | {workload} | {kind} | {TWINS[kind]} | {cells} |")
+    return lines if len(lines) > 2 else []
+
+
+def tables(results: dict[str, Any], args: argparse.Namespace) -> str:
+    tris = {s: results[s]["build"]["triangles"] for s in args.scenes}
+    lines = [
+        f"Measured with `python scripts/accel_study.py --resolution {args.resolution} "
+        f"--repeats {args.repeats} --scenes {','.join(args.scenes)} --accels "
+        f"{','.join(args.accels)}` (triangles: "
+        + ", ".join(f"{s} {n:,}" for s, n in tris.items())
+        + "). Build: one thread, median CPU time of the builds, on a machine shared with "
+        "other jobs; structure = every region but the triangle records (nodes; for the grid, "
+        "cells and references); node B = the record a step fetches (the grid: a cell).",
+        "",
+        *build_table(results, args),
+        "",
+        "Per ray of each kind (mean / p99) from the reference traversal (for the grid a step is "
+        "a cell step and every reference fetched is a triangle test); model at the default "
+        "config (approx) on the trace of that workload; *hits vs bvh2* counts the rays whose "
+        "hit (primitive and bits of t) differs from the binary BVH's"
+        + (
+            f"; '> {args.sim_timeout:g} s': the simulation was stopped after that long "
+            "(--sim-timeout) and has no model figures."
+            if args.sim_timeout
+            else "."
+        ),
+        "",
+        *ray_table(results, args),
+    ]
+    extra = extra_table(results, args)
     if extra:
-        lines += [
-            "",
-            "| structure | vs | rays | steps | box tests | tri tests |",
-            "|---|---|---|---:|---:|---:|",
-        ]
-        for kind, per in extra.items():
-            for ray_kind, e in per.items():
-                cols = " | ".join(f"{e[k]:+.1f}%" for k in WORK)
-                lines.append(f"| {kind} | {TWINS[kind]} | {ray_kind} | {cols} |")
-    return "\n".join(lines) + "\n"
+        lines += ["", "Extra work of quantisation and of the octant order, over the twin:", ""]
+        lines += extra
+    return "\n".join(lines)
 
 
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", required=True, type=Path)
-    p.add_argument("--scenes", default=DEFAULT_SCENES)
-    p.add_argument("--accel", default=DEFAULT_ACCEL)
-    p.add_argument("--resolution", default="256x192")
-    p.add_argument("--repeat", type=int, default=3)
-    p.add_argument("--no-model", action="store_true", help="skip the rtsim-sim runs")
-    p.add_argument("--keep-traces", action="store_true", help="keep the trace files")
-    p.add_argument("--render", action="store_true", help="only rewrite the tables from OUT's JSON")
+    p.add_argument("--out", type=Path, default=REPO / "out" / "accel_study")
+    p.add_argument("--scenes", default=DEFAULT_SCENES, type=lambda s: s.split(","))
+    p.add_argument("--accels", default=DEFAULT_ACCELS, type=lambda s: s.split(","))
+    p.add_argument("--workloads", default="primary,diffuse", type=lambda s: s.split(","))
+    p.add_argument("--resolution", default="128x96")
+    p.add_argument("--repeats", type=int, default=3, help="builds timed per structure (median)")
+    p.add_argument("--hairball-triangles", type=int, default=200_000)
+    p.add_argument("--jobs", type=int, default=2, help="traces and simulations at once")
+    p.add_argument("--no-sim", action="store_true", help="reference figures only")
+    p.add_argument(
+        "--sim-timeout", type=float, default=None, help="seconds per simulation (then no figures)"
+    )
+    p.add_argument("--fresh", action="store_true", help="redo cached builds, traces and runs")
+    p.add_argument("--render", action="store_true", help="only rewrite tables from OUT/study.json")
+    p.add_argument("--write-docs", action="store_true", help="write the tables into docs/accel.md")
     args = p.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    results: dict[str, Any] = {}
-    md = [
-        "## Comparison",
-        "",
-        f"Command: `python scripts/accel_study.py {' '.join(sys.argv[1:])}`",
-        "",
-    ]
     if args.render:
-        results = json.loads((args.out / "accel_study.json").read_text())
-        md += [markdown(scene, result) for scene, result in results.items()]
-        (args.out / "accel_study.md").write_text("\n".join(md))
-        print("\n".join(md))
-        return 0
-    for scene in args.scenes.split(","):
-        print(f"accel_study: {scene}", file=sys.stderr)
-        results[scene] = study_scene(scene, args, args.out)
-        results[scene]["extra_work_percent"] = extra_work(results[scene])
-        md.append(markdown(scene, results[scene]))
-        (args.out / "accel_study.json").write_text(json.dumps(results, indent=2) + "\n")
-    (args.out / "accel_study.md").write_text("\n".join(md))
-    print("\n".join(md))
+        results = json.loads((args.out / "study.json").read_text())
+    else:
+        results = study(args)
+        hit_differences(results, args)
+        (args.out / "study.json").write_text(json.dumps(results, indent=2) + "\n")
+    text = tables(results, args)
+    (args.out / "study.md").write_text(text + "\n")
+    print(text)
+    if args.write_docs:
+        doc = REPO / "docs" / "accel.md"
+        content = doc.read_text()
+        start, end = content.index(BEGIN) + len(BEGIN), content.index(END)
+        doc.write_text(content[:start] + "\n" + text + "\n" + content[end:])
     return 0
 
 

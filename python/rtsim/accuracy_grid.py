@@ -27,7 +27,7 @@ from rich.console import Console
 
 from rtsim.launcher import find_sim
 from rtsim.sweep.spec import RunPlan, load_spec
-from rtsim.sweep.tasks import TraceTask, make_trace
+from rtsim.sweep.tasks import make_trace
 
 REFERENCE = "detailed"
 PSEUDO = {"analytic_functional": ("analytic", ["analytic.caches=functional"])}
@@ -114,19 +114,10 @@ def run_level(exe: Path, trace: Path, run: RunPlan, level: str, folder: Path) ->
 
 
 def trace_of(run: RunPlan, out: Path) -> Path:
-    from rtsim.sweep.runner import _resolved
+    from rtsim.sweep.runner import trace_task
 
-    plan, w = run.trace, run.trace.workload
-    task = TraceTask(
-        trace_dir=str(out / "traces" / plan.folder_name),
-        scene=_resolved(plan.scene.source),
-        rays=list(w.rays),
-        width=w.width,
-        height=w.height,
-        bounces=w.bounces,
-        seed=w.seed,
-        hairball_triangles=plan.scene.hairball_triangles,
-    )
+    plan = run.trace
+    task = trace_task(plan, out)
     result = make_trace(task)
     if not result.get("ok"):
         raise RuntimeError(f"tracing {plan.folder_name} failed: {result.get('error')}")

@@ -273,6 +273,7 @@ void bind_trace(py::module_& m) {
             return out;
         },
         "The acceleration structures this build knows: name, description, builders.");
+    m.attr("trace_version") = kTraceVersion;  // the trace format this build writes and reads
     m.def("trace_sections", &trace_sections, py::arg("path"),
           "Validates a trace file's header, section table and BVH image; returns its sections.");
     m.def(

@@ -13,7 +13,7 @@ import pytest
 import rtsim
 from conftest import REPO, run_rtsim
 from rtsim.sweep.demo import demo_spec_text
-from rtsim.sweep.runner import _trace_task
+from rtsim.sweep.runner import trace_task
 from rtsim.sweep.spec import parse_spec
 from rtsim.trace_file import RAY_KINDS
 
@@ -91,10 +91,10 @@ def test_sweep_workload_defaults_to_the_scene(tmp_path: Path) -> None:
     assert narrowed.rays == ("primary",) and narrowed.label == "prim"
     plans = spec.traces()
     assert plans[0].trace_id != plans[1].trace_id
-    task = _trace_task(plans[0], tmp_path)
+    task = trace_task(plans[0], tmp_path)
     assert "--workload" not in task.command("OUT")
     assert task.command("OUT")[task.command("OUT").index("cornell") - 1] == "trace"
-    narrowed_cmd = _trace_task(plans[1], tmp_path).command("OUT")
+    narrowed_cmd = trace_task(plans[1], tmp_path).command("OUT")
     assert narrowed_cmd[narrowed_cmd.index("--workload") + 1] == "primary"
 
 

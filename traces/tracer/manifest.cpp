@@ -36,6 +36,10 @@ json scene_json(const Scene& scene, const std::string& name, bool procedural) {
 json accel_json(const AccelImage& image) {
     json j = image.stats;
     j["kind"] = image.kind;
+    // Every kind records these (docs/accel.md); null where a kind has no such thing (a grid has
+    // no branching width and no SAH cost).
+    for (const char* key : {"builder", "width", "node_bytes", "sah_cost"})
+        if (!j.contains(key)) j[key] = nullptr;
     j["footprint_bytes"] = image.footprint_bytes();
     j["build_ms"] = image.build_ms;
     json regions = json::array();

@@ -50,6 +50,8 @@ def is_categorical(values: list[Any]) -> bool:
 
 
 def short_label(key: str, value: Any) -> str:
+    if key == "accel":  # a structure's name says what it is
+        return str(value)
     if key in FLAG_KEYS:
         return FLAG_KEYS[key] if value else f"no {FLAG_KEYS[key]}"
     if key in SHORT_KEYS:

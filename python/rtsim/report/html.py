@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 from rtsim.report import figures
+from rtsim.report.accel_section import accel_section
 from rtsim.report.data import (
     COSTS,
     SweepData,
@@ -413,6 +414,7 @@ def render_report(data: SweepData) -> str:
             "cache hit rates per level",
             "L1 (mean over the per-unit L1s) and L2 hit rates against each swept key.",
         ),
+        *accel_section(data, _table),
         "<h2>Validation</h2>",
         "<h3>Hit mismatches per run (must be zero)</h3>",
         _validation(data),

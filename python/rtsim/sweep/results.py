@@ -1,5 +1,6 @@
-"""The tidy table of a sweep: one row per run with scene, workload, status, every config key,
-the on-chip SRAM and the summary stats (plus DRAM bytes per ray by data kind)."""
+"""The tidy table of a sweep: one row per run with scene, workload, acceleration structure,
+status, every config key, the on-chip SRAM and the summary stats (plus DRAM bytes per ray by
+data kind)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ ID_COLUMNS = (
     "run_id",
     "scene",
     "workload",
+    "accel",
     "preset",
     "status",
     "exit_code",
@@ -48,6 +50,8 @@ def key_value(rec: RunRecord, key: str) -> tuple[Any, bool]:
         return rec.params[key], True
     if key == "preset":
         return rec.preset, False
+    if key == "accel":
+        return rec.accel, False
     return flatten(rec.config or {}).get(key), False
 
 

@@ -24,6 +24,7 @@ from rich.progress import (
 )
 
 from rtsim import __version__
+from rtsim.sweep.accel_axis import folder_label
 from rtsim.sweep.lock import clean_stale_traces, sweep_lock
 from rtsim.sweep.spec import RunPlan, SweepSpec, TracePlan
 from rtsim.sweep.store import ResultsStore, RunRecord, open_store
@@ -55,7 +56,8 @@ class SweepOutcome:
 
 
 def run_dir_name(run: RunPlan) -> str:
-    return f"{run.trace.scene.label}-{run.trace.workload.label}-{run.run_id[:12]}"
+    parts = (run.trace.scene.label, run.trace.workload.label, folder_label(run.trace.accel))
+    return f"{'-'.join(parts)}-{run.run_id[:12]}"
 
 
 def _resolved(scene: str) -> str:
@@ -68,7 +70,8 @@ def _resolved(scene: str) -> str:
         return scene
 
 
-def _trace_task(plan: TracePlan, out: Path) -> TraceTask:
+def trace_task(plan: TracePlan, out: Path) -> TraceTask:
+    """The task that makes the plan's trace in OUT/traces (the sweep's trace cache)."""
     w = plan.workload
     return TraceTask(
         trace_dir=str(out / "traces" / plan.folder_name),
@@ -79,6 +82,8 @@ def _trace_task(plan: TracePlan, out: Path) -> TraceTask:
         bounces=w.bounces,
         seed=w.seed,
         hairball_triangles=plan.scene.hairball_triangles,
+        accel=plan.accel.kind,
+        builder=plan.accel.builder,
     )
 
 
@@ -185,8 +190,8 @@ def _run_locked(spec: SweepSpec, opts: SweepOptions, out: Path, console: Console
         console.print(
             f"[bold]rtsim sweep[/] {spec.name}: {len(runs)} runs "
             f"({len(spec.scenes)} scenes x {len(spec.workloads)} workloads x "
-            f"{len(spec.points())} configs), {outcome.skipped} already in {store.path.name}, "
-            f"{len(todo)} to run"
+            f"{len(spec.accels or [None])} structures x {len(spec.points())} configs), "
+            f"{outcome.skipped} already in {store.path.name}, {len(todo)} to run"
         )
         t0 = time.monotonic()
         if todo:
@@ -221,7 +226,7 @@ def _execute(
         traces = {
             client.submit(
                 make_trace,
-                _trace_task(runs[0].trace, out),
+                trace_task(runs[0].trace, out),
                 TRACE_TIMEOUT,
                 key=f"trace-{tid}",
                 pure=False,

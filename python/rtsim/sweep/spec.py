@@ -20,11 +20,31 @@ import yaml
 from rtsim.config import ConfigError, SimConfig, apply_patch, compose, field_info, unflatten
 from rtsim.kinds import RAY_KINDS
 from rtsim.scenes import resolve_scene
+from rtsim.sweep.accel_axis import (
+    AccelSpec,
+    default_accel,
+    folder_label,
+    parse_accel_entry,
+    registered_kinds,
+    trace_format_version,
+)
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
 SAMPLING_METHODS = ("random", "latin_hypercube")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
-TOP_KEYS = ("name", "scenes", "workloads", "config", "grid", "sampling", "timeout", "baseline")
+TOP_KEYS = (
+    "name",
+    "scenes",
+    "workloads",
+    "accel",
+    "config",
+    "grid",
+    "sampling",
+    "timeout",
+    "baseline",
+)
+#: The swept key (a store column, a report axis) under which the `accel` axis is recorded.
+ACCEL_KEY = "accel"
 #: Most runs one sweep may have (each is an rtsim-sim process and a row of the store); checked
 #: from the grid's and sample's sizes before any point is enumerated.
 MAX_RUNS = 100_000
@@ -75,18 +95,28 @@ class WorkloadSpec:
 
 @dataclass(frozen=True)
 class TracePlan:
-    """One trace: a scene under a workload, shared by every config point."""
+    """One trace: a scene under a workload through one acceleration structure, shared by every
+    config point. Its id keys the trace cache: scene, workload, structure, builder and trace
+    format version (a trace of another structure or format is never reused)."""
 
     scene: SceneSpec
     workload: WorkloadSpec
+    accel: AccelSpec
+    trace_version: int
 
     @property
     def trace_id(self) -> str:
-        return stable_hash({"scene": self.scene.key(), "workload": self.workload.key()}, 12)
+        key = {
+            "scene": self.scene.key(),
+            "workload": self.workload.key(),
+            "accel": self.accel.key(self.trace_version),
+        }
+        return stable_hash(key, 12)
 
     @property
     def folder_name(self) -> str:
-        return f"{self.scene.label}-{self.workload.label}-{self.trace_id[:8]}"
+        parts = (self.scene.label, self.workload.label, folder_label(self.accel))
+        return f"{'-'.join(parts)}-{self.trace_id[:8]}"
 
 
 @dataclass
@@ -116,6 +146,10 @@ class SweepSpec:
     name: str
     scenes: list[SceneSpec]
     workloads: list[WorkloadSpec]
+    # The structures to trace with; None: the spec has no `accel` key (the default structure,
+    # not recorded as a swept key).
+    accels: list[AccelSpec] | None = None
+    trace_version: int = 0  # the trace format version of this build (a trace cache key)
     preset: str = "base"
     sets: dict[str, Any] = field(default_factory=dict)
     grid: dict[str, list[Any]] = field(default_factory=dict)
@@ -128,7 +162,7 @@ class SweepSpec:
 
     @property
     def swept_keys(self) -> list[str]:
-        keys = list(self.grid)
+        keys = ([ACCEL_KEY] if self.accels is not None else []) + list(self.grid)
         if self.sampling:
             keys += [k for k in self.sampling.ranges if k not in keys]
         return keys
@@ -142,7 +176,13 @@ class SweepSpec:
         return [{**g, **s} for g in grid for s in samples]
 
     def traces(self) -> list[TracePlan]:
-        return [TracePlan(s, w) for s in self.scenes for w in self.workloads]
+        accels = self.accels if self.accels is not None else [default_accel()]
+        return [
+            TracePlan(s, w, a, self.trace_version)
+            for s in self.scenes
+            for w in self.workloads
+            for a in accels
+        ]
 
     def runs(self) -> list[RunPlan]:
         """Every run, traces outermost, without duplicates (same trace and resolved config)."""
@@ -153,7 +193,10 @@ class SweepSpec:
                 preset = str(point.get(PRESET_KEY, self.preset))
                 values = {k: v for k, v in point.items() if k != PRESET_KEY}
                 config = apply_patch(apply_patch(compose(preset), base_sets), unflatten(values))
-                run = RunPlan(trace, preset, point, config)
+                params = dict(point)
+                if self.accels is not None:
+                    params = {ACCEL_KEY: trace.accel.label, **params}
+                run = RunPlan(trace, preset, params, config)
                 if run.run_id not in seen:
                     seen.add(run.run_id)
                     runs.append(run)
@@ -267,6 +310,33 @@ class _Reader:
         label = str(d.get("name") or "-".join(rays) or "scene")
         return WorkloadSpec(label, tuple(rays), int(w), int(h), bounces, seed)
 
+    def accels(self, doc: LineDict) -> list[AccelSpec]:
+        """The `accel` axis: a list (or one entry) of KIND, KIND:BUILDER or {kind, builder,
+        label}, checked against the structures this build registers."""
+        items = doc["accel"]
+        if isinstance(items, (str, dict)):
+            items = LineList([items])
+            items.line = line_of(doc, "accel")
+        if not isinstance(items, list) or not items:
+            raise self.fail(doc, "accel", "accel", "expected a non-empty list of structures")
+        kinds = registered_kinds()
+        out = []
+        for i, entry in enumerate(items):
+
+            def fail(sub: str, message: str, i: int = i, entry: Any = entry) -> SpecError:
+                if sub and isinstance(entry, dict):
+                    where = entry if sub in entry else items
+                    key = sub if sub in entry else i
+                    return self.fail(where, key, f"accel[{i}].{sub}", message)
+                return self.fail(items, i, f"accel[{i}]", message)
+
+            out.append(parse_accel_entry(entry, kinds, fail))
+        labels = [a.label for a in out]
+        dup = next((x for x in labels if labels.count(x) > 1), None)
+        if dup:
+            raise self.fail(doc, "accel", "accel", f"two entries named '{dup}' (give one a label)")
+        return out
+
     def config_value(self, parent: Any, key: Any, path: str, config_key: str, value: Any) -> None:
         """Checks that config_key exists and value has its type (ranges: rtsim-sim validate())."""
         try:
@@ -372,6 +442,9 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
         if dup:
             raise rd.fail(doc, what, what, f"two entries named '{dup}' (give one a label/name)")
     spec = SweepSpec(str(doc.get("name") or Path(source).stem), scenes, workloads, text=text)
+    spec.trace_version = trace_format_version()
+    if "accel" in doc:
+        spec.accels = rd.accels(doc)
     if "config" in doc:
         c = rd.mapping(doc, "config", "config", ("preset", "set"))
         if "preset" in c:
@@ -409,7 +482,8 @@ def _check_size(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
     """Refuses a sweep of more than MAX_RUNS runs before anything is enumerated."""
     points = math.prod(len(v) for v in spec.grid.values())
     points *= spec.sampling.n if spec.sampling else 1
-    runs = points * len(spec.scenes) * len(spec.workloads)
+    accels = len(spec.accels) if spec.accels else 1
+    runs = points * len(spec.scenes) * len(spec.workloads) * accels
     if runs <= MAX_RUNS:
         return
     key = "grid" if "grid" in doc else "sampling"
@@ -418,8 +492,9 @@ def _check_size(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
         key,
         key,
         f"{runs:,} runs ({len(spec.scenes)} scenes x {len(spec.workloads)} workloads x "
-        f"{points:,} config points) exceed the limit of {MAX_RUNS:,} runs per sweep "
-        "(docs/sweeps.md); split the sweep, or sample points (sampling.n) instead of a grid",
+        f"{accels} structures x {points:,} config points) exceed the limit of {MAX_RUNS:,} "
+        "runs per sweep (docs/sweeps.md); split the sweep, or sample points (sampling.n) "
+        "instead of a grid",
     )
 
 

@@ -11,7 +11,8 @@ Schema (version 1):
   runs(run_id PRIMARY KEY, scene, workload, trace_id, preset, status, exit_code, error,
        started_utc, finished_utc, wall_seconds, worker, attempts,
        params_json, config_json, stats_json, provenance_json,
-       "<swept key>" ... one column per swept config key, added as keys appear)
+       "<swept key>" ... one column per swept key, added as keys appear: the config keys of
+       the grid and sampling, and `accel` when the spec has an accel axis)
 """
 
 from __future__ import annotations
@@ -94,6 +95,12 @@ class RunRecord:
     @property
     def summary(self) -> dict[str, Any]:
         return (self.stats or {}).get("summary", {})
+
+    @property
+    def accel(self) -> str:
+        """The acceleration structure the run's trace was made with (its label on the spec's
+        `accel` axis; a spec without one traces with the default structure)."""
+        return str(self.params.get("accel", "bvh2"))
 
 
 def _quote(name: str) -> str:

@@ -43,6 +43,8 @@ class TraceTask:
     bounces: int
     seed: int
     hairball_triangles: int
+    accel: str = "bvh2"  # the structure (rtsim trace --accel)
+    builder: str = ""  # its builder; empty: the structure's default
 
     def command(self, out: str) -> list[str]:
         workload = ["--workload", ",".join(self.rays)] if self.rays else []
@@ -63,6 +65,9 @@ class TraceTask:
             str(self.seed),
             "--hairball-triangles",
             str(self.hairball_triangles),
+            "--accel",
+            self.accel,
+            *(["--builder", self.builder] if self.builder else []),
         ]
 
 

@@ -90,6 +90,7 @@ nlohmann::json build_stats(const GridGeometry& g, const GridConfig& config, cons
             {"max_references_per_cell", max_list},
             {"empty_cell_fraction", double(empty) / double(g.cell_count())},
             {"cell_bytes", sizeof(GridCell)},
+            {"node_bytes", sizeof(GridCell)},  // a cell is the record a step fetches
             {"triangle_bytes", sizeof(HwTriangle)}};
 }
 
