@@ -168,6 +168,7 @@ PyScene load_scene(const fs::path& path, uint32_t hairball_triangles, uint64_t s
     if (!fs::exists(path)) {
         std::string known;
         for (const std::string& n : procedural_scene_names()) known += (known.empty() ? "" : ", ") + n;
+        for (const std::string& n : instanced_procedural_scene_names()) known += ", " + n;
         throw Error(text + ": no such file, and not a built-in scene (" + known + ")");
     }
     return PyScene(load_gltf(text));
@@ -213,7 +214,14 @@ void bind_scene(py::module_& m) {
     m.def("load_scene", &load_scene, py::arg("path"), py::arg("hairball_triangles") = 200000u,
           py::arg("seed") = 1u,
           "Loads a .gltf/.glb file, or a built-in procedural scene by name ('cornell', ...).");
-    m.def("procedural_scene_names", &procedural_scene_names, "Names of the built-in scenes.");
+    m.def(
+        "procedural_scene_names",
+        [] {
+            std::vector<std::string> names = procedural_scene_names();
+            for (const std::string& n : instanced_procedural_scene_names()) names.push_back(n);
+            return names;
+        },
+        "Names of the built-in scenes (the instanced forest and grove last).");
     m.def(
         "write_procedural_scene",
         [](const std::string& name, const fs::path& dir, uint32_t hairball_triangles, uint64_t seed) {
