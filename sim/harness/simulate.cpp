@@ -125,7 +125,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     json manifest = read_manifest(rtt);
     // The acceleration structure, whichever it is, validated structurally (load_accel).
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
-    check_sim_memory(o.config, accel->image().end_address(),
+    check_sim_memory(o.config, accel->image().footprint_bytes(),
                      "config (traversal.units=" + std::to_string(o.config.traversal.units) +
                          ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     WorkloadFeatures features;

@@ -124,3 +124,9 @@ def test_model_replays_two_level_traces(
     assert summary["rays"] == validation["rays_checked"] == len(rtsim.open_trace(trace).rays) > 0
     assert summary["hit_mismatches"] == 0, validation["first_mismatches"]
     assert summary["work_mismatches"] == 0, validation["first_mismatches"]
+    built = {b["block"]: b["instantiated"] for b in stats["instantiated"]}
+    assert built["instance_transform"]
+    if config in ("approx", "detailed", "shared_transform"):
+        # The transform pipeline ran one test per instance the reference entered.
+        tests = sum(p["tests"] for p in stats["model"]["transform"].values())
+        assert tests == int(rtsim.open_trace(trace).work["transforms"].sum()) > 0
