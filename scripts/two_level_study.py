@@ -82,6 +82,14 @@ def trace_row(scene: str, kind: str, flatten: bool, args: argparse.Namespace) ->
     return row
 
 
+def short_error(text: str) -> str:
+    """The part of a tracer error that says why (e.g. "flattens to N triangles (about X GiB)")."""
+    match = re.search(r"flattens to (\d+) triangles \(about ([0-9.]+ GiB)", text)
+    if match:
+        return f"flattens to {int(match.group(1)):,} triangles, about {match.group(2)} to trace"
+    return text
+
+
 def markdown(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
     head = (
         f"Measured with `python scripts/two_level_study.py --scenes {args.scenes} --accels "
@@ -102,7 +110,7 @@ def markdown(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
     for r in rows:
         lead = f"| {r['scene']} | {r['accel']} | {r['mode']} |"
         if "error" in r:
-            lines.append(f"{lead} - | does not run: {r['error']} |" + " |" * 10)
+            lines.append(f"{lead} - | does not run: {short_error(r['error'])} |" + " |" * 9)
             continue
         lines.append(
             f"{lead} {r['triangles']:,} | {cell(r, 'footprint_mib', '.1f')} | "
