@@ -132,3 +132,14 @@ def test_model_replays_two_level_traces(
         # The transform pipeline ran one test per instance the reference entered.
         tests = sum(p["tests"] for p in stats["model"]["transform"].values())
         assert tests == int(rtsim.open_trace(trace).work["transforms"].sum()) > 0
+
+
+def test_scene_exposes_its_instances(scenes_dir: Path) -> None:
+    scene = rtsim.load_scene(scenes_dir / "SimpleInstancing" / "SimpleInstancing.gltf")
+    instances = scene.instances
+    assert len(instances) == scene.instance_count == 125
+    assert [i["prim_base"] for i in instances] == [12 * k for k in range(125)]
+    matrices = np.array([i["object_to_world"] for i in instances])
+    assert matrices.shape == (125, 4, 4)
+    assert np.allclose(matrices[:, 3], [0, 0, 0, 1])
+    assert (np.abs(np.linalg.det(matrices[:, :3, :3])) > 0).all()
