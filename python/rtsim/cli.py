@@ -68,6 +68,7 @@ class TraceJob:
     hairball_triangles: int = 200_000
     accel: str = "bvh2"
     builder: str = ""  # empty: the structure's default builder (its first)
+    flatten: bool = False  # instanced scenes: one world-space structure instead of two levels
 
 
 def parse_workload(text: str) -> list[str]:
@@ -166,6 +167,7 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             progress=progress,
             accel=job.accel,
             builder=job.builder,
+            flatten=job.flatten,
         )
     trace = open_trace(job.out_dir)
     heatmaps = write_heatmaps(trace, size=(job.width, job.height))
@@ -194,6 +196,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         hairball_triangles=args.hairball_triangles,
         accel=args.accel,
         builder=args.builder,
+        flatten=args.flatten,
     )
     run_trace(job, console)
     return 0
@@ -341,6 +344,13 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
             "builder (default: the structure's first); the structures take: "
             + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in accel_kinds())
         ),
+    )
+    p.add_argument(
+        "--flatten",
+        action="store_true",
+        help="instanced scenes: one world-space structure of --accel over the flattened "
+        "triangles, instead of the default two levels (a BLAS of --accel per mesh, a TLAS "
+        "over the instances; docs/accel.md)",
     )
     p.set_defaults(func=cmd_trace)
 

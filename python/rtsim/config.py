@@ -357,14 +357,16 @@ class SimConfig:
     ideal_memory: bool = _flag(
         False, "Every access hits in L1 at L1 latency: the upper bound on performance"
     )
-    # Sections: the box, triangle, any-hit and cell pipelines and the two cache levels share a
-    # struct with per-section defaults, as in config.h.
+    # Sections: the box, triangle, any-hit, cell and transform pipelines and the two cache
+    # levels share a struct with per-section defaults, as in config.h.
     dispatch: DispatchConfig = field(default_factory=DispatchConfig)
     traversal: TraversalConfig = field(default_factory=TraversalConfig)
     box: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 2, "private", 4))
     triangle: PipelineConfig = field(default_factory=lambda: PipelineConfig(20, 1, 1, "private", 4))
     anyhit: PipelineConfig = field(default_factory=lambda: PipelineConfig(10, 1, 1, "private", 4))
     cell: PipelineConfig = field(default_factory=lambda: PipelineConfig(4, 1, 1, "private", 4))
+    # Instance transforms of two-level structures (docs/accel.md, "Two-level structures").
+    transform: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 1, "private", 4))
     # MSHRs: docs/presets.md, "How the defaults were chosen".
     l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 16, 1, 1))
     l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 64, 8, 1))
@@ -381,6 +383,7 @@ class SimConfig:
         "triangle",
         "anyhit",
         "cell",
+        "transform",
         "l1",
         "l2",
         "dram",

@@ -111,6 +111,19 @@ TRIANGLE_DTYPE = np.dtype(
 #: grid GridCell (8 bytes): the cell's list in prim_refs (docs/accel.md, "grid").
 CELL_DTYPE = np.dtype([("first_ref", "<u4"), ("ref_count", "<u4")])
 
+#: two_level InstanceRecord (128 bytes; docs/accel.md, "Two-level structures").
+INSTANCE_DTYPE = np.dtype(
+    [
+        ("world_to_object", "<f4", (3, 4)),
+        ("blas", "<u4"),
+        ("prim_base", "<u4"),
+        ("instance", "<u4"),
+        ("reserved0", "<u4"),
+        ("object_to_world", "<f4", (3, 4)),
+        ("reserved1", "<u4", (4,)),
+    ]
+)
+
 #: Section name (as the C++ section_name() spells it, lower-cased) -> record dtype.
 SECTION_DTYPES: dict[str, np.dtype] = {
     "rays": RAY_DTYPE,
@@ -132,6 +145,9 @@ REGION_DTYPES: dict[tuple[str, str], np.dtype] = {
     ("cwbvh8_octant", "nodes"): CWNODE8_DTYPE,
     ("grid", "cells"): CELL_DTYPE,
     ("grid", "prim_refs"): np.dtype("<u4"),
+    ("two_level", "tlas_nodes"): NODE_DTYPE,
+    ("two_level", "instances"): INSTANCE_DTYPE,
+    ("two_level", "blas_triangles"): TRIANGLE_DTYPE,
 }
 
 

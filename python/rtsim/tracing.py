@@ -59,12 +59,15 @@ def trace_scene(
     progress: Callable[[int, int, str], None] | None = None,
     accel: str = "bvh2",
     builder: str = "binned",
+    flatten: bool = False,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. workload: ray kinds ("primary,diffuse" or a list);
     None (the default) traces every kind the scene calls for (manifest["workload"]["effects"]
     says which and why). camera: (eye, target, vertical field of view in degrees). accel and
-    builder choose the acceleration structure (rtsim._core.accel_kinds(), docs/accel.md)."""
+    builder choose the acceleration structure (rtsim._core.accel_kinds(), docs/accel.md);
+    instanced scenes are traced through two levels (a BLAS of that kind per mesh, a TLAS over
+    the instances) unless flatten is true."""
     from rtsim import _core
 
     kinds = (
@@ -86,6 +89,7 @@ def trace_scene(
         progress=progress,
         accel=accel,
         builder=builder,
+        flatten=flatten,
     )
 
 

@@ -168,6 +168,7 @@ PyScene load_scene(const fs::path& path, uint32_t hairball_triangles, uint64_t s
     if (!fs::exists(path)) {
         std::string known;
         for (const std::string& n : procedural_scene_names()) known += (known.empty() ? "" : ", ") + n;
+        for (const std::string& n : instanced_procedural_scene_names()) known += ", " + n;
         throw Error(text + ": no such file, and not a built-in scene (" + known + ")");
     }
     return PyScene(load_gltf(text));
@@ -190,6 +191,28 @@ void bind_scene(py::module_& m) {
         .def_property_readonly("triangle_count", [](const PyScene& s) { return s.scene().triangle_count(); })
         .def_property_readonly("instance_count", [](const PyScene& s) { return s.scene().instances.size(); })
         .def_property_readonly("mesh_count", [](const PyScene& s) { return s.scene().meshes.size(); })
+        .def_property_readonly(
+            "instances",
+            [](const PyScene& s) {
+                // Placements in scene order: hits' inst indexes this list, and a hit's primitive
+                // is prim_base + its index in the mesh (docs/accel.md, "Two-level structures").
+                py::list out;
+                for (const Instance& inst : s.scene().instances) {
+                    py::list rows;
+                    for (int r = 0; r < 4; ++r)
+                        rows.append(py::make_tuple(inst.object_to_world[0][r], inst.object_to_world[1][r],
+                                                   inst.object_to_world[2][r], inst.object_to_world[3][r]));
+                    py::dict d;
+                    d["mesh"] = inst.mesh;
+                    d["prim_base"] = inst.prim_base;
+                    d["node"] = inst.node;
+                    d["object_to_world"] = rows;
+                    out.append(d);
+                }
+                return out;
+            },
+            "Instances in scene order: mesh, prim_base, glTF node and the 4x4 object_to_world "
+            "matrix (rows, double).")
         .def_property_readonly("uses_instancing", [](const PyScene& s) { return s.scene().uses_instancing(); })
         .def_property_readonly("materials", [](const PyScene& s) { return materials_of(s.scene()); })
         .def_property_readonly("lights", [](const PyScene& s) { return lights_of(s.scene()); })
@@ -213,7 +236,14 @@ void bind_scene(py::module_& m) {
     m.def("load_scene", &load_scene, py::arg("path"), py::arg("hairball_triangles") = 200000u,
           py::arg("seed") = 1u,
           "Loads a .gltf/.glb file, or a built-in procedural scene by name ('cornell', ...).");
-    m.def("procedural_scene_names", &procedural_scene_names, "Names of the built-in scenes.");
+    m.def(
+        "procedural_scene_names",
+        [] {
+            std::vector<std::string> names = procedural_scene_names();
+            for (const std::string& n : instanced_procedural_scene_names()) names.push_back(n);
+            return names;
+        },
+        "Names of the built-in scenes (the instanced forest and grove last).");
     m.def(
         "write_procedural_scene",
         [](const std::string& name, const fs::path& dir, uint32_t hairball_triangles, uint64_t seed) {

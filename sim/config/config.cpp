@@ -185,6 +185,7 @@ const PipelineConfig& SimConfig::pipeline(OpKind kind) const {
         case OpKind::triangle: return triangle;
         case OpKind::anyhit: return anyhit;
         case OpKind::cell: return cell;
+        case OpKind::transform: return transform;
         default: break;
     }
     throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");

@@ -40,6 +40,9 @@ struct SimConfig {
     PipelineConfig triangle{20, 1, 1, Sharing::per_unit, 4};
     PipelineConfig anyhit{10, 1, 1, Sharing::per_unit, 4};
     PipelineConfig cell{4, 1, 1, Sharing::per_unit, 4};
+    /// Instance transforms of two-level structures: a 3x4 matrix times the ray's origin and
+    /// direction (18 multiply-adds), pipelined like a box test (Vulkan-Sim's instance transform).
+    PipelineConfig transform{8, 1, 1, Sharing::per_unit, 4};
     // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
     // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
     CacheConfig l1{16, 4, 64, 4, 16, 1, 1};
@@ -68,6 +71,7 @@ struct SimConfig {
         v.section("triangle", triangle);
         v.section("anyhit", anyhit);
         v.section("cell", cell);
+        v.section("transform", transform);
         v.section("l1", l1);
         v.section("l2", l2);
         v.section("dram", dram);

@@ -116,7 +116,7 @@ def test_parse_progress() -> None:
 
 # Instance names and data or ray kinds that docs/stats.md writes as placeholders.
 PLACEHOLDER = re.compile(
-    r"^(tu\d+|l1_\d+|(box|triangle|anyhit)_(\d+|pool)|node|triangle|ray|hit|stack"
+    r"^(tu\d+|l1_\d+|(box|triangle|anyhit|transform|cell)_(\d+|pool)|node|triangle|ray|hit|stack"
     r"|primary|shadow|reflection|diffuse|refraction)$"
 )
 

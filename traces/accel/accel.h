@@ -54,6 +54,9 @@ struct AccelOptions {
     std::string kind = "bvh2";        ///< accel_kinds() name
     std::string builder;              ///< empty: the kind's default (its first); accel_kinds() lists each kind's builders
     BuildConfig build;
+    /// Two levels (docs/accel.md, "Two-level structures"): a BLAS of `kind` per mesh in object
+    /// space and a binary TLAS over the instances; the image's kind is then "two_level".
+    bool two_level = false;
 };
 
 struct AccelKindInfo {
@@ -66,7 +69,8 @@ struct AccelKindInfo {
 const std::vector<AccelKindInfo>& accel_kinds();
 /// Throws rtsim::Error listing the known kinds and builders if the options name none.
 void validate_accel_options(const AccelOptions& options);
-/// Builds the image of a structure over a flattened scene; build_ms is the wall time it took.
+/// Builds the image of a structure over a flattened scene (two-level: over its meshes and
+/// instances, flattened or not); build_ms is the wall time it took.
 AccelImage build_accel(const Scene& scene, const AccelOptions& options);
 /// Wraps an image (e.g. read from a trace) in its kind's Accel, validating it structurally;
 /// throws rtsim::Error naming `source` and the first problem.

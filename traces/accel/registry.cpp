@@ -8,6 +8,7 @@
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/accel/cwbvh/cwbvh.h"
 #include "traces/accel/grid/grid.h"
+#include "traces/accel/two_level/two_level.h"
 #include "traces/accel/wide/wide.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/builder.h"
@@ -141,10 +142,16 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
     validate_accel_options(options);
     AccelOptions o = options;
     if (o.builder.empty()) o.builder = find(o.kind)->info.builders.front();  // the kind's default
+    const auto start = std::chrono::steady_clock::now();
+    if (o.two_level) {
+        AccelImage image = build_two_level(scene, o);
+        image.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        image.stats["footprint_bytes"] = image.footprint_bytes();
+        return image;
+    }
     require(!scene.triangles.empty(), "scene has no triangles");
     require(scene.tri_material.size() == scene.triangles.size() && scene.tri_instance.size() == scene.triangles.size(),
             "build_accel: scene is not flattened (call Scene::flatten())");
-    const auto start = std::chrono::steady_clock::now();
     AccelImage image = find(o.kind)->build(scene, o);
     image.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     image.stats["footprint_bytes"] = image.footprint_bytes();
@@ -152,6 +159,7 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
 }
 
 std::unique_ptr<Accel> load_accel(AccelImage image, const std::string& source) {
+    if (image.kind == "two_level") return std::make_unique<TwoLevelAccel>(std::move(image), source);
     const Entry* e = find(image.kind);
     require(e != nullptr, source + ": unknown acceleration structure '" + image.kind + "' (this build knows: " +
                               known_kinds() + ")");

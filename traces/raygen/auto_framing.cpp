@@ -38,7 +38,7 @@ float enclosure(const Scene& scene, const Accel& accel, const Vec3& p) {
     for (const Vec3& d : dirs) {
         Hit h = accel.trace(Ray{p, 0.0f, d, INFINITY}, TraversalMode::closest_hit);
         if (!h.valid()) continue;
-        const Triangle& t = scene.triangles[h.prim];
+        const Triangle t = scene.world_triangle(uint32_t(h.prim));
         front += glm::dot(glm::cross(t.v1 - t.v0, t.v2 - t.v0), d) < 0.0f;
     }
     return float(front) / float(dirs.size());
@@ -58,7 +58,7 @@ float view_score(const Scene& scene, const Accel& accel, const Vec3& eye, const 
                 dist.push_back(1e30f);
                 continue;
             }
-            const Triangle& t = scene.triangles[h.prim];
+            const Triangle t = scene.world_triangle(uint32_t(h.prim));
             if (glm::dot(glm::cross(t.v1 - t.v0, t.v2 - t.v0), r.direction) > 0.0f) ++back_faces;
             dist.push_back(h.t);
         }

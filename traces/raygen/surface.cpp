@@ -17,7 +17,7 @@ constexpr float gamma(int n) {
 }  // namespace
 
 SurfacePoint surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
-    const Triangle& tri = scene.triangles[hit.prim];
+    const Triangle tri = scene.world_triangle(uint32_t(hit.prim));
     float b0 = 1.0f - hit.u - hit.v;
     SurfacePoint sp;
     // Barycentric interpolation and its error bound (pbrt-v4 Triangle::InteractionFromIntersection).
@@ -36,7 +36,7 @@ SurfacePoint surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
     if (!sp.front) n = -n;
     sp.normal = n;
     sp.prim = uint32_t(hit.prim);
-    sp.material = scene.tri_material[hit.prim];
+    sp.material = scene.material_of(uint32_t(hit.prim));
     return sp;
 }
 

@@ -28,16 +28,28 @@ std::string material_label(const Material& m, size_t index) {
 /// Materials used by at least one triangle, so unused entries do not trigger effects.
 std::vector<bool> used_materials(const Scene& scene) {
     std::vector<bool> used(scene.materials.size(), false);
-    for (uint32_t m : scene.tri_material) used[m] = true;
+    std::vector<bool> placed(scene.meshes.size(), false);
+    for (const Instance& inst : scene.instances) placed[inst.mesh] = true;
+    for (size_t m = 0; m < scene.meshes.size(); ++m)
+        if (placed[m])
+            for (uint32_t id : scene.meshes[m].materials) used[id] = true;
     return used;
 }
 
 void plan_emissive(const Scene& scene, const std::vector<bool>& used, WorkloadPlan* plan) {
     double total = 0.0;
     std::vector<double> areas;
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
-        if (!scene.materials[scene.tri_material[i]].is_emissive()) continue;
-        const Triangle& t = scene.triangles[i];
+    // Emissive triangles in primitive-id order, flattened or not (placed meshes only).
+    std::vector<std::vector<uint32_t>> in_mesh(scene.meshes.size());  // emissive triangles of each mesh
+    for (size_t m = 0; m < scene.meshes.size(); ++m)
+        for (size_t k = 0; k < scene.meshes[m].triangle_count(); ++k)
+            if (scene.materials[scene.meshes[m].materials[k]].is_emissive()) in_mesh[m].push_back(uint32_t(k));
+    std::vector<uint32_t> emissive;
+    for (const Instance& inst : scene.instances)
+        for (uint32_t k : in_mesh[inst.mesh]) emissive.push_back(inst.prim_base + k);
+    std::sort(emissive.begin(), emissive.end());
+    for (uint32_t i : emissive) {
+        const Triangle t = scene.world_triangle(i);
         double area = 0.5 * glm::length(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
         if (!(area > 0.0)) continue;
         plan->emissive_prims.push_back(uint32_t(i));
@@ -110,7 +122,7 @@ WorkloadPlan plan_workload(const Scene& scene, const std::vector<RayKind>& reque
     plan.effects.push_back({"instancing", false,
                             scene.uses_instancing()
                                 ? std::to_string(scene.instances.size()) + " instances of " + std::to_string(meshes_used) +
-                                      " meshes, flattened to one world-space BVH (two-level BVH not modelled yet)"
+                                      " meshes, flattened to one world-space structure (--flatten)"
                                 : "every mesh is placed once"});
     return plan;
 }
@@ -130,7 +142,7 @@ std::vector<LightSample> light_samples(const Scene& scene, const WorkloadPlan& p
     if (!plan.emissive_cdf.empty()) {
         size_t i = std::lower_bound(plan.emissive_cdf.begin(), plan.emissive_cdf.end(), u0) - plan.emissive_cdf.begin();
         i = std::min(i, plan.emissive_cdf.size() - 1);
-        const Triangle& t = scene.triangles[plan.emissive_prims[i]];
+        const Triangle t = scene.world_triangle(plan.emissive_prims[i]);
         // Uniform point on the triangle (square-root parameterisation).
         float su = std::sqrt(u1);
         float b1 = 1.0f - su, b2 = u2 * su;

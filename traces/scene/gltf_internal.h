@@ -16,6 +16,7 @@ namespace rtsim::gltf {
 struct Source {
     std::string file;
     const tinygltf::Model* model = nullptr;
+    bool flatten = true;  ///< the scene will be flattened (its size is checked against memory)
 
     /// Throws rtsim::Error("<file>: <what>").
     [[noreturn]] void fail(const std::string& what) const;

@@ -3,6 +3,7 @@
 #include "traces/scene/gltf_loader.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -114,6 +115,17 @@ glm::dmat4 local_matrix(const Source& src, const tinygltf::Node& node, size_t in
     return t * r * s;
 }
 
+/// Checks the triangles placed so far: against memory when the scene will be flattened
+/// (check_flat_size), else against the int32 primitive ids of a two-level scene.
+void check_placed(const Source& src, uint64_t placed, const std::string& what) {
+    if (src.flatten) {
+        check_flat_size(src.file, placed, what);
+        return;
+    }
+    if (placed > uint64_t(INT32_MAX))
+        src.fail(what + " places " + std::to_string(placed) + " triangles; primitive ids are int32");
+}
+
 /// Instance transforms of an EXT_mesh_gpu_instancing node: world x T_i x R_i x S_i.
 /// `flat` counts the scene's triangles so far (each instance counts at least one): the
 /// flattened size is checked before the instances are expanded.
@@ -140,10 +152,8 @@ std::vector<glm::dmat4> gpu_instances(const Source& src, const tinygltf::Value& 
     }
     if (!have_count) src.fail(where + ": no TRANSLATION, ROTATION or SCALE attribute");
     *flat += uint64_t(count) * std::max<uint64_t>(mesh_triangles, 1);
-    check_flat_size(src.file, *flat, where + " (" + std::to_string(count) + " instances of " +
-                                         std::to_string(mesh_triangles) +
-                                         " triangles, with the nodes before it; instances are flattened: "
-                                         "rtsim has no two-level BVH yet)");
+    check_placed(src, *flat, where + " (" + std::to_string(count) + " instances of " +
+                                 std::to_string(mesh_triangles) + " triangles, with the nodes before it)");
     std::vector<glm::dmat4> out(count);
     for (size_t i = 0; i < count; ++i) {
         glm::dmat4 t(1.0), r(1.0), s(1.0);
@@ -226,7 +236,7 @@ private:
         const uint64_t triangles = m_scene.meshes[size_t(mesh)].triangle_count();
         if (inst == node.extensions.end()) {
             m_flat += std::max<uint64_t>(triangles, 1);
-            check_flat_size(m_src.file, m_flat, element("node", index, node.name) + " (with the nodes before it)");
+            check_placed(m_src, m_flat, element("node", index, node.name) + " (with the nodes before it)");
             m_scene.instances.push_back({uint32_t(mesh), world, 0, int32_t(index)});
             return;
         }
@@ -241,12 +251,12 @@ private:
     uint64_t m_flat = 0;           ///< triangles placed so far (at least one per instance)
 };
 
-Scene load_gltf_checked(const std::string& path) {
+Scene load_gltf_checked(const std::string& path, bool flatten) {
     Scene scene;
     scene.source = path;
     tinygltf::Model model;
     load_model(path, model, scene);
-    Source src{path, &model};
+    Source src{path, &model, flatten};
     gltf::read_materials(src, scene);
 
     // Default scene: model.defaultScene, else scene 0, else every root node.
@@ -269,8 +279,9 @@ Scene load_gltf_checked(const std::string& path) {
     for (int r : roots) walker.walk_root(r);
 
     if (scene.materials.empty()) scene.default_material();
-    scene.flatten();
-    if (scene.triangles.empty())
+    if (flatten) scene.flatten();
+    else scene.index_instances();
+    if (scene.triangle_count() == 0)
         throw Error(path + ": the scene has no triangles (no mesh with TRIANGLES, TRIANGLE_STRIP or "
                            "TRIANGLE_FAN primitives in its default scene)");
     return scene;
@@ -278,9 +289,9 @@ Scene load_gltf_checked(const std::string& path) {
 
 }  // namespace
 
-Scene load_gltf(const std::string& path) {
+Scene load_gltf(const std::string& path, bool flatten) {
     try {
-        return load_gltf_checked(path);
+        return load_gltf_checked(path, flatten);
     } catch (const Error& e) {
         // Names and tinygltf's messages may quote bytes that are not UTF-8 (a Python caller
         // decodes the message): escape them rather than lose the message.

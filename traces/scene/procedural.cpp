@@ -20,6 +20,13 @@ const Entry kScenes[] = {
     {"rotated_walls", write_rotated_walls},
 };
 
+/// Instanced scenes: not in procedural_scene_names(), which the per-structure tests sweep
+/// flattened (the forest cannot be flattened).
+const Entry kInstancedScenes[] = {
+    {"forest", write_forest},
+    {"grove", write_grove},
+};
+
 }  // namespace
 
 std::vector<std::string> procedural_scene_names() {
@@ -28,8 +35,16 @@ std::vector<std::string> procedural_scene_names() {
     return names;
 }
 
+std::vector<std::string> instanced_procedural_scene_names() {
+    std::vector<std::string> names;
+    for (const Entry& e : kInstancedScenes) names.push_back(e.name);
+    return names;
+}
+
 bool is_procedural_scene(const std::string& name) {
     for (const Entry& e : kScenes)
+        if (name == e.name) return true;
+    for (const Entry& e : kInstancedScenes)
         if (name == e.name) return true;
     return false;
 }
@@ -38,8 +53,11 @@ std::string write_procedural_scene(const std::string& name, const std::string& d
                                    const ProceduralOptions& options) {
     for (const Entry& e : kScenes)
         if (name == e.name) return e.write(dir, options);
+    for (const Entry& e : kInstancedScenes)
+        if (name == e.name) return e.write(dir, options);
     std::string known;
     for (const Entry& e : kScenes) known += std::string(known.empty() ? "" : ", ") + e.name;
+    for (const Entry& e : kInstancedScenes) known += std::string(", ") + e.name;
     throw Error("unknown procedural scene '" + name + "' (known: " + known + ")");
 }
 

@@ -12,8 +12,11 @@ struct ProceduralOptions {
     uint64_t seed = 1;
 };
 
-/// Names of the built-in scenes: "cornell", "hairball", "teapot_stadium", "rotated_walls".
+/// Names of the built-in flat scenes: "cornell", "hairball", "teapot_stadium", "rotated_walls".
 std::vector<std::string> procedural_scene_names();
+/// Names of the built-in instanced scenes (procedural_forest.cpp): "forest" (72 x 72 instances,
+/// about 4.6 x 10^8 triangles if flattened: two-level only) and "grove" (6 x 6 instances).
+std::vector<std::string> instanced_procedural_scene_names();
 bool is_procedural_scene(const std::string& name);
 
 /// Writes scene `name` as `<dir>/<name>.gltf` (+ .bin) and returns the .gltf path.

@@ -40,7 +40,7 @@ void Scene::flatten() {
     uint64_t total = 0;
     for (const Instance& inst : instances) total += meshes[inst.mesh].triangle_count();
     check_flat_size(source, total, "the scene (" + std::to_string(instances.size()) +
-                                       " instances, flattened into one triangle list: rtsim has no two-level BVH yet)");
+                                       " instances, flattened into one triangle list)");
     total = 0;
     for (Instance& inst : instances) {
         inst.prim_base = uint32_t(total);

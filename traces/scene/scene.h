@@ -107,13 +107,27 @@ struct Scene {
     std::vector<Triangle> triangles;
     std::vector<uint32_t> tri_material;
     std::vector<uint32_t> tri_instance;
+    uint64_t placed_triangles = 0;  ///< set by index_instances() (flatten() fills triangles instead)
     Aabb bounds;
 
     /// Fills triangles/tri_material/tri_instance/bounds from meshes and instances. Vertices are
     /// transformed in double precision and rounded once to float. Throws rtsim::Error naming
     /// `source` if the result would not fit (check_flat_size) or a vertex is not finite.
     void flatten();
-    size_t triangle_count() const { return triangles.size(); }
+    /// Instead of flatten(), for two-level tracing (docs/accel.md, "Two-level structures"):
+    /// assigns each instance's prim_base and the world bounds (the meshes' boxes under each
+    /// instance's transform) without a world-space triangle list; placed_triangles counts the
+    /// triangles. Throws rtsim::Error naming `source` if primitive ids would not fit int32.
+    void index_instances();
+    bool flattened() const { return !triangles.empty(); }
+    /// Triangles the instances place: the flattened list's size, or placed_triangles.
+    size_t triangle_count() const { return flattened() ? triangles.size() : size_t(placed_triangles); }
+    /// Instance that places primitive `prim` (binary search over prim_base).
+    uint32_t instance_of(uint32_t prim) const;
+    /// World-space triangle `prim`: the flattened one, or computed as flatten() computes it.
+    Triangle world_triangle(uint32_t prim) const;
+    /// Material of primitive `prim`, flattened or not.
+    uint32_t material_of(uint32_t prim) const;
     /// True if some mesh is placed more than once (shared meshes or GPU instancing).
     bool uses_instancing() const;
     /// Index of the default material (white, rough dielectric) appended on demand.

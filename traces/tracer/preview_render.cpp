@@ -18,7 +18,7 @@ Vec3 sky(const Vec3& d) {
 }
 
 float headlight(const Scene& scene, const Ray& ray, const Hit& hit) {
-    const Triangle& t = scene.triangles[hit.prim];
+    const Triangle t = scene.world_triangle(uint32_t(hit.prim));
     Vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
     float len = glm::length(n) * glm::length(ray.direction);
     return len > 0.0f ? std::abs(glm::dot(n, ray.direction)) / len : 0.0f;
@@ -43,7 +43,7 @@ void PreviewRender::add(const Scene& scene, const std::vector<PendingRay>& rays,
         if (r.kind == RayKind::primary) {
             px.sky = sky(r.ray.direction);
             if (!h.valid()) continue;
-            const Material& m = scene.materials[scene.tri_material[h.prim]];
+            const Material& m = scene.materials[scene.material_of(uint32_t(h.prim))];
             px.hit = true;
             px.albedo = Vec3(m.base_color);
             px.emissive = m.emissive;
@@ -54,7 +54,7 @@ void PreviewRender::add(const Scene& scene, const std::vector<PendingRay>& rays,
         } else if (r.depth == 1 && r.kind == RayKind::reflection) {
             px.has_reflection = true;
             if (h.valid()) {
-                const Material& m = scene.materials[scene.tri_material[h.prim]];
+                const Material& m = scene.materials[scene.material_of(uint32_t(h.prim))];
                 px.reflected = Vec3(m.base_color) * (0.3f + 0.7f * headlight(scene, r.ray, h)) + m.emissive;
             } else {
                 px.reflected = sky(r.ray.direction);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "traces/accel/two_level/two_level.h"
 #include "traces/common/error.h"
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
@@ -93,6 +94,18 @@ void validate(const TraceOptions& o) {
     validate_accel_options(o.accel);
 }
 
+/// The instancing effect of a two-level trace: simulated (BLASes, TLAS, transform stage).
+void mark_instancing_simulated(WorkloadPlan& plan, const AccelImage& image) {
+    for (Effect& e : plan.effects) {
+        if (e.name != "instancing") continue;
+        e.simulated = true;
+        e.why = std::to_string(image.stats.value("instances", 0)) + " instances of " +
+                std::to_string(image.stats.value("blases", 0)) + " meshes: a " +
+                image.stats.value("blas_kind", std::string()) +
+                " BLAS per mesh, a TLAS over the instances, a transform stage (--flatten: one world-space structure)";
+    }
+}
+
 }  // namespace
 
 json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
@@ -106,13 +119,20 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     report(0, 1, "load");
     bool procedural = false;
     std::string path = resolve_scene(o, &procedural);
-    Scene scene = load_gltf(path);
+    // Kept as instances: flattened only for a single-level structure (so an instanced scene too
+    // large to flatten still traces two-level).
+    Scene scene = load_gltf(path, false);
+    AccelOptions accel_options = o.accel;
+    accel_options.two_level = !o.flatten && shares_geometry(scene);
+    if (!accel_options.two_level) scene.flatten();
     double load_ms = ms_since(t_start);
     require(scene.triangle_count() > 0, path + ": the scene has no triangles");
 
     report(0, 1, "accel");
-    const std::unique_ptr<Accel> accel = load_accel(build_accel(scene, o.accel), path + ": built " + o.accel.kind);
+    const std::unique_ptr<Accel> accel =
+        load_accel(build_accel(scene, accel_options), path + ": built " + o.accel.kind);
     WorkloadPlan plan = plan_workload(scene, o.workload);
+    if (accel_options.two_level) mark_instancing_simulated(plan, accel->image());
     std::string camera_source;
     Camera camera = choose_camera(o, scene, *accel, &camera_source);
     PinholeCamera pinhole = make_camera(camera, o.width, o.height);

@@ -37,6 +37,11 @@ struct TraceOptions {
     uint64_t seed = 1;
     std::optional<CameraOverride> camera;
     AccelOptions accel;  ///< which acceleration structure and builder (docs/accel.md)
+    /// Trace an instanced scene (one that places some geometry more than once: shares_geometry())
+    /// through one world-space structure of `accel.kind` instead of the default two levels: a
+    /// BLAS of that kind per geometry and a TLAS over the instances (docs/accel.md, "Two-level
+    /// structures"). No effect without instancing.
+    bool flatten = false;
     ProceduralOptions procedural;
     unsigned threads = 0;  ///< 0: all hardware threads. Output does not depend on it.
 };

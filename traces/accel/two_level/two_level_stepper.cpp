@@ -1,0 +1,154 @@
+// The two-level stepper (two_level_stepper.h): the TLAS walk is the binary BVH's (bvh2_kernel.h),
+// the BLAS walks are their kinds' own steppers on the object-space ray.
+#include "traces/accel/two_level/two_level_stepper.h"
+
+#include "traces/accel/two_level/two_level.h"
+
+namespace rtsim {
+
+using detail::cull_distance;
+
+namespace {
+
+void add_work(WorkCounts& total, const WorkCounts& w) {
+    total.steps += w.steps;
+    total.box_tests += w.box_tests;
+    total.tri_tests += w.tri_tests;
+    total.anyhit_calls += w.anyhit_calls;
+    total.transforms += w.transforms;
+    total.cell_steps += w.cell_steps;
+    total.plane_tests += w.plane_tests;
+    total.refs += w.refs;
+}
+
+}  // namespace
+
+TwoLevelStepper::TwoLevelStepper(const TwoLevelAccel& accel) : m_accel(accel) {
+    for (const auto& blas : accel.blases()) m_blas_steppers.push_back(blas->make_stepper());
+}
+
+void TwoLevelStepper::begin(const Ray& ray, TraversalMode mode) {
+    m_ray = ray;
+    m_mode = mode;
+    m_hit = Hit{};
+    m_work = WorkCounts{};
+    m_stack_size = m_tlas_size = 0;
+    m_inner = nullptr;
+    if (!ray_is_valid(ray) || m_accel.tlas().node_count == 0) {
+        finish();
+        return;
+    }
+    m_box = ray_box_precompute(ray);
+    m_hit.t = ray.tmax;  // the current best distance while traversing
+    m_cull_t = cull_distance(ray.tmax);
+    m_ref = 0;
+    m_count = 0;
+    plan_tlas();
+}
+
+void TwoLevelStepper::plan_tlas() {
+    const Bvh2View& tlas = m_accel.tlas();
+    if (m_count == 0) {
+        m_plan.reset(m_ref);
+        m_plan.add_fetch(tlas.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+        m_plan.add_op(OpKind::box, 2);
+    } else {
+        m_plan.reset(kNoLocality);  // an instance record belongs to its TLAS node's treelet
+        m_plan.add_fetch(m_accel.instances().base + uint64_t(m_ref) * sizeof(InstanceRecord), kInstanceFetchBytes,
+                         DataKind::instance);
+        m_plan.add_op(OpKind::transform, 1);
+    }
+    m_stack_size = m_tlas_size;
+}
+
+void TwoLevelStepper::plan_blas() {
+    m_plan = m_inner->plan();
+    if (m_plan.locality != kNoLocality) m_plan.locality += m_inner_offset;
+    m_stack_size = m_tlas_size + m_inner->stack_size();
+}
+
+StepOutcome TwoLevelStepper::execute() {
+    if (m_plan.done) return StepOutcome{};
+    if (m_inner) return blas_step();
+    if (m_count == 0) visit_node(m_accel.tlas().nodes[m_ref]);
+    else enter_instance(m_accel.instances().records[m_ref]);
+    return StepOutcome{};
+}
+
+void TwoLevelStepper::visit_node(const HwNode& node) {
+    m_work.steps += 1;
+    m_work.box_tests += 2;
+    float tnear[2];
+    const unsigned mask = detail::node_step(m_box, node, m_ray.tmin, m_cull_t, tnear);
+    if (mask == 0) {
+        pop_next();
+        return;
+    }
+    const unsigned next = detail::next_slot(mask, tnear);
+    if (mask == 3) {
+        const unsigned far = next ^ 1u;
+        if (m_tlas_size >= kTraversalStackSize) detail::throw_stack_overflow();
+        m_stack[m_tlas_size++] = {node.child_ref[far], node.child_count[far], tnear[far]};
+    }
+    m_ref = node.child_ref[next];
+    m_count = node.child_count[next];
+    plan_tlas();
+}
+
+void TwoLevelStepper::enter_instance(const InstanceRecord& record) {
+    m_work.transforms += 1;
+    Ray object_ray = transform_ray(record.world_to_object, m_ray);
+    object_ray.tmax = m_hit.t;  // t is the same in both spaces: nothing beyond the best hit
+    m_instance = &record;
+    m_inner_offset = m_accel.locality_offset(record.blas);
+    m_inner = m_blas_steppers[record.blas].get();
+    m_inner->begin(object_ray, m_mode);
+    if (m_inner->done()) leave_instance();
+    else plan_blas();
+}
+
+StepOutcome TwoLevelStepper::blas_step() {
+    const StepOutcome out = m_inner->execute();
+    if (m_inner->done()) leave_instance();
+    else plan_blas();
+    return out;
+}
+
+void TwoLevelStepper::leave_instance() {
+    add_work(m_work, m_inner->work());
+    const Hit& h = m_inner->hit();
+    m_inner = nullptr;
+    if (h.valid()) {
+        // Merge with global primitive ids, so ties between instances break as in a flat scene.
+        const uint32_t prim = m_instance->prim_base + uint32_t(h.prim);
+        if (m_mode == TraversalMode::any_hit || detail::closer(h.t, prim, m_hit.t, m_hit.prim)) {
+            m_hit = Hit{int32_t(prim), int32_t(m_instance->instance), h.t, h.u, h.v};
+            m_cull_t = cull_distance(h.t);
+            if (m_mode == TraversalMode::any_hit) {
+                finish();
+                return;
+            }
+        }
+    }
+    pop_next();
+}
+
+void TwoLevelStepper::pop_next() {
+    while (m_tlas_size > 0) {
+        const StackEntry& e = m_stack[--m_tlas_size];
+        if (e.tnear > m_cull_t) continue;  // entered beyond the (widened) best hit
+        m_ref = e.ref;
+        m_count = e.count;
+        plan_tlas();
+        return;
+    }
+    finish();
+}
+
+void TwoLevelStepper::finish() {
+    if (m_hit.prim < 0) m_hit = Hit{};
+    m_plan.finish();
+    m_stack_size = 0;
+}
+
+}  // namespace rtsim
