@@ -14,6 +14,7 @@
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/model_errors.h"
 #include "sim/harness/sampling.h"
+#include "sim/harness/sampling_warming.h"
 #include "sim/harness/summary.h"
 #include "sim/harness/timeline.h"
 #include "sim/harness/trace_stream.h"
@@ -125,7 +126,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     json manifest = read_manifest(rtt);
     // The acceleration structure, whichever it is, validated structurally (load_accel).
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
-    check_sim_memory(o.config, accel->image().end_address(),
+    check_sim_memory(o.config, accel->image().footprint_bytes(),
                      "config (traversal.units=" + std::to_string(o.config.traversal.units) +
                          ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     WorkloadFeatures features;
@@ -152,6 +153,7 @@ SimOutcome run_simulation(const SimOptions& o) {
                        o.progress ? HitChecker::Progress(report_progress) : HitChecker::Progress());
 
     json model, instantiated = json::array();
+    std::unique_ptr<FunctionalWarmer> warmer;  // sampled runs with functional warming
     Cycle cycles = 0;
     std::vector<uint8_t> kinds;  // only for the timeline
     Timeline timeline(o.config.clock_ghz);
@@ -181,6 +183,13 @@ SimOutcome run_simulation(const SimOptions& o) {
                 sampled->estimator.ray_done(r);
                 if (hook) hook(r);
             };
+        if (sampled && o.config.sampling.warming_rays > 0) {
+            warmer = std::make_unique<FunctionalWarmer>(
+                *accel, map, reader, tc.units,
+                [&top](uint32_t unit, uint64_t addr, uint32_t bytes) { top.warm(unit, addr, bytes); });
+            sampled->stream.set_warming(o.config.sampling.warming_rays,
+                                        [&](uint64_t first, uint64_t end) { warmer->warm(first, end); });
+        }
         try {
             sc_core::sc_start();
         } catch (const sc_core::sc_report& e) {
@@ -215,6 +224,11 @@ SimOutcome run_simulation(const SimOptions& o) {
     if (sampled) {
         apply_sampling_to_summary(out.stats["summary"], o.config, sampled->plan, sampled->estimator);
         out.stats["sampling"] = sampled->estimator.to_json(o.config, cycles, wall);
+        out.stats["sampling"]["functional_warming"] = {
+            {"rays_per_cluster", o.config.sampling.warming_rays},
+            {"warmed_rays", warmer ? warmer->warmed_rays() : 0},
+            {"warmed_reads", warmer ? warmer->warmed_reads() : 0},
+            {"seconds", warmer ? warmer->seconds() : 0.0}};
     }
     // Energy and area from the run's counts and config (docs/energy_area.md); the timed model
     // never sees them.
