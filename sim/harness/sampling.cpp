@@ -123,7 +123,7 @@ SampledRayStream::SampledRayStream(TraceReader& reader, const SamplePlan& plan) 
     if (!plan.clusters.empty()) m_next = plan.clusters[0].first;
 }
 
-void SampledRayStream::set_warming(uint64_t rays, std::function<void(uint64_t, uint64_t)> warm) {
+void SampledRayStream::set_warming(uint64_t rays, std::function<void(uint64_t, uint64_t, uint64_t)> warm) {
     m_warming_rays = rays;
     m_warm = std::move(warm);
 }
@@ -135,13 +135,14 @@ size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
         // Functional warming of the skipped rays just before the cluster (not into the previous one).
         const uint64_t floor = m_cluster ? m_plan.clusters[m_cluster - 1].end() : 0;
         const uint64_t from = std::max(floor, c.first - std::min(c.first, m_warming_rays));
-        m_warm(from, c.first);
+        m_warm(from, c.first, m_produced);
     }
     // A chunk never crosses into the next cluster, so its warming happens when the dispatch
     // asks for its first ray, after the previous cluster's rays were dealt.
     const size_t n = size_t(std::min<uint64_t>(max, c.end() - m_next));
     read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
     m_next += n;
+    m_produced += n;
     if (m_next == c.end() && ++m_cluster < m_plan.clusters.size()) m_next = m_plan.clusters[m_cluster].first;
     return n;
 }

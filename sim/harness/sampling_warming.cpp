@@ -10,7 +10,7 @@ FunctionalWarmer::FunctionalWarmer(const Accel& accel, const MemoryMap& map, Tra
     : m_map(map), m_reader(reader), m_units(std::max<uint32_t>(units, 1)), m_warm(std::move(warm)),
       m_stepper(accel.make_stepper()) {}
 
-void FunctionalWarmer::warm(uint64_t first, uint64_t end) {
+void FunctionalWarmer::warm(uint64_t first, uint64_t end, uint32_t next_unit) {
     const auto t0 = std::chrono::steady_clock::now();
     constexpr uint64_t kBatch = 4096;  // rays read from the trace at a time
     for (uint64_t at = first; at < end; at += kBatch) {
@@ -21,7 +21,7 @@ void FunctionalWarmer::warm(uint64_t first, uint64_t end) {
             const uint64_t id = at + i;
             const RayRecord& rec = m_records[size_t(i)];
             // Interleaved dispatch deals consecutive rays to the units in turn (block_rays = 1).
-            const uint32_t unit = uint32_t(id % m_units);
+            const uint32_t unit = uint32_t((next_unit + m_units - (end - id) % m_units) % m_units);
             m_warm(unit, m_map.ray(id), uint32_t(sizeof(RayRecord)));
             m_stepper->begin(ray_from_record(rec), (rec.flags & kRayFlagAnyHit) ? TraversalMode::any_hit : TraversalMode::closest_hit);
             while (!m_stepper->done()) {

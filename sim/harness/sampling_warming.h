@@ -25,8 +25,10 @@ using WarmRead = std::function<void(uint32_t unit, uint64_t addr, uint32_t bytes
 class FunctionalWarmer {
 public:
     FunctionalWarmer(const Accel& accel, const MemoryMap& map, TraceReader& reader, uint32_t units, WarmRead warm);
-    /// Replays rays [first, end) of the trace, in order, through the caches.
-    void warm(uint64_t first, uint64_t end);
+    /// Replays rays [first, end) of the trace, in order, through the caches. `next_unit` is the
+    /// unit the dispatch deals ray `end` to (interleaved, block_rays = 1: consecutive rays go to
+    /// consecutive units), so each warmed ray warms the L1 of the unit that would have run it.
+    void warm(uint64_t first, uint64_t end, uint32_t next_unit);
 
     uint64_t warmed_rays() const { return m_rays; }
     uint64_t warmed_reads() const { return m_reads; }

@@ -188,7 +188,9 @@ SimOutcome run_simulation(const SimOptions& o) {
                 *accel, map, reader, tc.units,
                 [&top](uint32_t unit, uint64_t addr, uint32_t bytes) { top.warm(unit, addr, bytes); });
             sampled->stream.set_warming(o.config.sampling.warming_rays,
-                                        [&](uint64_t first, uint64_t end) { warmer->warm(first, end); });
+                                        [&](uint64_t first, uint64_t end, uint64_t position) {
+                                            warmer->warm(first, end, uint32_t(position % tc.units));
+                                        });
         }
         try {
             sc_core::sc_start();
