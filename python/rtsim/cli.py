@@ -461,7 +461,8 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         metavar="TRACE",
         default=None,
         help="instead: benchmark the simulator on this trace folder (repeatable): simulated rays "
-        "per second per fidelity level and their ratios (docs/benchmarks.md)",
+        "per second per fidelity level and their ratios (docs/benchmarks.md; default: none, the "
+        "Embree comparison)",
     )
     p.add_argument(
         "--levels",
@@ -474,7 +475,7 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         action="append",
         metavar="KEY=VALUE",
         default=None,
-        help="with --model: config field for every run (repeatable)",
+        help="with --model: config field for every run (repeatable; default: none)",
     )
     p.set_defaults(func=cmd_bench)
 
