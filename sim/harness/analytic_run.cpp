@@ -4,6 +4,7 @@
 // analysis needs neither the structure's image nor a pass over the rays, so a run costs little
 // more than reading its config and writing its stats.
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include "sim/harness/analytic.h"
 #include "sim/harness/analytic_cache.h"
 #include "sim/harness/analytic_estimate.h"
+#include "sim/harness/energy_area.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/roofline.h"
 #include "sim/harness/sampling.h"
@@ -101,7 +103,19 @@ json analytic_summary(const SimOptions& o, const AnalyticProfile& p, const Analy
 struct RunStats {
     json summary, validation, latency, workload, instantiated, model;
     bool bad = false;  ///< a hit or work mismatch
+    WorkTotals work;   ///< every ray's work (energy and area, as at the other levels)
+    uint64_t rays = 0;
 };
+
+/// The whole trace's work from the analysis's sums (WORK section, field order of WorkRecord:
+/// work_field_name).
+WorkTotals work_totals(const AnalyticProfile& p) {
+    WorkTotals w;
+    uint64_t* fields[kWorkFields] = {&w.steps,      &w.box_tests,  &w.tri_tests,   &w.anyhit_calls,
+                                     &w.transforms, &w.cell_steps, &w.plane_tests, &w.refs};
+    for (int i = 0; i < kWorkFields; ++i) *fields[i] = uint64_t(std::llround(p.work[size_t(i)]));
+    return w;
+}
 
 SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json& manifest, std::time_t started,
                          RunStats r, const std::function<json(const json& model)>& verdict_of) {
@@ -117,6 +131,7 @@ SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json
                  {"model", r.model},
                  {"provenance", provenance(o.command_line, rtt, manifest, started)}};
     out.stats["summary"]["sampled"] = false;
+    add_energy_area(out.stats, o.config, r.work, r.rays);
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], r.model);
     const json verdict = o.verdict && out.stats["summary"].value("rays", 0) > 0 ? verdict_of(r.model) : json(nullptr);
     out.stats["verdict"] = verdict;
@@ -154,6 +169,8 @@ SimOutcome run_functional_caches(const SimOptions& o, TraceReader& reader, const
     r.instantiated = std::move(a.instantiated);
     r.model = std::move(a.model);
     r.bad = checker.hit_mismatches() || checker.work_mismatches();
+    r.work = checker.work_totals();
+    r.rays = checker.checked();
     return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
         return judge(VerdictContext{o.config, model, accel.get(), &map, &reader});
     });
@@ -203,6 +220,8 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     RunStats r;
     r.summary = analytic_summary(o, p, e, checker, wall);
+    r.work = work_totals(p);
+    r.rays = p.rays;
     r.validation = p.validation;
     r.validation["scope"] = "the analysis's sampled rays are checked bit for bit (hit and work); every other "
                             "ray's work record is read (CRC checked) as the work counted";
