@@ -18,7 +18,7 @@ from bad_corpus import SCENE_CASES, TRACE_CASES
 from conftest import run_rtsim
 from gltf_forge import png_bytes, triangle_doc, write_gltf
 from rtsim.cli import main
-from rtsim.simulate import find_sim
+from rtsim.launcher import find_sim
 from trace_forge import read_sections, write_trace
 
 # ---------------------------------------------------------------------------------------------
