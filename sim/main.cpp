@@ -80,6 +80,9 @@ int sc_main(int argc, char** argv) {
         const auto& s = r.stats["summary"];
         std::cerr << "rtsim-sim: " << s["rays"] << " rays, " << s["hit_mismatches"] << " hit mismatches, "
                   << s["work_mismatches"] << " work mismatches -> " << out_dir << "/stats.json\n";
+        if (r.stats.contains("sampling"))
+            for (const auto& why : r.stats["sampling"]["caveats"])
+                std::cerr << "rtsim-sim: warning: sample too small to trust: " << why.get<std::string>() << "\n";
         return r.exit_code;
     } catch (const rtsim::Error& e) {
         std::cerr << "rtsim-sim: error: " << e.what() << "\n";

@@ -432,8 +432,8 @@ def add_parser(sub: argparse._SubParsersAction, parse_resolution: Any) -> None: 
         "--spec",
         metavar="SPEC.yaml",
         help="a sweep spec (e.g. python/rtsim/specs/demo.yaml): each level's error, rank "
-        "agreement and speed-up across its grid instead (grid.md, grid.csv, grid.png; default: "
-        "no spec, the scenes' default configuration)",
+        "agreement and speed-up across its grid instead (grid.md, grid.csv, grid.png; "
+        "default: none, the SCENE table)",
     )
     p.add_argument(
         "--levels",

@@ -8,6 +8,7 @@ rtsim simulate TRACE [--config CFG] [--set k=v ...] -o RUN [--timeline]  replay 
 rtsim config --defaults | --schema                                   the simulator's config
 rtsim accuracy SCENE... [-o DIR] [--fractions 0.01,0.05]            fidelity: time against error
 rtsim bench [SCENE] [--json FILE] [--repeat N]                       rtsim against Embree
+rtsim bench --model TRACE [--levels L,...] [--repeat N] [--json FILE] the simulator's own speed
 rtsim sweep SPEC.yaml -o SWEEP [--scheduler tcp://HOST:PORT]        a design-space sweep
 rtsim results SWEEP [--csv [FILE]]                                  its tidy table
 rtsim report SWEEP [-o report.html]                                 its HTML report
@@ -243,6 +244,17 @@ def find_bench() -> Path | None:
 
 
 def cmd_bench(args: argparse.Namespace, console: Console) -> int:
+    if args.model:
+        from rtsim.model_bench import run_model_bench
+
+        return run_model_bench(
+            [Path(t) for t in args.model],
+            [lvl for lvl in args.levels.split(",") if lvl],
+            args.repeat,
+            args.set or [],
+            Path(args.json) if args.json else None,
+            console,
+        )
     exe = find_bench()
     if exe is None or not exe.is_file():
         print(
@@ -452,6 +464,28 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         default=None,
         metavar="KIND,...",
         help="structures to benchmark; the first is 'rtsim' in the summary (default: bvh8,bvh2)",
+    )
+    p.add_argument(
+        "--model",
+        action="append",
+        metavar="TRACE",
+        default=None,
+        help="instead: benchmark the simulator on this trace folder (repeatable): simulated rays "
+        "per second per fidelity level and their ratios (docs/benchmarks.md; default: none, the "
+        "Embree comparison)",
+    )
+    p.add_argument(
+        "--levels",
+        default="functional,analytic,approx,detailed,treelets",
+        metavar="LEVEL,...",
+        help="with --model: levels to run (treelets: approx with treelets.enabled=true)",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        default=None,
+        help="with --model: config field for every run (repeatable; default: none)",
     )
     p.set_defaults(func=cmd_bench)
 

@@ -173,6 +173,14 @@ class SamplingConfig:
         0,
         1 << 24,
     )
+    warming_rays: int = _f(
+        4096,
+        "rays",
+        "Skipped rays before each cluster replayed through the L1s and L2 without time "
+        "(functional warming, docs/fidelity.md; 0: none); about L2 lines / 4",
+        0,
+        2147483647,
+    )
     seed: int = _f(
         1, "seed", "Seed of each cluster's random offset within its stratum", 0, 2147483647
     )

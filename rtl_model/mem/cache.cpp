@@ -143,6 +143,30 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     return fill;
 }
 
+bool Cache::warm(uint64_t addr, uint32_t bytes) {
+    bool hit = true;
+    const uint64_t last = (addr + std::max<uint32_t>(bytes, 1) - 1) >> m_line_shift;
+    for (uint64_t line = addr >> m_line_shift; line <= last; ++line) {
+        Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
+        Line* victim = set;
+        for (uint32_t w = 0; w < m_config.ways; ++w) {
+            if (set[w].tag == line) {
+                victim = &set[w];
+                break;
+            }
+            if (set[w].last_use < victim->last_use) victim = &set[w];
+        }
+        if (victim->tag != line) {
+            hit = false;
+            victim->tag = line;
+            victim->ready = 0;
+            victim->filled_from = m_level;
+        }
+        victim->last_use = ++m_use_clock;
+    }
+    return hit;
+}
+
 void Cache::limit_out_of_order_misses() {
     m_mshr_occupancy = std::make_unique<OccupancyCalendar>(m_config.mshrs);
     m_expected_miss = double(2 * m_next_latency + m_config.latency + 100);  // first guess, then learnt

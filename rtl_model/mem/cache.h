@@ -36,6 +36,11 @@ public:
           bool exact = false, ServedBy level = ServedBy::l1);
 
     Cycle access(const MemRequest& req) override;
+    /// Functional warming (sampling, SMARTS): makes the lines of [addr, addr + bytes) present and
+    /// most recently used, as a read would, with no time, no stats and no traffic below.
+    /// Returns true when every line was already present (a hit: the level below would not see it).
+    bool warm(uint64_t addr, uint32_t bytes);
+    uint32_t line_bytes() const { return m_config.line_bytes; }
     /// For a shared cache reached out of time order (the approx L2): bound outstanding misses by
     /// `mshrs` with an occupancy calendar instead of leaving them unlimited.
     void limit_out_of_order_misses();

@@ -140,6 +140,19 @@ void Top::build_ray_buffer(const Accel& accel, const MemoryMap& map) {
                                           " rays), policy " + kTreeletPolicyChoices.name(t.policy)}});
 }
 
+void Top::warm(uint32_t unit, uint64_t addr, uint32_t bytes) {
+    if (!m_l2) return;
+    if (unit >= m_l1.size()) {
+        m_l2->warm(addr, bytes);
+        return;
+    }
+    // Line by line, as the L1 forwards misses: the L2 sees (and refreshes) only the L1's misses.
+    Cache& l1 = *m_l1[unit];
+    const uint64_t line = l1.line_bytes(), end = addr + std::max<uint32_t>(bytes, 1);
+    for (uint64_t lo = addr / line * line; lo < end; lo += line)
+        if (!l1.warm(lo, uint32_t(line))) m_l2->warm(lo, uint32_t(line));
+}
+
 Cycle Top::total_cycles() const {
     Cycle t = 0;
     for (const auto& u : m_units) t = std::max(t, u->finish_cycle());

@@ -43,6 +43,9 @@ public:
     const nlohmann::json& instantiated() const { return m_instantiated; }
     const Dram* dram() const { return m_dram.get(); }
     uint32_t units() const { return uint32_t(m_units.size()); }
+    /// Functional warming with a read of [addr, addr + bytes) by unit `unit`: its L1, and the L2
+    /// for the lines the L1 missed (Cache::warm; nothing with ideal_memory).
+    void warm(uint32_t unit, uint64_t addr, uint32_t bytes);
 
 private:
     using PipelineSet = std::vector<std::unique_ptr<Pipeline>>;

@@ -4,6 +4,7 @@
 // analysis needs neither the structure's image nor a pass over the rays, so a run costs little
 // more than reading its config and writing its stats.
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <filesystem>
 #include <fstream>
@@ -102,17 +103,18 @@ json analytic_summary(const SimOptions& o, const AnalyticProfile& p, const Analy
 /// What a run adds to stats.json beyond the common keys; written by write_outputs.
 struct RunStats {
     json summary, validation, latency, workload, instantiated, model;
-    WorkTotals work;    ///< the whole trace's work (for the energy model)
-    uint64_t rays = 0;  ///< rays that work covers
-    bool bad = false;   ///< a hit or work mismatch
+    bool bad = false;  ///< a hit or work mismatch
+    WorkTotals work;   ///< every ray's work (energy and area, as at the other levels)
+    uint64_t rays = 0;
 };
 
-/// The profile's whole-trace work sums as the energy model's totals.
-WorkTotals work_totals_of(const AnalyticProfile& p) {
-    auto n = [&p](int field) { return uint64_t(p.work[size_t(field)] + 0.5); };
+/// The whole trace's work from the analysis's sums (WORK section, field order of WorkRecord:
+/// work_field_name).
+WorkTotals work_totals(const AnalyticProfile& p) {
     WorkTotals w;
-    w.steps = n(0), w.box_tests = n(1), w.tri_tests = n(2), w.anyhit_calls = n(3);
-    w.transforms = n(4), w.cell_steps = n(5), w.plane_tests = n(6), w.refs = n(7);
+    uint64_t* fields[kWorkFields] = {&w.steps,      &w.box_tests,  &w.tri_tests,   &w.anyhit_calls,
+                                     &w.transforms, &w.cell_steps, &w.plane_tests, &w.refs};
+    for (int i = 0; i < kWorkFields; ++i) *fields[i] = uint64_t(std::llround(p.work[size_t(i)]));
     return w;
 }
 
@@ -220,6 +222,8 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     RunStats r;
     r.summary = analytic_summary(o, p, e, checker, wall);
+    r.work = work_totals(p);
+    r.rays = p.rays;
     r.validation = p.validation;
     r.validation["scope"] = "the analysis's sampled rays are checked bit for bit (hit and work); every other "
                             "ray's work record is read (CRC checked) as the work counted";
@@ -228,8 +232,6 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     r.instantiated = std::move(e.instantiated);
     r.model = std::move(e.model);
     r.bad = p.validation.value("hit_mismatches", 0) || p.validation.value("work_mismatches", 0);
-    r.work = work_totals_of(p);
-    r.rays = p.rays;
     return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
         // The verdict's analytic estimates come from this run's own analysis (no second pass).
         VerdictContext v{o.config, model, nullptr, nullptr, nullptr};

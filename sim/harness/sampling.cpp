@@ -20,11 +20,33 @@ uint64_t rays_in_flight(const SimConfig& c) { return uint64_t(c.traversal.units)
 /// (measured on Sponza diffuse rays, docs/fidelity.md: less leaves the L2 cold and the estimate
 /// several percent high).
 uint64_t warmup_target(const SimConfig& c) {
+    // Functional warming fills the caches: the simulated warm-up only refills the contexts and
+    // pipelines (SMARTS's detailed warming).
+    if (c.sampling.warming_rays > 0) return 2 * rays_in_flight(c);
     const uint64_t l2_lines = uint64_t(c.l2.size_kib) * 1024 / c.l2.line_bytes;
     return std::max<uint64_t>(2 * rays_in_flight(c), c.ideal_memory ? 0 : l2_lines / 8);
 }
 
 constexpr uint64_t kMinClusters = 5;  ///< below this the t interval is too wide to be useful
+constexpr uint64_t kFewClusters = 10;  ///< below this the sample is flagged as too small
+
+/// Why the estimate of a sample this small should not be trusted (empty: no reason known).
+json sample_caveats(const SimConfig& c, const SamplePlan& plan) {
+    json out = json::array();
+    const size_t k = plan.clusters.size();
+    if (k < kFewClusters)
+        out.push_back("only " + std::to_string(k) + " clusters: the interval rests on " + std::to_string(k - 1) +
+                      " degrees of freedom");
+    if (plan.warmup_rays < plan.warmup_target)
+        out.push_back("warm-up cut to " + std::to_string(plan.warmup_rays) + " of the " +
+                      std::to_string(plan.warmup_target) + " rays wanted per cluster: the estimate is biased high");
+    if (k && plan.clusters[0].measured < 4 * rays_in_flight(c))
+        out.push_back("clusters of " + std::to_string(plan.clusters[0].measured) +
+                      " measured rays, under 4 x the rays in flight: the estimate may be biased high");
+    if (c.sampling.warming_rays == 0 && !c.ideal_memory)
+        out.push_back("no functional warming: the caches see only the sampled rays (biased high)");
+    return out;
+}
 
 }  // namespace
 
@@ -38,7 +60,12 @@ SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
     // At least as many measured as warm-up rays per cluster: fewer clusters rather than clusters
     // that are mostly warm-up (their measurement would be mostly pipeline edge effects).
     plan.warmup_target = s.warmup_rays ? s.warmup_rays : warmup_target(c);
-    uint64_t w = plan.warmup_target, clusters = std::min<uint64_t>(s.clusters, budget / (2 * w));
+    uint64_t w = plan.warmup_target;
+    // With functional warming, a cluster measures at least 4 x the rays in flight: shorter ones
+    // (M = 2 x in flight) measured Sponza diffuse about 3% slow, as if the switch between regions
+    // cost more than the warm-up hides (docs/fidelity.md, "Sampling").
+    const uint64_t min_measured = s.warming_rays > 0 && s.warmup_rays == 0 ? 4 * rays_in_flight(c) : 0;
+    uint64_t clusters = std::min<uint64_t>(s.clusters, budget / (w + std::max(w, min_measured)));
     if (!s.warmup_rays && clusters < kMinClusters) {
         // Too small a sample for full warm-up: keep kMinClusters and shrink the warm-up to half of
         // each cluster, never below 2 x rays in flight (the estimate is then biased high).
@@ -96,17 +123,28 @@ SampledRayStream::SampledRayStream(TraceReader& reader, const SamplePlan& plan) 
     if (!plan.clusters.empty()) m_next = plan.clusters[0].first;
 }
 
+void SampledRayStream::set_warming(uint64_t rays, std::function<void(uint64_t, uint64_t, uint64_t)> warm) {
+    m_warming_rays = rays;
+    m_warm = std::move(warm);
+}
+
 size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
-    size_t produced = 0;
-    while (produced < max && m_cluster < m_plan.clusters.size()) {
-        const SamplePlan::Cluster& c = m_plan.clusters[m_cluster];
-        const size_t n = size_t(std::min<uint64_t>(max - produced, c.end() - m_next));
-        read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
-        produced += n;
-        m_next += n;
-        if (m_next == c.end() && ++m_cluster < m_plan.clusters.size()) m_next = m_plan.clusters[m_cluster].first;
+    if (m_cluster >= m_plan.clusters.size()) return 0;
+    const SamplePlan::Cluster& c = m_plan.clusters[m_cluster];
+    if (m_next == c.first && m_warm) {
+        // Functional warming of the skipped rays just before the cluster (not into the previous one).
+        const uint64_t floor = m_cluster ? m_plan.clusters[m_cluster - 1].end() : 0;
+        const uint64_t from = std::max(floor, c.first - std::min(c.first, m_warming_rays));
+        m_warm(from, c.first, m_produced);
     }
-    return produced;
+    // A chunk never crosses into the next cluster, so its warming happens when the dispatch
+    // asks for its first ray, after the previous cluster's rays were dealt.
+    const size_t n = size_t(std::min<uint64_t>(max, c.end() - m_next));
+    read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
+    m_next += n;
+    m_produced += n;
+    if (m_next == c.end() && ++m_cluster < m_plan.clusters.size()) m_next = m_plan.clusters[m_cluster].first;
+    return n;
 }
 
 SampledReference::SampledReference(TraceReader& reader, const SamplePlan& plan) : m_reader(reader), m_plan(plan) {
@@ -215,6 +253,7 @@ json SampleEstimator::to_json(const SimConfig& config, Cycle simulated_cycles, d
             {"rays_per_second_ci95", {n * hz / ci_high(), ci_low() > 0 ? n * hz / ci_low() : 0.0}},
             {"simulated_cycles", simulated_cycles},
             {"effective_rays_per_wall_second", wall > 0 ? n / wall : 0.0},
+            {"caveats", sample_caveats(config, m_plan)},
             {"strata", strata}};
 }
 

@@ -17,6 +17,7 @@
 // from a cold L2 small when the sample can afford it; docs/fidelity.md measures it.
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -59,10 +60,17 @@ public:
     SampledRayStream(TraceReader& reader, const SamplePlan& plan);
     size_t read_chunk(size_t max, std::vector<RayJob>* out) override;
     uint64_t total_rays() const override { return m_plan.simulated_rays; }
+    /// Before each cluster's first ray is read, calls warm(first, end, position) on up to `rays`
+    /// skipped rays just before it; position: how many rays the stream produced before it
+    /// (sampling_warming.h).
+    void set_warming(uint64_t rays, std::function<void(uint64_t first, uint64_t end, uint64_t position)> warm);
 
 private:
     TraceReader& m_reader;
     const SamplePlan& m_plan;
+    uint64_t m_warming_rays = 0;
+    std::function<void(uint64_t, uint64_t, uint64_t)> m_warm;
+    uint64_t m_produced = 0;  ///< rays returned so far
     size_t m_cluster = 0;
     uint64_t m_next = 0;  ///< next trace index within the current cluster
     std::vector<RayRecord> m_buffer;

@@ -14,6 +14,7 @@
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/model_errors.h"
 #include "sim/harness/sampling.h"
+#include "sim/harness/sampling_warming.h"
 #include "sim/harness/summary.h"
 #include "sim/harness/summary_schema.h"
 #include "sim/harness/timeline.h"
@@ -153,6 +154,7 @@ SimOutcome run_simulation(const SimOptions& o) {
                        o.progress ? HitChecker::Progress(report_progress) : HitChecker::Progress());
 
     json model, instantiated = json::array();
+    std::unique_ptr<FunctionalWarmer> warmer;  // sampled runs with functional warming
     Cycle cycles = 0;
     std::vector<uint8_t> kinds;  // only for the timeline
     Timeline timeline(o.config.clock_ghz);
@@ -182,6 +184,15 @@ SimOutcome run_simulation(const SimOptions& o) {
                 sampled->estimator.ray_done(r);
                 if (hook) hook(r);
             };
+        if (sampled && o.config.sampling.warming_rays > 0) {
+            warmer = std::make_unique<FunctionalWarmer>(
+                *accel, map, reader, tc.units,
+                [&top](uint32_t unit, uint64_t addr, uint32_t bytes) { top.warm(unit, addr, bytes); });
+            sampled->stream.set_warming(o.config.sampling.warming_rays,
+                                        [&](uint64_t first, uint64_t end, uint64_t position) {
+                                            warmer->warm(first, end, uint32_t(position % tc.units));
+                                        });
+        }
         try {
             sc_core::sc_start();
         } catch (const sc_core::sc_report& e) {
@@ -216,6 +227,11 @@ SimOutcome run_simulation(const SimOptions& o) {
     if (sampled) {
         apply_sampling_to_summary(out.stats["summary"], o.config, sampled->plan, sampled->estimator);
         out.stats["sampling"] = sampled->estimator.to_json(o.config, cycles, wall);
+        out.stats["sampling"]["functional_warming"] = {
+            {"rays_per_cluster", o.config.sampling.warming_rays},
+            {"warmed_rays", warmer ? warmer->warmed_rays() : 0},
+            {"warmed_reads", warmer ? warmer->warmed_reads() : 0},
+            {"seconds", warmer ? warmer->seconds() : 0.0}};
     }
     // Energy and area from the run's counts and config (docs/energy_area.md); the timed model
     // never sees them.

@@ -139,6 +139,41 @@ def test_interval_covers_the_full_run(traces: Callable[[str], Path], tmp_path: P
     assert abs(sum(errors) / len(errors)) < 0.2
 
 
+def test_functional_warming_replays_the_rays_before_each_cluster(
+    traces: Callable[[str], Path], tmp_path: Path
+) -> None:
+    """Up to sampling.warming_rays skipped rays before each cluster (never into the previous
+    cluster) go through the caches without time; 0 turns it off and says so."""
+    trace = traces("cornell")
+    sets = [*SMALL_MACHINE, "sampling.fraction=0.3", "sampling.warmup_rays=16"]
+    assert sim(trace, tmp_path / "w", *sets, "sampling.warming_rays=100").returncode == 0
+    sampling = stats_of(tmp_path / "w")["sampling"]
+    per_cluster = sampling["warmup_rays"] + sampling["measured_rays"]
+    expected, previous_end = 0, 0
+    for s in sampling["strata"]:
+        expected += min(100, s["cluster_first_ray"] - previous_end)
+        previous_end = s["cluster_first_ray"] + per_cluster
+    warming = sampling["functional_warming"]
+    assert warming["rays_per_cluster"] == 100
+    assert warming["warmed_rays"] == expected > 0
+    assert warming["warmed_reads"] > warming["warmed_rays"]  # a ray record and its nodes each
+    assert not any("warming" in c for c in sampling["caveats"])
+    assert sim(trace, tmp_path / "off", *sets, "sampling.warming_rays=0").returncode == 0
+    off = stats_of(tmp_path / "off")["sampling"]
+    assert off["functional_warming"]["warmed_rays"] == 0
+    assert any("no functional warming" in c for c in off["caveats"])
+
+
+def test_a_small_sample_says_it_is_too_small(traces: Callable[[str], Path], tmp_path: Path) -> None:
+    # 30% of 5,986 rays on the default machine (128 rays in flight): 3 clusters of 2 x 256 rays.
+    result = sim(traces("cornell"), tmp_path / "run", "sampling.fraction=0.3")
+    assert result.returncode == 0, result.stderr
+    sampling = stats_of(tmp_path / "run")["sampling"]
+    assert sampling["clusters"] < 10
+    assert any("clusters" in c for c in sampling["caveats"])
+    assert "warning: sample too small to trust" in result.stderr
+
+
 @pytest.mark.parametrize(
     ("sets", "message"),
     [

@@ -71,6 +71,21 @@ def test_bad_config_exits_2_naming_the_key(tiny_trace: Path, tmp_path: Path) -> 
     assert not (tmp_path / "run" / "stats.json").exists()
 
 
+def test_memory_check_counts_the_image_bytes_not_its_addresses(
+    tiny_trace: Path, tmp_path: Path
+) -> None:
+    """The structure's regions sit at addresses from 4 GiB up (accel_image.h): a host with a few
+    GiB must still run a tiny trace (the check once took the image's end address for its size
+    and asked for 24 GiB)."""
+    env = {**os.environ, "RTSIM_SIM_MEMORY_LIMIT_MIB": "1024"}
+    cmd = [*rtsim_command(), "simulate", str(tiny_trace), "-o", str(tmp_path / "run")]
+    result = subprocess.run(cmd, capture_output=True, text=True, env=env, check=False)
+    assert result.returncode == 0, result.stderr
+    env["RTSIM_SIM_MEMORY_LIMIT_MIB"] = "1"  # below the process's own base: refused, named
+    result = subprocess.run(cmd, capture_output=True, text=True, env=env, check=False)
+    assert result.returncode == 2 and "RTSIM_SIM_MEMORY_LIMIT_MIB" in result.stderr
+
+
 def test_unknown_key_exits_2(tiny_trace: Path, tmp_path: Path) -> None:
     result = run_rtsim(
         "simulate", str(tiny_trace), "-o", str(tmp_path / "run"), "--set", "l1.sise_kib=32"

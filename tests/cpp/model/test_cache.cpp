@@ -134,6 +134,23 @@ TEST(Cache, HandWorkedSequence) {
     EXPECT_EQ(j["by_kind"]["node"]["merged"], 1);
 }
 
+TEST(Cache, WarmedLinesHitWithoutTrafficOrStatsAndObeyLru) {
+    // Functional warming (sampling): warm() makes lines present and most recently used, as a
+    // read would, but sends nothing below and counts nothing.
+    Bench b(tiny_config(), true);
+    b.cache.warm(A, 64);
+    b.cache.warm(B + 200, 100);  // spans lines B (set 0) and E (set 1)
+    EXPECT_TRUE(b.next.requests.empty());
+    EXPECT_EQ(b.cache.stats_json(1000)["reads"], 0);
+    EXPECT_EQ(b.cache.access({E, 64, false, DataKind::node, 0}), 4u) << "E warmed: hit at tag time";
+    EXPECT_EQ(b.cache.access({A, 64, false, DataKind::node, 1}), 5u) << "A warmed: hit; B is now LRU in set 0";
+    b.cache.warm(C, 64);  // set 0 is full: evicts B, the least recently used
+    EXPECT_EQ(b.cache.access({A, 64, false, DataKind::node, 2}), 6u) << "A survives";
+    EXPECT_EQ(b.cache.access({B, 64, false, DataKind::node, 3}), 31u) << "B was evicted by the warm C: miss, 7 + 24";
+    EXPECT_EQ(b.next.requests.size(), 1u);
+    EXPECT_EQ(b.cache.stats_json(1000)["reads"], 4);
+}
+
 TEST(Cache, WithoutMshrsMissesNeverWait) {
     // A shared cache (the L2) accessed out of time order does not model MSHRs: three misses at
     // once all go down at their tag time.

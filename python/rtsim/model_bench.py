@@ -1,0 +1,190 @@
+"""`rtsim bench --model TRACE`: how fast the simulator itself runs, per fidelity level.
+
+For each trace and level, runs `rtsim-sim TRACE --no-verdict --set fidelity=LEVEL` `repeat` times
+(one process each, start-up included) and reports the median wall time, the median CPU time of
+the process (user + system, from the OS's accounting of the finished child: less sensitive to a
+shared machine than wall time), simulated rays per wall- and CPU-second, and the ratios the
+simulator's speed targets are stated in (issue 15; docs/benchmarks.md):
+
+    approx/functional, detailed/approx, treelets/approx, approx/analytic
+
+(a ratio is the CPU time of the first over the second: how many times slower it is). `treelets`
+is `approx` with `treelets.enabled=true`. The analytic level caches its per-trace analysis beside
+the trace: the first run builds it, later runs reuse it; both times are reported.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import tempfile
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+
+from rtsim.launcher import find_sim
+
+LEVELS: dict[str, list[str]] = {
+    "functional": ["fidelity=functional"],
+    "analytic": ["fidelity=analytic"],
+    "approx": ["fidelity=approx"],
+    "detailed": ["fidelity=detailed"],
+    "treelets": ["fidelity=approx", "treelets.enabled=true"],
+}
+#: (slower, faster): reported as cpu(slower) / cpu(faster).
+RATIOS = (
+    ("approx", "functional"),
+    ("detailed", "approx"),
+    ("treelets", "approx"),
+    ("approx", "analytic"),
+)
+
+
+@dataclass
+class LevelTiming:
+    """The runs of one level on one trace."""
+
+    level: str
+    rays: int = 0
+    wall_seconds: list[float] = field(default_factory=list)
+    cpu_seconds: list[float] = field(default_factory=list)
+    first_wall_seconds: float | None = None  # analytic: the run that built the analysis
+    error: str | None = None
+
+    def median_wall(self) -> float | None:
+        return statistics.median(self.wall_seconds) if self.wall_seconds else None
+
+    def median_cpu(self) -> float | None:
+        return statistics.median(self.cpu_seconds) if self.cpu_seconds else None
+
+    def summary(self) -> dict[str, Any]:
+        wall, cpu = self.median_wall(), self.median_cpu()
+        return {
+            **asdict(self),
+            "median_wall_seconds": wall,
+            "median_cpu_seconds": cpu,
+            "rays_per_wall_second": self.rays / wall if wall else None,
+            "rays_per_cpu_second": self.rays / cpu if cpu else None,
+        }
+
+
+def run_once(exe: Path, trace: Path, settings: list[str], out: Path) -> tuple[float, float, int]:
+    """One rtsim-sim process: (wall s, CPU s of the child, simulated rays)."""
+    cmd = [str(exe), str(trace), "-o", str(out), "--no-verdict"]
+    for s in settings:
+        cmd += ["--set", s]
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    stderr = proc.stderr.read() if proc.stderr else ""
+    if proc.returncode not in (0, 3):
+        lines = stderr.strip().splitlines()
+        raise RuntimeError(lines[-1] if lines else f"rtsim-sim exited with {proc.returncode}")
+    stats = json.loads((out / "stats.json").read_text())
+    rays = int(stats["summary"].get("rays") or stats["workload"]["rays"])
+    return wall, usage.ru_utime + usage.ru_stime, rays
+
+
+def bench_trace(
+    exe: Path, trace: Path, levels: list[str], repeat: int, extra: list[str], console: Console
+) -> dict[str, LevelTiming]:
+    timings: dict[str, LevelTiming] = {}
+    with tempfile.TemporaryDirectory(prefix="rtsim-bench-model-") as tmp:
+        # Rounds of every level in turn, so load on a shared machine hits all levels alike.
+        for round_ in range(repeat + (1 if "analytic" in levels else 0)):
+            for level in levels:
+                t = timings.setdefault(level, LevelTiming(level))
+                if t.error or (level != "analytic" and round_ >= repeat):
+                    continue
+                try:
+                    wall, cpu, rays = run_once(exe, trace, LEVELS[level] + extra, Path(tmp))
+                except RuntimeError as err:
+                    t.error = str(err)
+                    console.print(f"  {trace.name} {level}: {err}", highlight=False)
+                    continue
+                t.rays = rays
+                if level == "analytic" and round_ == 0:
+                    t.first_wall_seconds = wall  # built the per-trace analysis (or found it)
+                    continue
+                t.wall_seconds.append(wall)
+                t.cpu_seconds.append(cpu)
+                console.print(
+                    f"  {trace.name:<28} {level:<11} {wall:8.3f} s wall {cpu:8.3f} s cpu",
+                    highlight=False,
+                )
+    return timings
+
+
+def ratios(timings: dict[str, LevelTiming]) -> dict[str, float | None]:
+    out: dict[str, float | None] = {}
+    for slow, fast in RATIOS:
+        a = timings.get(slow)
+        b = timings.get(fast)
+        ca, cb = (a.median_cpu() if a else None), (b.median_cpu() if b else None)
+        out[f"{slow}/{fast}"] = ca / cb if ca and cb else None
+    return out
+
+
+def markdown(report: list[dict[str, Any]]) -> str:
+    lines = [
+        "| trace | level | rays | wall s (median) | CPU s (median) | rays per wall-s "
+        "| rays per CPU-s |",
+        "|---|---|---:|---:|---:|---:|---:|",
+    ]
+    for t in report:
+        for s in t["levels"].values():
+            if s["error"]:
+                lines.append(f"| {t['trace']} | {s['level']} | | | | {s['error']} | |")
+                continue
+            lines.append(
+                f"| {t['trace']} | {s['level']} | {s['rays']:,} | {s['median_wall_seconds']:.3f} "
+                f"| {s['median_cpu_seconds']:.3f} | {s['rays_per_wall_second']:,.0f} "
+                f"| {s['rays_per_cpu_second']:,.0f} |"
+            )
+    lines += ["", "| trace | " + " | ".join(f"{a}/{b} (CPU)" for a, b in RATIOS) + " |"]
+    lines.append("|---|" + "---:|" * len(RATIOS))
+    for t in report:
+        cells = [f"{v:.2f}x" if v else "" for v in t["ratios"].values()]
+        lines.append(f"| {t['trace']} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def run_model_bench(
+    traces: list[Path],
+    levels: list[str],
+    repeat: int,
+    extra: list[str],
+    json_path: Path | None,
+    console: Console,
+) -> int:
+    unknown = [lvl for lvl in levels if lvl not in LEVELS]
+    if unknown:
+        known = ", ".join(LEVELS)
+        console.print(f"rtsim: error: --levels: unknown {', '.join(unknown)} (known: {known})")
+        return 2
+    exe = find_sim()
+    report = []
+    for trace in traces:
+        if not trace.exists():
+            console.print(f"rtsim: error: {trace}: no such trace")
+            return 2
+        timings = bench_trace(exe, trace, levels, repeat, extra, console)
+        report.append(
+            {
+                "trace": str(trace),
+                "levels": {k: v.summary() for k, v in timings.items()},
+                "ratios": ratios(timings),
+            }
+        )
+    console.print(markdown(report), highlight=False, markup=False)
+    if json_path:
+        meta = {"sim": str(exe), "repeat": repeat, "set": extra, "cpu_count": os.cpu_count()}
+        json_path.write_text(json.dumps({**meta, "traces": report}, indent=2))
+    return 1 if any(s["error"] for t in report for s in t["levels"].values()) else 0

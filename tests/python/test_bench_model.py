@@ -1,0 +1,48 @@
+"""`rtsim bench --model`: the simulator's own speed per fidelity level, end to end on a tiny trace.
+
+No timing assertions (the machine may be shared): the report's shape, that every level ran, and
+that the ratios are the medians' quotients.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from conftest import run_rtsim
+
+
+def test_bench_model_reports_every_level_and_the_ratios(tmp_path: Path) -> None:
+    trace = tmp_path / "trace"
+    made = run_rtsim("trace", "cornell", "-o", str(trace), "--workload", "diffuse",
+                     "--resolution", "32x24")  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    out = tmp_path / "bench.json"
+    result = run_rtsim("bench", "--model", str(trace), "--repeat", "1", "--json", str(out),
+                       "--levels", "functional,analytic,approx,treelets",
+                       "--set", "traversal.units=2")  # fmt: skip
+    assert result.returncode == 0, result.stdout + result.stderr
+    report = json.loads(out.read_text())
+    assert report["repeat"] == 1 and report["set"] == ["traversal.units=2"]
+    (t,) = report["traces"]
+    assert set(t["levels"]) == {"functional", "analytic", "approx", "treelets"}
+    rays = {s["rays"] for s in t["levels"].values()}
+    assert len(rays) == 1 and rays.pop() > 0
+    for s in t["levels"].values():
+        assert s["error"] is None
+        assert len(s["wall_seconds"]) == len(s["cpu_seconds"]) == 1
+        assert s["rays_per_wall_second"] > 0 and s["median_cpu_seconds"] >= 0
+    # The analytic level's first run (which builds its per-trace analysis) is kept apart.
+    assert t["levels"]["analytic"]["first_wall_seconds"] > 0
+    cpu = {k: s["median_cpu_seconds"] for k, s in t["levels"].items()}
+    for slow, fast in (("approx", "functional"), ("treelets", "approx")):
+        if cpu[slow] and cpu[fast]:  # CPU time is counted in ticks: a tiny run may show 0
+            assert t["ratios"][f"{slow}/{fast}"] == cpu[slow] / cpu[fast]
+    assert t["ratios"]["detailed/approx"] is None  # not run
+    assert "approx/functional (CPU)" in result.stdout
+
+
+def test_bench_model_refuses_an_unknown_level(tmp_path: Path) -> None:
+    result = run_rtsim("bench", "--model", str(tmp_path), "--levels", "approx,fastest")
+    assert result.returncode == 2
+    assert "fastest" in result.stdout + result.stderr
