@@ -16,6 +16,7 @@
 #include "sim/harness/energy_area.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/roofline.h"
+#include "sim/harness/run_files.h"
 #include "sim/harness/sampling.h"
 #include "sim/harness/summary.h"
 #include "sim/harness/summary_schema.h"
@@ -31,48 +32,6 @@ using nlohmann::json;
 
 namespace {
 
-// The trace path and manifest as run_simulation resolves them (simulate.cpp).
-std::string trace_file(const std::string& path) {
-    fs::path p(path);
-    if (fs::is_directory(p)) p /= "trace.rtt";
-    require(fs::exists(p), path + ": no trace here (expected a trace folder or a .rtt file)");
-    return p.string();
-}
-
-json read_manifest(const std::string& rtt) {
-    const fs::path m = fs::path(rtt).parent_path() / "manifest.json";
-    if (!fs::exists(m)) return json::object();
-    std::ifstream in(m);
-    json j = json::parse(in, nullptr, false);
-    require(!j.is_discarded(), m.string() + ": not valid JSON");
-    return j;
-}
-
-void write_json(const fs::path& path, const json& j) {
-    std::ofstream out(path);
-    require(bool(out), path.string() + ": cannot write");
-    out << j.dump(2) << "\n";
-}
-
-/// Rays per kind and occlusion rays (the stats' "workload", as simulate.cpp reports it).
-json workload_json(TraceReader& reader) {
-    const uint64_t n = reader.section(SectionKind::rays).record_count;
-    std::vector<RayRecord> buf(65536);
-    uint64_t kinds[kRayKindCount] = {}, occlusion = 0;
-    for (uint64_t first = 0; first < n; first += buf.size()) {
-        const uint64_t count = std::min<uint64_t>(buf.size(), n - first);
-        reader.read(SectionKind::rays, first, count, buf.data());
-        for (uint64_t i = 0; i < count; ++i) {
-            if (buf[i].kind < kRayKindCount) ++kinds[buf[i].kind];
-            occlusion += (buf[i].flags & kRayFlagAnyHit) != 0;
-        }
-    }
-    json by_kind = json::object();
-    for (int k = 0; k < kRayKindCount; ++k)
-        if (kinds[k]) by_kind[ray_kind_name(RayKind(k))] = kinds[k];
-    return {{"rays", n}, {"by_kind", by_kind}, {"occlusion_rays", occlusion}};
-}
-
 /// Computes the analysis of the trace (the structure's image loaded, the sample stepped and
 /// checked through `checker`).
 AnalyticProfile build_analysis(const SimConfig& c, TraceReader& reader, const std::string& rtt, HitChecker& checker,
@@ -86,7 +45,7 @@ AnalyticProfile build_analysis(const SimConfig& c, TraceReader& reader, const st
                                                           std::to_string(checker.checked()) + " of " +
                                                           std::to_string(plan.simulated_rays) + " sampled rays");
     p.validation = checker.to_json();
-    p.workload = workload_json(reader);
+    p.workload = scan_workload(reader);
     return p;
 }
 
@@ -152,7 +111,7 @@ SimOutcome run_functional_caches(const SimOptions& o, TraceReader& reader, const
                                  std::chrono::steady_clock::time_point t0) {
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
     RunStats r;
-    r.workload = workload_json(reader);
+    r.workload = scan_workload(reader);
     reader.verify_all();
     const uint64_t total = r.workload["rays"];
     const TraversalConfig& tc = o.config.traversal;
