@@ -104,8 +104,12 @@ inline uint32_t node_test(const Lanes& l, const WideNode<N>& node, float* tnear)
 // Only the functions below are compiled for AVX; they are internal to this file, so no AVX code
 // can be chosen by the linker for a caller elsewhere (inline functions of the headers above are
 // compiled for the baseline and inlined here).
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx")
+#endif
 namespace avx {
 
 struct Lanes {
@@ -152,7 +156,11 @@ inline uint32_t node_test(const Lanes& l, const WideNode<N>& node, float* tnear)
 #include "traces/accel/wide/wide_trace_loop.inc"
 
 }  // namespace avx
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 /// AVX when the CPU has it, unless RTSIM_SIMD=sse2 asks for the baseline (benchmarks compare).
 bool cpu_has_avx() {
