@@ -83,7 +83,7 @@ TEST(GridHardCases, HugeAndTinyCoordinates) {
         const std::string what = "cube x " + std::to_string(scale) + " + " + std::to_string(offset);
         expect_brute(scene, GridConfig{}, lattice_rays(scale, Vec3(offset)), what, 100);
         // Random rays through the scaled soup.
-        const Scene soup_scene = [&] {
+        const Scene soup_scene = [&, scale = scale, offset = offset] {  // C++17: no captured bindings
             const Scene s = test::random_soup(11, 500);
             std::vector<Vec3> scaled;
             for (const Triangle& t : s.triangles)
