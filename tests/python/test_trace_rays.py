@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import rtsim
@@ -116,6 +116,7 @@ def test_per_ray_limits(cornell: rtsim.Scene) -> None:
         lambda d: sum(x * x for x in d) > 1e-6
     ),
 )
+@example(origin=[-1.401298464324817e-45, 0.0, 0.0], direction=[1.0, 0.0, 0.0])  # subnormal t
 def test_closest_hit_is_first_along_the_ray(
     cornell: rtsim.Scene, origin: list[float], direction: list[float]
 ) -> None:
@@ -126,7 +127,11 @@ def test_closest_hit_is_first_along_the_ray(
     if hit["prim"] < 0 or hit["t"] <= 0.0:  # a miss, or a hit at the origin itself
         return
     assert 0.0 <= hit["u"] <= 1.0 and 0.0 <= hit["v"] <= 1.0 and hit["u"] + hit["v"] <= 1.0001
-    before = rtsim.trace_rays(scene, o, d, 0.0, np.float32(hit["t"]) * np.float32(0.999))[0]
+    # Strictly before the hit: 0.999 t, or the float below t where 0.999 t rounds back to t (a
+    # subnormal t, e.g. an origin 1e-45 in front of a wall: hypothesis found it).
+    t = np.float32(hit["t"])
+    limit = min(t * np.float32(0.999), np.nextafter(t, np.float32(0.0)))
+    before = rtsim.trace_rays(scene, o, d, 0.0, limit)[0]
     assert before["prim"] == -1
 
 
