@@ -13,17 +13,8 @@ WindowRing::WindowRing(uint32_t horizon) {
     m_entries.resize(size);
 }
 
-uint64_t* WindowRing::used(uint64_t w) {
-    Entry& e = m_entries[w & m_mask];
-    if (e.window == w) return &e.used;
-    if (e.window != ~0ull && e.window > w) return nullptr;
-    e.window = w;  // empty or an older window: reuse the entry
-    e.used = 0;
-    return &e.used;
-}
-
 OccupancyCalendar::OccupancyCalendar(uint32_t slots, uint32_t window_cycles, uint32_t horizon)
-    : m_capacity(uint64_t(slots) * window_cycles), m_window(window_cycles), m_ring(horizon) {
+    : m_capacity(uint64_t(slots) * window_cycles), m_window(window_cycles), m_window_of(window_cycles), m_ring(horizon) {
     require(slots > 0 && window_cycles > 0, "OccupancyCalendar: slots and window must be positive");
 }
 
@@ -31,7 +22,7 @@ Cycle OccupancyCalendar::earliest(Cycle time, Cycle expected) {
     expected = std::max<Cycle>(expected, 1);
     for (Cycle start = time;;) {
         Cycle blocked = 0;  // first window that lacks room, if any
-        for (uint64_t w = start / m_window; w * m_window < start + expected; ++w) {
+        for (uint64_t w = m_window_of.div(start); w * m_window < start + expected; ++w) {
             const uint64_t* used = m_ring.used(w);
             if (!used) continue;  // beyond the horizon: treat as free
             Cycle lo = std::max<Cycle>(start, w * m_window), hi = std::min<Cycle>(start + expected, (w + 1) * m_window);
@@ -46,13 +37,13 @@ Cycle OccupancyCalendar::earliest(Cycle time, Cycle expected) {
 }
 
 void OccupancyCalendar::occupy(Cycle start, Cycle end) {
-    for (uint64_t w = start / m_window; w * m_window < end; ++w)
+    for (uint64_t w = m_window_of.div(start); w * m_window < end; ++w)
         if (uint64_t* used = m_ring.used(w))
             *used += std::min<Cycle>(end, (w + 1) * m_window) - std::max<Cycle>(start, w * m_window);
 }
 
 BandwidthCalendar::BandwidthCalendar(uint64_t capacity, uint32_t window_cycles, uint32_t horizon)
-    : m_capacity(capacity), m_window(window_cycles), m_ring(horizon) {
+    : m_capacity(capacity), m_window(window_cycles), m_window_of(window_cycles), m_per_unit(capacity), m_ring(horizon) {
     require(capacity > 0 && window_cycles > 0, "BandwidthCalendar: capacity and window must be positive");
 }
 
@@ -71,24 +62,24 @@ Cycle BandwidthCalendar::reserve(Cycle time, uint64_t amount) {
 }
 
 Cycle BandwidthCalendar::reserve_chunk(Cycle time, uint64_t amount) {
-    for (uint64_t w = time / m_window;; ++w) {
+    for (uint64_t w = m_window_of.div(time);; ++w) {
         uint64_t* used = m_ring.used(w);
         if (!used || *used + amount > m_capacity) continue;  // a later window in the entry: full
         // Start inside the window after what it already serves (fluid approximation).
-        Cycle start = w * m_window + (*used * m_window) / m_capacity;
+        Cycle start = w * m_window + m_per_unit.div(*used * m_window);
         *used += amount;
         return start > time ? start : time;
     }
 }
 
 SlotCalendar::SlotCalendar(uint64_t capacity, uint32_t slot_cycles, uint32_t horizon)
-    : m_capacity(capacity), m_slot(slot_cycles), m_ring(horizon) {
+    : m_capacity(capacity), m_slot(slot_cycles), m_slot_of(slot_cycles), m_ring(horizon) {
     require(capacity > 0 && slot_cycles > 0, "SlotCalendar: capacity and slot must be positive");
 }
 
 Cycle SlotCalendar::reserve(Cycle time, uint64_t amount) {
     if (amount > m_capacity) amount = m_capacity;
-    for (uint64_t w = time / m_slot;; ++w) {
+    for (uint64_t w = m_slot_of.div(time);; ++w) {
         uint64_t* used = m_ring.used(w);
         if (!used || *used + amount > m_capacity) continue;  // a later slot in the entry: full
         *used += amount;

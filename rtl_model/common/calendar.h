@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "rtl_model/common/divider.h"
 #include "rtl_model/common/interfaces.h"
 
 namespace rtsim {
@@ -37,7 +38,14 @@ public:
     explicit WindowRing(uint32_t horizon_windows);
     /// Usage counter of window w, or nullptr when its entry holds a later window (w lies more
     /// than a horizon behind the newest request; each calendar decides what that means).
-    uint64_t* used(uint64_t w);
+    uint64_t* used(uint64_t w) {
+        Entry& e = m_entries[w & m_mask];
+        if (e.window == w) return &e.used;
+        if (e.window != ~0ull && e.window > w) return nullptr;
+        e.window = w;  // empty or an older window: reuse the entry
+        e.used = 0;
+        return &e.used;
+    }
 
 private:
     struct Entry {
@@ -63,6 +71,7 @@ public:
 private:
     uint64_t m_capacity;  ///< occupancy-cycles per window
     uint32_t m_window;
+    Divider m_window_of;  ///< cycle -> window
     WindowRing m_ring;
 };
 
@@ -86,6 +95,8 @@ private:
 
     uint64_t m_capacity;
     uint32_t m_window;
+    Divider m_window_of;   ///< cycle -> window
+    Divider m_per_unit;    ///< (units x window cycles) -> cycles into the window
     WindowRing m_ring;
     uint64_t m_total = 0;
 };
@@ -107,6 +118,7 @@ public:
 private:
     uint64_t m_capacity;
     uint32_t m_slot;
+    Divider m_slot_of;  ///< cycle -> slot
     WindowRing m_ring;
 };
 

@@ -11,7 +11,8 @@ Pipeline::Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, b
 }
 
 Cycle Pipeline::issue(Cycle time, uint32_t tests) {
-    const uint32_t issues = (tests + m_config.width - 1) / m_config.width;
+    // One issue carries up to `width` tests (the common case: no division).
+    const uint32_t issues = tests <= m_config.width ? (tests ? 1 : 0) : (tests + m_config.width - 1) / m_config.width;
     if (issues == 0) return time;
     m_issues += issues;
     m_tests += tests;

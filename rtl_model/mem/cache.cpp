@@ -19,11 +19,12 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
       m_level(level),
       m_mshrs_enabled(mshrs_enabled),
       m_next_latency(next_latency),
-      m_line_shift(log2_exact(config.line_bytes)) {
+      m_line_shift(log2_exact(config.line_bytes)),
+      m_mshr_free(config.mshrs, 0),
+      m_bank_of(config.banks) {
     uint64_t sets = uint64_t(config.size_kib) * 1024 / config.line_bytes / config.ways;
     m_set_mask = sets - 1;
     m_lines.resize(sets * config.ways);
-    m_mshr_free.assign(config.mshrs, 0);
     // Each bank serves one access per bank_cycles; the calendar counts them per 16-access window
     // (a finer window only makes the forward search longer when a bank is busy).
     // The detailed level reserves single accesses exactly (one per bank_cycles, no fast path).
@@ -54,9 +55,9 @@ Cycle Cache::access(const MemRequest& req) {
 }
 
 Cycle Cache::bank_start(uint64_t line, Cycle time) {
-    if (!m_exact_banks.empty()) return m_exact_banks[line % m_exact_banks.size()].reserve(time, 1);
+    if (!m_exact_banks.empty()) return m_exact_banks[m_bank_of.mod(line)].reserve(time, 1);
     if (m_banks.size() == 1 && m_config.bank_cycles == 1) return time;  // fast path: one access per cycle
-    return m_banks[line % m_banks.size()].reserve(time, 1);
+    return m_banks[m_bank_of.mod(line)].reserve(time, 1);
 }
 
 Cycle Cache::access_line(uint64_t line, const MemRequest& req, AccessInfo* info) {
@@ -100,12 +101,12 @@ Cycle Cache::access_line(uint64_t line, const MemRequest& req, AccessInfo* info)
 
 Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessInfo* info) {
     Cycle issue = tag_done;
-    size_t mshr = 0;
+    uint32_t mshr = 0;
     if (m_mshrs_enabled) {
-        mshr = size_t(std::min_element(m_mshr_free.begin(), m_mshr_free.end()) - m_mshr_free.begin());
-        if (m_mshr_free[mshr] > issue) {
-            m_mshr_stall_cycles += m_mshr_free[mshr] - issue;
-            issue = m_mshr_free[mshr];
+        mshr = m_mshr_free.top();  // the earliest free (the lowest index among equals)
+        if (m_mshr_free.top_time() > issue) {
+            m_mshr_stall_cycles += m_mshr_free.top_time() - issue;
+            issue = m_mshr_free.top_time();
         }
     }
     if (m_mshr_occupancy) {
@@ -124,7 +125,7 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     }
     m_mshr_busy_cycles += fill - issue;
     m_mshr_use.add_interval(issue, fill);
-    if (m_mshrs_enabled) m_mshr_free[mshr] = fill;
+    if (m_mshrs_enabled) m_mshr_free.set(mshr, fill);
     if (m_mshr_occupancy) {
         m_mshr_occupancy->occupy(issue, fill);
         m_expected_miss += (double(fill - issue) - m_expected_miss) / 64.0;  // running mean

@@ -20,6 +20,7 @@
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/common/min_tree.h"
 #include "rtl_model/common/usage_series.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/mem/cache_config.h"
@@ -74,9 +75,10 @@ private:
     uint32_t m_line_shift;
     uint64_t m_set_mask;
     std::vector<Line> m_lines;  ///< sets x ways
-    std::vector<Cycle> m_mshr_free;
+    MinTree m_mshr_free;  ///< cycle each MSHR is free again; the earliest is the next one used
     std::unique_ptr<OccupancyCalendar> m_mshr_occupancy;  ///< out-of-order MSHR bound (approx L2)
     double m_expected_miss = 0;                           ///< running mean of miss durations
+    Divider m_bank_of;  ///< line -> bank (line-interleaved)
     std::vector<BandwidthCalendar> m_banks;
     std::vector<SlotCalendar> m_exact_banks;  ///< detailed level only
     uint64_t m_use_clock = 0;

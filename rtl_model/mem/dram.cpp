@@ -10,7 +10,11 @@ constexpr size_t kTimelinePoints = 256;
 }  // namespace
 
 Dram::Dram(sc_core::sc_module_name name, const DramConfig& config, bool detailed)
-    : sc_core::sc_module(name), m_config(config) {
+    : sc_core::sc_module(name),
+      m_config(config),
+      m_interleave(config.interleave_bytes),
+      m_channel_of(config.channels),
+      m_transfer(config.bytes_per_cycle) {
     if (detailed) {
         m_banks = std::make_unique<DramBanks>(config);
         return;
@@ -37,9 +41,9 @@ Cycle Dram::access(const MemRequest& req) {
         const Cycle bank_part = Cycle(m_config.t_rcd) + m_config.t_cas;
         ready = t.done + (m_config.latency > bank_part ? m_config.latency - bank_part : 0);
     } else {
-        BandwidthCalendar& channel = m_channels[(req.addr / m_config.interleave_bytes) % m_channels.size()];
+        BandwidthCalendar& channel = m_channels[m_channel_of.mod(m_interleave.div(req.addr))];
         start = channel.reserve(req.time, req.bytes);
-        Cycle transfer = (req.bytes + m_config.bytes_per_cycle - 1) / m_config.bytes_per_cycle;
+        Cycle transfer = m_transfer.div(req.bytes + m_config.bytes_per_cycle - 1);
         ready = start + m_config.latency + transfer;
     }
     m_queue_cycles += start - req.time;

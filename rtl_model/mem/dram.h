@@ -40,6 +40,7 @@ public:
 private:
     DramConfig m_config;
     std::vector<BandwidthCalendar> m_channels;
+    Divider m_interleave, m_channel_of, m_transfer;  ///< addr -> block -> channel; bytes -> cycles
     std::unique_ptr<DramBanks> m_banks;
     MemStats m_stats;
     UsageSeries m_bytes_use;  ///< bytes moved over time

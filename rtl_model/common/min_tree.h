@@ -1,0 +1,58 @@
+#pragma once
+// The earliest of a fixed set of per-slot times (ray contexts' next events, MSHRs' free cycles):
+// a tournament tree (Knuth, TAOCP vol. 3, 5.4.1 "replacement selection") over packed keys
+// (time << kSlotBits | slot), so each inner node holds the smaller key of its two children and
+// ties go to the lower slot by the key's order alone. Setting a slot's time updates its leaf and
+// the log2(slots) nodes above it with one load, one min and one store each (no indirection
+// through slot indices, no allocation); the earliest slot is the root. It replaced a binary heap
+// of events and a linear scan of MSHRs, each a fifth of the model's time in profiles (issue 15,
+// docs/benchmarks.md "Simulator speed").
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "rtl_model/common/interfaces.h"
+
+namespace rtsim {
+
+class MinTree {
+public:
+    static constexpr int kSlotBits = 12;  ///< up to 4,096 slots (the config's limits on contexts, MSHRs)
+    static constexpr Cycle kNever = std::numeric_limits<Cycle>::max() >> kSlotBits;  ///< no time set
+    static constexpr uint32_t kMaxSlots = 1u << kSlotBits;
+
+    /// `slots` slots, each at `initial` (kNever: empty).
+    explicit MinTree(uint32_t slots, Cycle initial = kNever) {
+        m_leaves = 1;
+        while (m_leaves < slots) m_leaves <<= 1;
+        m_key.assign(2 * m_leaves, key(kNever, 0));
+        for (uint32_t i = 0; i < m_leaves; ++i) m_key[m_leaves + i] = key(i < slots ? initial : kNever, i);
+        for (uint32_t n = m_leaves - 1; n >= 1; --n) m_key[n] = min(m_key[2 * n], m_key[2 * n + 1]);
+    }
+
+    /// Slot s's time is now `time` (< kNever, or kNever to empty it).
+    void set(uint32_t s, Cycle time) {
+        uint32_t n = m_leaves + s;
+        uint64_t k = key(time, s);
+        m_key[n] = k;
+        for (n >>= 1; n >= 1; n >>= 1) {
+            const uint64_t sibling_min = min(m_key[2 * n], m_key[2 * n + 1]);
+            if (m_key[n] == sibling_min) break;  // nothing above changes
+            m_key[n] = sibling_min;
+        }
+    }
+    /// Slot s's time without the tree (only valid for slots set with set()).
+    Cycle time_of(uint32_t s) const { return m_key[m_leaves + s] >> kSlotBits; }
+    /// The earliest slot (lowest index among equal times) and its time.
+    uint32_t top() const { return uint32_t(m_key[1] & (kMaxSlots - 1)); }
+    Cycle top_time() const { return m_key[1] >> kSlotBits; }
+    bool empty() const { return top_time() == kNever; }
+
+private:
+    static uint64_t key(Cycle time, uint32_t s) { return (time << kSlotBits) | s; }
+    static uint64_t min(uint64_t a, uint64_t b) { return a < b ? a : b; }
+    uint32_t m_leaves = 1;
+    std::vector<uint64_t> m_key;  ///< nodes 1..2L-1: the smallest key below each; leaves from L
+};
+
+}  // namespace rtsim
