@@ -15,14 +15,15 @@
 
 namespace rtsim {
 
-class MinTree {
+template <int SlotBits>
+class BasicMinTree {
 public:
-    static constexpr int kSlotBits = 12;  ///< up to 4,096 slots (the config's limits on contexts, MSHRs)
+    static constexpr int kSlotBits = SlotBits;
     static constexpr Cycle kNever = std::numeric_limits<Cycle>::max() >> kSlotBits;  ///< no time set
     static constexpr uint32_t kMaxSlots = 1u << kSlotBits;
 
-    /// `slots` slots, each at `initial` (kNever: empty).
-    explicit MinTree(uint32_t slots, Cycle initial = kNever) {
+    /// `slots` (<= kMaxSlots) slots, each at `initial` (kNever: empty).
+    explicit BasicMinTree(uint32_t slots, Cycle initial = kNever) {
         m_leaves = 1;
         while (m_leaves < slots) m_leaves <<= 1;
         m_key.assign(2 * m_leaves, key(kNever, 0));
@@ -54,5 +55,8 @@ private:
     uint32_t m_leaves = 1;
     std::vector<uint64_t> m_key;  ///< nodes 1..2L-1: the smallest key below each; leaves from L
 };
+
+/// Up to 4,096 slots (the config's limits on ray contexts and MSHRs); times below 2^52.
+using MinTree = BasicMinTree<12>;
 
 }  // namespace rtsim

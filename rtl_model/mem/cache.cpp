@@ -24,7 +24,9 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
       m_bank_of(config.banks) {
     uint64_t sets = uint64_t(config.size_kib) * 1024 / config.line_bytes / config.ways;
     m_set_mask = sets - 1;
-    m_lines.resize(sets * config.ways);
+    m_tags.assign(sets * config.ways, kInvalid);
+    m_last_use.assign(sets * config.ways, 0);
+    m_fills.resize(sets * config.ways);
     // Each bank serves one access per bank_cycles; the calendar counts them per 16-access window
     // (a finer window only makes the forward search longer when a bank is busy).
     // The detailed level reserves single accesses exactly (one per bank_cycles, no fast path).
@@ -83,14 +85,16 @@ Cycle Cache::access_line(uint64_t line, const MemRequest& req, AccessInfo* info)
     }
     ++c.reads;
     c.read_bytes += bytes;
-    Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
+    const size_t set = size_t(line & m_set_mask) * m_config.ways;
+    const uint64_t* tags = &m_tags[set];
     for (uint32_t w = 0; w < m_config.ways; ++w) {
-        if (set[w].tag != line) continue;
-        set[w].last_use = ++m_use_clock;
-        if (set[w].ready > tag_done) {
+        if (tags[w] != line) continue;
+        m_last_use[set + w] = ++m_use_clock;
+        const LineFill& fill = m_fills[set + w];
+        if (fill.ready > tag_done) {
             ++c.merged;
-            if (info) info->level = set[w].filled_from;  // waits for a fill in flight
-            return set[w].ready;
+            if (info) info->level = fill.filled_from;  // waits for a fill in flight
+            return fill.ready;
         }
         ++c.read_hits;
         if (info) info->level = m_level;
@@ -132,38 +136,36 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     }
 
     // LRU victim (invalid lines have last_use 0 and go first).
-    Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
-    Line* victim = set;
-    for (uint32_t w = 1; w < m_config.ways; ++w)
-        if (set[w].last_use < victim->last_use) victim = &set[w];
-    if (victim->tag != ~0ull) ++m_evictions;
-    victim->tag = line;
-    victim->ready = fill;
-    victim->filled_from = below.level;
-    victim->last_use = ++m_use_clock;
+    const size_t victim = lru_way(size_t(line & m_set_mask) * m_config.ways);
+    if (m_tags[victim] != kInvalid) ++m_evictions;
+    m_tags[victim] = line;
+    m_fills[victim] = {fill, below.level};
+    m_last_use[victim] = ++m_use_clock;
     return fill;
+}
+
+size_t Cache::lru_way(size_t set) const {
+    size_t victim = set;
+    for (size_t w = set + 1; w < set + m_config.ways; ++w)
+        if (m_last_use[w] < m_last_use[victim]) victim = w;
+    return victim;
 }
 
 bool Cache::warm(uint64_t addr, uint32_t bytes) {
     bool hit = true;
     const uint64_t last = (addr + std::max<uint32_t>(bytes, 1) - 1) >> m_line_shift;
     for (uint64_t line = addr >> m_line_shift; line <= last; ++line) {
-        Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
-        Line* victim = set;
-        for (uint32_t w = 0; w < m_config.ways; ++w) {
-            if (set[w].tag == line) {
-                victim = &set[w];
-                break;
-            }
-            if (set[w].last_use < victim->last_use) victim = &set[w];
-        }
-        if (victim->tag != line) {
+        const size_t set = size_t(line & m_set_mask) * m_config.ways;
+        size_t way = set + m_config.ways;
+        for (size_t w = set; w < set + m_config.ways; ++w)
+            if (m_tags[w] == line) way = w;
+        if (way == set + m_config.ways) {
             hit = false;
-            victim->tag = line;
-            victim->ready = 0;
-            victim->filled_from = m_level;
+            way = lru_way(set);
+            m_tags[way] = line;
+            m_fills[way] = {0, m_level};
         }
-        victim->last_use = ++m_use_clock;
+        m_last_use[way] = ++m_use_clock;
     }
     return hit;
 }

@@ -58,15 +58,16 @@ public:
     uint32_t mshrs() const { return m_config.mshrs; }
 
 private:
-    struct Line {
-        uint64_t tag = ~0ull;
-        Cycle ready = 0;     ///< cycle the fill completes
-        uint64_t last_use = 0;
+    /// A line's state besides its tag and LRU stamp (read only on a hit or a fill).
+    struct LineFill {
+        Cycle ready = 0;                      ///< cycle the fill completes
         ServedBy filled_from = ServedBy::l1;  ///< where its fill came from (for merged reads)
     };
+    static constexpr uint64_t kInvalid = ~0ull;  ///< tag of an empty line
     Cycle access_line(uint64_t line_addr, const MemRequest& req, AccessInfo* info);
     Cycle miss(uint64_t line_addr, const MemRequest& req, Cycle tag_done, AccessInfo* info);
     Cycle bank_start(uint64_t line_addr, Cycle time);
+    size_t lru_way(size_t set) const;  ///< least recently used way of the set starting at `set`
 
     CacheConfig m_config;
     ServedBy m_level;
@@ -74,7 +75,11 @@ private:
     Cycle m_next_latency;
     uint32_t m_line_shift;
     uint64_t m_set_mask;
-    std::vector<Line> m_lines;  ///< sets x ways
+    // Lines as three arrays of sets x ways (a set's tags are contiguous: a lookup touches one or
+    // two host cache lines instead of ways x 32 bytes; the simulator's time is mostly such misses).
+    std::vector<uint64_t> m_tags;      ///< line address, or kInvalid
+    std::vector<uint64_t> m_last_use;  ///< LRU stamp (0: never used, goes first)
+    std::vector<LineFill> m_fills;
     MinTree m_mshr_free;  ///< cycle each MSHR is free again; the earliest is the next one used
     std::unique_ptr<OccupancyCalendar> m_mshr_occupancy;  ///< out-of-order MSHR bound (approx L2)
     double m_expected_miss = 0;                           ///< running mean of miss durations

@@ -1,6 +1,9 @@
 #include "rtl_model/ray_buffer/ray_buffer.h"
 
 #include <algorithm>
+#include <string>
+
+#include "traces/common/error.h"
 
 namespace rtsim {
 
@@ -19,7 +22,12 @@ RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, 
       m_queues(partition.treelets.size()),
       m_unit_treelet(units, -1),
       m_admit_slots(config.admit_outstanding, 0),
-      m_sram(16ull * config.bytes_per_cycle, 16) {}
+      m_sram(16ull * config.bytes_per_cycle, 16),
+      m_by_size(config.policy == TreeletPolicy::largest ? uint32_t(partition.treelets.size()) : 1) {
+    require(config.policy != TreeletPolicy::largest || partition.treelets.size() <= SizeTree::kMaxSlots,
+            "ray buffer: " + std::to_string(partition.treelets.size()) + " treelets, at most " +
+                std::to_string(SizeTree::kMaxSlots) + " (raise treelets.treelet_kib)");
+}
 
 Cycle RayBuffer::sram(Cycle time) {
     // One ray state moved through the SRAM port: bandwidth, then latency.
@@ -86,16 +94,20 @@ Cycle RayBuffer::fetch_ray_record(uint64_t ray_id, Cycle time) {
 void RayBuffer::unindex(uint32_t t) {
     const auto& q = m_queues[t];
     if (q.empty()) return;
-    m_by_size.erase({q.size(), t});
-    m_by_age.erase({q.front().ready, t});
-    m_nonempty.erase(t);
+    if (m_config.policy == TreeletPolicy::oldest) m_by_age.erase({q.front().ready, t});
+    else if (m_config.policy == TreeletPolicy::round_robin) m_nonempty.erase(t);
+    // largest: index() overwrites the queue's key
 }
 
 void RayBuffer::index(uint32_t t) {
     const auto& q = m_queues[t];
+    if (m_config.policy == TreeletPolicy::largest) {
+        const uint32_t slot = uint32_t(m_queues.size()) - 1 - t;
+        m_by_size.set(slot, q.empty() ? SizeTree::kNever : SizeTree::kNever - q.size());
+        return;
+    }
     if (q.empty()) return;
-    if (m_config.policy == TreeletPolicy::largest) m_by_size.insert({q.size(), t});
-    else if (m_config.policy == TreeletPolicy::oldest) m_by_age.insert({q.front().ready, t});
+    if (m_config.policy == TreeletPolicy::oldest) m_by_age.insert({q.front().ready, t});
     else m_nonempty.insert(t);
 }
 
@@ -114,7 +126,7 @@ int64_t RayBuffer::pick(uint32_t) {
         return chosen >= 0;
     };
     if (policy == TreeletPolicy::largest) {
-        if (!m_by_size.empty()) consider(m_by_size.begin()->second);  // the largest decides
+        if (!m_by_size.empty()) consider(uint32_t(m_queues.size()) - 1 - m_by_size.top());  // the largest decides
     } else if (policy == TreeletPolicy::oldest) {
         int k = 0;
         for (auto it = m_by_age.begin(); it != m_by_age.end() && k < kLook; ++it, ++k)

@@ -26,6 +26,7 @@
 
 #include "rtl_model/common/calendar.h"
 #include "rtl_model/common/memory_map.h"
+#include "rtl_model/common/min_tree.h"
 #include "rtl_model/common/ray_state.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
 #include "traces/accel/locality.h"
@@ -85,9 +86,12 @@ private:
     uint64_t m_next_slot = 0;
     uint32_t m_round_robin = 0;
     // Ordered views of the non-empty queues for the scheduler (only the policy's is kept).
-    std::set<std::pair<uint64_t, uint32_t>, std::greater<>> m_by_size;  ///< largest first
-    std::set<std::pair<Cycle, uint32_t>> m_by_age;                      ///< oldest front first
-    std::set<uint32_t> m_nonempty;                                      ///< by treelet id
+    // largest: a MinTree keyed by (kNever - size) over slots T-1-t, so its top is the largest
+    // queue and, among equal sizes, the highest treelet id (O(log T) per change, no allocation).
+    using SizeTree = BasicMinTree<24>;
+    SizeTree m_by_size;
+    std::set<std::pair<Cycle, uint32_t>> m_by_age;  ///< oldest front first
+    std::set<uint32_t> m_nonempty;                  ///< by treelet id
     bool m_dispatch_empty = false;
     uint64_t m_occupancy = 0, m_max_occupancy = 0, m_in_machine = 0;
     uint64_t m_admitted = 0, m_parked = 0, m_taken = 0, m_overflows = 0, m_overflow_reads = 0;

@@ -120,7 +120,7 @@ bool TraversalUnit::take_parked_ray(uint32_t c, Cycle t) {
     m_steppers.release(std::move(ctx.ray.stepper));  // the finished ray's stepper is free again
     ctx.ray = std::move(taken);
     const Stepper& s = *ctx.ray.stepper;
-    if (!ray_is_valid(s.ray()) && s.work().steps == 0) ++m_rejected;
+    if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_rejected;
     ++m_takes;
     activate(c, t);
     account(c, CycleUse::ray_buffer, ready);
