@@ -254,6 +254,7 @@ def cmd_bench(args: argparse.Namespace, console: Console) -> int:
             args.set or [],
             Path(args.json) if args.json else None,
             console,
+            Path(args.against) if args.against else None,
         )
     exe = find_bench()
     if exe is None or not exe.is_file():
@@ -486,6 +487,13 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         metavar="KEY=VALUE",
         default=None,
         help="with --model: config field for every run (repeatable; default: none)",
+    )
+    p.add_argument(
+        "--against",
+        metavar="RTSIM_SIM",
+        default=None,
+        help="with --model: also run this other rtsim-sim binary after every run (same settings) "
+        "and report its CPU time, the speed-up and whether the cycles agree (default: none)",
     )
     p.set_defaults(func=cmd_bench)
 

@@ -11,6 +11,12 @@ simulator's speed targets are stated in (issue 15; docs/benchmarks.md):
 (a ratio is the CPU time of the first over the second: how many times slower it is). `treelets`
 is `approx` with `treelets.enabled=true`. The analytic level caches its per-trace analysis beside
 the trace: the first run builds it, later runs reuse it; both times are reported.
+
+`--against OTHER_RTSIM_SIM` measures a change side by side: every run is followed by the same run
+of the other binary (same trace, level and settings), and the report adds per level the other
+binary's median CPU time, the speed-up (its CPU time over ours) and whether both simulated the
+same number of cycles (a speed change should not change the simulation; when defaults differ
+between the binaries, pass the old defaults with --set).
 """
 
 from __future__ import annotations
@@ -55,6 +61,10 @@ class LevelTiming:
     cpu_seconds: list[float] = field(default_factory=list)
     first_wall_seconds: float | None = None  # analytic: the run that built the analysis
     error: str | None = None
+    cycles: int | None = None
+    against_cpu_seconds: list[float] = field(default_factory=list)  # --against: the other binary
+    against_cycles: int | None = None
+    against_error: str | None = None
 
     def median_wall(self) -> float | None:
         return statistics.median(self.wall_seconds) if self.wall_seconds else None
@@ -64,17 +74,25 @@ class LevelTiming:
 
     def summary(self) -> dict[str, Any]:
         wall, cpu = self.median_wall(), self.median_cpu()
+        against = statistics.median(self.against_cpu_seconds) if self.against_cpu_seconds else None
         return {
             **asdict(self),
             "median_wall_seconds": wall,
             "median_cpu_seconds": cpu,
             "rays_per_wall_second": self.rays / wall if wall else None,
             "rays_per_cpu_second": self.rays / cpu if cpu else None,
+            "against_median_cpu_seconds": against,
+            "speedup_over_against": against / cpu if against and cpu else None,
+            "same_cycles_as_against": (self.cycles == self.against_cycles)
+            if self.against_cpu_seconds
+            else None,
         }
 
 
-def run_once(exe: Path, trace: Path, settings: list[str], out: Path) -> tuple[float, float, int]:
-    """One rtsim-sim process: (wall s, CPU s of the child, simulated rays)."""
+def run_once(
+    exe: Path, trace: Path, settings: list[str], out: Path
+) -> tuple[float, float, int, int | None]:
+    """One rtsim-sim process: (wall s, CPU s of the child, simulated rays, simulated cycles)."""
     cmd = [str(exe), str(trace), "-o", str(out), "--no-verdict"]
     for s in settings:
         cmd += ["--set", s]
@@ -89,11 +107,18 @@ def run_once(exe: Path, trace: Path, settings: list[str], out: Path) -> tuple[fl
         raise RuntimeError(lines[-1] if lines else f"rtsim-sim exited with {proc.returncode}")
     stats = json.loads((out / "stats.json").read_text())
     rays = int(stats["summary"].get("rays") or stats["workload"]["rays"])
-    return wall, usage.ru_utime + usage.ru_stime, rays
+    cycles = stats["summary"].get("cycles")
+    return wall, usage.ru_utime + usage.ru_stime, rays, int(cycles) if cycles is not None else None
 
 
 def bench_trace(
-    exe: Path, trace: Path, levels: list[str], repeat: int, extra: list[str], console: Console
+    exe: Path,
+    trace: Path,
+    levels: list[str],
+    repeat: int,
+    extra: list[str],
+    console: Console,
+    against: Path | None = None,
 ) -> dict[str, LevelTiming]:
     timings: dict[str, LevelTiming] = {}
     with tempfile.TemporaryDirectory(prefix="rtsim-bench-model-") as tmp:
@@ -104,7 +129,9 @@ def bench_trace(
                 if t.error or (level != "analytic" and round_ >= repeat):
                     continue
                 try:
-                    wall, cpu, rays = run_once(exe, trace, LEVELS[level] + extra, Path(tmp))
+                    wall, cpu, rays, t.cycles = run_once(
+                        exe, trace, LEVELS[level] + extra, Path(tmp)
+                    )
                 except RuntimeError as err:
                     t.error = str(err)
                     console.print(f"  {trace.name} {level}: {err}", highlight=False)
@@ -115,10 +142,18 @@ def bench_trace(
                     continue
                 t.wall_seconds.append(wall)
                 t.cpu_seconds.append(cpu)
-                console.print(
-                    f"  {trace.name:<28} {level:<11} {wall:8.3f} s wall {cpu:8.3f} s cpu",
-                    highlight=False,
-                )
+                line = f"  {trace.name:<28} {level:<11} {wall:8.3f} s wall {cpu:8.3f} s cpu"
+                if against and not t.against_error:
+                    try:
+                        _, other_cpu, _, t.against_cycles = run_once(
+                            against, trace, LEVELS[level] + extra, Path(tmp)
+                        )
+                        t.against_cpu_seconds.append(other_cpu)
+                        line += f"   against: {other_cpu:8.3f} s cpu"
+                    except RuntimeError as err:
+                        t.against_error = str(err)
+                        line += f"   against: {err}"
+                console.print(line, highlight=False)
     return timings
 
 
@@ -153,6 +188,19 @@ def markdown(report: list[dict[str, Any]]) -> str:
     for t in report:
         cells = [f"{v:.2f}x" if v else "" for v in t["ratios"].values()]
         lines.append(f"| {t['trace']} | " + " | ".join(cells) + " |")
+    compared = [(t, s) for t in report for s in t["levels"].values() if s["against_cpu_seconds"]]
+    if compared:
+        lines += [
+            "",
+            "| trace | level | CPU s (median) | against: CPU s (median) | speed-up | same cycles |",
+        ]
+        lines.append("|---|---|---:|---:|---:|---|")
+        for t, s in compared:
+            lines.append(
+                f"| {t['trace']} | {s['level']} | {s['median_cpu_seconds']:.3f} "
+                f"| {s['against_median_cpu_seconds']:.3f} | {s['speedup_over_against'] or 0:.2f}x "
+                f"| {'yes' if s['same_cycles_as_against'] else 'NO'} |"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -163,6 +211,7 @@ def run_model_bench(
     extra: list[str],
     json_path: Path | None,
     console: Console,
+    against: Path | None = None,
 ) -> int:
     unknown = [lvl for lvl in levels if lvl not in LEVELS]
     if unknown:
@@ -170,12 +219,15 @@ def run_model_bench(
         console.print(f"rtsim: error: --levels: unknown {', '.join(unknown)} (known: {known})")
         return 2
     exe = find_sim()
+    if against is not None and not against.is_file():
+        console.print(f"rtsim: error: --against: {against}: no such binary")
+        return 2
     report = []
     for trace in traces:
         if not trace.exists():
             console.print(f"rtsim: error: {trace}: no such trace")
             return 2
-        timings = bench_trace(exe, trace, levels, repeat, extra, console)
+        timings = bench_trace(exe, trace, levels, repeat, extra, console, against)
         report.append(
             {
                 "trace": str(trace),
@@ -185,6 +237,12 @@ def run_model_bench(
         )
     console.print(markdown(report), highlight=False, markup=False)
     if json_path:
-        meta = {"sim": str(exe), "repeat": repeat, "set": extra, "cpu_count": os.cpu_count()}
+        meta = {
+            "sim": str(exe),
+            "against": str(against) if against else None,
+            "repeat": repeat,
+            "set": extra,
+            "cpu_count": os.cpu_count(),
+        }
         json_path.write_text(json.dumps({**meta, "traces": report}, indent=2))
     return 1 if any(s["error"] for t in report for s in t["levels"].values()) else 0

@@ -46,3 +46,28 @@ def test_bench_model_refuses_an_unknown_level(tmp_path: Path) -> None:
     result = run_rtsim("bench", "--model", str(tmp_path), "--levels", "approx,fastest")
     assert result.returncode == 2
     assert "fastest" in result.stdout + result.stderr
+
+
+def test_bench_model_against_another_binary_compares_cpu_and_cycles(tmp_path: Path) -> None:
+    from rtsim.launcher import find_sim
+
+    trace = tmp_path / "trace"
+    made = run_rtsim("trace", "cornell", "-o", str(trace), "--resolution", "16x12")
+    assert made.returncode == 0, made.stderr
+    out = tmp_path / "bench.json"
+    # Against itself: the same simulation, so the cycles agree.
+    result = run_rtsim("bench", "--model", str(trace), "--repeat", "1", "--json", str(out),
+                       "--levels", "approx", "--against", str(find_sim()))  # fmt: skip
+    assert result.returncode == 0, result.stdout + result.stderr
+    report = json.loads(out.read_text())
+    assert report["against"] == str(find_sim())
+    s = report["traces"][0]["levels"]["approx"]
+    assert len(s["against_cpu_seconds"]) == 1 and s["against_error"] is None
+    assert s["same_cycles_as_against"] is True and s["cycles"] == s["against_cycles"] > 0
+    assert "| yes |" in result.stdout.replace("\n", " ") or "yes |" in result.stdout
+
+
+def test_bench_model_against_a_missing_binary_is_refused(tmp_path: Path) -> None:
+    result = run_rtsim("bench", "--model", str(tmp_path), "--against", str(tmp_path / "nope"))
+    assert result.returncode == 2
+    assert "nope" in result.stdout + result.stderr
