@@ -49,7 +49,7 @@ void TwoLevelStepper::begin(const Ray& ray, TraversalMode mode) {
 void TwoLevelStepper::plan_tlas() {
     const Bvh2View& tlas = m_accel.tlas();
     if (m_count == 0) {
-        m_plan.reset(m_ref);
+        m_plan.reset(m_accel.tlas_key_base() + m_ref);
         m_plan.add_fetch(tlas.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
         m_plan.add_op(OpKind::box, 2);
     } else {
