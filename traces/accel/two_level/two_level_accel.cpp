@@ -94,7 +94,7 @@ TwoLevelAccel::TwoLevelAccel(AccelImage image, const std::string& source) : Acce
     }
     // Without "frames" the image is one frame: the whole regions.
     if (!params.contains("frames")) {
-        add_frame({{"tlas_first", 0}, {"tlas_count", nodes.count}, {"instances_first", 0},
+        add_frame({{"tlas_first", uint64_t(0)}, {"tlas_count", nodes.count}, {"instances_first", uint64_t(0)},
                    {"instances_count", records.count}},
                   where);
         return;
