@@ -70,6 +70,7 @@ class TraceJob:
     accel: str = "bvh2"
     builder: str = ""  # empty: the structure's default builder (its first)
     flatten: bool = False  # instanced scenes: one world-space structure instead of two levels
+    frames: int = 1  # animated frames of an instanced scene (docs/accel.md, "Frames")
 
 
 def parse_workload(text: str) -> list[str]:
@@ -169,6 +170,7 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             accel=job.accel,
             builder=job.builder,
             flatten=job.flatten,
+            frames=job.frames,
         )
     trace = open_trace(job.out_dir)
     heatmaps = write_heatmaps(trace, size=(job.width, job.height))
@@ -198,6 +200,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         accel=args.accel,
         builder=args.builder,
         flatten=args.flatten,
+        frames=args.frames,
     )
     run_trace(job, console)
     return 0
@@ -364,6 +367,16 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         help="instanced scenes: one world-space structure of --accel over the flattened "
         "triangles, instead of the default two levels (a BLAS of --accel per mesh, a TLAS "
         "over the instances; docs/accel.md)",
+    )
+    p.add_argument(
+        "--frames",
+        type=bounded_int(1, 1024),
+        default=1,
+        metavar="N",
+        help="animate an instanced scene over N frames: instances of shared geometry spin about "
+        "their up axis and bob (docs/accel.md, Frames); the BLASes are built once, the TLAS "
+        "rebuilt and the workload traced per frame; rtsim simulate replays the frames in order "
+        "with caches warm",
     )
     p.set_defaults(func=cmd_trace)
 

@@ -192,10 +192,40 @@ def instantiated_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def frames_table(stats: dict[str, Any]) -> Table:
+    """Each frame of an animated trace (stats.json "frames"), replayed in sequence."""
+    table = Table(title="frames (replayed in sequence, caches warm)", title_justify="left")
+    for column in (
+        "frame",
+        "rays",
+        "cycles",
+        "Mrays/s",
+        "DRAM B/ray",
+        "L1 hit",
+        "L2 hit",
+        "TLAS build ms",
+    ):
+        table.add_column(column, justify="right")
+    for f in stats.get("frames", []) or []:
+        table.add_row(
+            fmt_int(f.get("frame")),
+            fmt_int(f.get("rays")),
+            fmt_int(f.get("cycles")),
+            fmt_float(f.get("mrays_per_second")),
+            fmt_float(f.get("dram_bytes_per_ray"), 1),
+            fmt_pct(f.get("l1_hit_rate")),
+            fmt_pct(f.get("l2_hit_rate")),
+            fmt_float(f.get("tlas_build_ms")),
+        )
+    return table
+
+
 def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> None:
     """Prints the run's headline numbers, utilisation, latency and what was built and why."""
     console = console or Console()
     console.print(performance_table(stats))
+    if len(stats.get("frames", []) or []) > 1:
+        console.print(frames_table(stats))
     if _get(stats, "summary.cycles") is not None:
         console.print(utilisation_table(stats))
         if stats.get("verdict") or stats.get("roofline"):

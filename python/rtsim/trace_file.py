@@ -125,11 +125,15 @@ INSTANCE_DTYPE = np.dtype(
 )
 
 #: Section name (as the C++ section_name() spells it, lower-cased) -> record dtype.
+#: FrameRecord (16 bytes): an animated trace's frame, rays [first_ray, first_ray + rays).
+FRAME_DTYPE = np.dtype([("first_ray", "<u8"), ("rays", "<u8")])
+
 SECTION_DTYPES: dict[str, np.dtype] = {
     "rays": RAY_DTYPE,
     "hits": HIT_DTYPE,
     "work": WORK_DTYPE,
     "accl": np.dtype("u1"),
+    "frms": FRAME_DTYPE,
 }
 #: Layouts of image regions this package knows, by (structure kind, region name); ("*", name)
 #: for every kind. Other regions are read as raw records (docs/accel.md documents them).
@@ -230,6 +234,19 @@ class Trace:
     @cached_property
     def work(self) -> np.ndarray:
         return self._map("work")
+
+    @cached_property
+    def frames(self) -> np.ndarray:
+        """The frames (first_ray, rays): the FRMS table of an animated trace (`rtsim trace
+        --frames N`, docs/accel.md "Frames"), else one frame of every ray."""
+        if self.has("frms"):
+            return np.asarray(self._map("frms"))
+        return np.array([(0, len(self.rays))], dtype=FRAME_DTYPE)
+
+    def frame(self, f: int) -> slice:
+        """The rays of frame f, as a slice of rays, hits and work."""
+        first, count = (int(x) for x in self.frames[f])
+        return slice(first, first + count)
 
     @cached_property
     def nodes(self) -> np.ndarray | None:

@@ -60,6 +60,7 @@ def trace_scene(
     accel: str = "bvh2",
     builder: str = "binned",
     flatten: bool = False,
+    frames: int = 1,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. workload: ray kinds ("primary,diffuse" or a list);
@@ -67,7 +68,10 @@ def trace_scene(
     says which and why). camera: (eye, target, vertical field of view in degrees). accel and
     builder choose the acceleration structure (rtsim._core.accel_kinds(), docs/accel.md);
     instanced scenes are traced through two levels (a BLAS of that kind per mesh, a TLAS over
-    the instances) unless flatten is true."""
+    the instances) unless flatten is true. frames > 1 animates an instanced scene by the
+    documented motion (docs/accel.md, "Frames"): the BLASes are built once, a TLAS per frame, and
+    the workload is traced once per frame; manifest["frames"] lists each frame's rays and TLAS
+    build time."""
     from rtsim import _core
 
     kinds = (
@@ -90,6 +94,7 @@ def trace_scene(
         accel=accel,
         builder=builder,
         flatten=flatten,
+        frames=frames,
     )
 
 

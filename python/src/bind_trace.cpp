@@ -121,11 +121,12 @@ py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
                           uint32_t height, uint32_t bounces, uint64_t seed,
                           const py::object& camera, unsigned threads, uint32_t hairball_triangles,
                           const py::object& progress, const std::string& accel, const std::string& builder,
-                          bool flatten) {
+                          bool flatten, uint32_t frames) {
     TraceOptions opt;
     opt.accel.kind = accel;
     opt.accel.builder = builder;
     opt.flatten = flatten;
+    opt.frames = frames;
     opt.scene = scene_name(scene);
     opt.out_dir = out_dir.string();
     if (workload) {  // None: every kind the scene calls for
@@ -249,11 +250,13 @@ void bind_trace(py::module_& m) {
           py::arg("camera") = py::none(), py::arg("threads") = 0u,
           py::arg("hairball_triangles") = 200000u, py::arg("progress") = py::none(),
           py::arg("accel") = "bvh2", py::arg("builder") = "", py::arg("flatten") = false,
+          py::arg("frames") = 1u,
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
           "returns the manifest. workload: ray kinds (None: every kind the scene calls for).\n"
           "progress(done, total, stage) is called now and then. accel and builder choose the\n"
           "acceleration structure (accel_kinds()); instanced scenes get a BLAS of that kind per\n"
-          "mesh and a TLAS over the instances unless flatten is true.");
+          "mesh and a TLAS over the instances unless flatten is true. frames > 1 animates the\n"
+          "instances (docs/accel.md, Frames): BLASes once, a TLAS and the workload per frame.");
     m.def("write_trace", &write_trace_py, py::arg("scene"), py::arg("origins"),
           py::arg("directions"), py::arg("tmin"), py::arg("tmax"), py::arg("kinds"),
           py::arg("any_hit"), py::arg("out_dir"), py::arg("threads") = 0u,

@@ -53,15 +53,27 @@ struct RayJob {
     uint64_t id = 0;
     Ray ray;
     bool any_hit = false;
+    Cycle not_before = 0;  ///< the ray may not start earlier (a frame barrier's release cycle)
 };
 
-/// Contract: hands out each ray of the workload exactly once; false when none are left.
+/// Contract: hands out each ray of the workload exactly once; false when none are left now.
 /// `unit` is the traversal unit asking (kAnyUnit: the ray buffer, which serves all units).
+/// Frames (docs/model.md, "Frames"): a source may hold the next frame's rays back until every
+/// ray of the current one has finished (ray_finished()); next_ray() is then false while
+/// exhausted() is false, and `released()` is notified when the held rays may be taken.
 class RaySourceIf : public virtual sc_core::sc_interface {
 public:
     static constexpr uint32_t kAnyUnit = 0xFFFFFFFFu;
     virtual bool next_ray(uint32_t unit, RayJob* job) = 0;
     virtual uint64_t total_rays() const = 0;
+    /// True when every ray of every frame has been handed out.
+    virtual bool exhausted() const = 0;
+    /// The frame whose rays are being handed out (0 without frames).
+    virtual uint32_t frame() const { return 0; }
+    /// Notified when a frame's rays are released; null for a source without frames.
+    virtual const sc_core::sc_event* released() const { return nullptr; }
+    /// A ray the source handed out finished at `cycle` (its hit was written).
+    virtual void ray_finished(Cycle cycle) {}
 };
 
 /// A finished ray: what the model computed, for the hit checker and statistics.

@@ -17,7 +17,10 @@ bool RayDealer::next_on_demand(RayJob* job) {
     if (m_next == m_buffer.size()) {
         m_buffer.clear();
         m_next = 0;
-        if (m_stream.read_chunk(m_config.chunk_rays, &m_buffer) == 0) return false;
+        if (m_stream_done || m_stream.read_chunk(m_config.chunk_rays, &m_buffer) == 0) {
+            m_stream_done = true;
+            return false;
+        }
         ++m_chunks;
     }
     *job = m_buffer[m_next++];
@@ -59,12 +62,54 @@ bool RayDealer::next_interleaved(uint32_t unit, RayJob* job) {
     return true;
 }
 
+bool RayDealer::exhausted() const {
+    if (!m_stream_done || m_next < m_buffer.size()) return false;
+    return std::all_of(m_queues.begin(), m_queues.end(), [](const auto& q) { return q.empty(); });
+}
+
 nlohmann::json RayDealer::stats_json() const {
     return {{"rays", m_dispatched},
             {"chunks", m_chunks},
             {"chunk_rays", m_config.chunk_rays},
             {"policy", kDispatchPolicyChoices.name(m_config.policy)},
             {"steals", m_steals}};
+}
+
+Dispatch::Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream)
+    : sc_core::sc_module(name), RayDealer(config, units, stream), m_frame_rays{stream.total_rays()} {}
+
+void Dispatch::set_frames(std::vector<uint64_t> frame_rays, FrameEnd on_end, FrameBegin on_begin) {
+    m_frame_rays = std::move(frame_rays);
+    m_on_end = std::move(on_end);
+    m_on_begin = std::move(on_begin);
+    m_frame = 0;
+    stream().begin_frame(0);
+    if (m_on_begin) m_on_begin(0);
+}
+
+bool Dispatch::next_ray(uint32_t unit, RayJob* job) {
+    if (!RayDealer::next_ray(unit, job)) return false;
+    job->not_before = m_release;
+    return true;
+}
+
+bool Dispatch::exhausted() const { return m_frame + 1 >= m_frame_rays.size() && RayDealer::exhausted(); }
+
+void Dispatch::ray_finished(Cycle cycle) {
+    m_frame_end = std::max(m_frame_end, cycle);
+    if (++m_finished < m_frame_rays[m_frame]) return;
+    // The frame's last ray is done: the next frame (skipping empty ones) starts at its cycle.
+    do {
+        if (m_on_end) m_on_end(m_frame, m_frame_end);
+        if (m_frame + 1 >= m_frame_rays.size()) return;
+        ++m_frame;
+        m_finished = 0;
+        stream().begin_frame(m_frame);
+        if (m_on_begin) m_on_begin(m_frame);
+    } while (m_frame_rays[m_frame] == 0);
+    m_release = m_frame_end;
+    resume_stream();
+    m_released.notify(sc_core::SC_ZERO_TIME);
 }
 
 }  // namespace rtsim

@@ -10,6 +10,7 @@
 // decoupling a unit running ahead then takes runs of neighbouring rays, which flatters its L1.
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -24,9 +25,12 @@ namespace rtsim {
 class RayStream {
 public:
     virtual ~RayStream() = default;
-    /// Appends up to `max` rays in trace order to `out`; returns how many (0 at the end).
+    /// Appends up to `max` rays in trace order to `out`; returns how many (0 at the end, or at
+    /// the end of the current frame: see Dispatch::set_frames).
     virtual size_t read_chunk(size_t max, std::vector<RayJob>* out) = 0;
     virtual uint64_t total_rays() const = 0;
+    /// Frames: the stream goes on with frame `f`'s rays (its reads end at that frame's last ray).
+    virtual void begin_frame(uint32_t f) {}
 };
 
 /// The dealing policy itself, plain C++: the Dispatch block wraps it for the SystemC model, and
@@ -38,8 +42,15 @@ public:
 
     bool next_ray(uint32_t unit, RayJob* job) override;
     uint64_t total_rays() const override { return m_stream.total_rays(); }
+    /// The stream is at its end and every ray read from it was handed out.
+    bool exhausted() const override;
     uint64_t dispatched() const { return m_dispatched; }
     nlohmann::json stats_json() const;
+
+protected:
+    /// The stream has more rays again (its next frame): deal on.
+    void resume_stream() { m_stream_done = false; }
+    RayStream& stream() { return m_stream; }
 
 private:
     bool next_on_demand(RayJob* job);
@@ -57,10 +68,36 @@ private:
     uint64_t m_dispatched = 0, m_chunks = 0, m_steals = 0;
 };
 
+/// The dispatch block. With frames (docs/model.md, "Frames") it is also the frame barrier: it
+/// hands out frame f + 1's rays only once every ray of frame f has finished, at the cycle the
+/// last one finished (RayJob::not_before), after calling the frame hooks (the harness records
+/// the frame's figures and binds the structure's next frame).
 class Dispatch : public sc_core::sc_module, public RayDealer {
 public:
-    Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream)
-        : sc_core::sc_module(name), RayDealer(config, units, stream) {}
+    /// end: frame f's last ray finished at `cycle`; begin: frame f is about to be handed out.
+    using FrameEnd = std::function<void(uint32_t f, Cycle cycle)>;
+    using FrameBegin = std::function<void(uint32_t f)>;
+
+    Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream);
+
+    /// Rays per frame (summing to the stream's rays); without a call, one frame of every ray.
+    void set_frames(std::vector<uint64_t> frame_rays, FrameEnd on_end, FrameBegin on_begin);
+
+    bool next_ray(uint32_t unit, RayJob* job) override;
+    bool exhausted() const override;
+    uint32_t frame() const override { return m_frame; }
+    const sc_core::sc_event* released() const override { return &m_released; }
+    void ray_finished(Cycle cycle) override;
+
+private:
+    std::vector<uint64_t> m_frame_rays;
+    FrameEnd m_on_end;
+    FrameBegin m_on_begin;
+    uint32_t m_frame = 0;
+    uint64_t m_finished = 0;   ///< rays of the current frame finished
+    Cycle m_frame_end = 0;     ///< latest finish among them
+    Cycle m_release = 0;       ///< cycle the current frame's rays may start
+    sc_core::sc_event m_released;
 };
 
 }  // namespace rtsim

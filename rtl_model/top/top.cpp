@@ -153,6 +153,25 @@ void Top::warm(uint32_t unit, uint64_t addr, uint32_t bytes) {
         if (!l1.warm(lo, uint32_t(line))) m_l2->warm(lo, uint32_t(line));
 }
 
+namespace {
+void add(MemCounters& into, const MemCounters& c) {
+    into.reads += c.reads;
+    into.writes += c.writes;
+    into.read_hits += c.read_hits;
+    into.merged += c.merged;
+    into.read_bytes += c.read_bytes;
+    into.write_bytes += c.write_bytes;
+}
+}  // namespace
+
+MemoryTotals Top::memory_totals() const {
+    MemoryTotals t;
+    for (const auto& l1 : m_l1) add(t.l1, l1->stats().total());
+    if (m_l2) t.l2 = m_l2->stats().total();
+    if (m_dram) t.dram = m_dram->stats().total();
+    return t;
+}
+
 Cycle Top::total_cycles() const {
     Cycle t = 0;
     for (const auto& u : m_units) t = std::max(t, u->finish_cycle());

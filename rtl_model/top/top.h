@@ -29,6 +29,13 @@ struct WorkloadFeatures {
 
 class IdealMemory;
 
+/// Running totals of the memory levels; per-frame figures are differences of two snapshots.
+struct MemoryTotals {
+    MemCounters l1;    ///< summed over the units' L1s
+    MemCounters l2;
+    MemCounters dram;
+};
+
 class Top : public sc_core::sc_module {
 public:
     Top(sc_core::sc_module_name name, const SimConfig& config, const Accel& accel, const MemoryMap& map,
@@ -42,6 +49,9 @@ public:
     /// [{block, instantiated, why}]
     const nlohmann::json& instantiated() const { return m_instantiated; }
     const Dram* dram() const { return m_dram.get(); }
+    Dispatch& dispatch() { return *m_dispatch; }
+    /// The memory levels' counters so far (zeros with ideal_memory).
+    MemoryTotals memory_totals() const;
     uint32_t units() const { return uint32_t(m_units.size()); }
     /// Functional warming with a read of [addr, addr + bytes) by unit `unit`: its L1, and the L2
     /// for the lines the L1 missed (Cache::warm; nothing with ideal_memory).

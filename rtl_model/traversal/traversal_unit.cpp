@@ -27,10 +27,19 @@ void TraversalUnit::run() {
     Cycle now = 0;
     fill_idle_contexts(0);
     for (;;) {
+        if (m_events.empty() && !m_treelet_mode) {
+            // No ray in flight here. Dispatch is empty: done, unless it holds the next frame's
+            // rays until this frame's last ray finishes (frames, docs/model.md): wait for them.
+            const sc_core::sc_event* released = rays->released();
+            if (rays->exhausted() || !released) break;
+            if (rays->frame() == m_frame) wait(*released);
+            m_frame = rays->frame();
+            fill_idle_contexts(now);
+            continue;
+        }
         if (m_events.empty()) {
-            // No ray in flight here. Without treelets that means dispatch is empty: done. With
-            // treelets, rays may still be parked by other units: look again a little later.
-            if (!m_treelet_mode || ray_buffer->done()) break;
+            // With treelets, rays may still be parked by other units: look again a little later.
+            if (ray_buffer->done()) break;
             now += m_ctx.idle_poll_cycles;
             ++m_idle_polls;
             sync(now);
@@ -47,6 +56,10 @@ void TraversalUnit::run() {
         advance(c, t);
         m_events.finish_pop();
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
+        if (!m_treelet_mode && rays->frame() != m_frame) {  // a frame was released: fill every context
+            m_frame = rays->frame();
+            fill_idle_contexts(t);
+        }
     }
 }
 
@@ -94,6 +107,7 @@ bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
     if (m_treelet_mode) return take_parked_ray(c, t);
     RayJob job;
     if (!rays->next_ray(m_index, &job)) return false;
+    t = std::max(t, job.not_before);  // a frame's rays start when the previous frame is done
     Context& ctx = m_contexts[c];
     ctx.ray.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_rejected;
@@ -216,6 +230,7 @@ void TraversalUnit::finish_ray(uint32_t c, Cycle t) {
     const Stepper& s = *ctx.ray.stepper;
     sink->ray_done(RayResult{ctx.ray.ray_id, s.hit(), s.work(), ctx.ray.start, t, m_index, c});
     if (m_treelet_mode) ray_buffer->finished(t);
+    else rays->ray_finished(t);
     ++m_rays;
     m_finish = std::max(m_finish, t);
     deactivate(c, t);

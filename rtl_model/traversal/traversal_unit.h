@@ -101,6 +101,7 @@ private:
     Cycle m_busy_since = 0, m_busy_cycles = 0;
     uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0, m_syncs = 0;
     bool m_treelet_mode = false;
+    uint32_t m_frame = 0;  ///< the dispatch frame this unit last filled its contexts from
     Cycle m_next_fill = 0;
     uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
     CycleAccount m_account;

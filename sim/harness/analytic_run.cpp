@@ -10,6 +10,7 @@
 #include <fstream>
 #include <optional>
 
+#include "sim/harness/frames.h"
 #include "sim/harness/analytic.h"
 #include "sim/harness/analytic_cache.h"
 #include "sim/harness/analytic_estimate.h"
@@ -91,6 +92,7 @@ SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json
                  {"model", r.model},
                  {"provenance", provenance(o.command_line, rtt, manifest, started)}};
     out.stats["summary"]["sampled"] = false;
+    out.stats["summary"]["frames"] = 1;  // animated traces are refused (check_frames_supported)
     add_energy_area(out.stats, o.config, r.work, r.rays);
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], r.model);
     const json verdict = o.verdict && out.stats["summary"].value("rays", 0) > 0 ? verdict_of(r.model) : json(nullptr);
@@ -146,6 +148,8 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     const std::string rtt = trace_file(o.trace);
     TraceReader reader(rtt);
     const json manifest = read_manifest(rtt);
+    if (reader.has(SectionKind::frames))
+        check_frames_supported(o.config, reader.section(SectionKind::frames).record_count, rtt);
     fs::create_directories(o.out_dir);
     write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(o.config));
     if (o.config.analytic.caches == AnalyticCaches::functional)

@@ -9,6 +9,7 @@
 #include "rtl_model/top/top.h"
 #include "sim/harness/analytic.h"
 #include "sim/harness/energy_area.h"
+#include "sim/harness/frames.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/roofline.h"
 #include "sim/harness/run_files.h"
@@ -36,12 +37,15 @@ void report_progress(uint64_t done, uint64_t total) {
 }
 
 /// Functional level: the reference traversal in a loop, no time. Counts and the hit check only.
-json run_functional(const Accel& accel, TraceReader& reader, HitChecker& checker) {
+json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, const std::vector<FrameRecord>& frames) {
     const std::string& path = reader.path();
     TraceRayStream stream(reader);
     std::vector<RayJob> jobs;
+    uint32_t frame = 0;
+    accel.bind_frame(0);
     while (stream.read_chunk(65536, &jobs)) {
         for (const RayJob& job : jobs) {
+            while (job.id >= frames[frame].first_ray + frames[frame].rays) accel.bind_frame(++frame);
             RayResult r;
             r.id = job.id;
             try {
@@ -67,9 +71,13 @@ SimOutcome run_simulation(const SimOptions& o) {
     validate(o.config);
     const std::string rtt = trace_file(o.trace);
     TraceReader reader(rtt);
-    json manifest = read_manifest(rtt);
+    const json manifest = read_manifest(rtt);
     // The acceleration structure, whichever it is, validated structurally (load_accel).
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
+    // Animated traces (frames.h): replayed frame after frame, caches warm, one barrier between.
+    const std::vector<FrameRecord> frames = read_frame_table(reader, accel->frame_count());
+    check_frames_supported(o.config, frames.size(), rtt);
+    FrameRecorder frame_figures(o.config, frames, manifest.value("frames", json(nullptr)));
     check_sim_memory(o.config, accel->image().footprint_bytes(),
                      "config (traversal.units=" + std::to_string(o.config.traversal.units) +
                          ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
@@ -106,11 +114,19 @@ SimOutcome run_simulation(const SimOptions& o) {
     SimConfig timed_config = o.config;
     if (o.config.fidelity == Fidelity::detailed) timed_config.quantum_cycles = 1;
     if (o.config.fidelity == Fidelity::functional) {
-        run_functional(*accel, reader, checker);
+        run_functional(*accel, reader, checker, frames);
+        frame_figures.untimed();
     } else {
-        TraceRayStream stream(reader);
+        FrameRayStream stream(reader, frames);
         Top top("top", timed_config, *accel, map, sampled ? static_cast<RayStream&>(sampled->stream) : stream, checker,
                 features);
+        // Frame barriers: record each frame's figures, then bind the structure's next frame.
+        std::vector<uint64_t> frame_rays;
+        for (const FrameRecord& f : frames) frame_rays.push_back(f.rays);
+        if (!sampled)
+            top.dispatch().set_frames(
+                frame_rays, [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); },
+                [&](uint32_t f) { accel->bind_frame(f); });
         std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
         if (o.timeline) {
             kind_reader = std::make_unique<TraceReader>(rtt);
@@ -164,9 +180,11 @@ SimOutcome run_simulation(const SimOptions& o) {
                  {"workload", workload},
                  {"instantiated", instantiated},
                  {"effects", manifest.value("workload", json::object()).value("effects", json::array())},
+                 {"frames", frame_figures.to_json()},
                  {"model", model},
                  {"provenance", provenance(o.command_line, rtt, manifest, started)}};
     out.stats["summary"]["sampled"] = bool(sampled);
+    out.stats["summary"]["frames"] = frames.size();
     if (sampled) {
         apply_sampling_to_summary(out.stats["summary"], o.config, sampled->plan, sampled->estimator);
         out.stats["sampling"] = sampled->estimator.to_json(o.config, cycles, wall);
@@ -181,7 +199,8 @@ SimOutcome run_simulation(const SimOptions& o) {
     add_energy_area(out.stats, o.config, checker.work_totals(), checker.checked());
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);
     json verdict = nullptr;
-    if (o.verdict && o.config.fidelity != Fidelity::functional && total > 0)
+    // The verdict's estimates trace a sample of rays against one bound structure: not across frames.
+    if (o.verdict && o.config.fidelity != Fidelity::functional && total > 0 && frames.size() == 1)
         verdict = judge(VerdictContext{o.config, model, accel.get(), &map, &reader});
     out.stats["verdict"] = verdict;
     out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];

@@ -1,5 +1,6 @@
 #include "traces/accel/accel.h"
 
+#include "traces/common/error.h"
 #include "traces/common/hw_triangle.h"
 
 namespace rtsim {
@@ -36,6 +37,11 @@ bool Accel::has_anyhit_triangles() const {
             if (t[i].flags & kTriAnyHit) return true;
     }
     return false;
+}
+
+void Accel::bind_frame(uint32_t f) {
+    require(f < frame_count(), "accel image '" + kind() + "': frame " + std::to_string(f) + " of " +
+                                   std::to_string(frame_count()));
 }
 
 }  // namespace rtsim

@@ -44,6 +44,13 @@ public:
     virtual uint32_t max_stack_entries() const = 0;
     /// True when some triangle is alpha-MASKed (the any-hit stage is then needed).
     bool has_anyhit_triangles() const;
+    /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
+    /// two-level image traced with --frames, one TLAS per frame over the same BLASes.
+    virtual uint32_t frame_count() const { return 1; }
+    /// Makes frame `f` the one steppers traverse from their next step on (a driver binding that
+    /// frame's top-level buffer). Only between rays: no ray may be in flight. Throws
+    /// rtsim::Error if f >= frame_count().
+    virtual void bind_frame(uint32_t f);
 
 protected:
     AccelImage m_image;

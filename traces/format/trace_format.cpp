@@ -23,6 +23,7 @@ std::string section_name(SectionKind kind) {
     case SectionKind::hits: return "HITS";
     case SectionKind::work: return "WORK";
     case SectionKind::accel: return "ACCL";
+    case SectionKind::frames: return "FRMS";
     }
     uint32_t index;
     if (is_region_section(kind, &index)) return "RG" + std::to_string(index / 10) + std::to_string(index % 10);
@@ -35,6 +36,7 @@ uint32_t section_record_bytes(SectionKind kind) {
     case SectionKind::hits: return sizeof(HitRecord);
     case SectionKind::work: return sizeof(WorkRecord);
     case SectionKind::accel: return 1;
+    case SectionKind::frames: return sizeof(FrameRecord);
     }
     return 0;
 }

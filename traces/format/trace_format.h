@@ -14,7 +14,9 @@
 namespace rtsim {
 
 constexpr char kTraceMagic[8] = {'R', 'T', 'S', 'I', 'M', 'T', 'R', 'C'};
-constexpr uint32_t kTraceVersion = 3;  // 3: acceleration-structure image (ACCL + regions), 32-byte WORK
+constexpr uint32_t kTraceVersion = 4;  // 4: animated frames (FRMS; a two-level image's TLAS per frame)
+/// Oldest version this build reads (version 3 has no frames; its layout is otherwise version 4's).
+constexpr uint32_t kTraceVersionOldest = 3;
 
 /// Section kinds (fourcc, little-endian). Never renumber; add new kinds instead.
 enum class SectionKind : uint32_t {
@@ -22,6 +24,7 @@ enum class SectionKind : uint32_t {
     hits = 0x53544948,       // 'HITS': HitRecord
     work = 0x4B524F57,       // 'WORK': WorkRecord
     accel = 0x4C434341,      // 'ACCL': the acceleration structure's descriptor, JSON text (1-byte records)
+    frames = 0x534D5246,     // 'FRMS': FrameRecord, one per frame (animated traces only)
     // 'RG00'..'RG99': region i of the acceleration-structure image (record size: its descriptor)
 };
 /// The section holding region `index` (0..99) of the acceleration-structure image.
@@ -30,7 +33,7 @@ SectionKind region_section(uint32_t index);
 bool is_region_section(SectionKind kind, uint32_t* index = nullptr);
 /// "RAYS", "HITS", ..., "RG03"; "unknown" for a kind this build does not know.
 std::string section_name(SectionKind kind);
-/// Record size a kind must have (RAYS 40, HITS 20, WORK 32, ACCL 1); 0 if it varies (regions)
+/// Record size a kind must have (RAYS 40, HITS 20, WORK 32, ACCL 1, FRMS 16); 0 if it varies (regions)
 /// or the kind is unknown.
 uint32_t section_record_bytes(SectionKind kind);
 /// Regions an image may have (the region sections' two digits).
@@ -67,7 +70,14 @@ struct WorkRecord {
     uint32_t plane_tests;  // 24
     uint32_t refs;         // 28
 };
+/// One frame of an animated trace (16 bytes): its rays are RAYS[first_ray, first_ray + rays),
+/// traced against the structure's frame of the same index (Accel::bind_frame).
+struct FrameRecord {
+    uint64_t first_ray;    //  0
+    uint64_t rays;         //  8
+};
 #pragma pack(pop)
+static_assert(sizeof(FrameRecord) == 16, "FrameRecord layout");
 static_assert(sizeof(RayRecord) == 40, "RayRecord layout");
 static_assert(sizeof(HitRecord) == 20, "HitRecord layout");
 static_assert(sizeof(WorkRecord) == 32, "WorkRecord layout");

@@ -49,9 +49,10 @@ tl::FileHeader check_header(std::FILE* f, const std::string& path, uint64_t file
     // The header CRC (bytes 60..63 over 0..59) is the same in every version, so it comes first.
     require(tl::header_crc_ok(head), path + ": header checksum mismatch (header is corrupt)");
     const tl::FileHeader h = tl::decode_header(head);
-    require(h.version == kTraceVersion,
-            path + ": trace version " + num(h.version) + " is not supported by this build (reads version " +
-                num(kTraceVersion) + ")");
+    // Version 3 is version 4 without frames (no FRMS section), so both are read.
+    require(h.version >= kTraceVersionOldest && h.version <= kTraceVersion,
+            path + ": trace version " + num(h.version) + " is not supported by this build (reads versions " +
+                num(kTraceVersionOldest) + " to " + num(kTraceVersion) + ")");
     require(h.header_bytes == tl::kHeaderBytes,
             path + ": header_bytes is " + num(h.header_bytes) + ", expected " + num(tl::kHeaderBytes));
     require(file_bytes >= h.file_bytes, path + ": truncated: header says " + num(h.file_bytes) +

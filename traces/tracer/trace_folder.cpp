@@ -47,9 +47,15 @@ void TraceFolderWriter::add_wavefront(const WorkloadPlan& plan, const std::vecto
         hit_rec.push_back(to_record(res.hits[i]));
         work_rec.push_back(to_record(res.work[i]));
     }
+    m_rays_written += ray_rec.size();
     m_writer.append(SectionKind::rays, ray_rec);
     m_writer.append(SectionKind::hits, hit_rec);
     m_writer.append(SectionKind::work, work_rec);
+}
+
+void TraceFolderWriter::add_frame(uint64_t first_ray) {
+    const FrameRecord frame{first_ray, m_rays_written - first_ray};
+    m_writer.append(SectionKind::frames, &frame, 1, sizeof(FrameRecord));
 }
 
 json TraceFolderWriter::finish(const Scene& scene, const SceneLabel& label, const AccelImage& image,

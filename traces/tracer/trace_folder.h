@@ -38,6 +38,11 @@ public:
     void add_wavefront(const WorkloadPlan& plan, const std::vector<PendingRay>& rays,
                        const WavefrontResult& result);
 
+    /// Rays written so far (the next ray's index in the trace).
+    uint64_t rays_written() const { return m_rays_written; }
+    /// Animated traces: a FRMS record for the frame whose rays are [first_ray, rays_written()).
+    void add_frame(uint64_t first_ray);
+
     /// Closes trace.rtt, then writes manifest.json: the common keys plus `extra` (the producer's
     /// "camera", "workload", ...; `files` entries in extra are added to the common ones).
     /// Timing: `load_ms` is the producer's scene loading, `started` when the producer began.
@@ -52,6 +57,7 @@ private:
     std::string m_out_dir;
     TraceWriter m_writer;
     RayCounts m_counts;
+    uint64_t m_rays_written = 0;
     std::chrono::steady_clock::time_point m_start;
 };
 

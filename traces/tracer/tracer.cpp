@@ -10,6 +10,7 @@
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
 #include "traces/scene/gltf_loader.h"
+#include "traces/tracer/frames.h"
 #include "traces/tracer/preview_render.h"
 #include "traces/tracer/trace_folder.h"
 #include "traces/tracer/wavefront.h"
@@ -92,6 +93,8 @@ void validate(const TraceOptions& o) {
         require(c.eye != c.target, "camera eye " + vec_text(c.eye) + " equals the target: no view direction");
     }
     validate_accel_options(o.accel);
+    require(o.frames >= 1 && o.frames <= kMaxFrames,
+            "frames " + std::to_string(o.frames) + " is out of range (1.." + std::to_string(kMaxFrames) + ")");
 }
 
 /// The instancing effect of a two-level trace: simulated (BLASes, TLAS, transform stage).
@@ -124,13 +127,17 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     Scene scene = load_gltf(path, false);
     AccelOptions accel_options = o.accel;
     accel_options.two_level = !o.flatten && shares_geometry(scene);
+    check_frames(o.frames, o.flatten, accel_options.two_level, path);
     if (!accel_options.two_level) scene.flatten();
     double load_ms = ms_since(t_start);
     require(scene.triangle_count() > 0, path + ": the scene has no triangles");
 
     report(0, 1, "accel");
-    const std::unique_ptr<Accel> accel =
-        load_accel(build_accel(scene, accel_options), path + ": built " + o.accel.kind);
+    // Animated frames: BLASes once, a TLAS per frame (frames.h); else one structure.
+    AnimatedImage animated;
+    if (o.frames > 1) animated = build_animated(scene, accel_options, o.frames);
+    else animated.image = build_accel(scene, accel_options);
+    const std::unique_ptr<Accel> accel = load_accel(std::move(animated.image), path + ": built " + o.accel.kind);
     WorkloadPlan plan = plan_workload(scene, o.workload);
     if (accel_options.two_level) mark_instancing_simulated(plan, accel->image());
     std::string camera_source;
@@ -143,15 +150,27 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     TraceFolderWriter folder(o.out_dir, accel->image());
     uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
     PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
-    SpawnContext ctx{&scene, &plan, o.bounces, o.seed};
-
-    std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height, camera_where);
-    for (uint32_t depth = 0; !wave.empty(); ++depth) {
-        std::string stage = depth == 0 ? "primary" : "depth " + std::to_string(depth);
-        WavefrontResult res = trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
-        folder.add_wavefront(plan, wave, res);
-        render.add(scene, wave, res.hits);
-        wave = next_wavefront(ctx, wave, res.hits);
+    std::vector<uint64_t> first_ray, frame_rays;
+    for (uint32_t f = 0; f < o.frames; ++f) {
+        // Frame f: the instances posed, its TLAS bound, the same camera, its own seed.
+        if (o.frames > 1) {
+            pose_scene(scene, animated.motion, f);
+            accel->bind_frame(f);
+        }
+        const std::string prefix = o.frames > 1 ? "frame " + std::to_string(f) + " " : "";
+        SpawnContext ctx{&scene, &plan, o.bounces, frame_seed(o.seed, f)};
+        first_ray.push_back(folder.rays_written());
+        std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height, camera_where);
+        for (uint32_t depth = 0; !wave.empty(); ++depth) {
+            std::string stage = prefix + (depth == 0 ? "primary" : "depth " + std::to_string(depth));
+            WavefrontResult res =
+                trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
+            folder.add_wavefront(plan, wave, res);
+            if (f == 0) render.add(scene, wave, res.hits);  // the preview shows frame 0
+            wave = next_wavefront(ctx, wave, res.hits);
+        }
+        frame_rays.push_back(folder.rays_written() - first_ray.back());
+        if (o.frames > 1) folder.add_frame(first_ray.back());
     }
 
     json requested = "scene";  // the default: every kind the scene calls for
@@ -169,6 +188,10 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
           {"effects", effects_json(plan)}}},
         {"files", {{"render", "render.png"}}},
     };
+    if (o.frames > 1) {
+        pose_scene(scene, animated.motion, 0);  // the manifest describes the rest pose
+        extra["frames"] = frames_json(accel->image(), animated.timing, first_ray, frame_rays);
+    }
     SceneLabel label{procedural ? o.scene : fs::path(path).stem().string(), procedural};
     render.write_png((fs::path(o.out_dir) / "render.png").string());
     return folder.finish(scene, label, accel->image(), load_ms, t_start, std::move(extra));

@@ -44,6 +44,10 @@ struct TraceOptions {
     bool flatten = false;
     ProceduralOptions procedural;
     unsigned threads = 0;  ///< 0: all hardware threads. Output does not depend on it.
+    /// Animated frames (docs/accel.md, "Frames"): the instances move by the documented motion
+    /// (traces/scene/scene_motion.h), the BLASes are built once, a TLAS per frame, and the
+    /// workload is traced once per frame. Needs an instanced scene traced two-level (not --flatten).
+    uint32_t frames = 1;
 };
 
 /// Progress callback: rays traced so far, rays expected (an estimate until the last wavefront),

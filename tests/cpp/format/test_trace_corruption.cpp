@@ -154,8 +154,18 @@ TEST_F(CorruptionTest, WrongVersionAndForeignFilesAreRefused) {
     tl::FileHeader h = m_header;
     h.version = kTraceVersion + 1;
     tl::encode_header(h, b.data());
-    EXPECT_EQ(open_error(b), m_bad + ": trace version " + std::to_string(kTraceVersion + 1) +
-                                  " is not supported by this build (reads version " + std::to_string(kTraceVersion) + ")");
+    const std::string reads = " is not supported by this build (reads versions " +
+                              std::to_string(kTraceVersionOldest) + " to " + std::to_string(kTraceVersion) + ")";
+    EXPECT_EQ(open_error(b), m_bad + ": trace version " + std::to_string(kTraceVersion + 1) + reads);
+    // Versions before 3 (the BVH-only image) are refused the same way.
+    h.version = kTraceVersionOldest - 1;
+    tl::encode_header(h, b.data());
+    EXPECT_EQ(open_error(b), m_bad + ": trace version " + std::to_string(kTraceVersionOldest - 1) + reads);
+    // Version 3 (no frames) is read as it was written.
+    h.version = 3;
+    tl::encode_header(h, b.data());
+    test::write_bytes(m_bad, b);
+    EXPECT_EQ(TraceReader(m_bad).version(), 3u);
 
     const std::string text = "This is a text file, long enough to fill a whole trace header, honestly.\n";
     EXPECT_EQ(open_error(std::vector<uint8_t>(text.begin(), text.end())),

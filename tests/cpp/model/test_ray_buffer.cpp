@@ -25,6 +25,7 @@ public:
         return true;
     }
     uint64_t total_rays() const override { return m_n; }
+    bool exhausted() const override { return m_next == m_n; }
 
 private:
     uint64_t m_n, m_next = 0;

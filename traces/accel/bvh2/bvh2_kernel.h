@@ -59,5 +59,33 @@ inline unsigned next_slot(unsigned mask, const float tnear[2]) {
     return mask >> 1;
 }
 
+/// A traversal-stack entry of a binary walk: the child to resume at and its entry distance.
+struct Bvh2StackEntry {
+    uint32_t ref;    ///< node index, or first record of a leaf
+    uint32_t count;  ///< 0: node; else the leaf's record count
+    float tnear;
+};
+
+/// One node step of a binary walk (the BVH's stepper and the two-level TLAS walk): counts the
+/// step and its two box tests, pushes the farther hit child onto stack[size++] and names the
+/// nearer in *ref / *count. Returns false when no child is hit (the caller pops).
+inline bool descend(const RayBoxPre& pre, const HwNode& node, float tmin, float cull, WorkCounts& work,
+                    Bvh2StackEntry* stack, int& size, uint32_t* ref, uint32_t* count) {
+    work.steps += 1;
+    work.box_tests += 2;
+    float tnear[2];
+    const unsigned mask = node_step(pre, node, tmin, cull, tnear);
+    if (mask == 0) return false;
+    const unsigned next = next_slot(mask, tnear);
+    if (mask == 3) {
+        const unsigned far = next ^ 1u;
+        if (size >= kTraversalStackSize) throw_stack_overflow();
+        stack[size++] = {node.child_ref[far], node.child_count[far], tnear[far]};
+    }
+    *ref = node.child_ref[next];
+    *count = node.child_count[next];
+    return true;
+}
+
 }  // namespace detail
 }  // namespace rtsim

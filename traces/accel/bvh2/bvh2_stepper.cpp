@@ -73,23 +73,9 @@ StepOutcome Bvh2Stepper::execute() {
 }
 
 void Bvh2Stepper::visit_node(const HwNode& node) {
-    m_work.steps += 1;
-    m_work.box_tests += 2;
-    float tnear[2];
-    const unsigned mask = detail::node_step(m_box, node, m_ray.tmin, m_cull_t, tnear);
-    if (mask == 0) {
-        pop_next();
-        return;
-    }
-    const unsigned next = detail::next_slot(mask, tnear);
-    // Nearer child next (child 0 on equal entry distances); push the farther one.
-    if (mask == 3) {
-        const unsigned far = next ^ 1u;
-        if (m_stack_size >= kTraversalStackSize) detail::throw_stack_overflow();
-        m_stack[m_stack_size++] = {node.child_ref[far], node.child_count[far], tnear[far]};
-    }
-    m_ref = node.child_ref[next];
-    m_count = node.child_count[next];
+    // Nearer child next (child 0 on equal entry distances); the farther one pushed.
+    if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count))
+        return pop_next();
     plan_next();
 }
 
@@ -110,7 +96,7 @@ uint32_t Bvh2Stepper::visit_leaf(const HwTriangle* triangles) {
 void Bvh2Stepper::pop_next() {
     // Entries entered beyond the (widened) best hit are dropped without a fetch.
     while (m_stack_size > 0) {
-        const StackEntry& e = m_stack[--m_stack_size];
+        const detail::Bvh2StackEntry& e = m_stack[--m_stack_size];
         if (e.tnear > m_cull_t) continue;
         m_ref = e.ref;
         m_count = e.count;

@@ -36,11 +36,6 @@ public:
     StepOutcome execute() override;
 
 private:
-    struct StackEntry {
-        uint32_t ref;
-        uint32_t count;
-        float tnear;
-    };
     void visit_node(const HwNode& node);
     uint32_t visit_leaf(const HwTriangle* triangles);
     void pop_next();
@@ -53,7 +48,7 @@ private:
     float m_cull_t = 0.0f;  ///< boxes entered beyond this are culled: best t widened
     uint32_t m_ref = 0;     ///< node index, or first triangle of a leaf
     uint32_t m_count = 0;   ///< 0: m_ref is a node; else the leaf's triangle count
-    StackEntry m_stack[kTraversalStackSize];
+    detail::Bvh2StackEntry m_stack[kTraversalStackSize];
 };
 
 }  // namespace rtsim

@@ -7,7 +7,10 @@
 // instance: child_ref = instance record index, child_count = 1), "instances" (InstanceRecord,
 // 128 bytes, in TLAS leaf order), then for every region R of the BLAS kind a region "blas_R":
 // the BLASes' R regions concatenated, each starting on a 64-byte boundary. Params:
-// {"blas_kind", "blas": [{"params", "bounds", "first": {R: record}, "count": {R: records}}]}.
+// {"blas_kind", "blas": [{"params", "bounds", "first": {R: record}, "count": {R: records}}]}, and
+// for animated frames "frames": [{"tlas_first", "tlas_count", "instances_first",
+// "instances_count"}], each frame's TLAS (node 0 its root, leaves naming records of its own
+// slice) and records back to back in "tlas_nodes" and "instances" (build_two_level_frames).
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +34,21 @@ bool shares_geometry(const Scene& scene);
 /// (the scene need not be flattened).
 AccelImage build_two_level(const Scene& scene, const AccelOptions& options);
 
+/// Wall times of a multi-frame build (not in the image: images are deterministic).
+struct TwoLevelTiming {
+    double blas_ms = 0.0;         ///< every BLAS, built once
+    std::vector<double> tlas_ms;  ///< each frame's TLAS and instance records
+};
+
+/// Animated frames (docs/accel.md, "Frames"): the BLASes built once, then a TLAS and instance
+/// records per frame from poses[f][i], instance i's object-to-world in frame f. The frames'
+/// TLASes lie back to back in "tlas_nodes" and their records in "instances" (each frame at its
+/// own addresses, like a driver writing a new top-level buffer); params "frames" lists each
+/// frame's slices [{"tlas_first", "tlas_count", "instances_first", "instances_count"}] when
+/// there is more than one. One pose is exactly build_two_level().
+AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& options,
+                                  const std::vector<std::vector<glm::dmat4>>& poses, TwoLevelTiming* timing);
+
 class TwoLevelAccel final : public Accel {
 public:
     /// Splits the image into its BLASes (each loaded, so validated, by its kind) and validates
@@ -42,15 +60,30 @@ public:
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override;
 
-    const Bvh2View& tlas() const { return m_tlas; }
-    const InstanceRecordView& instances() const { return m_instances; }
+    uint32_t frame_count() const override { return uint32_t(m_frames.size()); }
+    void bind_frame(uint32_t f) override;
+
+    /// The bound frame's TLAS and instance records (frame 0 until bind_frame()).
+    const Bvh2View& tlas() const { return m_frames[m_frame].tlas; }
+    const InstanceRecordView& instances() const { return m_frames[m_frame].instances; }
+    /// Locality key of the bound frame's TLAS node 0 (TLAS node keys are their index in the
+    /// "tlas_nodes" region, every frame's nodes included).
+    uint32_t tlas_key_base() const { return m_frames[m_frame].key_base; }
     const std::vector<std::unique_ptr<Accel>>& blases() const { return m_blases; }
     /// Locality key of BLAS b's key 0 (TLAS nodes take keys 0..tlas node count - 1).
     uint32_t locality_offset(size_t blas) const { return m_locality_offset[blas]; }
 
 private:
-    Bvh2View m_tlas;
-    InstanceRecordView m_instances;
+    /// One frame's slice of the "tlas_nodes" and "instances" regions (two_level.h, frames).
+    struct Frame {
+        Bvh2View tlas;
+        InstanceRecordView instances;
+        uint32_t key_base = 0;
+    };
+    void add_frame(const nlohmann::json& slice, const std::string& where);
+
+    std::vector<Frame> m_frames;
+    uint32_t m_frame = 0;
     std::vector<std::unique_ptr<Accel>> m_blases;
     std::vector<uint32_t> m_locality_offset;
 };

@@ -81,47 +81,96 @@ TwoLevelAccel::TwoLevelAccel(AccelImage image, const std::string& source) : Acce
     const Region& records = m_image.region("instances");
     require(nodes.record_bytes == sizeof(HwNode) && records.record_bytes == sizeof(InstanceRecord),
             where + ": 'tlas_nodes' or 'instances' has the wrong record size");
-    m_tlas.nodes = nodes.records<HwNode>();
-    m_tlas.node_count = nodes.count;
-    m_tlas.node_base = nodes.base;
-    m_tlas.triangle_count = records.count;  // a TLAS leaf's "triangles" are instance records
-    m_tlas.triangle_base = records.base;
-    validate_bvh2(m_tlas, where + " TLAS");
-    for (uint64_t i = 0; i < nodes.count; ++i)
-        for (int c = 0; c < 2; ++c) {
-            const uint32_t n = m_tlas.nodes[i].child_count[c];
-            require(n <= 1 || n == kEmptyChild, where + ": TLAS node " + std::to_string(i) + " child " +
-                                                    std::to_string(c) + " is a leaf of " + std::to_string(n) +
-                                                    " instances (one per leaf)");
-        }
-    m_instances = {records.records<InstanceRecord>(), records.count, records.base};
-
     const json& params = m_image.params;
     const json& kind = field(params, "blas_kind", where + " params");
     const json& list = field(params, "blas", where + " params");
     require(kind.is_string() && list.is_array(), where + ": params 'blas_kind' or 'blas' has the wrong type");
-    uint32_t offset = uint32_t(m_tlas.node_count);
+    uint32_t offset = uint32_t(nodes.count);  // BLAS keys follow every frame's TLAS nodes
     for (size_t b = 0; b < list.size(); ++b) {
         const std::string at = where + " BLAS " + std::to_string(b);
         m_blases.push_back(load_accel(blas_image(m_image, kind.get<std::string>(), list[b], at), at));
         m_locality_offset.push_back(offset);
         offset += locality_key_count(m_blases.back()->image());
     }
-    for (uint64_t i = 0; i < records.count; ++i) {
-        const InstanceRecord& r = m_instances.records[i];
+    // Without "frames" the image is one frame: the whole regions.
+    if (!params.contains("frames")) {
+        add_frame({{"tlas_first", uint64_t(0)}, {"tlas_count", nodes.count}, {"instances_first", uint64_t(0)},
+                   {"instances_count", records.count}},
+                  where);
+        return;
+    }
+    const json& frames = params.at("frames");
+    require(frames.is_array() && !frames.empty(), where + ": params 'frames' must be a non-empty array");
+    for (size_t f = 0; f < frames.size(); ++f) add_frame(frames[f], where + " frame " + std::to_string(f));
+}
+
+void TwoLevelAccel::add_frame(const json& slice, const std::string& where) {
+    const Region& nodes = m_image.region("tlas_nodes");
+    const Region& records = m_image.region("instances");
+    auto range = [&](const char* first_key, const char* count_key, const Region& r) {
+        const json& f = field(slice, first_key, where), &c = field(slice, count_key, where);
+        require(f.is_number_unsigned() && c.is_number_unsigned(),
+                where + ": '" + first_key + "' or '" + count_key + "' is not an unsigned integer");
+        const uint64_t first = f.get<uint64_t>(), count = c.get<uint64_t>();
+        require(first <= r.count && count <= r.count - first, where + ": slice [" + std::to_string(first) + ", +" +
+                                                                  std::to_string(count) + ") is outside " + r.name);
+        return std::pair<uint64_t, uint64_t>(first, count);
+    };
+    const auto [node_first, node_count] = range("tlas_first", "tlas_count", nodes);
+    const auto [record_first, record_count] = range("instances_first", "instances_count", records);
+    Frame fr;
+    fr.tlas.nodes = nodes.records<HwNode>() + node_first;
+    fr.tlas.node_count = node_count;
+    fr.tlas.node_base = nodes.address(node_first);
+    fr.tlas.triangle_count = record_count;  // a TLAS leaf's "triangles" are instance records
+    fr.tlas.triangle_base = records.address(record_first);
+    fr.instances = {records.records<InstanceRecord>() + record_first, record_count, records.address(record_first)};
+    fr.key_base = uint32_t(node_first);
+    validate_bvh2(fr.tlas, where + " TLAS");
+    for (uint64_t i = 0; i < node_count; ++i)
+        for (int c = 0; c < 2; ++c) {
+            const uint32_t n = fr.tlas.nodes[i].child_count[c];
+            require(n <= 1 || n == kEmptyChild, where + ": TLAS node " + std::to_string(i) + " child " +
+                                                    std::to_string(c) + " is a leaf of " + std::to_string(n) +
+                                                    " instances (one per leaf)");
+        }
+    for (uint64_t i = 0; i < record_count; ++i) {
+        const InstanceRecord& r = fr.instances.records[i];
         const std::string at = where + ": instance record " + std::to_string(i);
         require(r.blas < m_blases.size(), at + " names BLAS " + std::to_string(r.blas) + " of " +
                                               std::to_string(m_blases.size()));
         require(finite_rows(r.world_to_object) && finite_rows(r.object_to_world), at + " has a non-finite transform");
         require(r.prim_base < (1u << 31), at + " has a primitive base beyond 2^31");
     }
+    m_frames.push_back(fr);
+}
+
+void TwoLevelAccel::bind_frame(uint32_t f) {
+    Accel::bind_frame(f);  // checks the range
+    m_frame = f;
 }
 
 std::unique_ptr<Stepper> TwoLevelAccel::make_stepper() const { return std::make_unique<TwoLevelStepper>(*this); }
 
 LocalityPartition TwoLevelAccel::partition(uint64_t budget_bytes) const {
     require(budget_bytes >= sizeof(HwNode), "treelet budget must be at least one node (64 bytes)");
-    LocalityPartition out = partition_tree(bvh2_locality_tree(m_tlas.nodes, m_tlas.node_count), budget_bytes);
+    // Each frame's TLAS partitioned on its own, its keys at the frame's place in "tlas_nodes".
+    LocalityPartition out;
+    out.budget_bytes = budget_bytes;
+    for (size_t f = 0; f < m_frames.size(); ++f) {
+        const Frame& fr = m_frames[f];
+        const LocalityPartition p =
+            partition_tree(bvh2_locality_tree(fr.tlas.nodes, fr.tlas.node_count), budget_bytes);
+        const uint32_t group_base = uint32_t(out.treelets.size());
+        if (f == 0) out.root_group = group_base + p.root_group;
+        out.group_of.resize(fr.key_base + fr.tlas.node_count, group_base + p.root_group);
+        for (size_t k = 0; k < p.group_of.size() && k < fr.tlas.node_count; ++k)
+            out.group_of[fr.key_base + k] = group_base + p.group_of[k];
+        for (TreeletInfo t : p.treelets) {
+            t.root += fr.key_base;
+            out.treelets.push_back(t);
+        }
+    }
     for (size_t b = 0; b < m_blases.size(); ++b) {
         const LocalityPartition p = m_blases[b]->partition(budget_bytes);
         const uint32_t group_base = uint32_t(out.treelets.size());

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <algorithm>
+#include <chrono>
 #include <limits>
 #include <numeric>
 #include <unordered_map>
@@ -122,63 +123,83 @@ Scene box_scene(const std::vector<Aabb>& boxes) {
 
 }  // namespace
 
-AccelImage build_two_level(const Scene& scene, const AccelOptions& options) {
-    // One BLAS per geometry some instance places (meshes without triangles are skipped; meshes
-    // of equal vertices and alpha tests share one, whatever their materials).
+namespace {
+
+/// The BLASes of a scene: one per geometry some instance places, and which instances place one.
+struct BlasSet {
+    std::vector<AccelImage> images;
+    std::vector<uint32_t> blas_of_mesh;  ///< per mesh (meaningful for placed meshes)
+    std::vector<uint32_t> placed;        ///< instances with geometry, scene order
+};
+
+BlasSet build_blases(const Scene& scene, const AccelOptions& options) {
+    // Meshes without triangles are skipped; meshes of equal vertices and alpha tests share one
+    // BLAS, whatever their materials.
     const std::vector<uint32_t> cls = geometry_classes(scene);
     std::vector<int32_t> blas_of_class(scene.meshes.size(), -1);
-    std::vector<AccelImage> blases;
     AccelOptions blas_options = options;
     blas_options.two_level = false;
-    std::vector<uint32_t> placed;  // instances with geometry, scene order
+    BlasSet set;
+    set.blas_of_mesh.assign(scene.meshes.size(), 0);
     for (uint32_t i = 0; i < scene.instances.size(); ++i) {
         const uint32_t mesh = scene.instances[i].mesh;
         require(mesh < scene.meshes.size(), scene.source + ": instance " + std::to_string(i) + " has no mesh");
         if (scene.meshes[mesh].triangle_count() == 0) continue;
         if (blas_of_class[cls[mesh]] < 0) {
-            blas_of_class[cls[mesh]] = int32_t(blases.size());
-            blases.push_back(build_accel(mesh_scene(scene, cls[mesh]), blas_options));
+            blas_of_class[cls[mesh]] = int32_t(set.images.size());
+            set.images.push_back(build_accel(mesh_scene(scene, cls[mesh]), blas_options));
         }
-        placed.push_back(i);
+        set.blas_of_mesh[mesh] = uint32_t(blas_of_class[cls[mesh]]);
+        set.placed.push_back(i);
     }
-    auto blas_of_mesh = [&](uint32_t mesh) { return uint32_t(blas_of_class[cls[mesh]]); };
-    require(!placed.empty(), scene.source + ": the scene has no triangles");
+    require(!set.placed.empty(), scene.source + ": the scene has no triangles");
+    return set;
+}
 
-    std::vector<Aabb> boxes(placed.size());
+/// One frame's TLAS and instance records (in TLAS leaf order) over the instances posed by `pose`.
+struct TlasFrame {
+    HwBvh tlas;
+    std::vector<InstanceRecord> records;
     Aabb bounds;
-    for (size_t k = 0; k < placed.size(); ++k) {
-        const Instance& inst = scene.instances[placed[k]];
-        boxes[k] = world_box(blases[blas_of_mesh(inst.mesh)].bounds, inst.object_to_world);
-        bounds.grow(boxes[k]);
+};
+
+TlasFrame build_tlas(const Scene& scene, const BlasSet& blases, const std::vector<glm::dmat4>& pose,
+                     const AccelOptions& options) {
+    TlasFrame out;
+    std::vector<Aabb> boxes(blases.placed.size());
+    for (size_t k = 0; k < blases.placed.size(); ++k) {
+        const uint32_t id = blases.placed[k];
+        boxes[k] = world_box(blases.images[blases.blas_of_mesh[scene.instances[id].mesh]].bounds, pose[id]);
+        out.bounds.grow(boxes[k]);
     }
     BuildConfig tlas_config = options.build;
     tlas_config.max_leaf_size = 1;
     const Scene tlas_input = box_scene(boxes);
-    const HwBvh tlas = flatten_bvh(build_binned_sah(tlas_input.triangles, tlas_config), tlas_input, tlas_config);
-
-    AccelImage image;
-    image.kind = "two_level";
-    image.bounds = bounds;
-    Region& nodes = image.add_region("tlas_nodes", DataKind::node, sizeof(HwNode), tlas.nodes.size());
-    std::memcpy(nodes.bytes.data(), tlas.nodes.data(), nodes.size_bytes());
-    Region& records = image.add_region("instances", DataKind::instance, sizeof(InstanceRecord), placed.size());
-    InstanceRecord* rec = records.records<InstanceRecord>();
-    for (size_t k = 0; k < placed.size(); ++k) {  // in TLAS leaf order
-        const uint32_t id = placed[tlas.triangles[k].prim];
+    out.tlas = flatten_bvh(build_binned_sah(tlas_input.triangles, tlas_config), tlas_input, tlas_config);
+    out.records.resize(blases.placed.size());
+    for (size_t k = 0; k < blases.placed.size(); ++k) {
+        const uint32_t id = blases.placed[out.tlas.triangles[k].prim];
         const Instance& inst = scene.instances[id];
-        rec[k] = InstanceRecord{};
-        store_affine_rows(glm::inverse(inst.object_to_world), rec[k].world_to_object);
-        store_affine_rows(inst.object_to_world, rec[k].object_to_world);
-        rec[k].blas = blas_of_mesh(inst.mesh);
-        rec[k].prim_base = inst.prim_base;
-        rec[k].instance = id;
+        InstanceRecord& rec = out.records[k];
+        store_affine_rows(glm::inverse(pose[id]), rec.world_to_object);
+        store_affine_rows(pose[id], rec.object_to_world);
+        rec.blas = blases.blas_of_mesh[inst.mesh];
+        rec.prim_base = inst.prim_base;
+        rec.instance = id;
     }
+    return out;
+}
 
-    // The BLASes' regions, concatenated per name; each BLAS starts on a 64-byte boundary.
+double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Appends the BLASes' regions to `image`, concatenated per name (each BLAS on a 64-byte
+/// boundary); returns the params' "blas" list and adds the BLAS bytes to *bytes.
+json add_blas_regions(AccelImage& image, const std::vector<AccelImage>& blases, uint64_t* bytes) {
     json blas_list = json::array();
     for (const AccelImage& b : blases) blas_list.push_back({{"params", b.params}, {"bounds", bounds_json(b.bounds)},
                                                             {"first", json::object()}, {"count", json::object()}});
-    uint64_t blas_bytes = 0;
     for (const Region& proto : blases[0].regions) {
         std::vector<uint64_t> first(blases.size());
         uint64_t total = 0;
@@ -196,20 +217,74 @@ AccelImage build_two_level(const Scene& scene, const AccelOptions& options) {
             const Region& r = blases[b].region(proto.name);
             std::memcpy(out.bytes.data() + first[b] * rb, r.bytes.data(), r.size_bytes());
         }
-        blas_bytes += out.size_bytes();
+        *bytes += out.size_bytes();
     }
+    return blas_list;
+}
+
+}  // namespace
+
+AccelImage build_two_level(const Scene& scene, const AccelOptions& options) {
+    std::vector<glm::dmat4> pose;
+    for (const Instance& inst : scene.instances) pose.push_back(inst.object_to_world);
+    return build_two_level_frames(scene, options, {pose}, nullptr);
+}
+
+AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& options,
+                                  const std::vector<std::vector<glm::dmat4>>& poses, TwoLevelTiming* timing) {
+    require(!poses.empty(), scene.source + ": no frame to build");
+    auto t0 = std::chrono::steady_clock::now();
+    const BlasSet blases = build_blases(scene, options);
+    if (timing) timing->blas_ms = ms_since(t0);
+
+    // Every frame's TLAS over the same BLASes (a driver rebuilding the top level each frame).
+    std::vector<TlasFrame> frames;
+    for (const std::vector<glm::dmat4>& pose : poses) {
+        require(pose.size() == scene.instances.size(), scene.source + ": a frame poses " +
+                                                           std::to_string(pose.size()) + " of " +
+                                                           std::to_string(scene.instances.size()) + " instances");
+        t0 = std::chrono::steady_clock::now();
+        frames.push_back(build_tlas(scene, blases, pose, options));
+        if (timing) timing->tlas_ms.push_back(ms_since(t0));
+    }
+
+    // Frames' TLASes back to back in "tlas_nodes", their records back to back in "instances".
+    AccelImage image;
+    image.kind = "two_level";
+    image.bounds = frames[0].bounds;
+    uint64_t node_total = 0, record_total = 0;
+    json frame_list = json::array();
+    for (const TlasFrame& f : frames) {
+        frame_list.push_back({{"tlas_first", node_total}, {"tlas_count", f.tlas.nodes.size()},
+                              {"instances_first", record_total}, {"instances_count", f.records.size()}});
+        node_total += f.tlas.nodes.size();
+        record_total += f.records.size();
+    }
+    Region& nodes = image.add_region("tlas_nodes", DataKind::node, sizeof(HwNode), node_total);
+    Region& records = image.add_region("instances", DataKind::instance, sizeof(InstanceRecord), record_total);
+    for (size_t f = 0; f < frames.size(); ++f) {
+        std::memcpy(nodes.records<HwNode>() + frame_list[f]["tlas_first"].get<uint64_t>(), frames[f].tlas.nodes.data(),
+                    frames[f].tlas.nodes.size() * sizeof(HwNode));
+        std::memcpy(records.records<InstanceRecord>() + frame_list[f]["instances_first"].get<uint64_t>(),
+                    frames[f].records.data(), frames[f].records.size() * sizeof(InstanceRecord));
+    }
+    const uint64_t tlas_bytes = nodes.size_bytes() + records.size_bytes();
+    uint64_t blas_bytes = 0;
+    json blas_list = add_blas_regions(image, blases.images, &blas_bytes);
     image.params = {{"blas_kind", options.kind}, {"blas", blas_list}};
+    if (frames.size() > 1) image.params["frames"] = frame_list;  // one frame: the whole regions
     image.place_regions();
 
     json blas_stats = json::array();
-    for (const AccelImage& b : blases) blas_stats.push_back(b.stats);
+    for (const AccelImage& b : blases.images) blas_stats.push_back(b.stats);
     image.stats = {{"blas_kind", options.kind},
-                   {"blases", blases.size()},
-                   {"instances", placed.size()},
-                   {"tlas_nodes", tlas.nodes.size()},
-                   {"tlas_bytes", image.region("tlas_nodes").size_bytes() + image.region("instances").size_bytes()},
+                   {"blases", blases.images.size()},
+                   {"instances", blases.placed.size()},
+                   {"tlas_nodes", frames[0].tlas.nodes.size()},
+                   {"tlas_bytes", tlas_bytes},
                    {"blas_bytes", blas_bytes},
                    {"blas", blas_stats}};
+    if (frames.size() > 1) image.stats["frames"] = frames.size();
     return image;
 }
 

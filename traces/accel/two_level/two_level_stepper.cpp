@@ -49,7 +49,7 @@ void TwoLevelStepper::begin(const Ray& ray, TraversalMode mode) {
 void TwoLevelStepper::plan_tlas() {
     const Bvh2View& tlas = m_accel.tlas();
     if (m_count == 0) {
-        m_plan.reset(m_ref);
+        m_plan.reset(m_accel.tlas_key_base() + m_ref);
         m_plan.add_fetch(tlas.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
         m_plan.add_op(OpKind::box, 2);
     } else {
@@ -76,22 +76,9 @@ StepOutcome TwoLevelStepper::execute() {
 }
 
 void TwoLevelStepper::visit_node(const HwNode& node) {
-    m_work.steps += 1;
-    m_work.box_tests += 2;
-    float tnear[2];
-    const unsigned mask = detail::node_step(m_box, node, m_ray.tmin, m_cull_t, tnear);
-    if (mask == 0) {
-        pop_next();
-        return;
-    }
-    const unsigned next = detail::next_slot(mask, tnear);
-    if (mask == 3) {
-        const unsigned far = next ^ 1u;
-        if (m_tlas_size >= kTraversalStackSize) detail::throw_stack_overflow();
-        m_stack[m_tlas_size++] = {node.child_ref[far], node.child_count[far], tnear[far]};
-    }
-    m_ref = node.child_ref[next];
-    m_count = node.child_count[next];
+    // The binary BVH's node step (bvh2_kernel.h): nearer child next, the farther pushed.
+    if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_tlas_size, &m_ref, &m_count))
+        return pop_next();
     plan_tlas();
 }
 
@@ -135,7 +122,7 @@ void TwoLevelStepper::leave_instance() {
 
 void TwoLevelStepper::pop_next() {
     while (m_tlas_size > 0) {
-        const StackEntry& e = m_stack[--m_tlas_size];
+        const detail::Bvh2StackEntry& e = m_stack[--m_tlas_size];
         if (e.tnear > m_cull_t) continue;  // entered beyond the (widened) best hit
         m_ref = e.ref;
         m_count = e.count;

@@ -30,11 +30,6 @@ public:
     StepOutcome execute() override;
 
 private:
-    struct StackEntry {
-        uint32_t ref;    ///< TLAS node, or instance record of a leaf
-        uint32_t count;  ///< 0: node; 1: leaf (one instance)
-        float tnear;
-    };
     void visit_node(const HwNode& node);
     void enter_instance(const InstanceRecord& record);
     StepOutcome blas_step();
@@ -54,7 +49,7 @@ private:
     Stepper* m_inner = nullptr;          ///< the BLAS being walked, or null in the TLAS
     const InstanceRecord* m_instance = nullptr;
     uint32_t m_inner_offset = 0;         ///< locality offset of the BLAS being walked
-    StackEntry m_stack[kTraversalStackSize];
+    detail::Bvh2StackEntry m_stack[kTraversalStackSize];  ///< TLAS entries (ref: node or instance record)
 };
 
 }  // namespace rtsim

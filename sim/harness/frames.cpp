@@ -1,0 +1,114 @@
+// Animated traces in the harness (frames.h).
+#include "sim/harness/frames.h"
+
+#include <algorithm>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+std::vector<FrameRecord> read_frame_table(TraceReader& reader, uint32_t accel_frames) {
+    const std::string& path = reader.path();
+    const uint64_t rays = reader.section(SectionKind::rays).record_count;
+    std::vector<FrameRecord> frames;
+    if (reader.has(SectionKind::frames)) frames = reader.read_all<FrameRecord>(SectionKind::frames);
+    else frames.push_back(FrameRecord{0, rays});
+    require(frames.size() == accel_frames,
+            path + ": the trace has " + std::to_string(frames.size()) + " frame(s) (section FRMS) but its structure " +
+                std::to_string(accel_frames));
+    uint64_t next = 0;
+    for (size_t f = 0; f < frames.size(); ++f) {
+        require(frames[f].first_ray == next && frames[f].rays <= rays - next,
+                path + ": frame " + std::to_string(f) + " (rays [" + std::to_string(frames[f].first_ray) + ", +" +
+                    std::to_string(frames[f].rays) + ")) does not follow frame " + std::to_string(f) +
+                    " - 1 within the trace's " + std::to_string(rays) + " rays");
+        next += frames[f].rays;
+    }
+    require(next == rays, path + ": the frames hold " + std::to_string(next) + " of the trace's " +
+                              std::to_string(rays) + " rays");
+    return frames;
+}
+
+void check_frames_supported(const SimConfig& config, size_t frames, const std::string& trace) {
+    if (frames <= 1) return;
+    const std::string what = trace + ": an animated trace (" + std::to_string(frames) + " frames) ";
+    require(config.fidelity != Fidelity::analytic,
+            what + "replays at fidelity functional, approx or detailed; fidelity=analytic does not replay frames yet");
+    require(!config.sampling.enabled(), what + "is replayed whole; sampling does not cut frames yet (sampling.fraction)");
+    require(!config.treelets.enabled,
+            what + "is replayed without treelet scheduling; treelets.enabled=true does not hold frame barriers yet");
+}
+
+FrameRayStream::FrameRayStream(TraceReader& reader, std::vector<FrameRecord> frames)
+    : m_reader(reader), m_frames(std::move(frames)), m_total(reader.section(SectionKind::rays).record_count) {
+    begin_frame(0);
+}
+
+void FrameRayStream::begin_frame(uint32_t f) {
+    m_next = m_frames.at(f).first_ray;
+    m_end = m_next + m_frames[f].rays;
+}
+
+size_t FrameRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
+    const size_t n = size_t(std::min<uint64_t>(max, m_end - m_next));
+    if (n == 0) return 0;
+    read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
+    m_next += n;
+    return n;
+}
+
+FrameRecorder::FrameRecorder(const SimConfig& config, std::vector<FrameRecord> frames, json manifest_frames)
+    : m_config(config), m_frames(std::move(frames)), m_manifest_frames(std::move(manifest_frames)) {}
+
+namespace {
+
+json hit_rate(const MemCounters& now, const MemCounters& before) {
+    const double reads = double(now.reads - before.reads);
+    const double served = double(now.read_hits + now.merged - before.read_hits - before.merged);
+    return reads > 0 ? json(served / reads) : json(nullptr);
+}
+
+}  // namespace
+
+void FrameRecorder::untimed() {
+    for (uint32_t f = 0; f < m_frames.size(); ++f) {
+        frame_end(f, 0, MemoryTotals{});
+        for (const char* key : {"start_cycle", "end_cycle", "cycles", "mrays_per_second", "dram_bytes",
+                                "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate"})
+            m_out.back()[key] = nullptr;
+    }
+}
+
+void FrameRecorder::frame_end(uint32_t f, Cycle cycle, const MemoryTotals& totals) {
+    const uint64_t rays = m_frames.at(f).rays;
+    const Cycle cycles = cycle - std::min(cycle, m_last_cycle);
+    const double seconds = double(cycles) / (m_config.clock_ghz * 1e9);
+    const double dram = double(totals.dram.read_bytes + totals.dram.write_bytes - m_last.dram.read_bytes -
+                               m_last.dram.write_bytes);
+    json tlas_ms = nullptr, tlas_nodes = nullptr;
+    if (m_manifest_frames.is_object() && m_manifest_frames.contains("per_frame") &&
+        f < m_manifest_frames["per_frame"].size()) {
+        tlas_ms = m_manifest_frames["per_frame"][f].value("tlas_build_ms", json(nullptr));
+        tlas_nodes = m_manifest_frames["per_frame"][f].value("tlas_nodes", json(nullptr));
+    }
+    const bool memory = !m_config.ideal_memory;
+    m_out.push_back({{"frame", f},
+                     {"rays", rays},
+                     {"first_ray", m_frames[f].first_ray},
+                     {"start_cycle", m_last_cycle},
+                     {"end_cycle", cycle},
+                     {"cycles", cycles},
+                     {"mrays_per_second", seconds > 0 ? double(rays) / seconds / 1e6 : 0.0},
+                     {"dram_bytes", dram},
+                     {"dram_bytes_per_ray", rays ? dram / double(rays) : 0.0},
+                     {"l1_hit_rate", memory ? hit_rate(totals.l1, m_last.l1) : json(nullptr)},
+                     {"l2_hit_rate", memory ? hit_rate(totals.l2, m_last.l2) : json(nullptr)},
+                     {"tlas_nodes", tlas_nodes},
+                     {"tlas_build_ms", tlas_ms}});
+    m_last = totals;
+    m_last_cycle = cycle;
+}
+
+}  // namespace rtsim

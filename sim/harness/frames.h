@@ -1,0 +1,64 @@
+#pragma once
+// Animated traces in the harness (docs/model.md, "Frames"): the frame table read and checked
+// against the structure, the ray stream cut at frame ends, and each frame's figures (cycles,
+// Mrays/s, DRAM bytes per ray, cache hit rates) from the model's counters at the frame barrier.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rtl_model/top/top.h"
+#include "sim/config/config.h"
+#include "sim/harness/trace_stream.h"
+#include "traces/format/trace_reader.h"
+
+namespace rtsim {
+
+/// The trace's frames: its FRMS records, or one frame of every ray when it has none. Throws
+/// rtsim::Error naming the trace unless the frames are back to back, cover every ray and match
+/// the structure's frame count (`accel_frames`).
+std::vector<FrameRecord> read_frame_table(TraceReader& reader, uint32_t accel_frames);
+
+/// Refuses (rtsim::Error naming the field) what does not replay frames yet: the analytic level,
+/// sampling and treelet scheduling.
+void check_frames_supported(const SimConfig& config, size_t frames, const std::string& trace);
+
+/// Rays of the trace in order, each read ending at the current frame's last ray.
+class FrameRayStream : public RayStream {
+public:
+    FrameRayStream(TraceReader& reader, std::vector<FrameRecord> frames);
+    size_t read_chunk(size_t max, std::vector<RayJob>* out) override;
+    uint64_t total_rays() const override { return m_total; }
+    void begin_frame(uint32_t f) override;
+
+private:
+    TraceReader& m_reader;
+    std::vector<FrameRecord> m_frames;
+    uint64_t m_total = 0, m_next = 0, m_end = 0;
+    std::vector<RayRecord> m_buffer;
+};
+
+/// Each frame's figures, from the memory counters at its barrier (stats.json "frames").
+class FrameRecorder {
+public:
+    /// `manifest_frames`: the trace manifest's "frames" (TLAS build times), or null.
+    FrameRecorder(const SimConfig& config, std::vector<FrameRecord> frames, nlohmann::json manifest_frames);
+    /// Frame f's last ray finished at `cycle`; `totals` are the counters then.
+    void frame_end(uint32_t f, Cycle cycle, const MemoryTotals& totals);
+    /// The functional level: each frame's rays and TLAS build time, no timing.
+    void untimed();
+    /// [{frame, rays, start_cycle, cycles, mrays_per_second, dram_bytes_per_ray, l1_hit_rate,
+    ///   l2_hit_rate, tlas_build_ms, ...}] (docs/stats.md, "Frames").
+    const nlohmann::json& to_json() const { return m_out; }
+
+private:
+    const SimConfig& m_config;
+    std::vector<FrameRecord> m_frames;
+    nlohmann::json m_manifest_frames;
+    MemoryTotals m_last;
+    Cycle m_last_cycle = 0;
+    nlohmann::json m_out = nlohmann::json::array();
+};
+
+}  // namespace rtsim

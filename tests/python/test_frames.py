@@ -1,0 +1,141 @@
+"""Animated frames through the whole chain (docs/accel.md, "Frames"): `rtsim trace --frames N`
+on the grove writes one trace of N frames (BLAS regions once, a TLAS per frame, a FRMS table);
+frame 0 is the one-frame trace; `rtsim-sim` replays the frames in sequence with every hit
+checked and reports each frame's figures; what cannot be animated or replayed is refused with a
+message naming the scene or the field.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rtsim
+from conftest import run_rtsim
+from rtsim.launcher import SimNotFoundError, find_sim
+
+FRAMES, RESOLUTION, WORKLOAD = 3, "24x18", "primary,shadow,diffuse"
+
+
+@pytest.fixture(scope="module")
+def sim_exe() -> Path:
+    try:
+        return find_sim()
+    except SimNotFoundError as error:
+        pytest.fail(str(error))
+
+
+def trace(out: Path, *extra: str) -> subprocess.CompletedProcess[str]:
+    return run_rtsim("trace", "grove", "-o", str(out), "--resolution", RESOLUTION,
+                     "--workload", WORKLOAD, *extra)  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def traces(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """(the grove over FRAMES frames, the grove's one-frame trace)."""
+    root = tmp_path_factory.mktemp("frames")
+    for name, extra in (("animated", ["--frames", str(FRAMES)]), ("still", [])):
+        result = trace(root / name, *extra)
+        assert result.returncode == 0, result.stderr
+    return root / "animated", root / "still"
+
+
+def simulate(sim: Path, folder: Path, out: Path, *sets: str) -> subprocess.CompletedProcess[str]:
+    cmd = [str(sim), str(folder), "-o", str(out)]
+    for s in sets:
+        cmd += ["--set", s]
+    return subprocess.run(cmd, capture_output=True, text=True, check=False)
+
+
+def test_manifest_and_image(traces: tuple[Path, Path]) -> None:
+    animated, still = traces
+    manifest = json.loads((animated / "manifest.json").read_text())
+    frames = manifest["frames"]
+    assert frames["count"] == FRAMES and "spin" in frames["motion"]
+    assert frames["blas_build_ms"] > 0
+    per = frames["per_frame"]
+    assert [f["frame"] for f in per] == list(range(FRAMES))
+    assert all(f["tlas_build_ms"] > 0 and f["tlas_nodes"] > 0 for f in per)
+    assert per[0]["first_ray"] == 0 and per[1]["first_ray"] == per[0]["rays"]
+    trace = rtsim.open_trace(animated)
+    assert len(trace.rays) == sum(f["rays"] for f in per)
+    assert manifest["accel"]["stats"]["frames"] == FRAMES if "stats" in manifest["accel"] else True
+    # Frame 0 is the one-frame trace: the same rays and the same reference hits, bit for bit.
+    one = rtsim.open_trace(still)
+    n = per[0]["rays"]
+    assert n == len(one.rays)
+    assert np.array_equal(trace.rays[:n].view(np.uint8), one.rays.view(np.uint8))
+    assert np.array_equal(trace.hits[:n].view(np.uint8), one.hits.view(np.uint8))
+    # Later frames differ: the trees moved.
+    assert not np.array_equal(trace.hits[n : 2 * n]["t"], one.hits["t"])
+
+
+@pytest.mark.parametrize("level", ["approx", "detailed", "functional"])
+def test_replay_checks_every_hit_of_every_frame(
+    traces: tuple[Path, Path], sim_exe: Path, tmp_path: Path, level: str
+) -> None:
+    animated, _ = traces
+    result = simulate(sim_exe, animated, tmp_path / "run", f"fidelity={level}")
+    assert result.returncode == 0, result.stderr
+    stats = json.loads((tmp_path / "run" / "stats.json").read_text())
+    s = stats["summary"]
+    assert s["frames"] == FRAMES and s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+    frames = stats["frames"]
+    assert [f["frame"] for f in frames] == list(range(FRAMES))
+    assert sum(f["rays"] for f in frames) == s["rays"]
+    if level == "functional":
+        assert all(f["cycles"] is None for f in frames)
+        return
+    # Frames follow one another: each starts when the previous one's last ray finished.
+    assert frames[0]["start_cycle"] == 0
+    for a, b in itertools.pairwise(frames):
+        assert b["start_cycle"] == a["end_cycle"] and b["end_cycle"] > a["end_cycle"]
+    assert frames[-1]["end_cycle"] == s["cycles"]
+    assert all(f["mrays_per_second"] > 0 and 0 < f["l1_hit_rate"] <= 1 for f in frames)
+    total_dram = sum(f["dram_bytes"] for f in frames)
+    assert total_dram == pytest.approx(s["dram_bytes"])
+    # Warm caches: later frames move fewer DRAM bytes per ray than the cold first frame.
+    assert min(f["dram_bytes_per_ray"] for f in frames[1:]) < frames[0]["dram_bytes_per_ray"]
+
+
+def test_one_frame_trace_has_one_frame_entry(
+    traces: tuple[Path, Path], sim_exe: Path, tmp_path: Path
+) -> None:
+    _, still = traces
+    result = simulate(sim_exe, still, tmp_path / "run")
+    assert result.returncode == 0, result.stderr
+    stats = json.loads((tmp_path / "run" / "stats.json").read_text())
+    assert stats["summary"]["frames"] == 1
+    [frame] = stats["frames"]
+    assert frame["cycles"] == stats["summary"]["cycles"] and frame["tlas_build_ms"] is None
+
+
+@pytest.mark.parametrize(
+    ("sets", "field"),
+    [
+        (["fidelity=analytic"], "fidelity=analytic"),
+        (["treelets.enabled=true"], "treelets.enabled"),
+        (["sampling.fraction=0.5"], "sampling"),
+    ],
+)
+def test_replay_refuses_what_does_not_hold_frames(
+    traces: tuple[Path, Path], sim_exe: Path, tmp_path: Path, sets: list[str], field: str
+) -> None:
+    animated, _ = traces
+    result = simulate(sim_exe, animated, tmp_path / "run", *sets)
+    assert result.returncode == 2, result.stderr
+    assert field in result.stderr and "animated trace" in result.stderr
+
+
+def test_trace_refuses_frames_without_instancing_or_with_flatten(tmp_path: Path) -> None:
+    result = run_rtsim("trace", "cornell", "-o", str(tmp_path / "c"), "--frames", "4",
+                       "--resolution", "8x6")  # fmt: skip
+    assert result.returncode != 0
+    assert "--frames 4" in result.stderr and "places no geometry more than once" in result.stderr
+    result = trace(tmp_path / "f", "--frames", "2", "--flatten")
+    assert result.returncode != 0 and "--flatten" in result.stderr
