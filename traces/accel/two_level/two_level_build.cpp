@@ -260,8 +260,11 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
         node_total += f.tlas.nodes.size();
         record_total += f.records.size();
     }
-    Region& nodes = image.add_region("tlas_nodes", DataKind::node, sizeof(HwNode), node_total);
-    Region& records = image.add_region("instances", DataKind::instance, sizeof(InstanceRecord), record_total);
+    // (References taken after both regions exist: adding a region may move the others.)
+    image.add_region("tlas_nodes", DataKind::node, sizeof(HwNode), node_total);
+    image.add_region("instances", DataKind::instance, sizeof(InstanceRecord), record_total);
+    Region& nodes = image.regions[image.regions.size() - 2];
+    Region& records = image.regions.back();
     for (size_t f = 0; f < frames.size(); ++f) {
         std::memcpy(nodes.records<HwNode>() + frame_list[f]["tlas_first"].get<uint64_t>(), frames[f].tlas.nodes.data(),
                     frames[f].tlas.nodes.size() * sizeof(HwNode));
