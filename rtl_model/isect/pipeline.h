@@ -31,6 +31,7 @@ public:
     uint64_t issues() const { return m_issues; }
     uint64_t tests() const { return m_tests; }
     uint32_t pipelines() const { return m_shared ? m_config.shared_count : 1; }
+    bool shared() const { return m_shared; }
     /// Issues over time (capacity: pipelines() / initiation_interval per cycle).
     const UsageSeries& issue_use() const { return m_issue_use; }
     double issue_capacity() const { return double(pipelines()) / m_config.initiation_interval; }

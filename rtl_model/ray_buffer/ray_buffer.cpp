@@ -9,7 +9,7 @@ namespace rtsim {
 
 RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const LocalityPartition& partition,
                      const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts,
-                     uint32_t state_bytes)
+                     uint32_t state_bytes, Cycle lookahead)
     : sc_core::sc_module(name),
       m_config(config),
       m_partition(partition),
@@ -22,8 +22,10 @@ RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, 
       m_queues(partition.treelets.size()),
       m_unit_treelet(units, -1),
       m_admit_slots(config.admit_outstanding, 0),
+      m_lookahead(lookahead),
       m_sram(16ull * config.bytes_per_cycle, 16),
       m_by_size(config.policy == TreeletPolicy::largest ? uint32_t(partition.treelets.size()) : 1) {
+    SC_THREAD(admission);
     require(config.policy != TreeletPolicy::largest || partition.treelets.size() <= SizeTree::kMaxSlots,
             "ray buffer: " + std::to_string(partition.treelets.size()) + " treelets, at most " +
                 std::to_string(SizeTree::kMaxSlots) + " (raise treelets.treelet_kib)");
@@ -58,13 +60,20 @@ void RayBuffer::push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time) 
     index(treelet);
 }
 
-void RayBuffer::admit(Cycle time) {
+bool RayBuffer::has_room() const {
+    // By default (no explicit limit) admission also waits for SRAM room, so it never overflows.
+    // It leaves one entry free: a unit parks a ray and takes the next in one step, so the SRAM
+    // briefly holds one more than before (a full SRAM would overflow that ray to memory).
+    const bool may_overflow = m_config.max_rays_in_flight != 0;
+    const uint64_t reserve = m_capacity > 1 ? 1 : 0;
+    return m_in_machine < m_max_in_flight && (may_overflow || m_occupancy + reserve < m_capacity);
+}
+
+void RayBuffer::admit_until(Cycle time, Cycle horizon) {
     // New rays enter the queue of their first step's treelet (the root treelet for a tree)
     // while the machine holds fewer than the limit.
     RayJob job;
-    // By default (no explicit limit) admission also waits for SRAM room, so it never overflows.
-    const bool may_overflow = m_config.max_rays_in_flight != 0;
-    while (!m_dispatch_empty && m_in_machine < m_max_in_flight && (may_overflow || m_occupancy < m_capacity)) {
+    while (!m_dispatch_empty && has_room() && next_admit_issue(time) <= horizon) {
         if (!rays->next_ray(RaySourceIf::kAnyUnit, &job)) {
             m_dispatch_empty = true;
             break;
@@ -73,14 +82,38 @@ void RayBuffer::admit(Cycle time) {
         s.stepper = m_steppers.acquire();
         s.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
         s.ray_id = job.id;
-        s.start = time;
         const uint32_t first = s.stepper->plan().locality;
         const uint32_t treelet = first == kNoLocality ? m_partition.root_group : m_partition.group_of[first];
-        const Cycle fetched = fetch_ray_record(job.id, time);
-        push(treelet, std::move(s), fetched, time);
+        const Cycle issue = next_admit_issue(time);
+        s.start = issue;
+        const Cycle fetched = fetch_ray_record(job.id, issue);
+        push(treelet, std::move(s), fetched, issue);
         ++m_admitted;
         ++m_in_machine;
     }
+}
+
+void RayBuffer::admission() {
+    // The engine streams: it issues a read only when the read's cycle is at most a lookahead
+    // past SystemC time, so the L2 and DRAM see its reads in time order with the units' own.
+    // (Until 2026-11-24 the first unit to ask admitted every ray at once, stamping thousands of
+    // reads up to 10^5 cycles into the future: at the detailed level those took the L2's MSHRs
+    // and the DRAM's slots ahead of the units' requests. docs/treelets.md, "Admission".)
+    for (;;) {
+        const Cycle now = sc_core::sc_time_stamp().value();
+        admit_until(now, now + m_lookahead);
+        if (m_dispatch_empty) return;
+        if (!has_room()) {
+            wait(m_room);
+            continue;
+        }
+        const Cycle next = next_admit_issue(now);  // > now + lookahead: sleep until it is near
+        wait(sc_core::sc_time::from_value(next - m_lookahead - now));
+    }
+}
+
+Cycle RayBuffer::next_admit_issue(Cycle time) const {
+    return std::max({time, *std::min_element(m_admit_slots.begin(), m_admit_slots.end()), m_admit_next});
 }
 
 Cycle RayBuffer::fetch_ray_record(uint64_t ray_id, Cycle time) {
@@ -152,7 +185,6 @@ int64_t RayBuffer::pick(uint32_t) {
 bool RayBuffer::take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) {
     int64_t& current = m_unit_treelet[unit];
     if (current < 0 || m_queues[current].empty()) {
-        admit(time);
         current = pick(unit);
         if (current < 0) return false;
     }
@@ -167,6 +199,7 @@ bool RayBuffer::take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet
     } else {
         *ready = sram(std::max(time, w.ready));
         --m_occupancy;
+        wake_admission();  // SRAM room
     }
     unindex(uint32_t(current));
     m_queues[current].pop_front();
@@ -181,7 +214,15 @@ Cycle RayBuffer::park(uint32_t treelet, RayState&& ray, Cycle time) {
     return m_queues[treelet].back().ready;
 }
 
-void RayBuffer::finished(Cycle) { --m_in_machine; }
+void RayBuffer::finished(Cycle) {
+    --m_in_machine;
+    wake_admission();
+}
+
+void RayBuffer::wake_admission() {
+    // (Module tests drive the buffer without a running simulation, where SystemC refuses events.)
+    if (sc_core::sc_is_running()) m_room.notify();
+}
 
 nlohmann::json RayBuffer::stats_json() const {
     const auto& t = m_partition.treelets;

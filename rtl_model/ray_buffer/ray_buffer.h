@@ -6,6 +6,8 @@
 //   max_rays_in_flight rays are in the machine (default: what the SRAM and the ray contexts hold,
 //   so nothing overflows); their ray record is read from memory on the way in. Admitting more
 //   makes longer queues (more rays share each treelet load) at the price of overflow traffic.
+//   An admission engine (a process of its own) streams the record reads in time: one per cycle,
+//   at most admit_outstanding in flight, at most a quantum ahead of SystemC time.
 // - A unit whose treelet queue runs dry asks the scheduler for another: by policy (largest queue,
 //   oldest waiting ray, round robin) among queues of at least `threshold` rays, or — when no
 //   queue is that long — the policy's best non-empty queue, so the machine always makes progress
@@ -39,10 +41,18 @@ public:
     sc_core::sc_port<MemIf> mem;          ///< ray records in, overflow out (the L2)
 
     /// units x ray_contexts: the rays the traversal units hold; state_bytes: ray_state_bytes().
+    /// lookahead: how far past SystemC time the admission engine may issue reads (the units'
+    /// quantum: 1 cycle at the detailed level, where the L2 and DRAM see requests in time order).
     RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const LocalityPartition& partition,
-              const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts, uint32_t state_bytes);
+              const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts, uint32_t state_bytes,
+              Cycle lookahead);
 
     bool take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) override;
+    /// The admission engine up to `horizon`, asked at `time`: issues, in order, every ray-record
+    /// read that can leave at or before `horizon` (one per cycle from `time` on, at most
+    /// admit_outstanding in flight) while the machine has room, and queues those rays. The
+    /// engine's own process calls it with horizon = SystemC time + lookahead; tests call it.
+    void admit_until(Cycle time, Cycle horizon);
     Cycle park(uint32_t treelet, RayState&& ray, Cycle time) override;
     void finished(Cycle time) override;
     bool done() const override { return m_dispatch_empty && m_in_machine == 0; }
@@ -59,7 +69,13 @@ private:
         bool overflowed;   ///< state lives in memory, not in the SRAM
         uint64_t slot;     ///< overflow slot
     };
-    void admit(Cycle time);
+    SC_HAS_PROCESS(RayBuffer);
+    /// The admission engine's process: streams ray-record reads in time (docs/treelets.md).
+    void admission();
+    bool has_room() const;
+    void wake_admission();  ///< a ray left the machine or the SRAM: the engine may go on
+    /// Cycle the admission engine can issue its next ray-record read, asked at `time`.
+    Cycle next_admit_issue(Cycle time) const;
     /// Reads a new ray's record through the admission engine: one read issued per cycle, at
     /// most admit_outstanding in flight (a burst of thousands of reads at one cycle would
     /// otherwise swamp the L2's MSHRs). Returns the cycle the record arrives.
@@ -81,6 +97,8 @@ private:
     std::vector<int64_t> m_unit_treelet;
     std::vector<Cycle> m_admit_slots;  ///< completion cycle of each admission read slot
     Cycle m_admit_next = 0;            ///< earliest cycle the next admission read can issue
+    Cycle m_lookahead;                 ///< the engine issues reads at most this far past SystemC time
+    sc_core::sc_event m_room;          ///< a ray left the machine or the SRAM: admission may go on
     BandwidthCalendar m_sram;
     std::vector<uint64_t> m_free_slots;
     uint64_t m_next_slot = 0;

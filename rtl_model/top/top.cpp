@@ -32,6 +32,13 @@ Top::Top(sc_core::sc_module_name name, const SimConfig& config, const Accel& acc
     build_memory();
     build_pipelines(accel);
     build_ray_buffer(accel, map);
+    // Detailed (quantum 1) with private pipelines: a unit's operations phases touch only its own
+    // blocks, so they need not wait for SystemC time (docs/model.md, "Detailed level").
+    bool private_ops = true;
+    for (const auto& pipes : m_pipes)
+        for (const auto& p : pipes) private_ops = private_ops && p->pipelines() == 1 && !p->shared();
+    m_unit_context.sync_private_steps =
+        !(m_config.fidelity == Fidelity::detailed && private_ops && !m_config.treelets.enabled);
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
         auto unit = std::make_unique<TraversalUnit>(("tu" + std::to_string(u)).c_str(), config.traversal,
                                                     m_unit_context, map, m_steppers, u);
@@ -129,7 +136,8 @@ void Top::build_ray_buffer(const Accel& accel, const MemoryMap& map) {
     m_partition = accel.partition(uint64_t(t.treelet_kib) * 1024);
     const TraversalConfig& tc = m_config.traversal;
     m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", t, m_partition, map, m_steppers, tc.units, tc.ray_contexts,
-                                               ray_state_bytes(tc.stack_entries, tc.stack_entry_bytes));
+                                               ray_state_bytes(tc.stack_entries, tc.stack_entry_bytes),
+                                               m_config.quantum_cycles);
     m_ray_buffer->rays(*m_dispatch);
     if (m_ideal) m_ray_buffer->mem(*m_ideal);
     else m_ray_buffer->mem(*m_l2);

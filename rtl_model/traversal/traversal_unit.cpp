@@ -52,11 +52,14 @@ void TraversalUnit::run() {
         Cycle t = std::max(ready, m_sched_free);
         m_sched_free = t + m_config.issue_cycles;
         now = t;
-        sync(t);
+        // An operations phase on private pipelines touches nothing shared (stack spills sync
+        // themselves in stack_traffic()), so it may run ahead of SystemC time.
+        if (m_ctx.sync_private_steps || m_contexts[c].phase != Phase::ops) sync(t);
         advance(c, t);
         m_events.finish_pop();
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
         if (!m_treelet_mode && rays->frame() != m_frame) {  // a frame was released: fill every context
+            if (!m_ctx.sync_private_steps) sync(t);  // dispatch is shared: in time order at detailed
             m_frame = rays->frame();
             fill_idle_contexts(t);
         }
@@ -213,10 +216,12 @@ Cycle TraversalUnit::stack_traffic(uint32_t c, int before, Cycle t, Cycle ready)
     map_stack_change(
         ray.local_stack, ray.spilled, before, ray.stepper->stack_size(), m_config.stack_entries,
         [&](uint32_t slot) {  // full on-chip stack: the oldest entry goes to memory (posted)
+            if (!m_ctx.sync_private_steps) sync(t);  // the write goes on to the shared L2
             mem->access({m_map.stack(owner, slot, bytes), bytes, true, DataKind::stack, t});
             ++m_spill_writes;
         },
         [&](uint32_t slot) {  // on-chip stack empty but entries in memory: read one back first
+            if (!m_ctx.sync_private_steps) sync(t);  // may miss to the shared L2
             ++m_spill_reads;
             ready = std::max(ready, mem->access({m_map.stack(owner, slot, bytes), bytes, false, DataKind::stack, t}));
         });

@@ -37,6 +37,10 @@ struct UnitContext {
     uint32_t quantum_cycles = 256;    ///< how far the unit may run ahead of SystemC time
     uint32_t dispatch_latency = 2;    ///< cycles to receive a ray from dispatch
     uint32_t idle_poll_cycles = 32;   ///< treelet mode: how often an idle unit looks for rays
+    /// false: a step that touches only the unit's private blocks (its pipelines, no stack spill)
+    /// does not synchronise with SystemC time first (the detailed level with private pipelines:
+    /// shared blocks still see every request in time order, at half the synchronisations).
+    bool sync_private_steps = true;
 };
 
 class TraversalUnit : public sc_core::sc_module {

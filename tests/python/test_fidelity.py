@@ -139,3 +139,23 @@ def test_every_level_writes_the_same_summary_keys(hairball: Path, sim: Sim, tmp_
     assert all(k == keys["approx"] for k in keys.values()), {
         k: v ^ keys["approx"] for k, v in keys.items()
     }
+
+
+def test_detailed_synchronises_only_steps_that_reach_shared_blocks(
+    hairball: Path, sim: Sim, tmp_path: Path
+) -> None:
+    """Detailed with private pipelines: operations phases run without waiting for SystemC time
+    (docs/model.md); with shared pipelines every step synchronises. Hits are checked either way."""
+    syncs = {}
+    for name, settings in {
+        "private": [],
+        "shared": ["box.sharing=shared", "triangle.sharing=shared"],
+    }.items():
+        out = tmp_path / name
+        result = sim(hairball, out, "fidelity=detailed", *settings)
+        assert result.returncode == 0, result.stderr
+        stats = stats_of(out)
+        assert stats["summary"]["hit_mismatches"] == 0 and stats["summary"]["work_mismatches"] == 0
+        units = stats["model"]["units"].values()
+        syncs[name] = sum(u["quantum_syncs"] for u in units) / sum(u["steps"] for u in units)
+    assert syncs["private"] < 0.75 * syncs["shared"]

@@ -55,8 +55,11 @@ std::unique_ptr<Accel> tiny_accel() {
 constexpr uint32_t kUnits = 2, kContexts = 16;
 
 struct Bench {
-    Bench(const TreeletConfig& c, uint64_t rays, uint32_t treelets, const std::string& tag)
-        : config(c),
+    /// lookahead: how far past the asking time admission may issue reads (default: unbounded).
+    Bench(const TreeletConfig& c, uint64_t rays, uint32_t treelets, const std::string& tag,
+          Cycle lookahead = Cycle(1) << 40)
+        : lookahead(lookahead),
+          config(c),
           partition(partition_of(treelets)),
           accel(tiny_accel()),
           map(accel->image().end_address(), rays, rays, 64, 8),
@@ -64,12 +67,19 @@ struct Bench {
           dispatch(("dispatch_" + tag).c_str(), rays),
           memory(("memory_" + tag).c_str(), 100),
           buffer(("ray_buffer_" + tag).c_str(), config, partition, map, steppers, kUnits, kContexts,
-                 ray_state_bytes(8, 8)) {
+                 ray_state_bytes(8, 8), lookahead) {
         buffer.rays(dispatch);
         buffer.mem(memory);
         kernel_elaborate();
     }
     void kernel_elaborate() { sc_core::sc_get_curr_simcontext()->elaborate(); }
+    /// A unit's take at cycle t, after the admission engine has run up to t + lookahead (its
+    /// process does that in a simulation; module tests have no sc_start).
+    bool take(uint32_t unit, Cycle t, RayState* ray, uint32_t* treelet, Cycle* ready) {
+        buffer.admit_until(t, t + lookahead);
+        return buffer.take(unit, t, ray, treelet, ready);
+    }
+    Cycle lookahead;
     TreeletConfig config;  ///< the buffer keeps a reference, as to Top's config
     LocalityPartition partition;
     std::unique_ptr<Accel> accel;
@@ -100,23 +110,24 @@ TEST(RayBuffer, AdmitsUpToCapacityAndOverflowsParkedRays) {
     RayState ray;
     uint32_t treelet = 0;
     Cycle ready = 0;
-    // The first take admits rays until the SRAM is full; take them all out.
+    // The engine admits rays until the SRAM is full but one entry (kept for a unit that parks a
+    // ray and takes the next in one step); take out as many rays as it holds.
     std::vector<RayState> held;
     for (uint64_t i = 0; i < capacity; ++i) {
-        ASSERT_TRUE(b.buffer.take(0, 10, &ray, &treelet, &ready));
+        ASSERT_TRUE(b.take(0, 10, &ray, &treelet, &ready));
         EXPECT_EQ(treelet, 0u);
         EXPECT_EQ(ray.ray_id, i);
         held.push_back(std::move(ray));
     }
-    EXPECT_EQ(b.buffer.max_occupancy(), capacity);
-    // The next take refills the SRAM (admission never overflows) and takes one: one slot free.
-    ASSERT_TRUE(b.buffer.take(0, 20, &ray, &treelet, &ready));
+    EXPECT_EQ(b.buffer.max_occupancy(), capacity - 1);
+    // The engine refills the SRAM (admission never overflows) and a take takes one: two free.
+    ASSERT_TRUE(b.take(0, 20, &ray, &treelet, &ready));
     EXPECT_EQ(ray.ray_id, capacity);
-    // Parking the held rays: one fits, the others overflow to memory as ray_buffer writes.
+    // Parking the held rays: two fit, the others overflow to memory as ray_buffer writes.
     for (RayState& r : held) b.buffer.park(2, std::move(r), 30);
     size_t overflow_writes = 0;
     for (const MemRequest& r : b.memory.requests) overflow_writes += r.write && r.kind == DataKind::ray_buffer;
-    EXPECT_EQ(overflow_writes, capacity - 1);
+    EXPECT_EQ(overflow_writes, capacity - 2);
     EXPECT_LE(b.buffer.max_occupancy(), b.buffer.capacity_rays());
     nlohmann::json s = b.buffer.stats_json();
     EXPECT_EQ(s["overflow_writes"].get<uint64_t>(), overflow_writes);
@@ -132,7 +143,7 @@ TEST(RayBuffer, AdmissionReadsAreStreamedNotBurst) {
     RayState ray;
     uint32_t treelet = 0;
     Cycle ready = 0;
-    ASSERT_TRUE(b.buffer.take(0, 1000, &ray, &treelet, &ready));
+    ASSERT_TRUE(b.take(0, 1000, &ray, &treelet, &ready));
     std::vector<Cycle> issued;
     for (const MemRequest& r : b.memory.requests)
         if (r.kind == DataKind::ray) issued.push_back(r.time);
@@ -145,6 +156,46 @@ TEST(RayBuffer, AdmissionReadsAreStreamedNotBurst) {
         }
     }
     EXPECT_GE(ready, 1000u + 100u);
+}
+
+TEST(RayBuffer, AdmissionIssuesNoReadBeyondTheLookahead) {
+    // With a lookahead of one cycle (the detailed level), the engine run at cycle t issues only the
+    // reads that can leave by t + 1; later runs stream on from there, still one read per cycle with
+    // at most admit_outstanding in flight, and every ray is admitted in the end.
+    test::TestKernel kernel;
+    TreeletConfig c = config_with(64, "largest", 1);
+    c.admit_outstanding = 4;
+    Bench b(c, 40, 4, "lookahead", 1);
+    RayState ray;
+    uint32_t treelet = 0;
+    Cycle ready = 0;
+    auto issued = [&] {
+        std::vector<Cycle> t;
+        for (const MemRequest& r : b.memory.requests)
+            if (r.kind == DataKind::ray) t.push_back(r.time);
+        return t;
+    };
+    ASSERT_TRUE(b.take(0, 1000, &ray, &treelet, &ready));
+    ASSERT_EQ(issued().size(), 2u);  // cycles 1000 and 1001
+    uint64_t taken = 1;
+    for (Cycle t = 1001; taken < 40 && t < 100000; t += 7) {
+        const size_t before = issued().size();
+        while (b.take(0, t, &ray, &treelet, &ready)) {
+            b.buffer.finished(t);
+            ++taken;
+        }
+        const std::vector<Cycle> now = issued();
+        for (size_t i = before; i < now.size(); ++i) EXPECT_LE(now[i], t + 1) << i;
+    }
+    EXPECT_EQ(taken, 40u);
+    const std::vector<Cycle> all = issued();
+    ASSERT_EQ(all.size(), 40u);
+    for (size_t i = 1; i < all.size(); ++i) {
+        EXPECT_GE(all[i], all[i - 1] + 1) << i;
+        if (i >= 4) {
+            EXPECT_GE(all[i], all[i - 4] + 100) << i;
+        }
+    }
 }
 
 TEST(RayBuffer, EveryRayIsHandedOutExactlyOnceUnderEveryPolicy) {
@@ -160,7 +211,7 @@ TEST(RayBuffer, EveryRayIsHandedOutExactlyOnceUnderEveryPolicy) {
             uint32_t treelet = 0;
             Cycle ready = 0, now = 0;
             for (int guard = 0; guard < 100000 && !b.buffer.done(); ++guard, now += 3) {
-                if (!b.buffer.take(guard % 2, now, &ray, &treelet, &ready)) continue;
+                if (!b.take(guard % 2, now, &ray, &treelet, &ready)) continue;
                 ++takes[ray.ray_id];
                 if (treelet == 0) {
                     b.buffer.park(1 + ray.ray_id % 5, std::move(ray), now + 1);
@@ -185,12 +236,12 @@ TEST(RayBuffer, LargestPolicyRunsTheLongestQueue) {
     Cycle ready = 0;
     std::vector<RayState> rays;
     for (int i = 0; i < 10; ++i) {
-        ASSERT_TRUE(b.buffer.take(0, 0, &ray, &treelet, &ready));
+        ASSERT_TRUE(b.take(0, 0, &ray, &treelet, &ready));
         rays.push_back(std::move(ray));
     }
     // 2 rays to treelet 1, 5 to treelet 2, 3 to treelet 3.
     for (int i = 0; i < 10; ++i) b.buffer.park(i < 2 ? 1 : i < 7 ? 2 : 3, std::move(rays[i]), 5);
-    ASSERT_TRUE(b.buffer.take(1, 10, &ray, &treelet, &ready));
+    ASSERT_TRUE(b.take(1, 10, &ray, &treelet, &ready));
     EXPECT_EQ(treelet, 2u);
     EXPECT_GE(ready, 10u);  // state read from the SRAM after it was written
 }
