@@ -256,6 +256,16 @@ class TreeletConfig:
         1,
         4096,
     )
+    quantum_cycles: int = _f(
+        16,
+        "cycles",
+        "At the approx level with treelets, the units (and the admission engine) run ahead of "
+        "each other by at most this many cycles (the smaller of this and quantum_cycles): "
+        "treelet queues' dynamics depend on the order of parks and takes, and longer quanta "
+        "made approx up to 37% off detailed (docs/fidelity.md)",
+        1,
+        1 << 20,
+    )
     max_rays_in_flight: int = _f(
         0,
         "rays",

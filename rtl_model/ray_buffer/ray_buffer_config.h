@@ -21,6 +21,7 @@ struct TreeletConfig {
     uint32_t idle_poll_cycles = 32;   ///< how often an idle unit looks for work again
     uint32_t max_rays_in_flight = 0;  ///< rays admitted at once (0: what the SRAM and contexts hold)
     uint32_t admit_outstanding = 16;  ///< ray-record reads in flight while admitting rays
+    uint32_t quantum_cycles = 16;     ///< approx with treelets: the units' quantum is at most this
 
     template <class V>
     void visit(V& v) {
@@ -34,6 +35,7 @@ struct TreeletConfig {
         v.field("idle_poll_cycles", idle_poll_cycles, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000);
         v.field("max_rays_in_flight", max_rays_in_flight, "rays", "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to DRAM (0: SRAM capacity plus the ray contexts, never overflows)", 0, 1u << 30);
         v.field("admit_outstanding", admit_outstanding, "reads", "Ray-record reads the ray buffer keeps in flight while admitting new rays (a streaming engine, one read issued per cycle)", 1, 4096);
+        v.field("quantum_cycles", quantum_cycles, "cycles", "At the approx level with treelets, the units (and the admission engine) run ahead of each other by at most this many cycles (the smaller of this and quantum_cycles): treelet queues' dynamics depend on the order of parks and takes, and longer quanta made approx up to 37% off detailed (docs/fidelity.md)", 1, 1u << 20);
     }
 };
 

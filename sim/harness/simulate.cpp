@@ -1,5 +1,6 @@
 #include "sim/harness/simulate.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -113,6 +114,9 @@ SimOutcome run_simulation(const SimOptions& o) {
     // order (docs/model.md, "The detailed level"); the resolved config keeps the user's value.
     SimConfig timed_config = o.config;
     if (o.config.fidelity == Fidelity::detailed) timed_config.quantum_cycles = 1;
+    // Approx with treelets: a shorter quantum (treelets.quantum_cycles; docs/fidelity.md).
+    else if (o.config.treelets.enabled)
+        timed_config.quantum_cycles = std::min(timed_config.quantum_cycles, o.config.treelets.quantum_cycles);
     if (o.config.fidelity == Fidelity::functional) {
         run_functional(*accel, reader, checker, frames);
         frame_figures.untimed();
