@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "traces/common/prefetch.h"
+
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -41,19 +43,15 @@ void Bvh2Stepper::begin(const Ray& ray, TraversalMode mode) {
 }
 
 void Bvh2Stepper::plan_next() {
-    // The host's copy of the data this step reads is prefetched now: whoever drives the stepper
-    // times the plan first (the model interleaves other rays meanwhile), so execute() finds it
-    // in the host's cache (the node load was the model's largest stall; docs/benchmarks.md).
+    // The host's copy of the data this step reads is prefetched now (traces/common/prefetch.h;
+    // the node load was the model's largest stall).
     if (m_count == 0) {
-        __builtin_prefetch(&m_view.nodes[m_ref]);
+        prefetch_range(&m_view.nodes[m_ref], sizeof(HwNode));
         m_plan.reset(m_ref);
         m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
         m_plan.add_op(OpKind::box, 2);
     } else {
-        const char* first = reinterpret_cast<const char*>(m_view.triangles + m_ref);
-        const size_t bytes = sizeof(HwTriangle) * m_count;
-        for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(first + b);
-        __builtin_prefetch(first + bytes - 1);
+        prefetch_range(m_view.triangles + m_ref, sizeof(HwTriangle) * m_count);
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
         m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
                          uint32_t(sizeof(HwTriangle) * m_count), DataKind::triangle);
