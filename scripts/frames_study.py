@@ -57,7 +57,8 @@ def table(manifest: dict[str, Any], stats: dict[str, Any], args: argparse.Namesp
         f"--resolution {args.resolution}`: `rtsim trace` of the workload the scene calls for, "
         f"then `rtsim-sim` at the default configuration ({s['fidelity']}), the frames replayed "
         f"in one process with caches warm. TLAS build: host wall time of the tracer "
-        f"({blas_ms:.0f} ms for the BLASes, once), on a 2-core machine shared with other jobs. "
+        f"({blas_ms:.0f} ms for the BLASes, once), on a 2-core machine (host times grow with "
+        "load). "
         f"{rays:,} rays in all; {mismatches}.",
         "",
         "| frame | rays | TLAS nodes | TLAS build ms | cycles | Mrays/s | DRAM B/ray "
