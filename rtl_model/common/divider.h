@@ -16,7 +16,6 @@ public:
     }
     uint64_t div(uint64_t x) const { return m_shift >= 0 ? x >> m_shift : x / m_divisor; }
     uint64_t mod(uint64_t x) const { return m_shift >= 0 ? x & (m_divisor - 1) : x % m_divisor; }
-    uint64_t divisor() const { return m_divisor; }
 
 private:
     uint64_t m_divisor;

@@ -42,8 +42,6 @@ public:
             m_key[n] = sibling_min;
         }
     }
-    /// Slot s's time without the tree (only valid for slots set with set()).
-    Cycle time_of(uint32_t s) const { return m_key[m_leaves + s] >> kSlotBits; }
     /// The earliest slot (lowest index among equal times) and its time.
     uint32_t top() const { return uint32_t(m_key[1] & (kMaxSlots - 1)); }
     Cycle top_time() const { return m_key[1] >> kSlotBits; }

@@ -13,14 +13,7 @@ nlohmann::json counters_json(const MemCounters& c) {
 
 MemCounters MemStats::total() const {
     MemCounters t;
-    for (const MemCounters& c : m_kinds) {
-        t.reads += c.reads;
-        t.writes += c.writes;
-        t.read_hits += c.read_hits;
-        t.merged += c.merged;
-        t.read_bytes += c.read_bytes;
-        t.write_bytes += c.write_bytes;
-    }
+    for (const MemCounters& c : m_kinds) t += c;
     return t;
 }
 

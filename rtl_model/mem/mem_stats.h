@@ -14,6 +14,16 @@ struct MemCounters {
     uint64_t read_hits = 0;       ///< reads served by this level (line present and filled)
     uint64_t merged = 0;          ///< reads of a line still being filled (hit under miss)
     uint64_t read_bytes = 0, write_bytes = 0;
+
+    MemCounters& operator+=(const MemCounters& o) {
+        reads += o.reads;
+        writes += o.writes;
+        read_hits += o.read_hits;
+        merged += o.merged;
+        read_bytes += o.read_bytes;
+        write_bytes += o.write_bytes;
+        return *this;
+    }
 };
 
 class MemStats {

@@ -21,7 +21,7 @@ RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, 
                                                 : m_capacity + uint64_t(units) * ray_contexts),
       m_queues(partition.treelets.size()),
       m_unit_treelet(units, -1),
-      m_admit_slots(config.admit_outstanding, 0),
+      m_admit_slots(config.admit_outstanding, 0),  // (the config allows at most MinTree::kMaxSlots)
       m_lookahead(lookahead),
       m_sram(16ull * config.bytes_per_cycle, 16),
       m_by_size(config.policy == TreeletPolicy::largest ? uint32_t(partition.treelets.size()) : 1) {
@@ -113,15 +113,14 @@ void RayBuffer::admission() {
 }
 
 Cycle RayBuffer::next_admit_issue(Cycle time) const {
-    return std::max({time, *std::min_element(m_admit_slots.begin(), m_admit_slots.end()), m_admit_next});
+    return std::max({time, m_admit_slots.top_time(), m_admit_next});
 }
 
-Cycle RayBuffer::fetch_ray_record(uint64_t ray_id, Cycle time) {
-    auto slot = std::min_element(m_admit_slots.begin(), m_admit_slots.end());
-    const Cycle issue = std::max({time, *slot, m_admit_next});
+Cycle RayBuffer::fetch_ray_record(uint64_t ray_id, Cycle issue) {
     m_admit_next = issue + 1;
-    *slot = mem->access({m_map.ray(ray_id), sizeof(RayRecord), false, DataKind::ray, issue});
-    return *slot;
+    const Cycle arrives = mem->access({m_map.ray(ray_id), sizeof(RayRecord), false, DataKind::ray, issue});
+    m_admit_slots.set(m_admit_slots.top(), arrives);
+    return arrives;
 }
 
 void RayBuffer::unindex(uint32_t t) {

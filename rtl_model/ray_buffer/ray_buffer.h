@@ -76,10 +76,10 @@ private:
     void wake_admission();  ///< a ray left the machine or the SRAM: the engine may go on
     /// Cycle the admission engine can issue its next ray-record read, asked at `time`.
     Cycle next_admit_issue(Cycle time) const;
-    /// Reads a new ray's record through the admission engine: one read issued per cycle, at
-    /// most admit_outstanding in flight (a burst of thousands of reads at one cycle would
-    /// otherwise swamp the L2's MSHRs). Returns the cycle the record arrives.
-    Cycle fetch_ray_record(uint64_t ray_id, Cycle time);
+    /// Reads a new ray's record at `issue` (= next_admit_issue()) in the earliest free read slot:
+    /// one read issued per cycle, at most admit_outstanding in flight (a burst of thousands of
+    /// reads at one cycle would swamp the L2's MSHRs). Returns the cycle the record arrives.
+    Cycle fetch_ray_record(uint64_t ray_id, Cycle issue);
     void unindex(uint32_t treelet);
     void index(uint32_t treelet);
     void push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time);
@@ -95,7 +95,7 @@ private:
     uint64_t m_max_in_flight;
     std::vector<std::deque<Waiting>> m_queues;
     std::vector<int64_t> m_unit_treelet;
-    std::vector<Cycle> m_admit_slots;  ///< completion cycle of each admission read slot
+    MinTree m_admit_slots;             ///< completion cycle of each admission read slot
     Cycle m_admit_next = 0;            ///< earliest cycle the next admission read can issue
     Cycle m_lookahead;                 ///< the engine issues reads at most this far past SystemC time
     sc_core::sc_event m_room;          ///< a ray left the machine or the SRAM: admission may go on

@@ -36,7 +36,7 @@ Top::Top(sc_core::sc_module_name name, const SimConfig& config, const Accel& acc
     // blocks, so they need not wait for SystemC time (docs/model.md, "Detailed level").
     bool private_ops = true;
     for (const auto& pipes : m_pipes)
-        for (const auto& p : pipes) private_ops = private_ops && p->pipelines() == 1 && !p->shared();
+        for (const auto& p : pipes) private_ops = private_ops && !p->shared();
     m_unit_context.sync_private_steps =
         !(m_config.fidelity == Fidelity::detailed && private_ops && !m_config.treelets.enabled);
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
@@ -161,20 +161,9 @@ void Top::warm(uint32_t unit, uint64_t addr, uint32_t bytes) {
         if (!l1.warm(lo, uint32_t(line))) m_l2->warm(lo, uint32_t(line));
 }
 
-namespace {
-void add(MemCounters& into, const MemCounters& c) {
-    into.reads += c.reads;
-    into.writes += c.writes;
-    into.read_hits += c.read_hits;
-    into.merged += c.merged;
-    into.read_bytes += c.read_bytes;
-    into.write_bytes += c.write_bytes;
-}
-}  // namespace
-
 MemoryTotals Top::memory_totals() const {
     MemoryTotals t;
-    for (const auto& l1 : m_l1) add(t.l1, l1->stats().total());
+    for (const auto& l1 : m_l1) t.l1 += l1->stats().total();
     if (m_l2) t.l2 = m_l2->stats().total();
     if (m_dram) t.dram = m_dram->stats().total();
     return t;

@@ -1,7 +1,9 @@
-"""Shared fixtures: the cornell scene, the shared scene folder, and one small traced folder."""
+"""Shared fixtures: the cornell scene, the shared scene folder, one small traced folder, and the
+rtsim-sim the package runs (with a helper that runs it and returns the stats)."""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -11,6 +13,7 @@ from pathlib import Path
 import pytest
 
 import rtsim
+from rtsim.launcher import SimNotFoundError, find_sim
 
 REPO = Path(__file__).resolve().parents[2]
 TRACE_WIDTH, TRACE_HEIGHT = 64, 48
@@ -35,6 +38,29 @@ def run_rtsim(*args: str, cwd: Path | None = None) -> subprocess.CompletedProces
         timeout=600,
         check=False,
     )
+
+
+def sim_or_fail() -> Path:
+    """The rtsim-sim the package would run (rtsim.launcher.find_sim), or fail the test."""
+    try:
+        return find_sim()
+    except SimNotFoundError as error:
+        pytest.fail(str(error))
+
+
+@pytest.fixture(scope="session")
+def sim_exe() -> Path:
+    return sim_or_fail()
+
+
+def sim_stats(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict:
+    """Runs `rtsim-sim TRACE -o OUT --set ...`, asserts it succeeded and returns its stats.json."""
+    args = [str(sim_exe), str(trace), "-o", str(out)]
+    for s in sets:
+        args += ["--set", s]
+    result = subprocess.run(args, capture_output=True, text=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr
+    return json.loads((out / "stats.json").read_text())
 
 
 @pytest.fixture(scope="session")

@@ -7,17 +7,14 @@ per child and ceil(children / width) issues per node; the manifest records the s
 from __future__ import annotations
 
 import json
-import subprocess
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim
-from rtsim.launcher import SimNotFoundError, find_sim
+from conftest import run_rtsim, sim_stats
 
 KINDS = ["bvh4", "bvh6", "bvh8", "cwbvh6", "cwbvh8", "bvh8_octant", "cwbvh8_octant"]
 NODE_BYTES = {"bvh4": 128, "bvh6": 192, "bvh8": 256, "cwbvh6": 64, "cwbvh8": 80}
@@ -30,14 +27,6 @@ CONFIGS = {
     "stack_spills": ["traversal.stack_entries=1"],
 }
 SCENE, RESOLUTION, WORKLOAD = "cornell", "32x24", "primary,shadow,reflection,diffuse"
-
-
-@pytest.fixture(scope="module")
-def sim_exe() -> Path:
-    try:
-        return find_sim()
-    except SimNotFoundError as error:
-        pytest.fail(str(error))
 
 
 @pytest.fixture(scope="module")
@@ -60,22 +49,13 @@ def trace_of(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Path]:
     return trace
 
 
-def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    args = [str(sim_exe), str(trace), "-o", str(out)]
-    for s in sets:
-        args += ["--set", s]
-    result = subprocess.run(args, capture_output=True, text=True, timeout=300, check=False)
-    assert result.returncode == 0, result.stderr
-    return json.loads((out / "stats.json").read_text())
-
-
 @pytest.mark.parametrize("config", list(CONFIGS))
 @pytest.mark.parametrize("kind", KINDS)
 def test_model_replays_every_structure(
     trace_of: Callable[[str], Path], sim_exe: Path, tmp_path: Path, kind: str, config: str
 ) -> None:
     trace = trace_of(kind)
-    stats = simulate(sim_exe, trace, tmp_path / "run", *CONFIGS[config])
+    stats = sim_stats(sim_exe, trace, tmp_path / "run", *CONFIGS[config])
     summary, validation = stats["summary"], stats["validation"]
     assert summary["rays"] == validation["rays_checked"] == len(rtsim.open_trace(trace).rays) > 0
     assert summary["hit_mismatches"] == 0, validation["first_mismatches"]
@@ -108,7 +88,7 @@ def test_box_pipeline_tests_each_child_and_issues_per_width(
     trace_of: Callable[[str], Path], sim_exe: Path, tmp_path: Path, kind: str, width: int
 ) -> None:
     trace = trace_of(kind)
-    stats = simulate(sim_exe, trace, tmp_path / "run", f"box.width={width}")
+    stats = sim_stats(sim_exe, trace, tmp_path / "run", f"box.width={width}")
     pipes = stats["model"]["box"].values()
     tests, issues = sum(p["tests"] for p in pipes), sum(p["issues"] for p in pipes)
     work = rtsim.open_trace(trace).work

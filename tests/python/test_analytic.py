@@ -20,7 +20,6 @@ import pytest
 import test_model
 from test_model import Sim
 
-sim_exe = test_model.sim_exe
 sim = test_model.sim
 trace_of = test_model.trace_of
 

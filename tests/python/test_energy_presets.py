@@ -13,7 +13,6 @@ import test_model
 from rtsim.config import PRESETS, SimConfig, compose
 from test_model import Sim
 
-sim_exe = test_model.sim_exe
 sim = test_model.sim
 trace_of = test_model.trace_of
 cornell_small = test_model.cornell_small

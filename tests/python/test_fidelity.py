@@ -22,7 +22,6 @@ import test_model
 from test_model import Sim
 
 # The session fixtures of test_model.py (one rtsim-sim and one trace per scene).
-sim_exe = test_model.sim_exe
 sim = test_model.sim
 trace_of = test_model.trace_of
 

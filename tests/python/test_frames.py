@@ -17,17 +17,8 @@ import pytest
 
 import rtsim
 from conftest import run_rtsim
-from rtsim.launcher import SimNotFoundError, find_sim
 
 FRAMES, RESOLUTION, WORKLOAD = 3, "24x18", "primary,shadow,diffuse"
-
-
-@pytest.fixture(scope="module")
-def sim_exe() -> Path:
-    try:
-        return find_sim()
-    except SimNotFoundError as error:
-        pytest.fail(str(error))
 
 
 def trace(out: Path, *extra: str) -> subprocess.CompletedProcess[str]:

@@ -7,29 +7,19 @@ with treelets, i.e. its brick partition, and on an alpha-MASK scene, i.e. the an
 from __future__ import annotations
 
 import json
-import subprocess
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 import rtsim
-from conftest import run_rtsim
-from rtsim.launcher import SimNotFoundError, find_sim
+from conftest import run_rtsim, sim_stats
 
 STRUCTURES = {
     "grid": ["--accel", "grid"],
     "sbvh": ["--accel", "bvh2", "--builder", "sbvh"],
 }
 LEVELS = ("functional", "analytic", "approx", "detailed")
-
-
-@pytest.fixture(scope="module")
-def sim_exe() -> Path:
-    try:
-        return find_sim()
-    except SimNotFoundError as error:
-        pytest.fail(str(error))
 
 
 @pytest.fixture(scope="module")
@@ -49,12 +39,7 @@ def traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 
 def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    args = [str(sim_exe), str(trace), "-o", str(out)]
-    for s in sets:
-        args += ["--set", s]
-    result = subprocess.run(args, capture_output=True, text=True, timeout=300, check=False)
-    assert result.returncode == 0, result.stderr
-    stats = json.loads((out / "stats.json").read_text())
+    stats = sim_stats(sim_exe, trace, out, *sets)
     summary = stats["summary"]
     assert summary["hit_mismatches"] == 0, stats["validation"]["first_mismatches"]
     assert summary["work_mismatches"] == 0, stats["validation"]["first_mismatches"]

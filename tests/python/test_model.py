@@ -22,8 +22,6 @@ import pytest
 
 import rtsim
 from conftest import run_rtsim
-from rtsim.launcher import SimNotFoundError
-from rtsim.launcher import find_sim as sim_executable
 
 SIM_EXE = "rtsim-sim"
 RESOLUTION = "48x32"
@@ -63,19 +61,6 @@ CONFIGS = {
     ],
 }
 NOISE = 1.02  # timing comparisons allow 2% (rays interleave differently when timing changes)
-
-
-def find_sim() -> Path:
-    """The rtsim-sim the package would run (rtsim.launcher.find_sim), or fail the test."""
-    try:
-        return sim_executable()
-    except SimNotFoundError as error:
-        pytest.fail(str(error))
-
-
-@pytest.fixture(scope="session")
-def sim_exe() -> Path:
-    return find_sim()
 
 
 Sim = Callable[..., subprocess.CompletedProcess[str]]

@@ -5,15 +5,12 @@ treelets on every scene is in test_model.py (CONFIGS "treelets*")."""
 
 from __future__ import annotations
 
-import json
-import subprocess
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from conftest import run_rtsim
-from test_model import find_sim
+from conftest import run_rtsim, sim_or_fail, sim_stats
 
 
 @pytest.fixture(scope="module")
@@ -28,12 +25,7 @@ def hairball_diffuse(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def simulate(trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    args = [str(find_sim()), str(trace), "-o", str(out)]
-    for s in sets:
-        args += ["--set", s]
-    result = subprocess.run(args, capture_output=True, text=True, timeout=300, check=False)
-    assert result.returncode == 0, result.stderr
-    return json.loads((out / "stats.json").read_text())
+    return sim_stats(sim_or_fail(), trace, out, *sets)
 
 
 # (buffer KiB, rays admitted at once: 0 = what the SRAM and contexts hold, never overflowing)

@@ -8,17 +8,14 @@ pipeline; primary rays hit the same primitives and instances as the flattened tr
 from __future__ import annotations
 
 import json
-import subprocess
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim
-from rtsim.launcher import SimNotFoundError, find_sim
+from conftest import run_rtsim, sim_stats
 
 SCENES = ["SimpleInstancing", "MetalRoughSpheresNoTextures", "grove"]  # grove: procedural
 KINDS = ["bvh2", "bvh8"]
@@ -32,14 +29,6 @@ CONFIGS = {
     "shared_transform": ["transform.sharing=shared", "transform.shared_count=1"],
 }
 RESOLUTION, WORKLOAD = "32x24", "primary,shadow,reflection,diffuse"
-
-
-@pytest.fixture(scope="module")
-def sim_exe() -> Path:
-    try:
-        return find_sim()
-    except SimNotFoundError as error:
-        pytest.fail(str(error))
 
 
 @pytest.fixture(scope="module")
@@ -63,15 +52,6 @@ def trace_of(
         return made[key]
 
     return trace
-
-
-def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    args = [str(sim_exe), str(trace), "-o", str(out)]
-    for s in sets:
-        args += ["--set", s]
-    result = subprocess.run(args, capture_output=True, text=True, timeout=300, check=False)
-    assert result.returncode == 0, result.stderr
-    return json.loads((out / "stats.json").read_text())
 
 
 @pytest.mark.parametrize("scene", SCENES)
@@ -120,7 +100,7 @@ def test_model_replays_two_level_traces(
     config: str,
 ) -> None:
     trace = trace_of(scene, kind, False)
-    stats = simulate(sim_exe, trace, tmp_path / "run", *CONFIGS[config])
+    stats = sim_stats(sim_exe, trace, tmp_path / "run", *CONFIGS[config])
     summary, validation = stats["summary"], stats["validation"]
     assert summary["rays"] == validation["rays_checked"] == len(rtsim.open_trace(trace).rays) > 0
     assert summary["hit_mismatches"] == 0, validation["first_mismatches"]

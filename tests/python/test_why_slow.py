@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 
-from test_model import Sim, hairball, sim, sim_exe, trace_of  # noqa: F401  (fixtures)
+from test_model import Sim, hairball, sim, trace_of  # noqa: F401  (fixtures)
 
 
 def stats_of(run: Path) -> dict[str, Any]:

@@ -56,6 +56,17 @@ struct WorkCounts {
     uint32_t plane_tests = 0;  ///< ray/split-plane tests (kd-trees, BIH)
     uint32_t refs = 0;         ///< primitive references fetched (structures with index lists)
 
+    WorkCounts& operator+=(const WorkCounts& o) {
+        steps += o.steps;
+        box_tests += o.box_tests;
+        tri_tests += o.tri_tests;
+        anyhit_calls += o.anyhit_calls;
+        transforms += o.transforms;
+        cell_steps += o.cell_steps;
+        plane_tests += o.plane_tests;
+        refs += o.refs;
+        return *this;
+    }
     bool operator==(const WorkCounts& o) const {
         return steps == o.steps && box_tests == o.box_tests && tri_tests == o.tri_tests &&
                anyhit_calls == o.anyhit_calls && transforms == o.transforms &&

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers for the structure tests: every registered kind built through the registry (as the
 // tracer builds it), random rays around a scene, and bit-exact hit comparison.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -10,6 +11,8 @@
 #include "../isect/isect_test_util.h"
 #include "traces/accel/accel.h"
 #include "traces/accel/wide/wide_accel.h"
+#include "traces/common/error.h"
+#include "traces/scene/scene.h"
 
 namespace rtsim::test {
 
@@ -74,5 +77,28 @@ inline Hit trace_sse2(const Accel& accel, const Ray& r, TraversalMode mode, Work
 }
 
 inline const Region& triangles_of(const Accel& a) { return a.image().region("triangles"); }
+
+/// The message of the rtsim::Error `fn` throws, or "" when it does not throw.
+inline std::string error_of(const std::function<void()>& fn) {
+    try {
+        fn();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+/// A mesh of `triangles` small random triangles in [-1.3, 1.3]^3 (the two-level tests' BLASes).
+inline Mesh soup_mesh(uint64_t seed, int triangles) {
+    Rng rng(seed);
+    Mesh m;
+    m.name = "soup";
+    for (int i = 0; i < triangles; ++i) {
+        const Vec3 c = random_point(rng, Vec3(-1.0f), Vec3(1.0f));
+        for (int k = 0; k < 3; ++k) m.positions.push_back(c + 0.3f * random_point(rng, Vec3(-1.0f), Vec3(1.0f)));
+    }
+    m.materials.assign(m.positions.size() / 3, 0);
+    return m;
+}
 
 }  // namespace rtsim::test

@@ -16,15 +16,6 @@
 namespace rtsim {
 namespace {
 
-std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
-
 /// A coordinate of random magnitude: sign, exponent from 2^-120 to 2^120, mantissa; sometimes 0.
 float random_coordinate(Rng& rng) {
     if (rng.next() < 0.05f) return rng.next() < 0.5f ? 0.0f : -0.0f;
@@ -152,7 +143,7 @@ template <class Node>
 std::string corrupt(const AccelImage& good, const std::function<void(Node&)>& edit, uint32_t index = 0) {
     AccelImage bad = good;
     edit(bad.region("nodes").records<Node>()[index]);
-    return error_of([&] { load_accel(std::move(bad), "bad.rtt"); });
+    return test::error_of([&] { load_accel(std::move(bad), "bad.rtt"); });
 }
 
 TEST(Cwbvh, CorruptImagesAreRefusedByName) {
@@ -175,7 +166,7 @@ TEST(Cwbvh, CorruptImagesAreRefusedByName) {
            "references triangles");
     AccelImage bad_order = good8;
     bad_order.params["order"] = "random";
-    expect(error_of([&] { load_accel(std::move(bad_order), "p.rtt"); }), "p.rtt: cwbvh8: params.order");
+    expect(test::error_of([&] { load_accel(std::move(bad_order), "p.rtt"); }), "p.rtt: cwbvh8: params.order");
 
     o.kind = "cwbvh6";
     const AccelImage good6 = build_accel(scene, o);
@@ -194,7 +185,7 @@ TEST(Cwbvh, CorruptImagesAreRefusedByName) {
            "is in two leaves");
     AccelImage wrong_size = good4;
     wrong_size.region("nodes").record_bytes = 64;
-    expect(error_of([&] { load_accel(std::move(wrong_size), "w.rtt"); }), "w.rtt: bvh4 regions must hold 128-byte nodes");
+    expect(test::error_of([&] { load_accel(std::move(wrong_size), "w.rtt"); }), "w.rtt: bvh4 regions must hold 128-byte nodes");
 }
 
 }  // namespace

@@ -35,18 +35,6 @@ Mesh sphere_mesh(int stacks, int slices) {
     return m;
 }
 
-Mesh soup_mesh(uint64_t seed, int triangles) {
-    Rng rng(seed);
-    Mesh m;
-    m.name = "soup";
-    for (int i = 0; i < triangles; ++i) {
-        const Vec3 c = random_point(rng, Vec3(-1.0f), Vec3(1.0f));
-        for (int k = 0; k < 3; ++k) m.positions.push_back(c + 0.3f * random_point(rng, Vec3(-1.0f), Vec3(1.0f)));
-    }
-    m.materials.assign(m.positions.size() / 3, 0);
-    return m;
-}
-
 /// Instances of two meshes on a grid: rotations, non-uniform scales, mirrors (negative
 /// determinant), each under a parent transform as a nested node hierarchy composes it.
 Scene instanced_scene(int per_side) {

@@ -15,24 +15,12 @@
 namespace rtsim::test {
 namespace {
 
-Mesh soup(uint64_t seed, int triangles) {
-    Rng rng(seed);
-    Mesh m;
-    m.name = "soup";
-    for (int i = 0; i < triangles; ++i) {
-        const Vec3 c = random_point(rng, Vec3(-1.0f), Vec3(1.0f));
-        for (int k = 0; k < 3; ++k) m.positions.push_back(c + 0.3f * random_point(rng, Vec3(-1.0f), Vec3(1.0f)));
-    }
-    m.materials.assign(m.positions.size() / 3, 0);
-    return m;
-}
-
 /// A 3 x 3 grid of two shared meshes plus one mesh placed once (a "ground" that must not move).
 Scene grid_scene() {
     Scene s;
     s.source = "frames test scene";
     s.materials = {Material{}};
-    s.meshes = {soup(1, 40), soup(2, 30), soup(3, 10)};
+    s.meshes = {soup_mesh(1, 40), soup_mesh(2, 30), soup_mesh(3, 10)};
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
             s.instances.push_back(Instance{uint32_t((i + j) % 2),
@@ -48,15 +36,6 @@ std::vector<glm::dmat4> pose(const Scene& s, const SceneMotion& m, uint32_t fram
     std::vector<glm::dmat4> out;
     for (uint32_t i = 0; i < s.instances.size(); ++i) out.push_back(animated_transform(m, i, frame));
     return out;
-}
-
-std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
 }
 
 AccelOptions options() {

@@ -8,21 +8,6 @@ namespace rtsim {
 
 using detail::cull_distance;
 
-namespace {
-
-void add_work(WorkCounts& total, const WorkCounts& w) {
-    total.steps += w.steps;
-    total.box_tests += w.box_tests;
-    total.tri_tests += w.tri_tests;
-    total.anyhit_calls += w.anyhit_calls;
-    total.transforms += w.transforms;
-    total.cell_steps += w.cell_steps;
-    total.plane_tests += w.plane_tests;
-    total.refs += w.refs;
-}
-
-}  // namespace
-
 TwoLevelStepper::TwoLevelStepper(const TwoLevelAccel& accel) : m_accel(accel) {
     for (const auto& blas : accel.blases()) m_blas_steppers.push_back(blas->make_stepper());
 }
@@ -102,7 +87,7 @@ StepOutcome TwoLevelStepper::blas_step() {
 }
 
 void TwoLevelStepper::leave_instance() {
-    add_work(m_work, m_inner->work());
+    m_work += m_inner->work();
     const Hit& h = m_inner->hit();
     m_inner = nullptr;
     if (h.valid()) {
