@@ -47,7 +47,8 @@ SECTION_NOTES = {
     "for structures that issue cell steps (`grid`, docs/accel.md).",
     "l1": "The private per-unit L1 caches (MSHRs modelled exactly).",
     "l2": "The shared banked L2 (MSHRs: occupancy bound at approx, exact at detailed).",
-    "dram": "DRAM channels: bandwidth calendars plus a fixed latency.",
+    "dram": "DRAM channels: banks and row buffers behind each channel's data bus "
+    "(or bandwidth calendars only, `dram.model = bandwidth`).",
     "energy": "The first-order energy and area model, computed after a run from its counts "
     "(docs/energy_area.md gives every number's source): the technology node, the DRAM kind and "
     "the 45 nm reference figures (Horowitz 2014) it scales with Stillmaker & Baas (2017). "

@@ -87,30 +87,33 @@ class DramConfig:
     latency: int = _f(
         120,
         "cycles",
-        "Unloaded access latency (request to data; at detailed: to a closed bank)",
+        "Unloaded access latency, request to data (model banks: of an access to a closed bank)",
         1,
         100000,
+    )
+    model: str = _choice(
+        "banks",
+        ("banks", "bandwidth"),
+        "DRAM timing: banks and row buffers (hits, misses, conflicts) or channel bandwidth "
+        "calendars only (every access costs latency)",
     )
     interleave_bytes: int = _f(
         256, "bytes", "Channel interleaving granule (power of two, >= line size)", 64, 1 << 20
     )
-    # Banks and row buffers: used by fidelity = "detailed" only (docs/model.md).
-    banks: int = _f(16, "banks", "Banks per channel, one row buffer each (detailed only)", 1, 256)
+    # Banks and row buffers: used with model = "banks" (docs/model.md, "DRAM").
+    banks: int = _f(16, "banks", "Banks per channel, one row buffer each (model banks)", 1, 256)
     row_bytes: int = _f(
-        2048, "bytes", "Row (page) size of a bank (power of two; detailed only)", 64, 1 << 20
+        2048, "bytes", "Row (page) size of a bank (power of two; model banks)", 64, 1 << 20
     )
     page_policy: str = _choice(
         "open",
         ("open", "close"),
-        "Row buffer policy: keep rows open (row hits) or precharge after each access "
-        "(detailed only)",
+        "Row buffer policy: keep rows open (row hits) or precharge after each access (model banks)",
     )
-    t_rcd: int = _f(
-        14, "cycles", "Activate to column command, core cycles (detailed only)", 0, 10000
-    )
-    t_rp: int = _f(14, "cycles", "Precharge time, core cycles (detailed only)", 0, 10000)
+    t_rcd: int = _f(14, "cycles", "Activate to column command, core cycles (model banks)", 0, 10000)
+    t_rp: int = _f(14, "cycles", "Precharge time, core cycles (model banks)", 0, 10000)
     t_cas: int = _f(
-        14, "cycles", "Column command to first data, core cycles (detailed only)", 0, 10000
+        14, "cycles", "Column command to first data, core cycles (model banks)", 0, 10000
     )
 
 
@@ -360,7 +363,7 @@ class SimConfig:
         "approx",
         ("functional", "analytic", "approx", "detailed"),
         "Simulation level: functional (counts only), analytic (cache simulation + roofline), "
-        "approx (timed SystemC model) or detailed (per-cycle arbitration, L2 MSHRs, DRAM banks)",
+        "approx (timed SystemC model) or detailed (per-cycle arbitration, L2 MSHRs)",
     )
     quantum_cycles: int = _f(
         256,

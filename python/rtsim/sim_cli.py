@@ -26,7 +26,7 @@ FIDELITY_LEVELS = {
     "functional": "reference traversal, fetch and test counts, no time (fastest; hit check)",
     "analytic": "counts + functional caches + a closed-form roofline of pipelines and DRAM",
     "approx": "event-driven SystemC model of every block (the default)",
-    "detailed": "approx + per-cycle arbitration, L2 MSHRs, DRAM banks and row buffers",
+    "detailed": "approx + per-cycle arbitration, L2 MSHRs",
 }
 
 

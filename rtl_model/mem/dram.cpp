@@ -9,13 +9,13 @@ constexpr uint32_t kWindowCycles = 32;  // calendar granularity; bandwidth is ex
 constexpr size_t kTimelinePoints = 256;
 }  // namespace
 
-Dram::Dram(sc_core::sc_module_name name, const DramConfig& config, bool detailed)
+Dram::Dram(sc_core::sc_module_name name, const DramConfig& config)
     : sc_core::sc_module(name),
       m_config(config),
       m_interleave(config.interleave_bytes),
       m_channel_of(config.channels),
       m_transfer(config.bytes_per_cycle) {
-    if (detailed) {
+    if (config.model == DramModel::banks) {
         m_banks = std::make_unique<DramBanks>(config);
         return;
     }

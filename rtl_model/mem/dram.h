@@ -1,10 +1,10 @@
 #pragma once
-// DRAM: channels interleaved by address, each a bandwidth calendar of bytes per cycle, plus a
-// fixed latency. When requests exceed a channel's bandwidth they queue (start later), so the
-// delivered bandwidth saturates at channels x bytes_per_cycle (tested).
-// With `detailed`, timing comes from DramBanks instead (banks, row buffers, activate/precharge,
-// exact per-cycle data bus): `latency` is then the unloaded latency of an access to a closed bank,
-// split into tRCD + tCAS at the bank and a fixed front end of latency - tRCD - tCAS.
+// DRAM: channels interleaved by address. With model "banks" (the default) timing comes from
+// DramBanks (banks, row buffers, activate/precharge, exact per-cycle data bus): `latency` is the
+// unloaded latency of an access to a closed bank, split into tRCD + tCAS at the bank and a fixed
+// front end of latency - tRCD - tCAS. With model "bandwidth" each channel is a bandwidth calendar
+// of bytes per cycle plus a fixed latency: requests beyond a channel's bandwidth queue (start
+// later), so delivered bandwidth saturates at channels x bytes_per_cycle (tested).
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -21,7 +21,7 @@ namespace rtsim {
 
 class Dram : public sc_core::sc_module, public MemIf {
 public:
-    Dram(sc_core::sc_module_name name, const DramConfig& config, bool detailed = false);
+    Dram(sc_core::sc_module_name name, const DramConfig& config);
 
     Cycle access(const MemRequest& req) override;
 
@@ -34,7 +34,7 @@ public:
     double peak_bytes_per_cycle() const { return double(m_config.bytes_per_cycle) * m_config.channels; }
     uint64_t queue_cycles() const { return m_queue_cycles; }
     nlohmann::json stats_json(Cycle total_cycles, double clock_ghz) const;
-    /// The bank model (detailed only), else null.
+    /// The bank model (model "banks"), else null.
     const DramBanks* banks() const { return m_banks.get(); }
 
 private:

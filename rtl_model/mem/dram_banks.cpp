@@ -29,6 +29,29 @@ Cycle DramBanks::to_column(RowResult r) const {
     return 0;
 }
 
+uint32_t DramBanks::Bank::upper_bound(Cycle time) {
+    // Usually the answer is the end: look there first, then bisect.
+    if (size == 0 || at(size - 1).start <= time) return size;
+    uint32_t lo = 0, hi = size - 1;  // at(hi).start > time
+    while (lo < hi) {
+        const uint32_t mid = (lo + hi) / 2;
+        if (at(mid).start > time) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+void DramBanks::Bank::insert(uint32_t i, const Booking& b) {
+    for (uint32_t k = size; k > i; --k) at(k) = at(k - 1);
+    at(i) = b;
+    ++size;
+    if (size > kKept) {  // forget the oldest (requests never arrive that far out of order)
+        base_row = at(0).row;
+        head = (head + 1) & (kRing - 1);
+        --size;
+    }
+}
+
 DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time) {
     const DramAddress a = map(addr);
     Bank& bank = m_banks[size_t(a.channel) * m_config.banks + a.bank];
@@ -41,31 +64,25 @@ DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time) {
     };
     // The first idle gap at or after `time` long enough for this access, given the row the
     // access before it leaves open.
-    auto next = bank.busy.upper_bound(time);
+    uint32_t next = bank.upper_bound(time);
     uint64_t open = bank.base_row;
     Cycle s = time;
-    if (next != bank.busy.begin()) {
-        auto prev = std::prev(next);
-        open = prev->second.row;
-        s = std::max(s, prev->second.end);
+    if (next > 0) {
+        const Booking& prev = bank.at(next - 1);
+        open = prev.row;
+        s = std::max(s, prev.end);
     }
     RowResult result = outcome(open);
-    while (next != bank.busy.end() && s + to_column(result) + tail > next->first) {
-        s = std::max(s, next->second.end);
-        open = next->second.row;
+    for (; next < bank.size && s + to_column(result) + tail > bank.at(next).start; ++next) {
+        s = std::max(s, bank.at(next).end);
+        open = bank.at(next).row;
         result = outcome(open);
-        ++next;
     }
     Timing t;
     t.start = s;
     t.result = result;
     t.column = s + to_column(result);
-    bank.busy.emplace(s, Busy{t.column + tail, m_close_page ? kClosed : a.row});
-    // Forget old bookings (requests never arrive that far out of order).
-    while (bank.busy.size() > 64) {
-        bank.base_row = bank.busy.begin()->second.row;
-        bank.busy.erase(bank.busy.begin());
-    }
+    bank.insert(next, Booking{s, t.column + tail, m_close_page ? kClosed : a.row});
     // The burst takes the first free cycles of the channel's data bus from column + tCAS.
     SlotCalendar& bus = m_buses[a.channel];
     Cycle cycle = t.column + m_config.t_cas;

@@ -23,7 +23,6 @@
 // of the later, already booked access is not revised.
 // Pure C++ (no SystemC), owned by Dram.
 #include <cstdint>
-#include <map>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -69,14 +68,25 @@ public:
 
 private:
     static constexpr uint64_t kClosed = ~0ull;
-    struct Busy {
-        Cycle end;         ///< first idle cycle after this access
+    struct Booking {
+        Cycle start;       ///< cycle the bank starts this access
+        Cycle end;         ///< first idle cycle after it
         uint64_t row;      ///< row open after it (kClosed: precharged)
     };
+    /// The bank's recent bookings sorted by start, in a ring (requests arrive nearly in time
+    /// order, so a new booking goes at or near the end and the oldest is forgotten from the front).
     struct Bank {
-        std::map<Cycle, Busy> busy;    ///< booked accesses by start cycle (recent ones only)
+        static constexpr uint32_t kKept = 64;        ///< bookings remembered
+        static constexpr uint32_t kRing = 2 * kKept; ///< ring size (power of two, > kKept)
+        Booking ring[kRing];
+        uint32_t head = 0, size = 0;
         uint64_t base_row = kClosed;   ///< row open after the oldest forgotten access
         uint64_t counts[3] = {};       ///< hits, misses, conflicts
+        Booking& at(uint32_t i) { return ring[(head + i) & (kRing - 1)]; }
+        /// Index of the first booking starting after `time` (size if none).
+        uint32_t upper_bound(Cycle time);
+        /// Inserts at index i (shifting later ones), then forgets the oldest beyond kKept.
+        void insert(uint32_t i, const Booking& b);
     };
     /// Cycles from the start of service to the column command, for a row outcome.
     Cycle to_column(RowResult r) const;

@@ -1,5 +1,6 @@
 #pragma once
-// Configuration of the DRAM channels (banks and row buffers at the detailed level only).
+// Configuration of the DRAM channels: banks and row buffers (model "banks", the default, at the
+// approx and detailed levels) or plain channel bandwidth calendars (model "bandwidth").
 #include <cstdint>
 
 #include "rtl_model/common/choice.h"
@@ -9,12 +10,16 @@ namespace rtsim {
 enum class PagePolicy : uint8_t { open = 0, close = 1 };
 inline constexpr Choices<PagePolicy, 2> kPagePolicyChoices{{"open", "close"}};
 
+enum class DramModel : uint8_t { banks = 0, bandwidth = 1 };
+inline constexpr Choices<DramModel, 2> kDramModelChoices{{"banks", "bandwidth"}};
+
 struct DramConfig {
     uint32_t channels = 2;          ///< independent channels, interleaved every interleave_bytes
     uint32_t bytes_per_cycle = 16;  ///< peak bandwidth of one channel in bytes per core cycle
     uint32_t latency = 120;         ///< cycles from request to first data, unloaded
     uint32_t interleave_bytes = 256;///< address interleaving granule across channels
-    // Banks and row buffers: used by fidelity = "detailed" only (docs/model.md, detailed DRAM).
+    DramModel model = DramModel::banks;  ///< banks and row buffers, or bandwidth calendars only
+    // Banks and row buffers: used with model = "banks" (docs/model.md, "DRAM").
     uint32_t banks = 16;            ///< banks per channel, each with one row buffer
     uint32_t row_bytes = 2048;      ///< row (page) size per bank
     PagePolicy page_policy = PagePolicy::open;  ///< open: rows stay open; close: auto-precharge
@@ -26,14 +31,15 @@ struct DramConfig {
     void visit(V& v) {
         v.field("channels", channels, "channels", "Independent DRAM channels", 1, 64);
         v.field("bytes_per_cycle", bytes_per_cycle, "B/cycle", "Peak bandwidth per channel, bytes per core cycle", 1, 4096);
-        v.field("latency", latency, "cycles", "Unloaded access latency (request to data; at detailed: to a closed bank)", 1, 100000);
+        v.field("latency", latency, "cycles", "Unloaded access latency, request to data (model banks: of an access to a closed bank)", 1, 100000);
+        v.choice("model", model, kDramModelChoices, "DRAM timing: banks and row buffers (hits, misses, conflicts) or channel bandwidth calendars only (every access costs latency)");
         v.field("interleave_bytes", interleave_bytes, "bytes", "Channel interleaving granule (power of two, >= line size)", 64, 1u << 20);
-        v.field("banks", banks, "banks", "Banks per channel, one row buffer each (detailed only)", 1, 256);
-        v.field("row_bytes", row_bytes, "bytes", "Row (page) size of a bank (power of two; detailed only)", 64, 1u << 20);
-        v.choice("page_policy", page_policy, kPagePolicyChoices, "Row buffer policy: keep rows open (row hits) or precharge after each access (detailed only)");
-        v.field("t_rcd", t_rcd, "cycles", "Activate to column command, core cycles (detailed only)", 0, 10000);
-        v.field("t_rp", t_rp, "cycles", "Precharge time, core cycles (detailed only)", 0, 10000);
-        v.field("t_cas", t_cas, "cycles", "Column command to first data, core cycles (detailed only)", 0, 10000);
+        v.field("banks", banks, "banks", "Banks per channel, one row buffer each (model banks)", 1, 256);
+        v.field("row_bytes", row_bytes, "bytes", "Row (page) size of a bank (power of two; model banks)", 64, 1u << 20);
+        v.choice("page_policy", page_policy, kPagePolicyChoices, "Row buffer policy: keep rows open (row hits) or precharge after each access (model banks)");
+        v.field("t_rcd", t_rcd, "cycles", "Activate to column command, core cycles (model banks)", 0, 10000);
+        v.field("t_rp", t_rp, "cycles", "Precharge time, core cycles (model banks)", 0, 10000);
+        v.field("t_cas", t_cas, "cycles", "Column command to first data, core cycles (model banks)", 0, 10000);
     }
 };
 

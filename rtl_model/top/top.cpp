@@ -73,10 +73,11 @@ void Top::build_memory() {
                                   {"why", "ideal_memory: every access hits at L1 latency, no L2/DRAM"}});
         return;
     }
-    // The detailed level adds DRAM banks and row buffers, exact per-cycle cache banks and the
-    // L2's MSHRs (its units synchronise every cycle, so the shared L2 sees requests in time order).
+    // The detailed level adds exact per-cycle cache banks and the L2's MSHRs (its units
+    // synchronise every cycle, so the shared L2 sees requests in time order). DRAM banks and row
+    // buffers are modelled at both timed levels (dram.model).
     const bool detailed = c.fidelity == Fidelity::detailed;
-    m_dram = std::make_unique<Dram>("dram", c.dram, detailed);
+    m_dram = std::make_unique<Dram>("dram", c.dram);
     // At approx the L2 is reached out of time order within a quantum: its MSHRs bound outstanding
     // misses through an occupancy calendar (docs/model.md); the private L1s model theirs exactly.
     m_l2 = std::make_unique<Cache>("l2", c.l2, detailed, 0, detailed, ServedBy::l2);
@@ -90,9 +91,11 @@ void Top::build_memory() {
     m_instantiated.push_back({{"block", "memory"}, {"instantiated", true},
                               {"why", "per-unit L1, shared " + std::to_string(c.l2.banks) + "-bank L2, " +
                                           std::to_string(c.dram.channels) + " DRAM channels" +
-                                          (detailed ? " of " + std::to_string(c.dram.banks) + " banks (" +
-                                                          kPagePolicyChoices.name(c.dram.page_policy) + " page), L2 MSHRs"
-                                                    : std::string())}});
+                                          (c.dram.model == DramModel::banks
+                                               ? " of " + std::to_string(c.dram.banks) + " banks (" +
+                                                     kPagePolicyChoices.name(c.dram.page_policy) + " page)"
+                                               : std::string(" (bandwidth calendars)")) +
+                                          (detailed ? ", L2 MSHRs" : std::string())}});
 }
 
 void Top::build_pipelines(const Accel& accel) {

@@ -6,6 +6,7 @@ Hit equality of every level on every scene is in test_model.py (CONFIGS "functio
 - the analytic model never predicts faster than the physical roofline of its own inputs, on
   several configurations (bounds recomputed here from the counters it reports);
 - the detailed level reports DRAM row-buffer outcomes that add up, and models the L2's MSHRs;
+- approx models DRAM banks too, or bandwidth calendars with dram.model=bandwidth;
 - every level writes the same summary keys (null where a level cannot know).
 """
 
@@ -118,6 +119,39 @@ def test_detailed_reports_row_buffer_outcomes(hairball: Path, sim: Sim, tmp_path
     assert runs["close"]["model"]["dram"]["row_hits"] == 0
     assert runs["close"]["model"]["dram"]["row_conflicts"] == 0
     assert runs["open"]["model"]["dram"]["row_hits"] > 0
+
+
+def test_approx_models_dram_banks_unless_told_bandwidth(
+    hairball: Path, sim: Sim, tmp_path: Path
+) -> None:
+    """dram.model: banks and row buffers at approx by default; bandwidth calendars on request."""
+    runs = {}
+    for model in ("banks", "bandwidth"):
+        out = tmp_path / model
+        result = sim(hairball, out, "fidelity=approx", f"dram.model={model}")
+        assert result.returncode == 0, result.stderr
+        runs[model] = stats_of(out)
+    banks, bandwidth = runs["banks"]["model"]["dram"], runs["bandwidth"]["model"]["dram"]
+    assert (
+        banks["row_hits"] + banks["row_misses"] + banks["row_conflicts"]
+        == banks["reads"] + banks["writes"]
+    )
+    assert "row_hits" not in bandwidth
+    # About the same traffic (timing moves merges and evictions a little), different timing.
+    assert banks["read_bytes"] == pytest.approx(bandwidth["read_bytes"], rel=0.01)
+    assert runs["banks"]["summary"]["cycles"] != runs["bandwidth"]["summary"]["cycles"]
+
+
+def test_bank_timing_longer_than_the_latency_is_refused(
+    hairball: Path, sim: Sim, tmp_path: Path
+) -> None:
+    result = sim(hairball, tmp_path / "bad", "fidelity=approx", "dram.latency=20")
+    assert result.returncode != 0
+    assert "dram.latency" in result.stderr and "dram.model=bandwidth" in result.stderr
+    ok = sim(
+        hairball, tmp_path / "ok", "fidelity=approx", "dram.latency=20", "dram.model=bandwidth"
+    )
+    assert ok.returncode == 0, ok.stderr
 
 
 def test_every_level_writes_the_same_summary_keys(hairball: Path, sim: Sim, tmp_path: Path) -> None:

@@ -19,6 +19,7 @@ DramConfig two_channels() {
     c.bytes_per_cycle = 16;  // peak 32 B/cycle over both channels
     c.latency = uint32_t(kLatency);
     c.interleave_bytes = 256;
+    c.model = DramModel::bandwidth;  // these tests check the bandwidth calendars
     return c;
 }
 

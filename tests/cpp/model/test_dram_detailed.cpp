@@ -42,7 +42,7 @@ struct Step {
 void run_table(const DramConfig& config, const std::vector<Step>& table) {
     TestKernel kernel;
     DramBanks banks(config);
-    Dram dram("dram", config, true);
+    Dram dram("dram", config);
     for (size_t i = 0; i < table.size(); ++i) {
         const Step& s = table[i];
         DramBanks::Timing t = banks.access(s.addr, 64, s.arrive);
@@ -96,7 +96,7 @@ TEST(DramDetailed, ClosePageEveryAccessActivates) {
 
 TEST(DramDetailed, CountsRowOutcomesPerBank) {
     TestKernel kernel;
-    Dram dram("dram", small(), true);
+    Dram dram("dram", small());
     for (uint64_t addr : {0ull, 64ull, 2048ull, 1024ull, 2112ull}) dram.access({addr, 64, false, DataKind::node, 0});
     const nlohmann::json j = dram.stats_json(1000, 1.0);
     EXPECT_EQ(j["row_hits"], 2);
@@ -111,15 +111,17 @@ TEST(DramDetailed, CountsRowOutcomesPerBank) {
     EXPECT_EQ(j["reads"], 5);
 }
 
-TEST(DramDetailed, UnloadedClosedBankMatchesApproxLatency) {
-    // A closed-bank access costs exactly `latency + burst`, the approx model's unloaded latency.
+TEST(DramDetailed, UnloadedClosedBankMatchesBandwidthModelLatency) {
+    // A closed-bank access costs exactly `latency + burst`, the bandwidth model's unloaded latency.
     TestKernel kernel;
     DramConfig c = small("close");  // every access finds its bank closed
     c.channels = 2;
-    Dram approx("approx", c, false), detailed("detailed", c, true);
+    DramConfig calendars = c;
+    calendars.model = DramModel::bandwidth;
+    Dram bandwidth("bandwidth", calendars), banks("banks", c);
     for (Cycle t : {Cycle(0), Cycle(5000)}) {
         const uint64_t addr = 64 * 1024 * (t + 1);
-        EXPECT_EQ(detailed.access({addr, 64, false, DataKind::node, t}), approx.access({addr, 64, false, DataKind::node, t}));
+        EXPECT_EQ(banks.access({addr, 64, false, DataKind::node, t}), bandwidth.access({addr, 64, false, DataKind::node, t}));
     }
 }
 
