@@ -23,9 +23,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from rtsim.doc_markers import write_between
 from rtsim.launcher import find_sim
-
-BEGIN, END = "<!-- frames-study:begin -->", "<!-- frames-study:end -->"
 
 
 def trace(args: argparse.Namespace) -> Path:
@@ -105,15 +104,6 @@ def plot(manifest: dict[str, Any], stats: dict[str, Any], path: Path, scene: str
     plt.close(fig)
 
 
-def write_doc(doc: Path, text: str) -> None:
-    content = doc.read_text()
-    if BEGIN not in content or END not in content:
-        raise SystemExit(f"{doc}: no {BEGIN} ... {END} markers to write the table between")
-    head, rest = content.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    doc.write_text(f"{head}{BEGIN}\n{text}{END}{tail}")
-
-
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", type=Path, required=True)
@@ -140,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
     text = table(manifest, stats, args)
     print(text)
     if args.doc:
-        write_doc(args.doc, text)
+        write_between(args.doc, "frames-study", text)
     if args.figure:
         plot(manifest, stats, args.figure, args.scene)
     return 0

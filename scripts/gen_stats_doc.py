@@ -16,9 +16,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from rtsim.doc_markers import replace_between
+
 REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "stats.md"
-BEGIN, END = "<!-- summary-keys:begin -->", "<!-- summary-keys:end -->"
 
 
 def find_sim() -> str:
@@ -48,11 +49,7 @@ def render_table(schema: list[dict[str, Any]]) -> str:
 
 def render(doc: str, schema: list[dict[str, Any]]) -> str:
     """The doc with the table between the markers replaced."""
-    if BEGIN not in doc or END not in doc:
-        raise ValueError(f"{DOC}: markers {BEGIN} and {END} are missing")
-    head, rest = doc.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    return f"{head}{BEGIN}\n{render_table(schema)}\n{END}{tail}"
+    return replace_between(doc, "summary-keys", render_table(schema), str(DOC))
 
 
 def main() -> int:

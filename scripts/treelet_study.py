@@ -23,10 +23,10 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from rtsim.doc_markers import write_between
 from rtsim.launcher import find_sim
 
 REPO = Path(__file__).resolve().parents[1]
-BEGIN, END = "<!-- treelet-study:begin -->", "<!-- treelet-study:end -->"
 
 
 @dataclass(frozen=True)
@@ -220,15 +220,6 @@ def plot(rows: list[dict[str, Any]], path: Path, scenes: list[str], title: str) 
     plt.close(fig)
 
 
-def write_doc(doc: Path, text: str) -> None:
-    content = doc.read_text()
-    if BEGIN not in content or END not in content:
-        raise SystemExit(f"{doc}: no {BEGIN} ... {END} markers to write the table between")
-    head, rest = content.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    doc.write_text(f"{head}{BEGIN}\n{text}{END}{tail}")
-
-
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", type=Path, default=REPO / "out" / "treelet_study")
@@ -280,7 +271,7 @@ def main() -> None:
         f'{", ".join(gits)}). BVH = node + triangle reads from DRAM; "queue at pick" = mean rays '
         "in the queue a unit picked; every run has 0 hit and 0 work mismatches.\n\n"
     )
-    write_doc(args.docs / "treelets.md", note + table(rows))
+    write_between(args.docs / "treelets.md", "treelet-study", note + table(rows))
     plot(
         rows,
         args.docs / "treelets.png",

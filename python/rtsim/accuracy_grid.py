@@ -3,8 +3,10 @@
 Traces every scene and workload of a sweep spec once, runs every configuration of its grid at
 each level (one rtsim-sim process per run, --no-verdict), and reports per trace and level the
 error in cycles against `detailed` (median and max of |error|), the rank agreement of the
-configurations (Kendall's tau-b over the points both levels ran), whether the level picks the
-same best design, and the wall time of the whole grid against detailed's (the sweep speed-up:
+configurations (Kendall's tau-b over the points both levels ran, and the largest gap in
+`detailed` between two configurations the level ranks the other way round), whether the level
+picks the same best design and the same Pareto front of cycles against area, and the wall time
+of the whole grid against detailed's (the sweep speed-up:
 at the analytic level the first run per trace and key builds the per-trace analysis, the others
 reuse it). The pseudo-level `analytic_functional` is the analytic level with functional caches
 (analytic.caches=functional): the analytic level's hit rates are compared with it per cache
@@ -47,6 +49,7 @@ class GridRow:
     l1_hit_rate: float | None = None
     l2_hit_rate: float | None = None
     dram_bytes: float | None = None
+    area_mm2: float | None = None
     analysis_reused: bool | None = None
     hit_mismatches: int | None = None
 
@@ -72,6 +75,28 @@ def kendall_tau(x: list[float], y: list[float]) -> float | None:
                 disc += 1
     denom = ((conc + disc + tx) * (conc + disc + ty)) ** 0.5
     return (conc - disc) / denom if denom else None
+
+
+def largest_misordered_gap(x: list[float], y: list[float]) -> float:
+    """The largest relative gap in x between two points that y ranks the other way round (0: none).
+
+    Tau counts a swap of two designs 0.1% apart like one of two designs 2x apart; this says how
+    far apart, in the reference, the designs a level misorders are."""
+    gap = 0.0
+    for i in range(len(x)):
+        for j in range(i + 1, len(x)):
+            if (x[i] - x[j]) * (y[i] - y[j]) < 0:
+                gap = max(gap, abs(x[i] - x[j]) / min(x[i], x[j]))
+    return gap
+
+
+def pareto_front(points: dict[str, tuple[float, float]]) -> set[str]:
+    """The points no other point beats on both cycles and area (lower is better on both)."""
+
+    def beaten(p: tuple[float, float]) -> bool:
+        return any(q[0] <= p[0] and q[1] <= p[1] and q != p for q in points.values())
+
+    return {name for name, p in points.items() if not beaten(p)}
 
 
 def point_label(run: RunPlan) -> str:
@@ -103,10 +128,11 @@ def run_level(exe: Path, trace: Path, run: RunPlan, level: str, folder: Path) ->
     stats = json.loads(stats_path.read_text())
     s = stats["summary"]
     row.cycles, row.hit_mismatches = s.get("cycles"), s.get("hit_mismatches")
-    row.l1_hit_rate, row.l2_hit_rate, row.dram_bytes = (
+    row.l1_hit_rate, row.l2_hit_rate, row.dram_bytes, row.area_mm2 = (
         s.get("l1_hit_rate"),
         s.get("l2_hit_rate"),
         s.get("dram_bytes"),
+        s.get("area_mm2"),
     )
     analysis = stats.get("model", {}).get("analytic", {}).get("analysis")
     row.analysis_reused = analysis.get("reused") if analysis else None
@@ -167,7 +193,10 @@ def summarize_grid(rows: list[GridRow]) -> list[dict[str, Any]]:
             mine = [r for r in rows if r.trace == trace and r.level == level and r.cycles]
             both = [r for r in mine if r.point in ref]
             errors = [abs(r.error) for r in both if r.error is not None]
-            tau = kendall_tau([ref[r.point].cycles for r in both], [r.cycles for r in both])  # type: ignore[misc]
+            ref_cycles = [ref[r.point].cycles for r in both]
+            tau = kendall_tau(ref_cycles, [r.cycles for r in both])  # type: ignore[arg-type]
+            gap = largest_misordered_gap(ref_cycles, [r.cycles for r in both])  # type: ignore[arg-type]
+            front = same_front(both, ref)
             best = min(both, key=lambda r: r.cycles).point if both else None  # type: ignore[arg-type,return-value]
             best_ref = (
                 min((ref[r.point] for r in both), key=lambda r: r.cycles).point if both else None
@@ -184,6 +213,8 @@ def summarize_grid(rows: list[GridRow]) -> list[dict[str, Any]]:
                 "median_abs_error": statistics.median(errors) if errors else None,
                 "max_abs_error": max(errors) if errors else None,
                 "kendall_tau": tau,
+                "largest_misordered_gap": gap if both else None,
+                "same_pareto_front": front,
                 "same_best": best == best_ref if both else None,
                 "wall_seconds": wall,
                 "speedup": ref_wall / wall if wall > 0 else None,
@@ -201,6 +232,19 @@ def summarize_grid(rows: list[GridRow]) -> list[dict[str, Any]]:
     return out
 
 
+def same_front(mine: list[GridRow], ref: dict[str, GridRow]) -> bool | None:
+    """Whether the level's Pareto front (cycles against area) is the reference's; None: no area."""
+    if not mine or any(r.area_mm2 is None or ref[r.point].area_mm2 is None for r in mine):
+        return None
+    front = pareto_front({r.point: (r.cycles, r.area_mm2) for r in mine})  # type: ignore[misc]
+    ref_front = pareto_front({r.point: (ref[r.point].cycles, ref[r.point].area_mm2) for r in mine})  # type: ignore[misc]
+    return front == ref_front
+
+
+def yes_no(x: bool | None) -> str:
+    return "" if x is None else ("yes" if x else "no")
+
+
 def fmt(x: float | None, pct: bool = False, digits: int = 1) -> str:
     if x is None:
         return ""
@@ -213,10 +257,11 @@ def _median_max(s: dict[str, Any], key: str) -> str:
 
 def markdown(summary: list[dict[str, Any]]) -> str:
     lines = [
-        "| trace | level | configs | median abs error | max abs error | Kendall tau | same best "
+        "| trace | level | configs | median abs error | max abs error | Kendall tau "
+        "| largest misordered gap | same best | same Pareto front (cycles, area) "
         "| grid wall (s) | speed-up vs detailed | L1 hit-rate error (median / max) "
         "| L2 hit-rate error |",
-        "|" + "---|" * 11,
+        "|" + "---|" * 13,
     ]
     for s in summary:
         hr = ""
@@ -230,7 +275,8 @@ def markdown(summary: list[dict[str, Any]]) -> str:
             f"| {s['trace']} | {s['level']} | {s['points']}{skipped} "
             f"| {fmt(s['median_abs_error'], True)} "
             f"| {fmt(s['max_abs_error'], True)} | {fmt(s['kendall_tau'], digits=2)} "
-            f"| {'' if s['same_best'] is None else ('yes' if s['same_best'] else 'no')} "
+            f"| {fmt(s['largest_misordered_gap'], True, 2)} "
+            f"| {yes_no(s['same_best'])} | {yes_no(s['same_pareto_front'])} "
             f"| {fmt(s['wall_seconds'], digits=2)} | {fmt(s['speedup'])}x | {hr} | {hr2} |"
         )
     return "\n".join(lines) + "\n"
