@@ -13,6 +13,7 @@
 #include "rtl_model/mem/functional_cache.h"
 #include "sim/harness/analytic.h"
 #include "sim/harness/analytic_cache.h"
+#include "sim/harness/analytic_closed_form.h"
 #include "sim/harness/analytic_estimate.h"
 #include "sim/harness/analytic_reuse.h"
 #include "sim/harness/analytic_sample.h"
@@ -228,6 +229,37 @@ TEST(AnalyticLevel, SecondConfigurationOnTheSameRaysReusesTheAnalysis) {
     EXPECT_EQ(second.rays, w.jobs.size());  // replayed to the sink
     EXPECT_EQ(first.steps, second.steps);
     EXPECT_GT(slow.cycles, base.cycles);
+}
+
+/// Demands of `misses` L2 misses of 64-byte lines (no writes) under the default DRAM config.
+AnalyticDemands l2_misses(const SimConfig& c, double misses) {
+    AnalyticDemands d;
+    d.rays = 1000;
+    d.dram_bytes = misses * 64;
+    d.l2_hold = misses * (c.dram.latency + std::ceil(64.0 / c.dram.bytes_per_cycle));
+    return d;
+}
+
+TEST(AnalyticClosedForm, L2MshrBoundAddsDramQueueingNearThePeak) {
+    SimConfig c;  // 2 channels x 16 B/cycle, latency 120: a 64-byte line is 4 bus cycles
+    c.l2.mshrs = 64;
+    const AnalyticDemands d = l2_misses(c, 1e6);
+    const double unloaded = d.l2_hold / c.l2.mshrs;  // 1e6 x 124 / 64 = 1.94 M cycles
+    const double dram = d.dram_bytes / (2.0 * 16);  // 2 M cycles: the loop is near the knee
+    const ClosedForm f = closed_form(c, {}, d);
+    const double bound = f.bounds["l2_mshrs"].get<double>();
+    // Queueing at the channels keeps MSHRs held longer: above both the unloaded occupancy and
+    // the DRAM's peak, and below their sum.
+    EXPECT_GT(bound, 1.05 * std::max(unloaded, dram));
+    EXPECT_LT(bound, unloaded + dram);
+    // With many MSHRs the loop is bound by the channels alone.
+    c.l2.mshrs = 4096;
+    EXPECT_NEAR(closed_form(c, {}, d).bounds["l2_mshrs"].get<double>(), dram, 0.02 * dram);
+    // With few MSHRs and fast DRAM there is next to no queueing: the unloaded occupancy.
+    c.l2.mshrs = 4;
+    c.dram.bytes_per_cycle = 1024;
+    const AnalyticDemands light = l2_misses(c, 1e6);
+    EXPECT_NEAR(closed_form(c, {}, light).bounds["l2_mshrs"].get<double>(), light.l2_hold / 4, 0.01 * light.l2_hold / 4);
 }
 
 TEST(AnalyticCache, KeyHoldsWhatShapesTheAccessStreamsOnly) {
