@@ -211,9 +211,10 @@ class AnalyticConfig:
         8, "clusters", "Clusters of consecutive rays the analysis steps in larger traces", 1, 4096
     )
     warmup_rays: int = _f(
-        3072,
+        0,
         "rays",
-        "Warm-up rays per cluster: their accesses only build reuse history",
+        "Warm-up rays per cluster: their accesses only build reuse history; 0: automatic, "
+        "max(3072, L2 lines / 4), enough history to see the L2's reuse",
         0,
         1 << 24,
     )

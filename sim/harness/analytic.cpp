@@ -150,7 +150,8 @@ SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig
     SamplePlan plan;
     plan.trace_rays = rays;
     const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.ray_contexts;
-    const uint64_t length = uint64_t(s.warmup_rays) + s.measured_rays + tail;
+    const uint32_t warmup = s.resolved_warmup_rays(uint64_t(config.l2.size_kib) * 1024 / config.l2.line_bytes);
+    const uint64_t length = uint64_t(warmup) + s.measured_rays + tail;
     const uint64_t clusters = std::min<uint64_t>(s.clusters, length ? rays / length : 0);
     if (rays <= s.whole_trace_rays || clusters == 0) {
         plan.clusters.push_back({0, rays, 0, 0, rays});
@@ -159,9 +160,9 @@ SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig
         for (uint64_t k = 0; k < clusters; ++k) {
             const uint64_t first = rays * k / clusters, end = rays * (k + 1) / clusters;
             const uint64_t start = first + (end - first - length) / 2;
-            plan.clusters.push_back({first, end - first, start, s.warmup_rays, s.measured_rays + tail});
+            plan.clusters.push_back({first, end - first, start, warmup, s.measured_rays + tail});
         }
-        plan.warmup_rays = s.warmup_rays;
+        plan.warmup_rays = warmup;
     }
     for (const auto& c : plan.clusters) plan.simulated_rays += c.warmup + c.measured;
     return plan;

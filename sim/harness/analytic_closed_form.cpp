@@ -78,9 +78,13 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
         const double bound = bounds[name].get<double>();
         const double demand = shared ? bound / rays : bound * units / rays;
         stations.push_back({demand, shared});
-        // The MSHR queues' unloaded demand D/m is part of the unloaded latency already.
+        // The delay is the unloaded latency less the service the stations add back: the MSHR
+        // queues' unloaded demand D/m, and the pipelines', banks' and DRAM bus's service (a
+        // pipeline's initiation intervals, a bank's cycle and a line's transfer are in the
+        // unloaded latency). The scheduler's issue cycles are not, so its demand stays on top.
         if (name == "l1_mshrs") think -= d.l1_hold / (double(c.l1.mshrs) * units) * units / rays;
-        if (name == "l2_mshrs") think -= d.l2_hold / double(c.l2.mshrs) / rays;
+        else if (name == "l2_mshrs") think -= d.l2_hold / double(c.l2.mshrs) / rays;
+        else if (name != "scheduler") think -= demand;
     }
     think = std::max(think, 0.0);
     std::vector<double> queue(stations.size(), 0.0), r(stations.size());

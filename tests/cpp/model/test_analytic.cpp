@@ -274,9 +274,19 @@ TEST(AnalyticCache, KeyHoldsWhatShapesTheAccessStreamsOnly) {
     for (const char* set : {"traversal.units=4", "traversal.ray_contexts=4", "l1.line_bytes=128",
                             "dispatch.block_rays=4", "dispatch.policy=on_demand", "traversal.stack_entries=2"})
         EXPECT_TRUE(changed(set)) << set;
-    for (const char* set : {"l1.size_kib=64", "l1.ways=8", "l2.size_kib=4096", "dram.channels=8", "l2.mshrs=64",
+    for (const char* set : {"l1.size_kib=64", "l1.ways=8", "l2.ways=8", "dram.channels=8", "l2.mshrs=64",
                             "box.latency=20", "traversal.issue_cycles=4"})
         EXPECT_FALSE(changed(set)) << set;
+    // The automatic warm-up grows with the L2 (L2 lines / 4 rays, at least 3072): a 4 MiB L2 needs
+    // a longer history; a fixed warm-up does not depend on it.
+    EXPECT_TRUE(changed("l2.size_kib=4096"));
+    AnalyticConfig fixed = s;
+    fixed.warmup_rays = 3072;
+    SimConfig big = base;
+    config_set(big, "l2.size_kib=4096");
+    EXPECT_EQ(analysis_key(big, fixed, "abc"), analysis_key(base, fixed, "abc"));
+    EXPECT_EQ(s.resolved_warmup_rays(uint64_t(4096) * 1024 / 64), 16384u);
+    EXPECT_EQ(s.resolved_warmup_rays(uint64_t(256) * 1024 / 64), 3072u);
     EXPECT_NE(analysis_key(base, s, "abd"), key);  // another trace
     AnalyticConfig other = s;
     other.clusters += 1;
