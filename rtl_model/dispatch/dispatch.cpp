@@ -19,7 +19,7 @@ bool RayDealer::next_on_demand(RayJob* job) {
         m_next = 0;
         if (m_stream_done || m_stream.read_chunk(m_config.chunk_rays, &m_buffer) == 0) {
             m_stream_done = true;
-            return false;
+            return next_segment() && next_on_demand(job);
         }
         ++m_chunks;
     }
@@ -43,6 +43,15 @@ bool RayDealer::deal_chunk() {
     return true;
 }
 
+bool RayDealer::next_segment() {
+    if (!m_stream_done) return false;
+    for (const auto& q : m_queues)
+        if (!q.empty()) return false;
+    if (!m_stream.next_segment()) return false;
+    m_stream_done = false;
+    return true;
+}
+
 bool RayDealer::next_interleaved(uint32_t unit, RayJob* job) {
     if (unit == kAnyUnit) unit = m_any_unit++ % m_queues.size();
     unit %= m_queues.size();
@@ -50,15 +59,18 @@ bool RayDealer::next_interleaved(uint32_t unit, RayJob* job) {
     if (!m_queues[unit].empty()) {
         *job = m_queues[unit].front();
         m_queues[unit].pop_front();
-        return true;
+    } else {
+        // Nothing left for this unit: steal the last ray of the longest queue.
+        auto longest = std::max_element(m_queues.begin(), m_queues.end(),
+                                        [](const auto& a, const auto& b) { return a.size() < b.size(); });
+        if (longest->empty()) return next_segment() && next_interleaved(unit, job);
+        *job = longest->back();
+        longest->pop_back();
+        ++m_steals;
     }
-    // Nothing left for this unit: steal the last ray of the longest queue.
-    auto longest = std::max_element(m_queues.begin(), m_queues.end(),
-                                    [](const auto& a, const auto& b) { return a.size() < b.size(); });
-    if (longest->empty()) return false;
-    *job = longest->back();
-    longest->pop_back();
-    ++m_steals;
+    // The last ray of a segment is out: the next segment, if any, is read on the next request
+    // (so exhausted() is true only at the stream's end).
+    if (m_stream_done) next_segment();
     return true;
 }
 

@@ -31,6 +31,11 @@ public:
     virtual uint64_t total_rays() const = 0;
     /// Frames: the stream goes on with frame `f`'s rays (its reads end at that frame's last ray).
     virtual void begin_frame(uint32_t f) {}
+    /// Segments (a sampled run's clusters, sim/harness/sampling.h): read_chunk returns 0 at a
+    /// segment's end; the dealer calls this once it has handed out every ray read so far, and
+    /// reads on if it returns true. So a segment's first read (and what the stream does then)
+    /// comes after the last ray of the previous segment has entered a context.
+    virtual bool next_segment() { return false; }
 };
 
 /// The dealing policy itself, plain C++: the Dispatch block wraps it for the SystemC model, and
@@ -56,6 +61,9 @@ private:
     bool next_on_demand(RayJob* job);
     bool next_interleaved(uint32_t unit, RayJob* job);
     bool deal_chunk();
+    /// Every ray read so far is handed out and the stream is at a segment's end: go on with the
+    /// next segment (false at the stream's end).
+    bool next_segment();
 
     DispatchConfig m_config;
     RayStream& m_stream;

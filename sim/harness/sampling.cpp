@@ -61,9 +61,10 @@ SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
     // that are mostly warm-up (their measurement would be mostly pipeline edge effects).
     plan.warmup_target = s.warmup_rays ? s.warmup_rays : warmup_target(c);
     uint64_t w = plan.warmup_target;
-    // With functional warming, a cluster measures at least 4 x the rays in flight: shorter ones
-    // (M = 2 x in flight) measured Sponza diffuse about 3% slow, as if the switch between regions
-    // cost more than the warm-up hides (docs/fidelity.md, "Sampling").
+    // With functional warming, a cluster measures at least 4 x the rays in flight: fewer, longer
+    // clusters. Before the cluster hand-off (SampledRayStream::next_segment) shorter ones (M = 2 x
+    // in flight) measured Sponza diffuse about 3% slow; with it, 16 units at K = 7, M = 601 still
+    // +3% against +1.4% at K = 5, M = 1046 (docs/fidelity.md, "Cluster hand-off").
     const uint64_t min_measured = s.warming_rays > 0 && s.warmup_rays == 0 ? 4 * rays_in_flight(c) : 0;
     uint64_t clusters = std::min<uint64_t>(s.clusters, budget / (w + std::max(w, min_measured)));
     if (!s.warmup_rays && clusters < kMinClusters) {
@@ -128,8 +129,14 @@ void SampledRayStream::set_warming(uint64_t rays, std::function<void(uint64_t, u
     m_warm = std::move(warm);
 }
 
+bool SampledRayStream::next_segment() {
+    if (m_cluster >= m_plan.clusters.size()) return false;
+    m_open_cluster = m_cluster;
+    return true;
+}
+
 size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
-    if (m_cluster >= m_plan.clusters.size()) return 0;
+    if (m_cluster >= m_plan.clusters.size() || m_cluster != m_open_cluster) return 0;
     const SamplePlan::Cluster& c = m_plan.clusters[m_cluster];
     if (m_next == c.first && m_warm) {
         // Functional warming of the skipped rays just before the cluster (not into the previous one).
@@ -137,8 +144,8 @@ size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
         const uint64_t from = std::max(floor, c.first - std::min(c.first, m_warming_rays));
         m_warm(from, c.first, m_produced);
     }
-    // A chunk never crosses into the next cluster, so its warming happens when the dispatch
-    // asks for its first ray, after the previous cluster's rays were dealt.
+    // A chunk never crosses into the next cluster, and the next cluster is read only after
+    // next_segment(), so its warming happens once every ray of this one has entered a context.
     const size_t n = size_t(std::min<uint64_t>(max, c.end() - m_next));
     read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
     m_next += n;

@@ -7,14 +7,16 @@
 // stratum one cluster of consecutive rays at a random offset is simulated: W warm-up rays (detailed
 // warming: simulated, caches and pipelines warm up, not measured) then M measured rays. All
 // clusters run back to back in one simulation through a SampledRayStream; ray ids stay the
-// trace's, so the hit checker checks every simulated ray. Each cluster's steady-state cost in
-// cycles per ray is measured from the start cycles of its measured rays (rays enter contexts in
-// dispatch order as contexts free up, so the span of the measured rays' starts over the number of
-// rays started in it is the machine's throughput while it worked on that stratum, with the fill
-// of the pipeline excluded by the warm-up rays before). The total is the sum over strata of
-// stratum size x cycles per ray; the interval is Student t over the K strata. The caches see only
-// the sampled rays: the automatic warm-up (an eighth of the L2's lines in rays) keeps the bias
-// from a cold L2 small when the sample can afford it; docs/fidelity.md measures it.
+// trace's, so the hit checker checks every simulated ray. A cluster's rays (and its functional
+// warming) reach the dispatch only once it has handed out every ray of the cluster before, so
+// the machine stays full across the switch and no measured ray starts after the next cluster's
+// warming. Each cluster's steady-state cost in cycles per ray is measured from the start cycles
+// of its measured rays (rays enter contexts in dispatch order as contexts free up, so the span of
+// the measured rays' starts over the number of rays started in it is the machine's throughput
+// while it worked on that stratum, with the fill of the pipeline excluded by the warm-up rays
+// before). The total is the sum over strata of stratum size x cycles per ray; the interval is
+// Student t over the K strata. Functional warming (sampling_warming.h) fills the caches before
+// each cluster; docs/fidelity.md measures the bias.
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -64,6 +66,12 @@ public:
     /// skipped rays just before it; position: how many rays the stream produced before it
     /// (sampling_warming.h).
     void set_warming(uint64_t rays, std::function<void(uint64_t first, uint64_t end, uint64_t position)> warm);
+    /// Each cluster is a segment (RayStream::next_segment): its reads end at its last ray, and the
+    /// next cluster's first read, where its functional warming runs, waits until the dispatch has
+    /// handed out every ray of this one. Else the warming would replace the caches' lines under
+    /// the cluster's last measured rays while some still wait in the dispatch's per-unit queues
+    /// (docs/fidelity.md, "Cluster hand-off").
+    bool next_segment() override;
 
 private:
     TraceReader& m_reader;
@@ -71,7 +79,8 @@ private:
     uint64_t m_warming_rays = 0;
     std::function<void(uint64_t, uint64_t, uint64_t)> m_warm;
     uint64_t m_produced = 0;  ///< rays returned so far
-    size_t m_cluster = 0;
+    size_t m_cluster = 0;       ///< the cluster being read (clusters.size() at the end)
+    size_t m_open_cluster = 0;  ///< the cluster the dispatch may read (next_segment opens the next)
     uint64_t m_next = 0;  ///< next trace index within the current cluster
     std::vector<RayRecord> m_buffer;
 };
