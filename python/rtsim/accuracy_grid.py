@@ -299,6 +299,8 @@ def write_grid(rows: list[GridRow], out: Path) -> None:
 
 
 def plot_grid(rows: list[GridRow], path: Path) -> None:
+    """Each configuration's error against detailed (left) and its rank by cycles at the level
+    against its rank at detailed (right), one colour per level and one marker per trace."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -306,30 +308,48 @@ def plot_grid(rows: list[GridRow], path: Path) -> None:
 
     ref = {(r.trace, r.point): r.cycles for r in rows if r.level == REFERENCE and r.cycles}
     levels = [lvl for lvl in dict.fromkeys(r.level for r in rows) if lvl != REFERENCE]
-    fig, ax = plt.subplots(figsize=(6.4, 5.2))
+    traces = sorted({r.trace for r in rows})
+    markers = dict(zip(traces, "osD^vP*X", strict=False))
     colors = {"analytic": "#2ca02c", "approx": "#1f77b4", "analytic_functional": "#9467bd"}
-    lo, hi = float("inf"), 0.0
+    fig, (err_ax, rank_ax) = plt.subplots(1, 2, figsize=(12, 6.2))
     for level in levels:
-        pts = [
-            (ref[(r.trace, r.point)], r.cycles)
-            for r in rows
-            if r.level == level and r.cycles and (r.trace, r.point) in ref
-        ]
-        if not pts:
-            continue
-        xs, ys = zip(*pts, strict=True)
-        ax.scatter(xs, ys, s=22, label=level, color=colors.get(level), alpha=0.8)
-        lo, hi = min(lo, *xs, *ys), max(hi, *xs, *ys)
-    if hi > 0:
-        for f, style in ((1.0, "-"), (1.15, ":"), (1 / 1.15, ":")):
-            ax.plot([lo, hi], [lo * f, hi * f], color="#999999", ls=style, lw=0.8)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("detailed cycles")
-    ax.set_ylabel("level's cycles (dotted: +-15%)")
-    ax.set_title("Each configuration of the grid: level against detailed", fontsize=11)
-    ax.legend(fontsize=9)
-    ax.grid(True, which="both", alpha=0.25)
-    fig.tight_layout()
-    fig.savefig(path, dpi=72)
+        for trace in traces:
+            mine = [
+                r
+                for r in rows
+                if r.level == level and r.trace == trace and r.cycles and (trace, r.point) in ref
+            ]
+            if not mine:
+                continue
+            xs = [ref[(trace, r.point)] for r in mine]
+            errs = [100 * (r.cycles - x) / x for r, x in zip(mine, xs, strict=True)]  # type: ignore[operator]
+            style = {"color": colors.get(level), "marker": markers[trace], "alpha": 0.8, "s": 26}
+            err_ax.scatter(xs, errs, label=f"{level}, {trace.split('-bvh')[0]}", **style)  # type: ignore[arg-type]
+            order_ref = sorted(range(len(mine)), key=lambda i: xs[i])
+            order_lvl = sorted(range(len(mine)), key=lambda i: mine[i].cycles)  # type: ignore[arg-type,return-value]
+            rank_ref = {i: k for k, i in enumerate(order_ref)}
+            rank_lvl = {i: k for k, i in enumerate(order_lvl)}
+            rank_ax.scatter(
+                [rank_ref[i] + 1 for i in range(len(mine))],
+                [rank_lvl[i] + 1 for i in range(len(mine))],
+                **style,  # type: ignore[arg-type]
+            )
+    for band, style in ((0, "-"), (5, "--"), (-5, "--"), (15, ":"), (-15, ":")):
+        err_ax.axhline(band, color="#999999", ls=style, lw=0.8)
+    err_ax.set_xscale("log")
+    err_ax.set_xlabel("detailed cycles (one point per configuration and trace)")
+    err_ax.set_ylabel("error against detailed, % (dashed: 5%, dotted: 15%)")
+    err_ax.set_title("Error of each configuration", fontsize=11)
+    fig.legend(fontsize=8, ncol=4, loc="lower center", frameon=False)
+    err_ax.grid(True, which="both", alpha=0.25)
+    top = max(
+        (len([r for r in rows if r.level == REFERENCE and r.trace == t]) for t in traces), default=1
+    )
+    rank_ax.plot([1, top], [1, top], color="#999999", lw=0.8)
+    rank_ax.set_xlabel("rank at detailed (1: fastest configuration of its trace)")
+    rank_ax.set_ylabel("rank at the level")
+    rank_ax.set_title("Does the level order the designs as detailed does?", fontsize=11)
+    rank_ax.grid(True, alpha=0.25)
+    fig.tight_layout(rect=(0, 0.13, 1, 1))  # room for the legend below
+    fig.savefig(path, dpi=80)
     plt.close(fig)
