@@ -103,6 +103,14 @@ def utilisation_table(stats: dict[str, Any]) -> Table:
     bw = fmt_float(s.get("dram_bandwidth_gbps"))
     table.add_row("DRAM bandwidth (GB/s)", bw + (f" of {peak:,.1f}" if _is_num(peak) else ""))
     table.add_row("DRAM bandwidth utilisation", fmt_pct(s.get("dram_bandwidth_utilization")))
+    dram = model.get("dram") or {}
+    outcomes = [dram.get(k) for k in ("row_hits", "row_misses", "row_conflicts")]
+    if all(_is_num(x) for x in outcomes) and sum(outcomes) > 0:  # type: ignore[arg-type]
+        hits, misses, conflicts = (x / sum(outcomes) for x in outcomes)  # type: ignore[operator,arg-type]
+        table.add_row(
+            "DRAM row buffers (hit / miss / conflict)",
+            f"{fmt_pct(hits)} / {fmt_pct(misses)} / {fmt_pct(conflicts)}",
+        )
     return table
 
 
