@@ -182,6 +182,7 @@ def test_a_small_sample_says_it_is_too_small(traces: Callable[[str], Path], tmp_
         (["sampling.fraction=1.5"], "sampling.fraction"),
         (["sampling.count=100"], "sampling.count"),  # too small for 2 clusters with warm-up
         (["sampling.count=100000000"], "sampling.count"),  # more than the trace
+        (["sampling.fraction=0.5", "treelets.enabled=true"], "treelets.enabled"),  # start span
     ],
 )
 def test_bad_sampling_config_exits_2(
