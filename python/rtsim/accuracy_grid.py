@@ -309,7 +309,7 @@ def plot_grid(rows: list[GridRow], path: Path) -> None:
     ref = {(r.trace, r.point): r.cycles for r in rows if r.level == REFERENCE and r.cycles}
     levels = [lvl for lvl in dict.fromkeys(r.level for r in rows) if lvl != REFERENCE]
     traces = sorted({r.trace for r in rows})
-    markers = dict(zip(traces, "osD^vP*X", strict=False))
+    markers = {t: "osD^vP*X"[i % 8] for i, t in enumerate(traces)}
     colors = {"analytic": "#2ca02c", "approx": "#1f77b4", "analytic_functional": "#9467bd"}
     fig, (err_ax, rank_ax) = plt.subplots(1, 2, figsize=(12, 6.2))
     for level in levels:

@@ -20,6 +20,8 @@ def replace_between(content: str, name: str, text: str, where: str = "the doc") 
     if begin not in content or end not in content:
         raise ValueError(f"{where}: no {begin} ... {end} markers to write between")
     head, rest = content.split(begin, 1)
+    if end not in rest:
+        raise ValueError(f"{where}: {end} comes before {begin}")
     _, tail = rest.split(end, 1)
     body = text if text.endswith("\n") else text + "\n"
     return f"{head}{begin}\n{body}{end}{tail}"

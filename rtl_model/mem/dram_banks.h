@@ -1,5 +1,5 @@
 #pragma once
-// DRAM banks and row buffers for the detailed fidelity level: per channel `banks` banks, each
+// DRAM banks and row buffers (dram.model = "banks", at the approx and detailed levels): per channel `banks` banks, each
 // with one row buffer, an open-page or close-page policy, and activate (tRCD), precharge (tRP)
 // and column (tCAS) timing in core cycles, in front of the channel's data bus (bytes_per_cycle).
 // Timing after JEDEC DDR command rules reduced to their first-order terms (Jacob, Ng & Wang,
@@ -16,8 +16,11 @@
 //   after column + tCAS; done = cycle after the last data cycle.
 //   the bank is busy from s to column + burst cycles (open page; the row stays open), or to
 //   column + burst + tRP with close page (auto-precharge: every access finds the bank closed).
-// Requests normally arrive in time order (the detailed level synchronises units every cycle),
-// and then this is first come, first served. A request stamped earlier than one already booked
+// At detailed requests normally arrive in time order (units synchronise every cycle), and then
+// this is first come, first served; at approx units run up to a quantum apart, so requests
+// arrive out of order within a quantum and back-fill as below. Only the last 64 bookings per
+// bank are kept: a request older than all of them starts at its own time with the row the
+// forgotten bookings left open (optimistic; rare unless a bank is saturated for a whole quantum). A request stamped earlier than one already booked
 // (a miss that waited for an MSHR is stamped in the future) takes an idle gap before it, the
 // way a bandwidth calendar back-fills, instead of queueing behind the future; the row outcome
 // of the later, already booked access is not revised.

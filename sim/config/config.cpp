@@ -252,9 +252,12 @@ void validate(const SimConfig& config) {
             "config: 'dram.interleave_bytes' must be a power of two and at least the line size");
     require(power_of_two(config.dram.row_bytes) && power_of_two(config.dram.banks),
             "config: 'dram.row_bytes' and 'dram.banks' must be powers of two (address bit fields)");
-    require(config.dram.model != DramModel::banks || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
+    const bool banks_run = config.dram.model == DramModel::banks && !config.ideal_memory &&
+                           (config.fidelity == Fidelity::approx || config.fidelity == Fidelity::detailed);
+    require(!banks_run || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
             "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas with dram.model banks (it is the "
-            "latency of an access to a closed bank); lower them or set dram.model=bandwidth");
+            "latency of an access to a closed bank); raise dram.latency, lower dram.t_rcd/dram.t_cas, or set "
+            "dram.model=bandwidth");
     require(!config.treelets.enabled || config.fidelity != Fidelity::analytic,
             "config: 'treelets.enabled' is not supported at fidelity 'analytic' (its closed form models plain "
             "dispatch); use approx or detailed");

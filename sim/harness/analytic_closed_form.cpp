@@ -14,7 +14,9 @@ namespace {
 /// each spends the DRAM latency as a pure delay and its share of a channel's bus (all DRAM bytes,
 /// writes too, spread evenly over the channels) in a queue. Mean value analysis of that loop with
 /// every MSHR busy gives the most misses per cycle the L2 can have served; the bound is the
-/// misses over that rate. Unloaded it equals l2_hold / mshrs; near the DRAM's peak it adds the
+/// misses over that rate. Unloaded and without writes it equals l2_hold / mshrs (writes, which
+/// hold no MSHR, are charged to the misses' channel time: slightly pessimistic when they are
+/// many and the MSHRs few); near the DRAM's peak it adds the
 /// queueing that keeps the MSHRs held longer (what -18% on a DRAM-saturated machine missed).
 /// Row-buffer hits and conflicts are not known here: every miss costs the closed-bank latency.
 double l2_loop_bound(const SimConfig& c, const AnalyticDemands& d) {

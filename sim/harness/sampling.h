@@ -9,8 +9,9 @@
 // clusters run back to back in one simulation through a SampledRayStream; ray ids stay the
 // trace's, so the hit checker checks every simulated ray. A cluster's rays (and its functional
 // warming) reach the dispatch only once it has handed out every ray of the cluster before, so
-// the machine stays full across the switch and no measured ray starts after the next cluster's
-// warming. Each cluster's steady-state cost in cycles per ray is measured from the start cycles
+// the machine stays full across the switch and the next cluster's warming comes after the last
+// ray of the cluster was handed out (in dispatch order; at approx a unit up to a quantum behind
+// in simulated time may still start one of them after it). Each cluster's steady-state cost in cycles per ray is measured from the start cycles
 // of its measured rays (rays enter contexts in dispatch order as contexts free up, so the span of
 // the measured rays' starts over the number of rays started in it is the machine's throughput
 // while it worked on that stratum, with the fill of the pipeline excluded by the warm-up rays

@@ -95,3 +95,14 @@ def test_small_grid_end_to_end(
     assert approx["same_pareto_front"] is not None
     assert "largest misordered gap" in (out / "grid.md").read_text()
     assert (out / "grid.png").stat().st_size > 0
+
+
+def test_figure_with_more_traces_than_markers(tmp_path: Path) -> None:
+    from rtsim.accuracy_grid import plot_grid
+
+    rows = []
+    for t in range(10):  # more traces than the figure has marker shapes
+        rows += [row("detailed", "p", 100.0 + t, 1.0), row("approx", "p", 101.0 + t, 1.0)]
+        rows[-1].trace = rows[-2].trace = f"trace{t}"
+    plot_grid(rows, tmp_path / "grid.png")
+    assert (tmp_path / "grid.png").stat().st_size > 0

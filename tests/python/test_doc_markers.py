@@ -30,3 +30,8 @@ def test_write_between_rewrites_the_file(tmp_path: Path) -> None:
     doc.write_text(DOC)
     write_between(doc, "t", "a\nb")
     assert doc.read_text() == "intro\n<!-- t:begin -->\na\nb\n<!-- t:end -->\nafter\n"
+
+
+def test_end_marker_before_begin_is_named() -> None:
+    with pytest.raises(ValueError, match="comes before"):
+        replace_between("<!-- t:end -->\n<!-- t:begin -->\n", "t", "x")

@@ -1,6 +1,10 @@
-// Detailed DRAM (fidelity = detailed): banks, row buffers, activate/precharge/column timing and
-// the data bus, against hand-worked sequences (docs/model.md, "Detailed DRAM").
+// DRAM banks and row buffers (dram.model = banks): activate/precharge/column timing and
+// the data bus, against hand-worked sequences (docs/model.md, "Banks and row buffers"), and the
+// ring of bookings against the std::map model it replaced, on random out-of-order streams.
 #include <gtest/gtest.h>
+
+#include <map>
+#include <random>
 
 #include "model_test_util.h"
 #include "rtl_model/mem/dram.h"
@@ -133,6 +137,100 @@ TEST(DramDetailed, BusSaturatesAtChannelBandwidthOnRowHits) {
     for (uint64_t i = 0; i < 16; ++i) done = std::max(done, banks.access(i * 64, 64, 0).done);
     EXPECT_EQ(banks.row_hits(), 15u);
     EXPECT_EQ(done, 16u + 16 * 4);  // first data at tRCD + tCAS = 16, then 64 bus cycles
+}
+
+/// The bank model as it was before its bookings became a ring: a std::map per bank, the same
+/// rules (the reference the ring must reproduce access for access).
+class MapBanks {
+public:
+    explicit MapBanks(const DramConfig& c) : m_c(c), m_map(c), m_banks(size_t(c.channels) * c.banks) {
+        for (uint32_t i = 0; i < c.channels; ++i) m_buses.emplace_back(c.bytes_per_cycle, 1);
+    }
+    DramBanks::Timing access(uint64_t addr, uint32_t bytes, Cycle time) {
+        const DramAddress a = m_map.map(addr);
+        Bank& bank = m_banks[size_t(a.channel) * m_c.banks + a.bank];
+        const bool close = m_c.page_policy == PagePolicy::close;
+        const Cycle burst = (std::max<uint32_t>(bytes, 1) + m_c.bytes_per_cycle - 1) / m_c.bytes_per_cycle;
+        const Cycle tail = burst + (close ? m_c.t_rp : 0);
+        auto outcome = [&](uint64_t open) {
+            if (open == a.row && !close) return Row::hit;
+            return open == kClosed ? Row::miss : Row::conflict;
+        };
+        auto to_column = [&](Row r) {
+            return r == Row::hit ? Cycle(0) : r == Row::miss ? Cycle(m_c.t_rcd) : Cycle(m_c.t_rp) + m_c.t_rcd;
+        };
+        auto next = bank.busy.upper_bound(time);
+        uint64_t open = bank.base_row;
+        Cycle s = time;
+        if (next != bank.busy.begin()) {
+            auto prev = std::prev(next);
+            open = prev->second.second;
+            s = std::max(s, prev->second.first);
+        }
+        Row result = outcome(open);
+        while (next != bank.busy.end() && s + to_column(result) + tail > next->first) {
+            s = std::max(s, next->second.first);
+            open = next->second.second;
+            result = outcome(open);
+            ++next;
+        }
+        DramBanks::Timing t;
+        t.start = s;
+        t.result = result;
+        t.column = s + to_column(result);
+        bank.busy.emplace(s, std::make_pair(t.column + tail, close ? kClosed : a.row));
+        while (bank.busy.size() > 64) {
+            bank.base_row = bank.busy.begin()->second.second;
+            bank.busy.erase(bank.busy.begin());
+        }
+        Cycle cycle = t.column + m_c.t_cas;
+        uint32_t left = std::max<uint32_t>(bytes, 1);
+        for (Cycle i = 0; i < burst; ++i) {
+            const uint32_t chunk = std::min(left, m_c.bytes_per_cycle);
+            cycle = m_buses[a.channel].reserve(cycle, chunk) + 1;
+            left -= chunk;
+        }
+        t.done = cycle;
+        return t;
+    }
+
+private:
+    static constexpr uint64_t kClosed = ~0ull;
+    struct Bank {
+        std::map<Cycle, std::pair<Cycle, uint64_t>> busy;  ///< start -> (end, row after)
+        uint64_t base_row = kClosed;
+    };
+    DramConfig m_c;
+    DramBanks m_map;  ///< for its address map only
+    std::vector<Bank> m_banks;
+    std::vector<SlotCalendar> m_buses;
+};
+
+TEST(DramDetailed, RingBookingsMatchTheMapModelOnRandomOutOfOrderStreams) {
+    // Random streams with arrivals up to far in the past (more than 64 bookings back) and in the
+    // future, same-row runs and all outcomes, open and close page, one and two channels.
+    for (const char* policy : {"open", "close"})
+        for (uint32_t channels : {1u, 2u}) {
+            DramConfig c = small(policy);
+            c.channels = channels;
+            DramBanks ring(c);
+            MapBanks reference(c);
+            std::mt19937_64 rng(channels * 7 + policy[0]);
+            Cycle now = 0;
+            uint64_t addr = 0;
+            for (int i = 0; i < 20000; ++i) {
+                now += rng() % 8;
+                const int64_t skew = int64_t(rng() % 4000) - 3000;  // mostly earlier than now
+                const Cycle t = skew < 0 && Cycle(-skew) > now ? 0 : Cycle(int64_t(now) + skew);
+                addr = rng() % 4 ? addr + 64 : (rng() % 64) * 1024;  // runs in a row, then a jump
+                const uint32_t bytes = rng() % 5 ? 64 : 20;
+                const DramBanks::Timing a = ring.access(addr, bytes, t), b = reference.access(addr, bytes, t);
+                ASSERT_EQ(a.start, b.start) << "access " << i;
+                ASSERT_EQ(a.column, b.column) << "access " << i;
+                ASSERT_EQ(a.done, b.done) << "access " << i;
+                ASSERT_EQ(a.result, b.result) << "access " << i;
+            }
+        }
 }
 
 }  // namespace
