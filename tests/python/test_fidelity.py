@@ -152,6 +152,9 @@ def test_bank_timing_longer_than_the_latency_is_refused(
         hairball, tmp_path / "ok", "fidelity=approx", "dram.latency=20", "dram.model=bandwidth"
     )
     assert ok.returncode == 0, ok.stderr
+    # The analytic level runs no bank model: nothing to refuse.
+    analytic = sim(hairball, tmp_path / "analytic", "fidelity=analytic", "dram.latency=20")
+    assert analytic.returncode == 0, analytic.stderr
 
 
 def test_every_level_writes_the_same_summary_keys(hairball: Path, sim: Sim, tmp_path: Path) -> None:
