@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/cpp/error_of.h"
 #include "../isect/isect_test_util.h"
 #include "traces/accel/accel.h"
 #include "traces/accel/wide/wide_accel.h"
@@ -77,16 +78,6 @@ inline Hit trace_sse2(const Accel& accel, const Ray& r, TraversalMode mode, Work
 }
 
 inline const Region& triangles_of(const Accel& a) { return a.image().region("triangles"); }
-
-/// The message of the rtsim::Error `fn` throws, or "" when it does not throw.
-inline std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
 
 /// A mesh of `triangles` small random triangles in [-1.3, 1.3]^3 (the two-level tests' BLASes).
 inline Mesh soup_mesh(uint64_t seed, int triangles) {

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <set>
 
+#include "tests/cpp/error_of.h"
 #include "structure_test_util.h"
 #include "traces/accel/accel_io.h"
 #include "traces/accel/bvh2/bvh2.h"
@@ -34,14 +35,7 @@ std::unique_ptr<Accel> bvh2_of(const Scene& scene) {
 
 const GridView& view_of(const Accel& a) { return static_cast<const GridAccel&>(a).view(); }
 
-std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::error_of;
 
 /// Hits of `grid` against brute force and the binary BVH on `rays`: zero differences.
 void expect_same_hits(const Accel& grid, const Scene& scene, const std::vector<Ray>& rays, const std::string& what,

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 
+#include "tests/cpp/error_of.h"
 #include "structure_test_util.h"
 #include "traces/accel/accel_io.h"
 #include "traces/accel/bvh2/bvh2.h"
@@ -16,14 +17,7 @@
 namespace rtsim {
 namespace {
 
-std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::error_of;
 
 /// Zero differences against brute force (closest: bits; any: hit or miss).
 void expect_brute(const Scene& scene, const GridConfig& config, const std::vector<Ray>& rays, const std::string& what,

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 
+#include "tests/cpp/error_of.h"
 #include "../bvh/bvh_test_scenes.h"
 #include "traces/accel/accel_io.h"
 #include "traces/accel/bvh2/bvh2.h"
@@ -15,14 +16,7 @@ using namespace rtsim;
 
 namespace {
 
-std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using rtsim::test::error_of;
 
 AccelImage small_bvh2(size_t triangles = 500, uint64_t seed = 3) {
     AccelOptions o;

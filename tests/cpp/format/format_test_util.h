@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include "tests/cpp/error_of.h"
 #include "traces/common/error.h"
 #include "traces/format/trace_format.h"
 
@@ -45,16 +46,6 @@ inline std::vector<uint8_t> read_bytes(const std::string& path) {
 }
 inline void write_bytes(const std::string& path, const std::vector<uint8_t>& bytes) {
     std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-}
-
-/// The message of the rtsim::Error `fn` throws, or "" when it does not throw.
-inline std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
 }
 
 /// Record i of each kind: a pure function of i, so large traces can be checked piecewise.

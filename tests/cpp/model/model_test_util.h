@@ -8,6 +8,7 @@
 
 #include <systemc>
 
+#include "tests/cpp/error_of.h"
 #include "rtl_model/common/interfaces.h"
 #include "traces/common/error.h"
 
@@ -40,15 +41,5 @@ public:
 private:
     Cycle m_latency;
 };
-
-/// The message of the rtsim::Error `fn` throws, or "" when it does not throw.
-inline std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
 
 }  // namespace rtsim::test

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "tests/cpp/error_of.h"
 #include "tests/cpp/bvh/bvh_test_scenes.h"
 #include "traces/accel/accel.h"
 #include "traces/common/error.h"
@@ -14,14 +15,7 @@
 namespace rtsim {
 namespace {
 
-std::string error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::error_of;
 
 /// A one-triangle scene spanning `size` around `offset` (as a loader would flatten it).
 Scene triangle_at(float offset, float size) {
