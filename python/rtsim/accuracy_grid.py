@@ -194,8 +194,9 @@ def summarize_grid(rows: list[GridRow]) -> list[dict[str, Any]]:
             both = [r for r in mine if r.point in ref]
             errors = [abs(r.error) for r in both if r.error is not None]
             ref_cycles = [ref[r.point].cycles for r in both]
-            tau = kendall_tau(ref_cycles, [r.cycles for r in both])  # type: ignore[arg-type]
-            gap = largest_misordered_gap(ref_cycles, [r.cycles for r in both])  # type: ignore[arg-type]
+            level_cycles = [r.cycles for r in both]
+            tau = kendall_tau(ref_cycles, level_cycles)  # type: ignore[arg-type]
+            gap = largest_misordered_gap(ref_cycles, level_cycles)  # type: ignore[arg-type]
             front = same_front(both, ref)
             best = min(both, key=lambda r: r.cycles).point if both else None  # type: ignore[arg-type,return-value]
             best_ref = (

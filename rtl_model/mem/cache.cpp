@@ -22,7 +22,7 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
       m_line_shift(log2_exact(config.line_bytes)),
       m_mshr_free(config.mshrs, 0),
       m_bank_of(config.banks) {
-    uint64_t sets = uint64_t(config.size_kib) * 1024 / config.line_bytes / config.ways;
+    uint64_t sets = config.lines() / config.ways;
     m_set_mask = sets - 1;
     m_tags.assign(sets * config.ways, kInvalid);
     m_last_use.assign(sets * config.ways, 0);

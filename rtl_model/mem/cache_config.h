@@ -13,6 +13,8 @@ struct CacheConfig {
     uint32_t banks = 1;       ///< independently accessible banks (line-interleaved)
     uint32_t bank_cycles = 1; ///< cycles a bank is busy per access
 
+    uint64_t lines() const { return uint64_t(size_kib) * 1024 / line_bytes; }
+
     template <class V>
     void visit(V& v) {
         v.field("size_kib", size_kib, "KiB", "Capacity", 1, 1u << 20);

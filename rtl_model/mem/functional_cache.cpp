@@ -4,7 +4,7 @@ namespace rtsim {
 
 FunctionalCache::FunctionalCache(const CacheConfig& config) : m_config(config) {
     while ((1u << m_line_shift) < config.line_bytes) ++m_line_shift;
-    const uint64_t sets = uint64_t(config.size_kib) * 1024 / config.line_bytes / config.ways;
+    const uint64_t sets = config.lines() / config.ways;
     m_set_mask = sets - 1;
     m_lines.resize(sets * config.ways);
 }

@@ -170,7 +170,7 @@ bool power_of_two(uint64_t x) { return x && !(x & (x - 1)); }
 void validate_cache(const CacheConfig& c, const char* name) {
     std::string p = std::string("config: '") + name;
     require(power_of_two(c.line_bytes), p + ".line_bytes' must be a power of two");
-    uint64_t lines = uint64_t(c.size_kib) * 1024 / c.line_bytes;
+    uint64_t lines = c.lines();
     require(lines >= c.ways && lines % c.ways == 0,
             p + ".size_kib' must hold a whole number of sets of " + std::to_string(c.ways) + " ways of " +
                 std::to_string(c.line_bytes) + "-byte lines");

@@ -150,7 +150,7 @@ SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig
     SamplePlan plan;
     plan.trace_rays = rays;
     const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.ray_contexts;
-    const uint32_t warmup = s.resolved_warmup_rays(uint64_t(config.l2.size_kib) * 1024 / config.l2.line_bytes);
+    const uint32_t warmup = s.resolved_warmup_rays(config.l2.lines());
     const uint64_t length = uint64_t(warmup) + s.measured_rays + tail;
     const uint64_t clusters = std::min<uint64_t>(s.clusters, length ? rays / length : 0);
     if (rays <= s.whole_trace_rays || clusters == 0) {

@@ -74,7 +74,7 @@ json analysis_key(const SimConfig& c, const AnalyticConfig& s, const std::string
             {"line_bytes", c.l1.line_bytes},
             {"sample", {{"whole_trace_rays", s.whole_trace_rays},
                         {"clusters", s.clusters},
-                        {"warmup_rays", s.resolved_warmup_rays(uint64_t(c.l2.size_kib) * 1024 / c.l2.line_bytes)},
+                        {"warmup_rays", s.resolved_warmup_rays(c.l2.lines())},
                         {"measured_rays", s.measured_rays}}}};
 }
 

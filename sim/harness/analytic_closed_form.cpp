@@ -16,8 +16,8 @@ namespace {
 /// every MSHR busy gives the most misses per cycle the L2 can have served; the bound is the
 /// misses over that rate. Unloaded and without writes it equals l2_hold / mshrs (writes, which
 /// hold no MSHR, are charged to the misses' channel time: slightly pessimistic when they are
-/// many and the MSHRs few); near the DRAM's peak it adds the
-/// queueing that keeps the MSHRs held longer (what -18% on a DRAM-saturated machine missed).
+/// many and the MSHRs few); near the DRAM's peak it adds the queueing that keeps the MSHRs held
+/// longer (what -18% on a DRAM-saturated machine missed).
 /// Row-buffer hits and conflicts are not known here: every miss costs the closed-bank latency.
 double l2_loop_bound(const SimConfig& c, const AnalyticDemands& d) {
     const double service = std::ceil(double(c.l2.line_bytes) / c.dram.bytes_per_cycle);
@@ -84,8 +84,9 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
         // queues' unloaded demand D/m, and the pipelines', banks' and DRAM bus's service (a
         // pipeline's initiation intervals, a bank's cycle and a line's transfer are in the
         // unloaded latency). The scheduler's issue cycles are not, so its demand stays on top.
-        if (name == "l1_mshrs") think -= d.l1_hold / (double(c.l1.mshrs) * units) * units / rays;
-        else if (name == "l2_mshrs") think -= d.l2_hold / double(c.l2.mshrs) / rays;
+        // The L2's bound holds DRAM queueing too (l2_loop_bound): only its unloaded part is in
+        // the latency.
+        if (name == "l2_mshrs") think -= d.l2_hold / double(c.l2.mshrs) / rays;
         else if (name != "scheduler") think -= demand;
     }
     think = std::max(think, 0.0);

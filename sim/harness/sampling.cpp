@@ -23,7 +23,7 @@ uint64_t warmup_target(const SimConfig& c) {
     // Functional warming fills the caches: the simulated warm-up only refills the contexts and
     // pipelines (SMARTS's detailed warming).
     if (c.sampling.warming_rays > 0) return 2 * rays_in_flight(c);
-    const uint64_t l2_lines = uint64_t(c.l2.size_kib) * 1024 / c.l2.line_bytes;
+    const uint64_t l2_lines = c.l2.lines();
     return std::max<uint64_t>(2 * rays_in_flight(c), c.ideal_memory ? 0 : l2_lines / 8);
 }
 

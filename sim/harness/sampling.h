@@ -11,11 +11,11 @@
 // warming) reach the dispatch only once it has handed out every ray of the cluster before, so
 // the machine stays full across the switch and the next cluster's warming comes after the last
 // ray of the cluster was handed out (in dispatch order; at approx a unit up to a quantum behind
-// in simulated time may still start one of them after it). Each cluster's steady-state cost in cycles per ray is measured from the start cycles
-// of its measured rays (rays enter contexts in dispatch order as contexts free up, so the span of
-// the measured rays' starts over the number of rays started in it is the machine's throughput
-// while it worked on that stratum, with the fill of the pipeline excluded by the warm-up rays
-// before). The total is the sum over strata of stratum size x cycles per ray; the interval is
+// in simulated time may still start one of them after it). Each cluster's steady-state cost in
+// cycles per ray is measured from the start cycles of its measured rays (rays enter contexts in
+// dispatch order as contexts free up, so the span of the measured rays' starts over the number of
+// rays started in it is the machine's throughput while it worked on that stratum, with the fill
+// of the pipeline excluded by the warm-up rays before). The total is the sum over strata of stratum size x cycles per ray; the interval is
 // Student t over the K strata. Functional warming (sampling_warming.h) fills the caches before
 // each cluster; docs/fidelity.md measures the bias.
 #include <cstdint>

@@ -262,6 +262,27 @@ TEST(AnalyticClosedForm, L2MshrBoundAddsDramQueueingNearThePeak) {
     EXPECT_NEAR(closed_form(c, {}, light).bounds["l2_mshrs"].get<double>(), light.l2_hold / 4, 0.01 * light.l2_hold / 4);
 }
 
+TEST(AnalyticClosedForm, OneRayInFlightTakesItsUnloadedLatencyPlusIssueCycles) {
+    // One unit with one ray context: no queueing, so the MVA's residence is the delay plus each
+    // queue's service. The pipelines', banks' and DRAM's service is in the unloaded latency
+    // already; only the scheduler's issue cycles come on top.
+    SimConfig c;
+    c.traversal.units = 1;
+    c.traversal.ray_contexts = 1;
+    c.traversal.issue_cycles = 2;
+    AnalyticDemands d = l2_misses(c, 10);
+    d.rays = 100;
+    d.issues[0] = 5000;
+    d.scheduler_steps = 3000;
+    d.l1_accesses = 3000;
+    d.l2_accesses = 50;
+    d.l1_hold = 10 * 200.0;
+    d.latency_sum = 100 * 5000.0;  // 5000 cycles a ray unloaded
+    const ClosedForm f = closed_form(c, {OpKind(0)}, d);
+    // (Within 0.01%: the L2's loop bound holds the DRAM queueing of busy MSHRs, a few cycles here.)
+    EXPECT_NEAR(f.queueing, d.latency_sum + d.scheduler_steps * c.traversal.issue_cycles, 1e-4 * d.latency_sum);
+}
+
 TEST(AnalyticCache, KeyHoldsWhatShapesTheAccessStreamsOnly) {
     const AnalyticConfig s;
     const SimConfig base;
