@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The analytic level's speed-up over detailed (issue 16; docs/benchmarks.md, "The analytic
+"""The analytic level's speed-up over detailed (docs/benchmarks.md, "The analytic
 level"): on one trace, CPU time (user + system of each rtsim-sim process, from the OS) of
 
 - `detailed` at the default config (--detailed-runs runs, median);

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark of the SystemC model (issue 3): simulated rays per wall-second on Sponza diffuse
+"""Benchmark of the SystemC model: simulated rays per wall-second on Sponza diffuse
 rays with the default config, the ratio of simulation wall time to the reference tracer's time
 for the same rays (both single-threaded, same run), linearity of wall time in the ray count, and
 peak memory as the trace grows 10x. Not a test: it prints figures for docs/benchmarks.md.

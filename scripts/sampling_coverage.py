@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Sampling accuracy and interval coverage over seeds and configurations (issue 15 item 2;
+"""Sampling accuracy and interval coverage over seeds and configurations (
 docs/fidelity.md, "Sampling"): for each configuration, the full run of the level, then sampled
 runs at --fraction for every seed and every functional-warming setting; per setting, the error
 of the estimate against the full run (mean, max |error|), how often the 95% interval contains the

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The treelet study of issue 4 (docs/treelets.md): Sponza and a procedural hairball, primary and
+"""The treelet study (docs/treelets.md): Sponza and a procedural hairball, primary and
 diffuse rays, simulated with the baseline (treelets off) and with treelet scheduling at several
 ray-buffer sizes and two treelet budgets, default config otherwise. Collects DRAM bytes per ray
 (total and BVH = node + triangle reads), L2 traffic, Mrays/s and the ray buffer's counters, checks

@@ -4,7 +4,7 @@ For each trace and level, runs `rtsim-sim TRACE --no-verdict --set fidelity=LEVE
 (one process each, start-up included) and reports the median wall time, the median CPU time of
 the process (user + system, from the OS's accounting of the finished child: less sensitive to a
 shared machine than wall time), simulated rays per wall- and CPU-second, and the ratios the
-simulator's speed targets are stated in (issue 15; docs/benchmarks.md):
+simulator's speed targets are stated in (docs/benchmarks.md):
 
     approx/functional, detailed/approx, treelets/approx, approx/analytic
 

@@ -2,7 +2,7 @@
 // Division and remainder by a divisor fixed at construction (window cycles, bank counts, channel
 // interleaving): a shift and a mask when the divisor is a power of two (the usual configs), a
 // hardware division otherwise. The model divides on every access, and a 64-bit division costs
-// tens of cycles where a shift costs one (issue 15, docs/benchmarks.md "Simulator speed").
+// tens of cycles where a shift costs one (docs/benchmarks.md "Simulator speed").
 #include <cstdint>
 
 namespace rtsim {

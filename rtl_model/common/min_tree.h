@@ -5,8 +5,8 @@
 // ties go to the lower slot by the key's order alone. Setting a slot's time updates its leaf and
 // the log2(slots) nodes above it with one load, one min and one store each (no indirection
 // through slot indices, no allocation); the earliest slot is the root. It replaced a binary heap
-// of events and a linear scan of MSHRs, each a fifth of the model's time in profiles (issue 15,
-// docs/benchmarks.md "Simulator speed").
+// of events and a linear scan of MSHRs, each a fifth of the model's time in profiles
+// (docs/benchmarks.md, "Simulator speed").
 #include <cstdint>
 #include <limits>
 #include <vector>

@@ -43,7 +43,7 @@ struct AnalyticOutcome {
 AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
                              RaySinkIf& sink);
 
-/// The exact variant (before issue 16): every ray stepped, every access through functional
+/// The exact variant: every ray stepped, every access through functional
 /// caches on unloaded clocks (analytic_exact.cpp); for tests and comparisons.
 AnalyticOutcome run_analytic_exact(const SimConfig& config, const Accel& accel, const MemoryMap& map,
                                    RayStream& rays, RaySinkIf& sink);

@@ -1,7 +1,8 @@
 // The exact variant of the analytic level: every ray stepped, every access through functional
 // L1s and L2 (tags, LRU, fills in flight) on unloaded per-context clocks, then the closed form
 // (analytic_closed_form.h). The statistical level (analytic.h) is checked against it
-// (tests/cpp/model/test_analytic.cpp) and it is what the analytic level was before issue 16.
+// (tests/cpp/model/test_analytic.cpp); it is slower, not more
+// accurate, than the statistical level in the timed levels' terms (docs/fidelity.md).
 #include "sim/harness/analytic.h"
 
 #include <algorithm>

@@ -106,8 +106,8 @@ SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json
     return out;
 }
 
-/// analytic.caches = functional: every ray stepped through functional caches (the analytic level
-/// before issue 16; analytic_exact.cpp), every ray checked.
+/// analytic.caches = functional: every ray stepped through functional caches (the exact
+/// variant, analytic_exact.cpp), every ray checked.
 SimOutcome run_functional_caches(const SimOptions& o, TraceReader& reader, const std::string& rtt,
                                  const json& manifest, std::time_t started,
                                  std::chrono::steady_clock::time_point t0) {

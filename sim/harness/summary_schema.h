@@ -1,5 +1,5 @@
 #pragma once
-// The keys of stats.json "summary", declared once (issue 13 item 6): name, unit and meaning.
+// The keys of stats.json "summary", declared once: name, unit and meaning.
 // summarize() and the sampling, energy and verdict steps write exactly these keys (a test checks
 // both directions on real runs), `rtsim-sim --dump-stats-schema` prints them, and the summary
 // table of docs/stats.md is generated from them (scripts/gen_stats_doc.py; a test checks it).

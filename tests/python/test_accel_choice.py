@@ -1,4 +1,4 @@
-"""The structure is a choice everywhere (issue 11, item 6): every registered kind (and the SBVH
+"""The structure is a choice everywhere: every registered kind (and the SBVH
 builder) records kind, builder, width, node bytes, footprint and SAH cost in the manifest, and
 `rtsim simulate` takes the structure from the trace, with no option naming it."""
 

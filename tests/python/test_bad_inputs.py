@@ -1,4 +1,4 @@
-"""The bad-input corpus of issue 10, generated at test time: every case gives exit status 2 (or
+"""The bad-input corpus, generated at test time: every case gives exit status 2 (or
 RtsimError from Python) and a message naming the file and the element, key or ray.
 
 Scene and trace cases run in-process through ``rtsim.cli.main`` and the Python API (fast);

@@ -1,4 +1,4 @@
-"""Sweeps under hostile conditions (issue 10): a grid too big to enumerate, two sweeps on one
+"""Sweeps under hostile conditions: a grid too big to enumerate, two sweeps on one
 folder, and the unfinished trace folders a killed sweep leaves behind."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Treelet scheduling end to end (issue 4): no ray lost or duplicated under any policy or under
+"""Treelet scheduling end to end: no ray lost or duplicated under any policy or under
 overflow, the ray buffer never holds more than its capacity, overflow traffic is counted as
 ray_buffer bytes, and on incoherent rays treelets cut DRAM traffic. Hit equality with and without
 treelets on every scene is in test_model.py (CONFIGS "treelets*")."""

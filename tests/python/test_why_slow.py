@@ -1,4 +1,4 @@
-"""Why is this design slow (issue 13): cycle accounting, the verdict, the roofline, and the treelet
+"""Why is this design slow: cycle accounting, the verdict, the roofline, and the treelet
 ray buffer's admission burst that used to swamp the L2 MSHR stall counter.
 
 Each simulation is one `rtsim-sim` process on a small hairball trace (fixtures in test_model).

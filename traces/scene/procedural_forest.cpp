@@ -1,4 +1,4 @@
-// Forest and grove: thousands of instances of a few detailed meshes (issue 12), the scene that
+// Forest and grove: thousands of instances of a few detailed meshes, the scene that
 // needs a two-level structure. "forest" places 72 x 72 trees and rocks (about 4.6 x 10^8
 // triangles if flattened: more than this machine can flatten); "grove" places 6 x 6 of the same
 // meshes (about 3.4 x 10^6 flattened), small enough to compare flattened against two-level.

@@ -17,7 +17,7 @@
 
 namespace rtsim::test {
 
-/// The structures of issue 11 items 2 and 3 (the wide and compressed BVHs).
+/// The wide and compressed BVHs.
 inline const std::vector<std::string>& wide_kinds() {
     static const std::vector<std::string> kinds = {"bvh4", "bvh6", "bvh8", "cwbvh6", "cwbvh8", "bvh8_octant",
                                                    "cwbvh8_octant"};

@@ -1,4 +1,4 @@
-// Model failures and memory (issue 10): a SystemC-wrapped error becomes a message naming the
+// Model failures and memory: a SystemC-wrapped error becomes a message naming the
 // trace and ray; the memory estimate refuses absurd configs with the figure.
 #include <gtest/gtest.h>
 

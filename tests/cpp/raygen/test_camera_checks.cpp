@@ -1,4 +1,4 @@
-// Cameras that would make invalid rays (issue 10, item 5): check_camera, check_scene_reach and
+// Cameras that would make invalid rays: check_camera, check_scene_reach and
 // automatic framing of scenes far from the origin, very wide, or of zero extent.
 #include <gtest/gtest.h>
 

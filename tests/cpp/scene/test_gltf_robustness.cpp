@@ -1,4 +1,4 @@
-// Hostile glTF (issue 10): inputs that crashed tinygltf, slipped through it, or cost memory
+// Hostile glTF: inputs that crashed tinygltf, slipped through it, or cost memory
 // without need. Each is refused with an Error naming the file and the element, or loads cheaply.
 #include <cmath>
 #include <filesystem>
