@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the `summary` table of docs/stats.md from the simulator's declaration of the summary
-keys (sim/harness/summary_schema.cpp, `rtsim-sim --dump-stats-schema`): a key is declared once,
+keys (sim/report/summary_schema.cpp, `rtsim-sim --dump-stats-schema`): a key is declared once,
 in C++, and the docs follow (tests/python/test_stats_doc.py checks they agree).
 
     python scripts/gen_stats_doc.py [--sim PATH] [--check]

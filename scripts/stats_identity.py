@@ -43,10 +43,32 @@ TRACES: dict[str, tuple[str, list[str]]] = {
     "cornell_bvh4": ("cornell", ["--resolution", "48x36", "--accel", "bvh4"]),
     "cornell_cwbvh8": ("cornell", ["--resolution", "48x36", "--accel", "cwbvh8"]),
     "cornell_grid": ("cornell", ["--resolution", "48x36", "--accel", "grid"]),
-    "hairball_bvh8": ("hairball", ["--resolution", "40x30", "--hairball-triangles", "20000",
-                                   "--accel", "bvh8", "--workload", "diffuse"]),
-    "hairball_sbvh": ("hairball", ["--resolution", "40x30", "--hairball-triangles", "20000",
-                                   "--builder", "sbvh", "--workload", "primary"]),
+    "hairball_bvh8": (
+        "hairball",
+        [
+            "--resolution",
+            "40x30",
+            "--hairball-triangles",
+            "20000",
+            "--accel",
+            "bvh8",
+            "--workload",
+            "diffuse",
+        ],
+    ),
+    "hairball_sbvh": (
+        "hairball",
+        [
+            "--resolution",
+            "40x30",
+            "--hairball-triangles",
+            "20000",
+            "--builder",
+            "sbvh",
+            "--workload",
+            "primary",
+        ],
+    ),
     "grove_frames": ("grove", ["--resolution", "32x24", "--frames", "2"]),
     "alpha_bvh2": ("AlphaBlendModeTest", ["--resolution", "40x30"]),
 }
@@ -61,8 +83,12 @@ CONFIGS: dict[str, list[str]] = {
     "treelets": ["treelets.enabled=true"],
     "treelets_detailed": ["treelets.enabled=true", "fidelity=detailed"],
     "sampled": ["sampling.fraction=0.3"],
-    "spills_shared": ["traversal.stack_entries=2", "box.sharing=shared",
-                      "triangle.sharing=shared", "traversal.units=4"],
+    "spills_shared": [
+        "traversal.stack_entries=2",
+        "box.sharing=shared",
+        "triangle.sharing=shared",
+        "traversal.units=4",
+    ],
     "ideal_bandwidth": ["ideal_memory=true", "dram.model=bandwidth"],
     "big_l1_detailed": ["fidelity=detailed", "l1.size_kib=64", "l2.mshrs=16"],
 }
@@ -72,8 +98,9 @@ QUICK_CONFIGS = ("approx", "detailed", "analytic", "treelets")
 
 def strip_host(node: Any, path: tuple[str, ...] = ()) -> Any:
     if isinstance(node, dict):
-        return {k: strip_host(v, (*path, k)) for k, v in node.items()
-                if (*path, k) not in HOST_FIELDS}
+        return {
+            k: strip_host(v, (*path, k)) for k, v in node.items() if (*path, k) not in HOST_FIELDS
+        }
     if isinstance(node, list):
         return [strip_host(v, path) for v in node]
     return node
@@ -88,7 +115,7 @@ def differences(a: Any, b: Any, path: str = "") -> list[str]:
         return out
     if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
         out: list[str] = []
-        for i, (x, y) in enumerate(zip(a, b)):
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
             out += differences(x, y, f"{path}[{i}]")
         return out
     if a != b or type(a) is not type(b):
@@ -110,7 +137,7 @@ def run(exe: Path, trace: Path, out: Path, sets: list[str]) -> dict[str, Any]:
     stats_file = out / "stats.json"
     if stats_file.is_file():
         return json.loads(stats_file.read_text())
-    # The analytic level keeps its per-trace analysis beside the trace: each binary must make its own.
+    # The analytic level keeps its per-trace analysis beside the trace: each binary makes its own.
     shutil.rmtree(trace / "analytic", ignore_errors=True)
     result = run_sim(SimJob(trace=trace, out_dir=out, sets=sets), exe=exe)
     if result.stats is None:
@@ -121,7 +148,7 @@ def run(exe: Path, trace: Path, out: Path, sets: list[str]) -> dict[str, Any]:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("old", type=Path, help="the rtsim-sim before the change")
-    parser.add_argument("new", type=Path, nargs="?", help="the rtsim-sim after (default: installed)")
+    parser.add_argument("new", type=Path, nargs="?", help="the rtsim-sim after (default: on PATH)")
     parser.add_argument("-o", "--out", type=Path, default=Path("out/stats_identity"))
     parser.add_argument("--quick", action="store_true", help=f"only {', '.join(QUICK_CONFIGS)}")
     args = parser.parse_args(argv)

@@ -11,7 +11,7 @@
 #include <systemc>
 
 #include "sim/harness/simulate.h"
-#include "sim/harness/summary_schema.h"
+#include "sim/report/summary_schema.h"
 #include "traces/common/error.h"
 
 namespace {

@@ -192,7 +192,7 @@ class SamplingConfig:
 @dataclass
 class AnalyticConfig:
     """The analytic level (docs/fidelity.md): its cache model and how its per-trace analysis
-    samples the trace (sim/harness/analytic_config.h)."""
+    samples the trace (sim/analytic/analytic_config.h)."""
 
     caches: str = _choice(
         "statistical",

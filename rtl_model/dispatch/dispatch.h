@@ -31,7 +31,7 @@ public:
     virtual uint64_t total_rays() const = 0;
     /// Frames: the stream goes on with frame `f`'s rays (its reads end at that frame's last ray).
     virtual void begin_frame(uint32_t f) {}
-    /// Segments (a sampled run's clusters, sim/harness/sampling.h): read_chunk returns 0 at a
+    /// Segments (a sampled run's clusters, sim/sampling/sampling.h): read_chunk returns 0 at a
     /// segment's end; the dealer calls this once it has handed out every ray read so far, and
     /// reads on if it returns true. So a segment's first read (and what the stream does then)
     /// comes after the last ray of the previous segment has entered a context.

@@ -22,7 +22,7 @@ private:
     MemStats m_stats;
 };
 
-Top::Top(sc_core::sc_module_name name, const SimConfig& config, const Accel& accel, const MemoryMap& map,
+Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const MemoryMap& map,
          RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features)
     : sc_core::sc_module(name),
       m_config(config),
@@ -66,7 +66,7 @@ Top::Top(sc_core::sc_module_name name, const SimConfig& config, const Accel& acc
 Top::~Top() = default;
 
 void Top::build_memory() {
-    const SimConfig& c = m_config;
+    const ModelConfig& c = m_config;
     if (c.ideal_memory) {
         m_ideal = std::make_unique<IdealMemory>("ideal_memory", c.l1.latency);
         m_instantiated.push_back({{"block", "memory"}, {"instantiated", false},

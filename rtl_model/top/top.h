@@ -18,7 +18,7 @@
 #include "rtl_model/mem/dram.h"
 #include "rtl_model/ray_buffer/ray_buffer.h"
 #include "rtl_model/traversal/traversal_unit.h"
-#include "sim/config/config.h"
+#include "rtl_model/top/model_config.h"
 
 namespace rtsim {
 
@@ -38,7 +38,7 @@ struct MemoryTotals {
 
 class Top : public sc_core::sc_module {
 public:
-    Top(sc_core::sc_module_name name, const SimConfig& config, const Accel& accel, const MemoryMap& map,
+    Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const MemoryMap& map,
         RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features);
     ~Top() override;
 
@@ -65,7 +65,7 @@ private:
     void build_pipelines(const Accel& accel);
     void build_ray_buffer(const Accel& accel, const MemoryMap& map);
 
-    const SimConfig& m_config;
+    const ModelConfig& m_config;
     UnitContext m_unit_context;
     StepperPool m_steppers;
     std::unique_ptr<Dispatch> m_dispatch;

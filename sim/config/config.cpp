@@ -165,31 +165,7 @@ private:
     std::string m_prefix;
 };
 
-bool power_of_two(uint64_t x) { return x && !(x & (x - 1)); }
-
-void validate_cache(const CacheConfig& c, const char* name) {
-    std::string p = std::string("config: '") + name;
-    require(power_of_two(c.line_bytes), p + ".line_bytes' must be a power of two");
-    uint64_t lines = c.lines();
-    require(lines >= c.ways && lines % c.ways == 0,
-            p + ".size_kib' must hold a whole number of sets of " + std::to_string(c.ways) + " ways of " +
-                std::to_string(c.line_bytes) + "-byte lines");
-    require(power_of_two(lines / c.ways), p + ".size_kib' / (ways x line_bytes) must be a power of two (sets)");
-}
-
 }  // namespace
-
-const PipelineConfig& SimConfig::pipeline(OpKind kind) const {
-    switch (kind) {
-        case OpKind::box: return box;
-        case OpKind::triangle: return triangle;
-        case OpKind::anyhit: return anyhit;
-        case OpKind::cell: return cell;
-        case OpKind::transform: return transform;
-        default: break;
-    }
-    throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");
-}
 
 SimConfig config_from_json(const json& j, const SimConfig& base) {
     SimConfig c = base;
@@ -243,21 +219,7 @@ void validate(const SimConfig& config) {
     SimConfig copy = config;
     RangeValidator ranges;
     copy.visit(ranges);
-    validate_cache(config.l1, "l1");
-    validate_cache(config.l2, "l2");
-    require(config.l1.line_bytes == config.l2.line_bytes,
-            "config: 'l1.line_bytes' (" + std::to_string(config.l1.line_bytes) + ") must equal 'l2.line_bytes' (" +
-                std::to_string(config.l2.line_bytes) + ")");
-    require(power_of_two(config.dram.interleave_bytes) && config.dram.interleave_bytes >= config.l2.line_bytes,
-            "config: 'dram.interleave_bytes' must be a power of two and at least the line size");
-    require(power_of_two(config.dram.row_bytes) && power_of_two(config.dram.banks),
-            "config: 'dram.row_bytes' and 'dram.banks' must be powers of two (address bit fields)");
-    const bool banks_run = config.dram.model == DramModel::banks && !config.ideal_memory &&
-                           (config.fidelity == Fidelity::approx || config.fidelity == Fidelity::detailed);
-    require(!banks_run || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
-            "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas with dram.model banks (it is the "
-            "latency of an access to a closed bank); raise dram.latency, lower dram.t_rcd/dram.t_cas, or set "
-            "dram.model=bandwidth");
+    validate_model(config);
     require(!config.treelets.enabled || config.fidelity != Fidelity::analytic,
             "config: 'treelets.enabled' is not supported at fidelity 'analytic' (its closed form models plain "
             "dispatch); use approx or detailed");
@@ -268,7 +230,7 @@ void validate(const SimConfig& config) {
             "the ray buffer admits a cluster's rays long before the machine can trace them, so the span of their "
             "starts does not measure throughput (a 1% sample of Sponza on 4 units estimated -81%); simulate the "
             "whole trace");
-    require(!config.sampling.enabled() || config.fidelity == Fidelity::approx || config.fidelity == Fidelity::detailed,
+    require(!config.sampling.enabled() || config.timed(),
             "config: sampling ('sampling.fraction' or 'sampling.count') needs a timed SystemC level: fidelity approx "
             "or detailed, not '" + std::string(kFidelityChoices.name(config.fidelity)) + "'");
 }

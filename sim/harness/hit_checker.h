@@ -17,7 +17,7 @@
 namespace rtsim {
 
 /// Work summed over the rays checked (64-bit: a frame's box tests overflow 32 bits). The energy
-/// model (sim/harness/energy_area.h) prices these operations at every fidelity level.
+/// model (sim/report/energy_area.h) prices these operations at every fidelity level.
 struct WorkTotals {
     uint64_t steps = 0, box_tests = 0, tri_tests = 0, anyhit_calls = 0, transforms = 0, cell_steps = 0,
              plane_tests = 0, refs = 0;

@@ -1,5 +1,5 @@
 #pragma once
-// What every level's run does with its files (simulate.cpp, analytic_run.cpp): find the trace,
+// What every level's run does with its files (simulate.cpp, run_analytic.cpp): find the trace,
 // read and check its manifest, scan its rays once, write JSON outputs. One copy, so every level
 // refuses the same bad input with the same message (docs/validation.md).
 #include <filesystem>

@@ -8,21 +8,21 @@
 #include <memory>
 
 #include "rtl_model/top/top.h"
-#include "sim/harness/analytic.h"
-#include "sim/harness/energy_area.h"
+#include "sim/analytic/analytic.h"
+#include "sim/report/energy_area.h"
 #include "sim/harness/frames.h"
 #include "sim/harness/hit_checker.h"
-#include "sim/harness/roofline.h"
+#include "sim/report/roofline.h"
 #include "sim/harness/run_files.h"
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/model_errors.h"
-#include "sim/harness/sampling.h"
-#include "sim/harness/sampling_warming.h"
-#include "sim/harness/summary.h"
-#include "sim/harness/summary_schema.h"
-#include "sim/harness/timeline.h"
+#include "sim/sampling/sampling.h"
+#include "sim/sampling/warming.h"
+#include "sim/report/summary.h"
+#include "sim/report/summary_schema.h"
+#include "sim/report/timeline.h"
 #include "sim/harness/trace_stream.h"
-#include "sim/harness/verdict.h"
+#include "sim/report/verdict.h"
 #include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
 
@@ -65,7 +65,7 @@ json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, cons
 }  // namespace
 
 SimOutcome run_simulation(const SimOptions& o) {
-    // The analytic level works from a per-trace analysis and a closed form (sim/harness/analytic.h).
+    // The analytic level works from a per-trace analysis and a closed form (sim/analytic/analytic.h).
     if (o.config.fidelity == Fidelity::analytic) return run_analytic_simulation(o);
     auto t0 = std::chrono::steady_clock::now();
     const std::time_t started = std::time(nullptr);
@@ -89,7 +89,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     // of an error naming the file (exit 2).
     reader.verify_all();
     const uint64_t total = workload["rays"];
-    // Sampling (sim/harness/sampling.h): only the sample's rays are simulated and checked.
+    // Sampling (sim/sampling/sampling.h): only the sample's rays are simulated and checked.
     std::unique_ptr<SampledRun> sampled;
     if (o.config.sampling.enabled()) sampled = std::make_unique<SampledRun>(reader, o.config, total);
     const uint64_t simulated = sampled ? sampled->plan.simulated_rays : total;

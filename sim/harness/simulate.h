@@ -17,7 +17,7 @@ struct SimOptions {
     std::string out_dir;  ///< created if missing
     bool timeline = false;
     bool progress = false;  ///< JSON progress lines on stderr: {"progress": done, "total": n}
-    bool verdict = true;    ///< name the bottleneck and estimate what relaxing it buys (sim/harness/verdict.h)
+    bool verdict = true;    ///< name the bottleneck and estimate what relaxing it buys (sim/report/verdict.h)
     std::string command_line;
 };
 

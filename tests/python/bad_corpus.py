@@ -1,4 +1,4 @@
-"""Generators of the bad inputs every reader must refuse: malformed glTF/GLB scenes and traces whose CRCs
+"""Generators of inputs every reader must refuse: malformed glTF/GLB scenes and traces whose CRCs
 are valid but whose content is not. Used by test_bad_inputs.py and by scripts/make_fuzz_corpus.py
 (the sanitizer run's corpus and the fuzzers' seeds). Each case returns what the error must say.
 """

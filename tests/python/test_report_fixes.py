@@ -1,4 +1,4 @@
-"""Report defects that once slipped through, on synthetic runs: categorical keys split marginal lines,
+"""Report defects once found, on synthetic runs: categorical keys split marginal lines,
 speed-up over a named baseline, powers of two on log axes, no ray-buffer size on treelets-off
 labels, Pareto fronts against area and energy, heatmap clipping and panels, the accuracy legend,
 and `rtsim results` key columns for stores that mix specs."""

@@ -1,4 +1,4 @@
-"""The summary keys are declared once (sim/harness/summary_schema.cpp): docs/stats.md's summary
+"""The summary keys are declared once (sim/report/summary_schema.cpp): docs/stats.md's summary
 table is generated from that declaration, and a real run writes exactly the declared keys."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-// The analytic level's statistical cache model (sim/harness/analytic_reuse.h,
-// analytic_estimate.h) against exact LRU caches, its closed form against its own roofline, and
+// The analytic level's statistical cache model (sim/analytic/reuse.h,
+// estimate.h) against exact LRU caches, its closed form against its own roofline, and
 // the per-trace analysis cache's key.
 #include <gtest/gtest.h>
 
@@ -11,12 +11,12 @@
 
 #include "../bvh/bvh_test_scenes.h"
 #include "rtl_model/mem/functional_cache.h"
-#include "sim/harness/analytic.h"
-#include "sim/harness/analytic_cache.h"
-#include "sim/harness/analytic_closed_form.h"
-#include "sim/harness/analytic_estimate.h"
-#include "sim/harness/analytic_reuse.h"
-#include "sim/harness/analytic_sample.h"
+#include "sim/analytic/analytic.h"
+#include "sim/analytic/analysis_cache.h"
+#include "sim/analytic/closed_form.h"
+#include "sim/analytic/estimate.h"
+#include "sim/analytic/reuse.h"
+#include "sim/analytic/sample.h"
 #include "traces/raygen/camera.h"
 
 namespace rtsim {

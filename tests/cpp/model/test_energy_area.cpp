@@ -1,9 +1,9 @@
-// The first-order energy and area model (sim/harness/energy_area.h, docs/energy_area.md): the
+// The first-order energy and area model (sim/report/energy_area.h, docs/energy_area.md): the
 // 45 nm reference reproduces Horowitz's figures, scaling follows Stillmaker & Baas, counts are
 // priced block by block, and what a level cannot know is null.
 #include <gtest/gtest.h>
 
-#include "sim/harness/energy_area.h"
+#include "sim/report/energy_area.h"
 
 namespace rtsim {
 namespace {

@@ -1,8 +1,8 @@
-// The summary keys are declared once (sim/harness/summary_schema.h): a summary with an
+// The summary keys are declared once (sim/report/summary_schema.h): a summary with an
 // undeclared key, or without a declared one, is refused with the key's name.
 #include <gtest/gtest.h>
 
-#include "sim/harness/summary_schema.h"
+#include "sim/report/summary_schema.h"
 #include "tests/cpp/model/model_test_util.h"
 #include "traces/common/error.h"
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "rtl_model/traversal/cycle_accounting.h"
-#include "sim/harness/verdict.h"
+#include "sim/report/verdict.h"
 
 namespace rtsim {
 namespace {

@@ -1,0 +1,54 @@
+#include "rtl_model/top/model_config.h"
+
+#include <string>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+namespace {
+
+bool power_of_two(uint64_t x) { return x && !(x & (x - 1)); }
+
+void validate_cache(const CacheConfig& c, const char* name) {
+    std::string p = std::string("config: '") + name;
+    require(power_of_two(c.line_bytes), p + ".line_bytes' must be a power of two");
+    uint64_t lines = c.lines();
+    require(lines >= c.ways && lines % c.ways == 0,
+            p + ".size_kib' must hold a whole number of sets of " + std::to_string(c.ways) + " ways of " +
+                std::to_string(c.line_bytes) + "-byte lines");
+    require(power_of_two(lines / c.ways), p + ".size_kib' / (ways x line_bytes) must be a power of two (sets)");
+}
+
+}  // namespace
+
+const PipelineConfig& ModelConfig::pipeline(OpKind kind) const {
+    switch (kind) {
+        case OpKind::box: return box;
+        case OpKind::triangle: return triangle;
+        case OpKind::anyhit: return anyhit;
+        case OpKind::cell: return cell;
+        case OpKind::transform: return transform;
+        default: break;
+    }
+    throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");
+}
+
+void validate_model(const ModelConfig& config) {
+    validate_cache(config.l1, "l1");
+    validate_cache(config.l2, "l2");
+    require(config.l1.line_bytes == config.l2.line_bytes,
+            "config: 'l1.line_bytes' (" + std::to_string(config.l1.line_bytes) + ") must equal 'l2.line_bytes' (" +
+                std::to_string(config.l2.line_bytes) + ")");
+    require(power_of_two(config.dram.interleave_bytes) && config.dram.interleave_bytes >= config.l2.line_bytes,
+            "config: 'dram.interleave_bytes' must be a power of two and at least the line size");
+    require(power_of_two(config.dram.row_bytes) && power_of_two(config.dram.banks),
+            "config: 'dram.row_bytes' and 'dram.banks' must be powers of two (address bit fields)");
+    const bool banks_run = config.dram.model == DramModel::banks && !config.ideal_memory && config.timed();
+    require(!banks_run || config.dram.latency >= config.dram.t_rcd + config.dram.t_cas,
+            "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas with dram.model banks (it is the "
+            "latency of an access to a closed bank); raise dram.latency, lower dram.t_rcd/dram.t_cas, or set "
+            "dram.model=bandwidth");
+}
+
+}  // namespace rtsim

@@ -1,0 +1,82 @@
+#pragma once
+// The accelerator model's configuration: the blocks' configs (each declared next to its block,
+// rtl_model/<block>/*_config.h) and the level flags that change how the model times (fidelity,
+// ideal memory). The model owns it; the harness composes it with its own sections (sampling,
+// energy, the analytic level: sim/config/config.h) into the one config tree. Each struct lists
+// its fields once in visit() with name, unit, range and a one-line doc.
+#include <cstdint>
+#include <utility>
+
+#include "rtl_model/common/choice.h"
+#include "rtl_model/dispatch/dispatch_config.h"
+#include "rtl_model/isect/pipeline_config.h"
+#include "rtl_model/mem/cache_config.h"
+#include "rtl_model/mem/dram_config.h"
+#include "rtl_model/ray_buffer/ray_buffer_config.h"
+#include "rtl_model/traversal/traversal_config.h"
+#include "traces/accel/step_plan.h"
+
+namespace rtsim {
+
+/// How a run is simulated (docs/fidelity.md). The SystemC model runs approx and detailed; the
+/// harness runs functional (reference traversal, no time) and analytic (a closed form).
+enum class Fidelity : uint8_t { functional = 0, analytic = 1, approx = 2, detailed = 3 };
+inline constexpr Choices<Fidelity, 4> kFidelityChoices{{"functional", "analytic", "approx", "detailed"}};
+
+struct ModelConfig {
+    double clock_ghz = 1.0;          ///< converts cycles to seconds
+    Fidelity fidelity = Fidelity::approx;  ///< functional | analytic | approx | detailed (docs/fidelity.md)
+    uint32_t quantum_cycles = 256;   ///< how far a unit may run ahead of SystemC time
+    uint32_t interconnect_latency = 8;  ///< L1 to L2 one-way cycles
+    bool ideal_memory = false;       ///< every access hits in L1 (upper bound on performance)
+    DispatchConfig dispatch;
+    TraversalConfig traversal;
+    PipelineConfig box{8, 1, 2, Sharing::per_unit, 4};
+    PipelineConfig triangle{20, 1, 1, Sharing::per_unit, 4};
+    PipelineConfig anyhit{10, 1, 1, Sharing::per_unit, 4};
+    PipelineConfig cell{4, 1, 1, Sharing::per_unit, 4};
+    /// Instance transforms of two-level structures: a 3x4 matrix times the ray's origin and
+    /// direction (18 multiply-adds), pipelined like a box test (Vulkan-Sim's instance transform).
+    PipelineConfig transform{8, 1, 1, Sharing::per_unit, 4};
+    // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
+    // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
+    CacheConfig l1{16, 4, 64, 4, 16, 1, 1};
+    CacheConfig l2{1024, 16, 64, 20, 64, 8, 1};
+    DramConfig dram;
+    TreeletConfig treelets;
+
+    /// The pipeline operations of `kind` go to. Adding an operation kind adds a PipelineConfig
+    /// member, its visit() line and a case here (docs/accel.md, "Adding a structure"); a kind with
+    /// no pipeline is an error naming it.
+    const PipelineConfig& pipeline(OpKind kind) const;
+    PipelineConfig& pipeline(OpKind kind) { return const_cast<PipelineConfig&>(std::as_const(*this).pipeline(kind)); }
+    /// True when the SystemC model times this level (approx, detailed).
+    bool timed() const { return fidelity == Fidelity::approx || fidelity == Fidelity::detailed; }
+
+    template <class V>
+    void visit(V& v) {
+        v.field("clock_ghz", clock_ghz, "GHz", "Core clock: converts cycles to seconds", 0.001, 100.0);
+        v.choice("fidelity", fidelity, kFidelityChoices, "Simulation level: functional (counts only), analytic (cache simulation + roofline), approx (timed SystemC model) or detailed (per-cycle arbitration, L2 MSHRs)");
+        v.field("quantum_cycles", quantum_cycles, "cycles", "How far a traversal unit may run ahead of the others (temporal decoupling)", 1, 1u << 20);
+        v.field("interconnect_latency", interconnect_latency, "cycles", "One-way latency between an L1 and the L2", 0, 10000);
+        v.flag("ideal_memory", ideal_memory, "Every access hits in L1 at L1 latency: the upper bound on performance");
+        v.section("dispatch", dispatch);
+        v.section("traversal", traversal);
+        v.section("box", box);
+        v.section("triangle", triangle);
+        v.section("anyhit", anyhit);
+        v.section("cell", cell);
+        v.section("transform", transform);
+        v.section("l1", l1);
+        v.section("l2", l2);
+        v.section("dram", dram);
+        v.section("treelets", treelets);
+    }
+};
+
+/// The model's cross-field rules (cache geometry, line sizes, DRAM address fields and timing);
+/// throws rtsim::Error naming the field and what to change. Ranges are checked by the harness's
+/// visitor over the whole tree.
+void validate_model(const ModelConfig& config);
+
+}  // namespace rtsim

@@ -1,0 +1,196 @@
+#include "sim/analytic/analytic.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sim/analytic/analysis_cache.h"
+#include "sim/analytic/estimate.h"
+#include "sim/analytic/sample.h"
+#include "sim/sampling/sampling.h"
+#include "sim/harness/trace_stream.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// Sums every ray's work record (one streaming pass; each chunk's CRC is checked as it is read).
+void work_totals(TraceReader& reader, AnalyticProfile* p) {
+    const uint64_t n = reader.section(SectionKind::work).record_count;
+    std::vector<WorkRecord> buf(65536);
+    p->rays = n;
+    p->work.fill(0.0);
+    for (uint64_t first = 0; first < n; first += buf.size()) {
+        const uint64_t count = std::min<uint64_t>(buf.size(), n - first);
+        reader.read(SectionKind::work, first, count, buf.data());
+        uint64_t sums[kWorkFields] = {};
+        for (uint64_t i = 0; i < count; ++i) {
+            const WorkRecord& w = buf[i];
+            sums[0] += w.steps, sums[1] += w.box_tests, sums[2] += w.tri_tests, sums[3] += w.anyhit_calls;
+            sums[4] += w.transforms, sums[5] += w.cell_steps, sums[6] += w.plane_tests, sums[7] += w.refs;
+            const double steps = double(w.steps) + w.cell_steps;
+            if (steps > p->longest_ray_steps) p->longest_ray_steps = steps, p->longest_ray_tests = w.tri_tests;
+        }
+        for (int f = 0; f < kWorkFields; ++f) p->work[size_t(f)] += double(sums[f]);
+    }
+}
+
+/// A vector of rays as a stream.
+class VectorStream : public RayStream {
+public:
+    explicit VectorStream(const std::vector<RayJob>& jobs) : m_jobs(jobs) {}
+    size_t read_chunk(size_t max, std::vector<RayJob>* out) override {
+        const size_t n = std::min(max, m_jobs.size() - m_next);
+        out->insert(out->end(), m_jobs.begin() + long(m_next), m_jobs.begin() + long(m_next + n));
+        m_next += n;
+        return n;
+    }
+    uint64_t total_rays() const override { return m_jobs.size(); }
+
+private:
+    const std::vector<RayJob>& m_jobs;
+    size_t m_next = 0;
+};
+
+/// Keeps the results of the rays it forwards (for replay) and the longest ray's work.
+class RecordingSink : public RaySinkIf {
+public:
+    explicit RecordingSink(RaySinkIf& next) : m_next(next) {}
+    void ray_done(const RayResult& r) override {
+        results.push_back(r);
+        m_next.ray_done(r);
+    }
+    std::vector<RayResult> results;
+
+private:
+    RaySinkIf& m_next;
+};
+
+struct Memo {
+    AnalyticProfile profile;
+    std::vector<RayResult> results;
+};
+
+/// Analyses of ray streams already stepped in this process (the verdict evaluates several
+/// configurations on the same sample), by key; a handful at most.
+std::map<std::string, Memo>& memo() {
+    static std::map<std::string, Memo> m;
+    return m;
+}
+
+std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& accel) {
+    uint64_t h = 1469598103934665603ull;
+    auto add = [&](const void* data, size_t n) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    };
+    const void* a = &accel;
+    add(&a, sizeof a);
+    for (const RayJob& j : jobs) {
+        add(&j.id, sizeof j.id);
+        add(&j.ray, sizeof j.ray);
+        add(&j.any_hit, sizeof j.any_hit);
+    }
+    return std::to_string(h) + ":" + std::to_string(jobs.size());
+}
+
+AnalyticOutcome outcome_of(const SimConfig& config, const AnalyticProfile& profile) {
+    AnalyticEstimate e = estimate_analytic(config, profile);
+    AnalyticOutcome out;
+    out.cycles = Cycle(e.form.cycles);
+    out.model = std::move(e.model);
+    out.instantiated = std::move(e.instantiated);
+    return out;
+}
+
+}  // namespace
+
+AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
+                             RaySinkIf& sink) {
+    std::vector<RayJob> jobs;
+    while (rays.read_chunk(65536, &jobs)) {
+    }
+    const std::string key = analysis_key(config, config.analytic, stream_fingerprint(jobs, accel)).dump();
+    auto& cache = memo();
+    auto it = cache.find(key);
+    if (it != cache.end()) {
+        for (const RayResult& r : it->second.results) sink.ray_done(r);
+        return outcome_of(config, it->second.profile);
+    }
+    Memo m;
+    AnalyticProfile& p = m.profile;
+    p.accel_kind = accel.kind();
+    p.op_kinds = accel.op_kinds();
+    RecordingSink recording(sink);
+    SampleProfiler profiler(config, accel, map, p);
+    VectorStream stream(jobs);
+    profiler.run_cluster(stream, 0, ~0ull, recording);
+    profiler.finish();
+    // The stream is its own sample: its work totals are the stepped rays'; nothing ran before it.
+    p.whole_trace = true;
+    p.rays = uint64_t(p.sample_rays);
+    p.work = p.sample_work;
+    for (const RayResult& r : recording.results) {
+        const double steps = double(r.work.steps) + r.work.cell_steps;
+        if (steps > p.longest_ray_steps) p.longest_ray_steps = steps, p.longest_ray_tests = r.work.tri_tests;
+    }
+    m.results = std::move(recording.results);
+    if (cache.size() >= 8) cache.erase(cache.begin());
+    const AnalyticOutcome out = outcome_of(config, p);
+    cache.emplace(key, std::move(m));
+    return out;
+}
+
+SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig& config) {
+    SamplePlan plan;
+    plan.trace_rays = rays;
+    const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.ray_contexts;
+    const uint32_t warmup = s.resolved_warmup_rays(config.l2.lines());
+    const uint64_t length = uint64_t(warmup) + s.measured_rays + tail;
+    const uint64_t clusters = std::min<uint64_t>(s.clusters, length ? rays / length : 0);
+    if (rays <= s.whole_trace_rays || clusters == 0) {
+        plan.clusters.push_back({0, rays, 0, 0, rays});
+    } else {
+        // One cluster in the middle of each of K equal strata (deterministic).
+        for (uint64_t k = 0; k < clusters; ++k) {
+            const uint64_t first = rays * k / clusters, end = rays * (k + 1) / clusters;
+            const uint64_t start = first + (end - first - length) / 2;
+            plan.clusters.push_back({first, end - first, start, warmup, s.measured_rays + tail});
+        }
+        plan.warmup_rays = warmup;
+    }
+    for (const auto& c : plan.clusters) plan.simulated_rays += c.warmup + c.measured;
+    return plan;
+}
+
+AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map, TraceReader& reader,
+                              RaySinkIf& sink, const AnalyticConfig& sample) {
+    const auto t0 = std::chrono::steady_clock::now();
+    AnalyticProfile p;
+    p.accel_kind = accel.kind();
+    p.op_kinds = accel.op_kinds();
+    work_totals(reader, &p);
+    const SamplePlan plan = analysis_plan(p.rays, sample, config);
+    const bool whole = plan.clusters.size() == 1 && plan.clusters[0].warmup == 0;
+    SampleProfiler profiler(config, accel, map, p);
+    std::vector<RayRecord> buffer;
+    for (const SamplePlan::Cluster& c : plan.clusters) {
+        std::vector<RayJob> jobs;
+        read_ray_jobs(reader, c.first, size_t(c.warmup + c.measured), &buffer, &jobs);
+        VectorStream stream(jobs);
+        const uint64_t measure_first = c.first + c.warmup;
+        const uint64_t measure_end = whole ? c.end() : measure_first + sample.measured_rays;
+        profiler.run_cluster(stream, measure_first, measure_end, sink);
+    }
+    profiler.finish();
+    p.whole_trace = whole;
+    p.analysis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return p;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,297 @@
+#include "sim/analytic/estimate.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "sim/analytic/reuse.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// Miss probabilities per reuse bin for one configuration's L1 and L2, computed on first use.
+class MissTables {
+public:
+    MissTables(const SimConfig& c, const AnalyticProfile& p)
+        : m_unit(p.unit_events, p.unit_censored),
+          m_global(p.global_events, p.global_censored),
+          m_c(c),
+          m_cold(p.whole_trace),
+          m_m1(2 * DistanceBins::kBins, -1.0),
+          m_m2(2 * DistanceBins::kBins, -1.0) {}
+    /// P(L1 miss) and P(L1 miss and L2 miss) of an access in a joint cell.
+    std::pair<double, double> cell(uint32_t key) const {
+        if (m_c.ideal_memory) return {0.0, 0.0};
+        int ub, gb;
+        bool uc, gc;
+        JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
+        const double p1 = lookup(m_m1, m_unit, ub, uc, m_c.l1, m_cold);
+        return {p1, p1 * lookup(m_m2, m_global, gb, gc, m_c.l2, m_cold)};
+    }
+
+private:
+    static double lookup(std::vector<double>& table, const ReuseCurve& curve, int b, bool censored,
+                         const CacheConfig& cache, bool cold) {
+        double& m = table[size_t(2 * b + censored)];
+        if (m < 0) {
+            const double lines = double(cache.size_kib) * 1024.0 / cache.line_bytes;
+            m = bin_miss_probability(curve, b, censored, lines, cache.ways, cold);
+        }
+        return m;
+    }
+    ReuseCurve m_unit, m_global;
+    const SimConfig& m_c;
+    bool m_cold;  ///< censored accesses are compulsory misses (whole-trace analysis)
+    mutable std::vector<double> m_m1, m_m2;
+};
+
+/// Whole-trace counts of one data kind.
+struct KindCounts {
+    double reads = 0, read_bytes = 0, l1_misses = 0, l2_misses = 0, writes = 0, write_bytes = 0;
+};
+
+json counters_json(double reads, double writes, double hits, double read_bytes, double write_bytes) {
+    return {{"reads", reads},         {"writes", writes},           {"read_hits", hits},
+            {"merged", 0.0},          {"hit_rate", reads > 0 ? hits / reads : 0.0},
+            {"read_bytes", read_bytes}, {"write_bytes", write_bytes}};
+}
+
+/// Work field of an operation kind's tests (WorkRecord order).
+int test_field(OpKind kind) {
+    switch (kind) {
+        case OpKind::box: return 1;
+        case OpKind::triangle: return 2;
+        case OpKind::anyhit: return 3;
+        case OpKind::transform: return 4;
+        case OpKind::cell: return 5;
+        case OpKind::plane: return 6;
+    }
+    return 1;
+}
+
+class Estimator {
+public:
+    Estimator(const SimConfig& c, const AnalyticProfile& p) : m_c(c), m_p(p), m_miss(c, p) {
+        const double line = c.l1.line_bytes;
+        const double ic = c.interconnect_latency;
+        m_lat_l1 = c.l1.latency;
+        m_lat_l2 = double(c.l1.latency) + 2.0 * ic + c.l2.latency;
+        m_dram = double(c.dram.latency) + std::ceil(line / c.dram.bytes_per_cycle);
+        m_lat_dram = m_lat_l2 + m_dram;
+    }
+    AnalyticEstimate run();
+    PredictedRates rates();
+
+private:
+    double aux(int field, bool sample) const {
+        if (field < 0) return sample ? m_p.sample_rays : double(m_p.rays);
+        return sample ? m_p.sample_work[size_t(field)] : m_p.work[size_t(field)];
+    }
+    /// Whole trace over sample for a data kind's accesses (ratio estimator).
+    double scale(DataKind kind) const {
+        const int f = AnalyticProfile::aux_field(kind);
+        if (aux(f, true) > 0) return aux(f, false) / aux(f, true);
+        return m_p.sample_rays > 0 ? double(m_p.rays) / m_p.sample_rays : 0.0;
+    }
+    double plan_steps() const {
+        const double x1 = m_p.work[0] + m_p.work[5], x2 = m_p.work[2];
+        const double fit = m_p.plan_steps_per[0] * x1 + m_p.plan_steps_per[1] * x2;
+        if (fit > 0) return fit;
+        return m_p.sample_rays > 0 ? m_p.sample_plan_steps * double(m_p.rays) / m_p.sample_rays : 0.0;
+    }
+    /// Mean unloaded latency of the accesses of a histogram (their slowest lines).
+    double mean_latency(const JointHistogram& h) const {
+        double n = 0, sum = 0;
+        for (const auto& [key, count] : h.cells) {
+            const auto [m1, m12] = m_miss.cell(key);
+            sum += count * ((1.0 - m1) * m_lat_l1 + (m1 - m12) * m_lat_l2 + m12 * m_lat_dram);
+            n += count;
+        }
+        return n > 0 ? sum / n : m_lat_l1;
+    }
+    void count_kinds();
+    void ops(double* op_latency);
+    json memory_json(double cycles) const;
+
+    const SimConfig& m_c;
+    const AnalyticProfile& m_p;
+    MissTables m_miss;
+    double m_lat_l1, m_lat_l2, m_lat_dram, m_dram;
+    std::array<KindCounts, kDataKindCount> m_kinds;
+    AnalyticDemands m_d;
+    double m_tests[kOpKindCount] = {};
+};
+
+void Estimator::count_kinds() {
+    for (int k = 0; k < kDataKindCount; ++k) {
+        KindCounts& kc = m_kinds[size_t(k)];
+        const JointHistogram& h = m_p.reads[size_t(k)];
+        const double s = scale(DataKind(k));
+        double n = 0, m1 = 0, m12 = 0;
+        for (const auto& [key, count] : h.cells) {
+            const auto [a, b] = m_miss.cell(key);
+            n += count, m1 += count * a, m12 += count * b;
+        }
+        kc.reads = n * s;
+        kc.read_bytes = m_p.read_bytes[size_t(k)] * s;
+        kc.l1_misses = m1 * s;
+        kc.l2_misses = m12 * s;
+        kc.writes = m_p.writes[size_t(k)] * s;
+        kc.write_bytes = m_p.write_bytes[size_t(k)] * s;
+    }
+}
+
+/// Pipeline issues per kind (each operation of n tests takes ceil(n / width) issues), from the
+/// sample's operation sizes scaled by the trace's test counts; returns their unloaded latency.
+void Estimator::ops(double* op_latency) {
+    *op_latency = 0;
+    for (OpKind kind : m_p.op_kinds) {
+        const PipelineConfig& pc = m_c.pipeline(kind);
+        const size_t k = size_t(kind);
+        double tests = 0, issues = 0, latency = 0;
+        for (const auto& [n, f] : m_p.op_sizes[k]) {
+            const double i = std::ceil(double(n) / pc.width);
+            tests += f * n, issues += f * i;
+            if (i > 0) latency += f * ((i - 1) * pc.initiation_interval + pc.latency);
+        }
+        const double total = m_p.work[size_t(test_field(kind))];
+        const double s = tests > 0 ? total / tests : 0.0;
+        m_d.issues[k] = tests > 0 ? issues * s : std::ceil(total / pc.width);
+        m_tests[k] = total;
+        *op_latency += latency * s;
+    }
+}
+
+AnalyticEstimate Estimator::run() {
+    count_kinds();
+    double op_latency = 0;
+    ops(&op_latency);
+    const double rays = double(m_p.rays), steps = plan_steps();
+    m_d.rays = rays;
+    m_d.scheduler_steps = rays + 2.0 * steps;
+    for (const KindCounts& kc : m_kinds) {
+        m_d.l1_accesses += kc.reads + kc.writes;
+        m_d.l2_accesses += kc.l1_misses + kc.writes;
+        m_d.dram_bytes += kc.l2_misses * m_c.l1.line_bytes + kc.write_bytes;
+        m_d.l1_hold += kc.l1_misses * (m_lat_l2 - m_lat_l1) + kc.l2_misses * m_dram;
+        m_d.l2_hold += kc.l2_misses * m_dram;
+    }
+    if (m_c.ideal_memory) m_d.l1_accesses = m_d.l2_accesses = m_d.dram_bytes = m_d.l1_hold = m_d.l2_hold = 0;
+    const double ray_start = m_c.dispatch.latency + mean_latency(m_p.ray_critical);
+    const double fetch = mean_latency(m_p.step_critical);
+    m_d.latency_sum = rays * ray_start + steps * fetch + op_latency;
+    // The longest ray: its planned steps at the mean cost of a step.
+    const double per_step = steps > 0 ? (steps * fetch + op_latency) / steps : 0.0;
+    const double longest = m_p.plan_steps_per[0] * m_p.longest_ray_steps + m_p.plan_steps_per[1] * m_p.longest_ray_tests;
+    m_d.latency_max = ray_start + longest * per_step;
+
+    AnalyticEstimate e;
+    e.demands = m_d;
+    e.form = closed_form(m_c, m_p.op_kinds, m_d);
+    e.mean_latency = rays > 0 ? m_d.latency_sum / rays : 0.0;
+    const double units = m_c.traversal.units;
+    const std::vector<double> none(kOpKindCount, 0.0);
+    std::vector<std::vector<double>> unit_issues(m_c.traversal.units, none), unit_tests(m_c.traversal.units, none);
+    for (size_t u = 0; u < unit_issues.size(); ++u)
+        for (int k = 0; k < kOpKindCount; ++k) unit_issues[u][k] = m_d.issues[k] / units, unit_tests[u][k] = m_tests[k] / units;
+    json& m = e.model;
+    m = pipelines_json(m_c, m_p.op_kinds, unit_issues, unit_tests, e.form.cycles);
+    m["dispatch"] = {{"rays", rays}, {"policy", kDispatchPolicyChoices.name(m_c.dispatch.policy)},
+                     {"chunk_rays", m_c.dispatch.chunk_rays}, {"chunks", nullptr}, {"steals", nullptr}};
+    for (uint32_t u = 0; u < m_c.traversal.units; ++u)
+        m["units"]["tu" + std::to_string(u)] = {
+            {"rays", rays / units}, {"steps", m_d.scheduler_steps / units}, {"busy_cycles", nullptr},
+            {"busy_fraction", nullptr}, {"stack_spill_writes", m_p.spill_writes * scale(DataKind::stack) / units},
+            {"stack_spill_reads", m_p.spill_reads * scale(DataKind::stack) / units}, {"rejected_rays", nullptr},
+            {"quantum_syncs", nullptr}, {"finish_cycle", nullptr}};
+    json memory = memory_json(e.form.cycles);
+    for (auto& [k, v] : memory.items()) m[k] = std::move(v);
+    m["analytic"] = closed_form_json(e.form, m_d);
+    e.instantiated = analytic_instantiated(m_c, m_p.accel_kind, m_p.op_kinds,
+                                           "statistical L1s and L2 (reuse distances of a sample, StatStack), DRAM bytes");
+    return e;
+}
+
+json Estimator::memory_json(double cycles) const {
+    json out = json::object();
+    if (m_c.ideal_memory) {
+        json ideal = json::object();
+        double reads = 0, writes = 0, rb = 0, wb = 0;
+        for (int k = 0; k < kDataKindCount; ++k) {
+            const KindCounts& kc = m_kinds[size_t(k)];
+            if (kc.reads + kc.writes <= 0) continue;
+            ideal["by_kind"][data_kind_name(DataKind(k))] = counters_json(kc.reads, kc.writes, kc.reads, kc.read_bytes, kc.write_bytes);
+            reads += kc.reads, writes += kc.writes, rb += kc.read_bytes, wb += kc.write_bytes;
+        }
+        json t = counters_json(reads, writes, reads, rb, wb);
+        t["by_kind"] = ideal.value("by_kind", json::object());
+        out["ideal_memory"] = t;
+        return out;
+    }
+    const double units = m_c.traversal.units, line = m_c.l1.line_bytes;
+    json l1 = json::object(), l2 = json::object(), dram = json::object();
+    double t1[5] = {}, t2[5] = {}, td[4] = {};  // reads, writes, hits, read bytes, write bytes
+    for (int k = 0; k < kDataKindCount; ++k) {
+        const KindCounts& kc = m_kinds[size_t(k)];
+        if (kc.reads + kc.writes <= 0) continue;
+        const char* name = data_kind_name(DataKind(k));
+        const double v1[5] = {kc.reads, kc.writes, kc.reads - kc.l1_misses, kc.read_bytes, kc.write_bytes};
+        const double v2[5] = {kc.l1_misses, kc.writes, kc.l1_misses - kc.l2_misses, kc.l1_misses * line, kc.write_bytes};
+        const double vd[4] = {kc.l2_misses, kc.writes, kc.l2_misses * line, kc.write_bytes};
+        l1["by_kind"][name] = counters_json(v1[0] / units, v1[1] / units, v1[2] / units, v1[3] / units, v1[4] / units);
+        l2["by_kind"][name] = counters_json(v2[0], v2[1], v2[2], v2[3], v2[4]);
+        dram["by_kind"][name] = {{"reads", vd[0]}, {"writes", vd[1]}, {"read_bytes", vd[2]}, {"write_bytes", vd[3]}};
+        for (int i = 0; i < 5; ++i) t1[i] += v1[i], t2[i] += v2[i];
+        for (int i = 0; i < 4; ++i) td[i] += vd[i];
+    }
+    auto cache_json = [&](const json& kinds, const double* t, double div, const CacheConfig& cc) {
+        json j = counters_json(t[0] / div, t[1] / div, t[2] / div, t[3] / div, t[4] / div);
+        j["by_kind"] = kinds.value("by_kind", json::object());
+        j["evictions"] = nullptr;  // not estimated
+        j["mshr_stall_cycles"] = nullptr;
+        j["config"] = {{"size_kib", cc.size_kib}, {"ways", cc.ways}, {"line_bytes", cc.line_bytes},
+                       {"latency", cc.latency},   {"mshrs", nullptr}, {"banks", cc.banks}};
+        return j;
+    };
+    json l1_one = cache_json(l1, t1, units, m_c.l1);
+    for (uint32_t u = 0; u < m_c.traversal.units; ++u) out["l1"]["l1_" + std::to_string(u)] = l1_one;
+    out["l2"] = cache_json(l2, t2, 1.0, m_c.l2);
+    json d = {{"reads", td[0]}, {"writes", td[1]}, {"read_bytes", td[2]}, {"write_bytes", td[3]},
+              {"by_kind", dram.value("by_kind", json::object())}};
+    const double seconds = cycles / (m_c.clock_ghz * 1e9);
+    const double peak = double(m_c.dram.bytes_per_cycle) * m_c.dram.channels * m_c.clock_ghz;
+    const double achieved = seconds > 0 ? (td[2] + td[3]) / seconds / 1e9 : 0.0;
+    d["bandwidth_gbps"] = achieved;
+    d["peak_bandwidth_gbps"] = peak;
+    d["bandwidth_utilization"] = peak > 0 ? achieved / peak : 0.0;
+    d["avg_queue_cycles"] = nullptr;
+    d["bandwidth_over_time"] = json::array();
+    out["dram"] = d;
+    return out;
+}
+
+PredictedRates Estimator::rates() {
+    count_kinds();
+    PredictedRates r;
+    double reads = 0, m1 = 0, m12 = 0;
+    for (const KindCounts& kc : m_kinds) reads += kc.reads, m1 += kc.l1_misses, m12 += kc.l2_misses;
+    r.l1_read_hit_rate = reads > 0 ? 1.0 - m1 / reads : 0.0;
+    r.l2_read_hit_rate = m1 > 0 ? 1.0 - m12 / m1 : 0.0;
+    r.dram_read_lines = m12;
+    return r;
+}
+
+}  // namespace
+
+AnalyticEstimate estimate_analytic(const SimConfig& config, const AnalyticProfile& profile) {
+    return Estimator(config, profile).run();
+}
+
+PredictedRates predicted_rates(const SimConfig& config, const AnalyticProfile& profile) {
+    return Estimator(config, profile).rates();
+}
+
+}  // namespace rtsim

@@ -1,0 +1,36 @@
+#pragma once
+// From a per-trace analysis (profile.h) and a configuration to the analytic level's
+// answer: hit rates of the L1s and the L2 from the reuse-distance curves (reuse.h),
+// traffic and unloaded latencies scaled to the whole trace by its work counts, then the closed
+// form (closed_form.h). Costs microseconds to milliseconds per configuration; no ray is
+// stepped, so a sweep evaluates every configuration against one analysis.
+#include <nlohmann/json.hpp>
+
+#include "sim/config/config.h"
+#include "sim/analytic/closed_form.h"
+#include "sim/analytic/profile.h"
+
+namespace rtsim {
+
+struct AnalyticEstimate {
+    AnalyticDemands demands;
+    ClosedForm form;
+    nlohmann::json model;         ///< same block names and keys as the SystemC model, plus "analytic"
+    nlohmann::json instantiated;  ///< [{block, instantiated, why}]
+    double mean_latency = 0;      ///< unloaded cycles per ray
+};
+
+/// Evaluates `config` against `profile`. The profile should match the config's key
+/// (analysis_cache.h); when it does not (the verdict trying twice the ray contexts), the
+/// estimate keeps the profile's hit rates: first order.
+AnalyticEstimate estimate_analytic(const SimConfig& config, const AnalyticProfile& profile);
+
+/// Hit rates the profile predicts for one cache level: {l1: {kind: rate}, l2: ...} (tests).
+struct PredictedRates {
+    double l1_read_hit_rate = 0;  ///< over all line reads
+    double l2_read_hit_rate = 0;  ///< over the L1's read misses
+    double dram_read_lines = 0;   ///< line reads reaching DRAM, whole trace
+};
+PredictedRates predicted_rates(const SimConfig& config, const AnalyticProfile& profile);
+
+}  // namespace rtsim

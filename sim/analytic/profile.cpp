@@ -1,0 +1,153 @@
+#include "sim/analytic/profile.h"
+
+#include "sim/analytic/reuse.h"
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+json hist_json(const JointHistogram& h) {
+    json a = json::array();
+    for (const auto& [k, n] : h.cells) a.push_back({k, n});
+    return a;
+}
+
+JointHistogram hist_from(const json& a) {
+    JointHistogram h;
+    for (const json& e : a) h.cells[e.at(0).get<uint32_t>()] = e.at(1).get<double>();
+    return h;
+}
+
+template <class Array>
+json array_json(const Array& a) {
+    return json(std::vector<double>(a.begin(), a.end()));
+}
+
+template <class Array>
+void array_from(const json& j, Array* a) {
+    const std::vector<double> v = j.get<std::vector<double>>();
+    require(v.size() == a->size(), "analytic profile: array of " + std::to_string(v.size()) + " values, expected " +
+                                       std::to_string(a->size()));
+    std::copy(v.begin(), v.end(), a->begin());
+}
+
+}  // namespace
+
+const char* work_field_name(int field) {
+    static const char* names[kWorkFields] = {"steps",      "box_tests",  "tri_tests",   "anyhit_calls",
+                                             "transforms", "cell_steps", "plane_tests", "refs"};
+    return names[field];
+}
+
+double JointHistogram::total() const {
+    double t = 0;
+    for (const auto& [k, n] : cells) t += n;
+    return t;
+}
+
+AnalyticProfile::AnalyticProfile()
+    : op_sizes(kOpKindCount),
+      unit_events(DistanceBins::kBins, 0.0),
+      unit_censored(DistanceBins::kBins, 0.0),
+      global_events(DistanceBins::kBins, 0.0),
+      global_censored(DistanceBins::kBins, 0.0) {}
+
+int AnalyticProfile::aux_field(DataKind kind) {
+    switch (kind) {
+        case DataKind::triangle: return 2;   // tri_tests
+        case DataKind::prim_ref: return 7;   // refs
+        case DataKind::cell: return 5;       // cell_steps
+        case DataKind::instance: return 4;   // transforms
+        case DataKind::ray:
+        case DataKind::hit: return -1;       // rays
+        default: return 0;                   // steps (nodes, stack, ray buffer)
+    }
+}
+
+json AnalyticProfile::to_json() const {
+    json ops = json::array();
+    for (const auto& sizes : op_sizes) {
+        json o = json::array();
+        for (const auto& [n, f] : sizes) o.push_back({n, f});
+        ops.push_back(o);
+    }
+    std::vector<int> kinds;
+    for (OpKind k : op_kinds) kinds.push_back(int(k));
+    json reads_j = json::array();
+    for (const JointHistogram& h : reads) reads_j.push_back(hist_json(h));
+    return {{"schema", "rtsim-analytic-profile/1"},
+            {"key", key},
+            {"accel_kind", accel_kind},
+            {"op_kinds", kinds},
+            {"rays", rays},
+            {"work", array_json(work)},
+            {"longest_ray_steps", longest_ray_steps},
+            {"longest_ray_tests", longest_ray_tests},
+            {"sample_rays", sample_rays},
+            {"whole_trace", whole_trace},
+            {"sample_work", array_json(sample_work)},
+            {"sample_plan_steps", sample_plan_steps},
+            {"plan_steps_per", {plan_steps_per[0], plan_steps_per[1]}},
+            {"op_sizes", ops},
+            {"reads", reads_j},
+            {"read_bytes", array_json(read_bytes)},
+            {"step_critical", hist_json(step_critical)},
+            {"ray_critical", hist_json(ray_critical)},
+            {"writes", array_json(writes)},
+            {"write_bytes", array_json(write_bytes)},
+            {"spill_writes", spill_writes},
+            {"spill_reads", spill_reads},
+            {"unit_events", unit_events},
+            {"unit_censored", unit_censored},
+            {"global_events", global_events},
+            {"global_censored", global_censored},
+            {"validation", validation},
+            {"workload", workload},
+            {"stepped_rays", stepped_rays},
+            {"analysis_seconds", analysis_seconds}};
+}
+
+AnalyticProfile AnalyticProfile::from_json(const json& j) {
+    require(j.value("schema", "") == "rtsim-analytic-profile/1", "analytic profile: unknown schema");
+    AnalyticProfile p;
+    p.key = j.at("key");
+    p.accel_kind = j.at("accel_kind");
+    for (int k : j.at("op_kinds").get<std::vector<int>>()) p.op_kinds.push_back(OpKind(k));
+    p.rays = j.at("rays");
+    array_from(j.at("work"), &p.work);
+    p.longest_ray_steps = j.at("longest_ray_steps");
+    p.longest_ray_tests = j.at("longest_ray_tests");
+    p.sample_rays = j.at("sample_rays");
+    p.whole_trace = j.at("whole_trace");
+    array_from(j.at("sample_work"), &p.sample_work);
+    p.sample_plan_steps = j.at("sample_plan_steps");
+    p.plan_steps_per[0] = j.at("plan_steps_per").at(0);
+    p.plan_steps_per[1] = j.at("plan_steps_per").at(1);
+    const json& ops = j.at("op_sizes");
+    for (size_t k = 0; k < ops.size() && k < p.op_sizes.size(); ++k)
+        for (const json& e : ops[k]) p.op_sizes[k][e.at(0).get<uint32_t>()] = e.at(1).get<double>();
+    const json& reads = j.at("reads");
+    require(reads.size() == p.reads.size(), "analytic profile: reads per data kind");
+    for (size_t k = 0; k < reads.size(); ++k) p.reads[k] = hist_from(reads[k]);
+    array_from(j.at("read_bytes"), &p.read_bytes);
+    p.step_critical = hist_from(j.at("step_critical"));
+    p.ray_critical = hist_from(j.at("ray_critical"));
+    array_from(j.at("writes"), &p.writes);
+    array_from(j.at("write_bytes"), &p.write_bytes);
+    p.spill_writes = j.at("spill_writes");
+    p.spill_reads = j.at("spill_reads");
+    p.unit_events = j.at("unit_events").get<std::vector<double>>();
+    p.unit_censored = j.at("unit_censored").get<std::vector<double>>();
+    p.global_events = j.at("global_events").get<std::vector<double>>();
+    p.global_censored = j.at("global_censored").get<std::vector<double>>();
+    p.validation = j.at("validation");
+    p.workload = j.at("workload");
+    p.stepped_rays = j.at("stepped_rays");
+    p.analysis_seconds = j.at("analysis_seconds");
+    return p;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,88 @@
+#pragma once
+// The per-trace analysis of the analytic level (docs/fidelity.md, "The analytic level"): what
+// the closed form needs from a trace, independent of cache sizes, pipelines, DRAM, MSHRs and
+// latencies, so one analysis serves every configuration of a sweep that shares its key.
+//
+//   work:   the trace's per-ray work counts summed over every ray (the WORK section, one
+//           streaming pass; no traversal)
+//   sample: clusters of consecutive rays stepped with the structure's steppers in the machine's
+//           interleaving (units x ray contexts, the dispatch policy): per data kind, the line
+//           reads with their reuse distances in the unit's stream (its L1) and in the stream of
+//           all units (the L2), jointly binned; the critical line of each step (for latency);
+//           line writes; operation sizes per kind; steps per unit of work
+//
+// Quantities per unit of work come from the sample's measured rays and are scaled to the whole
+// trace by its work counts (ratio estimators, Cochran 1977, ch. 6).
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "traces/accel/step_plan.h"
+#include "traces/common/data_kind.h"
+
+namespace rtsim {
+
+/// Work fields of WorkRecord, in order.
+constexpr int kWorkFields = 8;
+const char* work_field_name(int field);
+
+/// A 2D histogram of accesses: (unit-stream bin, censored) x (global-stream bin, censored).
+struct JointHistogram {
+    std::map<uint32_t, double> cells;  ///< key: pack(...)
+    static uint32_t pack(int unit_bin, bool unit_censored, int global_bin, bool global_censored) {
+        return uint32_t(unit_bin) | uint32_t(unit_censored) << 8 | uint32_t(global_bin) << 9 |
+               uint32_t(global_censored) << 17;
+    }
+    static void unpack(uint32_t key, int* ub, bool* uc, int* gb, bool* gc) {
+        *ub = int(key & 0xFF), *uc = (key >> 8) & 1, *gb = int((key >> 9) & 0xFF), *gc = (key >> 17) & 1;
+    }
+    void add(uint32_t key, double n = 1) { cells[key] += n; }
+    double total() const;
+};
+
+struct AnalyticProfile {
+    nlohmann::json key;  ///< what the analysis depends on (analysis_cache.h)
+    std::string accel_kind;        ///< the structure's kind (for the stats' why texts)
+    std::vector<OpKind> op_kinds;  ///< operation kinds it issues (the pipelines it needs)
+
+    // The whole trace (WORK section).
+    uint64_t rays = 0;
+    std::array<double, kWorkFields> work{};  ///< sums over all rays
+    double longest_ray_steps = 0;            ///< max over rays of steps + cell_steps
+    double longest_ray_tests = 0;            ///< that ray's triangle tests
+
+    // The sample's measured rays.
+    double sample_rays = 0;
+    bool whole_trace = false;  ///< the sample is the whole trace from its first ray: no history before it
+    std::array<double, kWorkFields> sample_work{};
+    double sample_plan_steps = 0;           ///< steps the stepper planned (node and leaf steps)
+    double plan_steps_per[2] = {0, 0};      ///< regression: plan steps = a (steps + cell_steps) + b tri_tests
+    std::vector<std::map<uint32_t, double>> op_sizes;  ///< per OpKind: operations by count
+    std::array<JointHistogram, kDataKindCount> reads;   ///< line reads by reuse distances
+    std::array<double, kDataKindCount> read_bytes{};    ///< bytes those reads asked for
+    JointHistogram step_critical;   ///< per planned step: its slowest line (largest distances)
+    JointHistogram ray_critical;    ///< per ray: its ray record's slowest line
+    std::array<double, kDataKindCount> writes{};      ///< line pieces written (write-through)
+    std::array<double, kDataKindCount> write_bytes{};
+    double spill_writes = 0, spill_reads = 0;        ///< stack entries
+    // Reuse distance curves (events and censored by bin), all measured reads.
+    std::vector<double> unit_events, unit_censored, global_events, global_censored;
+
+    // Sampled rays checked against the reference (every stepped ray, warm-up included).
+    nlohmann::json validation;
+    nlohmann::json workload;  ///< rays per kind (stats.json "workload")
+    uint64_t stepped_rays = 0;
+    double analysis_seconds = 0;
+
+    AnalyticProfile();
+    nlohmann::json to_json() const;
+    static AnalyticProfile from_json(const nlohmann::json& j);
+    /// Which work total scales a data kind's accesses (docs/fidelity.md).
+    static int aux_field(DataKind kind);
+};
+
+}  // namespace rtsim

@@ -1,0 +1,176 @@
+#include "sim/analytic/sample.h"
+
+#include <algorithm>
+
+#include "rtl_model/traversal/stack_spill.h"
+
+namespace rtsim {
+
+SampleProfiler::SampleProfiler(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                               AnalyticProfile& profile)
+    : m_c(config),
+      m_map(map),
+      m_p(profile),
+      m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts),
+      m_units(config.traversal.units),
+      m_slots(config.traversal.ray_contexts),
+      m_shift(0),
+      m_unit_pos(config.traversal.units, 0) {
+    for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper();
+    while ((1u << m_shift) < config.l1.line_bytes) ++m_shift;
+}
+
+void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint64_t measure_end, RaySinkIf& sink) {
+    m_measure_first = measure_first;
+    m_measure_end = measure_end;
+    m_unit_last.clear();
+    m_global_last.clear();
+    m_global_pos = 0;
+    std::fill(m_unit_pos.begin(), m_unit_pos.end(), 0);
+    RayDealer dealer(m_c.dispatch, m_units, stream);
+    for (uint32_t c = 0; c < m_slots; ++c)
+        for (uint32_t u = 0; u < m_units; ++u) start_ray(dealer, u, c, sink);
+    // Rounds: every active context takes one step, context-major then unit.
+    for (bool any = true; any;) {
+        any = false;
+        for (uint32_t c = 0; c < m_slots; ++c)
+            for (uint32_t u = 0; u < m_units; ++u)
+                if (m_contexts[size_t(u) * m_slots + c].active) {
+                    step(dealer, u, c, sink);
+                    any = true;
+                }
+    }
+}
+
+bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink) {
+    RayJob job;
+    Context& ctx = m_contexts[size_t(unit) * m_slots + slot];
+    ctx.active = false;
+    if (!dealer.next_ray(unit, &job)) return false;
+    ctx.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+    ctx.id = job.id;
+    ctx.local_stack = ctx.spilled = ctx.plan_steps = 0;
+    ctx.measured = job.id >= m_measure_first && job.id < m_measure_end;
+    ctx.active = true;
+    const Access a = read(unit, m_map.ray(job.id), sizeof(RayRecord), DataKind::ray, ctx.measured);
+    if (ctx.measured) m_p.ray_critical.add(a.key);
+    (void)sink;
+    return true;
+}
+
+void SampleProfiler::finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink) {
+    const Stepper& s = *ctx.stepper;
+    write(m_map.hit(ctx.id), sizeof(HitRecord), DataKind::hit, ctx.measured);
+    sink.ray_done(RayResult{ctx.id, s.hit(), s.work(), 0, 0, unit, slot});
+    ++m_p.stepped_rays;
+    if (!ctx.measured) return;
+    const WorkCounts& w = s.work();
+    const uint32_t fields[kWorkFields] = {w.steps,      w.box_tests,  w.tri_tests,   w.anyhit_calls,
+                                          w.transforms, w.cell_steps, w.plane_tests, w.refs};
+    for (int f = 0; f < kWorkFields; ++f) m_p.sample_work[f] += fields[f];
+    m_p.sample_rays += 1;
+    m_p.sample_plan_steps += ctx.plan_steps;
+    const double x1 = double(w.steps) + w.cell_steps, x2 = w.tri_tests, y = ctx.plan_steps;
+    m_fit[0] += x1 * x1, m_fit[1] += x1 * x2, m_fit[2] += x2 * x2, m_fit[3] += x1 * y, m_fit[4] += x2 * y;
+}
+
+void SampleProfiler::step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink) {
+    Context& ctx = m_contexts[size_t(unit) * m_slots + slot];
+    Stepper& stepper = *ctx.stepper;
+    const StepPlan& plan = stepper.plan();
+    if (plan.done) {
+        finish_ray(ctx, unit, slot, sink);
+        start_ray(dealer, unit, slot, sink);
+        return;
+    }
+    ++ctx.plan_steps;
+    // The step's slowest line sets its latency: the one with the longest reuse in the L2's
+    // stream (a censored one beats any observed one).
+    Access critical;
+    for (int i = 0; i < plan.fetch_count; ++i) {
+        const Access a = read(unit, plan.fetch[i].addr, plan.fetch[i].bytes, plan.fetch[i].kind, ctx.measured);
+        if (i == 0 || a.rank > critical.rank) critical = a;
+    }
+    if (ctx.measured && plan.fetch_count) m_p.step_critical.add(critical.key);
+    Op ops[StepPlan::kMaxOps];
+    const int op_count = plan.op_count;
+    std::copy(plan.op, plan.op + op_count, ops);
+    const int before = stepper.stack_size();
+    const StepOutcome outcome = stepper.execute();
+    if (ctx.measured) {
+        for (int i = 0; i < op_count; ++i) m_p.op_sizes[size_t(ops[i].kind)][ops[i].count] += 1;
+        for (int i = 0; i < outcome.op_count; ++i) m_p.op_sizes[size_t(outcome.op[i].kind)][outcome.op[i].count] += 1;
+    }
+    stack_traffic(unit, slot, before, ctx.measured);
+}
+
+SampleProfiler::Access SampleProfiler::read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind,
+                                            bool measured) {
+    Access worst;
+    bool first = true;
+    for (uint64_t line = addr >> m_shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> m_shift; ++line) {
+        const Access a = read_line(unit, line, kind, measured);
+        if (first || a.rank > worst.rank) worst = a;
+        first = false;
+    }
+    if (measured) m_p.read_bytes[size_t(kind)] += bytes;
+    return worst;
+}
+
+SampleProfiler::Access SampleProfiler::read_line(uint32_t unit, uint64_t line, DataKind kind, bool measured) {
+    const uint64_t gpos = ++m_global_pos, upos = ++m_unit_pos[unit];
+    const uint64_t gprev = m_global_last.exchange(line, gpos);
+    const uint64_t uprev = m_unit_last.exchange(line << 16 | unit, upos);
+    if (!measured) return {};
+    // A distance with no earlier access in the cluster is censored at the access's position.
+    const bool gc = gprev == ~0ull, uc = uprev == ~0ull;
+    const uint64_t gd = gc ? gpos : gpos - gprev, ud = uc ? upos : upos - uprev;
+    const int gb = DistanceBins::bin(gd), ub = DistanceBins::bin(ud);
+    (uc ? m_p.unit_censored : m_p.unit_events)[ub] += 1;
+    (gc ? m_p.global_censored : m_p.global_events)[gb] += 1;
+    const uint32_t key = JointHistogram::pack(ub, uc, gb, gc);
+    m_p.reads[size_t(kind)].add(key);
+    return {key, (uint64_t(gc) << 63) | (uint64_t(uc) << 62) | (uint64_t(gb) << 8) | uint64_t(ub)};
+}
+
+void SampleProfiler::write(uint64_t addr, uint32_t bytes, DataKind kind, bool measured) {
+    if (!measured) return;
+    for (uint64_t line = addr >> m_shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> m_shift; ++line) {
+        const uint64_t lo = std::max(addr, line << m_shift), hi = std::min(addr + bytes, (line + 1) << m_shift);
+        m_p.writes[size_t(kind)] += 1;
+        m_p.write_bytes[size_t(kind)] += double(hi > lo ? hi - lo : 0);
+    }
+}
+
+/// Stack spills (posted writes) and refills (reads), as the traversal unit maps the stepper's
+/// stack onto stack_entries on-chip entries (rtl_model/traversal/stack_spill.h).
+void SampleProfiler::stack_traffic(uint32_t unit, uint32_t slot, int before, bool measured) {
+    Context& ctx = m_contexts[size_t(unit) * m_slots + slot];
+    const uint32_t bytes = m_c.traversal.stack_entry_bytes;
+    const uint64_t owner = uint64_t(unit) * m_slots + slot;
+    map_stack_change(
+        ctx.local_stack, ctx.spilled, before, ctx.stepper->stack_size(), m_c.traversal.stack_entries,
+        [&](uint32_t s) {
+            write(m_map.stack(owner, s, bytes), bytes, DataKind::stack, measured);
+            m_p.spill_writes += measured;
+        },
+        [&](uint32_t s) {
+            read(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack, measured);
+            m_p.spill_reads += measured;
+        });
+}
+
+void SampleProfiler::finish() {
+    // Least squares without intercept: plan steps = a (steps + cell_steps) + b tri_tests.
+    const double det = m_fit[0] * m_fit[2] - m_fit[1] * m_fit[1];
+    if (det > 1e-9 * m_fit[0] * m_fit[2] && det > 0) {
+        m_p.plan_steps_per[0] = (m_fit[3] * m_fit[2] - m_fit[4] * m_fit[1]) / det;
+        m_p.plan_steps_per[1] = (m_fit[4] * m_fit[0] - m_fit[3] * m_fit[1]) / det;
+    } else {
+        const double x = m_p.sample_work[0] + m_p.sample_work[5];
+        m_p.plan_steps_per[0] = x > 0 ? m_p.sample_plan_steps / x : 0.0;
+        m_p.plan_steps_per[1] = 0;
+    }
+}
+
+}  // namespace rtsim

@@ -1,0 +1,66 @@
+#pragma once
+// The sampled part of the analytic level's per-trace analysis (profile.h): clusters of
+// consecutive rays stepped with the structure's steppers (the ones the model's units drive, so
+// the plans' fetches are the model's) in the machine's interleaving: rays go to units by the
+// model's dispatch policy (RayDealer), each unit runs ray_contexts rays, and the contexts of all
+// units take one step each in turn (unit 0 context 0, unit 1 context 0, ..., then context 1).
+// Each line read is recorded with its reuse distance in its unit's stream (the unit's L1 sees
+// it) and in the stream of all units (the L2). Clusters are contiguous in trace order, so the
+// local reuse (neighbouring pixels) is the full run's; each starts with warm-up rays whose
+// accesses only build history (as SMARTS warms caches, Wunderlich et al. 2003).
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "rtl_model/common/interfaces.h"
+#include "rtl_model/common/memory_map.h"
+#include "rtl_model/dispatch/dispatch.h"
+#include "sim/config/config.h"
+#include "sim/analytic/profile.h"
+#include "sim/analytic/reuse.h"
+#include "traces/accel/accel.h"
+
+namespace rtsim {
+
+class SampleProfiler {
+public:
+    SampleProfiler(const SimConfig& config, const Accel& accel, const MemoryMap& map, AnalyticProfile& profile);
+    /// Steps every ray of `stream` (one cluster, fresh history); rays with trace index in
+    /// [measure_first, measure_end) are measured. Every stepped ray goes to `sink` (the checker).
+    void run_cluster(RayStream& stream, uint64_t measure_first, uint64_t measure_end, RaySinkIf& sink);
+    /// Fits steps per unit of work; call once after the clusters.
+    void finish();
+
+private:
+    struct Context {
+        std::unique_ptr<Stepper> stepper;
+        uint64_t id = 0;
+        uint32_t local_stack = 0, spilled = 0, plan_steps = 0;
+        bool active = false, measured = false;
+    };
+    /// A line read's reuse key (JointHistogram::pack) and its ordering weight for "slowest".
+    struct Access {
+        uint32_t key = 0;
+        uint64_t rank = 0;
+    };
+    bool start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink);
+    void step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink);
+    Access read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind, bool measured);
+    Access read_line(uint32_t unit, uint64_t line, DataKind kind, bool measured);
+    void write(uint64_t addr, uint32_t bytes, DataKind kind, bool measured);
+    void stack_traffic(uint32_t unit, uint32_t slot, int before, bool measured);
+    void finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink);
+
+    const SimConfig& m_c;
+    const MemoryMap& m_map;
+    AnalyticProfile& m_p;
+    std::vector<Context> m_contexts;  ///< unit-major
+    uint32_t m_units, m_slots, m_shift;
+    uint64_t m_measure_first = 0, m_measure_end = 0;
+    LastUse m_unit_last, m_global_last;
+    uint64_t m_global_pos = 0;
+    std::vector<uint64_t> m_unit_pos;
+    double m_fit[5] = {};  ///< sums x1x1, x1x2, x2x2, x1y, x2y of the steps regression
+};
+
+}  // namespace rtsim

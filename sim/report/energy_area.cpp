@@ -1,0 +1,289 @@
+#include "sim/report/energy_area.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+// ---- Technology scaling: Stillmaker & Baas 2017, "Scaling equations for the accurate prediction
+// of CMOS device performance from 180 nm to 7 nm", Integration 58:74-81. Energy: their per-node
+// polynomial in the supply voltage, a*V^2 + b*V + c (Table 5 coefficients), normalised to 45 nm at
+// 1.0 V; area: their area factors relative to 45 nm (Table 3). Nominal voltages are typical values
+// for each node (our assumption, docs/energy_area.md); energy.vdd overrides them.
+struct Node {
+    double nm, a, b, c, area_vs_45, nominal_vdd;
+};
+constexpr std::array<Node, 10> kNodes{{
+    {130, 7.171, -6.709, 2.904, 6.4, 1.3},
+    {90, 4.762, -4.781, 2.092, 2.8, 1.2},
+    {65, 3.755, -4.398, 1.975, 1.5, 1.1},
+    {45, 1.103, -0.362, 0.2767, 1.0, 1.0},
+    {32, 0.9559, -0.7823, 0.471, 0.46, 0.9},
+    {20, 0.373, -0.1582, 0.04104, 0.21, 0.9},
+    {16, 0.2958, -0.1241, 0.03024, 0.19, 0.8},
+    {14, 0.2363, -0.09675, 0.02239, 0.17, 0.8},
+    {10, 0.2068, -0.09311, 0.02375, 0.1, 0.75},
+    {7, 0.1776, -0.09097, 0.02447, 0.059, 0.7},
+}};
+
+double poly(const Node& n, double v) { return n.a * v * v + n.b * v + n.c; }
+
+/// Interpolates f(node) linearly in log(nm) between the two table nodes around `nm`.
+template <class F>
+double across_nodes(double nm, F f) {
+    nm = std::clamp(nm, kNodes.back().nm, kNodes.front().nm);
+    for (size_t i = 0; i + 1 < kNodes.size(); ++i) {
+        const Node& big = kNodes[i];
+        const Node& small = kNodes[i + 1];
+        if (nm <= big.nm && nm >= small.nm) {
+            const double w = std::log(big.nm / nm) / std::log(big.nm / small.nm);
+            return (1 - w) * f(big) + w * f(small);
+        }
+    }
+    return f(kNodes.back());
+}
+
+// ---- Floating-point operations per test of our arithmetic (docs/energy_area.md, "Operations").
+// A fixed-function pipeline evaluates every stage of every test, so each is priced on its full path.
+struct Flops {
+    double add, mul, cmp, div;
+};
+// traces/isect/ray_box_kernel.h (Ize 2013 slab test), per child box: per axis 2 sub + 2 mul +
+// 1 max + 1 min; then far >= 0, the far scale (1 mul), min with tmax and tnear <= tfar.
+constexpr Flops kBoxFlops{6, 7, 9, 0};
+// traces/isect/ray_triangle_kernel.h (Woop, Benthin & Wald 2013), hit path: 9 sub (vertices minus
+// origin), shear 6 mul + 6 sub, edge functions 6 mul + 3 sub, 6 sign compares, det 2 add, det == 0,
+// scaled z 3 mul, t 3 mul + 2 add, sign fold, interval 2 mul + 2 cmp, t / det and u, v / det
+// (3 div), t re-check 2 cmp.
+constexpr Flops kTriangleFlops{22, 20, 12, 3};
+// Alpha test: interpolate the texture coordinate from the barycentrics (w = 1 - u - v: 2 add;
+// 2 x (3 mul + 2 add)), compare with the cutoff. The texture fetch is not modelled.
+constexpr Flops kAnyhitFlops{6, 6, 1, 0};
+// Instance transform: a 3x4 affine map of the origin (9 mul + 9 add) and a 3x3 of the direction
+// (9 mul + 6 add), then the ray's precomputation again (as kRaySetupFlops).
+constexpr Flops kTransformFlops{15, 20, 2, 4};
+// Grid step (Amanatides & Woo 1987): the smallest of three tMax (2 cmp), tMax += tDelta, exit test.
+constexpr Flops kCellFlops{1, 0, 3, 0};
+// Split-plane test (kd-tree, BIH): (plane - origin) * inv_dir, compared with tmin and tmax.
+constexpr Flops kPlaneFlops{1, 1, 2, 0};
+// Per ray: inv_dir (3 div) for the box test; the triangle test's shear constants (RayTrianglePre:
+// the largest axis, 2 cmp; 1 / dir_kz, 1 div; sx, sy, 2 mul).
+constexpr Flops kRaySetupFlops{0, 2, 2, 4};
+/// A divide priced as 4 multiplies: a reciprocal by table plus Newton-Raphson steps (our
+/// assumption; Horowitz 2014 lists no divider).
+constexpr double kDivInMuls = 4.0;
+/// Bytes of a ray context's state read per traversal step (origin, inverse direction, t interval).
+constexpr double kContextReadBytes = 32;
+/// Bytes of a ray context's state in the unit (ray, inverse direction, hit so far, id): its SRAM.
+constexpr double kContextStateBytes = 64;
+
+double flops_pj(const EnergyConfig& c, const Flops& f) {
+    return (f.add * c.fp_add_pj + (f.mul + kDivInMuls * f.div) * c.fp_mul_pj + f.cmp * c.cmp_pj) * c.datapath_overhead;
+}
+double flops_um2(const EnergyConfig& c, const Flops& f) {
+    return (f.add * c.fp_add_um2 + (f.mul + kDivInMuls * f.div) * c.fp_mul_um2 + f.cmp * c.cmp_um2) *
+           c.datapath_overhead;
+}
+
+double num(const json& j, const char* key) {
+    auto it = j.find(key);
+    return it != j.end() && it->is_number() ? it->get<double>() : 0.0;
+}
+
+/// Energy of one cache's activity, pJ: reads of a whole line, fills of missed lines, writes of
+/// their bytes; tag bits ride along on every access.
+double cache_pj(const EnergyConfig& c, const json& cache, double size_bytes, double line_bytes) {
+    const double reads = num(cache, "reads");
+    const double misses = std::max(0.0, reads - num(cache, "read_hits") - num(cache, "merged"));
+    const double bits = (reads + misses) * line_bytes * 8 + num(cache, "write_bytes") * 8;
+    return sram_access_pj(c, size_bytes, bits * (1 + c.sram_tag_overhead));
+}
+
+json per_ray(double pj, uint64_t rays) { return rays ? json(pj / 1000.0 / double(rays)) : json(nullptr); }
+
+/// Area of the pipelines behind one operation kind, mm^2: lanes (width / initiation interval, so
+/// a pipeline issuing every other cycle can share its units) x the arithmetic of one test.
+double pipeline_mm2(const EnergyConfig& c, const SimConfig& s, const PipelineConfig& p, const Flops& f) {
+    const double pipes = p.sharing == Sharing::shared ? p.shared_count : s.traversal.units;
+    const double lanes = double(p.width) / double(p.initiation_interval);
+    return pipes * lanes * flops_um2(c, f) * 1e-6 * area_scale(c);
+}
+
+bool instantiated(const json& list, const char* block) {
+    for (const json& b : list)
+        if (b.value("block", "") == block) return b.value("instantiated", false);
+    return false;
+}
+
+json area_json(const SimConfig& s, const json& stats) {
+    const EnergyConfig& c = s.energy;
+    const TraversalConfig& t = s.traversal;
+    const double tags = 1 + c.sram_tag_overhead;
+    json mm2 = json::object();
+    if (!s.ideal_memory) {
+        mm2["l1"] = sram_mm2(c, double(t.units) * s.l1.size_kib * 1024) * tags;
+        mm2["l2"] = sram_mm2(c, double(s.l2.size_kib) * 1024) * tags;
+    } else {
+        mm2["l1"] = mm2["l2"] = 0.0;
+    }
+    mm2["ray_buffer"] = s.treelets.enabled ? sram_mm2(c, double(s.treelets.buffer_kib) * 1024) : 0.0;
+    mm2["stacks"] = sram_mm2(c, double(t.units) * t.ray_contexts * t.stack_entries * t.stack_entry_bytes);
+    mm2["ray_contexts"] = sram_mm2(c, double(t.units) * t.ray_contexts * kContextStateBytes);
+    mm2["box"] = pipeline_mm2(c, s, s.box, kBoxFlops);
+    mm2["triangle"] = pipeline_mm2(c, s, s.triangle, kTriangleFlops);
+    mm2["anyhit"] = instantiated(stats.value("instantiated", json::array()), "anyhit")
+                        ? pipeline_mm2(c, s, s.anyhit, kAnyhitFlops)
+                        : 0.0;
+    double total = 0, sram = 0;
+    for (auto it = mm2.begin(); it != mm2.end(); ++it) {
+        total += it->get<double>();
+        if (it.key() != "box" && it.key() != "triangle" && it.key() != "anyhit") sram += it->get<double>();
+    }
+    return {{"mm2", mm2}, {"total_mm2", total}, {"sram_mm2", sram}, {"logic_mm2", total - sram}};
+}
+
+}  // namespace
+
+double supply_voltage(const EnergyConfig& c) {
+    return c.vdd > 0 ? c.vdd : across_nodes(c.node_nm, [](const Node& n) { return n.nominal_vdd; });
+}
+
+double energy_scale(const EnergyConfig& c) {
+    const double v = supply_voltage(c);
+    return across_nodes(c.node_nm, [v](const Node& n) { return poly(n, v); }) / poly(kNodes[3], 1.0);
+}
+
+double area_scale(const EnergyConfig& c) {
+    return across_nodes(c.node_nm, [](const Node& n) { return n.area_vs_45; });
+}
+
+double dram_pj_per_bit(const EnergyConfig& c) {
+    if (c.dram_pj_per_bit > 0) return c.dram_pj_per_bit;
+    switch (c.dram_kind) {
+        case DramKind::gddr6: return 7.5;   // Micron GDDR6 device figure (docs/energy_area.md)
+        case DramKind::lpddr5: return 5.0;  // assumed from LPDDR4 figures less ~30% (docs/energy_area.md)
+        case DramKind::hbm2: return 3.9;    // O'Connor et al., MICRO 2017
+        case DramKind::ddr4: return 13.0;   // Horowitz 2014's 1.3 nJ / 64 bit at (1.2 / 1.5 V)^2
+    }
+    return 0;
+}
+
+OpEnergies op_energies(const EnergyConfig& c) {
+    const double s = energy_scale(c);
+    return {flops_pj(c, kBoxFlops) * s,       flops_pj(c, kTriangleFlops) * s, flops_pj(c, kAnyhitFlops) * s,
+            flops_pj(c, kTransformFlops) * s, flops_pj(c, kCellFlops) * s,     flops_pj(c, kPlaneFlops) * s,
+            flops_pj(c, kRaySetupFlops) * s};
+}
+
+double sram_access_pj(const EnergyConfig& c, double bytes, double bits) {
+    // Horowitz's 45 nm points (64-bit reads: 8 KiB 10 pJ, 32 KiB 20 pJ, 1 MiB 100 pJ) follow
+    // size^0.46-0.5; below 1 KiB the fit is held (small arrays are dominated by their periphery).
+    const double size = std::max(bytes, 1024.0) / 8192.0;
+    return c.sram_pj_64b * (bits / 64.0) * std::pow(size, c.sram_size_exponent) * energy_scale(c);
+}
+
+double sram_mm2(const EnergyConfig& c, double bytes) {
+    return bytes / double(1 << 20) * c.sram_mm2_per_mib * area_scale(c);
+}
+
+void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint64_t rays) {
+    const EnergyConfig& c = s.energy;
+    const OpEnergies op = op_energies(c);
+    const json& model = stats.value("model", json::object());
+    json& summary = stats["summary"];
+    const TraversalConfig& t = s.traversal;
+    const double line = s.l1.line_bytes;
+
+    // Dynamic energy by block, pJ; null where this level has no counts.
+    json pj = json::object();
+    pj["box"] = double(w.box_tests) * op.box;
+    pj["triangle"] = double(w.tri_tests) * op.triangle;
+    pj["anyhit"] = double(w.anyhit_calls) * op.anyhit;
+    pj["transform"] = double(w.transforms) * op.transform;
+    pj["cell"] = double(w.cell_steps) * op.cell;
+    pj["plane"] = double(w.plane_tests) * op.plane;
+    // Traversal units: the ray's setup, and per step a read of the context's ray state and one
+    // stack push or pop, each in the unit's SRAM of that kind.
+    pj["traversal"] = double(rays) * op.ray_setup +
+                      double(w.steps) * (sram_access_pj(c, t.ray_contexts * kContextStateBytes, kContextReadBytes * 8) +
+                                         sram_access_pj(c, double(t.ray_contexts) * t.stack_entries * t.stack_entry_bytes,
+                                                        t.stack_entry_bytes * 8.0));
+    const bool has_memory = model.contains("l1") || model.contains("ideal_memory");
+    if (model.contains("ideal_memory")) {
+        pj["l1"] = cache_pj(c, model["ideal_memory"], s.l1.size_kib * 1024.0, line);
+        pj["l2"] = 0.0;
+        pj["dram"] = 0.0;
+    } else if (has_memory) {
+        double l1 = 0;
+        for (const json& cache : model["l1"]) l1 += cache_pj(c, cache, s.l1.size_kib * 1024.0, line);
+        pj["l1"] = l1;
+        pj["l2"] = model.contains("l2") ? json(cache_pj(c, model["l2"], s.l2.size_kib * 1024.0, line)) : json(0.0);
+        const json& d = model.value("dram", json::object());
+        pj["dram"] = (num(d, "read_bytes") + num(d, "write_bytes")) * 8 * dram_pj_per_bit(c);
+    } else {
+        pj["l1"] = pj["l2"] = pj["dram"] = nullptr;
+    }
+    if (model.contains("ray_buffer")) {
+        const json& rb = model["ray_buffer"];
+        const double accesses = num(rb, "admitted") + num(rb, "parked") + num(rb, "taken");
+        pj["ray_buffer"] = accesses * sram_access_pj(c, s.treelets.buffer_kib * 1024.0, num(rb, "ray_state_bytes") * 8);
+    } else {
+        pj["ray_buffer"] = s.treelets.enabled && !has_memory ? json(nullptr) : json(0.0);
+    }
+
+    json area = area_json(s, stats);
+    const double total_mm2 = area["total_mm2"];
+    const double leak_w = total_mm2 * c.leakage_mw_per_mm2 * 1e-3;
+    const json rps = summary.value("rays_per_second", json(nullptr));
+    const bool timed = rps.is_number() && rps.get<double>() > 0;
+
+    json per_ray_nj = json::object();
+    double dynamic_nj = 0;
+    bool complete = rays > 0;
+    json missing = json::array();
+    for (auto it = pj.begin(); it != pj.end(); ++it) {
+        per_ray_nj[it.key()] = it->is_number() ? per_ray(it->get<double>(), rays) : json(nullptr);
+        if (it->is_number() && rays) dynamic_nj += it->get<double>() / 1000.0 / double(rays);
+        else if (!it->is_number()) { complete = false; missing.push_back(it.key()); }
+    }
+    per_ray_nj["leakage"] = timed ? json(leak_w / rps.get<double>() * 1e9) : json(nullptr);
+    if (!timed) { complete = false; missing.push_back("leakage"); }
+    const json total_nj = complete ? json(dynamic_nj + per_ray_nj["leakage"].get<double>()) : json(nullptr);
+    per_ray_nj["total"] = total_nj;
+    const json power = complete && timed ? json(total_nj.get<double>() * 1e-9 * rps.get<double>()) : json(nullptr);
+    const json mrays_per_joule = complete ? json(1e3 / total_nj.get<double>()) : json(nullptr);
+
+    stats["energy"] = {
+        {"model", "first-order, docs/energy_area.md"},
+        {"node_nm", c.node_nm},
+        {"vdd", supply_voltage(c)},
+        {"energy_scale", energy_scale(c)},
+        {"area_scale", area_scale(c)},
+        {"dram_kind", kDramKindChoices.name(c.dram_kind)},
+        {"dram_pj_per_bit", dram_pj_per_bit(c)},
+        {"op_pj",
+         {{"box", op.box}, {"triangle", op.triangle}, {"anyhit", op.anyhit}, {"transform", op.transform},
+          {"cell", op.cell}, {"plane", op.plane}, {"ray_setup", op.ray_setup}}},
+        {"rays", rays},
+        {"per_ray_nj", per_ray_nj},
+        {"dynamic_nj", rays ? json(dynamic_nj * double(rays)) : json(nullptr)},
+        {"leakage_w", leak_w},
+        {"power_w", power},
+        {"mrays_per_joule", mrays_per_joule},
+        {"complete", complete},
+        {"missing", missing},
+    };
+    stats["area"] = area;
+    summary["energy_per_ray_nj"] = total_nj;
+    summary["mrays_per_joule"] = mrays_per_joule;
+    summary["power_w"] = power;
+    summary["area_mm2"] = total_mm2;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,43 @@
+#include "sim/report/roofline.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+json roofline_json(const SimConfig& c, const json& summary, const json& model) {
+    if (c.fidelity == Fidelity::functional || !summary.value("rays", json(0)).is_number()) return nullptr;
+    const double rays = summary.value("rays", 0.0), hz = c.clock_ghz * 1e9;
+    if (rays <= 0) return nullptr;
+    json ceilings = json::object();
+    const json bytes = summary.value("dram_bytes_per_ray", json(nullptr));
+    if (bytes.is_number() && bytes.get<double>() > 0 && !c.ideal_memory)
+        ceilings["dram"] = double(c.dram.bytes_per_cycle) * c.dram.channels * hz / bytes.get<double>();
+    for (int k = 0; k < kOpKindCount; ++k) {
+        const char* name = op_kind_name(OpKind(k));
+        if (!model.contains(name)) continue;
+        double issues = 0, pipelines = 0;
+        for (const json& p : model[name]) {
+            issues += p.value("issues", 0.0);
+            pipelines += p.value("pipelines", 0.0);
+        }
+        if (issues > 0) ceilings[name] = pipelines * hz / c.pipeline(OpKind(k)).initiation_interval / (issues / rays);
+    }
+    double steps = 0;
+    for (const json& u : model.value("units", json::object())) steps += u.value("steps", 0.0);
+    if (steps > 0) ceilings["scheduler"] = double(c.traversal.units) * hz / c.traversal.issue_cycles / (steps / rays);
+    std::string bound;
+    double lowest = 0;
+    for (auto it = ceilings.begin(); it != ceilings.end(); ++it)
+        if (bound.empty() || it.value().get<double>() < lowest) {
+            lowest = it.value().get<double>();
+            bound = it.key();
+        }
+    return {{"dram_bytes_per_ray", bytes},
+            {"rays_per_second", summary.value("rays_per_second", json(nullptr))},
+            {"peak_dram_bytes_per_second", double(c.dram.bytes_per_cycle) * c.dram.channels * hz},
+            {"ceilings", ceilings},
+            {"bound", bound},
+            {"bound_rays_per_second", bound.empty() ? json(nullptr) : json(lowest)}};
+}
+
+}  // namespace rtsim

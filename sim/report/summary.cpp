@@ -1,0 +1,114 @@
+#include "sim/report/summary.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <string>
+#include <ctime>
+
+#include "sim/report/summary_schema.h"
+#include "traces/common/build_info.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// Hit rate over all caches of a level (reads served, including merged misses, over reads).
+json hit_rate(const json& caches) {
+    double reads = 0, served = 0;
+    for (const json& c : caches) {
+        reads += c.value("reads", 0.0);
+        served += c.value("read_hits", 0.0) + c.value("merged", 0.0);
+    }
+    return reads > 0 ? json(served / reads) : json(nullptr);
+}
+
+/// Mean of a field over the blocks of a group ({"box_0": {...}, ...}).
+json mean_of(const json& group, const char* key) {
+    if (!group.is_object() || group.empty()) return nullptr;
+    double sum = 0, n = 0;
+    for (const json& b : group) {
+        auto it = b.find(key);
+        if (it == b.end() || !it->is_number()) continue;  // null: this level does not produce it
+        sum += it->get<double>();
+        ++n;
+    }
+    return n > 0 ? json(sum / n) : json(nullptr);
+}
+
+/// Peak resident memory of this process's address space (VmHWM). getrusage's ru_maxrss would
+/// also count the parent's pages a forked child held before exec (a Python caller's, say).
+double peak_memory_mib() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // kB
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0;
+}
+
+}  // namespace
+
+json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& model, const HitChecker& checker,
+               double wall) {
+    json s = {{"rays", rays},
+              {"fidelity", kFidelityChoices.name(c.fidelity)},
+              {"hit_mismatches", checker.hit_mismatches()},
+              {"work_mismatches", checker.work_mismatches()},
+              {"wall_seconds", wall},
+              {"peak_memory_mib", peak_memory_mib()},
+              {"simulated_rays_per_wall_second", wall > 0 ? double(rays) / wall : 0.0}};
+    if (c.fidelity == Fidelity::functional) {
+        // Every level reports the same keys; what the functional level cannot know is null
+        // (the keys summary_schema.cpp marks as timed; the energy and verdict steps add theirs).
+        for (const StatDecl& d : summary_schema())
+            if (d.timed) s[d.key] = nullptr;
+        return s;
+    }
+    double seconds = double(cycles) / (c.clock_ghz * 1e9);
+    s["cycles"] = cycles;
+    s["seconds"] = seconds;
+    s["rays_per_second"] = seconds > 0 ? double(rays) / seconds : 0.0;
+    s["mrays_per_second"] = seconds > 0 ? double(rays) / seconds / 1e6 : 0.0;
+    s["avg_ray_latency_cycles"] = checker.latency().mean();
+    s["unit_busy_fraction"] = mean_of(model.value("units", json::object()), "busy_fraction");
+    s["box_utilization"] = mean_of(model.value("box", json::object()), "utilization");
+    s["triangle_utilization"] = mean_of(model.value("triangle", json::object()), "utilization");
+    s["l1_hit_rate"] = model.contains("l1") ? hit_rate(model["l1"]) : json(nullptr);
+    s["l2_hit_rate"] = model.contains("l2") ? hit_rate(json::array({model["l2"]})) : json(nullptr);
+    if (model.contains("dram")) {
+        const json& d = model["dram"];
+        double bytes = d.value("read_bytes", 0.0) + d.value("write_bytes", 0.0);
+        s["dram_bytes"] = bytes;
+        s["dram_bytes_per_ray"] = rays ? bytes / double(rays) : 0.0;
+        s["dram_bandwidth_gbps"] = d["bandwidth_gbps"];
+        s["dram_bandwidth_utilization"] = d["bandwidth_utilization"];
+    } else {
+        s["dram_bytes"] = 0;
+        s["dram_bytes_per_ray"] = 0;
+        s["dram_bandwidth_gbps"] = 0;
+        s["dram_bandwidth_utilization"] = 0;
+    }
+    return s;
+}
+
+json provenance(const std::string& command_line, const std::string& trace, const json& manifest, std::time_t started) {
+    char host[256] = {};
+    gethostname(host, sizeof(host) - 1);
+    char when[64];
+    std::strftime(when, sizeof(when), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&started));
+    return {{"rtsim_version", rtsim_version()},
+            {"git", rtsim_git_hash()},
+            {"command_line", command_line},
+            {"host", host},
+            {"started_utc", when},
+            {"trace", trace},
+            {"scene", manifest.value("scene", json::object()).value("name", "")},
+            {"trace_git", manifest.value("git", "")}};
+}
+
+}  // namespace rtsim

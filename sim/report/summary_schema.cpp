@@ -1,0 +1,126 @@
+// The summary keys (summary_schema.h). Add a key here first; docs/stats.md follows from it.
+#include "sim/report/summary_schema.h"
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+const std::vector<StatDecl>& summary_schema() {
+    static const std::vector<StatDecl> keys = {
+        {"rays", "rays",
+         "rays in the trace, all simulated",
+         false, false},
+        {"fidelity", "",
+         "the level that ran (as the top-level `fidelity`)",
+         false, false},
+        {"cycles", "cycles",
+         "cycle the last ray's hit was written (max over units' `finish_cycle`); `null` at functional",
+         true, false},
+        {"seconds", "s",
+         "`cycles / (clock_ghz * 1e9)`; `null` at functional",
+         true, false},
+        {"rays_per_second", "rays/s",
+         "`rays / seconds`: the simulated chip's throughput; `null` at functional",
+         true, false},
+        {"mrays_per_second", "Mrays/s",
+         "the same in millions",
+         true, false},
+        {"avg_ray_latency_cycles", "cycles",
+         "mean of `latency` (ray assigned to a context to hit written)",
+         true, false},
+        {"hit_mismatches", "rays",
+         "rays whose hit (primitive id or the bits of t) differ from the reference; must be 0",
+         false, false},
+        {"work_mismatches", "rays",
+         "rays with the same hit but different node/box/triangle/alpha-test counts",
+         false, false},
+        {"wall_seconds", "s",
+         "host wall time of the whole run (reading, simulating, writing)",
+         false, false},
+        {"simulated_rays_per_wall_second", "rays/s",
+         "simulator speed: `rays / wall_seconds`",
+         false, false},
+        {"peak_memory_mib", "MiB",
+         "peak resident memory of the rtsim-sim process (VmHWM); stays flat as traces grow, since rays are streamed in chunks",
+         false, false},
+        {"unit_busy_fraction", "fraction",
+         "mean over units of `model.units.<unit>.busy_fraction`",
+         true, false},
+        {"box_utilization", "fraction",
+         "mean over box pipeline blocks of `utilization`",
+         true, false},
+        {"triangle_utilization", "fraction",
+         "mean over triangle pipeline blocks of `utilization`",
+         true, false},
+        {"l1_hit_rate", "fraction",
+         "over all L1s: (read_hits + merged) / reads; `null` with `ideal_memory`",
+         true, false},
+        {"l2_hit_rate", "fraction",
+         "the L2's (read_hits + merged) / reads; `null` with `ideal_memory`",
+         true, false},
+        {"dram_bytes", "bytes",
+         "DRAM read + write bytes (0 with `ideal_memory`)",
+         true, false},
+        {"dram_bytes_per_ray", "bytes/ray",
+         "`dram_bytes / rays`",
+         true, false},
+        {"dram_bandwidth_gbps", "GB/s",
+         "`model.dram.bandwidth_gbps`: average over the whole run",
+         true, false},
+        {"dram_bandwidth_utilization", "fraction",
+         "achieved over peak DRAM bandwidth",
+         true, false},
+        {"frames", "frames",
+         "frames replayed in sequence with caches warm (an animated trace, `rtsim trace --frames N`; 1 otherwise); each frame's figures are in stats.json `frames` ([stats.md](stats.md#frames))",
+         false, false},
+        {"sampled", "bool",
+         "true when only a sample of the rays was simulated ([fidelity.md](fidelity.md#sampling))",
+         false, false},
+        {"cycles_ci95", "cycles",
+         "sampled runs only: `[lo, hi]`, the 95% confidence interval of `cycles`",
+         false, true},
+        {"rays_per_second_ci95", "rays/s",
+         "sampled runs only: `[lo, hi]`, the same interval for `rays_per_second`",
+         false, true},
+        {"energy_per_ray_nj", "nJ/ray",
+         "`energy.per_ray_nj.total`: dynamic energy of every block plus leakage, per ray ([energy_area.md](energy_area.md)); `null` at functional",
+         true, false},
+        {"mrays_per_joule", "Mrays/J",
+         "`1e3 / energy_per_ray_nj`: rays per joule, in millions; `null` at functional",
+         true, false},
+        {"power_w", "W",
+         "`energy_per_ray_nj x rays_per_second`: the average power that implies; `null` at functional",
+         true, false},
+        {"area_mm2", "mm^2",
+         "`area.total_mm2`: SRAM plus pipelines at `energy.node_nm`; every level",
+         false, false},
+        {"bottleneck", "",
+         "`verdict.binding`: the resource the verdict names (`dram`, `l2_mshrs`, `pipe_box`, ...); `null` without a verdict",
+         true, false},
+        {"verdict", "",
+         "`verdict.text`: one sentence, printed by `rtsim simulate`",
+         true, false},
+    };
+    return keys;
+}
+
+nlohmann::json summary_schema_json() {
+    nlohmann::json out = nlohmann::json::array();
+    for (const StatDecl& d : summary_schema())
+        out.push_back({{"key", d.key}, {"unit", d.unit}, {"meaning", d.meaning}, {"timed", d.timed},
+                       {"sampled_only", d.sampled_only}});
+    return out;
+}
+
+void check_summary(const nlohmann::json& summary, bool sampled) {
+    for (const StatDecl& d : summary_schema())
+        require(summary.contains(d.key) || (d.sampled_only && !sampled),
+                std::string("stats summary: declared key '") + d.key + "' was not written (summary_schema.cpp)");
+    for (auto it = summary.begin(); it != summary.end(); ++it) {
+        bool declared = false;
+        for (const StatDecl& d : summary_schema()) declared = declared || it.key() == d.key;
+        require(declared, "stats summary: key '" + it.key() + "' is not declared in sim/report/summary_schema.cpp");
+    }
+}
+
+}  // namespace rtsim

@@ -1,0 +1,286 @@
+#include "sim/sampling/sampling.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "traces/common/error.h"
+#include "traces/common/rng.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// Rays the machine holds at once: what a cluster's warm-up must at least replace.
+uint64_t rays_in_flight(const SimConfig& c) { return uint64_t(c.traversal.units) * c.traversal.ray_contexts; }
+
+/// The warm-up a cluster wants: the rays in flight twice over (pipelines and L1s), and an eighth
+/// of the L2's lines in rays, about what refills the L2's share of the region the cluster is in
+/// (measured on Sponza diffuse rays, docs/fidelity.md: less leaves the L2 cold and the estimate
+/// several percent high).
+uint64_t warmup_target(const SimConfig& c) {
+    // Functional warming fills the caches: the simulated warm-up only refills the contexts and
+    // pipelines (SMARTS's detailed warming).
+    if (c.sampling.warming_rays > 0) return 2 * rays_in_flight(c);
+    const uint64_t l2_lines = c.l2.lines();
+    return std::max<uint64_t>(2 * rays_in_flight(c), c.ideal_memory ? 0 : l2_lines / 8);
+}
+
+constexpr uint64_t kMinClusters = 5;  ///< below this the t interval is too wide to be useful
+constexpr uint64_t kFewClusters = 10;  ///< below this the sample is flagged as too small
+
+/// Why the estimate of a sample this small should not be trusted (empty: no reason known).
+json sample_caveats(const SimConfig& c, const SamplePlan& plan) {
+    json out = json::array();
+    const size_t k = plan.clusters.size();
+    if (k < kFewClusters)
+        out.push_back("only " + std::to_string(k) + " clusters: the interval rests on " + std::to_string(k - 1) +
+                      " degrees of freedom");
+    if (plan.warmup_rays < plan.warmup_target)
+        out.push_back("warm-up cut to " + std::to_string(plan.warmup_rays) + " of the " +
+                      std::to_string(plan.warmup_target) + " rays wanted per cluster: the estimate is biased high");
+    if (k && plan.clusters[0].measured < 4 * rays_in_flight(c))
+        out.push_back("clusters of " + std::to_string(plan.clusters[0].measured) +
+                      " measured rays, under 4 x the rays in flight: the estimate may be biased high");
+    if (c.sampling.warming_rays == 0 && !c.ideal_memory)
+        out.push_back("no functional warming: the caches see only the sampled rays (biased high)");
+    return out;
+}
+
+}  // namespace
+
+SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
+    const SamplingConfig& s = c.sampling;
+    SamplePlan plan;
+    plan.trace_rays = n;
+    require(s.count <= n, "config: 'sampling.count' = " + std::to_string(s.count) + " is more than the trace's " +
+                              std::to_string(n) + " rays");
+    const uint64_t budget = s.count ? s.count : uint64_t(std::llround(s.fraction * double(n)));
+    // At least as many measured as warm-up rays per cluster: fewer clusters rather than clusters
+    // that are mostly warm-up (their measurement would be mostly pipeline edge effects).
+    plan.warmup_target = s.warmup_rays ? s.warmup_rays : warmup_target(c);
+    uint64_t w = plan.warmup_target;
+    // With functional warming, a cluster measures at least 4 x the rays in flight: fewer, longer
+    // clusters. Before the cluster hand-off (SampledRayStream::next_segment) shorter ones (M = 2 x
+    // in flight) measured Sponza diffuse about 3% slow; with it, 16 units at K = 7, M = 601 still
+    // +3% against +1.4% at K = 5, M = 1046 (docs/fidelity.md, "Cluster hand-off").
+    const uint64_t min_measured = s.warming_rays > 0 && s.warmup_rays == 0 ? 4 * rays_in_flight(c) : 0;
+    uint64_t clusters = std::min<uint64_t>(s.clusters, budget / (w + std::max(w, min_measured)));
+    if (!s.warmup_rays && clusters < kMinClusters) {
+        // Too small a sample for full warm-up: keep kMinClusters and shrink the warm-up to half of
+        // each cluster, never below 2 x rays in flight (the estimate is then biased high).
+        clusters = std::min<uint64_t>(s.clusters, kMinClusters);
+        w = std::max<uint64_t>(2 * rays_in_flight(c), budget / (2 * clusters));
+        clusters = std::min<uint64_t>(clusters, budget / (2 * w));
+    }
+    plan.warmup_rays = w;
+    require(clusters >= 2, "config: sampling: a sample of " + std::to_string(budget) + " rays is too small for " +
+                               "2 clusters of " + std::to_string(plan.warmup_rays) + " warm-up and as many measured " +
+                               "rays (need " + std::to_string(4 * plan.warmup_rays) +
+                               "); raise 'sampling.fraction' or 'sampling.count', or lower 'sampling.warmup_rays'");
+    const uint64_t size = budget / clusters;  // <= n / clusters <= every stratum
+    for (uint64_t k = 0; k < clusters; ++k) {
+        SamplePlan::Cluster cl;
+        cl.stratum_first = k * n / clusters;
+        cl.stratum_rays = (k + 1) * n / clusters - cl.stratum_first;
+        // A random offset within the stratum (stratified random sampling, one cluster each).
+        const uint64_t slack = cl.stratum_rays - size;
+        cl.first = cl.stratum_first + hash_combine(s.seed, k, 0x5a3b1e) % (slack + 1);
+        cl.warmup = plan.warmup_rays;
+        cl.measured = size - plan.warmup_rays;
+        plan.clusters.push_back(cl);
+    }
+    plan.simulated_rays = clusters * size;
+    return plan;
+}
+
+double student_t_975(uint64_t df) {
+    // t_{0.975} for df = 1..30 (standard tables), then the Cornish-Fisher expansion in 1/df
+    // around the normal quantile, accurate to 1e-4 beyond 30.
+    static const double table[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
+                                   2.201,  2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,
+                                   2.080,  2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042};
+    require(df >= 1, "student_t_975: df must be at least 1");
+    if (df <= 30) return table[df - 1];
+    const double z = 1.959963984540054, d = double(df);
+    const double z3 = z * z * z, z5 = z3 * z * z, z7 = z5 * z * z;
+    return z + (z3 + z) / (4 * d) + (5 * z5 + 16 * z3 + 3 * z) / (96 * d * d) +
+           (3 * z7 + 19 * z5 + 17 * z3 - 15 * z) / (384 * d * d * d);
+}
+
+size_t sample_index(const SamplePlan& plan, uint64_t id, size_t* cluster) {
+    auto it = std::upper_bound(plan.clusters.begin(), plan.clusters.end(), id,
+                               [](uint64_t v, const SamplePlan::Cluster& c) { return v < c.first; });
+    require(it != plan.clusters.begin() && id < std::prev(it)->end(),
+            "sampling: ray " + std::to_string(id) + " is not in the sample");
+    const size_t k = size_t(std::prev(it) - plan.clusters.begin());
+    if (cluster) *cluster = k;
+    const uint64_t size = plan.clusters[0].warmup + plan.clusters[0].measured;
+    return size_t(k * size + (id - plan.clusters[k].first));
+}
+
+SampledRayStream::SampledRayStream(TraceReader& reader, const SamplePlan& plan) : m_reader(reader), m_plan(plan) {
+    if (!plan.clusters.empty()) m_next = plan.clusters[0].first;
+}
+
+void SampledRayStream::set_warming(uint64_t rays, std::function<void(uint64_t, uint64_t, uint64_t)> warm) {
+    m_warming_rays = rays;
+    m_warm = std::move(warm);
+}
+
+bool SampledRayStream::next_segment() {
+    if (m_cluster >= m_plan.clusters.size()) return false;
+    m_open_cluster = m_cluster;
+    return true;
+}
+
+size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
+    if (m_cluster >= m_plan.clusters.size() || m_cluster != m_open_cluster) return 0;
+    const SamplePlan::Cluster& c = m_plan.clusters[m_cluster];
+    if (m_next == c.first && m_warm) {
+        // Functional warming of the skipped rays just before the cluster (not into the previous one).
+        const uint64_t floor = m_cluster ? m_plan.clusters[m_cluster - 1].end() : 0;
+        const uint64_t from = std::max(floor, c.first - std::min(c.first, m_warming_rays));
+        m_warm(from, c.first, m_produced);
+    }
+    // A chunk never crosses into the next cluster, and the next cluster is read only after
+    // next_segment(), so its warming happens once every ray of this one has entered a context.
+    const size_t n = size_t(std::min<uint64_t>(max, c.end() - m_next));
+    read_ray_jobs(m_reader, m_next, n, &m_buffer, out);
+    m_next += n;
+    m_produced += n;
+    if (m_next == c.end() && ++m_cluster < m_plan.clusters.size()) m_next = m_plan.clusters[m_cluster].first;
+    return n;
+}
+
+SampledReference::SampledReference(TraceReader& reader, const SamplePlan& plan) : m_reader(reader), m_plan(plan) {
+    require(reader.section(SectionKind::hits).record_count == plan.trace_rays &&
+                reader.section(SectionKind::work).record_count == plan.trace_rays,
+            reader.path() + ": sections RAYS, HITS and WORK have different record counts");
+}
+
+SampledReference::Loaded& SampledReference::loaded_for(uint64_t id) {
+    size_t k = 0;
+    sample_index(m_plan, id, &k);
+    for (Loaded& l : m_loaded)
+        if (l.cluster == k) return l;
+    const SamplePlan::Cluster& c = m_plan.clusters[k];
+    const uint64_t n = c.end() - c.first;
+    Loaded l{k, std::vector<HitRecord>(n), std::vector<WorkRecord>(n), n};
+    m_reader.read(SectionKind::hits, c.first, n, l.hits.data());
+    m_reader.read(SectionKind::work, c.first, n, l.work.data());
+    m_loaded.push_back(std::move(l));
+    return m_loaded.back();
+}
+
+const HitRecord& SampledReference::hit(uint64_t id) {
+    Loaded& l = loaded_for(id);
+    return l.hits[id - m_plan.clusters[l.cluster].first];
+}
+
+const WorkRecord& SampledReference::work(uint64_t id) {
+    Loaded& l = loaded_for(id);
+    return l.work[id - m_plan.clusters[l.cluster].first];
+}
+
+void SampledReference::checked(uint64_t id) {
+    Loaded& l = loaded_for(id);
+    if (--l.remaining == 0)
+        m_loaded.erase(std::find_if(m_loaded.begin(), m_loaded.end(), [&](const Loaded& x) { return &x == &l; }));
+}
+
+SampleEstimator::SampleEstimator(const SamplePlan& plan)
+    : m_plan(plan), m_start(plan.simulated_rays, 0), m_seen(plan.simulated_rays, 0) {}
+
+void SampleEstimator::ray_done(const RayResult& r) {
+    const size_t i = sample_index(m_plan, r.id);
+    m_start[i] = r.start;
+    m_seen[i] = 1;
+    m_done = false;
+}
+
+void SampleEstimator::finish() const {
+    if (m_done) return;
+    // Every ray's start, sorted: the rays the machine took on within a window of cycles.
+    std::vector<Cycle> starts(m_start);
+    std::sort(starts.begin(), starts.end());
+    const size_t per_cluster = size_t(m_plan.warmup_rays + m_plan.clusters[0].measured);
+    m_cycles_per_ray.clear();
+    std::vector<double> y;  // per stratum: estimated cycles of the whole stratum
+    for (size_t k = 0; k < m_plan.clusters.size(); ++k) {
+        const SamplePlan::Cluster& c = m_plan.clusters[k];
+        const auto first = m_start.begin() + std::ptrdiff_t(k * per_cluster + c.warmup);
+        const auto [lo, hi] = std::minmax_element(first, first + std::ptrdiff_t(c.measured));
+        // Rays that started within [first measured start, last measured start], minus one: the
+        // number of start-to-start intervals the window spans (ties at one cycle count as 0-length).
+        const size_t started = size_t(std::upper_bound(starts.begin(), starts.end(), *hi) -
+                                      std::lower_bound(starts.begin(), starts.end(), *lo));
+        const double cpr = started > 1 ? double(*hi - *lo) / double(started - 1) : 0.0;
+        m_cycles_per_ray.push_back(cpr);
+        y.push_back(cpr * double(c.stratum_rays));
+    }
+    const double k = double(y.size());
+    double sum = 0, sq = 0;
+    for (double v : y) sum += v;
+    const double mean = sum / k;
+    for (double v : y) sq += (v - mean) * (v - mean);
+    // The K strata as a sample of K: Var(total) = K s^2 (conservative for stratified sampling:
+    // it also counts the variation between strata, which stratification removes).
+    m_total = sum;
+    m_half = student_t_975(y.size() - 1) * std::sqrt(k * sq / (k - 1));
+    m_done = true;
+}
+
+double SampleEstimator::cycles() const { return finish(), m_total; }
+double SampleEstimator::ci_low() const { return finish(), std::max(0.0, m_total - m_half); }
+double SampleEstimator::ci_high() const { return finish(), m_total + m_half; }
+
+json SampleEstimator::to_json(const SimConfig& config, Cycle simulated_cycles, double wall) const {
+    finish();
+    const double hz = config.clock_ghz * 1e9, n = double(m_plan.trace_rays);
+    json strata = json::array();
+    for (size_t k = 0; k < m_plan.clusters.size(); ++k) {
+        const SamplePlan::Cluster& c = m_plan.clusters[k];
+        strata.push_back({{"first_ray", c.stratum_first}, {"rays", c.stratum_rays}, {"cluster_first_ray", c.first},
+                          {"cycles_per_ray", m_cycles_per_ray[k]}});
+    }
+    return {{"clusters", m_plan.clusters.size()},
+            {"warmup_rays", m_plan.warmup_rays},
+            {"warmup_target_rays", m_plan.warmup_target},
+            {"measured_rays", m_plan.clusters[0].measured},
+            {"simulated_rays", m_plan.simulated_rays},
+            {"trace_rays", m_plan.trace_rays},
+            {"fraction", double(m_plan.simulated_rays) / n},
+            {"seed", config.sampling.seed},
+            {"cycles", m_total},
+            {"cycles_ci95", {ci_low(), ci_high()}},
+            {"relative_half_width", m_total > 0 ? m_half / m_total : 0.0},
+            {"rays_per_second", m_total > 0 ? n * hz / m_total : 0.0},
+            {"rays_per_second_ci95", {n * hz / ci_high(), ci_low() > 0 ? n * hz / ci_low() : 0.0}},
+            {"simulated_cycles", simulated_cycles},
+            {"effective_rays_per_wall_second", wall > 0 ? n / wall : 0.0},
+            {"caveats", sample_caveats(config, m_plan)},
+            {"strata", strata}};
+}
+
+void apply_sampling_to_summary(json& s, const SimConfig& config, const SamplePlan& plan, const SampleEstimator& e) {
+    const double hz = config.clock_ghz * 1e9, n = double(plan.trace_rays), sim = double(plan.simulated_rays);
+    const double seconds = e.cycles() / hz;
+    s["sampled"] = true;
+    s["cycles"] = uint64_t(std::llround(e.cycles()));
+    s["cycles_ci95"] = {e.ci_low(), e.ci_high()};
+    s["seconds"] = seconds;
+    s["rays_per_second"] = seconds > 0 ? n / seconds : 0.0;
+    s["mrays_per_second"] = seconds > 0 ? n / seconds / 1e6 : 0.0;
+    s["rays_per_second_ci95"] = {n * hz / e.ci_high(), e.ci_low() > 0 ? n * hz / e.ci_low() : 0.0};
+    // Bytes were measured on the simulated rays (warm-up included): scale per ray to the trace.
+    const double bytes = s.value("dram_bytes", 0.0);
+    s["dram_bytes_per_ray"] = sim > 0 ? bytes / sim : 0.0;
+    s["dram_bytes"] = sim > 0 ? bytes / sim * n : 0.0;
+    // Simulator speed: rays actually simulated per wall second (sampling.* has the effective one).
+    const double wall = s.value("wall_seconds", 0.0);
+    s["simulated_rays_per_wall_second"] = wall > 0 ? sim / wall : 0.0;
+}
+
+}  // namespace rtsim
