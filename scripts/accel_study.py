@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 import rtsim
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, run_sim
 from rtsim.scenes import resolve_scene
 
 REPO = Path(__file__).resolve().parents[1]
@@ -109,9 +109,10 @@ def simulate(folder: Path, args: argparse.Namespace) -> dict[str, Any]:
     if args.fresh or not stats_file.is_file():
         shutil.rmtree(out, ignore_errors=True)
         try:
-            cmd = [str(find_sim()), str(folder), "-o", str(out)]
-            subprocess.run(cmd, capture_output=True, timeout=args.sim_timeout)
-        except subprocess.TimeoutExpired:
+            result = run_sim(SimJob(trace=folder, out_dir=out), timeout=args.sim_timeout)
+        except OSError as err:
+            sys.exit(f"accel_study: cannot run rtsim-sim: {err}")
+        if result.timed_out:
             print(f"accel_study: {out.name}: no model figures (over {args.sim_timeout} s)")
             return {"timed_out": args.sim_timeout}
     if not stats_file.is_file():

@@ -29,7 +29,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, find_sim
 
 GRID = {
     "l1.size_kib": [8, 16, 32, 64, 128],
@@ -39,9 +39,7 @@ GRID = {
 
 
 def cpu_run(exe: Path, trace: Path, out: Path, sets: list[str], env: dict[str, str]) -> float:
-    cmd = [str(exe), str(trace), "-o", str(out), "--no-verdict"]
-    for s in sets:
-        cmd += ["--set", s]
+    cmd = SimJob(trace=trace, out_dir=out, sets=sets, verdict=False).command(exe)
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
     _, status, usage = os.wait4(proc.pid, 0)
     if os.waitstatus_to_exitcode(status) != 0:

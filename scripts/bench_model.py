@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import rtsim
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, run_sim
 from rtsim.scenes import resolve_scene
 
 
@@ -65,16 +65,11 @@ def reference_seconds(scene_path: str, trace_dir: Path) -> tuple[float, int]:
 def simulate(trace_dir: Path, run_dir: Path) -> dict:
     """Runs rtsim-sim once; wall time, and its peak resident memory as it reports it (the
     rusage of a forked child would include this Python process's pages from before exec)."""
-    start = time.perf_counter()
-    proc = subprocess.run(
-        [str(find_sim()), str(trace_dir), "-o", str(run_dir)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-    )
-    wall = time.perf_counter() - start
-    if proc.returncode != 0:
-        raise SystemExit(f"rtsim-sim failed on {trace_dir}: {proc.stderr.decode()[-400:]}")
-    stats = json.loads((run_dir / "stats.json").read_text())
+    result = run_sim(SimJob(trace=trace_dir, out_dir=run_dir))
+    wall = result.wall_seconds
+    if result.returncode != 0 or result.stats is None:
+        raise SystemExit(f"rtsim-sim failed on {trace_dir}: {result.stderr[-400:]}")
+    stats = result.stats
     return {
         "wall_seconds": wall,
         "peak_rss_mib": stats["summary"]["peak_memory_mib"],

@@ -44,12 +44,14 @@ def load_average() -> str:
 
 
 def commands(trace: Path, runs: Path, sim: str) -> dict[str, list[str]]:
+    from rtsim.launcher import SimJob  # the one place rtsim-sim command lines are made
+
     py = [sys.executable, "-m", "rtsim"]
     return {
         "python -c pass": [sys.executable, "-c", "pass"],  # the interpreter's own start-up
         "rtsim --version": [*py, "--version"],
         "import rtsim": [sys.executable, "-c", "import rtsim"],
-        "rtsim-sim TRACE": [sim, str(trace), "-o", str(runs / "sim")],
+        "rtsim-sim TRACE": SimJob(trace=trace, out_dir=runs / "sim").command(Path(sim)),
         "rtsim simulate TRACE": [
             *py,
             "simulate",

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from rtsim.doc_markers import write_between
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, run_sim
 
 
 def trace(args: argparse.Namespace) -> Path:
@@ -39,12 +39,10 @@ def trace(args: argparse.Namespace) -> Path:
 def simulate(folder: Path, args: argparse.Namespace) -> dict[str, Any]:
     run = args.out / "run"
     shutil.rmtree(run, ignore_errors=True)
-    proc = subprocess.run(
-        [str(find_sim()), str(folder), "-o", str(run)], capture_output=True, text=True
-    )
-    if proc.returncode != 0:
-        raise SystemExit(f"rtsim-sim exit {proc.returncode}: {proc.stderr[-600:]}")
-    return json.loads((run / "stats.json").read_text())
+    result = run_sim(SimJob(trace=folder, out_dir=run))
+    if result.returncode != 0 or result.stats is None:
+        raise SystemExit(f"rtsim-sim exit {result.returncode}: {result.stderr[-600:]}")
+    return result.stats
 
 
 def table(manifest: dict[str, Any], stats: dict[str, Any], args: argparse.Namespace) -> str:

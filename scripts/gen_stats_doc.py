@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Writes the `summary` table of docs/stats.md from the simulator's declaration of the summary
-keys (sim/report/summary_schema.cpp, `rtsim-sim --dump-stats-schema`): a key is declared once,
-in C++, and the docs follow (tests/python/test_stats_doc.py checks they agree).
+"""Writes the stats tables of docs/stats.md from the simulator's declarations: each block declares
+its stats once, in C++, beside its code (rtl_model/common/stats.h; `rtsim-sim
+--dump-stats-schema` prints them), and each table sits between `<!-- stats PATH:begin -->` and
+`<!-- stats PATH:end -->` markers (tests/python/test_stats_doc.py checks they agree).
 
     python scripts/gen_stats_doc.py [--sim PATH] [--check]
 """
@@ -34,22 +35,25 @@ def find_sim() -> str:
 
 
 def load_schema(sim: str | None = None) -> list[dict[str, Any]]:
+    """[{path, stats: [{key, unit, meaning, timed, optional}]}, ...] of every block."""
     out = subprocess.run(
         [sim or find_sim(), "--dump-stats-schema"], capture_output=True, text=True, check=True
     )
     return json.loads(out.stdout)
 
 
-def render_table(schema: list[dict[str, Any]]) -> str:
+def render_table(stats: list[dict[str, Any]]) -> str:
     lines = ["| key | unit | meaning |", "|---|---|---|"]
-    for d in schema:
+    for d in stats:
         lines.append(f"| `{d['key']}` | {d['unit']} | {d['meaning']} |")
     return "\n".join(lines)
 
 
 def render(doc: str, schema: list[dict[str, Any]]) -> str:
-    """The doc with the table between the markers replaced."""
-    return replace_between(doc, "summary-keys", render_table(schema), str(DOC))
+    """The doc with every block's table between its markers replaced."""
+    for block in schema:
+        doc = replace_between(doc, f"stats {block['path']}", render_table(block["stats"]), str(DOC))
+    return doc
 
 
 def main() -> int:

@@ -18,22 +18,18 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
-import subprocess
 import tempfile
 from pathlib import Path
 from typing import Any
 
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, find_sim, run_sim
 
 
 def run(exe: Path, trace: Path, out: Path, sets: list[str]) -> dict[str, Any]:
-    cmd = [str(exe), str(trace), "-o", str(out), "--no-verdict"]
-    for s in sets:
-        cmd += ["--set", s]
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    if proc.returncode != 0:
-        raise SystemExit(f"{' '.join(cmd)}: {proc.stderr.strip().splitlines()[-1]}")
-    return json.loads((out / "stats.json").read_text())
+    result = run_sim(SimJob(trace=trace, out_dir=out, sets=sets, verdict=False), exe=exe)
+    if result.returncode != 0 or result.stats is None:
+        raise SystemExit(f"{' '.join(result.command)}: {(result.messages or ['?'])[-1]}")
+    return result.stats
 
 
 def main() -> int:

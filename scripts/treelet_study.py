@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from rtsim.doc_markers import write_between
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, run_sim
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -79,13 +79,10 @@ def simulate(point: Point, trace: Path, out: Path, fresh: bool) -> dict[str, Any
     stats_file = run / "stats.json"
     if fresh or not stats_file.is_file():
         shutil.rmtree(run, ignore_errors=True)
-        cmd = [str(find_sim()), str(trace), "-o", str(run)]
-        for s in point.sets():
-            cmd += ["--set", s]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        if proc.returncode != 0:
+        result = run_sim(SimJob(trace=trace, out_dir=run, sets=list(point.sets())))
+        if result.returncode != 0:
             raise SystemExit(
-                f"{point.name}: rtsim-sim exit {proc.returncode}: {proc.stderr[-600:]}"
+                f"{point.name}: rtsim-sim exit {result.returncode}: {result.stderr[-600:]}"
             )
     return json.loads(stats_file.read_text())
 

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 import rtsim
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, find_sim
 from rtsim.scenes import resolve_scene
 
 
@@ -68,7 +68,7 @@ def trace_row(scene: str, kind: str, flatten: bool, args: argparse.Namespace) ->
         "transforms_per_ray": float(work["transforms"].sum()) / rays,
         "tri_tests_per_ray": float(work["tri_tests"].sum()) / rays,
     }
-    result, rss = timed([str(find_sim()), str(out / "trace"), "-o", str(out / "sim")])
+    result, rss = timed(SimJob(trace=out / "trace", out_dir=out / "sim").command(find_sim()))
     if result.returncode != 0:
         row["sim_error"] = result.stderr.strip().splitlines()[-1][:200]
         return row

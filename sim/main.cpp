@@ -11,7 +11,7 @@
 #include <systemc>
 
 #include "sim/harness/simulate.h"
-#include "sim/report/summary_schema.h"
+#include "sim/report/stats_schema.h"
 #include "traces/common/error.h"
 
 namespace {
@@ -54,11 +54,11 @@ int sc_main(int argc, char** argv) {
     app.add_flag("--no-verdict", no_verdict, "Skip the bottleneck verdict (its analytic estimates on a sample of the trace)");
     app.add_flag("--dump-defaults", dump_defaults, "Print the default config as JSON and exit");
     app.add_flag("--dump-schema", dump_schema, "Print every config field with default, unit, range, doc");
-    app.add_flag("--dump-stats-schema", dump_stats_schema, "Print every stats.json summary key with unit and meaning");
+    app.add_flag("--dump-stats-schema", dump_stats_schema, "Print every stats.json block's declared keys with unit and meaning");
     CLI11_PARSE(app, argc, argv);
     try {
         if (dump_stats_schema) {
-            std::cout << rtsim::summary_schema_json().dump(2) << "\n";
+            std::cout << rtsim::stats_schema_json().dump(2) << "\n";
             return 0;
         }
         if (dump_defaults || dump_schema) {

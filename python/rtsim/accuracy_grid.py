@@ -19,15 +19,13 @@ from __future__ import annotations
 import csv
 import json
 import statistics
-import subprocess
-import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 from rich.console import Console
 
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, find_sim, run_sim
 from rtsim.sweep.spec import RunPlan, load_spec
 from rtsim.sweep.tasks import make_trace
 
@@ -109,23 +107,20 @@ def run_level(exe: Path, trace: Path, run: RunPlan, level: str, folder: Path) ->
     folder.mkdir(parents=True, exist_ok=True)
     config = run.config.to_dict()
     (folder / "config.json").write_text(json.dumps(config))
-    cmd = [str(exe), str(trace), "--config", str(folder / "config.json"), "-o", str(folder)]
-    cmd += ["--no-verdict", "--set", f"fidelity={fidelity}"]
-    for s in extra:
-        cmd += ["--set", s]
-    (folder / "stats.json").unlink(missing_ok=True)
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    row.wall_seconds = time.perf_counter() - t0
-    stats_path = folder / "stats.json"
-    if proc.returncode not in (0, 3) or not stats_path.is_file():
-        lines = proc.stderr.strip().splitlines()
-        row.status = (lines[-1] if lines else f"exit {proc.returncode}").replace(
+    sets = [f"fidelity={fidelity}", *extra]
+    job = SimJob(
+        trace=trace, out_dir=folder, config=folder / "config.json", sets=sets, verdict=False
+    )
+    result = run_sim(job, exe=exe)
+    row.wall_seconds = result.wall_seconds
+    if result.returncode not in (0, 3) or result.stats is None:
+        lines = result.messages
+        row.status = (lines[-1] if lines else result.describe_failure()).replace(
             "rtsim-sim: error: ", ""
         )
         row.wall_seconds = None
         return row
-    stats = json.loads(stats_path.read_text())
+    stats = result.stats
     s = stats["summary"]
     row.cycles, row.hit_mismatches = s.get("cycles"), s.get("hit_mismatches")
     row.l1_hit_rate, row.l2_hit_rate, row.dram_bytes, row.area_mm2 = (

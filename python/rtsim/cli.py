@@ -46,6 +46,13 @@ WORKLOAD_DEFAULT = (
 )
 
 
+def tracer_default(name: str) -> Any:
+    """A `rtsim trace` option's default, as the tracer declares it (trace_defaults())."""
+    from rtsim.tracing import trace_defaults
+
+    return trace_defaults()[name]
+
+
 def accel_kinds() -> list[dict[str, Any]]:
     """The acceleration structures of this build (name, description, builders)."""
     from rtsim import _core
@@ -59,18 +66,19 @@ class TraceJob:
 
     scene: str
     out_dir: Path
+    # None: the tracer's default (rtsim.tracing.trace_defaults(), declared once in C++).
     workload: list[str] | None = None  # None: every kind the scene calls for
-    width: int = 320
-    height: int = 240
-    bounces: int = 1
-    seed: int = 1
+    width: int | None = None
+    height: int | None = None
+    bounces: int | None = None
+    seed: int | None = None
     camera: tuple[tuple[float, float, float], tuple[float, float, float], float] | None = None
-    threads: int = 0
-    hairball_triangles: int = 200_000
-    accel: str = "bvh2"
-    builder: str = ""  # empty: the structure's default builder (its first)
-    flatten: bool = False  # instanced scenes: one world-space structure instead of two levels
-    frames: int = 1  # animated frames of an instanced scene (docs/accel.md, "Frames")
+    threads: int | None = None
+    hairball_triangles: int | None = None
+    accel: str | None = None
+    builder: str | None = None  # None: the structure's default builder (its first)
+    flatten: bool | None = None  # instanced scenes: one world-space structure instead of two levels
+    frames: int | None = None  # animated frames of an instanced scene (docs/accel.md, "Frames")
 
 
 def parse_workload(text: str) -> list[str]:
@@ -173,7 +181,8 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             frames=job.frames,
         )
     trace = open_trace(job.out_dir)
-    heatmaps = write_heatmaps(trace, size=(job.width, job.height))
+    width, height = manifest["workload"]["resolution"]
+    heatmaps = write_heatmaps(trace, size=(width, height))
     print_summary(manifest, console)
     console.print(f"trace:    {trace.path}")
     render = job.out_dir / "render.png"
@@ -185,7 +194,7 @@ def run_trace(job: TraceJob, console: Console) -> dict:
 
 
 def cmd_trace(args: argparse.Namespace, console: Console) -> int:
-    width, height = args.resolution
+    width, height = args.resolution or (None, None)
     job = TraceJob(
         scene=args.scene,
         out_dir=Path(args.output),
@@ -199,7 +208,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         hairball_triangles=args.hairball_triangles,
         accel=args.accel,
         builder=args.builder,
-        flatten=args.flatten,
+        flatten=args.flatten or None,
         frames=args.frames,
     )
     run_trace(job, console)
@@ -306,19 +315,29 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
     p.add_argument(
         "--resolution",
         type=parse_resolution,
-        default="320x240",
+        action=LazyHelpStore,
         metavar="WxH",
-        help="camera image size: one primary ray per pixel",
+        help_text=lambda: (
+            "camera image size: one primary ray per pixel (default: "
+            f"{tracer_default('width')}x{tracer_default('height')})"
+        ),
     )
     p.add_argument(
         "--bounces",
         type=bounded_int(0, 64),
-        default=1,
+        action=LazyHelpStore,
         metavar="N",
-        help="depth of diffuse, reflection and refraction bounces",
+        help_text=lambda: (
+            "depth of diffuse, reflection and refraction bounces (default: "
+            f"{tracer_default('bounces')})"
+        ),
     )
     p.add_argument(
-        "--seed", type=seed_int, default=1, metavar="S", help="seed of the random numbers"
+        "--seed",
+        type=seed_int,
+        action=LazyHelpStore,
+        metavar="S",
+        help_text=lambda: f"seed of the random numbers (default: {tracer_default('seed')})",
     )
     p.add_argument(
         "--camera",
@@ -330,31 +349,35 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
     p.add_argument(
         "--threads",
         type=bounded_int(0, 4096),
-        default=0,
+        action=LazyHelpStore,
         metavar="N",
-        help="tracing threads, 0 for all cores (the trace is the same for any N)",
+        help_text=lambda: (
+            "tracing threads, 0 for all cores (the trace is the same for any N) "
+            f"(default: {tracer_default('threads')})"
+        ),
     )
     p.add_argument(
         "--hairball-triangles",
         type=hairball_int,
-        default=200_000,
+        action=LazyHelpStore,
         metavar="N",
-        help="triangles of the built-in hairball scene",
+        help_text=lambda: (
+            "triangles of the built-in hairball scene (default: "
+            f"{tracer_default('hairball_triangles')})"
+        ),
     )
     p.add_argument(
         "--accel",
         action=LazyHelpStore,
-        default="bvh2",
         metavar="KIND",
         help_text=lambda: (
-            "acceleration structure (default: bvh2): "
+            f"acceleration structure (default: {tracer_default('accel')}): "
             + "; ".join(f"{k['name']}: {k['description']}" for k in accel_kinds())
         ),
     )
     p.add_argument(
         "--builder",
         action=LazyHelpStore,
-        default="",
         metavar="NAME",
         help_text=lambda: (
             "builder (default: the structure's first); the structures take: "
@@ -371,12 +394,14 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
     p.add_argument(
         "--frames",
         type=bounded_int(1, 1024),
-        default=1,
+        action=LazyHelpStore,
         metavar="N",
-        help="animate an instanced scene over N frames: instances of shared geometry spin about "
-        "their up axis and bob (docs/accel.md, Frames); the BLASes are built once, the TLAS "
-        "rebuilt and the workload traced per frame; rtsim simulate replays the frames in order "
-        "with caches warm",
+        help_text=lambda: (
+            "animate an instanced scene over N frames: instances of shared geometry spin "
+            "about their up axis and bob (docs/accel.md, Frames); the BLASes are built once, "
+            "the TLAS rebuilt and the workload traced per frame; rtsim simulate replays the "
+            f"frames in order with caches warm (default: {tracer_default('frames')})"
+        ),
     )
     p.set_defaults(func=cmd_trace)
 

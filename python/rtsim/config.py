@@ -1,8 +1,12 @@
 """The simulator's config tree as typed dataclasses (docs/architecture.md, rule 5).
 
-Mirrors ``sim/config/config.h`` exactly: the same sections, field names and defaults, with the
-unit, range and doc of each field in its metadata. ``tests/python/test_config_py.py`` compares
-this tree with ``rtsim-sim --dump-schema`` both ways, so the two cannot drift.
+The tree is built from the C++ declaration itself: each block's ``visit()`` lists its fields
+with default, unit, range, choices and doc (rtl_model/*/*_config.h, sim/config/config.h); the
+build writes that schema (``rtsim-sim --dump-schema``) into the package as config_schema.json,
+and this module makes one dataclass per section (``TraversalConfig``, ``L1Config``, ...) and the
+root ``SimConfig`` from it (reading a JSON file: no C++ extension, no numpy). Nothing here
+re-types a default, a unit or a range, so Python and rtsim-sim cannot drift apart
+(tests/python/test_config_py.py also checks the installed rtsim-sim's schema against this one).
 
 Configs are composed Accel-Sim style from a named preset plus modifiers, e.g.
 ``compose("base+tu16+l1-64k")``. Presets and modifiers are data (nested dict patches), so a new
@@ -15,7 +19,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 import json
-from dataclasses import dataclass, field
+from dataclasses import field
+from importlib import resources
 from typing import Any, ClassVar, TypeVar
 
 T = TypeVar("T")
@@ -25,404 +30,43 @@ class ConfigError(ValueError):
     """A config dict, key path or patch that does not fit the tree; the message names the key."""
 
 
-def _f(default: Any, unit: str, doc: str, lo: float, hi: float) -> Any:
-    return field(default=default, metadata={"unit": unit, "doc": doc, "min": lo, "max": hi})
+#: Python type names of the schema's field types (_check_value checks values by them).
+_TYPES = {"int": "int", "float": "float", "choice": "str", "bool": "bool"}
 
 
-def _choice(default: str, choices: tuple[str, ...], doc: str) -> Any:
-    return field(default=default, metadata={"choices": choices, "doc": doc})
+def _field(entry: dict[str, Any]) -> Any:
+    """A dataclass field from a schema entry: its default and its metadata (unit, doc, range or
+    choices), as rtsim-sim declares them."""
+    if entry["type"] in ("int", "float"):
+        meta = {k: entry[k] for k in ("unit", "doc", "min", "max")}
+    elif entry["type"] == "choice":
+        meta = {"choices": tuple(entry["choices"]), "doc": entry["doc"]}
+    else:
+        meta = {"doc": entry["doc"]}
+    return field(default=entry["default"], metadata=meta)
 
 
-def _flag(default: bool, doc: str) -> Any:
-    return field(default=default, metadata={"doc": doc})
+def _in_order(fields: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+    return sorted(fields.items(), key=lambda item: item[1]["index"])
 
 
-@dataclass
-class PipelineConfig:
-    """A ray-box or ray-triangle pipeline (timing only; the arithmetic is traces/isect/)."""
-
-    latency: int = _f(8, "cycles", "Cycles from issue to result", 1, 1000)
-    initiation_interval: int = _f(
-        1, "cycles", "Cycles between two issues into one pipeline", 1, 1000
-    )
-    width: int = _f(
-        1,
-        "tests",
-        "Tests per issue (a node's child boxes take ceil(children / width) issues; "
-        "width 2 tests a binary node in one issue)",
-        1,
-        64,
-    )
-    sharing: str = _choice(
-        "private",
-        ("private", "shared"),
-        "One pipeline per traversal unit, or a pool shared by all units",
-    )
-    shared_count: int = _f(
-        4, "pipelines", "Pipelines in the shared pool (sharing = shared)", 1, 1024
-    )
+def _class_name(section: str) -> str:
+    return "".join(part.capitalize() for part in section.split("_")) + "Config"
 
 
-@dataclass
-class CacheConfig:
-    """One cache level (every L1 has the same config)."""
+class _Root:
+    """What the root of the tree can do besides holding it (SimConfig's methods)."""
 
-    size_kib: int = _f(16, "KiB", "Capacity", 1, 1 << 20)
-    ways: int = _f(4, "ways", "Associativity (LRU replacement)", 1, 64)
-    line_bytes: int = _f(64, "bytes", "Line size (power of two, same at every level)", 16, 1024)
-    latency: int = _f(4, "cycles", "Hit latency", 1, 1000)
-    mshrs: int = _f(8, "entries", "Outstanding misses; a miss waits for a free MSHR", 1, 1024)
-    banks: int = _f(
-        1, "banks", "Line-interleaved banks, each serving one access per bank_cycles", 1, 256
-    )
-    bank_cycles: int = _f(1, "cycles", "Cycles a bank is busy per access", 1, 100)
-
-
-@dataclass
-class DramConfig:
-    channels: int = _f(2, "channels", "Independent DRAM channels", 1, 64)
-    bytes_per_cycle: int = _f(
-        16, "B/cycle", "Peak bandwidth per channel, bytes per core cycle", 1, 4096
-    )
-    latency: int = _f(
-        120,
-        "cycles",
-        "Unloaded access latency, request to data (model banks: of an access to a closed bank)",
-        1,
-        100000,
-    )
-    model: str = _choice(
-        "banks",
-        ("banks", "bandwidth"),
-        "DRAM timing: banks and row buffers (hits, misses, conflicts) or channel bandwidth "
-        "calendars only (every access costs latency)",
-    )
-    interleave_bytes: int = _f(
-        256, "bytes", "Channel interleaving granule (power of two, >= line size)", 64, 1 << 20
-    )
-    # Banks and row buffers: used with model = "banks" (docs/model.md, "DRAM").
-    banks: int = _f(16, "banks", "Banks per channel, one row buffer each (model banks)", 1, 256)
-    row_bytes: int = _f(
-        2048, "bytes", "Row (page) size of a bank (power of two; model banks)", 64, 1 << 20
-    )
-    page_policy: str = _choice(
-        "open",
-        ("open", "close"),
-        "Row buffer policy: keep rows open (row hits) or precharge after each access (model banks)",
-    )
-    t_rcd: int = _f(14, "cycles", "Activate to column command, core cycles (model banks)", 0, 10000)
-    t_rp: int = _f(14, "cycles", "Precharge time, core cycles (model banks)", 0, 10000)
-    t_cas: int = _f(
-        14, "cycles", "Column command to first data, core cycles (model banks)", 0, 10000
-    )
-
-
-@dataclass
-class TraversalConfig:
-    units: int = _f(8, "units", "MIMD traversal units", 1, 4096)
-    ray_contexts: int = _f(16, "rays", "Ray contexts per unit (rays in flight)", 1, 4096)
-    stack_entries: int = _f(
-        8, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64
-    )
-    stack_entry_bytes: int = _f(8, "bytes", "Bytes per stack entry (spill traffic)", 4, 64)
-    issue_cycles: int = _f(1, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100)
-
-
-@dataclass
-class DispatchConfig:
-    chunk_rays: int = _f(16384, "rays", "Rays streamed from the trace file per chunk", 64, 1 << 24)
-    latency: int = _f(
-        2, "cycles", "Cycles to assign a ray to a free context, before its fetch", 0, 1000
-    )
-    policy: str = _choice(
-        "interleaved",
-        ("interleaved", "on_demand"),
-        "interleaved: rays dealt to units in turn, blocks of block_rays, idle units steal; "
-        "on_demand: the next ray to whichever unit asks first (depends on quantum_cycles)",
-    )
-    block_rays: int = _f(
-        1, "rays", "Consecutive rays dealt to one unit at a time (interleaved policy)", 1, 1 << 20
-    )
-
-
-@dataclass
-class SamplingConfig:
-    """Statistical sampling (docs/fidelity.md): a stratified sample of clusters of rays, each
-    warm-up then measured, estimating the full run's cycles with a 95% interval (SMARTS)."""
-
-    fraction: float = _f(
-        0.0,
-        "fraction",
-        "Fraction of the trace's rays to simulate, warm-up included (0: no sampling)",
-        0.0,
-        1.0,
-    )
-    count: int = _f(
-        0, "rays", "Rays to simulate instead of a fraction (0: no sampling)", 0, 2147483647
-    )
-    clusters: int = _f(
-        30,
-        "clusters",
-        "Strata of the trace, one sampled cluster each (fewer when the sample cannot hold them "
-        "with their warm-up)",
-        2,
-        100000,
-    )
-    warmup_rays: int = _f(
-        0,
-        "rays",
-        "Warm-up rays simulated before each cluster's measured rays "
-        "(0: automatic, docs/fidelity.md)",
-        0,
-        1 << 24,
-    )
-    warming_rays: int = _f(
-        4096,
-        "rays",
-        "Skipped rays before each cluster replayed through the L1s and L2 without time "
-        "(functional warming, docs/fidelity.md; 0: none); about L2 lines / 4",
-        0,
-        2147483647,
-    )
-    seed: int = _f(
-        1, "seed", "Seed of each cluster's random offset within its stratum", 0, 2147483647
-    )
-
-
-@dataclass
-class AnalyticConfig:
-    """The analytic level (docs/fidelity.md): its cache model and how its per-trace analysis
-    samples the trace (sim/analytic/analytic_config.h)."""
-
-    caches: str = _choice(
-        "statistical",
-        ("statistical", "functional"),
-        "statistical: reuse distances of a sample of rays (StatStack) scaled by the trace's work "
-        "counts; functional: every ray through functional caches (exact, slow)",
-    )
-    whole_trace_rays: int = _f(
-        32768,
-        "rays",
-        "Traces up to this many rays are analysed whole (statistical caches)",
-        0,
-        1 << 30,
-    )
-    clusters: int = _f(
-        8, "clusters", "Clusters of consecutive rays the analysis steps in larger traces", 1, 4096
-    )
-    warmup_rays: int = _f(
-        0,
-        "rays",
-        "Warm-up rays per cluster: their accesses only build reuse history; 0: automatic, "
-        "max(3072, L2 lines / 4), enough history to see the L2's reuse",
-        0,
-        1 << 24,
-    )
-    measured_rays: int = _f(1024, "rays", "Measured rays per cluster", 1, 1 << 24)
-
-
-@dataclass
-class TreeletConfig:
-    """Treelet scheduling with ray buffers (docs/treelets.md; Aila & Karras 2010, STRaTA)."""
-
-    enabled: bool = _flag(
-        False, "Treelet scheduling: rays queue per treelet in the ray buffer SRAM"
-    )
-    treelet_kib: int = _f(
-        16, "KiB", "Byte budget per treelet (nodes and their leaf triangles)", 1, 1 << 20
-    )
-    buffer_kib: int = _f(
-        512, "KiB", "Ray buffer SRAM capacity; rays beyond it overflow to DRAM", 1, 1 << 22
-    )
-    policy: str = _choice(
-        "largest",
-        ("largest", "oldest", "round_robin"),
-        "Queue a free unit runs next: largest queue, oldest waiting ray, or round robin",
-    )
-    threshold: int = _f(
-        64,
-        "rays",
-        "Queues of at least this many rays are preferred (oldest, round_robin); shorter ones run "
-        "only when no queue is that long. No effect with largest",
-        1,
-        1 << 20,
-    )
-    latency: int = _f(4, "cycles", "Ray buffer SRAM access latency", 1, 1000)
-    bytes_per_cycle: int = _f(512, "B/cycle", "Ray buffer SRAM bandwidth", 1, 4096)
-    idle_poll_cycles: int = _f(
-        32, "cycles", "How often a unit with no rays looks for a queue again", 1, 100000
-    )
-    admit_outstanding: int = _f(
-        16,
-        "reads",
-        "Ray-record reads the ray buffer keeps in flight while admitting new rays (a streaming "
-        "engine, one read issued per cycle)",
-        1,
-        4096,
-    )
-    quantum_cycles: int = _f(
-        16,
-        "cycles",
-        "At the approx level with treelets, the units (and the admission engine) run ahead of "
-        "each other by at most this many cycles (the smaller of this and quantum_cycles): "
-        "treelet queues' dynamics depend on the order of parks and takes, and longer quanta "
-        "made approx up to 37% off detailed (docs/fidelity.md)",
-        1,
-        1 << 20,
-    )
-    max_rays_in_flight: int = _f(
-        0,
-        "rays",
-        "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to "
-        "DRAM (0: SRAM capacity plus the ray contexts, never overflows)",
-        0,
-        1 << 30,
-    )
-
-
-@dataclass
-class EnergyConfig:
-    """The first-order energy and area model's technology (docs/energy_area.md): 45 nm reference
-    figures (Horowitz, ISSCC 2014) scaled to node_nm (Stillmaker & Baas 2017)."""
-
-    node_nm: float = _f(
-        7.0,
-        "nm",
-        "Technology node; 45 nm reference figures are scaled to it (Stillmaker & Baas 2017)",
-        7,
-        130,
-    )
-    vdd: float = _f(
-        0.0,
-        "V",
-        "Supply voltage for the energy scaling (0: the node's nominal voltage, "
-        "docs/energy_area.md)",
-        0,
-        2,
-    )
-    dram_kind: str = _choice(
-        "gddr6",
-        ("gddr6", "lpddr5", "hbm2", "ddr4"),
-        "DRAM kind: picks the energy per bit moved (docs/energy_area.md)",
-    )
-    dram_pj_per_bit: float = _f(
-        0.0,
-        "pJ/bit",
-        "DRAM energy per bit read or written, overriding the kind's figure (0: the kind's)",
-        0,
-        1000,
-    )
-    fp_add_pj: float = _f(0.9, "pJ", "32-bit floating-point add (or subtract) at 45 nm", 0, 1000)
-    fp_mul_pj: float = _f(3.7, "pJ", "32-bit floating-point multiply at 45 nm", 0, 1000)
-    cmp_pj: float = _f(
-        0.1, "pJ", "Compare, min or max of two floats at 45 nm (a 32-bit integer add)", 0, 1000
-    )
-    fp_add_um2: float = _f(4184.0, "um^2", "32-bit floating-point adder area at 45 nm", 0, 1e7)
-    fp_mul_um2: float = _f(7700.0, "um^2", "32-bit floating-point multiplier area at 45 nm", 0, 1e7)
-    cmp_um2: float = _f(137.0, "um^2", "Comparator area at 45 nm (a 32-bit integer adder)", 0, 1e7)
-    datapath_overhead: float = _f(
-        1.5,
-        "x",
-        "Pipeline registers, operand muxes and control, as a multiple of the arithmetic's "
-        "energy and area",
-        1,
-        100,
-    )
-    sram_pj_64b: float = _f(
-        10.0,
-        "pJ",
-        "64-bit read of an 8 KiB SRAM at 45 nm (wider accesses scale per bit)",
-        0,
-        10000,
-    )
-    sram_size_exponent: float = _f(
-        0.5, "", "SRAM access energy grows as (size / 8 KiB) to this power", 0, 2
-    )
-    sram_mm2_per_mib: float = _f(5.8, "mm^2/MiB", "SRAM area per MiB of data at 45 nm", 0, 1000)
-    sram_tag_overhead: float = _f(
-        0.08,
-        "fraction",
-        "Cache tag and state bits as a fraction of data bits (area and access energy)",
-        0,
-        1,
-    )
-    leakage_mw_per_mm2: float = _f(
-        50.0,
-        "mW/mm^2",
-        "Static (leakage) power per mm^2 of SRAM and datapath at the configured node",
-        0,
-        10000,
-    )
-
-
-@dataclass
-class SimConfig:
-    """The whole simulator config: the root of the tree rtsim-sim reads with --config."""
-
-    clock_ghz: float = _f(1.0, "GHz", "Core clock: converts cycles to seconds", 0.001, 100.0)
-    fidelity: str = _choice(
-        "approx",
-        ("functional", "analytic", "approx", "detailed"),
-        "Simulation level: functional (counts only), analytic (cache simulation + roofline), "
-        "approx (timed SystemC model) or detailed (per-cycle arbitration, L2 MSHRs)",
-    )
-    quantum_cycles: int = _f(
-        256,
-        "cycles",
-        "How far a traversal unit may run ahead of the others (temporal decoupling)",
-        1,
-        1 << 20,
-    )
-    interconnect_latency: int = _f(
-        8, "cycles", "One-way latency between an L1 and the L2", 0, 10000
-    )
-    ideal_memory: bool = _flag(
-        False, "Every access hits in L1 at L1 latency: the upper bound on performance"
-    )
-    # Sections: the box, triangle, any-hit, cell and transform pipelines and the two cache
-    # levels share a struct with per-section defaults, as in config.h.
-    dispatch: DispatchConfig = field(default_factory=DispatchConfig)
-    traversal: TraversalConfig = field(default_factory=TraversalConfig)
-    box: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 2, "private", 4))
-    triangle: PipelineConfig = field(default_factory=lambda: PipelineConfig(20, 1, 1, "private", 4))
-    anyhit: PipelineConfig = field(default_factory=lambda: PipelineConfig(10, 1, 1, "private", 4))
-    cell: PipelineConfig = field(default_factory=lambda: PipelineConfig(4, 1, 1, "private", 4))
-    # Instance transforms of two-level structures (docs/accel.md, "Two-level structures").
-    transform: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 1, "private", 4))
-    # MSHRs: docs/presets.md, "How the defaults were chosen".
-    l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 16, 1, 1))
-    l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 64, 8, 1))
-    dram: DramConfig = field(default_factory=DramConfig)
-    treelets: TreeletConfig = field(default_factory=TreeletConfig)
-    sampling: SamplingConfig = field(default_factory=SamplingConfig)
-    energy: EnergyConfig = field(default_factory=EnergyConfig)
-    analytic: AnalyticConfig = field(default_factory=AnalyticConfig)
-
-    sections: ClassVar[tuple[str, ...]] = (
-        "dispatch",
-        "traversal",
-        "box",
-        "triangle",
-        "anyhit",
-        "cell",
-        "transform",
-        "l1",
-        "l2",
-        "dram",
-        "treelets",
-        "sampling",
-        "energy",
-        "analytic",
-    )
+    sections: ClassVar[tuple[str, ...]]
 
     def to_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
+        return dataclasses.asdict(self)  # type: ignore[call-overload]
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SimConfig:
         """A config from a (partial) dict over the defaults; unknown keys and wrong types raise
         ConfigError naming the key's full path (e.g. 'l1.size_kb')."""
-        return _read(cls, data, "")
+        return _read(SimConfig, data, "")
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2, sort_keys=True)
@@ -441,15 +85,55 @@ class SimConfig:
     def with_values(self, values: dict[str, Any]) -> SimConfig:
         """A copy with dotted keys set ({'l1.size_kib': 64}); types checked, ranges left to the
         one validate() in rtsim-sim."""
-        return apply_patch(self, unflatten(values))
+        return apply_patch(self, unflatten(values))  # type: ignore[arg-type]
 
     def sram_bytes(self) -> int:
         """On-chip SRAM of the accelerator: the L1s, the L2, the traversal stacks and, with
         treelet scheduling, the ray buffer."""
-        t = self.traversal
+        c: Any = self
+        t = c.traversal
         stacks = t.units * t.ray_contexts * t.stack_entries * t.stack_entry_bytes
-        ray_buffer = self.treelets.buffer_kib * 1024 if self.treelets.enabled else 0
-        return (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks + ray_buffer
+        ray_buffer = c.treelets.buffer_kib * 1024 if c.treelets.enabled else 0
+        return (c.l1.size_kib * t.units + c.l2.size_kib) * 1024 + stacks + ray_buffer
+
+
+def _build_tree(schema: dict[str, Any]) -> tuple[type, dict[str, type]]:
+    """SimConfig and the section classes from the C++ schema, in declaration order."""
+    sections: dict[str, type] = {}
+    root_fields: list[tuple[str, str, Any]] = []
+    for name, entry in _in_order(schema):
+        if entry["type"] == "section":
+            cls = dataclasses.make_dataclass(
+                _class_name(name),
+                [(n, _TYPES[e["type"]], _field(e)) for n, e in _in_order(entry["fields"])],
+            )
+            cls.__doc__ = f"Section `{name}` of the config tree (as rtsim-sim declares it)."
+            cls.__module__ = __name__
+            sections[name] = cls
+            root_fields.append((name, cls.__name__, field(default_factory=cls)))
+        else:
+            root_fields.append((name, _TYPES[entry["type"]], _field(entry)))
+    root = dataclasses.make_dataclass("SimConfig", root_fields, bases=(_Root,))
+    root.__doc__ = "The whole simulator config: the root of the tree rtsim-sim reads with --config."
+    root.__module__ = __name__
+    root.sections = tuple(sections)
+    return root, sections
+
+
+def config_schema() -> dict[str, Any]:
+    """The schema the build wrote (python/CMakeLists.txt: rtsim-sim --dump-schema)."""
+    schema = resources.files("rtsim").joinpath("config_schema.json")
+    if not schema.is_file():
+        raise ImportError(
+            "rtsim/config_schema.json is missing: the package was not built and installed "
+            "(bash scripts/setup.sh)"
+        )
+    return dict(json.loads(schema.read_text()))
+
+
+SimConfig: Any
+SimConfig, SECTIONS = _build_tree(config_schema())
+globals().update({cls.__name__: cls for cls in SECTIONS.values()})
 
 
 def _names(cls: type) -> dict[str, dataclasses.Field[Any]]:

@@ -69,6 +69,7 @@ class SimJob:
     sets: list[str] = field(default_factory=list)  # key.path=value, applied after config
     timeline: bool = False  # also write RUN/timeline.json
     progress: bool = False  # JSON progress lines on stderr
+    verdict: bool = True  # False: --no-verdict (no bottleneck estimates after the run)
 
     def command(self, exe: Path) -> list[str]:
         """The command line; sweeps record it in RUN/command.txt (keep the order stable)."""
@@ -82,6 +83,8 @@ class SimJob:
             cmd.append("--timeline")
         if self.progress:
             cmd.append("--progress")
+        if not self.verdict:
+            cmd.append("--no-verdict")
         return cmd
 
 
@@ -95,6 +98,7 @@ class SimResult:
     stats: dict[str, Any] | None  # RUN/stats.json as this run wrote it, else None
     wall_seconds: float  # the whole process, start to exit
     timed_out: bool = False
+    cpu_seconds: float = 0.0  # user + system CPU time of the process
 
     @property
     def messages(self) -> list[str]:
@@ -180,7 +184,10 @@ def run_sim(
                 kept.append(line)
                 if on_message is not None and line.strip():
                     on_message(line.rstrip("\n"))
-            returncode = proc.wait()
+            # wait4: the exit status and this child's own CPU time (rusage), with no other
+            # concurrent child's mixed in.
+            _, status, usage = os.wait4(proc.pid, 0)
+            returncode = proc.returncode = os.waitstatus_to_exitcode(status)
         except BaseException:
             proc.kill()  # e.g. KeyboardInterrupt in a notebook: do not wait for the run to end
             raise
@@ -190,4 +197,5 @@ def run_sim(
     wall = time.perf_counter() - t0
     timed_out = expired.is_set() and returncode < 0
     stats = None if timed_out else read_json(job.out_dir / "stats.json")
-    return SimResult(command, returncode, "".join(kept), stats, wall, timed_out)
+    cpu = usage.ru_utime + usage.ru_stime
+    return SimResult(command, returncode, "".join(kept), stats, wall, timed_out, cpu)

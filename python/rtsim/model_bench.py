@@ -24,16 +24,14 @@ from __future__ import annotations
 import json
 import os
 import statistics
-import subprocess
 import tempfile
-import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 from rich.console import Console
 
-from rtsim.launcher import find_sim
+from rtsim.launcher import SimJob, find_sim, run_sim
 
 LEVELS: dict[str, list[str]] = {
     "functional": ["fidelity=functional"],
@@ -93,22 +91,15 @@ def run_once(
     exe: Path, trace: Path, settings: list[str], out: Path
 ) -> tuple[float, float, int, int | None]:
     """One rtsim-sim process: (wall s, CPU s of the child, simulated rays, simulated cycles)."""
-    cmd = [str(exe), str(trace), "-o", str(out), "--no-verdict"]
-    for s in settings:
-        cmd += ["--set", s]
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    stderr = proc.stderr.read() if proc.stderr else ""
-    if proc.returncode not in (0, 3):
-        lines = stderr.strip().splitlines()
-        raise RuntimeError(lines[-1] if lines else f"rtsim-sim exited with {proc.returncode}")
-    stats = json.loads((out / "stats.json").read_text())
+    result = run_sim(SimJob(trace=trace, out_dir=out, sets=settings, verdict=False), exe=exe)
+    if result.returncode not in (0, 3) or result.stats is None:
+        lines = result.messages
+        raise RuntimeError(lines[-1] if lines else result.describe_failure())
+    stats = result.stats
     rays = int(stats["summary"].get("rays") or stats["workload"]["rays"])
     cycles = stats["summary"].get("cycles")
-    return wall, usage.ru_utime + usage.ru_stime, rays, int(cycles) if cycles is not None else None
+    simulated = int(cycles) if cycles is not None else None
+    return result.wall_seconds, result.cpu_seconds, rays, simulated
 
 
 def bench_trace(

@@ -1,8 +1,9 @@
 """Trace folders as numpy arrays: each section of ``trace.rtt`` memory-mapped at its offset.
 
-The dtypes below mirror the packed C++ records in ``traces/format/trace_format.h`` field by
-field; ``open_trace`` checks each against the record size the file declares, so a layout change
-on one side is caught instead of silently misread.
+Every record is read with the layout C++ declares for it (traces/common/record_layout.h): the
+sections' through ``rtsim._core.section_layouts()``, an image region's from the trace's own ACCL
+descriptor, so nothing here re-declares a layout and a new structure's regions read as records
+with no change here. ``open_trace`` checks each section's record size against the file's.
 """
 
 from __future__ import annotations
@@ -15,144 +16,38 @@ from typing import Any
 
 import numpy as np
 
-from rtsim._core import RtsimError, trace_sections, verify_trace
+from rtsim._core import RtsimError, section_layouts, trace_sections, verify_trace
 from rtsim.kinds import RAY_KINDS as RAY_KINDS  # RayKind values stored in RayRecord.kind
 
 TRACE_FILE = "trace.rtt"
 MANIFEST_FILE = "manifest.json"
 
-#: RayRecord (40 bytes).
-RAY_DTYPE = np.dtype(
-    [
-        ("origin", "<f4", (3,)),
-        ("tmin", "<f4"),
-        ("direction", "<f4", (3,)),
-        ("tmax", "<f4"),
-        ("pixel", "<u4"),
-        ("kind", "u1"),
-        ("flags", "u1"),
-        ("depth", "<u2"),
-    ]
-)
-#: HitRecord (20 bytes).
-HIT_DTYPE = np.dtype([("prim", "<i4"), ("inst", "<i4"), ("t", "<f4"), ("u", "<f4"), ("v", "<f4")])
-#: WorkRecord (32 bytes): the neutral work counts of every acceleration structure.
-WORK_DTYPE = np.dtype(
-    [
-        ("steps", "<u4"),
-        ("box_tests", "<u4"),
-        ("tri_tests", "<u4"),
-        ("anyhit_calls", "<u4"),
-        ("transforms", "<u4"),
-        ("cell_steps", "<u4"),
-        ("plane_tests", "<u4"),
-        ("refs", "<u4"),
-    ]
-)
-#: bvh2 HwNode (64 bytes): two child boxes, child references and leaf sizes.
-#: bounds[axis][0 = min, 1 = max][child] (docs/bvh_layout.md).
-NODE_DTYPE = np.dtype(
-    [
-        ("bounds", "<f4", (3, 2, 2)),
-        ("child_ref", "<u4", (2,)),
-        ("child_count", "<u4", (2,)),
-    ]
-)
+
+def dtype_of(fields: list[dict[str, Any]], itemsize: int | None = None) -> np.dtype:
+    """The numpy dtype of a record layout as C++ declares it (traces/common/record_layout.h):
+    [{name, type, offset, shape}]; a single unnamed field is a plain scalar record."""
+    if len(fields) == 1 and fields[0]["name"] == "":
+        return np.dtype(fields[0]["type"])
+    spec: dict[str, Any] = {
+        "names": [f["name"] for f in fields],
+        "formats": [(f["type"], tuple(f["shape"])) if f["shape"] else f["type"] for f in fields],
+        "offsets": [f["offset"] for f in fields],
+    }
+    if itemsize is not None:
+        spec["itemsize"] = itemsize
+    return np.dtype(spec)
 
 
-def wide_node_dtype(width: int) -> np.dtype:
-    """fp32 wide node WideNode<N> (32 N bytes): bounds[axis][0 = min, 1 = max][slot], child
-    references, child counts (0 interior, 0xFFFFFFFF empty, else leaf size; docs/accel.md)."""
-    return np.dtype(
-        [
-            ("bounds", "<f4", (3, 2, width)),
-            ("child_ref", "<u4", (width,)),
-            ("child_count", "<u4", (width,)),
-        ]
-    )
-
-
-#: CwNode8 (80 bytes): compressed 8-wide node (Ylitie et al. 2017; docs/accel.md).
-CWNODE8_DTYPE = np.dtype(
-    [
-        ("p", "<f4", (3,)),
-        ("e", "u1", (3,)),
-        ("imask", "u1"),
-        ("base_node", "<u4"),
-        ("base_tri", "<u4"),
-        ("meta", "u1", (8,)),
-        ("qlo", "u1", (3, 8)),
-        ("qhi", "u1", (3, 8)),
-    ]
-)
-#: CwNode6 (64 bytes): compressed 6-wide node; bases = base_node | base_tri << 28 (56 bits, LE).
-CWNODE6_DTYPE = np.dtype(
-    [
-        ("p", "<f4", (3,)),
-        ("e", "u1", (3,)),
-        ("meta", "u1", (6,)),
-        ("bases", "u1", (7,)),
-        ("qlo", "u1", (3, 6)),
-        ("qhi", "u1", (3, 6)),
-    ]
-)
-#: HwTriangle (48 bytes).
-TRIANGLE_DTYPE = np.dtype(
-    [
-        ("v0", "<f4", (3,)),
-        ("v1", "<f4", (3,)),
-        ("v2", "<f4", (3,)),
-        ("prim", "<u4"),
-        ("inst", "<u4"),
-        ("flags", "<u4"),
-    ]
-)
-
-#: grid GridCell (8 bytes): the cell's list in prim_refs (docs/accel.md, "grid").
-CELL_DTYPE = np.dtype([("first_ref", "<u4"), ("ref_count", "<u4")])
-
-#: two_level InstanceRecord (128 bytes; docs/accel.md, "Two-level structures").
-INSTANCE_DTYPE = np.dtype(
-    [
-        ("world_to_object", "<f4", (3, 4)),
-        ("blas", "<u4"),
-        ("prim_base", "<u4"),
-        ("instance", "<u4"),
-        ("reserved0", "<u4"),
-        ("object_to_world", "<f4", (3, 4)),
-        ("reserved1", "<u4", (4,)),
-    ]
-)
-
-#: Section name (as the C++ section_name() spells it, lower-cased) -> record dtype.
-#: FrameRecord (16 bytes): an animated trace's frame, rays [first_ray, first_ray + rays).
-FRAME_DTYPE = np.dtype([("first_ray", "<u8"), ("rays", "<u8")])
-
+#: The trace sections' records (RayRecord, HitRecord, WorkRecord, FrameRecord), with the layouts
+#: the C++ declares (rtsim._core.section_layouts); ACCL is JSON bytes.
 SECTION_DTYPES: dict[str, np.dtype] = {
-    "rays": RAY_DTYPE,
-    "hits": HIT_DTYPE,
-    "work": WORK_DTYPE,
-    "accl": np.dtype("u1"),
-    "frms": FRAME_DTYPE,
+    name: dtype_of(fields) for name, fields in section_layouts().items()
 }
-#: Layouts of image regions this package knows, by (structure kind, region name); ("*", name)
-#: for every kind. Other regions are read as raw records (docs/accel.md documents them).
-REGION_DTYPES: dict[tuple[str, str], np.dtype] = {
-    ("*", "triangles"): TRIANGLE_DTYPE,
-    ("bvh2", "nodes"): NODE_DTYPE,
-    ("bvh4", "nodes"): wide_node_dtype(4),
-    ("bvh6", "nodes"): wide_node_dtype(6),
-    ("bvh8", "nodes"): wide_node_dtype(8),
-    ("bvh8_octant", "nodes"): wide_node_dtype(8),
-    ("cwbvh6", "nodes"): CWNODE6_DTYPE,
-    ("cwbvh8", "nodes"): CWNODE8_DTYPE,
-    ("cwbvh8_octant", "nodes"): CWNODE8_DTYPE,
-    ("grid", "cells"): CELL_DTYPE,
-    ("grid", "prim_refs"): np.dtype("<u4"),
-    ("two_level", "tlas_nodes"): NODE_DTYPE,
-    ("two_level", "instances"): INSTANCE_DTYPE,
-    ("two_level", "blas_triangles"): TRIANGLE_DTYPE,
-}
+SECTION_DTYPES["accl"] = np.dtype("u1")
+RAY_DTYPE = SECTION_DTYPES["rays"]
+HIT_DTYPE = SECTION_DTYPES["hits"]
+WORK_DTYPE = SECTION_DTYPES["work"]
+FRAME_DTYPE = SECTION_DTYPES["frms"]
 
 
 @dataclass(frozen=True)
@@ -202,18 +97,16 @@ class Trace:
         return data
 
     def region(self, name: str) -> np.ndarray:
-        """Records of an image region: a structured array where the layout is known (bvh2
-        nodes, grid cells and prim_refs, triangles), else a (count, record_bytes) array of bytes."""
+        """Records of an image region: a structured array in the layout the trace declares for
+        it (nodes, triangles, cells, ...), else a (count, record_bytes) array of bytes."""
         regions = self.accel["regions"]
         for index, info in enumerate(regions):
             if info.get("name") != name:
                 continue
-            kind = str(self.accel.get("kind", ""))
-            dtype = REGION_DTYPES.get((kind, name), REGION_DTYPES.get(("*", name)))
             record_bytes = int(info["record_bytes"])
             count = int(info["count"])
-            if dtype is None or dtype.itemsize != record_bytes:
-                dtype = np.dtype(("u1", (record_bytes,)))
+            fields = info.get("fields")
+            dtype = dtype_of(fields, record_bytes) if fields else np.dtype(("u1", (record_bytes,)))
             section = self.sections.get(f"rg{index:02d}")
             if count == 0 or section is None:
                 return np.zeros(0, dtype=dtype)

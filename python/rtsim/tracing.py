@@ -45,33 +45,42 @@ def _scene_arg(scene: SceneLike) -> Any:
     return scene if isinstance(scene, _core.Scene) else resolve_scene(scene)
 
 
+def trace_defaults() -> dict[str, Any]:
+    """The tracer's option defaults, as C++ declares them once (TraceOptions in
+    traces/tracer/tracer.h): width, height, bounces, seed, accel, builder, ..."""
+    from rtsim import _core
+
+    return dict(_core.trace_defaults())
+
+
 def trace_scene(
     scene: SceneLike,
     out_dir: str | os.PathLike[str],
     workload: Sequence[str] | str | None = None,
-    width: int = 320,
-    height: int = 240,
-    bounces: int = 1,
-    seed: int = 1,
+    width: int | None = None,
+    height: int | None = None,
+    bounces: int | None = None,
+    seed: int | None = None,
     camera: tuple[Sequence[float], Sequence[float], float] | None = None,
-    threads: int = 0,
-    hairball_triangles: int = 200_000,
+    threads: int | None = None,
+    hairball_triangles: int | None = None,
     progress: Callable[[int, int, str], None] | None = None,
-    accel: str = "bvh2",
-    builder: str = "binned",
-    flatten: bool = False,
-    frames: int = 1,
+    accel: str | None = None,
+    builder: str | None = None,
+    flatten: bool | None = None,
+    frames: int | None = None,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
-    render.png, and returns the manifest. workload: ray kinds ("primary,diffuse" or a list);
-    None (the default) traces every kind the scene calls for (manifest["workload"]["effects"]
-    says which and why). camera: (eye, target, vertical field of view in degrees). accel and
-    builder choose the acceleration structure (rtsim._core.accel_kinds(), docs/accel.md);
-    instanced scenes are traced through two levels (a BLAS of that kind per mesh, a TLAS over
-    the instances) unless flatten is true. frames > 1 animates an instanced scene by the
-    documented motion (docs/accel.md, "Frames"): the BLASes are built once, a TLAS per frame, and
-    the workload is traced once per frame; manifest["frames"] lists each frame's rays and TLAS
-    build time."""
+    render.png, and returns the manifest. Every option left None takes the tracer's default
+    (trace_defaults(): 320x240, one bounce, seed 1, bvh2 with its default builder, ...).
+    workload: ray kinds ("primary,diffuse" or a list); None traces every kind the scene calls
+    for (manifest["workload"]["effects"] says which and why). camera: (eye, target, vertical
+    field of view in degrees). accel and builder choose the acceleration structure
+    (rtsim._core.accel_kinds(), docs/accel.md); instanced scenes are traced through two levels
+    (a BLAS of that kind per mesh, a TLAS over the instances) unless flatten is true. frames > 1
+    animates an instanced scene by the documented motion (docs/accel.md, "Frames"): the BLASes
+    are built once, a TLAS per frame, and the workload is traced once per frame;
+    manifest["frames"] lists each frame's rays and TLAS build time."""
     from rtsim import _core
 
     kinds = (
@@ -79,23 +88,22 @@ def trace_scene(
         if isinstance(workload, str)
         else workload
     )
-    return _core.trace_scene(
-        _scene_arg(scene),
-        os.fspath(out_dir),
-        workload=None if kinds is None else list(kinds),
-        width=width,
-        height=height,
-        bounces=bounces,
-        seed=seed,
-        camera=camera,
-        threads=threads,
-        hairball_triangles=hairball_triangles,
-        progress=progress,
-        accel=accel,
-        builder=builder,
-        flatten=flatten,
-        frames=frames,
-    )
+    options = {
+        "workload": None if kinds is None else list(kinds),
+        "width": width,
+        "height": height,
+        "bounces": bounces,
+        "seed": seed,
+        "camera": camera,
+        "threads": threads,
+        "hairball_triangles": hairball_triangles,
+        "accel": accel,
+        "builder": builder,
+        "flatten": flatten,
+        "frames": frames,
+    }
+    given = {k: v for k, v in options.items() if v is not None}
+    return _core.trace_scene(_scene_arg(scene), os.fspath(out_dir), progress=progress, **given)
 
 
 def _kind_codes(kind: str | Sequence[str] | Any, n: int) -> np.ndarray:
@@ -132,8 +140,8 @@ def write_trace(
     kind: str | Sequence[str] | Any = "primary",
     any_hit: bool | Sequence[bool] | Any | None = None,
     threads: int = 0,
-    accel: str = "bvh2",
-    builder: str = "binned",
+    accel: str | None = None,
+    builder: str | None = None,
 ) -> dict[str, Any]:
     """Traces your rays with the reference tracer and writes a trace folder (OUT/trace.rtt and
     manifest.json, exactly as trace_scene writes one) that rtsim.simulate replays.
@@ -142,7 +150,8 @@ def write_trace(
     of every ray ("primary", "shadow", "reflection", "diffuse", "refraction") or one per ray.
     any_hit: None makes shadow rays any-hit (occlusion) rays and the others closest-hit, as the
     tracer does; or a bool for every ray, or one per ray. accel and builder choose the
-    acceleration structure, built as trace_scene builds it. Returns the manifest; rays are
+    acceleration structure, built as trace_scene builds it (None: the tracer's defaults,
+    trace_defaults()). Returns the manifest; rays are
     written in order, each with its index as `pixel`."""
     import numpy as np
 
@@ -167,6 +176,5 @@ def write_trace(
         flags,
         os.fspath(out),
         threads=threads,
-        accel=accel,
-        builder=builder,
+        **{k: v for k, v in (("accel", accel), ("builder", builder)) if v is not None},
     )

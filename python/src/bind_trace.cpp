@@ -116,32 +116,60 @@ std::string scene_name(const py::object& obj) {
     return obj.cast<fs::path>().string();
 }
 
-py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
-                          const std::optional<std::vector<std::string>>& workload, uint32_t width,
-                          uint32_t height, uint32_t bounces, uint64_t seed,
-                          const py::object& camera, unsigned threads, uint32_t hairball_triangles,
-                          const py::object& progress, const std::string& accel, const std::string& builder,
-                          bool flatten, uint32_t frames) {
+/// Reads TraceOptions' defaults into a dict (TraceOptions::visit).
+struct DefaultsReader {
+    py::dict out;
+    void operator()(const char* name, const std::vector<RayKind>&, const char*) { out[name] = py::none(); }
+    void operator()(const char* name, const std::optional<CameraOverride>&, const char*) { out[name] = py::none(); }
+    template <class T>
+    void operator()(const char* name, const T& value, const char*) { out[name] = value; }
+};
+
+/// Applies keyword arguments to TraceOptions by name (TraceOptions::visit); None keeps the default.
+struct KwargsApplier {
+    const py::kwargs& kw;
+    int used = 0;
+    bool take(const char* name, py::object* value) {
+        if (!kw.contains(name)) return false;
+        ++used;
+        *value = kw[name];
+        return !value->is_none();
+    }
+    void operator()(const char* name, std::vector<RayKind>& kinds, const char*) {
+        py::object v;
+        if (!take(name, &v)) return;
+        const auto names = v.cast<std::vector<std::string>>();
+        if (names.empty()) throw py::value_error("workload: empty list (None: what the scene calls for)");
+        for (const std::string& kind : names) kinds.push_back(parse_ray_kind(kind.c_str()));
+    }
+    void operator()(const char* name, std::optional<CameraOverride>& camera, const char*) {
+        py::object v;
+        if (take(name, &v)) camera = camera_from(v);
+    }
+    template <class T>
+    void operator()(const char* name, T& value, const char*) {
+        py::object v;
+        if (take(name, &v)) value = v.cast<T>();
+    }
+};
+
+py::object trace_scene_py(const py::object& scene, const fs::path& out_dir, const py::object& progress,
+                          const py::kwargs& options) {
     TraceOptions opt;
-    opt.accel.kind = accel;
-    opt.accel.builder = builder;
-    opt.flatten = flatten;
-    opt.frames = frames;
+    KwargsApplier apply{options};
+    opt.visit(apply);
+    if (apply.used != int(options.size())) {
+        DefaultsReader known;
+        opt.visit(known);
+        for (const auto& item : options)
+            if (!known.out.contains(item.first))
+                throw py::type_error("trace_scene: unknown option '" + item.first.cast<std::string>() +
+                                     "' (options: " + py::str(py::list(known.out.attr("keys")())).cast<std::string>() + ")");
+    }
+    if (opt.width == 0 || opt.height == 0) throw py::value_error("width and height must be positive");
     opt.scene = scene_name(scene);
     opt.out_dir = out_dir.string();
-    if (workload) {  // None: every kind the scene calls for
-        if (workload->empty()) throw py::value_error("workload: empty list (None: what the scene calls for)");
-        for (const std::string& kind : *workload) opt.workload.push_back(parse_ray_kind(kind.c_str()));
-    }
-    if (width == 0 || height == 0) throw py::value_error("width and height must be positive");
-    opt.width = width;
-    opt.height = height;
-    opt.bounces = bounces;
-    opt.seed = seed;
-    opt.camera = camera_from(camera);
-    opt.threads = threads;
-    opt.procedural.hairball_triangles = hairball_triangles;
-    opt.procedural.seed = seed;
+    opt.procedural.seed = opt.seed;
     const ProgressFn fn = make_progress(progress);
 
     std::string manifest;
@@ -232,10 +260,38 @@ py::list trace_sections(const fs::path& path) {
 }  // namespace
 
 void bind_trace(py::module_& m) {
-    // The one mapping of the C++ WorkCounts fields to Python names (trace_rays' `work` field).
-    PYBIND11_NUMPY_DTYPE(WorkCounts, steps, box_tests, tri_tests, anyhit_calls, transforms,
-                         cell_steps, plane_tests, refs);
+    // WorkCounts as a numpy record: its fields as work_counts.h declares them (trace_rays' `work`
+    // field, and the trace's WORK section through work_fields()).
+    ::pybind11::detail::npy_format_descriptor<WorkCounts>::register_dtype({
+#define RTSIM_WORK_DESCRIPTOR(name, tests_of, plan_step, doc) PYBIND11_FIELD_DESCRIPTOR(WorkCounts, name),
+        RTSIM_WORK_FIELDS(RTSIM_WORK_DESCRIPTOR)
+#undef RTSIM_WORK_DESCRIPTOR
+    });
+    m.def(
+        "work_fields",
+        [] {
+            py::list out;
+            for (const WorkFieldInfo& f : kWorkFields)
+                out.append(py::dict(py::arg("name") = f.name, py::arg("doc") = f.doc,
+                                    py::arg("tests_of") = f.tests_of == kNoOpKind ? py::object(py::none())
+                                                                                  : py::str(op_kind_name(f.tests_of))));
+            return out;
+        },
+        "The per-ray work counters in WORK record order (traces/common/work_counts.h): name, doc and the\n"
+        "operation kind whose tests each counts (None for none).");
     PYBIND11_NUMPY_DTYPE(PyHit, prim, inst, t, u, v, valid, work);
+    m.def(
+        "section_layouts",
+        [] {
+            const nlohmann::json j = {{"rays", layout_json(layout_of(static_cast<const RayRecord*>(nullptr)))},
+                                      {"hits", layout_json(layout_of(static_cast<const HitRecord*>(nullptr)))},
+                                      {"work", layout_json(layout_of(static_cast<const WorkRecord*>(nullptr)))},
+                                      {"frms", layout_json(layout_of(static_cast<const FrameRecord*>(nullptr)))}};
+            return py::module_::import("json").attr("loads")(j.dump());
+        },
+        "The record layouts of the trace's RAYS, HITS, WORK and FRMS sections as C++ declares them\n"
+        "(traces/format/trace_format.h): {section: [{name, type, offset, shape}]}. Image regions carry\n"
+        "their layouts in the ACCL descriptor.");
 
     m.def("trace_rays", &trace_rays, py::arg("scene"), py::arg("origins"), py::arg("directions"),
           py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
@@ -244,24 +300,27 @@ void bind_trace(py::module_& m) {
           "Returns a structured array with fields prim (-1: miss), inst, t, u, v, valid\n"
           "(False for rays rejected as invalid: NaN, zero direction, tmin > tmax) and work,\n"
           "the traversal's work counts (work.dtype.names: the C++ WorkCounts fields).");
-    m.def("trace_scene", &trace_scene_py, py::arg("scene"), py::arg("out_dir"),
-          py::arg("workload") = py::none(), py::arg("width") = 320u,
-          py::arg("height") = 240u, py::arg("bounces") = 1u, py::arg("seed") = 1u,
-          py::arg("camera") = py::none(), py::arg("threads") = 0u,
-          py::arg("hairball_triangles") = 200000u, py::arg("progress") = py::none(),
-          py::arg("accel") = "bvh2", py::arg("builder") = "", py::arg("flatten") = false,
-          py::arg("frames") = 1u,
+    m.def("trace_scene", &trace_scene_py, py::arg("scene"), py::arg("out_dir"), py::kw_only(),
+          py::arg("progress") = py::none(),
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
-          "returns the manifest. workload: ray kinds (None: every kind the scene calls for).\n"
-          "progress(done, total, stage) is called now and then. accel and builder choose the\n"
-          "acceleration structure (accel_kinds()); instanced scenes get a BLAS of that kind per\n"
-          "mesh and a TLAS over the instances unless flatten is true. frames > 1 animates the\n"
-          "instances (docs/accel.md, Frames): BLASes once, a TLAS and the workload per frame.");
+          "returns the manifest. Keyword options are trace_defaults()'s (None or absent: the\n"
+          "default): workload (ray kinds; None: every kind the scene calls for), width, height,\n"
+          "bounces, seed, camera, accel and builder (accel_kinds()), flatten, hairball_triangles,\n"
+          "threads, frames. progress(done, total, stage) is called now and then.");
+    m.def(
+        "trace_defaults",
+        [] {
+            TraceOptions opt;
+            DefaultsReader r;
+            opt.visit(r);
+            return r.out;
+        },
+        "The tracer's option defaults (traces/tracer/tracer.h, TraceOptions), declared once in C++.");
     m.def("write_trace", &write_trace_py, py::arg("scene"), py::arg("origins"),
           py::arg("directions"), py::arg("tmin"), py::arg("tmax"), py::arg("kinds"),
           py::arg("any_hit"), py::arg("out_dir"), py::arg("threads") = 0u,
-          py::arg("progress") = py::none(), py::arg("accel") = "bvh2",
-          py::arg("builder") = "binned",
+          py::arg("progress") = py::none(), py::arg("accel") = AccelOptions{}.kind,
+          py::arg("builder") = AccelOptions{}.builder,
           "Traces the given rays (kinds: RayKind per ray, any_hit: flag per ray) and writes\n"
           "OUT/trace.rtt and manifest.json exactly as trace_scene writes a workload; returns\n"
           "the manifest. Use rtsim.write_trace, which takes kind names and scene names.");

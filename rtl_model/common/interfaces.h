@@ -42,10 +42,11 @@ public:
     virtual Cycle access(const MemRequest& req) = 0;
 };
 
-/// Contract: `tests` tests issued at or after `time`; returns the cycle the last result is ready.
+/// Contract: `tests` tests in `issues` issues (the step-demand function's count at this
+/// pipeline's width) issued at or after `time`; returns the cycle the last result is ready.
 class PipeIf : public virtual sc_core::sc_interface {
 public:
-    virtual Cycle issue(Cycle time, uint32_t tests) = 0;
+    virtual Cycle issue(Cycle time, uint32_t issues, uint32_t tests) = 0;
 };
 
 /// A ray handed to a traversal unit: its index in the trace and the ray itself.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rtl_model/common/interfaces.h"
+#include "rtl_model/common/stack_split.h"
 #include "traces/accel/accel.h"
 
 namespace rtsim {
@@ -15,8 +16,7 @@ struct RayState {
     std::unique_ptr<Stepper> stepper;
     uint64_t ray_id = 0;
     Cycle start = 0;           ///< cycle the ray entered the machine (latency is measured from it)
-    uint32_t local_stack = 0;  ///< stack entries held on chip
-    uint32_t spilled = 0;      ///< stack entries spilled to memory
+    StackSplit stack;          ///< its stack entries on chip and spilled to memory
 };
 
 /// Steppers for rays in flight, reused: a free list over the structure's make_stepper().

@@ -79,12 +79,29 @@ bool RayDealer::exhausted() const {
     return std::all_of(m_queues.begin(), m_queues.end(), [](const auto& q) { return q.empty(); });
 }
 
+const StatBlock& dispatch_stats() {
+    static const StatBlock block{
+        "model.dispatch",
+        {
+            {"rays", "rays", "rays handed to ray contexts"},
+            {"chunks", "chunks", "chunks read from the trace file"},
+            {"chunk_rays", "rays", "the configured chunk size (`dispatch.chunk_rays`)"},
+            {"policy", "", "`interleaved` (rays dealt to units in turn) or `on_demand` (`dispatch.policy`)"},
+            {"steals", "rays", "rays an idle unit took from another unit's queue (interleaved, at the end of the trace)"},
+        }};
+    return block;
+}
+
 nlohmann::json RayDealer::stats_json() const {
-    return {{"rays", m_dispatched},
-            {"chunks", m_chunks},
-            {"chunk_rays", m_config.chunk_rays},
-            {"policy", kDispatchPolicyChoices.name(m_config.policy)},
-            {"steals", m_steals}};
+    nlohmann::json j;
+    StatsWriter(dispatch_stats(), j)
+        .set("rays", m_dispatched)
+        .set("chunks", m_chunks)
+        .set("chunk_rays", m_config.chunk_rays)
+        .set("policy", kDispatchPolicyChoices.name(m_config.policy))
+        .set("steals", m_steals)
+        .done();
+    return j;
 }
 
 Dispatch::Dispatch(sc_core::sc_module_name name, const DispatchConfig& config, uint32_t units, RayStream& stream)

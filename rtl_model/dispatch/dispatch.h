@@ -17,9 +17,13 @@
 #include <systemc>
 
 #include "rtl_model/common/interfaces.h"
+#include "rtl_model/common/stats.h"
 #include "rtl_model/dispatch/dispatch_config.h"
 
 namespace rtsim {
+
+/// The stats every dispatch writes (model.dispatch; the analytic level's RayDealer too).
+const StatBlock& dispatch_stats();
 
 /// Where rays come from (implemented by the harness over the trace file).
 class RayStream {

@@ -10,9 +10,7 @@ Pipeline::Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, b
     else if (shared) m_pool = std::make_unique<BandwidthCalendar>(16ull * config.shared_count, 16 * config.initiation_interval);
 }
 
-Cycle Pipeline::issue(Cycle time, uint32_t tests) {
-    // One issue carries up to `width` tests (the common case: no division).
-    const uint32_t issues = tests <= m_config.width ? (tests ? 1 : 0) : (tests + m_config.width - 1) / m_config.width;
+Cycle Pipeline::issue(Cycle time, uint32_t issues, uint32_t tests) {
     if (issues == 0) return time;
     m_issues += issues;
     m_tests += tests;
@@ -32,13 +30,30 @@ Cycle Pipeline::issue(Cycle time, uint32_t tests) {
     return last + m_config.latency;
 }
 
+const StatBlock& pipeline_stats() {
+    static const StatBlock block{
+        "model.<kind>.<pipe>",
+        {
+            {"issues", "issues", "issues into the pipeline(s): `ceil(tests / width)` per operation"},
+            {"tests", "tests", "tests of the block's kind: ray-box (one per child of each node visited), ray-triangle (one per leaf triangle), alpha, transform, cell or plane"},
+            {"pipelines", "pipelines", "pipelines behind this block: 1 (private) or `shared_count`"},
+            {"utilization", "fraction", "`issues / (summary.cycles * pipelines / initiation_interval)`: issue slots used"},
+            {"avg_wait_cycles", "cycles", "mean cycles an issue waited for a free slot (contention); `null` at analytic", true},
+        }};
+    return block;
+}
+
 nlohmann::json Pipeline::stats_json(Cycle total_cycles) const {
     double capacity = double(total_cycles) * pipelines() / double(m_config.initiation_interval);
-    return {{"issues", m_issues},
-            {"tests", m_tests},
-            {"pipelines", pipelines()},
-            {"utilization", capacity > 0 ? double(m_issues) / capacity : 0.0},
-            {"avg_wait_cycles", m_issues ? double(m_wait_cycles) / double(m_issues) : 0.0}};
+    nlohmann::json j;
+    StatsWriter(pipeline_stats(), j)
+        .set("issues", m_issues)
+        .set("tests", m_tests)
+        .set("pipelines", pipelines())
+        .set("utilization", capacity > 0 ? double(m_issues) / capacity : 0.0)
+        .set("avg_wait_cycles", m_issues ? double(m_wait_cycles) / double(m_issues) : 0.0)
+        .done();
+    return j;
 }
 
 }  // namespace rtsim

@@ -16,17 +16,21 @@
 #include <systemc>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/common/stats.h"
 #include "rtl_model/common/usage_series.h"
 #include "rtl_model/isect/pipeline_config.h"
 
 namespace rtsim {
+
+/// The stats every pipeline block writes (model.<kind>.<pipe>; the analytic level's too).
+const StatBlock& pipeline_stats();
 
 class Pipeline : public sc_core::sc_module, public PipeIf {
 public:
     /// count: pipelines behind this block (1 when private, shared_count when shared).
     Pipeline(sc_core::sc_module_name name, const PipelineConfig& config, bool shared, bool exact = false);
 
-    Cycle issue(Cycle time, uint32_t tests) override;
+    Cycle issue(Cycle time, uint32_t issues, uint32_t tests) override;
 
     uint64_t issues() const { return m_issues; }
     uint64_t tests() const { return m_tests; }

@@ -176,23 +176,25 @@ void Cache::limit_out_of_order_misses() {
 }
 
 nlohmann::json Cache::stats_json(Cycle total_cycles, bool series) const {
-    nlohmann::json j = m_stats.to_json();
-    j["evictions"] = m_evictions;
-    j["mshr_stall_cycles"] = m_mshr_stall_cycles;
-    j["mshr_busy_cycles"] = m_mshr_busy_cycles;
+    nlohmann::json j;
+    StatsWriter w(cache_stats(), j);
+    w.merge(m_stats.to_json());
+    w.set("evictions", m_evictions);
+    w.set("mshr_stall_cycles", m_mshr_stall_cycles);
+    w.set("mshr_busy_cycles", m_mshr_busy_cycles);
     const double cycles = double(std::max<Cycle>(total_cycles, 1));
     uint64_t accesses = 0;
     for (uint64_t b : m_bank_use.buckets()) accesses += b;
-    j["bank_utilization"] = double(accesses) / cycles / bank_capacity();
-    j["mshr_occupancy"] = double(m_mshr_busy_cycles) / cycles;  // mean outstanding misses
-    j["mshr_utilization"] = double(m_mshr_busy_cycles) / cycles / m_config.mshrs;
+    w.set("bank_utilization", double(accesses) / cycles / bank_capacity());
+    w.set("mshr_occupancy", double(m_mshr_busy_cycles) / cycles);  // mean outstanding misses
+    w.set("mshr_utilization", double(m_mshr_busy_cycles) / cycles / m_config.mshrs);
     if (series) {
-        j["bank_utilization_over_time"] = m_bank_use.to_json(bank_capacity());
-        j["mshr_utilization_over_time"] = m_mshr_use.to_json(double(m_config.mshrs));
+        w.set("bank_utilization_over_time", m_bank_use.to_json(bank_capacity()));
+        w.set("mshr_utilization_over_time", m_mshr_use.to_json(double(m_config.mshrs)));
     }
-    j["config"] = {{"size_kib", m_config.size_kib}, {"ways", m_config.ways}, {"line_bytes", m_config.line_bytes},
-                   {"latency", m_config.latency},   {"mshrs", (m_mshrs_enabled || m_mshr_occupancy) ? m_config.mshrs : 0},
-                   {"banks", m_config.banks}};
+    const uint32_t mshrs = (m_mshrs_enabled || m_mshr_occupancy) ? m_config.mshrs : 0u;
+    w.set("config", cache_config_json(m_config, mshrs));
+    w.done();
     return j;
 }
 

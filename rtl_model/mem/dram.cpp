@@ -53,21 +53,12 @@ Cycle Dram::access(const MemRequest& req) {
 }
 
 nlohmann::json Dram::stats_json(Cycle total_cycles, double clock_ghz) const {
-    nlohmann::json j = m_stats.to_json();
-    // DRAM serves every read: hit rates and merges mean nothing at this level.
-    auto drop_cache_fields = [](nlohmann::json& c) {
-        for (const char* k : {"read_hits", "merged", "hit_rate"}) c.erase(k);
-    };
-    drop_cache_fields(j);
-    for (auto& [kind, c] : j["by_kind"].items()) drop_cache_fields(c);
+    nlohmann::json j;
+    StatsWriter w(dram_stats(), j);
+    w.merge(dram_counters_json(m_stats));
     MemCounters t = m_stats.total();
-    double seconds = double(total_cycles) / (clock_ghz * 1e9);
-    double peak = double(m_config.bytes_per_cycle) * m_config.channels * clock_ghz;  // GB/s
-    double achieved = seconds > 0 ? double(t.read_bytes + t.write_bytes) / seconds / 1e9 : 0.0;
-    j["bandwidth_gbps"] = achieved;
-    j["peak_bandwidth_gbps"] = peak;
-    j["bandwidth_utilization"] = peak > 0 ? achieved / peak : 0.0;
-    j["avg_queue_cycles"] = (t.reads + t.writes) ? double(m_queue_cycles) / double(t.reads + t.writes) : 0.0;
+    dram_bandwidth_stats(w, m_config, double(t.read_bytes + t.write_bytes), double(total_cycles), clock_ghz);
+    w.set("avg_queue_cycles", (t.reads + t.writes) ? double(m_queue_cycles) / double(t.reads + t.writes) : 0.0);
     // Bandwidth over time, resampled to at most kTimelinePoints points.
     const std::vector<uint64_t>& buckets = m_bytes_use.buckets();
     size_t n = buckets.size(), group = std::max<size_t>(1, (n + kTimelinePoints - 1) / kTimelinePoints);
@@ -79,8 +70,9 @@ nlohmann::json Dram::stats_json(Cycle total_cycles, double clock_ghz) const {
         double cycles = double((end - i) * bucket_cycles());
         series.push_back({{"cycle", i * bucket_cycles()}, {"gbps", double(bytes) / cycles * clock_ghz}});
     }
-    j["bandwidth_over_time"] = series;
-    if (m_banks) j.update(m_banks->stats_json());
+    w.set("bandwidth_over_time", series);
+    if (m_banks) w.merge(m_banks->stats_json());
+    w.done();
     return j;
 }
 

@@ -38,11 +38,13 @@ void FunctionalCache::write(uint32_t bytes, DataKind kind) {
 }
 
 nlohmann::json FunctionalCache::stats_json() const {
-    nlohmann::json j = m_stats.to_json();
-    j["evictions"] = m_evictions;
-    j["mshr_stall_cycles"] = nullptr;
-    j["config"] = {{"size_kib", m_config.size_kib}, {"ways", m_config.ways}, {"line_bytes", m_config.line_bytes},
-                   {"latency", m_config.latency},   {"mshrs", nullptr},      {"banks", m_config.banks}};
+    nlohmann::json j;
+    StatsWriter(cache_stats(), j)
+        .merge(m_stats.to_json())
+        .set("evictions", m_evictions)
+        .set("mshr_stall_cycles", nullptr)  // no time here
+        .set("config", cache_config_json(m_config, nullptr))
+        .done();
     return j;
 }
 

@@ -6,6 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "rtl_model/common/interfaces.h"
+#include "rtl_model/common/stats.h"
+#include "rtl_model/mem/cache_config.h"
+#include "rtl_model/mem/dram_config.h"
 
 namespace rtsim {
 
@@ -37,5 +40,22 @@ public:
 private:
     MemCounters m_kinds[kDataKindCount];
 };
+
+/// The stats of the memory levels, declared once; every level and the analytic level write
+/// through them. A cache (model.l1.<l1>, model.l2):
+const StatBlock& cache_stats();
+/// DRAM (model.dram), the bank model's counters optional:
+const StatBlock& dram_stats();
+/// Ideal memory (model.ideal_memory):
+const StatBlock& ideal_memory_stats();
+
+/// A memory level's counters as DRAM reports them: DRAM serves every read, so hit rates and
+/// merges mean nothing there and are left out (at the top and per kind).
+nlohmann::json dram_counters_json(const MemStats& stats);
+/// A cache's `config` stats: its geometry and the MSHRs modelled (null where none are).
+nlohmann::json cache_config_json(const CacheConfig& c, const nlohmann::json& mshrs);
+/// DRAM's bandwidth stats (bandwidth_gbps, peak_bandwidth_gbps, bandwidth_utilization) for
+/// `bytes` moved in `cycles` at `clock_ghz`.
+void dram_bandwidth_stats(StatsWriter& w, const DramConfig& c, double bytes, double cycles, double clock_ghz);
 
 }  // namespace rtsim

@@ -223,6 +223,28 @@ void RayBuffer::wake_admission() {
     if (sc_core::sc_is_running()) m_room.notify();
 }
 
+const StatBlock& ray_buffer_stats() {
+    static const StatBlock block{
+        "model.ray_buffer",
+        {
+            {"ray_state_bytes", "bytes", "SRAM bytes one waiting ray occupies (ray, hit so far, id, on-chip stack)"},
+            {"capacity_rays", "rays", "rays the SRAM holds: `buffer_kib * 1024 / ray_state_bytes`"},
+            {"max_rays_in_flight", "rays", "admission limit in effect (`treelets.max_rays_in_flight`, 0 = capacity + ray contexts)"},
+            {"max_occupancy", "rays", "most rays ever waiting in the SRAM; never above `capacity_rays` (tested)"},
+            {"admitted", "rays", "new rays taken from dispatch into the root treelet's queue (= rays of the trace)"},
+            {"parked", "rays", "times a ray left its treelet and joined another treelet's queue"},
+            {"taken", "rays", "rays handed to ray contexts (`admitted + parked`)"},
+            {"overflow_writes", "rays", "ray states written to memory because the SRAM was full"},
+            {"overflow_reads", "rays", "ray states read back from memory"},
+            {"overflow_bytes", "bytes", "`(overflow_writes + overflow_reads) * ray_state_bytes` (also in the memory levels as data kind `ray_buffer`)"},
+            {"picks", "picks", "times a unit chose a new treelet queue"},
+            {"drain_picks", "picks", "picks where no queue reached `treelets.threshold` (the policy's best queue ran anyway)"},
+            {"avg_queue_rays_at_pick", "rays", "mean length of the chosen queue: how many rays share a treelet's load"},
+            {"treelets", "", "the partition: `count` treelets, `budget_bytes`, `mean_bytes` and `max_bytes` of a treelet, `max_depth` (deepest treelet level)"},
+        }};
+    return block;
+}
+
 nlohmann::json RayBuffer::stats_json() const {
     const auto& t = m_partition.treelets;
     uint64_t max_bytes = 0, sum_bytes = 0;
@@ -232,25 +254,28 @@ nlohmann::json RayBuffer::stats_json() const {
         sum_bytes += i.bytes;
         max_depth = std::max(max_depth, i.depth);
     }
-    return {{"ray_state_bytes", m_state_bytes},
-            {"capacity_rays", m_capacity},
-            {"max_rays_in_flight", m_max_in_flight},
-            {"max_occupancy", m_max_occupancy},
-            {"admitted", m_admitted},
-            {"parked", m_parked},
-            {"taken", m_taken},
-            {"overflow_writes", m_overflows},
-            {"overflow_reads", m_overflow_reads},
-            {"overflow_bytes", (m_overflows + m_overflow_reads) * m_state_bytes},
-            {"picks", m_picks},
-            {"drain_picks", m_drain_picks},
-            {"avg_queue_rays_at_pick", m_picks ? double(m_picked_queue_rays) / double(m_picks) : 0.0},
-            {"treelets",
-             {{"count", t.size()},
-              {"budget_bytes", m_partition.budget_bytes},
-              {"mean_bytes", t.empty() ? 0.0 : double(sum_bytes) / double(t.size())},
-              {"max_bytes", max_bytes},
-              {"max_depth", max_depth}}}};
+    nlohmann::json j;
+    StatsWriter(ray_buffer_stats(), j)
+        .set("ray_state_bytes", m_state_bytes)
+        .set("capacity_rays", m_capacity)
+        .set("max_rays_in_flight", m_max_in_flight)
+        .set("max_occupancy", m_max_occupancy)
+        .set("admitted", m_admitted)
+        .set("parked", m_parked)
+        .set("taken", m_taken)
+        .set("overflow_writes", m_overflows)
+        .set("overflow_reads", m_overflow_reads)
+        .set("overflow_bytes", (m_overflows + m_overflow_reads) * m_state_bytes)
+        .set("picks", m_picks)
+        .set("drain_picks", m_drain_picks)
+        .set("avg_queue_rays_at_pick", m_picks ? double(m_picked_queue_rays) / double(m_picks) : 0.0)
+        .set("treelets", nlohmann::json{{"count", t.size()},
+                                        {"budget_bytes", m_partition.budget_bytes},
+                                        {"mean_bytes", t.empty() ? 0.0 : double(sum_bytes) / double(t.size())},
+                                        {"max_bytes", max_bytes},
+                                        {"max_depth", max_depth}})
+        .done();
+    return j;
 }
 
 }  // namespace rtsim

@@ -30,10 +30,14 @@
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/common/min_tree.h"
 #include "rtl_model/common/ray_state.h"
+#include "rtl_model/common/stats.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
 #include "traces/accel/locality.h"
 
 namespace rtsim {
+
+/// The ray buffer's stats (model.ray_buffer).
+const StatBlock& ray_buffer_stats();
 
 class RayBuffer : public sc_core::sc_module, public RayBufferIf {
 public:

@@ -6,6 +6,7 @@
 // its fields once in visit() with name, unit, range and a one-line doc.
 #include <cstdint>
 #include <utility>
+#include <vector>
 
 #include "rtl_model/common/choice.h"
 #include "rtl_model/dispatch/dispatch_config.h"
@@ -13,6 +14,7 @@
 #include "rtl_model/mem/cache_config.h"
 #include "rtl_model/mem/dram_config.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
+#include "rtl_model/traversal/step_demand.h"
 #include "rtl_model/traversal/traversal_config.h"
 #include "traces/accel/step_plan.h"
 
@@ -73,6 +75,12 @@ struct ModelConfig {
         v.section("treelets", treelets);
     }
 };
+
+/// What the step-demand function needs of this machine for a structure issuing `kinds`;
+/// throws rtsim::Error naming a kind the machine has no pipeline for.
+inline StepCosts step_costs(const ModelConfig& config, const std::vector<OpKind>& kinds) {
+    return StepCosts::of(config.traversal, kinds, [&](OpKind k) -> const PipelineConfig& { return config.pipeline(k); });
+}
 
 /// The model's cross-field rules (cache geometry, line sizes, DRAM address fields and timing);
 /// throws rtsim::Error naming the field and what to change. Ranges are checked by the harness's

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "rtl_model/top/model_stats.h"
+
 namespace rtsim {
 
 /// Memory where every access hits at the L1 latency: the performance upper bound.
@@ -15,7 +17,11 @@ public:
         if (!req.write) ++c.read_hits;
         return req.time + m_latency;
     }
-    nlohmann::json stats_json() const { return m_stats.to_json(); }
+    nlohmann::json stats_json() const {
+        nlohmann::json j;
+        StatsWriter(ideal_memory_stats(), j).merge(m_stats.to_json()).done();
+        return j;
+    }
 
 private:
     Cycle m_latency;
@@ -39,9 +45,9 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
         for (const auto& p : pipes) private_ops = private_ops && !p->shared();
     m_unit_context.sync_private_steps =
         !(m_config.fidelity == Fidelity::detailed && private_ops && !m_config.treelets.enabled);
+    const UnitSetup setup{config.traversal, m_unit_context, map, m_steppers, step_costs(config, accel.op_kinds())};
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
-        auto unit = std::make_unique<TraversalUnit>(("tu" + std::to_string(u)).c_str(), config.traversal,
-                                                    m_unit_context, map, m_steppers, u);
+        auto unit = make_traversal_unit(("tu" + std::to_string(u)).c_str(), setup, u);
         unit->rays(*m_dispatch);
         unit->sink(sink);
         if (m_ideal) unit->mem(*m_ideal);
@@ -54,9 +60,7 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
         m_units.push_back(std::move(unit));
     }
     m_instantiated.push_back({{"block", "traversal"}, {"instantiated", true},
-                              {"why", std::to_string(config.traversal.units) + " units x " +
-                                          std::to_string(config.traversal.ray_contexts) + " ray contexts, " +
-                                          accel.kind() + " structure"}});
+                              {"why", traversal_units_text(config.traversal) + ", " + accel.kind() + " structure"}});
     m_instantiated.push_back({{"block", "occlusion_early_exit"}, {"instantiated", features.occlusion_rays > 0},
                               {"why", features.occlusion_rays ? std::to_string(features.occlusion_rays) +
                                                                     " any-hit (shadow) rays stop at their first hit"
@@ -70,7 +74,7 @@ void Top::build_memory() {
     if (c.ideal_memory) {
         m_ideal = std::make_unique<IdealMemory>("ideal_memory", c.l1.latency);
         m_instantiated.push_back({{"block", "memory"}, {"instantiated", false},
-                                  {"why", "ideal_memory: every access hits at L1 latency, no L2/DRAM"}});
+                                  {"why", kIdealMemoryWhy}});
         return;
     }
     // The detailed level adds exact per-cycle cache banks and the L2's MSHRs (its units
@@ -192,6 +196,7 @@ nlohmann::json Top::stats_json() const {
     if (m_dram) j["dram"] = m_dram->stats_json(total, m_config.clock_ghz);
     j["cycle_accounting"] = cycle_accounting_json(total);
     j["utilization"] = utilization_json(total);
+    check_model_stats(j);
     return j;
 }
 
@@ -203,16 +208,23 @@ nlohmann::json Top::cycle_accounting_json(Cycle total) const {
     nlohmann::json fractions = nlohmann::json::object();
     for (auto it = by_use.begin(); it != by_use.end(); ++it)
         fractions[it.key()] = context_cycles > 0 ? it.value().get<double>() / context_cycles : 0.0;
-    return {{"context_cycles", all.total()}, {"by_use", by_use}, {"fractions", fractions}};
+    nlohmann::json j;
+    StatsWriter(cycle_accounting_stats(), j)
+        .set("context_cycles", all.total())
+        .set("by_use", by_use)
+        .set("fractions", fractions)
+        .done();
+    return j;
 }
 
 nlohmann::json Top::utilization_json(Cycle total) const {
     // Every shared resource as one total over the run and over time (docs/stats.md).
     nlohmann::json j = nlohmann::json::object();
     const double cycles = double(std::max<Cycle>(total, 1));
+    StatsWriter w(utilization_stats(), j);
     auto add = [&](const std::string& name, const UsageSeries& use, double capacity) {
-        j[name] = {{"mean", capacity > 0 ? double(use.total()) / cycles / capacity : 0.0},
-                   {"over_time", use.to_json(capacity)}};
+        w.set(name.c_str(), nlohmann::json{{"mean", capacity > 0 ? double(use.total()) / cycles / capacity : 0.0},
+                                           {"over_time", use.to_json(capacity)}});
     };
     for (int k = 0; k < kOpKindCount; ++k) {
         if (m_pipes[size_t(k)].empty()) continue;

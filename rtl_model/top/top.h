@@ -17,7 +17,7 @@
 #include "rtl_model/mem/cache.h"
 #include "rtl_model/mem/dram.h"
 #include "rtl_model/ray_buffer/ray_buffer.h"
-#include "rtl_model/traversal/traversal_unit.h"
+#include "rtl_model/traversal/unit_registry.h"
 #include "rtl_model/top/model_config.h"
 
 namespace rtsim {

@@ -1,11 +1,18 @@
 #pragma once
-// Configuration of the MIMD traversal units.
+// Configuration of the traversal units.
 #include <cstdint>
+
+#include "rtl_model/common/choice.h"
 
 namespace rtsim {
 
+/// Execution models of traversal units (rtl_model/traversal/unit_registry.cpp builds each).
+enum class UnitModel : uint8_t { mimd = 0 };
+inline constexpr Choices<UnitModel, 1> kUnitModelChoices{{"mimd"}};
+
 struct TraversalConfig {
-    uint32_t units = 8;              ///< MIMD traversal units
+    UnitModel model = UnitModel::mimd;  ///< how a unit runs its rays (unit_registry.h)
+    uint32_t units = 8;              ///< traversal units
     uint32_t ray_contexts = 16;      ///< rays in flight per unit, each advancing independently
     uint32_t stack_entries = 8;      ///< on-chip traversal stack entries per ray; deeper entries spill
     uint32_t stack_entry_bytes = 8;  ///< bytes per stack entry (node reference + entry distance)
@@ -13,7 +20,8 @@ struct TraversalConfig {
 
     template <class V>
     void visit(V& v) {
-        v.field("units", units, "units", "MIMD traversal units", 1, 4096);
+        v.choice("model", model, kUnitModelChoices, "Execution model of the traversal units: mimd (each ray context steps on its own, TRaX/STRaTA-style)");
+        v.field("units", units, "units", "Traversal units", 1, 4096);
         v.field("ray_contexts", ray_contexts, "rays", "Ray contexts per unit (rays in flight)", 1, 4096);
         v.field("stack_entries", stack_entries, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64);
         v.field("stack_entry_bytes", stack_entry_bytes, "bytes", "Bytes per stack entry (spill traffic)", 4, 64);

@@ -28,15 +28,14 @@ void work_totals(TraceReader& reader, AnalyticProfile* p) {
     for (uint64_t first = 0; first < n; first += buf.size()) {
         const uint64_t count = std::min<uint64_t>(buf.size(), n - first);
         reader.read(SectionKind::work, first, count, buf.data());
-        uint64_t sums[kWorkFields] = {};
+        WorkTotals sums;
         for (uint64_t i = 0; i < count; ++i) {
             const WorkRecord& w = buf[i];
-            sums[0] += w.steps, sums[1] += w.box_tests, sums[2] += w.tri_tests, sums[3] += w.anyhit_calls;
-            sums[4] += w.transforms, sums[5] += w.cell_steps, sums[6] += w.plane_tests, sums[7] += w.refs;
-            const double steps = double(w.steps) + w.cell_steps;
+            sums.add(w);
+            const double steps = plan_step_work(w);
             if (steps > p->longest_ray_steps) p->longest_ray_steps = steps, p->longest_ray_tests = w.tri_tests;
         }
-        for (int f = 0; f < kWorkFields; ++f) p->work[size_t(f)] += double(sums[f]);
+        for (int f = 0; f < kWorkFieldCount; ++f) p->work[size_t(f)] += double(sums.field[size_t(f)]);
     }
 }
 
@@ -136,7 +135,7 @@ AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const 
     p.rays = uint64_t(p.sample_rays);
     p.work = p.sample_work;
     for (const RayResult& r : recording.results) {
-        const double steps = double(r.work.steps) + r.work.cell_steps;
+        const double steps = plan_step_work(r.work);
         if (steps > p.longest_ray_steps) p.longest_ray_steps = steps, p.longest_ray_tests = r.work.tri_tests;
     }
     m.results = std::move(recording.results);

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rtl_model/isect/pipeline.h"
+#include "rtl_model/top/model_stats.h"
+
 namespace rtsim {
 
 using nlohmann::json;
@@ -120,6 +123,29 @@ ClosedForm closed_form(const SimConfig& c, const std::vector<OpKind>& ops, const
     return f;
 }
 
+const StatBlock& analytic_stats() {
+    static const StatBlock block{
+        "model.analytic",
+        {
+            {"bounds", "cycles", "`{resource: cycles}`: each resource's roofline bound (the closed form's terms below)"},
+            {"binding", "", "the name of the largest bound"},
+            {"roofline_cycles", "cycles", "the largest bound"},
+            {"queueing_cycles", "cycles", "the mean-value-analysis estimate (never below the roofline's throughput bounds)"},
+            {"cycles", "cycles", "`max(roofline_cycles, queueing_cycles)`, rounded up: `summary.cycles`"},
+            {"unloaded_latency_mean_cycles", "cycles", "mean unloaded ray latency"},
+            {"unloaded_latency_max_cycles", "cycles", "longest unloaded ray latency"},
+            {"caches", "", "`statistical` (reuse distances of a sample, the default) or `functional` (every ray through functional caches)"},
+            {"assignment", "", "functional caches only: how rays are assigned to contexts and how contexts interleave (text)", false, true},
+            {"analysis", "", "statistical only: `file` (the per-trace analysis beside the trace), `reused` (loaded, or built by this run), `seconds`, `stepped_rays`, `sample_rays` (what building it cost) and `key` (what it depends on)", false, true},
+        }};
+    return block;
+}
+
+void check_analytic_model(const json& model) {
+    check_model_stats(model);
+    if (model.contains("analytic")) analytic_stats().check(model.at("analytic"));
+}
+
 json closed_form_json(const ClosedForm& f, const AnalyticDemands& d) {
     return {{"bounds", f.bounds},
             {"binding", f.binding},
@@ -139,8 +165,15 @@ json pipelines_json(const SimConfig& c, const std::vector<OpKind>& ops, const st
         const PipelineConfig& pc = c.pipeline(kind);
         auto block = [&](double issues, double tests, uint32_t pipelines) {
             const double capacity = cycles * pipelines / pc.initiation_interval;
-            return json{{"issues", issues},     {"tests", tests}, {"pipelines", pipelines},
-                        {"utilization", capacity > 0 ? issues / capacity : 0.0}, {"avg_wait_cycles", nullptr}};
+            json j;
+            StatsWriter(pipeline_stats(), j)
+                .set("issues", issues)
+                .set("tests", tests)
+                .set("pipelines", pipelines)
+                .set("utilization", capacity > 0 ? issues / capacity : 0.0)
+                .untimed()
+                .done();
+            return j;
         };
         if (pc.shared()) {
             double issues = 0, tests = 0;
@@ -156,13 +189,11 @@ json pipelines_json(const SimConfig& c, const std::vector<OpKind>& ops, const st
 
 json analytic_instantiated(const SimConfig& c, const std::string& accel_kind, const std::vector<OpKind>& ops,
                            const std::string& memory_why) {
-    const TraversalConfig& tc = c.traversal;
     json out = json::array(
         {{{"block", "traversal"}, {"instantiated", true},
-          {"why", std::to_string(tc.units) + " units x " + std::to_string(tc.ray_contexts) +
-                      " ray contexts (analytic: counted, not timed)"}},
+          {"why", traversal_units_text(c.traversal) + " (analytic: counted, not timed)"}},
          {{"block", "memory"}, {"instantiated", !c.ideal_memory},
-          {"why", c.ideal_memory ? "ideal_memory: every access hits at L1 latency, no L2/DRAM" : memory_why}}});
+          {"why", c.ideal_memory ? std::string(kIdealMemoryWhy) : memory_why}}});
     for (int k = 0; k < kOpKindCount; ++k) {
         const bool used = std::find(ops.begin(), ops.end(), OpKind(k)) != ops.end();
         out.push_back({{"block", op_kind_name(OpKind(k))},

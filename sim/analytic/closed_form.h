@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
 #include "sim/config/config.h"
 #include "traces/accel/step_plan.h"
 
@@ -47,7 +48,13 @@ struct ClosedForm {
 /// DRAM bounds).
 ClosedForm closed_form(const SimConfig& config, const std::vector<OpKind>& ops, const AnalyticDemands& d);
 
-/// model.analytic (docs/stats.md) for a closed form.
+/// The stats of model.analytic, declared once.
+const StatBlock& analytic_stats();
+/// Checks a model tree the analytic level wrote against the declarations (the model's blocks
+/// and model.analytic), as the timed levels' is checked (check_model_stats).
+void check_analytic_model(const nlohmann::json& model);
+
+/// The closed form's keys of model.analytic (docs/stats.md).
 nlohmann::json closed_form_json(const ClosedForm& f, const AnalyticDemands& d);
 
 /// The pipeline blocks of stats.json (model.box, model.triangle, ...) from per-unit issues and

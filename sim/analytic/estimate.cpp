@@ -4,6 +4,9 @@
 #include <array>
 #include <cmath>
 
+#include "rtl_model/dispatch/dispatch.h"
+#include "rtl_model/mem/mem_stats.h"
+#include "rtl_model/traversal/traversal_unit.h"
 #include "sim/analytic/reuse.h"
 
 namespace rtsim {
@@ -59,19 +62,6 @@ json counters_json(double reads, double writes, double hits, double read_bytes, 
             {"read_bytes", read_bytes}, {"write_bytes", write_bytes}};
 }
 
-/// Work field of an operation kind's tests (WorkRecord order).
-int test_field(OpKind kind) {
-    switch (kind) {
-        case OpKind::box: return 1;
-        case OpKind::triangle: return 2;
-        case OpKind::anyhit: return 3;
-        case OpKind::transform: return 4;
-        case OpKind::cell: return 5;
-        case OpKind::plane: return 6;
-    }
-    return 1;
-}
-
 class Estimator {
 public:
     Estimator(const SimConfig& c, const AnalyticProfile& p) : m_c(c), m_p(p), m_miss(c, p) {
@@ -86,18 +76,19 @@ public:
     PredictedRates rates();
 
 private:
-    double aux(int field, bool sample) const {
-        if (field < 0) return sample ? m_p.sample_rays : double(m_p.rays);
-        return sample ? m_p.sample_work[size_t(field)] : m_p.work[size_t(field)];
+    /// Whole trace over sample of what a data kind's accesses happen per (kDataKinds).
+    double aux(DataKind kind, bool sample) const {
+        const DataKindInfo& k = kDataKinds[size_t(kind)];
+        if (k.per_ray) return sample ? m_p.sample_rays : double(m_p.rays);
+        return sample ? m_p.sample_work[size_t(k.per_work)] : m_p.work[size_t(k.per_work)];
     }
     /// Whole trace over sample for a data kind's accesses (ratio estimator).
     double scale(DataKind kind) const {
-        const int f = AnalyticProfile::aux_field(kind);
-        if (aux(f, true) > 0) return aux(f, false) / aux(f, true);
+        if (aux(kind, true) > 0) return aux(kind, false) / aux(kind, true);
         return m_p.sample_rays > 0 ? double(m_p.rays) / m_p.sample_rays : 0.0;
     }
     double plan_steps() const {
-        const double x1 = m_p.work[0] + m_p.work[5], x2 = m_p.work[2];
+        const double x1 = AnalyticProfile::plan_step_work(m_p.work), x2 = m_p.work[size_t(WorkField::tri_tests)];
         const double fit = m_p.plan_steps_per[0] * x1 + m_p.plan_steps_per[1] * x2;
         if (fit > 0) return fit;
         return m_p.sample_rays > 0 ? m_p.sample_plan_steps * double(m_p.rays) / m_p.sample_rays : 0.0;
@@ -153,11 +144,11 @@ void Estimator::ops(double* op_latency) {
         const size_t k = size_t(kind);
         double tests = 0, issues = 0, latency = 0;
         for (const auto& [n, f] : m_p.op_sizes[k]) {
-            const double i = std::ceil(double(n) / pc.width);
+            const double i = issues_for(n, pc.width);
             tests += f * n, issues += f * i;
             if (i > 0) latency += f * ((i - 1) * pc.initiation_interval + pc.latency);
         }
-        const double total = m_p.work[size_t(test_field(kind))];
+        const double total = m_p.work[size_t(work_field_of(kind))];
         const double s = tests > 0 ? total / tests : 0.0;
         m_d.issues[k] = tests > 0 ? issues * s : std::ceil(total / pc.width);
         m_tests[k] = total;
@@ -171,7 +162,7 @@ AnalyticEstimate Estimator::run() {
     ops(&op_latency);
     const double rays = double(m_p.rays), steps = plan_steps();
     m_d.rays = rays;
-    m_d.scheduler_steps = rays + 2.0 * steps;
+    m_d.scheduler_steps = rays * kSchedulerSlotsPerRay + steps * kSchedulerSlotsPerStep;
     for (const KindCounts& kc : m_kinds) {
         m_d.l1_accesses += kc.reads + kc.writes;
         m_d.l2_accesses += kc.l1_misses + kc.writes;
@@ -199,17 +190,26 @@ AnalyticEstimate Estimator::run() {
         for (int k = 0; k < kOpKindCount; ++k) unit_issues[u][k] = m_d.issues[k] / units, unit_tests[u][k] = m_tests[k] / units;
     json& m = e.model;
     m = pipelines_json(m_c, m_p.op_kinds, unit_issues, unit_tests, e.form.cycles);
-    m["dispatch"] = {{"rays", rays}, {"policy", kDispatchPolicyChoices.name(m_c.dispatch.policy)},
-                     {"chunk_rays", m_c.dispatch.chunk_rays}, {"chunks", nullptr}, {"steals", nullptr}};
-    for (uint32_t u = 0; u < m_c.traversal.units; ++u)
-        m["units"]["tu" + std::to_string(u)] = {
-            {"rays", rays / units}, {"steps", m_d.scheduler_steps / units}, {"busy_cycles", nullptr},
-            {"busy_fraction", nullptr}, {"stack_spill_writes", m_p.spill_writes * scale(DataKind::stack) / units},
-            {"stack_spill_reads", m_p.spill_reads * scale(DataKind::stack) / units}, {"rejected_rays", nullptr},
-            {"quantum_syncs", nullptr}, {"finish_cycle", nullptr}};
+    StatsWriter(dispatch_stats(), m["dispatch"])  // chunks and steals: not estimated
+        .set("rays", rays)
+        .set("policy", kDispatchPolicyChoices.name(m_c.dispatch.policy))
+        .set("chunk_rays", m_c.dispatch.chunk_rays)
+        .set("chunks", nullptr)
+        .set("steals", nullptr)
+        .done();
+    json unit;  // every unit the average unit
+    StatsWriter(unit_stats(), unit)
+        .set("rays", rays / units)
+        .set("steps", m_d.scheduler_steps / units)
+        .set("stack_spill_writes", m_p.spill_writes * scale(DataKind::stack) / units)
+        .set("stack_spill_reads", m_p.spill_reads * scale(DataKind::stack) / units)
+        .set("rejected_rays", nullptr)
+        .untimed()
+        .done();
+    for (uint32_t u = 0; u < m_c.traversal.units; ++u) m["units"]["tu" + std::to_string(u)] = unit;
     json memory = memory_json(e.form.cycles);
     for (auto& [k, v] : memory.items()) m[k] = std::move(v);
-    m["analytic"] = closed_form_json(e.form, m_d);
+    StatsWriter(analytic_stats(), m["analytic"]).merge(closed_form_json(e.form, m_d));
     e.instantiated = analytic_instantiated(m_c, m_p.accel_kind, m_p.op_kinds,
                                            "statistical L1s and L2 (reuse distances of a sample, StatStack), DRAM bytes");
     return e;
@@ -226,9 +226,10 @@ json Estimator::memory_json(double cycles) const {
             ideal["by_kind"][data_kind_name(DataKind(k))] = counters_json(kc.reads, kc.writes, kc.reads, kc.read_bytes, kc.write_bytes);
             reads += kc.reads, writes += kc.writes, rb += kc.read_bytes, wb += kc.write_bytes;
         }
-        json t = counters_json(reads, writes, reads, rb, wb);
-        t["by_kind"] = ideal.value("by_kind", json::object());
-        out["ideal_memory"] = t;
+        StatsWriter(ideal_memory_stats(), out["ideal_memory"])
+            .merge(counters_json(reads, writes, reads, rb, wb))
+            .set("by_kind", ideal.value("by_kind", json::object()))
+            .done();
         return out;
     }
     const double units = m_c.traversal.units, line = m_c.l1.line_bytes;
@@ -248,28 +249,24 @@ json Estimator::memory_json(double cycles) const {
         for (int i = 0; i < 4; ++i) td[i] += vd[i];
     }
     auto cache_json = [&](const json& kinds, const double* t, double div, const CacheConfig& cc) {
-        json j = counters_json(t[0] / div, t[1] / div, t[2] / div, t[3] / div, t[4] / div);
-        j["by_kind"] = kinds.value("by_kind", json::object());
-        j["evictions"] = nullptr;  // not estimated
-        j["mshr_stall_cycles"] = nullptr;
-        j["config"] = {{"size_kib", cc.size_kib}, {"ways", cc.ways}, {"line_bytes", cc.line_bytes},
-                       {"latency", cc.latency},   {"mshrs", nullptr}, {"banks", cc.banks}};
+        json j;
+        StatsWriter(cache_stats(), j)
+            .merge(counters_json(t[0] / div, t[1] / div, t[2] / div, t[3] / div, t[4] / div))
+            .set("by_kind", kinds.value("by_kind", json::object()))
+            .set("evictions", nullptr)  // not estimated
+            .set("config", cache_config_json(cc, nullptr))
+            .untimed()
+            .done();
         return j;
     };
     json l1_one = cache_json(l1, t1, units, m_c.l1);
     for (uint32_t u = 0; u < m_c.traversal.units; ++u) out["l1"]["l1_" + std::to_string(u)] = l1_one;
     out["l2"] = cache_json(l2, t2, 1.0, m_c.l2);
-    json d = {{"reads", td[0]}, {"writes", td[1]}, {"read_bytes", td[2]}, {"write_bytes", td[3]},
-              {"by_kind", dram.value("by_kind", json::object())}};
-    const double seconds = cycles / (m_c.clock_ghz * 1e9);
-    const double peak = double(m_c.dram.bytes_per_cycle) * m_c.dram.channels * m_c.clock_ghz;
-    const double achieved = seconds > 0 ? (td[2] + td[3]) / seconds / 1e9 : 0.0;
-    d["bandwidth_gbps"] = achieved;
-    d["peak_bandwidth_gbps"] = peak;
-    d["bandwidth_utilization"] = peak > 0 ? achieved / peak : 0.0;
-    d["avg_queue_cycles"] = nullptr;
-    d["bandwidth_over_time"] = json::array();
-    out["dram"] = d;
+    StatsWriter d(dram_stats(), out["dram"]);
+    d.set("reads", td[0]).set("writes", td[1]).set("read_bytes", td[2]).set("write_bytes", td[3]);
+    d.set("by_kind", dram.value("by_kind", json::object()));
+    dram_bandwidth_stats(d, m_c.dram, td[2] + td[3], cycles, m_c.clock_ghz);
+    d.set("bandwidth_over_time", json::array()).untimed().done();
     return out;
 }
 

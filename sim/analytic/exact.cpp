@@ -15,7 +15,7 @@
 
 #include "rtl_model/dispatch/dispatch.h"
 #include "rtl_model/mem/functional_cache.h"
-#include "rtl_model/traversal/stack_spill.h"
+#include "rtl_model/traversal/traversal_unit.h"
 #include "sim/analytic/closed_form.h"
 
 namespace rtsim {
@@ -33,7 +33,7 @@ struct UnitCounts {
 class AnalyticModel {
 public:
     AnalyticModel(const SimConfig& config, const Accel& accel, const MemoryMap& map, RaySinkIf& sink)
-        : m_c(config), m_map(map), m_sink(sink), m_ops(accel.op_kinds()), m_units(config.traversal.units),
+        : m_c(config), m_costs(step_costs(config, accel.op_kinds())), m_map(map), m_sink(sink), m_ops(accel.op_kinds()), m_units(config.traversal.units),
           m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts) {
         for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper();
         if (!config.ideal_memory) {
@@ -52,19 +52,20 @@ private:
         uint64_t id = 0;
         Cycle clock = 0;    ///< this context's unloaded clock
         Cycle start = 0;    ///< clock the ray started at
-        uint32_t local_stack = 0, spilled = 0;
+        StackSplit stack;
         bool active = false;
     };
     bool start_ray(uint32_t unit, uint32_t slot);
     void step(uint32_t unit, uint32_t slot);
     Cycle read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind, Cycle now);
     void write(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind);
-    Cycle stack_traffic(uint32_t unit, uint32_t slot, int before, Cycle now);
-    Cycle pipe(uint32_t unit, const Op& op);
+    Cycle stack_traffic(uint32_t unit, uint32_t slot, const StepDemand& d, Cycle now);
+    Cycle pipe(uint32_t unit, const OpIssue& op);
     bool uses(OpKind kind) const { return std::find(m_ops.begin(), m_ops.end(), kind) != m_ops.end(); }
     AnalyticDemands demands() const;
 
     const SimConfig& m_c;
+    const StepCosts m_costs;
     const MemoryMap& m_map;
     RaySinkIf& m_sink;
     std::vector<OpKind> m_ops;  ///< operation kinds the structure issues
@@ -110,9 +111,9 @@ bool AnalyticModel::start_ray(uint32_t unit, uint32_t slot) {
     ctx.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_units[unit].rejected;
     ctx.id = job.id;
-    ctx.local_stack = ctx.spilled = 0;
+    ctx.stack = StackSplit{};
     ctx.active = true;
-    ++m_units[unit].steps;  // the ray-fetch step
+    m_units[unit].steps += kSchedulerSlotsPerRay;  // the ray-fetch step (and the end)
     ctx.start = ctx.clock;
     const Cycle fetch = ctx.clock + m_c.dispatch.latency;
     ctx.clock = fetch + read(unit, m_map.ray(job.id), sizeof(RayRecord), DataKind::ray, fetch);
@@ -135,31 +136,26 @@ void AnalyticModel::step(uint32_t unit, uint32_t slot) {
         start_ray(unit, slot);
         return;
     }
-    // The step as the traversal unit takes it: its fetches, then its operations in order, then
-    // those its results call for (alpha tests); two scheduler steps (fetch, operations).
-    uc.steps += 2;
+    // The step as the traversal unit takes it (the step-demand function): its fetches, then its
+    // operations in order, then the stack entries read back.
+    StepDemand d;
+    take_step(stepper, ctx.stack, m_costs, d);
+    uc.steps += d.scheduler_slots;
     Cycle fetched = 0;
-    for (int i = 0; i < plan.fetch_count; ++i)
-        fetched = std::max(fetched, read(unit, plan.fetch[i].addr, plan.fetch[i].bytes, plan.fetch[i].kind, ctx.clock));
+    for (int i = 0; i < d.read_count; ++i)
+        fetched = std::max(fetched, read(unit, d.reads[i].addr, d.reads[i].bytes, d.reads[i].kind, ctx.clock));
     ctx.clock += fetched;
-    Op ops[StepPlan::kMaxOps];
-    const int op_count = plan.op_count;
-    std::copy(plan.op, plan.op + op_count, ops);
-    const int before = stepper.stack_size();
-    const StepOutcome outcome = stepper.execute();
     Cycle ready = 0;
-    for (int i = 0; i < op_count; ++i) ready += pipe(unit, ops[i]);
-    for (int i = 0; i < outcome.op_count; ++i) ready += pipe(unit, outcome.op[i]);
-    ctx.clock += std::max(ready, stack_traffic(unit, slot, before, ctx.clock));
+    for (int i = 0; i < d.issue_count; ++i) ready += pipe(unit, d.issues[i]);
+    ctx.clock += std::max(ready, stack_traffic(unit, slot, d, ctx.clock));
 }
 
 /// Issues an operation into its pipeline; returns its unloaded latency.
-Cycle AnalyticModel::pipe(uint32_t unit, const Op& op) {
+Cycle AnalyticModel::pipe(uint32_t unit, const OpIssue& op) {
     const PipelineConfig& pc = m_c.pipeline(op.kind);
-    const uint32_t issues = (op.count + pc.width - 1) / pc.width;
-    m_units[unit].issues[size_t(op.kind)] += issues;
-    m_units[unit].tests[size_t(op.kind)] += op.count;
-    return issues ? Cycle(issues - 1) * pc.initiation_interval + pc.latency : 0;
+    m_units[unit].issues[size_t(op.kind)] += op.issues;
+    m_units[unit].tests[size_t(op.kind)] += op.tests;
+    return op.issues ? Cycle(op.issues - 1) * pc.initiation_interval + pc.latency : 0;
 }
 
 /// One read through L1, L2 and DRAM at cycle `now` (line by line, as Cache does); returns the
@@ -176,14 +172,12 @@ Cycle AnalyticModel::read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind
     const Cycle ic = m_c.interconnect_latency;
     const Cycle dram = m_c.dram.latency + (m_line_bytes + m_c.dram.bytes_per_cycle - 1) / m_c.dram.bytes_per_cycle;
     Cycle done = now;
-    for (uint64_t line = addr >> shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> shift; ++line) {
-        const uint64_t lo = std::max(addr, line << shift), hi = std::min(addr + bytes, (line + 1) << shift);
-        const uint32_t part = uint32_t(hi > lo ? hi - lo : 0);
+    for_each_line(addr, bytes, shift, [&](uint64_t line, uint32_t part) {
         const Cycle l1_tag = now + m_c.l1.latency;
         Cycle ready = 0, *fill = nullptr;
         if (m_l1[unit].read(line, part, kind, l1_tag, &ready, &fill)) {
             done = std::max(done, std::max(l1_tag, ready));
-            continue;
+            return;
         }
         // L1 miss: to the L2 over the interconnect; its fill comes back the same way.
         const Cycle l2_tag = l1_tag + ic + m_c.l2.latency;
@@ -201,7 +195,7 @@ Cycle AnalyticModel::read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind
         *fill = l2_done + ic;
         m_l1_hold += double(*fill - l1_tag);
         done = std::max(done, *fill);
-    }
+    });
     return done - now;
 }
 
@@ -213,33 +207,28 @@ void AnalyticModel::write(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind
         return;
     }
     const uint32_t shift = m_l1[unit].line_shift();
-    for (uint64_t line = addr >> shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> shift; ++line) {
-        const uint64_t lo = std::max(addr, line << shift), hi = std::min(addr + bytes, (line + 1) << shift);
-        const uint32_t part = uint32_t(hi > lo ? hi - lo : 0);
+    for_each_line(addr, bytes, shift, [&](uint64_t, uint32_t part) {
         m_l1[unit].write(part, kind);
         m_l2->write(part, kind);
         ++m_dram[kind].writes;
         m_dram[kind].write_bytes += part;
-    }
+    });
 }
 
-/// Stack spills (posted writes) and refills (reads the ray waits for), as the traversal unit
-/// maps the stepper's stack onto stack_entries on-chip entries; returns the refill latency.
-Cycle AnalyticModel::stack_traffic(uint32_t unit, uint32_t slot, int before, Cycle now) {
-    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
-    const uint32_t bytes = m_c.traversal.stack_entry_bytes;
+/// The step's stack spills (posted writes) and refills (reads the ray waits for), from its
+/// demand; returns the refill latency.
+Cycle AnalyticModel::stack_traffic(uint32_t unit, uint32_t slot, const StepDemand& d, Cycle now) {
+    const uint32_t bytes = m_costs.stack_entry_bytes;
     const uint64_t owner = uint64_t(unit) * m_c.traversal.ray_contexts + slot;
     Cycle refill = 0;
-    map_stack_change(
-        ctx.local_stack, ctx.spilled, before, ctx.stepper->stack_size(), m_c.traversal.stack_entries,
-        [&](uint32_t s) {
-            write(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack);
-            ++m_units[unit].spill_writes;
-        },
-        [&](uint32_t s) {
-            ++m_units[unit].spill_reads;
-            refill = std::max(refill, read(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack, now));
-        });
+    d.for_each_spill([&](uint32_t s) {
+        write(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack);
+        ++m_units[unit].spill_writes;
+    });
+    d.for_each_fill([&](uint32_t s) {
+        ++m_units[unit].spill_reads;
+        refill = std::max(refill, read(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack, now));
+    });
     return refill;
 }
 
@@ -278,38 +267,31 @@ AnalyticOutcome AnalyticModel::outcome(const Accel& accel) const {
     m["dispatch"] = m_dispatch->stats_json();
     for (size_t u = 0; u < m_units.size(); ++u) {
         const UnitCounts& uc = m_units[u];
-        // Time-dependent counters do not exist at this level: null.
-        m["units"]["tu" + std::to_string(u)] = {
-            {"rays", uc.rays},          {"steps", uc.steps},      {"busy_cycles", nullptr},
-            {"busy_fraction", nullptr}, {"stack_spill_writes", uc.spill_writes},
-            {"stack_spill_reads", uc.spill_reads}, {"rejected_rays", uc.rejected},
-            {"quantum_syncs", nullptr}, {"finish_cycle", nullptr}};
+        StatsWriter(unit_stats(), m["units"]["tu" + std::to_string(u)])
+            .set("rays", uc.rays)
+            .set("steps", uc.steps)
+            .set("stack_spill_writes", uc.spill_writes)
+            .set("stack_spill_reads", uc.spill_reads)
+            .set("rejected_rays", uc.rejected)
+            .untimed()
+            .done();
     }
     if (m_c.ideal_memory) {
-        m["ideal_memory"] = m_ideal.to_json();
+        StatsWriter(ideal_memory_stats(), m["ideal_memory"]).merge(m_ideal.to_json()).done();
     } else {
         for (size_t u = 0; u < m_l1.size(); ++u) m["l1"]["l1_" + std::to_string(u)] = m_l1[u].stats_json();
         m["l2"] = m_l2->stats_json();
-        json dj = m_dram.to_json();
-        auto drop_cache_fields = [](json& c) {
-            for (const char* k : {"read_hits", "merged", "hit_rate"}) c.erase(k);
-        };
-        drop_cache_fields(dj);
-        for (auto& [kind, c] : dj["by_kind"].items()) drop_cache_fields(c);
-        const double seconds = total / (m_c.clock_ghz * 1e9);
-        const double peak = double(m_c.dram.bytes_per_cycle) * m_c.dram.channels * m_c.clock_ghz;
-        const double achieved = seconds > 0 ? d.dram_bytes / seconds / 1e9 : 0.0;
-        dj["bandwidth_gbps"] = achieved;
-        dj["peak_bandwidth_gbps"] = peak;
-        dj["bandwidth_utilization"] = peak > 0 ? achieved / peak : 0.0;
-        dj["avg_queue_cycles"] = nullptr;
-        dj["bandwidth_over_time"] = json::array();
-        m["dram"] = dj;
+        StatsWriter w(dram_stats(), m["dram"]);
+        w.merge(dram_counters_json(m_dram));
+        dram_bandwidth_stats(w, m_c.dram, d.dram_bytes, total, m_c.clock_ghz);
+        w.set("bandwidth_over_time", json::array()).untimed().done();
     }
-    m["analytic"] = closed_form_json(form, d);
-    m["analytic"]["caches"] = "functional";
-    m["analytic"]["assignment"] =
-        "rays to contexts in trace order as contexts free up; the context with the earliest unloaded clock steps next";
+    StatsWriter(analytic_stats(), m["analytic"])
+        .merge(closed_form_json(form, d))
+        .set("caches", "functional")
+        .set("assignment", "rays to contexts in trace order as contexts free up; the context with the earliest "
+                           "unloaded clock steps next")
+        .done();
     out.instantiated = analytic_instantiated(m_c, accel.kind(), m_ops,
                                              "functional L1 per unit and shared L2 (tags only), DRAM bytes");
     return out;

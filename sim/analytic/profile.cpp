@@ -36,12 +36,6 @@ void array_from(const json& j, Array* a) {
 
 }  // namespace
 
-const char* work_field_name(int field) {
-    static const char* names[kWorkFields] = {"steps",      "box_tests",  "tri_tests",   "anyhit_calls",
-                                             "transforms", "cell_steps", "plane_tests", "refs"};
-    return names[field];
-}
-
 double JointHistogram::total() const {
     double t = 0;
     for (const auto& [k, n] : cells) t += n;
@@ -55,16 +49,11 @@ AnalyticProfile::AnalyticProfile()
       global_events(DistanceBins::kBins, 0.0),
       global_censored(DistanceBins::kBins, 0.0) {}
 
-int AnalyticProfile::aux_field(DataKind kind) {
-    switch (kind) {
-        case DataKind::triangle: return 2;   // tri_tests
-        case DataKind::prim_ref: return 7;   // refs
-        case DataKind::cell: return 5;       // cell_steps
-        case DataKind::instance: return 4;   // transforms
-        case DataKind::ray:
-        case DataKind::hit: return -1;       // rays
-        default: return 0;                   // steps (nodes, stack, ray buffer)
-    }
+double AnalyticProfile::plan_step_work(const std::array<double, kWorkFieldCount>& sums) {
+    double n = 0;
+    for (size_t f = 0; f < sums.size(); ++f)
+        if (kWorkFields[f].plan_step) n += sums[f];
+    return n;
 }
 
 json AnalyticProfile::to_json() const {

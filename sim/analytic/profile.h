@@ -26,10 +26,6 @@
 
 namespace rtsim {
 
-/// Work fields of WorkRecord, in order.
-constexpr int kWorkFields = 8;
-const char* work_field_name(int field);
-
 /// A 2D histogram of accesses: (unit-stream bin, censored) x (global-stream bin, censored).
 struct JointHistogram {
     std::map<uint32_t, double> cells;  ///< key: pack(...)
@@ -51,16 +47,16 @@ struct AnalyticProfile {
 
     // The whole trace (WORK section).
     uint64_t rays = 0;
-    std::array<double, kWorkFields> work{};  ///< sums over all rays
-    double longest_ray_steps = 0;            ///< max over rays of steps + cell_steps
+    std::array<double, kWorkFieldCount> work{};  ///< sums over all rays, per field of work_counts.h
+    double longest_ray_steps = 0;            ///< max over rays of its plan-step work (plan_step_work)
     double longest_ray_tests = 0;            ///< that ray's triangle tests
 
     // The sample's measured rays.
     double sample_rays = 0;
     bool whole_trace = false;  ///< the sample is the whole trace from its first ray: no history before it
-    std::array<double, kWorkFields> sample_work{};
+    std::array<double, kWorkFieldCount> sample_work{};
     double sample_plan_steps = 0;           ///< steps the stepper planned (node and leaf steps)
-    double plan_steps_per[2] = {0, 0};      ///< regression: plan steps = a (steps + cell_steps) + b tri_tests
+    double plan_steps_per[2] = {0, 0};      ///< regression: plan steps = a plan-step work + b tri_tests
     std::vector<std::map<uint32_t, double>> op_sizes;  ///< per OpKind: operations by count
     std::array<JointHistogram, kDataKindCount> reads;   ///< line reads by reuse distances
     std::array<double, kDataKindCount> read_bytes{};    ///< bytes those reads asked for
@@ -81,8 +77,8 @@ struct AnalyticProfile {
     AnalyticProfile();
     nlohmann::json to_json() const;
     static AnalyticProfile from_json(const nlohmann::json& j);
-    /// Which work total scales a data kind's accesses (docs/fidelity.md).
-    static int aux_field(DataKind kind);
+    /// Sum of the plan-step fields of work sums (work or sample_work).
+    static double plan_step_work(const std::array<double, kWorkFieldCount>& sums);
 };
 
 }  // namespace rtsim

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 
-#include "rtl_model/traversal/stack_spill.h"
 
 namespace rtsim {
 
 SampleProfiler::SampleProfiler(const SimConfig& config, const Accel& accel, const MemoryMap& map,
                                AnalyticProfile& profile)
     : m_c(config),
+      m_costs(step_costs(config, accel.op_kinds())),
       m_map(map),
       m_p(profile),
       m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts),
@@ -49,7 +49,8 @@ bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, 
     if (!dealer.next_ray(unit, &job)) return false;
     ctx.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     ctx.id = job.id;
-    ctx.local_stack = ctx.spilled = ctx.plan_steps = 0;
+    ctx.stack = StackSplit{};
+    ctx.plan_steps = 0;
     ctx.measured = job.id >= m_measure_first && job.id < m_measure_end;
     ctx.active = true;
     const Access a = read(unit, m_map.ray(job.id), sizeof(RayRecord), DataKind::ray, ctx.measured);
@@ -65,12 +66,10 @@ void SampleProfiler::finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RayS
     ++m_p.stepped_rays;
     if (!ctx.measured) return;
     const WorkCounts& w = s.work();
-    const uint32_t fields[kWorkFields] = {w.steps,      w.box_tests,  w.tri_tests,   w.anyhit_calls,
-                                          w.transforms, w.cell_steps, w.plane_tests, w.refs};
-    for (int f = 0; f < kWorkFields; ++f) m_p.sample_work[f] += fields[f];
+    for (int f = 0; f < kWorkFieldCount; ++f) m_p.sample_work[size_t(f)] += w[WorkField(f)];
     m_p.sample_rays += 1;
     m_p.sample_plan_steps += ctx.plan_steps;
-    const double x1 = double(w.steps) + w.cell_steps, x2 = w.tri_tests, y = ctx.plan_steps;
+    const double x1 = plan_step_work(w), x2 = w.tri_tests, y = ctx.plan_steps;
     m_fit[0] += x1 * x1, m_fit[1] += x1 * x2, m_fit[2] += x2 * x2, m_fit[3] += x1 * y, m_fit[4] += x2 * y;
 }
 
@@ -84,35 +83,30 @@ void SampleProfiler::step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySi
         return;
     }
     ++ctx.plan_steps;
+    StepDemand d;
+    take_step(stepper, ctx.stack, m_costs, d);
     // The step's slowest line sets its latency: the one with the longest reuse in the L2's
     // stream (a censored one beats any observed one).
     Access critical;
-    for (int i = 0; i < plan.fetch_count; ++i) {
-        const Access a = read(unit, plan.fetch[i].addr, plan.fetch[i].bytes, plan.fetch[i].kind, ctx.measured);
+    for (int i = 0; i < d.read_count; ++i) {
+        const Access a = read(unit, d.reads[i].addr, d.reads[i].bytes, d.reads[i].kind, ctx.measured);
         if (i == 0 || a.rank > critical.rank) critical = a;
     }
-    if (ctx.measured && plan.fetch_count) m_p.step_critical.add(critical.key);
-    Op ops[StepPlan::kMaxOps];
-    const int op_count = plan.op_count;
-    std::copy(plan.op, plan.op + op_count, ops);
-    const int before = stepper.stack_size();
-    const StepOutcome outcome = stepper.execute();
-    if (ctx.measured) {
-        for (int i = 0; i < op_count; ++i) m_p.op_sizes[size_t(ops[i].kind)][ops[i].count] += 1;
-        for (int i = 0; i < outcome.op_count; ++i) m_p.op_sizes[size_t(outcome.op[i].kind)][outcome.op[i].count] += 1;
-    }
-    stack_traffic(unit, slot, before, ctx.measured);
+    if (ctx.measured && d.read_count) m_p.step_critical.add(critical.key);
+    if (ctx.measured)  // tests per operation: the pipelines' widths are applied per configuration
+        for (int i = 0; i < d.issue_count; ++i) m_p.op_sizes[size_t(d.issues[i].kind)][d.issues[i].tests] += 1;
+    stack_traffic(unit, slot, d, ctx.measured);
 }
 
 SampleProfiler::Access SampleProfiler::read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind,
                                             bool measured) {
     Access worst;
     bool first = true;
-    for (uint64_t line = addr >> m_shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> m_shift; ++line) {
+    for_each_line(addr, bytes, m_shift, [&](uint64_t line, uint32_t) {
         const Access a = read_line(unit, line, kind, measured);
         if (first || a.rank > worst.rank) worst = a;
         first = false;
-    }
+    });
     if (measured) m_p.read_bytes[size_t(kind)] += bytes;
     return worst;
 }
@@ -135,39 +129,34 @@ SampleProfiler::Access SampleProfiler::read_line(uint32_t unit, uint64_t line, D
 
 void SampleProfiler::write(uint64_t addr, uint32_t bytes, DataKind kind, bool measured) {
     if (!measured) return;
-    for (uint64_t line = addr >> m_shift; line <= (addr + std::max<uint32_t>(bytes, 1) - 1) >> m_shift; ++line) {
-        const uint64_t lo = std::max(addr, line << m_shift), hi = std::min(addr + bytes, (line + 1) << m_shift);
+    for_each_line(addr, bytes, m_shift, [&](uint64_t, uint32_t part) {
         m_p.writes[size_t(kind)] += 1;
-        m_p.write_bytes[size_t(kind)] += double(hi > lo ? hi - lo : 0);
-    }
+        m_p.write_bytes[size_t(kind)] += double(part);
+    });
 }
 
-/// Stack spills (posted writes) and refills (reads), as the traversal unit maps the stepper's
-/// stack onto stack_entries on-chip entries (rtl_model/traversal/stack_spill.h).
-void SampleProfiler::stack_traffic(uint32_t unit, uint32_t slot, int before, bool measured) {
-    Context& ctx = m_contexts[size_t(unit) * m_slots + slot];
-    const uint32_t bytes = m_c.traversal.stack_entry_bytes;
+/// The step's stack spills (posted writes) and refills (reads), from its demand.
+void SampleProfiler::stack_traffic(uint32_t unit, uint32_t slot, const StepDemand& d, bool measured) {
+    const uint32_t bytes = m_costs.stack_entry_bytes;
     const uint64_t owner = uint64_t(unit) * m_slots + slot;
-    map_stack_change(
-        ctx.local_stack, ctx.spilled, before, ctx.stepper->stack_size(), m_c.traversal.stack_entries,
-        [&](uint32_t s) {
-            write(m_map.stack(owner, s, bytes), bytes, DataKind::stack, measured);
-            m_p.spill_writes += measured;
-        },
-        [&](uint32_t s) {
-            read(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack, measured);
-            m_p.spill_reads += measured;
-        });
+    d.for_each_spill([&](uint32_t s) {
+        write(m_map.stack(owner, s, bytes), bytes, DataKind::stack, measured);
+        m_p.spill_writes += measured;
+    });
+    d.for_each_fill([&](uint32_t s) {
+        read(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack, measured);
+        m_p.spill_reads += measured;
+    });
 }
 
 void SampleProfiler::finish() {
-    // Least squares without intercept: plan steps = a (steps + cell_steps) + b tri_tests.
+    // Least squares without intercept: plan steps = a (plan-step work) + b tri_tests.
     const double det = m_fit[0] * m_fit[2] - m_fit[1] * m_fit[1];
     if (det > 1e-9 * m_fit[0] * m_fit[2] && det > 0) {
         m_p.plan_steps_per[0] = (m_fit[3] * m_fit[2] - m_fit[4] * m_fit[1]) / det;
         m_p.plan_steps_per[1] = (m_fit[4] * m_fit[0] - m_fit[3] * m_fit[1]) / det;
     } else {
-        const double x = m_p.sample_work[0] + m_p.sample_work[5];
+        const double x = AnalyticProfile::plan_step_work(m_p.sample_work);
         m_p.plan_steps_per[0] = x > 0 ? m_p.sample_plan_steps / x : 0.0;
         m_p.plan_steps_per[1] = 0;
     }

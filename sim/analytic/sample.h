@@ -15,6 +15,7 @@
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/dispatch/dispatch.h"
+#include "rtl_model/traversal/step_demand.h"
 #include "sim/config/config.h"
 #include "sim/analytic/profile.h"
 #include "sim/analytic/reuse.h"
@@ -35,7 +36,8 @@ private:
     struct Context {
         std::unique_ptr<Stepper> stepper;
         uint64_t id = 0;
-        uint32_t local_stack = 0, spilled = 0, plan_steps = 0;
+        StackSplit stack;
+        uint32_t plan_steps = 0;
         bool active = false, measured = false;
     };
     /// A line read's reuse key (JointHistogram::pack) and its ordering weight for "slowest".
@@ -48,10 +50,11 @@ private:
     Access read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind, bool measured);
     Access read_line(uint32_t unit, uint64_t line, DataKind kind, bool measured);
     void write(uint64_t addr, uint32_t bytes, DataKind kind, bool measured);
-    void stack_traffic(uint32_t unit, uint32_t slot, int before, bool measured);
+    void stack_traffic(uint32_t unit, uint32_t slot, const StepDemand& d, bool measured);
     void finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink);
 
     const SimConfig& m_c;
+    const StepCosts m_costs;
     const MemoryMap& m_map;
     AnalyticProfile& m_p;
     std::vector<Context> m_contexts;  ///< unit-major

@@ -116,27 +116,33 @@ public:
     explicit SchemaWriter(json& out) : m_out(out) { m_out = json::object(); }
     template <class T>
     void field(const char* name, T& value, const char* unit, const char* doc, double lo, double hi) {
-        m_out[name] = {{"type", std::is_integral_v<T> ? "int" : "float"}, {"default", value}, {"unit", unit},
-                       {"min", lo}, {"max", hi}, {"doc", doc}};
+        add(name, {{"type", std::is_integral_v<T> ? "int" : "float"}, {"default", value}, {"unit", unit},
+                   {"min", lo}, {"max", hi}, {"doc", doc}});
     }
     template <class E, size_t N>
     void choice(const char* name, E& value, const Choices<E, N>& choices, const char* doc) {
-        m_out[name] = {{"type", "choice"}, {"default", choices.name(value)},
-                       {"choices", std::vector<std::string>(choices.names.begin(), choices.names.end())}, {"doc", doc}};
+        add(name, {{"type", "choice"}, {"default", choices.name(value)},
+                   {"choices", std::vector<std::string>(choices.names.begin(), choices.names.end())}, {"doc", doc}});
     }
     void flag(const char* name, bool& value, const char* doc) {
-        m_out[name] = {{"type", "bool"}, {"default", value}, {"doc", doc}};
+        add(name, {{"type", "bool"}, {"default", value}, {"doc", doc}});
     }
     template <class S>
     void section(const char* name, S& s) {
-        json& sec = m_out[name];
-        sec = {{"type", "section"}};
+        json sec = {{"type", "section"}};
         SchemaWriter inner(sec["fields"]);
         s.visit(inner);
+        add(name, std::move(sec));
     }
 
 private:
+    /// Entries carry their declaration order ("index"): JSON objects are unordered.
+    void add(const char* name, json entry) {
+        entry["index"] = m_next++;
+        m_out[name] = std::move(entry);
+    }
     json& m_out;
+    int m_next = 0;
 };
 
 class RangeValidator {
@@ -204,6 +210,51 @@ json config_to_json(const SimConfig& config) {
     SimConfig copy = config;
     JsonWriter writer(out);
     copy.visit(writer);
+    return out;
+}
+
+namespace {
+
+/// Finds one field by its dotted path.
+class FieldFinder {
+public:
+    FieldFinder(const std::string& key, std::string prefix, ConfigField* out, bool* found)
+        : m_key(key), m_prefix(std::move(prefix)), m_out(out), m_found(found) {}
+    template <class T>
+    void field(const char* name, T& value, const char*, const char*, double lo, double hi) {
+        if (join_path(m_prefix, name) == m_key) *m_out = {json(value), lo, hi}, *m_found = true;
+    }
+    template <class E, size_t N>
+    void choice(const char* name, E& value, const Choices<E, N>& choices, const char*) {
+        if (join_path(m_prefix, name) == m_key) *m_out = {json(choices.name(value)), 0, 0}, *m_found = true;
+    }
+    void flag(const char* name, bool& value, const char*) {
+        if (join_path(m_prefix, name) == m_key) *m_out = {json(value), 0, 0}, *m_found = true;
+    }
+    template <class S>
+    void section(const char* name, S& s) {
+        const std::string path = join_path(m_prefix, name);
+        if (m_key.rfind(path + ".", 0) != 0) return;
+        FieldFinder inner(m_key, path, m_out, m_found);
+        s.visit(inner);
+    }
+
+private:
+    const std::string& m_key;
+    std::string m_prefix;
+    ConfigField* m_out;
+    bool* m_found;
+};
+
+}  // namespace
+
+ConfigField config_field(const SimConfig& config, const std::string& key) {
+    SimConfig copy = config;
+    ConfigField out;
+    bool found = false;
+    FieldFinder finder(key, "", &out, &found);
+    copy.visit(finder);
+    require(found, "config: unknown key '" + key + "'");
     return out;
 }
 

@@ -37,6 +37,13 @@ SimConfig config_from_json(const nlohmann::json& j, const SimConfig& base = {});
 /// Applies "key.path=value" (value parsed by the field's type).
 void config_set(SimConfig& config, const std::string& assignment);
 nlohmann::json config_to_json(const SimConfig& config);
+/// One field as the tree declares it: its value (JSON) and range (choices and flags: 0, 0).
+struct ConfigField {
+    nlohmann::json value;
+    double min = 0, max = 0;
+};
+/// The field at a dotted key path ("l1.mshrs"); throws rtsim::Error naming an unknown key.
+ConfigField config_field(const SimConfig& config, const std::string& key);
 /// Every field with default, unit, range, choices and doc: the schema the Python side mirrors.
 nlohmann::json config_schema();
 /// Range checks plus cross-field rules; throws rtsim::Error naming the field.

@@ -111,4 +111,25 @@ void FrameRecorder::frame_end(uint32_t f, Cycle cycle, const MemoryTotals& total
     m_last_cycle = cycle;
 }
 
+const StatBlock& frame_stats() {
+    static const StatBlock block{
+        "frames[]",
+        {
+            {"frame", "", "frame index"},
+            {"rays", "rays", "the frame's rays"},
+            {"first_ray", "ray", "the frame's first ray's index in the trace"},
+            {"start_cycle", "cycles", "the previous frame's last finish (0 for frame 0)", true},
+            {"end_cycle", "cycles", "this frame's last finish", true},
+            {"cycles", "cycles", "`end_cycle - start_cycle`: the frame's time, its cold start and tail included", true},
+            {"mrays_per_second", "Mrays/s", "`rays / (cycles / clock_ghz)`, in millions", true},
+            {"dram_bytes", "bytes", "DRAM reads + writes during the frame", true},
+            {"dram_bytes_per_ray", "bytes/ray", "`dram_bytes / rays`", true},
+            {"l1_hit_rate", "fraction", "(read_hits + merged) / reads during the frame; `null` with `ideal_memory`", true},
+            {"l2_hit_rate", "fraction", "the L2's the same way", true},
+            {"tlas_nodes", "nodes", "the frame's TLAS nodes (from the trace's manifest; `null` without frames)"},
+            {"tlas_build_ms", "ms", "host wall time the tracer took to build the frame's TLAS and instance records (manifest; `null` without frames): not simulated"},
+        }};
+    return block;
+}
+
 }  // namespace rtsim

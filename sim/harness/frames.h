@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
 #include "rtl_model/top/top.h"
 #include "sim/config/config.h"
 #include "sim/harness/trace_stream.h"
@@ -60,5 +61,8 @@ private:
     Cycle m_last_cycle = 0;
     nlohmann::json m_out = nlohmann::json::array();
 };
+
+/// One entry of stats.json "frames", declared once.
+const StatBlock& frame_stats();
 
 }  // namespace rtsim

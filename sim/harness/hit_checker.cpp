@@ -17,21 +17,14 @@ uint32_t bits(float f) {
 std::string compare_with_reference(const RayResult& r, const HitRecord& h, const WorkRecord& w, bool* hit_differs) {
     *hit_differs = r.hit.prim != h.prim || (h.prim >= 0 && bits(r.hit.t) != bits(h.t));
     const WorkCounts& m = r.work;
-    const WorkCounts ref = work_from_record(w);
-    if (!*hit_differs && m == ref) return std::string();  // every ray comes here: no text unless needed
+    if (!*hit_differs && m == w) return std::string();  // every ray comes here: no text unless needed
     std::ostringstream out;
     if (*hit_differs)
         out << "hit: model prim " << r.hit.prim << " t " << r.hit.t << ", reference prim " << h.prim << " t " << h.t;
-    if (m != ref) {
-        if (*hit_differs) out << "; ";
-        auto counts = [&out](const WorkCounts& c) {
-            out << c.steps << "/" << c.box_tests << "/" << c.tri_tests << "/" << c.anyhit_calls << "/" << c.transforms
-                << "/" << c.cell_steps << "/" << c.plane_tests << "/" << c.refs;
-        };
-        out << "work (steps/box/tri/alpha/transforms/cells/planes/refs): model ";
-        counts(m);
-        out << ", reference ";
-        counts(ref);
+    if (m != w) {
+        out << (*hit_differs ? "; " : "") << "work (model/reference):";
+        for (const WorkFieldInfo& f : kWorkFields)
+            if (m.*f.member != w.*f.member) out << " " << f.name << " " << m.*f.member << "/" << w.*f.member;
     }
     return out.str();
 }
@@ -61,6 +54,20 @@ nlohmann::json HitChecker::to_json() const {
             {"hit_mismatches", m_hit_mismatches},
             {"work_mismatches", m_work_mismatches},
             {"first_mismatches", m_examples}};
+}
+
+const StatBlock& validation_stats() {
+    static const StatBlock block{
+        "validation",
+        {
+            {"rays_checked", "rays", "rays the model finished and the checker compared"},
+            {"rays_expected", "rays", "rays in the trace, or the simulated rays of a sampled run (a run that finishes fewer is an error, exit 2)"},
+            {"hit_mismatches", "rays", "hit differs: primitive id, or the bit pattern of t for a hit"},
+            {"work_mismatches", "rays", "hit equal, work differs: any field of the ray's work counts"},
+            {"first_mismatches", "list", "up to 20 `{ray, difference}`: the ray index and the fields that differ, model/reference"},
+            {"scope", "", "analytic level only: which rays were checked (the analysis's sampled rays)", false, true},
+        }};
+    return block;
 }
 
 }  // namespace rtsim

@@ -1,8 +1,8 @@
 #pragma once
 // The hit checker (docs/architecture.md, rule 2): every ray the model finishes is compared with the
-// trace's reference hit (primitive id and the bits of t) and reference work (every WorkCounts
-// field: steps, box, triangle, alpha and plane tests, transforms, cell steps, references). Mismatches are counted, the first ones listed, and make rtsim-sim exit
-// non-zero. It also keeps the per-ray latency histogram and reports progress.
+// trace's reference hit (primitive id and the bits of t) and reference work (every field of
+// traces/common/work_counts.h). Mismatches are counted, the first ones listed, and make rtsim-sim
+// exit non-zero. It also keeps the per-ray latency histogram and reports progress.
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -10,28 +10,12 @@
 #include <nlohmann/json.hpp>
 #include <systemc>
 
+#include "rtl_model/common/stats.h"
 #include "rtl_model/common/interfaces.h"
 #include "sim/harness/latency_histogram.h"
 #include "sim/harness/trace_stream.h"
 
 namespace rtsim {
-
-/// Work summed over the rays checked (64-bit: a frame's box tests overflow 32 bits). The energy
-/// model (sim/report/energy_area.h) prices these operations at every fidelity level.
-struct WorkTotals {
-    uint64_t steps = 0, box_tests = 0, tri_tests = 0, anyhit_calls = 0, transforms = 0, cell_steps = 0,
-             plane_tests = 0, refs = 0;
-    void add(const WorkCounts& w) {
-        steps += w.steps;
-        box_tests += w.box_tests;
-        tri_tests += w.tri_tests;
-        anyhit_calls += w.anyhit_calls;
-        transforms += w.transforms;
-        cell_steps += w.cell_steps;
-        plane_tests += w.plane_tests;
-        refs += w.refs;
-    }
-};
 
 class HitChecker : public sc_core::sc_module, public RaySinkIf {
 public:
@@ -63,5 +47,8 @@ private:
 /// Compares one result with the reference; returns "" when equal, else a description.
 std::string compare_with_reference(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work,
                                    bool* hit_differs);
+
+/// stats.json "validation", declared once.
+const StatBlock& validation_stats();
 
 }  // namespace rtsim

@@ -55,4 +55,20 @@ nlohmann::json LatencyHistogram::to_json() const {
             {"histogram", {{"bucket_upper_cycles", upper_bounds}, {"rays", counts}}}};
 }
 
+const StatBlock& latency_stats() {
+    static const StatBlock block{
+        "latency",
+        {
+            {"rays", "rays", "rays recorded (= `summary.rays`)"},
+            {"mean_cycles", "cycles", "exact mean (the analytic level: the mean unloaded latency)"},
+            {"p50_cycles", "cycles", "inclusive upper bound of the bucket holding the median (at most `max_cycles`); not at the statistical analytic level", false, true},
+            {"p95_cycles", "cycles", "the same for the 95th percentile", false, true},
+            {"p99_cycles", "cycles", "the same for the 99th percentile", false, true},
+            {"max_cycles", "cycles", "exact maximum", false, true},
+            {"histogram", "", "`bucket_upper_cycles`: inclusive upper bound of each non-empty bucket, ascending; `rays`: rays in each", false, true},
+            {"estimated", "", "the statistical analytic level only: what `mean_cycles` estimates", false, true},
+        }};
+    return block;
+}
+
 }  // namespace rtsim

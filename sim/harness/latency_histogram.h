@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
+
 namespace rtsim {
 
 class LatencyHistogram {
@@ -23,5 +25,8 @@ private:
     std::vector<uint64_t> m_buckets;
     uint64_t m_count = 0, m_sum = 0, m_max = 0;
 };
+
+/// stats.json "latency", declared once.
+const StatBlock& latency_stats();
 
 }  // namespace rtsim

@@ -13,6 +13,7 @@
 #include "sim/harness/frames.h"
 #include "sim/analytic/analytic.h"
 #include "sim/analytic/analysis_cache.h"
+#include "sim/analytic/closed_form.h"
 #include "sim/analytic/estimate.h"
 #include "sim/report/energy_area.h"
 #include "sim/harness/hit_checker.h"
@@ -20,6 +21,7 @@
 #include "sim/harness/run_files.h"
 #include "sim/sampling/sampling.h"
 #include "sim/report/summary.h"
+#include "sim/report/stats_schema.h"
 #include "sim/report/summary_schema.h"
 #include "sim/harness/trace_stream.h"
 #include "sim/report/verdict.h"
@@ -68,18 +70,16 @@ struct RunStats {
     uint64_t rays = 0;
 };
 
-/// The whole trace's work from the analysis's sums (WORK section, field order of WorkRecord:
-/// work_field_name).
+/// The whole trace's work from the analysis's sums (the WORK section's fields).
 WorkTotals work_totals(const AnalyticProfile& p) {
     WorkTotals w;
-    uint64_t* fields[kWorkFields] = {&w.steps,      &w.box_tests,  &w.tri_tests,   &w.anyhit_calls,
-                                     &w.transforms, &w.cell_steps, &w.plane_tests, &w.refs};
-    for (int i = 0; i < kWorkFields; ++i) *fields[i] = uint64_t(std::llround(p.work[size_t(i)]));
+    for (size_t i = 0; i < w.field.size(); ++i) w.field[i] = uint64_t(std::llround(p.work[i]));
     return w;
 }
 
 SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json& manifest, std::time_t started,
                          RunStats r, const std::function<json(const json& model)>& verdict_of) {
+    check_analytic_model(r.model);  // the blocks' declarations, as the timed levels' model is checked
     SimOutcome out;
     out.stats = {{"schema", "rtsim-stats/1"},
                  {"fidelity", kFidelityChoices.name(o.config.fidelity)},
@@ -99,7 +99,7 @@ SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json
     out.stats["verdict"] = verdict;
     out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
     out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
-    check_summary(out.stats["summary"], false);  // every key declared once (summary_schema.cpp)
+    check_run_stats(out.stats, false);  // every key declared once, by its producer (stats_schema.h)
     write_json(fs::path(o.out_dir) / "stats.json", out.stats);
     write_json(fs::path(o.out_dir) / "provenance.json", out.stats["provenance"]);
     out.exit_code = r.bad ? 3 : 0;
@@ -175,13 +175,15 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     }
     const AnalyticProfile& p = *profile;
     AnalyticEstimate e = estimate_analytic(o.config, p);
-    e.model["analytic"]["caches"] = "statistical";
-    e.model["analytic"]["analysis"] = {{"file", path.empty() ? json(nullptr) : json(path)},
-                                       {"reused", reused},
-                                       {"seconds", p.analysis_seconds},
-                                       {"stepped_rays", p.stepped_rays},
-                                       {"sample_rays", p.sample_rays},
-                                       {"key", key}};
+    StatsWriter(analytic_stats(), e.model["analytic"])
+        .set("caches", "statistical")
+        .set("analysis", json{{"file", path.empty() ? json(nullptr) : json(path)},
+                              {"reused", reused},
+                              {"seconds", p.analysis_seconds},
+                              {"stepped_rays", p.stepped_rays},
+                              {"sample_rays", p.sample_rays},
+                              {"key", key}})
+        .done();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     RunStats r;
     r.summary = analytic_summary(o, p, e, checker, wall);

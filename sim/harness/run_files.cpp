@@ -71,4 +71,15 @@ void write_json(const fs::path& path, const json& j) {
     out << j.dump(2) << "\n";
 }
 
+const StatBlock& workload_stats() {
+    static const StatBlock block{
+        "workload",
+        {
+            {"rays", "rays", "rays in the trace"},
+            {"by_kind", "rays", "`{kind: rays}` for each ray kind present (`primary`, `shadow`, `reflection`, `diffuse`, `refraction`)"},
+            {"occlusion_rays", "rays", "rays with the any-hit flag (shadow rays): they stop at their first hit"},
+        }};
+    return block;
+}
+
 }  // namespace rtsim

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
 #include "rtl_model/top/top.h"
 #include "traces/format/trace_reader.h"
 
@@ -25,5 +26,8 @@ nlohmann::json scan_workload(TraceReader& reader, WorkloadFeatures* features = n
 
 /// Writes `j` (indented) to `path`; throws rtsim::Error naming it if it cannot.
 void write_json(const std::filesystem::path& path, const nlohmann::json& j);
+
+/// stats.json "workload", declared once.
+const StatBlock& workload_stats();
 
 }  // namespace rtsim

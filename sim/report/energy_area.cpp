@@ -5,6 +5,9 @@
 #include <cmath>
 #include <string>
 
+#include "rtl_model/mem/mem_stats.h"
+#include "rtl_model/ray_buffer/ray_buffer.h"
+
 namespace rtsim {
 
 using nlohmann::json;
@@ -72,6 +75,9 @@ constexpr Flops kTransformFlops{15, 20, 2, 4};
 constexpr Flops kCellFlops{1, 0, 3, 0};
 // Split-plane test (kd-tree, BIH): (plane - origin) * inv_dir, compared with tmin and tmax.
 constexpr Flops kPlaneFlops{1, 1, 2, 0};
+/// Per operation kind (OpKind order).
+constexpr std::array<Flops, kOpKindCount> kTestFlops{kBoxFlops, kTriangleFlops, kAnyhitFlops, kTransformFlops,
+                                                     kCellFlops, kPlaneFlops};
 // Per ray: inv_dir (3 div) for the box test; the triangle test's shear constants (RayTrianglePre:
 // the largest axis, 2 cmp; 1 / dir_kz, 1 div; sx, sy, 2 mul).
 constexpr Flops kRaySetupFlops{0, 2, 2, 4};
@@ -91,17 +97,19 @@ double flops_um2(const EnergyConfig& c, const Flops& f) {
            c.datapath_overhead;
 }
 
-double num(const json& j, const char* key) {
-    auto it = j.find(key);
-    return it != j.end() && it->is_number() ? it->get<double>() : 0.0;
+/// A block's stat by its declared key (`block`), 0 when the level wrote null.
+double num(const StatBlock& block, const json& j, const char* key) {
+    const json& v = StatsReader(block, j)[key];
+    return v.is_number() ? v.get<double>() : 0.0;
 }
 
 /// Energy of one cache's activity, pJ: reads of a whole line, fills of missed lines, writes of
 /// their bytes; tag bits ride along on every access.
-double cache_pj(const EnergyConfig& c, const json& cache, double size_bytes, double line_bytes) {
-    const double reads = num(cache, "reads");
-    const double misses = std::max(0.0, reads - num(cache, "read_hits") - num(cache, "merged"));
-    const double bits = (reads + misses) * line_bytes * 8 + num(cache, "write_bytes") * 8;
+double cache_pj(const EnergyConfig& c, const StatBlock& block, const json& cache, double size_bytes,
+                double line_bytes) {
+    const double reads = num(block, cache, "reads");
+    const double misses = std::max(0.0, reads - num(block, cache, "read_hits") - num(block, cache, "merged"));
+    const double bits = (reads + misses) * line_bytes * 8 + num(block, cache, "write_bytes") * 8;
     return sram_access_pj(c, size_bytes, bits * (1 + c.sram_tag_overhead));
 }
 
@@ -176,9 +184,10 @@ double dram_pj_per_bit(const EnergyConfig& c) {
 
 OpEnergies op_energies(const EnergyConfig& c) {
     const double s = energy_scale(c);
-    return {flops_pj(c, kBoxFlops) * s,       flops_pj(c, kTriangleFlops) * s, flops_pj(c, kAnyhitFlops) * s,
-            flops_pj(c, kTransformFlops) * s, flops_pj(c, kCellFlops) * s,     flops_pj(c, kPlaneFlops) * s,
-            flops_pj(c, kRaySetupFlops) * s};
+    OpEnergies e;
+    for (int k = 0; k < kOpKindCount; ++k) e.test[size_t(k)] = flops_pj(c, kTestFlops[size_t(k)]) * s;
+    e.ray_setup = flops_pj(c, kRaySetupFlops) * s;
+    return e;
 }
 
 double sram_access_pj(const EnergyConfig& c, double bytes, double bits) {
@@ -202,37 +211,34 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
 
     // Dynamic energy by block, pJ; null where this level has no counts.
     json pj = json::object();
-    pj["box"] = double(w.box_tests) * op.box;
-    pj["triangle"] = double(w.tri_tests) * op.triangle;
-    pj["anyhit"] = double(w.anyhit_calls) * op.anyhit;
-    pj["transform"] = double(w.transforms) * op.transform;
-    pj["cell"] = double(w.cell_steps) * op.cell;
-    pj["plane"] = double(w.plane_tests) * op.plane;
+    for (int k = 0; k < kOpKindCount; ++k)
+        pj[op_kind_name(OpKind(k))] = double(w[work_field_of(OpKind(k))]) * op[OpKind(k)];
     // Traversal units: the ray's setup, and per step a read of the context's ray state and one
     // stack push or pop, each in the unit's SRAM of that kind.
     pj["traversal"] = double(rays) * op.ray_setup +
-                      double(w.steps) * (sram_access_pj(c, t.ray_contexts * kContextStateBytes, kContextReadBytes * 8) +
+                      double(w[WorkField::steps]) * (sram_access_pj(c, t.ray_contexts * kContextStateBytes, kContextReadBytes * 8) +
                                          sram_access_pj(c, double(t.ray_contexts) * t.stack_entries * t.stack_entry_bytes,
                                                         t.stack_entry_bytes * 8.0));
     const bool has_memory = model.contains("l1") || model.contains("ideal_memory");
     if (model.contains("ideal_memory")) {
-        pj["l1"] = cache_pj(c, model["ideal_memory"], s.l1.size_kib * 1024.0, line);
+        pj["l1"] = cache_pj(c, ideal_memory_stats(), model["ideal_memory"], s.l1.size_kib * 1024.0, line);
         pj["l2"] = 0.0;
         pj["dram"] = 0.0;
     } else if (has_memory) {
         double l1 = 0;
-        for (const json& cache : model["l1"]) l1 += cache_pj(c, cache, s.l1.size_kib * 1024.0, line);
+        for (const json& cache : model["l1"]) l1 += cache_pj(c, cache_stats(), cache, s.l1.size_kib * 1024.0, line);
         pj["l1"] = l1;
-        pj["l2"] = model.contains("l2") ? json(cache_pj(c, model["l2"], s.l2.size_kib * 1024.0, line)) : json(0.0);
+        pj["l2"] = model.contains("l2") ? json(cache_pj(c, cache_stats(), model["l2"], s.l2.size_kib * 1024.0, line)) : json(0.0);
         const json& d = model.value("dram", json::object());
-        pj["dram"] = (num(d, "read_bytes") + num(d, "write_bytes")) * 8 * dram_pj_per_bit(c);
+        pj["dram"] = (num(dram_stats(), d, "read_bytes") + num(dram_stats(), d, "write_bytes")) * 8 * dram_pj_per_bit(c);
     } else {
         pj["l1"] = pj["l2"] = pj["dram"] = nullptr;
     }
     if (model.contains("ray_buffer")) {
         const json& rb = model["ray_buffer"];
-        const double accesses = num(rb, "admitted") + num(rb, "parked") + num(rb, "taken");
-        pj["ray_buffer"] = accesses * sram_access_pj(c, s.treelets.buffer_kib * 1024.0, num(rb, "ray_state_bytes") * 8);
+        const double accesses = num(ray_buffer_stats(), rb, "admitted") + num(ray_buffer_stats(), rb, "parked") +
+                                num(ray_buffer_stats(), rb, "taken");
+        pj["ray_buffer"] = accesses * sram_access_pj(c, s.treelets.buffer_kib * 1024.0, num(ray_buffer_stats(), rb, "ray_state_bytes") * 8);
     } else {
         pj["ray_buffer"] = s.treelets.enabled && !has_memory ? json(nullptr) : json(0.0);
     }
@@ -259,6 +265,8 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     const json power = complete && timed ? json(total_nj.get<double>() * 1e-9 * rps.get<double>()) : json(nullptr);
     const json mrays_per_joule = complete ? json(1e3 / total_nj.get<double>()) : json(nullptr);
 
+    json op_pj = {{"ray_setup", op.ray_setup}};
+    for (int k = 0; k < kOpKindCount; ++k) op_pj[op_kind_name(OpKind(k))] = op[OpKind(k)];
     stats["energy"] = {
         {"model", "first-order, docs/energy_area.md"},
         {"node_nm", c.node_nm},
@@ -267,9 +275,7 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
         {"area_scale", area_scale(c)},
         {"dram_kind", kDramKindChoices.name(c.dram_kind)},
         {"dram_pj_per_bit", dram_pj_per_bit(c)},
-        {"op_pj",
-         {{"box", op.box}, {"triangle", op.triangle}, {"anyhit", op.anyhit}, {"transform", op.transform},
-          {"cell", op.cell}, {"plane", op.plane}, {"ray_setup", op.ray_setup}}},
+        {"op_pj", op_pj},
         {"rays", rays},
         {"per_ray_nj", per_ray_nj},
         {"dynamic_nj", rays ? json(dynamic_nj * double(rays)) : json(nullptr)},
@@ -284,6 +290,42 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     summary["mrays_per_joule"] = mrays_per_joule;
     summary["power_w"] = power;
     summary["area_mm2"] = total_mm2;
+}
+
+const StatBlock& energy_stats() {
+    static const StatBlock block{
+        "energy",
+        {
+            {"model", "", "`\"first-order, docs/energy_area.md\"`"},
+            {"node_nm", "nm", "the technology node"},
+            {"vdd", "V", "the supply voltage used (`energy.vdd`, or the node's nominal)"},
+            {"energy_scale", "x", "Stillmaker & Baas energy factor from 45 nm to the node"},
+            {"area_scale", "x", "Stillmaker & Baas area factor from 45 nm to the node"},
+            {"dram_kind", "", "the DRAM kind (`energy.dram_kind`)"},
+            {"dram_pj_per_bit", "pJ/bit", "its energy per bit (or the override)"},
+            {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`) and one `ray_setup` at the node"},
+            {"rays", "rays", "rays the energy is divided by: the rays checked (a sampled run's simulated rays, warm-up included)"},
+            {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
+            {"dynamic_nj", "nJ", "dynamic energy of the blocks with counts, summed over the rays"},
+            {"leakage_w", "W", "`area.total_mm2 x energy.leakage_mw_per_mm2`"},
+            {"power_w", "W", "as `summary.power_w`"},
+            {"mrays_per_joule", "Mrays/J", "as `summary.mrays_per_joule`"},
+            {"complete", "bool", "every block has counts (false at functional)"},
+            {"missing", "list", "the blocks this level cannot price (`l1`, `l2`, `dram`, `leakage` at functional)"},
+        }};
+    return block;
+}
+
+const StatBlock& area_stats() {
+    static const StatBlock block{
+        "area",
+        {
+            {"mm2", "mm^2", "`{block: mm^2}`: `l1` (all units, tags in), `l2` (tags in), `ray_buffer` (treelets on), `stacks`, `ray_contexts`, and each pipeline kind built"},
+            {"total_mm2", "mm^2", "all blocks"},
+            {"sram_mm2", "mm^2", "the SRAM blocks"},
+            {"logic_mm2", "mm^2", "the pipelines"},
+        }};
+    return block;
 }
 
 }  // namespace rtsim

@@ -6,10 +6,12 @@
 // is priced per bit by kind; everything is scaled to the configured node with Stillmaker & Baas
 // (2017). Every level reports what its counts allow: the functional level has no caches and no
 // time, so its memory energy, leakage, energy per ray and power are null.
+#include <array>
 #include <cstdint>
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
 #include "sim/config/config.h"
 #include "sim/harness/hit_checker.h"
 
@@ -17,7 +19,9 @@ namespace rtsim {
 
 /// Energy of one test of each operation kind at the configured node, pJ (datapath overhead in).
 struct OpEnergies {
-    double box = 0, triangle = 0, anyhit = 0, transform = 0, cell = 0, plane = 0, ray_setup = 0;
+    std::array<double, kOpKindCount> test{};  ///< one test of each operation kind
+    double ray_setup = 0;                     ///< a ray's precomputation
+    double operator[](OpKind kind) const { return test[size_t(kind)]; }
 };
 
 /// Energy scale from 45 nm (1.0 V) to the configured node and voltage (Stillmaker & Baas 2017).
@@ -38,5 +42,9 @@ double sram_mm2(const EnergyConfig& c, double bytes);
 /// `power_w` to stats["summary"] (null where the level cannot know them). Reads stats["model"],
 /// stats["summary"] (rays_per_second: the estimate of a sampled run) and stats["instantiated"].
 void add_energy_area(nlohmann::json& stats, const SimConfig& config, const WorkTotals& work, uint64_t rays);
+
+/// stats.json "energy" and "area", declared once.
+const StatBlock& energy_stats();
+const StatBlock& area_stats();
 
 }  // namespace rtsim

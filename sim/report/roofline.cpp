@@ -1,5 +1,8 @@
 #include "sim/report/roofline.h"
 
+#include "rtl_model/isect/pipeline.h"
+#include "rtl_model/traversal/traversal_unit.h"
+
 namespace rtsim {
 
 using nlohmann::json;
@@ -17,13 +20,14 @@ json roofline_json(const SimConfig& c, const json& summary, const json& model) {
         if (!model.contains(name)) continue;
         double issues = 0, pipelines = 0;
         for (const json& p : model[name]) {
-            issues += p.value("issues", 0.0);
-            pipelines += p.value("pipelines", 0.0);
+            const StatsReader pipe(pipeline_stats(), p);
+            issues += pipe["issues"].get<double>();
+            pipelines += pipe["pipelines"].get<double>();
         }
         if (issues > 0) ceilings[name] = pipelines * hz / c.pipeline(OpKind(k)).initiation_interval / (issues / rays);
     }
     double steps = 0;
-    for (const json& u : model.value("units", json::object())) steps += u.value("steps", 0.0);
+    for (const json& u : model.value("units", json::object())) steps += StatsReader(unit_stats(), u)["steps"].get<double>();
     if (steps > 0) ceilings["scheduler"] = double(c.traversal.units) * hz / c.traversal.issue_cycles / (steps / rays);
     std::string bound;
     double lowest = 0;
@@ -38,6 +42,20 @@ json roofline_json(const SimConfig& c, const json& summary, const json& model) {
             {"ceilings", ceilings},
             {"bound", bound},
             {"bound_rays_per_second", bound.empty() ? json(nullptr) : json(lowest)}};
+}
+
+const StatBlock& roofline_stats() {
+    static const StatBlock block{
+        "roofline",
+        {
+            {"rays_per_second", "rays/s", "achieved (`summary.rays_per_second`)"},
+            {"ceilings", "rays/s", "`{resource: rays/s}` what each resource alone allows: `dram` = peak DRAM bytes/s over `dram_bytes_per_ray`, `box`, `triangle`, ... = pipeline issue slots/s over issues per ray, `scheduler` = units x clock / (steps per ray x `issue_cycles`)"},
+            {"bound", "", "the lowest ceiling's name"},
+            {"bound_rays_per_second", "rays/s", "the lowest ceiling; the run can never be faster (tested)"},
+            {"dram_bytes_per_ray", "bytes/ray", "as `summary.dram_bytes_per_ray`"},
+            {"peak_dram_bytes_per_second", "B/s", "`channels x bytes_per_cycle x clock`"},
+        }};
+    return block;
 }
 
 }  // namespace rtsim

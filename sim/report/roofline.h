@@ -7,6 +7,7 @@
 // A run sits under all of them; the lowest ceiling is the roofline's bound for its work.
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
 #include "sim/config/config.h"
 
 namespace rtsim {
@@ -14,5 +15,8 @@ namespace rtsim {
 /// {dram_bytes_per_ray, rays_per_second, ceilings: {name: rays/s}, bound, bound_rays_per_second};
 /// null when the level has no time (functional).
 nlohmann::json roofline_json(const SimConfig& config, const nlohmann::json& summary, const nlohmann::json& model);
+
+/// stats.json "roofline", declared once.
+const StatBlock& roofline_stats();
 
 }  // namespace rtsim

@@ -8,6 +8,9 @@
 #include <string>
 #include <ctime>
 
+#include "rtl_model/isect/pipeline.h"
+#include "rtl_model/mem/mem_stats.h"
+#include "rtl_model/traversal/traversal_unit.h"
 #include "sim/report/summary_schema.h"
 #include "traces/common/build_info.h"
 
@@ -17,24 +20,30 @@ using nlohmann::json;
 
 namespace {
 
+/// A number a block declares (`block`), 0 when the level wrote null.
+double number(const StatBlock& block, const json& stats, const char* key) {
+    const json& v = StatsReader(block, stats)[key];
+    return v.is_number() ? v.get<double>() : 0.0;
+}
+
 /// Hit rate over all caches of a level (reads served, including merged misses, over reads).
 json hit_rate(const json& caches) {
     double reads = 0, served = 0;
     for (const json& c : caches) {
-        reads += c.value("reads", 0.0);
-        served += c.value("read_hits", 0.0) + c.value("merged", 0.0);
+        reads += number(cache_stats(), c, "reads");
+        served += number(cache_stats(), c, "read_hits") + number(cache_stats(), c, "merged");
     }
     return reads > 0 ? json(served / reads) : json(nullptr);
 }
 
-/// Mean of a field over the blocks of a group ({"box_0": {...}, ...}).
-json mean_of(const json& group, const char* key) {
+/// Mean of a stat over the blocks of a group ({"box_0": {...}, ...}) that all declare it in `block`.
+json mean_of(const json& group, const StatBlock& block, const char* key) {
     if (!group.is_object() || group.empty()) return nullptr;
     double sum = 0, n = 0;
     for (const json& b : group) {
-        auto it = b.find(key);
-        if (it == b.end() || !it->is_number()) continue;  // null: this level does not produce it
-        sum += it->get<double>();
+        const json& v = StatsReader(block, b)[key];
+        if (!v.is_number()) continue;  // null: this level does not produce it
+        sum += v.get<double>();
         ++n;
     }
     return n > 0 ? json(sum / n) : json(nullptr);
@@ -65,7 +74,7 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
     if (c.fidelity == Fidelity::functional) {
         // Every level reports the same keys; what the functional level cannot know is null
         // (the keys summary_schema.cpp marks as timed; the energy and verdict steps add theirs).
-        for (const StatDecl& d : summary_schema())
+        for (const StatDecl& d : summary_stats().stats)
             if (d.timed) s[d.key] = nullptr;
         return s;
     }
@@ -75,14 +84,14 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
     s["rays_per_second"] = seconds > 0 ? double(rays) / seconds : 0.0;
     s["mrays_per_second"] = seconds > 0 ? double(rays) / seconds / 1e6 : 0.0;
     s["avg_ray_latency_cycles"] = checker.latency().mean();
-    s["unit_busy_fraction"] = mean_of(model.value("units", json::object()), "busy_fraction");
-    s["box_utilization"] = mean_of(model.value("box", json::object()), "utilization");
-    s["triangle_utilization"] = mean_of(model.value("triangle", json::object()), "utilization");
+    s["unit_busy_fraction"] = mean_of(model.value("units", json::object()), unit_stats(), "busy_fraction");
+    s["box_utilization"] = mean_of(model.value("box", json::object()), pipeline_stats(), "utilization");
+    s["triangle_utilization"] = mean_of(model.value("triangle", json::object()), pipeline_stats(), "utilization");
     s["l1_hit_rate"] = model.contains("l1") ? hit_rate(model["l1"]) : json(nullptr);
     s["l2_hit_rate"] = model.contains("l2") ? hit_rate(json::array({model["l2"]})) : json(nullptr);
     if (model.contains("dram")) {
-        const json& d = model["dram"];
-        double bytes = d.value("read_bytes", 0.0) + d.value("write_bytes", 0.0);
+        const StatsReader d(dram_stats(), model["dram"]);
+        double bytes = d["read_bytes"].get<double>() + d["write_bytes"].get<double>();
         s["dram_bytes"] = bytes;
         s["dram_bytes_per_ray"] = rays ? bytes / double(rays) : 0.0;
         s["dram_bandwidth_gbps"] = d["bandwidth_gbps"];

@@ -5,8 +5,8 @@
 
 namespace rtsim {
 
-const std::vector<StatDecl>& summary_schema() {
-    static const std::vector<StatDecl> keys = {
+const StatBlock& summary_stats() {
+    static const StatBlock block{"summary", {
         {"rays", "rays",
          "rays in the trace, all simulated",
          false, false},
@@ -100,27 +100,55 @@ const std::vector<StatDecl>& summary_schema() {
         {"verdict", "",
          "`verdict.text`: one sentence, printed by `rtsim simulate`",
          true, false},
-    };
-    return keys;
+    }};
+    return block;
 }
 
-nlohmann::json summary_schema_json() {
-    nlohmann::json out = nlohmann::json::array();
-    for (const StatDecl& d : summary_schema())
-        out.push_back({{"key", d.key}, {"unit", d.unit}, {"meaning", d.meaning}, {"timed", d.timed},
-                       {"sampled_only", d.sampled_only}});
-    return out;
+const StatBlock& run_stats() {
+    static const StatBlock block{
+        "stats.json",
+        {
+            {"schema", "", "format tag, `\"rtsim-stats/1\"`; bumped when a key changes meaning"},
+            {"fidelity", "", "the level that ran: `functional` (counts only), `analytic` (statistical or functional caches + closed form), `approx` (timed SystemC model) or `detailed` (approx + per-cycle arbitration, L2 MSHRs); see [fidelity.md](fidelity.md)"},
+            {"summary", "", "the headline numbers (below); what `rtsim simulate` prints and sweeps tabulate"},
+            {"validation", "", "the hit check against the reference tracer"},
+            {"latency", "", "per-ray latency distribution"},
+            {"workload", "", "what the trace asked for"},
+            {"instantiated", "list", "which optional blocks the model built, and why"},
+            {"effects", "list", "the effects the trace simulates and why (copied from the trace's `manifest.json`)"},
+            {"model", "", "every block's own counters, keyed by SystemC instance name (`{}` at functional)"},
+            {"provenance", "", "version, git hash, command line, host, trace"},
+            {"sampling", "", "only in sampled runs (`sampling.fraction` or `sampling.count`): the sample and the estimate (below)", false, true},
+            {"energy", "", "energy per ray by block, power, Mrays/J from the first-order model of [energy_area.md](energy_area.md) (below)"},
+            {"area", "", "chip area by block, mm^2, from the same model (below)"},
+            {"verdict", "", "why the run is slow: the binding resource, its evidence and the knob that relaxes it (below); `null` at functional or with `--no-verdict`"},
+            {"roofline", "", "the run against its throughput ceilings (below); `null` at functional"},
+            {"frames", "list", "one entry per frame of the trace (below): a single entry for a trace without frames; absent at the analytic level (it does not replay frames)", false, true},
+        }};
+    return block;
+}
+
+const StatBlock& provenance_stats() {
+    static const StatBlock block{
+        "provenance",
+        {
+            {"rtsim_version", "", "rtsim version (top-level `CMakeLists.txt`)"},
+            {"git", "", "git hash of the build (`RTSIM_GIT_HASH`)"},
+            {"command_line", "", "the `rtsim-sim` command line, as run"},
+            {"host", "", "host name"},
+            {"started_utc", "", "when the run's stats were written (UTC, ISO 8601)"},
+            {"trace", "", "path of the `trace.rtt` simulated"},
+            {"scene", "", "scene name from the trace manifest"},
+            {"trace_git", "", "git hash of the tracer that wrote the trace (from the manifest)"},
+        }};
+    return block;
 }
 
 void check_summary(const nlohmann::json& summary, bool sampled) {
-    for (const StatDecl& d : summary_schema())
-        require(summary.contains(d.key) || (d.sampled_only && !sampled),
-                std::string("stats summary: declared key '") + d.key + "' was not written (summary_schema.cpp)");
-    for (auto it = summary.begin(); it != summary.end(); ++it) {
-        bool declared = false;
-        for (const StatDecl& d : summary_schema()) declared = declared || it.key() == d.key;
-        require(declared, "stats summary: key '" + it.key() + "' is not declared in sim/report/summary_schema.cpp");
-    }
+    summary_stats().check(summary);
+    for (const StatDecl& d : summary_stats().stats)
+        require(!d.optional || !sampled || summary.contains(d.key),
+                std::string("stats: 'summary.") + d.key + "' is declared for sampled runs but was not written");
 }
 
 }  // namespace rtsim

@@ -19,30 +19,57 @@ namespace {
 /// Utilisation at which a resource counts as saturated rather than merely slow.
 constexpr double kSaturated = 0.7;
 
-struct Resource {
-    const char* label;  ///< what a person calls it
+/// The resources the verdict can name besides the pipelines: the name the analytic bounds and
+/// stats use, what a person calls it, the utilisation that shows it busy (model.utilization;
+/// "" if none) and the config knob that relaxes it, doubled ("" if none, or a rule below).
+struct ResourceInfo {
+    const char* name;
+    const char* label;
+    const char* busy;
+    const char* knob;
 };
 
-const std::map<std::string, Resource>& resources() {
-    static const std::map<std::string, Resource> r = {
-        {"l1_mshrs", {"L1 MSHRs"}},
-        {"l2_mshrs", {"L2 MSHRs"}},
-        {"dram", {"DRAM bandwidth"}},
-        {"l1_banks", {"L1 banks"}},
-        {"l2_banks", {"L2 banks"}},
-        {"latency", {"latency not hidden (memory and pipeline latency over too few ray contexts)"}},
-        {"scheduler", {"the traversal units' schedulers (one step per issue_cycles)"}},
-        {"stack", {"stack spills (spilled entries read back)"}},
-        {"ray_buffer", {"the ray buffer SRAM"}},
-        {"workload", {"the workload: too few rays to keep the machine busy (contexts idle)"}},
+const std::vector<ResourceInfo>& resource_table() {
+    static const std::vector<ResourceInfo> r = {
+        {"l1_mshrs", "L1 MSHRs", "l1_mshrs", "l1.mshrs"},
+        {"l2_mshrs", "L2 MSHRs", "l2_mshrs", "l2.mshrs"},
+        {"dram", "DRAM bandwidth", "dram_bandwidth", "dram.channels"},
+        {"l1_banks", "L1 banks", "l1_banks", "l1.banks"},
+        {"l2_banks", "L2 banks", "l2_banks", "l2.banks"},
+        {"latency", "latency not hidden (memory and pipeline latency over too few ray contexts)", "",
+         "traversal.ray_contexts"},
+        {"scheduler", "the traversal units' schedulers (one step per issue_cycles)", "", ""},
+        {"stack", "stack spills (spilled entries read back)", "", "traversal.stack_entries"},
+        {"ray_buffer", "the ray buffer SRAM", "", "treelets.bytes_per_cycle"},
+        {"workload", "the workload: too few rays to keep the machine busy (contexts idle)", "", ""},
     };
     return r;
 }
 
+const ResourceInfo* find_resource(const std::string& name) {
+    for (const ResourceInfo& r : resource_table())
+        if (name == r.name) return &r;
+    return nullptr;
+}
+
+/// The operation kind a resource names (its pipelines), if it names one.
+bool op_kind_of(const std::string& resource, OpKind* kind) {
+    for (int k = 0; k < kOpKindCount; ++k)
+        if (resource == op_kind_name(OpKind(k))) return *kind = OpKind(k), true;
+    return false;
+}
+
 std::string label_of(const std::string& resource) {
-    auto it = resources().find(resource);
-    if (it != resources().end()) return it->second.label;
-    return resource + " pipelines";  // an operation kind
+    const ResourceInfo* r = find_resource(resource);
+    return r ? r->label : resource + " pipelines";  // an operation kind
+}
+
+/// The utilisation that shows a resource busy ("" if none).
+std::string busy_of(const std::string& resource) {
+    OpKind kind;
+    if (op_kind_of(resource, &kind)) return std::string("pipe_") + op_kind_name(kind);
+    const ResourceInfo* r = find_resource(resource);
+    return r ? r->busy : "";
 }
 
 /// What a context waits for, in words, for each cycle use.
@@ -202,32 +229,35 @@ std::vector<std::string> timed_candidates(const json& model, json* evidence) {
 
 }  // namespace
 
+/// The knob `key` doubled, within the range its config field declares; none past the range.
+Relaxation doubled(const SimConfig& c, const std::string& key) {
+    const ConfigField f = config_field(c, key);
+    const double value = f.value.get<double>();
+    if (value * 2 > f.max) return {};
+    return {key, f.value, json(f.value.get<uint64_t>() * 2)};
+}
+
+/// The knob `key` halved (a cost per operation, at least its declared minimum).
+Relaxation halved(const SimConfig& c, const std::string& key) {
+    const ConfigField f = config_field(c, key);
+    const uint64_t value = f.value.get<uint64_t>();
+    if (value / 2 < f.min || value < 2) return {};
+    return {key, f.value, json(value / 2)};
+}
+
 Relaxation relaxation_for(const std::string& resource, const SimConfig& c) {
-    auto doubled = [](const char* key, uint32_t value, uint32_t max) {
-        return value * 2 <= max ? Relaxation{key, value, value * 2} : Relaxation{};
-    };
-    if (resource == "l1_mshrs") return doubled("l1.mshrs", c.l1.mshrs, 1024);
-    if (resource == "l2_mshrs") return doubled("l2.mshrs", c.l2.mshrs, 1024);
-    if (resource == "dram") return doubled("dram.channels", c.dram.channels, 64);
-    if (resource == "l1_banks") return doubled("l1.banks", c.l1.banks, 256);
-    if (resource == "l2_banks") return doubled("l2.banks", c.l2.banks, 256);
-    if (resource == "latency") return doubled("traversal.ray_contexts", c.traversal.ray_contexts, 4096);
-    if (resource == "stack") return doubled("traversal.stack_entries", c.traversal.stack_entries, 64);
-    if (resource == "ray_buffer") return doubled("treelets.bytes_per_cycle", c.treelets.bytes_per_cycle, 4096);
-    if (resource == "scheduler") {
-        if (c.traversal.issue_cycles > 1)
-            return {"traversal.issue_cycles", c.traversal.issue_cycles, c.traversal.issue_cycles / 2};
-        return doubled("traversal.units", c.traversal.units, 4096);
-    }
-    for (int k = 0; k < kOpKindCount; ++k) {
-        if (resource != op_kind_name(OpKind(k))) continue;
-        const PipelineConfig& p = c.pipeline(OpKind(k));
+    OpKind kind;
+    if (op_kind_of(resource, &kind)) {
+        const PipelineConfig& p = c.pipeline(kind);
         const std::string base = resource + ".";
-        if (p.shared()) return doubled((base + "shared_count").c_str(), p.shared_count, 1024);
-        if (p.initiation_interval > 1) return {base + "initiation_interval", p.initiation_interval, p.initiation_interval / 2};
-        return doubled((base + "width").c_str(), p.width, 64);
+        if (p.shared()) return doubled(c, base + "shared_count");
+        if (p.initiation_interval > 1) return halved(c, base + "initiation_interval");
+        return doubled(c, base + "width");
     }
-    return {};  // the workload: no hardware knob
+    if (resource == "scheduler")
+        return c.traversal.issue_cycles > 1 ? halved(c, "traversal.issue_cycles") : doubled(c, "traversal.units");
+    const ResourceInfo* r = find_resource(resource);
+    return r && *r->knob ? doubled(c, r->knob) : Relaxation{};  // the workload: no hardware knob
 }
 
 json judge(const VerdictContext& c) {
@@ -277,15 +307,12 @@ json judge(const VerdictContext& c) {
                 {"wall_seconds",
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}}}};
     std::string text = v["label"].get<std::string>() + ": " + evidence.value("text", std::string());
-    static const std::map<std::string, std::string> busy_of = {
-        {"l1_mshrs", "l1_mshrs"}, {"l2_mshrs", "l2_mshrs"}, {"dram", "dram_bandwidth"},
-        {"l1_banks", "l1_banks"}, {"l2_banks", "l2_banks"}};
-    auto busy = busy_of.find(binding);
-    if (busy != busy_of.end() && !evidence.value("utilization", json::object()).contains(busy->second) &&
-        c.model.contains("utilization")) {
-        const double u = utilization(c.model, busy->second);
-        v["evidence"]["utilization"][busy->second] = u;
-        text += "; " + busy->second + " " + percent(u) + " busy";
+    const std::string busy = busy_of(binding);
+    if (!busy.empty() && busy.rfind("pipe_", 0) != 0 &&
+        !evidence.value("utilization", json::object()).contains(busy) && c.model.contains("utilization")) {
+        const double u = utilization(c.model, busy);
+        v["evidence"]["utilization"][busy] = u;
+        text += "; " + busy + " " + percent(u) + " busy";
     }
     if (chosen["key"].is_null()) {
         text += "; no hardware knob relaxes it";
@@ -302,6 +329,22 @@ json judge(const VerdictContext& c) {
     text += " (analytic binding bound: " + analytic_binding + ")";
     v["text"] = text;
     return v;
+}
+
+const StatBlock& verdict_stats() {
+    static const StatBlock block{
+        "verdict",
+        {
+            {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l2`, `l1_banks`, `pipe_<kind>`, `scheduler`, `stack`, `ray_buffer`, `dispatch`, `latency`"},
+            {"label", "", "the same in words (e.g. \"DRAM bandwidth\")"},
+            {"text", "", "one sentence: label, evidence and the best relaxation with its estimated speed-up"},
+            {"evidence", "", "`use` (the cycle-accounting use that points at it), `context_fraction` (that use's share of context cycles), `utilization.<resource>` (the utilisations that confirm it), `text` (the evidence in words)"},
+            {"candidates", "list", "best first, each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to)) and, without an estimate, `why_not`"},
+            {"relax", "", "the best candidate, with the same fields; `null` when no knob relaxes the binding resource"},
+            {"estimate", "", "`method` (the analytic level on N sampled rays), `base_cycles` (its cycles for the run's own config on that sample), `wall_seconds` (the host time the estimates took)"},
+            {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
+        }};
+    return block;
 }
 
 }  // namespace rtsim

@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
 #include "rtl_model/common/memory_map.h"
 #include "sim/config/config.h"
 #include "traces/accel/accel.h"
@@ -53,5 +54,8 @@ struct VerdictContext {
 
 /// {binding, label, evidence, relax, estimate, analytic_binding, text}; null for the functional level.
 nlohmann::json judge(const VerdictContext& context);
+
+/// stats.json "verdict", declared once.
+const StatBlock& verdict_stats();
 
 }  // namespace rtsim

@@ -283,4 +283,30 @@ void apply_sampling_to_summary(json& s, const SimConfig& config, const SamplePla
     s["simulated_rays_per_wall_second"] = wall > 0 ? sim / wall : 0.0;
 }
 
+const StatBlock& sampling_stats() {
+    static const StatBlock block{
+        "sampling",
+        {
+            {"clusters", "clusters", "strata of the trace, one simulated cluster each (K)"},
+            {"warmup_rays", "rays", "warm-up rays at the start of each cluster: simulated, not measured (W)"},
+            {"warmup_target_rays", "rays", "the warm-up wanted (`sampling.warmup_rays` or automatic); more than `warmup_rays` when the sample was too small for it, and then the estimate is biased high"},
+            {"measured_rays", "rays", "measured rays per cluster, after its warm-up (M)"},
+            {"simulated_rays", "rays", "`clusters x (warmup_rays + measured_rays)`: the rays the model ran and the checker checked"},
+            {"trace_rays", "rays", "rays in the trace (= `summary.rays`)"},
+            {"fraction", "fraction", "`simulated_rays / trace_rays`"},
+            {"seed", "", "`sampling.seed`: picks each cluster's offset in its stratum"},
+            {"cycles", "cycles", "the estimate: sum over strata of stratum rays x cycles per ray (unrounded `summary.cycles`)"},
+            {"cycles_ci95", "cycles", "`[lo, hi]`: Student t 95% interval over the strata"},
+            {"relative_half_width", "fraction", "half the interval over the estimate"},
+            {"rays_per_second", "rays/s", "`trace_rays` over the estimated seconds"},
+            {"rays_per_second_ci95", "rays/s", "`[lo, hi]` for `rays_per_second`"},
+            {"simulated_cycles", "cycles", "cycles the sampled simulation itself ran (all clusters back to back)"},
+            {"effective_rays_per_wall_second", "rays/s", "`trace_rays / summary.wall_seconds`: what sampling buys"},
+            {"strata", "list", "per stratum: `first_ray`, `rays` (its trace range), `cluster_first_ray` (where its cluster starts), `cycles_per_ray` (measured)"},
+            {"caveats", "list", "why this sample is too small to trust, one text each (fewer than 10 clusters; warm-up cut below its target; clusters shorter than twice the rays in flight; no functional warming); empty when none applies. `rtsim-sim` also prints each as a warning"},
+            {"functional_warming", "", "`rays_per_cluster` (`sampling.warming_rays`: skipped rays before each cluster replayed through the L1s and L2 without time; 0: none), `warmed_rays` (rays replayed in all), `warmed_reads` (the fetches those rays' steps made, plus one ray record each, all made present in the caches), `seconds` (wall time spent warming, part of `summary.wall_seconds`)"},
+        }};
+    return block;
+}
+
 }  // namespace rtsim

@@ -25,6 +25,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/stats.h"
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/dispatch/dispatch.h"
 #include "sim/config/config.h"
@@ -151,5 +152,8 @@ struct SampledRun {
 /// (for the whole trace), cycles_ci95, rays_per_second_ci95, dram_bytes (scaled), sampled.
 void apply_sampling_to_summary(nlohmann::json& summary, const SimConfig& config, const SamplePlan& plan,
                                const SampleEstimator& estimator);
+
+/// stats.json "sampling" (sampled runs only), declared once.
+const StatBlock& sampling_stats();
 
 }  // namespace rtsim

@@ -5,9 +5,10 @@
 
 namespace rtsim {
 
-FunctionalWarmer::FunctionalWarmer(const Accel& accel, const MemoryMap& map, TraceReader& reader, uint32_t units,
-                                   WarmRead warm)
-    : m_map(map), m_reader(reader), m_units(std::max<uint32_t>(units, 1)), m_warm(std::move(warm)),
+FunctionalWarmer::FunctionalWarmer(const Accel& accel, const StepCosts& costs, const MemoryMap& map,
+                                   TraceReader& reader, uint32_t units, WarmRead warm)
+    : m_costs(costs),
+      m_map(map), m_reader(reader), m_units(std::max<uint32_t>(units, 1)), m_warm(std::move(warm)),
       m_stepper(accel.make_stepper()) {}
 
 void FunctionalWarmer::warm(uint64_t first, uint64_t end, uint32_t next_unit) {
@@ -24,11 +25,12 @@ void FunctionalWarmer::warm(uint64_t first, uint64_t end, uint32_t next_unit) {
             const uint32_t unit = uint32_t((next_unit + m_units - (end - id) % m_units) % m_units);
             m_warm(unit, m_map.ray(id), uint32_t(sizeof(RayRecord)));
             m_stepper->begin(ray_from_record(rec), (rec.flags & kRayFlagAnyHit) ? TraversalMode::any_hit : TraversalMode::closest_hit);
+            StackSplit stack;
+            StepDemand d;
             while (!m_stepper->done()) {
-                const StepPlan& plan = m_stepper->plan();
-                for (int f = 0; f < plan.fetch_count; ++f) m_warm(unit, plan.fetch[f].addr, plan.fetch[f].bytes);
-                m_reads += uint64_t(plan.fetch_count);
-                m_stepper->execute();
+                take_step(*m_stepper, stack, m_costs, d);
+                for (int f = 0; f < d.read_count; ++f) m_warm(unit, d.reads[f].addr, d.reads[f].bytes);
+                m_reads += uint64_t(d.read_count);
             }
         }
         m_rays += n;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "rtl_model/common/memory_map.h"
+#include "rtl_model/traversal/step_demand.h"
 #include "traces/accel/accel.h"
 #include "traces/format/trace_reader.h"
 
@@ -24,7 +25,8 @@ using WarmRead = std::function<void(uint32_t unit, uint64_t addr, uint32_t bytes
 
 class FunctionalWarmer {
 public:
-    FunctionalWarmer(const Accel& accel, const MemoryMap& map, TraceReader& reader, uint32_t units, WarmRead warm);
+    FunctionalWarmer(const Accel& accel, const StepCosts& costs, const MemoryMap& map, TraceReader& reader,
+                     uint32_t units, WarmRead warm);
     /// Replays rays [first, end) of the trace, in order, through the caches. `next_unit` is the
     /// unit the dispatch deals ray `end` to (interleaved, block_rays = 1: consecutive rays go to
     /// consecutive units), so each warmed ray warms the L1 of the unit that would have run it.
@@ -35,6 +37,7 @@ public:
     double seconds() const { return m_seconds; }
 
 private:
+    const StepCosts m_costs;
     const MemoryMap& m_map;
     TraceReader& m_reader;
     uint32_t m_units;

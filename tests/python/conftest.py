@@ -3,7 +3,6 @@ rtsim-sim the package runs (with a helper that runs it and returns the stats).""
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import subprocess
@@ -13,7 +12,7 @@ from pathlib import Path
 import pytest
 
 import rtsim
-from rtsim.launcher import SimNotFoundError, find_sim
+from rtsim.launcher import SimJob, SimNotFoundError, SimResult, find_sim, run_sim
 
 REPO = Path(__file__).resolve().parents[2]
 TRACE_WIDTH, TRACE_HEIGHT = 64, 48
@@ -53,14 +52,16 @@ def sim_exe() -> Path:
     return sim_or_fail()
 
 
+def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> SimResult:
+    """One `rtsim-sim TRACE -o OUT --set ...` through the one launcher (rtsim/launcher.py)."""
+    return run_sim(SimJob(trace=trace, out_dir=out, sets=list(sets)), exe=sim_exe, timeout=300)
+
+
 def sim_stats(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict:
     """Runs `rtsim-sim TRACE -o OUT --set ...`, asserts it succeeded and returns its stats.json."""
-    args = [str(sim_exe), str(trace), "-o", str(out)]
-    for s in sets:
-        args += ["--set", s]
-    result = subprocess.run(args, capture_output=True, text=True, timeout=300, check=False)
-    assert result.returncode == 0, result.stderr
-    return json.loads((out / "stats.json").read_text())
+    result = simulate(sim_exe, trace, out, *sets)
+    assert result.returncode == 0 and result.stats is not None, result.stderr
+    return result.stats
 
 
 @pytest.fixture(scope="session")

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim
+from conftest import run_rtsim, simulate
 
 FRAMES, RESOLUTION, WORKLOAD = 3, "24x18", "primary,shadow,diffuse"
 
@@ -34,13 +34,6 @@ def traces(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
         result = trace(root / name, *extra)
         assert result.returncode == 0, result.stderr
     return root / "animated", root / "still"
-
-
-def simulate(sim: Path, folder: Path, out: Path, *sets: str) -> subprocess.CompletedProcess[str]:
-    cmd = [str(sim), str(folder), "-o", str(out)]
-    for s in sets:
-        cmd += ["--set", s]
-    return subprocess.run(cmd, capture_output=True, text=True, check=False)
 
 
 def test_manifest_and_image(traces: tuple[Path, Path]) -> None:

@@ -330,7 +330,8 @@ def test_wrong_reference_is_detected(cornell_small: Path, sim: Sim, tmp_path: Pa
     listed = {m["ray"]: m["difference"] for m in validation["first_mismatches"]}
     assert set(listed) == {hit_ray, work_ray}
     assert listed[hit_ray].startswith("hit:")
-    assert listed[work_ray].startswith("work") and f"reference {nodes + 1}/" in listed[work_ray]
+    # The work difference names the field that differs, model/reference.
+    assert listed[work_ray].startswith("work") and f"steps {nodes}/{nodes + 1}" in listed[work_ray]
     # The functional level checks the same way.
     result = sim(doctored, tmp_path / "functional", "fidelity=functional")
     assert result.returncode == 3

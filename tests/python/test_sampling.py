@@ -19,18 +19,15 @@ from typing import Any
 
 import pytest
 
-from conftest import REPO, run_rtsim
-from rtsim.launcher import find_sim
+from conftest import REPO, run_rtsim, simulate
+from rtsim.launcher import SimResult, find_sim
 
 # Two units of four contexts: few rays in flight, so a small trace has many clusters.
 SMALL_MACHINE = ["traversal.units=2", "traversal.ray_contexts=4"]
 
 
-def sim(trace: Path, out: Path, *sets: str) -> subprocess.CompletedProcess[str]:
-    args = [str(find_sim()), str(trace), "-o", str(out)]
-    for s in sets:
-        args += ["--set", s]
-    return subprocess.run(args, capture_output=True, text=True, timeout=300, check=False)
+def sim(trace: Path, out: Path, *sets: str) -> SimResult:
+    return simulate(find_sim(), trace, out, *sets)
 
 
 def sim_levels() -> list[str]:

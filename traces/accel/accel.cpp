@@ -5,18 +5,6 @@
 
 namespace rtsim {
 
-const char* op_kind_name(OpKind kind) {
-    switch (kind) {
-        case OpKind::box: return "box";
-        case OpKind::triangle: return "triangle";
-        case OpKind::anyhit: return "anyhit";
-        case OpKind::transform: return "transform";
-        case OpKind::cell: return "cell";
-        case OpKind::plane: return "plane";
-    }
-    return "unknown";
-}
-
 Hit trace_with_stepper(Stepper& stepper, const Ray& ray, TraversalMode mode, WorkCounts* work) {
     stepper.begin(ray, mode);
     while (!stepper.done()) stepper.execute();

@@ -8,13 +8,15 @@ namespace rtsim {
 
 using nlohmann::json;
 
-Region& AccelImage::add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count) {
+Region& AccelImage::add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count,
+                               RecordLayout layout) {
     require(!has_region(name), "accel image '" + this->kind + "': region '" + name + "' added twice");
     Region r;
     r.name = name;
     r.kind = kind;
     r.record_bytes = record_bytes;
     r.count = count;
+    r.layout = std::move(layout);
     r.bytes.resize(count * record_bytes);
     regions.push_back(std::move(r));
     return regions.back();
@@ -60,12 +62,14 @@ json vec3(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 
 json AccelImage::descriptor() const {
     json rs = json::array();
-    for (const Region& r : regions)
+    for (const Region& r : regions) {
         rs.push_back({{"name", r.name},
                       {"kind", data_kind_name(r.kind)},
                       {"record_bytes", r.record_bytes},
                       {"count", r.count},
                       {"base", r.base}});
+        if (!r.layout.empty()) rs.back()["fields"] = layout_json(r.layout);
+    }
     return {{"kind", kind},
             {"params", params},
             {"stats", stats},
@@ -118,6 +122,12 @@ AccelImage AccelImage::from_descriptor(const json& d, const std::string& source)
         region.record_bytes = uint32_t(rb);
         region.count = count;
         region.base = base;
+        if (r.contains("fields")) {
+            region.layout = layout_from_json(r.at("fields"), where + ": '" + at + ".fields'");
+            for (const FieldLayout& f : region.layout)
+                require(f.offset + f.bytes() <= rb, where + ": '" + at + ".fields': field '" + f.name +
+                                                        "' runs past the " + std::to_string(rb) + "-byte record");
+        }
         image.regions.push_back(std::move(region));  // bytes are allocated by the reader
     }
     // The addresses must be the ones place_regions() gives: the model relies on the layout.

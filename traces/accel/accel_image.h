@@ -13,6 +13,7 @@
 #include "traces/accel/aligned_bytes.h"
 #include "traces/common/aabb.h"
 #include "traces/common/data_kind.h"
+#include "traces/common/record_layout.h"
 
 namespace rtsim {
 
@@ -22,6 +23,7 @@ struct Region {
     uint32_t record_bytes = 0;       ///< size of one record (its layout: docs/accel.md)
     uint64_t count = 0;              ///< records
     uint64_t base = 0;               ///< address of record 0 (AccelImage::place_regions)
+    RecordLayout layout;             ///< its fields (the record struct's layout_of); empty: raw bytes
     AlignedBytes bytes;              ///< count x record_bytes, 64-byte aligned
 
     uint64_t address(uint64_t index) const { return base + index * record_bytes; }
@@ -44,8 +46,15 @@ struct AccelImage {
     Aabb bounds;                               ///< of the whole scene
     std::vector<Region> regions;
 
-    /// Adds a zero-filled region; addresses are assigned by place_regions().
-    Region& add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count);
+    /// Adds a zero-filled region of `count` records of `record_bytes` in `layout`; addresses are
+    /// assigned by place_regions().
+    Region& add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count,
+                       RecordLayout layout = {});
+    /// Adds a region of records of type T, in T's declared layout (layout_of(const T*)).
+    template <class T>
+    Region& add_region(const std::string& name, DataKind kind, uint64_t count) {
+        return add_region(name, kind, uint32_t(sizeof(T)), count, layout_of(static_cast<const T*>(nullptr)));
+    }
     /// The region called `name`; throws rtsim::Error naming it (and the image's kind) if absent.
     const Region& region(const std::string& name) const;
     Region& region(const std::string& name);
@@ -58,7 +67,8 @@ struct AccelImage {
     /// Bytes of all regions.
     uint64_t footprint_bytes() const;
 
-    /// kind, params, stats, bounds and each region's name, kind, record size, count and base:
+    /// kind, params, stats, bounds and each region's name, kind, record size, count, base and
+    /// record layout:
     /// what the trace's ACCL section holds besides the region payloads (docs/trace_format.md).
     nlohmann::json descriptor() const;
     /// Reads a descriptor back into an image whose regions are allocated but not filled.

@@ -29,11 +29,13 @@ struct Entry {
     LoadFn load;
 };
 
-/// The binary build tree of the chosen builder (the tree every BVH kind starts from): "binned"
-/// (binned SAH) or "sbvh" (spatial splits; prim_ids may repeat a primitive). What the builder
-/// reports beyond the tree's own statistics goes to `stats`.
-BuildTree build_tree(const Scene& scene, const AccelOptions& o, nlohmann::json* stats) {
-    if (o.builder != "sbvh") return build_binned_sah(scene.triangles, o.build);
+BuildTree build_binned(const Scene& scene, const AccelOptions& o, nlohmann::json*) {
+    return build_binned_sah(scene.triangles, o.build);
+}
+
+/// Spatial splits (Stich et al. 2009): prim_ids may repeat a primitive; its statistics go to
+/// the structure's stats.
+BuildTree build_spatial_splits(const Scene& scene, const AccelOptions& o, nlohmann::json* stats) {
     const SbvhConfig c;
     SbvhStats s;
     BuildTree tree = build_sbvh(scene.triangles, o.build, c, &s);
@@ -49,6 +51,26 @@ BuildTree build_tree(const Scene& scene, const AccelOptions& o, nlohmann::json* 
                         {"median_splits", s.median_splits},
                         {"unsplit_references", s.unsplit}};
     return tree;
+}
+
+using TreeBuilder = BuildTree (*)(const Scene&, const AccelOptions&, nlohmann::json*);
+
+/// The builders of binary build trees (the tree every BVH kind starts from), by name: a kind's
+/// builders list names from here, and adding one is a line here.
+const std::vector<std::pair<std::string, TreeBuilder>>& tree_builders() {
+    static const std::vector<std::pair<std::string, TreeBuilder>> b = {
+        {"binned", build_binned},          // binned SAH
+        {"sbvh", build_spatial_splits},    // SAH with spatial splits
+    };
+    return b;
+}
+
+/// The binary build tree of the chosen builder; what the builder reports beyond the tree's own
+/// statistics goes to `stats`.
+BuildTree build_tree(const Scene& scene, const AccelOptions& o, nlohmann::json* stats) {
+    for (const auto& [name, build] : tree_builders())
+        if (name == o.builder) return build(scene, o, stats);
+    throw Error("accel: no tree builder '" + o.builder + "'");
 }
 
 AccelImage build_bvh2(const Scene& scene, const AccelOptions& o) {

@@ -7,21 +7,9 @@
 #include <cstdint>
 
 #include "traces/common/data_kind.h"
+#include "traces/common/op_kind.h"
 
 namespace rtsim {
-
-/// Operation kinds; the model sends each to the pipeline configured for its kind. A structure
-/// that needs a new kind adds one here and one pipeline config (docs/accel.md). Append only.
-enum class OpKind : uint8_t {
-    box = 0,        ///< ray/box test
-    triangle = 1,   ///< ray/triangle test
-    anyhit = 2,     ///< alpha (any-hit) evaluation of a MASK triangle
-    transform = 3,  ///< ray transform into an instance's object space
-    cell = 4,       ///< 3D-DDA step to the next grid cell
-    plane = 5,      ///< ray/split-plane test
-};
-constexpr int kOpKindCount = 6;
-const char* op_kind_name(OpKind kind);
 
 /// One read the step needs before its operations can run.
 struct Fetch {

@@ -9,6 +9,7 @@
 
 #include "traces/common/aabb.h"
 #include "traces/common/hw_triangle.h"
+#include "traces/common/record_layout.h"
 
 namespace rtsim {
 
@@ -28,6 +29,9 @@ struct alignas(64) HwNode {     // 64 bytes, 64-byte aligned in memory (one line
     float& hi(int child, int axis) { return bounds[axis][1][child]; }
 };
 static_assert(sizeof(HwNode) == 64, "HwNode must be one 64-byte line");
+inline RecordLayout layout_of(const HwNode*) {
+    return {RTSIM_FIELD(HwNode, bounds), RTSIM_FIELD(HwNode, child_ref), RTSIM_FIELD(HwNode, child_count)};
+}
 
 /// Statistics of a built BVH (written to the trace manifest).
 struct BvhStats {

@@ -4,19 +4,14 @@
 
 namespace rtsim {
 
-namespace {
-constexpr const char* kNames[kDataKindCount] = {"node", "triangle", "ray", "hit", "stack",
-                                                "ray_buffer", "prim_ref", "cell", "instance"};
-}
-
 const char* data_kind_name(DataKind kind) {
-    const auto i = static_cast<int>(kind);
-    return i < kDataKindCount ? kNames[i] : "unknown";
+    const auto i = static_cast<size_t>(kind);
+    return i < kDataKinds.size() ? kDataKinds[i].name : "unknown";
 }
 
 bool parse_data_kind(const char* name, DataKind* kind) {
-    for (int i = 0; i < kDataKindCount; ++i)
-        if (std::strcmp(name, kNames[i]) == 0) {
+    for (size_t i = 0; i < kDataKinds.size(); ++i)
+        if (std::strcmp(name, kDataKinds[i].name) == 0) {
             *kind = static_cast<DataKind>(i);
             return true;
         }

@@ -2,7 +2,10 @@
 // What a byte in the accelerator's memory is: every region of an acceleration-structure image
 // and every region the model adds (rays, hits, stacks, ray-buffer overflow) has one kind, and
 // caches and DRAM count bytes and hit rates per kind (docs/stats.md).
+#include <array>
 #include <cstdint>
+
+#include "traces/common/work_counts.h"
 
 namespace rtsim {
 
@@ -19,6 +22,27 @@ enum class DataKind : uint8_t {
     instance = 8,    ///< instance records (transforms) of two-level structures
 };
 constexpr int kDataKindCount = 9;
+
+/// A kind's name and what its accesses happen per: once per ray (ray records, hit records) or
+/// once per unit of one work counter of the ray (a node or stack access per step, a triangle per
+/// triangle test, ...). The analytic level scales a sample's accesses of each kind to the whole
+/// trace by that counter (docs/fidelity.md, "The analytic level").
+struct DataKindInfo {
+    const char* name;
+    bool per_ray;
+    WorkField per_work;  ///< when not per_ray
+};
+inline constexpr std::array<DataKindInfo, kDataKindCount> kDataKinds{{
+    {"node", false, WorkField::steps},
+    {"triangle", false, WorkField::tri_tests},
+    {"ray", true, WorkField::steps},
+    {"hit", true, WorkField::steps},
+    {"stack", false, WorkField::steps},
+    {"ray_buffer", false, WorkField::steps},
+    {"prim_ref", false, WorkField::refs},
+    {"cell", false, WorkField::cell_steps},
+    {"instance", false, WorkField::transforms},
+}};
 
 /// "node", "triangle", ...
 const char* data_kind_name(DataKind kind);

@@ -3,6 +3,8 @@
 // docs/bvh_layout.md): the one triangle layout the reference tracer and the model both read.
 #include <cstdint>
 
+#include "traces/common/record_layout.h"
+
 namespace rtsim {
 
 /// HwTriangle::flags bits.
@@ -19,5 +21,9 @@ struct HwTriangle {             // 48 bytes
     uint32_t flags;             // 44: kTriAnyHit | coverage << 8 | material << 16
 };
 static_assert(sizeof(HwTriangle) == 48, "HwTriangle must be 48 bytes");
+inline RecordLayout layout_of(const HwTriangle*) {
+    return {RTSIM_FIELD(HwTriangle, v0),   RTSIM_FIELD(HwTriangle, v1),   RTSIM_FIELD(HwTriangle, v2),
+            RTSIM_FIELD(HwTriangle, prim), RTSIM_FIELD(HwTriangle, inst), RTSIM_FIELD(HwTriangle, flags)};
+}
 
 }  // namespace rtsim

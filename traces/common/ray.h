@@ -5,6 +5,8 @@
 
 #include <glm/glm.hpp>
 
+#include "traces/common/work_counts.h"
+
 namespace rtsim {
 
 using Vec3 = glm::vec3;
@@ -42,37 +44,6 @@ struct Hit {
     float u = 0.0f;  ///< barycentric weight of vertex 1
     float v = 0.0f;  ///< barycentric weight of vertex 2
     bool valid() const { return prim >= 0; }
-};
-
-/// Work one ray caused in the reference traversal; the model must count the same. Names are
-/// neutral so every acceleration structure reports in them (docs/accel.md).
-struct WorkCounts {
-    uint32_t steps = 0;        ///< traversal steps that fetched a node or a cell
-    uint32_t box_tests = 0;    ///< ray/box tests (a node's child boxes, a grid's bounds)
-    uint32_t tri_tests = 0;    ///< ray/triangle tests
-    uint32_t anyhit_calls = 0; ///< alpha-mask (any-hit) evaluations on MASK triangles
-    uint32_t transforms = 0;   ///< instance transforms (two-level structures)
-    uint32_t cell_steps = 0;   ///< 3D-DDA steps from cell to cell (grids)
-    uint32_t plane_tests = 0;  ///< ray/split-plane tests (kd-trees, BIH)
-    uint32_t refs = 0;         ///< primitive references fetched (structures with index lists)
-
-    WorkCounts& operator+=(const WorkCounts& o) {
-        steps += o.steps;
-        box_tests += o.box_tests;
-        tri_tests += o.tri_tests;
-        anyhit_calls += o.anyhit_calls;
-        transforms += o.transforms;
-        cell_steps += o.cell_steps;
-        plane_tests += o.plane_tests;
-        refs += o.refs;
-        return *this;
-    }
-    bool operator==(const WorkCounts& o) const {
-        return steps == o.steps && box_tests == o.box_tests && tri_tests == o.tri_tests &&
-               anyhit_calls == o.anyhit_calls && transforms == o.transforms &&
-               cell_steps == o.cell_steps && plane_tests == o.plane_tests && refs == o.refs;
-    }
-    bool operator!=(const WorkCounts& o) const { return !(*this == o); }
 };
 
 /// True when a ray may be traversed: finite origin and direction, non-zero direction,

@@ -77,22 +77,4 @@ Hit hit_from_record(const HitRecord& h) {
     return hit;
 }
 
-WorkRecord to_record(const WorkCounts& w) {
-    return WorkRecord{w.steps,      w.box_tests,  w.tri_tests,   w.anyhit_calls,
-                      w.transforms, w.cell_steps, w.plane_tests, w.refs};
-}
-
-WorkCounts work_from_record(const WorkRecord& w) {
-    WorkCounts c;
-    c.steps = w.steps;
-    c.box_tests = w.box_tests;
-    c.tri_tests = w.tri_tests;
-    c.anyhit_calls = w.anyhit_calls;
-    c.transforms = w.transforms;
-    c.cell_steps = w.cell_steps;
-    c.plane_tests = w.plane_tests;
-    c.refs = w.refs;
-    return c;
-}
-
 }  // namespace rtsim

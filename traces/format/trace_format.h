@@ -10,6 +10,7 @@
 #include <string>
 
 #include "traces/common/ray.h"
+#include "traces/common/record_layout.h"
 
 namespace rtsim {
 
@@ -59,17 +60,9 @@ struct HitRecord {
     float u;              // 12
     float v;              // 16
 };
-/// Work the reference traversal did for the ray at the same index (32 bytes; WorkCounts).
-struct WorkRecord {
-    uint32_t steps;        //  0: steps that fetched a node or a cell
-    uint32_t box_tests;    //  4
-    uint32_t tri_tests;    //  8
-    uint32_t anyhit_calls; // 12
-    uint32_t transforms;   // 16
-    uint32_t cell_steps;   // 20
-    uint32_t plane_tests;  // 24
-    uint32_t refs;         // 28
-};
+/// Work the reference traversal did for the ray at the same index: WorkCounts itself (4 bytes
+/// per field of traces/common/work_counts.h, in declaration order, no padding).
+using WorkRecord = WorkCounts;
 /// One frame of an animated trace (16 bytes): its rays are RAYS[first_ray, first_ray + rays),
 /// traced against the structure's frame of the same index (Accel::bind_frame).
 struct FrameRecord {
@@ -80,7 +73,28 @@ struct FrameRecord {
 static_assert(sizeof(FrameRecord) == 16, "FrameRecord layout");
 static_assert(sizeof(RayRecord) == 40, "RayRecord layout");
 static_assert(sizeof(HitRecord) == 20, "HitRecord layout");
-static_assert(sizeof(WorkRecord) == 32, "WorkRecord layout");
+static_assert(sizeof(WorkRecord) == kWorkFieldCount * sizeof(uint32_t), "WorkRecord layout");
+
+/// The records' layouts (numpy reads the sections with them: python/rtsim/trace_file.py).
+inline RecordLayout layout_of(const RayRecord*) {
+    return {RTSIM_FIELD(RayRecord, origin), RTSIM_FIELD(RayRecord, tmin),  RTSIM_FIELD(RayRecord, direction),
+            RTSIM_FIELD(RayRecord, tmax),   RTSIM_FIELD(RayRecord, pixel), RTSIM_FIELD(RayRecord, kind),
+            RTSIM_FIELD(RayRecord, flags),  RTSIM_FIELD(RayRecord, depth)};
+}
+inline RecordLayout layout_of(const HitRecord*) {
+    return {RTSIM_FIELD(HitRecord, prim), RTSIM_FIELD(HitRecord, inst), RTSIM_FIELD(HitRecord, t),
+            RTSIM_FIELD(HitRecord, u),    RTSIM_FIELD(HitRecord, v)};
+}
+inline RecordLayout layout_of(const WorkRecord*) {
+    return {
+#define RTSIM_WORK_LAYOUT(name, tests_of, plan_step, doc) RTSIM_FIELD(WorkRecord, name),
+        RTSIM_WORK_FIELDS(RTSIM_WORK_LAYOUT)
+#undef RTSIM_WORK_LAYOUT
+    };
+}
+inline RecordLayout layout_of(const FrameRecord*) {
+    return {RTSIM_FIELD(FrameRecord, first_ray), RTSIM_FIELD(FrameRecord, rays)};
+}
 
 constexpr uint8_t kRayFlagAnyHit = 1u << 0;
 
@@ -89,7 +103,5 @@ RayRecord to_record(const Ray& ray, RayKind kind, uint32_t pixel, uint16_t depth
 Ray ray_from_record(const RayRecord& r);
 HitRecord to_record(const Hit& hit);
 Hit hit_from_record(const HitRecord& h);
-WorkRecord to_record(const WorkCounts& w);
-WorkCounts work_from_record(const WorkRecord& w);
 
 }  // namespace rtsim

@@ -48,6 +48,25 @@ struct TraceOptions {
     /// (traces/scene/scene_motion.h), the BLASes are built once, a TLAS per frame, and the
     /// workload is traced once per frame. Needs an instanced scene traced two-level (not --flatten).
     uint32_t frames = 1;
+
+    /// The options a caller chooses, each with its name and meaning (scene and out_dir aside):
+    /// the Python bindings read the defaults and apply keyword arguments through this, so every
+    /// default above is declared once, here (rtsim._core.trace_defaults()).
+    template <class V>
+    void visit(V& v) {
+        v("workload", workload, "ray kinds (empty: every kind the scene calls for)");
+        v("width", width, "camera image width: one primary ray per pixel");
+        v("height", height, "camera image height");
+        v("bounces", bounces, "depth of diffuse, reflection and refraction bounces");
+        v("seed", seed, "seed of the random numbers (bounce directions, procedural scenes)");
+        v("camera", camera, "(eye, target, vertical field of view in degrees); none: the scene's camera or a framing");
+        v("accel", accel.kind, "acceleration structure (accel_kinds())");
+        v("builder", accel.builder, "its builder; empty: the structure's default");
+        v("flatten", flatten, "instanced scenes: one world-space structure instead of two levels");
+        v("hairball_triangles", procedural.hairball_triangles, "triangles of the built-in hairball");
+        v("threads", threads, "tracing threads, 0 for all cores (the trace is the same for any)");
+        v("frames", frames, "animated frames of an instanced scene");
+    }
 };
 
 /// Progress callback: rays traced so far, rays expected (an estimate until the last wavefront),

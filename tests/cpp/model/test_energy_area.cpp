@@ -25,9 +25,9 @@ TEST(EnergyArea, ReferenceNodeIsHorowitz) {
     EXPECT_NEAR(sram_access_pj(c, 32768, 64), 20.0, 1e-9);
     EXPECT_NEAR(sram_access_pj(c, 1 << 20, 64), 113.1, 0.1);
     // A box test: (6 add x 0.9 + 7 mul x 3.7 + 9 cmp x 0.1) x 1.5 overhead = 48.3 pJ.
-    EXPECT_NEAR(op_energies(c).box, 48.3, 1e-9);
+    EXPECT_NEAR(op_energies(c)[OpKind::box], 48.3, 1e-9);
     // A triangle test: (22 x 0.9 + (20 + 3 x 4) x 3.7 + 12 x 0.1) x 1.5 = 209.1 pJ.
-    EXPECT_NEAR(op_energies(c).triangle, 209.1, 1e-9);
+    EXPECT_NEAR(op_energies(c)[OpKind::triangle], 209.1, 1e-9);
 }
 
 TEST(EnergyArea, SmallerNodesCostLess) {
@@ -72,15 +72,15 @@ json timed_stats(double dram_bytes) {
 TEST(EnergyArea, PricesEveryBlockAndSums) {
     SimConfig s;
     WorkTotals w;
-    w.box_tests = 2000;
-    w.tri_tests = 100;
-    w.steps = 1000;
+    w[WorkField::box_tests] = 2000;
+    w[WorkField::tri_tests] = 100;
+    w[WorkField::steps] = 1000;
     json stats = timed_stats(64000);
     add_energy_area(stats, s, w, 100);
     const json& e = stats["energy"]["per_ray_nj"];
     const OpEnergies op = op_energies(s.energy);
-    EXPECT_NEAR(e["box"].get<double>(), 20 * op.box / 1000, 1e-12);
-    EXPECT_NEAR(e["triangle"].get<double>(), op.triangle / 1000, 1e-12);
+    EXPECT_NEAR(e["box"].get<double>(), 20 * op[OpKind::box] / 1000, 1e-12);
+    EXPECT_NEAR(e["triangle"].get<double>(), op[OpKind::triangle] / 1000, 1e-12);
     // 640 DRAM bytes per ray x 8 bits x 7.5 pJ (GDDR6) = 38.4 nJ.
     EXPECT_NEAR(e["dram"].get<double>(), 38.4, 1e-9);
     double sum = 0;
@@ -101,7 +101,7 @@ TEST(EnergyArea, FunctionalLevelReportsWhatItCan) {
     SimConfig s;
     s.fidelity = Fidelity::functional;
     WorkTotals w;
-    w.box_tests = 10;
+    w[WorkField::box_tests] = 10;
     json stats = {{"summary", {{"rays_per_second", nullptr}}}, {"model", json::object()}};
     add_energy_area(stats, s, w, 5);
     EXPECT_TRUE(stats["energy"]["per_ray_nj"]["box"].is_number());

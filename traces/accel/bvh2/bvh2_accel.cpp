@@ -32,9 +32,9 @@ AccelImage bvh2_image(const HwBvh& bvh, const BuildConfig& c, const std::string&
     AccelImage image;
     image.kind = "bvh2";
     image.bounds = bvh.bounds;
-    Region& nodes = image.add_region("nodes", DataKind::node, sizeof(HwNode), bvh.nodes.size());
+    Region& nodes = image.add_region<HwNode>("nodes", DataKind::node, bvh.nodes.size());
     std::copy(bvh.nodes.begin(), bvh.nodes.end(), nodes.records<HwNode>());
-    Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), bvh.triangles.size());
+    Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, bvh.triangles.size());
     std::copy(bvh.triangles.begin(), bvh.triangles.end(), tris.records<HwTriangle>());
     image.place_regions();
     const BvhStats& s = bvh.stats;

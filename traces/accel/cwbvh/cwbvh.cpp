@@ -68,13 +68,13 @@ AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std:
     image.kind = kind;
     image.bounds = tree.nodes[0].box;
     image.params = {{"order", child_order_name(order)}};
-    const uint32_t bytes = tree.width == 8 ? sizeof(CwNode8) : sizeof(CwNode6);
-    Region& nodes = image.add_region("nodes", DataKind::node, bytes, o.stored.size());
+    Region& nodes = tree.width == 8 ? image.add_region<CwNode8>("nodes", DataKind::node, o.stored.size())
+                                    : image.add_region<CwNode6>("nodes", DataKind::node, o.stored.size());
     for (size_t i = 0; i < o.stored.size(); ++i) {
         if (tree.width == 8) write_node<CwNode8, 8>(tree, o, o.stored[i], nodes.records<CwNode8>()[i]);
         else write_node<CwNode6, 6>(tree, o, o.stored[i], nodes.records<CwNode6>()[i]);
     }
-    Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), o.prims.size());
+    Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
     for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
     image.place_regions();

@@ -34,6 +34,7 @@
 #include <cstring>
 
 #include "traces/accel/cwbvh/quantize.h"
+#include "traces/common/record_layout.h"
 
 namespace rtsim {
 
@@ -48,6 +49,11 @@ struct alignas(16) CwNode8 {
     uint8_t qhi[3][8];
 };
 static_assert(sizeof(CwNode8) == 80, "CwNode8 must be 80 bytes");
+inline RecordLayout layout_of(const CwNode8*) {
+    return {RTSIM_FIELD(CwNode8, p),         RTSIM_FIELD(CwNode8, e),        RTSIM_FIELD(CwNode8, imask),
+            RTSIM_FIELD(CwNode8, base_node), RTSIM_FIELD(CwNode8, base_tri), RTSIM_FIELD(CwNode8, meta),
+            RTSIM_FIELD(CwNode8, qlo),       RTSIM_FIELD(CwNode8, qhi)};
+}
 
 struct alignas(16) CwNode6 {
     float p[3];
@@ -71,6 +77,11 @@ struct alignas(16) CwNode6 {
     }
 };
 static_assert(sizeof(CwNode6) == 64, "CwNode6 must be 64 bytes");
+/// bases: base_node | base_tri << 28, 56 bits little-endian (read them with base_node(), base_tri()).
+inline RecordLayout layout_of(const CwNode6*) {
+    return {RTSIM_FIELD(CwNode6, p),     RTSIM_FIELD(CwNode6, e),   RTSIM_FIELD(CwNode6, meta),
+            RTSIM_FIELD(CwNode6, bases), RTSIM_FIELD(CwNode6, qlo), RTSIM_FIELD(CwNode6, qhi)};
+}
 static_assert(offsetof(CwNode6, bases) == 21 && offsetof(CwNode6, qlo) == 28, "CwNode6 byte offsets");
 static_assert(offsetof(CwNode8, meta) == 24 && offsetof(CwNode8, qhi) == 56, "CwNode8 byte offsets");
 

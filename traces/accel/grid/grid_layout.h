@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "traces/common/aabb.h"
+#include "traces/common/record_layout.h"
 
 namespace rtsim {
 
@@ -23,6 +24,9 @@ struct GridCell {          // 8 bytes
     uint32_t ref_count;    // 4: entries in the list (0: an empty cell)
 };
 static_assert(sizeof(GridCell) == 8, "GridCell must be 8 bytes");
+inline RecordLayout layout_of(const GridCell*) {
+    return {RTSIM_FIELD(GridCell, first_ref), RTSIM_FIELD(GridCell, ref_count)};
+}
 
 /// Bytes of one prim_refs entry.
 constexpr uint32_t kGridRefBytes = 4;

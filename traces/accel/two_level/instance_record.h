@@ -2,6 +2,7 @@
 // The instance record of a two-level structure (docs/accel.md, "Two-level structures"): where a
 // TLAS leaf points. 128 bytes, two cache lines; the transform step fetches the first line only
 // (what traversal needs), the second holds the object-to-world matrix for shading and tools.
+#include "traces/common/record_layout.h"
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -20,6 +21,12 @@ struct InstanceRecord {             // 128 bytes
     uint32_t reserved1[4];          // 112: 0
 };
 static_assert(sizeof(InstanceRecord) == 128, "InstanceRecord must be 128 bytes");
+inline RecordLayout layout_of(const InstanceRecord*) {
+    return {RTSIM_FIELD(InstanceRecord, world_to_object), RTSIM_FIELD(InstanceRecord, blas),
+            RTSIM_FIELD(InstanceRecord, prim_base),       RTSIM_FIELD(InstanceRecord, instance),
+            RTSIM_FIELD(InstanceRecord, reserved0),       RTSIM_FIELD(InstanceRecord, object_to_world),
+            RTSIM_FIELD(InstanceRecord, reserved1)};
+}
 
 /// Where the instance records live: the array and its address in the memory image.
 struct InstanceRecordView {

@@ -51,7 +51,7 @@ AccelImage blas_image(const AccelImage& image, const std::string& kind, const js
         const uint64_t f0 = f.get<uint64_t>(), n = c.get<uint64_t>();
         require(f0 <= r.count && n <= r.count - f0, where + ": region '" + name + "' slice [" + std::to_string(f0) +
                                                         ", +" + std::to_string(n) + ") is outside " + r.name);
-        Region& out = sub.add_region(name, r.kind, r.record_bytes, 0);
+        Region& out = sub.add_region(name, r.kind, r.record_bytes, 0, r.layout);
         out.count = n;
         out.base = r.address(f0);
         out.bytes.resize(n * r.record_bytes, false);

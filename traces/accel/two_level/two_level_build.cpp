@@ -212,7 +212,7 @@ json add_blas_regions(AccelImage& image, const std::vector<AccelImage>& blases, 
             blas_list[b]["first"][proto.name] = first[b];
             blas_list[b]["count"][proto.name] = r.count;
         }
-        Region& out = image.add_region("blas_" + proto.name, proto.kind, uint32_t(rb), total);
+        Region& out = image.add_region("blas_" + proto.name, proto.kind, uint32_t(rb), total, proto.layout);
         for (size_t b = 0; b < blases.size(); ++b) {
             const Region& r = blases[b].region(proto.name);
             std::memcpy(out.bytes.data() + first[b] * rb, r.bytes.data(), r.size_bytes());
@@ -261,8 +261,8 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
         record_total += f.records.size();
     }
     // (References taken after both regions exist: adding a region may move the others.)
-    image.add_region("tlas_nodes", DataKind::node, sizeof(HwNode), node_total);
-    image.add_region("instances", DataKind::instance, sizeof(InstanceRecord), record_total);
+    image.add_region<HwNode>("tlas_nodes", DataKind::node, node_total);
+    image.add_region<InstanceRecord>("instances", DataKind::instance, record_total);
     Region& nodes = image.regions[image.regions.size() - 2];
     Region& records = image.regions.back();
     for (size_t f = 0; f < frames.size(); ++f) {

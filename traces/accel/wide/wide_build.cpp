@@ -58,6 +58,13 @@ void write_fp32_nodes(const WideBuildTree& tree, const WideOrder& order, WideNod
     }
 }
 
+/// The "nodes" region of N-wide fp32 nodes, written.
+template <int N>
+void add_fp32_nodes(const WideBuildTree& tree, const WideOrder& o, AccelImage& image) {
+    Region& nodes = image.add_region<WideNode<N>>("nodes", DataKind::node, o.stored.size());
+    write_fp32_nodes<N>(tree, o, nodes.records<WideNode<N>>());
+}
+
 }  // namespace
 
 AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::string& kind, ChildOrder order) {
@@ -66,15 +73,13 @@ AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::
     image.kind = kind;
     image.bounds = tree.nodes[0].box;
     image.params = {{"order", child_order_name(order)}};
-    const uint32_t bytes = uint32_t(32 * tree.width);
-    Region& nodes = image.add_region("nodes", DataKind::node, bytes, o.stored.size());
     switch (tree.width) {
-        case 4: write_fp32_nodes<4>(tree, o, nodes.records<WideNode<4>>()); break;
-        case 6: write_fp32_nodes<6>(tree, o, nodes.records<WideNode<6>>()); break;
-        case 8: write_fp32_nodes<8>(tree, o, nodes.records<WideNode<8>>()); break;
+        case 4: add_fp32_nodes<4>(tree, o, image); break;
+        case 6: add_fp32_nodes<6>(tree, o, image); break;
+        case 8: add_fp32_nodes<8>(tree, o, image); break;
         default: throw Error("wide_image: no fp32 layout of width " + std::to_string(tree.width));
     }
-    Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), o.prims.size());
+    Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
     for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
     image.place_regions();

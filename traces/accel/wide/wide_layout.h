@@ -33,5 +33,9 @@ struct alignas(64) WideNode {
 static_assert(sizeof(WideNode<4>) == 128, "WideNode<4> must be 128 bytes");
 static_assert(sizeof(WideNode<6>) == 192, "WideNode<6> must be 192 bytes");
 static_assert(sizeof(WideNode<8>) == 256, "WideNode<8> must be 256 bytes");
+template <int N>
+RecordLayout layout_of(const WideNode<N>*) {
+    return {RTSIM_FIELD(WideNode<N>, bounds), RTSIM_FIELD(WideNode<N>, child_ref), RTSIM_FIELD(WideNode<N>, child_count)};
+}
 
 }  // namespace rtsim

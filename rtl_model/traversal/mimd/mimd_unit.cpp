@@ -1,26 +1,23 @@
-#include "rtl_model/traversal/traversal_unit.h"
+#include "rtl_model/traversal/mimd/mimd_unit.h"
 
 #include <algorithm>
 
-#include "rtl_model/traversal/stack_spill.h"
-
 namespace rtsim {
 
-TraversalUnit::TraversalUnit(sc_core::sc_module_name name, const TraversalConfig& config, const UnitContext& context,
-                             const MemoryMap& map, StepperPool& steppers, uint32_t index)
-    : sc_core::sc_module(name),
-      pipes("pipes", kOpKindCount),
-      m_config(config),
-      m_ctx(context),
-      m_map(map),
-      m_steppers(steppers),
+MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
+    : TraversalUnit(name),
+      m_config(setup.config),
+      m_ctx(setup.context),
+      m_map(setup.map),
+      m_steppers(setup.steppers),
+      m_costs(setup.costs),
       m_index(index),
-      m_contexts(config.ray_contexts),
-      m_events(config.ray_contexts) {
+      m_contexts(setup.config.ray_contexts),
+      m_events(setup.config.ray_contexts) {
     SC_THREAD(run);
 }
 
-void TraversalUnit::run() {
+void MimdUnit::run() {
     m_treelet_mode = ray_buffer.size() > 0;
     if (!m_treelet_mode)
         for (Context& ctx : m_contexts) ctx.ray.stepper = m_steppers.acquire();
@@ -66,7 +63,7 @@ void TraversalUnit::run() {
     }
 }
 
-void TraversalUnit::sync(Cycle t) {
+void MimdUnit::sync(Cycle t) {
     // Temporal decoupling: run ahead of SystemC time by at most a quantum, then let others catch up.
     if (t < m_synced + m_ctx.quantum_cycles) return;
     uint64_t now = sc_core::sc_time_stamp().value();
@@ -75,38 +72,38 @@ void TraversalUnit::sync(Cycle t) {
     ++m_syncs;
 }
 
-void TraversalUnit::fill_idle_contexts(Cycle t) {
+void MimdUnit::fill_idle_contexts(Cycle t) {
     for (uint32_t c = 0; c < m_contexts.size(); ++c)
         if (!m_contexts[c].active && !start_ray(c, t)) break;
     m_next_fill = t + m_ctx.idle_poll_cycles;
 }
 
-void TraversalUnit::account(uint32_t c, CycleUse use, Cycle until) {
+void MimdUnit::account(uint32_t c, CycleUse use, Cycle until) {
     Context& ctx = m_contexts[c];
     if (until <= ctx.accounted) return;
     m_account.add(use, until - ctx.accounted);
     ctx.accounted = until;
 }
 
-void TraversalUnit::account_read(uint32_t c, Cycle ready, const AccessInfo& info) {
+void MimdUnit::account_read(uint32_t c, Cycle ready, const AccessInfo& info) {
     Context& ctx = m_contexts[c];
     if (ready <= ctx.accounted) return;
     account_memory(m_account, ctx.accounted, ready, info);
     ctx.accounted = ready;
 }
 
-void TraversalUnit::activate(uint32_t c, Cycle t) {
+void MimdUnit::activate(uint32_t c, Cycle t) {
     account(c, CycleUse::starved, t);  // idle until now, while rays were still to come
     m_contexts[c].active = true;
     if (m_active++ == 0) m_busy_since = t;
 }
 
-void TraversalUnit::deactivate(uint32_t c, Cycle t) {
+void MimdUnit::deactivate(uint32_t c, Cycle t) {
     m_contexts[c].active = false;
     if (--m_active == 0) m_busy_cycles += t - m_busy_since;  // a busy interval ends (may restart now)
 }
 
-bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
+bool MimdUnit::start_ray(uint32_t c, Cycle t) {
     if (m_treelet_mode) return take_parked_ray(c, t);
     RayJob job;
     if (!rays->next_ray(m_index, &job)) return false;
@@ -116,7 +113,7 @@ bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
     if (!ray_is_valid(job.ray)) ++m_rejected;
     ctx.ray.ray_id = job.id;
     ctx.ray.start = t;
-    ctx.ray.local_stack = ctx.ray.spilled = 0;
+    ctx.ray.stack = StackSplit{};
     activate(c, t);
     // The ray record is read from memory before traversal starts.
     const Cycle fetch = t + m_ctx.dispatch_latency;
@@ -129,7 +126,7 @@ bool TraversalUnit::start_ray(uint32_t c, Cycle t) {
     return true;
 }
 
-bool TraversalUnit::take_parked_ray(uint32_t c, Cycle t) {
+bool MimdUnit::take_parked_ray(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
     RayState taken;
     Cycle ready = t;
@@ -146,21 +143,21 @@ bool TraversalUnit::take_parked_ray(uint32_t c, Cycle t) {
     return true;
 }
 
-void TraversalUnit::park_ray(uint32_t c, uint32_t treelet, Cycle t) {
+void MimdUnit::park_ray(uint32_t c, uint32_t treelet, Cycle t) {
     ray_buffer->park(treelet, std::move(m_contexts[c].ray), t);
     ++m_parks;
     deactivate(c, t);
     start_ray(c, t);
 }
 
-void TraversalUnit::advance(uint32_t c, Cycle t) {
+void MimdUnit::advance(uint32_t c, Cycle t) {
     ++m_steps;
     account(c, CycleUse::issue, t);  // ready since its event, waiting for the scheduler
     if (m_contexts[c].phase == Phase::ops) run_ops(c, t);
     else step(c, t);
 }
 
-void TraversalUnit::step(uint32_t c, Cycle t) {
+void MimdUnit::step(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
     const StepPlan& plan = ctx.ray.stepper->plan();
     if (plan.done) return finish_ray(c, t);
@@ -168,10 +165,14 @@ void TraversalUnit::step(uint32_t c, Cycle t) {
         const uint32_t target = ray_buffer->treelet_of(plan.locality);
         if (target != ctx.treelet) return park_ray(c, target, t);  // leaves its treelet
     }
+    // The step is costed (and run, with the one arithmetic) as its fetches issue; its
+    // operations phase issues what the demand says once the data has arrived.
+    StepDemand& d = ctx.demand;
+    take_step(*ctx.ray.stepper, ctx.ray.stack, m_costs, d);
     Cycle ready = t;
     AccessInfo slowest, info;
-    for (int i = 0; i < plan.fetch_count; ++i) {
-        const Fetch& f = plan.fetch[i];
+    for (int i = 0; i < d.read_count; ++i) {
+        const Fetch& f = d.reads[i];
         const Cycle done = mem->access({f.addr, f.bytes, false, f.kind, t, &info});
         if (done > ready || i == 0) slowest = info;
         ready = std::max(ready, done);
@@ -181,54 +182,42 @@ void TraversalUnit::step(uint32_t c, Cycle t) {
     schedule(c, ready);
 }
 
-void TraversalUnit::run_ops(uint32_t c, Cycle t) {
-    Context& ctx = m_contexts[c];
-    Stepper& stepper = *ctx.ray.stepper;
-    // The plan's operations run on its pipelines in order; execute() then plans the next step
-    // and reports what the results called for (alpha tests), which run after them.
-    const StepPlan& plan = stepper.plan();
-    Op ops[StepPlan::kMaxOps];
-    const int op_count = plan.op_count;
-    std::copy(plan.op, plan.op + op_count, ops);
-    const int before = stepper.stack_size();
-    const StepOutcome outcome = stepper.execute();
+void MimdUnit::run_ops(uint32_t c, Cycle t) {
+    // The step's operations run on their pipelines in order (the plan's, then those its results
+    // called for), then spilled stack entries are read back.
+    const StepDemand& d = m_contexts[c].demand;
     Cycle ready = t;
-    for (int i = 0; i < op_count; ++i) {
-        ready = pipes[size_t(ops[i].kind)]->issue(ready, ops[i].count);
-        account(c, pipe_use(ops[i].kind), ready);
+    for (int i = 0; i < d.issue_count; ++i) {
+        ready = pipes[size_t(d.issues[i].kind)]->issue(ready, d.issues[i].issues, d.issues[i].tests);
+        account(c, pipe_use(d.issues[i].kind), ready);
     }
-    for (int i = 0; i < outcome.op_count; ++i) {
-        ready = pipes[size_t(outcome.op[i].kind)]->issue(ready, outcome.op[i].count);
-        account(c, pipe_use(outcome.op[i].kind), ready);
-    }
-    ready = stack_traffic(c, before, t, ready);
+    ready = stack_traffic(c, t, ready);
     account(c, CycleUse::stack, ready);  // spilled entries read back after the operations
-    ctx.phase = Phase::step;
+    m_contexts[c].phase = Phase::step;
     schedule(c, ready);
 }
 
-Cycle TraversalUnit::stack_traffic(uint32_t c, int before, Cycle t, Cycle ready) {
-    RayState& ray = m_contexts[c].ray;
-    const uint32_t bytes = m_config.stack_entry_bytes;
+Cycle MimdUnit::stack_traffic(uint32_t c, Cycle t, Cycle ready) {
+    const RayState& ray = m_contexts[c].ray;
+    const StepDemand& d = m_contexts[c].demand;
+    const uint32_t bytes = m_costs.stack_entry_bytes;
     // Spill slots belong to the context (reused ray after ray); with treelets they belong to the
     // ray (its id), since the ray moves between contexts and units through the ray buffer.
     const uint64_t owner = m_treelet_mode ? ray.ray_id : uint64_t(m_index) * m_contexts.size() + c;
-    map_stack_change(
-        ray.local_stack, ray.spilled, before, ray.stepper->stack_size(), m_config.stack_entries,
-        [&](uint32_t slot) {  // full on-chip stack: the oldest entry goes to memory (posted)
-            if (!m_ctx.sync_private_steps) sync(t);  // the write goes on to the shared L2
-            mem->access({m_map.stack(owner, slot, bytes), bytes, true, DataKind::stack, t});
-            ++m_spill_writes;
-        },
-        [&](uint32_t slot) {  // on-chip stack empty but entries in memory: read one back first
-            if (!m_ctx.sync_private_steps) sync(t);  // may miss to the shared L2
-            ++m_spill_reads;
-            ready = std::max(ready, mem->access({m_map.stack(owner, slot, bytes), bytes, false, DataKind::stack, t}));
-        });
+    d.for_each_spill([&](uint32_t slot) {  // full on-chip stack: the oldest entry goes to memory (posted)
+        if (!m_ctx.sync_private_steps) sync(t);  // the write goes on to the shared L2
+        mem->access({m_map.stack(owner, slot, bytes), bytes, true, DataKind::stack, t});
+        ++m_spill_writes;
+    });
+    d.for_each_fill([&](uint32_t slot) {  // on-chip stack empty but entries in memory: read one back first
+        if (!m_ctx.sync_private_steps) sync(t);  // may miss to the shared L2
+        ++m_spill_reads;
+        ready = std::max(ready, mem->access({m_map.stack(owner, slot, bytes), bytes, false, DataKind::stack, t}));
+    });
     return ready;
 }
 
-void TraversalUnit::finish_ray(uint32_t c, Cycle t) {
+void MimdUnit::finish_ray(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
     // The hit record is written back (posted).
     mem->access({m_map.hit(ctx.ray.ray_id), sizeof(HitRecord), true, DataKind::hit, t});
@@ -242,29 +231,28 @@ void TraversalUnit::finish_ray(uint32_t c, Cycle t) {
     start_ray(c, t);
 }
 
-CycleAccount TraversalUnit::cycle_account(Cycle total_cycles) const {
+CycleAccount MimdUnit::cycle_account(Cycle total_cycles) const {
     CycleAccount a = m_account;
     for (const Context& ctx : m_contexts)
         if (total_cycles > ctx.accounted) a.add(CycleUse::tail, total_cycles - ctx.accounted);
     return a;
 }
 
-nlohmann::json TraversalUnit::stats_json(Cycle total_cycles) const {
-    nlohmann::json j = {{"rays", m_rays},
-                        {"steps", m_steps},
-                        {"busy_cycles", m_busy_cycles},
-                        {"busy_fraction", total_cycles ? double(m_busy_cycles) / double(total_cycles) : 0.0},
-                        {"stack_spill_writes", m_spill_writes},
-                        {"stack_spill_reads", m_spill_reads},
-                        {"rejected_rays", m_rejected},
-                        {"quantum_syncs", m_syncs},
-                        {"finish_cycle", m_finish},
-                        {"cycle_accounting", cycle_account(total_cycles).to_json()}};
-    if (m_treelet_mode) {
-        j["rays_taken"] = m_takes;
-        j["rays_parked"] = m_parks;
-        j["idle_polls"] = m_idle_polls;
-    }
+nlohmann::json MimdUnit::stats_json(Cycle total_cycles) const {
+    nlohmann::json j;
+    StatsWriter w(unit_stats(), j);
+    w.set("rays", m_rays)
+        .set("steps", m_steps)
+        .set("busy_cycles", m_busy_cycles)
+        .set("busy_fraction", total_cycles ? double(m_busy_cycles) / double(total_cycles) : 0.0)
+        .set("stack_spill_writes", m_spill_writes)
+        .set("stack_spill_reads", m_spill_reads)
+        .set("rejected_rays", m_rejected)
+        .set("quantum_syncs", m_syncs)
+        .set("finish_cycle", m_finish)
+        .set("cycle_accounting", cycle_account(total_cycles).to_json());
+    if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
+    w.done();
     return j;
 }
 

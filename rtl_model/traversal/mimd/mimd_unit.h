@@ -1,0 +1,90 @@
+#pragma once
+// The MIMD traversal unit, traversal.model = "mimd" (in the spirit of TRaX/STRaTA, Kopta et al. 2013): `ray_contexts` rays in
+// flight, each stepping its own stepper (traces/accel/stepper.h) on its own, no lock-step. The
+// unit knows no acceleration structure: each step's plan says what to fetch and which operations
+// to run (docs/architecture.md, the acceleration-structure seam), and the step-demand function
+// (../step_demand.h) says what it costs. A step takes two phases so the unit's requests to its
+// private L1 and pipelines come in time order:
+//
+//   fetch ray -> [step: issue the plan's fetches -> ops: run the plan's operations on their
+//   pipelines (box, triangle, ...), then any the results call for (alpha tests)]* -> write hit
+//
+// A scheduler picks the context whose next phase is ready earliest (one step per issue_cycles).
+// The on-chip stack holds `stack_entries` entries per ray; pushes beyond spill to memory (posted
+// writes), pops of spilled entries read them back (the ray waits), all counted as stack traffic.
+// The unit runs ahead of SystemC time by at most quantum_cycles, then waits (temporal decoupling).
+//
+// With treelet scheduling (ray_buffer bound), contexts take rays from the ray buffer queue of the
+// unit's current treelet instead of from dispatch; a ray whose next step lies in another treelet
+// is parked in that treelet's queue and the context takes the next ray. Traversal order, hits and
+// work counts do not change: the stepper is the same, the ray only waits in between.
+#include <cstdint>
+#include <vector>
+
+#include "rtl_model/traversal/context_queue.h"
+#include "rtl_model/traversal/traversal_unit.h"
+
+namespace rtsim {
+
+class MimdUnit : public TraversalUnit {
+public:
+    SC_HAS_PROCESS(MimdUnit);
+    MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index);
+
+    Cycle finish_cycle() const override { return m_finish; }
+    uint64_t rays_done() const override { return m_rays; }
+    CycleAccount cycle_account(Cycle total_cycles) const override;
+    nlohmann::json stats_json(Cycle total_cycles) const override;
+
+private:
+    enum class Phase : uint8_t { fetch_ray, step, ops };
+    struct Context {
+        RayState ray;              ///< stepper, ray id, start cycle, stack split
+        StepDemand demand;         ///< the step in flight: costed when its fetches issue
+        Phase phase = Phase::step;
+        uint32_t treelet = 0;      ///< treelet the ray is traversing (treelet mode)
+        bool active = false;
+        Cycle accounted = 0;       ///< its cycles up to here are in m_account
+    };
+
+    void run();
+    void sync(Cycle t);
+    bool start_ray(uint32_t c, Cycle t);
+    bool take_parked_ray(uint32_t c, Cycle t);
+    void park_ray(uint32_t c, uint32_t treelet, Cycle t);
+    void fill_idle_contexts(Cycle t);
+    void activate(uint32_t c, Cycle t);
+    void deactivate(uint32_t c, Cycle t);
+    void advance(uint32_t c, Cycle t);
+    void step(uint32_t c, Cycle t);
+    void run_ops(uint32_t c, Cycle t);
+    void finish_ray(uint32_t c, Cycle t);
+    Cycle stack_traffic(uint32_t c, Cycle t, Cycle ready);
+    void schedule(uint32_t c, Cycle t) { m_events.schedule(c, t); }
+    /// Context c's cycles from its last accounted cycle to `until` went to `use`.
+    void account(uint32_t c, CycleUse use, Cycle until);
+    /// Context c waited from its last accounted cycle to `ready` for a read (split by `info`).
+    void account_read(uint32_t c, Cycle ready, const AccessInfo& info);
+
+    const TraversalConfig& m_config;
+    UnitContext m_ctx;
+    const MemoryMap& m_map;
+    StepperPool& m_steppers;
+    const StepCosts m_costs;
+    uint32_t m_index;
+    std::vector<Context> m_contexts;
+    ContextQueue m_events;  ///< each context's next phase, earliest first
+    Cycle m_sched_free = 0;
+    Cycle m_synced = 0;
+    Cycle m_finish = 0;
+    uint32_t m_active = 0;
+    Cycle m_busy_since = 0, m_busy_cycles = 0;
+    uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0, m_syncs = 0;
+    bool m_treelet_mode = false;
+    uint32_t m_frame = 0;  ///< the dispatch frame this unit last filled its contexts from
+    Cycle m_next_fill = 0;
+    uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
+    CycleAccount m_account;
+};
+
+}  // namespace rtsim

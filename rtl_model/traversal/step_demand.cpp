@@ -1,0 +1,66 @@
+#include "rtl_model/traversal/step_demand.h"
+
+#include <algorithm>
+#include <string>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+namespace {
+
+void add_issue(const Op& op, const StepCosts& costs, StepDemand& d) {
+    const uint32_t width = costs.width[size_t(op.kind)];
+    if (width == 0)
+        throw Error(std::string("model: a step issued '") + op_kind_name(op.kind) +
+                    "' operations but the machine has no pipeline for them");
+    d.issues[d.issue_count++] = OpIssue{op.kind, op.count, issues_for(op.count, width)};
+}
+
+void plan_demand(const StepPlan& plan, const StepCosts& costs, StepDemand& d) {
+    d.read_count = plan.fetch_count;
+    std::copy(plan.fetch, plan.fetch + plan.fetch_count, d.reads);
+    d.issue_count = 0;
+    for (int i = 0; i < plan.op_count; ++i) add_issue(plan.op[i], costs, d);
+    d.scheduler_slots = kSchedulerSlotsPerStep;
+}
+
+void outcome_demand(const StepOutcome& outcome, const StepCosts& costs, StepDemand& d) {
+    for (int i = 0; i < outcome.op_count; ++i) add_issue(outcome.op[i], costs, d);
+}
+
+/// Pushes beyond the on-chip entries spill the oldest entry to the next spill slot; pops with
+/// no entry on chip read the newest spilled one back (docs/model.md, "Traversal stack").
+void stack_demand(int before, int after, StackSplit& stack, const StepCosts& costs, StepDemand& d) {
+    d.spill_first = stack.spilled;
+    d.spills = d.fills = 0;
+    for (int i = before; i < after; ++i) {
+        if (stack.local < costs.stack_entries) ++stack.local;
+        else ++stack.spilled, ++d.spills;
+    }
+    d.fill_first = stack.spilled - 1;
+    for (int i = after; i < before; ++i) {
+        if (stack.local > 0) --stack.local;
+        else --stack.spilled, ++d.fills;
+    }
+}
+
+}  // namespace
+
+StepDemand step_demand(const StepPlan& plan, const StepOutcome& outcome, int stack_before, int stack_after,
+                       StackSplit& stack, const StepCosts& costs) {
+    StepDemand d;
+    plan_demand(plan, costs, d);
+    outcome_demand(outcome, costs, d);
+    stack_demand(stack_before, stack_after, stack, costs, d);
+    return d;
+}
+
+void take_step(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& d) {
+    plan_demand(stepper.plan(), costs, d);  // execute() plans the next step over this one
+    const int before = stepper.stack_size();
+    outcome_demand(stepper.execute(), costs, d);
+    stack_demand(before, stepper.stack_size(), stack, costs, d);
+}
+
+}  // namespace rtsim

@@ -1,0 +1,94 @@
+#pragma once
+// Work one ray caused in the reference traversal; the model must count the same (docs/accel.md).
+// Names are neutral so every acceleration structure reports in them.
+//
+// Every counter is declared once, in RTSIM_WORK_FIELDS: WorkCounts' members, the trace's WORK
+// record, the hit checker's totals and messages, the analytic level's sums, the energy model's
+// prices, the Python bindings and the trace dtypes all iterate it, so adding a counter is one
+// line here plus the code that counts it (and a trace-format version bump: WORK records grow).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "traces/common/op_kind.h"
+
+// X(name, tests_of, plan_step, doc)
+//   tests_of:  the operation kind whose tests the field counts (what a pipeline of that kind
+//              does for the ray), or kNoOpKind
+//   plan_step: the field counts steps a traversal unit plans (each a fetch, then operations)
+#define RTSIM_WORK_FIELDS(X)                                                                        \
+    X(steps, kNoOpKind, true, "traversal steps that fetched a node or a cell")                     \
+    X(box_tests, OpKind::box, false, "ray/box tests (a node's child boxes, a grid's bounds)")      \
+    X(tri_tests, OpKind::triangle, false, "ray/triangle tests")                                    \
+    X(anyhit_calls, OpKind::anyhit, false, "alpha-mask (any-hit) evaluations on MASK triangles")   \
+    X(transforms, OpKind::transform, false, "instance transforms (two-level structures)")         \
+    X(cell_steps, OpKind::cell, true, "3D-DDA steps from cell to cell (grids)")                    \
+    X(plane_tests, OpKind::plane, false, "ray/split-plane tests (kd-trees, BIH)")                  \
+    X(refs, kNoOpKind, false, "primitive references fetched (structures with index lists)")
+
+namespace rtsim {
+
+/// The work fields by position (WORK record order).
+enum class WorkField : uint8_t {
+#define RTSIM_WORK_ENUM(name, tests_of, plan_step, doc) name,
+    RTSIM_WORK_FIELDS(RTSIM_WORK_ENUM)
+#undef RTSIM_WORK_ENUM
+};
+#define RTSIM_WORK_ONE(name, tests_of, plan_step, doc) +1
+constexpr int kWorkFieldCount = 0 RTSIM_WORK_FIELDS(RTSIM_WORK_ONE);
+#undef RTSIM_WORK_ONE
+
+struct WorkCounts {
+#define RTSIM_WORK_MEMBER(name, tests_of, plan_step, doc) uint32_t name = 0;
+    RTSIM_WORK_FIELDS(RTSIM_WORK_MEMBER)
+#undef RTSIM_WORK_MEMBER
+
+    uint32_t& operator[](WorkField f);
+    uint32_t operator[](WorkField f) const;
+    WorkCounts& operator+=(const WorkCounts& o);
+    bool operator==(const WorkCounts& o) const;
+    bool operator!=(const WorkCounts& o) const { return !(*this == o); }
+};
+
+/// One field's declaration.
+struct WorkFieldInfo {
+    const char* name;
+    uint32_t WorkCounts::*member;
+    OpKind tests_of;  ///< kNoOpKind: the field counts no pipeline's tests
+    bool plan_step;
+    const char* doc;
+};
+inline constexpr std::array<WorkFieldInfo, kWorkFieldCount> kWorkFields{{
+#define RTSIM_WORK_INFO(name, tests_of, plan_step, doc) {#name, &WorkCounts::name, tests_of, plan_step, doc},
+    RTSIM_WORK_FIELDS(RTSIM_WORK_INFO)
+#undef RTSIM_WORK_INFO
+}};
+
+inline uint32_t& WorkCounts::operator[](WorkField f) { return this->*kWorkFields[size_t(f)].member; }
+inline uint32_t WorkCounts::operator[](WorkField f) const { return this->*kWorkFields[size_t(f)].member; }
+inline WorkCounts& WorkCounts::operator+=(const WorkCounts& o) {
+    for (const WorkFieldInfo& f : kWorkFields) this->*f.member += o.*f.member;
+    return *this;
+}
+inline bool WorkCounts::operator==(const WorkCounts& o) const {
+    for (const WorkFieldInfo& f : kWorkFields)
+        if (this->*f.member != o.*f.member) return false;
+    return true;
+}
+
+/// The field counting the tests of `kind`; throws rtsim::Error naming the kind when none does.
+WorkField work_field_of(OpKind kind);
+/// Sum of the fields that count plan steps (what a unit's scheduler sees per ray, less the ray's own slot).
+double plan_step_work(const WorkCounts& w);
+
+/// Work summed over many rays (64-bit: a frame's box tests overflow 32 bits).
+struct WorkTotals {
+    std::array<uint64_t, kWorkFieldCount> field{};
+    uint64_t operator[](WorkField f) const { return field[size_t(f)]; }
+    uint64_t& operator[](WorkField f) { return field[size_t(f)]; }
+    void add(const WorkCounts& w) {
+        for (size_t i = 0; i < field.size(); ++i) field[i] += w.*kWorkFields[i].member;
+    }
+};
+
+}  // namespace rtsim
