@@ -16,6 +16,7 @@
 #include "sim/harness/analytic_estimate.h"
 #include "sim/harness/energy_area.h"
 #include "sim/harness/hit_checker.h"
+#include "sim/harness/memory_estimate.h"
 #include "sim/harness/roofline.h"
 #include "sim/harness/run_files.h"
 #include "sim/harness/sampling.h"
@@ -150,6 +151,16 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     const json manifest = read_manifest(rtt);
     if (reader.has(SectionKind::frames))
         check_frames_supported(o.config, reader.section(SectionKind::frames).record_count, rtt);
+    uint64_t image_bytes = 0;  // the structure's sections: what load_accel will hold
+    for (const SectionInfo& s : reader.sections()) {
+        const bool per_ray = s.kind == SectionKind::rays || s.kind == SectionKind::hits || s.kind == SectionKind::work;
+        if (!per_ray) image_bytes += s.bytes;
+    }
+    check_sim_memory(o.config, image_bytes,
+                     "config (fidelity=analytic, analytic.caches=" +
+                         std::string(o.config.analytic.caches == AnalyticCaches::functional ? "functional" : "statistical") +
+                         ", traversal.units=" + std::to_string(o.config.traversal.units) +
+                         ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     fs::create_directories(o.out_dir);
     write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(o.config));
     if (o.config.analytic.caches == AnalyticCaches::functional)

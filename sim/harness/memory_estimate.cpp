@@ -47,6 +47,10 @@ MemoryEstimate estimate_sim_memory(const SimConfig& c, uint64_t image_bytes) {
         model = units * kPerUnit;
         context_bytes = contexts * kPerContext;
     }
+    // The analytic level's functional caches step every ray in a context of its own (a stepper
+    // and its stack, as a SystemC context holds), without the units' modules.
+    if (c.fidelity == Fidelity::analytic && c.analytic.caches == AnalyticCaches::functional)
+        context_bytes = contexts * kPerContext;
     const double total = kBase + image + model + context_bytes + l1 + l2;
     char detail[256];
     std::snprintf(detail, sizeof detail,

@@ -8,7 +8,8 @@
 //   base process (SystemC kernel, stats, buffers)        16 MiB
 //   acceleration-structure image (read, then loaded)    2 x its bytes
 //   per traversal unit (module, thread stack, pipelines)  280 KiB + its L1 lines x 24 B
-//   per ray context (traversal stepper and stack)        1.1 KiB
+//   per ray context (traversal stepper and stack)        1.1 KiB (approx, detailed, and analytic
+//                                                        with analytic.caches = functional)
 //   L2                                                   lines x 24 B
 // Queues that grow with the run (treelet ray queues, the DRAM timeline) are not included.
 #include <cstdint>
