@@ -65,12 +65,12 @@ def int_arg(
     return number
 
 
-def float_arg(value: Any, name: str) -> float:
-    """A finite real number (bool refused)."""
+def float_arg(value: Any, name: str, finite: bool = True) -> float:
+    """A real number (bool refused), finite unless `finite` is False."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ArgumentTypeError(f"{name}: expected a number, got {_kind(value)} {value!r}")
     number = float(value)
-    if not math.isfinite(number):
+    if finite and not math.isfinite(number):
         raise ArgumentValueError(f"{name}: expected a finite number, got {number}")
     return number
 

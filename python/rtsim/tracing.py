@@ -83,7 +83,12 @@ def _camera_arg(camera: Any) -> tuple[list[float], list[float], float] | None:
                 point = None
             if point is None or len(point) != 3:
                 raise ArgumentTypeError(f"camera {name}: expected 3 coordinates, got {camera!r}")
-        points.append([float_arg(v, f"camera {name}") for v in point])
+        values = [float_arg(v, f"camera {name}", finite=False) for v in point]
+        if not all(math.isfinite(v) for v in values):
+            raise ArgumentValueError(
+                f"camera eye and target must be finite numbers (camera {name}: {values})"
+            )
+        points.append(values)
     fov = float_arg(camera[2], "camera fov_degrees")
     if not 0.0 < fov < 180.0:
         raise ArgumentValueError(f"camera: field of view must be in (0, 180) degrees, got {fov:g}")

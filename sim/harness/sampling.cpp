@@ -98,6 +98,7 @@ SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
 
 bool sample_covers_trace(const SimConfig& c, uint64_t n) {
     const SamplingConfig& s = c.sampling;
+    if (s.count > n) return false;  // more rays than the trace: plan_sample says so
     const uint64_t budget = s.count ? s.count : uint64_t(std::llround(s.fraction * double(n)));
     if (budget >= n) return true;
     SimConfig all = c;  // the largest sample: every ray

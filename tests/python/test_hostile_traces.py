@@ -5,6 +5,7 @@ refuse the same inputs; nothing crashes, hangs or answers wrongly with exit 0.""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 from pathlib import Path
 
@@ -183,3 +184,18 @@ def test_sample_of_the_whole_small_trace_runs_exact(
     assert sim.returncode == 0, sim.stderr
     summary = json.loads((tmp_path / "run" / "stats.json").read_text())["summary"]
     assert summary["sampled"] is False and summary["rays"] == rtsim.open_trace(small).ray_count
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dev_zero"])
+def test_trace_that_is_a_special_file(kind: str, tmp_path: Path) -> None:
+    """A FIFO would block the reader's open and /dev/zero read without end: both refused."""
+    trace = tmp_path / "t"
+    trace.mkdir()
+    if kind == "fifo":
+        os.mkfifo(trace / "trace.rtt")
+    else:
+        (trace / "trace.rtt").symlink_to("/dev/zero")
+    sim = _sim(trace, tmp_path / "run")  # times out (fails) if it blocks
+    assert sim.returncode == 2 and "is not a regular file" in sim.stderr, sim.stderr
+    with pytest.raises(rtsim.RtsimError, match="not a regular file"):
+        rtsim.open_trace(trace)
