@@ -152,13 +152,13 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     if (reader.has(SectionKind::frames))
         check_frames_supported(o.config, reader.section(SectionKind::frames).record_count, rtt);
     uint64_t image_bytes = 0;  // the structure's sections: what load_accel will hold
-    for (const SectionInfo& s : reader.sections()) {
-        const bool per_ray = s.kind == SectionKind::rays || s.kind == SectionKind::hits || s.kind == SectionKind::work;
-        if (!per_ray) image_bytes += s.bytes;
-    }
+    for (const SectionInfo& s : reader.sections())
+        if (s.kind != SectionKind::rays && s.kind != SectionKind::hits && s.kind != SectionKind::work)
+            image_bytes += s.bytes;
+    const bool functional = o.config.analytic.caches == AnalyticCaches::functional;
     check_sim_memory(o.config, image_bytes,
-                     "config (fidelity=analytic, analytic.caches=" +
-                         std::string(o.config.analytic.caches == AnalyticCaches::functional ? "functional" : "statistical") +
+                     std::string("config (fidelity=analytic, analytic.caches=") +
+                         (functional ? "functional" : "statistical") +
                          ", traversal.units=" + std::to_string(o.config.traversal.units) +
                          ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     fs::create_directories(o.out_dir);

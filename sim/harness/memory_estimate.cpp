@@ -53,11 +53,13 @@ MemoryEstimate estimate_sim_memory(const SimConfig& c, uint64_t image_bytes) {
     if (c.fidelity == Fidelity::analytic && c.analytic.caches == AnalyticCaches::functional)
         context_bytes = contexts * kPerAnalyticContext;
     const double total = kBase + image + model + context_bytes + l1 + l2;
+    const double per_context = (context_bytes > 0 ? context_bytes / contexts : kPerContext) / 1024;
     char detail[256];
     std::snprintf(detail, sizeof detail,
                   "%.0f ray contexts x %.3g KiB = %.2f GiB, %.0f units = %.2f GiB, L1s %.2f GiB, L2 %.2f GiB, "
                   "structure image %.2f GiB",
-                  contexts, (context_bytes > 0 ? context_bytes / contexts : kPerContext) / 1024, context_bytes / kGiB, units, model / kGiB, l1 / kGiB, l2 / kGiB, image / kGiB);
+                  contexts, per_context, context_bytes / kGiB, units, model / kGiB, l1 / kGiB, l2 / kGiB,
+                  image / kGiB);
     return MemoryEstimate{uint64_t(total), memory_limit_bytes(), detail};
 }
 

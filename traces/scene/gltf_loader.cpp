@@ -177,7 +177,8 @@ std::vector<glm::dmat4> gpu_instances(const Source& src, const tinygltf::Value& 
                          (type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT));
         if (!ok)
             src.fail(where + ": " + names[a] + " has componentType " + std::to_string(type) +
-                     (a == 1 ? " (must be 5126 float, or normalized 5120 byte or 5122 short)" : " (must be 5126 float)"));
+                     (a == 1 ? " (must be 5126 float, or normalized 5120 byte or 5122 short)"
+                             : " (must be 5126 float)"));
         if (have_count && views[a].count != count) src.fail(where + ": attribute counts differ");
         count = views[a].count;
         have_count = present[a] = true;
