@@ -49,6 +49,15 @@ def test_trace_output_path_refused(where: str, tmp_path: Path, capsys) -> None:
         assert not (tmp_path / NON_UTF8).exists()  # refused before tracing
 
 
+def test_sweep_output_path_not_utf8_refused(tmp_path: Path, capsys) -> None:
+    (tmp_path / "s.yaml").write_text(SPEC)
+    out = tmp_path / NON_UTF8
+    code = main(["sweep", str(tmp_path / "s.yaml"), "-o", str(out), "--no-progress"])
+    err = _err(capsys)
+    assert code == 2 and "not valid UTF-8" in err, err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("where", ["non_utf8", "a_file", "proc"])
 def test_sim_output_path_refused(where: str, cornell_trace: Path, tmp_path: Path) -> None:
     out = {
