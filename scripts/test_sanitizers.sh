@@ -88,7 +88,8 @@ for trace in "$work"/corpus/sim/*; do
   fi
 done
 echo "== sanitizers: bad-input pytest corpus against the sanitized rtsim-sim"
-RTSIM_SIM="$PWD/build/asan/sim/rtsim-sim" "$PYTHON" -m pytest tests/python/test_bad_inputs.py -q -k "trace or manifest or config" \
+RTSIM_SIM="$PWD/build/asan/sim/rtsim-sim" "$PYTHON" -m pytest tests/python/test_bad_inputs.py \
+  tests/python/test_hostile_traces.py -q -k "trace or manifest or config or frame or grid or edits" \
   || status=1
 fi
 

@@ -13,17 +13,16 @@
 #include "sim/harness/simulate.h"
 #include "sim/report/stats_schema.h"
 #include "traces/common/error.h"
+#include "traces/common/files.h"
 
 namespace {
 
 rtsim::SimConfig load_config(const std::string& path, const std::vector<std::string>& sets) {
     rtsim::SimConfig config;
     if (!path.empty()) {
-        std::error_code ec;
-        rtsim::require(!std::filesystem::is_directory(path, ec), path + ": is a folder, not a config JSON file");
-        std::ifstream in(path);
-        rtsim::require(bool(in), path + ": cannot open config");
-        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        rtsim::require_utf8_path(path, "--config");
+        // A FIFO or /dev/zero is refused; a config is small (the defaults are 6 KB).
+        const std::string text = rtsim::read_small_file(path, "config JSON file", 64u << 20);
         nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
         rtsim::require(!j.is_discarded(), path + ": not valid JSON");
         try {
@@ -33,7 +32,17 @@ rtsim::SimConfig load_config(const std::string& path, const std::vector<std::str
         }
     }
     for (const std::string& s : sets) rtsim::config_set(config, s);
-    rtsim::validate(config);
+    try {
+        rtsim::validate(config);
+    } catch (const rtsim::Error& e) {
+        // Name the file the value came from, unless a --set assignment named in the message did.
+        const std::string what = e.what();
+        bool from_set = false;
+        for (const std::string& s : sets)
+            from_set = from_set || what.find("'" + s.substr(0, s.find('=')) + "'") != std::string::npos;
+        if (path.empty() || from_set) throw;
+        throw rtsim::Error(path + ": " + what);
+    }
     return config;
 }
 
@@ -67,10 +76,13 @@ int sc_main(int argc, char** argv) {
         }
         rtsim::require(!trace.empty(), "no trace given (rtsim-sim TRACE -o RUN)");
         rtsim::require(!out_dir.empty(), "no run folder given (-o RUN)");
+        rtsim::require_utf8_path(trace, "trace");
+        rtsim::require_utf8_path(out_dir, "run folder (-o)");
         sc_core::sc_set_time_resolution(1, sc_core::SC_NS);  // one SystemC ns per cycle
         rtsim::SimOptions o;
         o.trace = trace;
         o.config = load_config(config_path, sets);
+        rtsim::make_output_folder(out_dir, "run");
         o.out_dir = out_dir;
         o.timeline = timeline;
         o.progress = progress;
@@ -85,6 +97,10 @@ int sc_main(int argc, char** argv) {
                 std::cerr << "rtsim-sim: warning: sample too small to trust: " << why.get<std::string>() << "\n";
         return r.exit_code;
     } catch (const rtsim::Error& e) {
+        std::cerr << "rtsim-sim: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::filesystem::filesystem_error& e) {
+        // A folder or file that cannot be made or read after the checks above (a race).
         std::cerr << "rtsim-sim: error: " << e.what() << "\n";
         return 2;
     } catch (const sc_core::sc_report& e) {

@@ -29,10 +29,10 @@ except ImportError:  # not built by scikit-build-core (e.g. a source checkout on
 _LAZY = {
     "Scene": "rtsim._core",
     "procedural_scene_names": "rtsim._core",
-    "trace_rays": "rtsim._core",
-    "trace_sections": "rtsim._core",
-    "verify_trace": "rtsim._core",
-    "write_procedural_scene": "rtsim._core",
+    "trace_rays": "rtsim.tracing",
+    "trace_sections": "rtsim.trace_file",
+    "verify_trace": "rtsim.trace_file",
+    "write_procedural_scene": "rtsim.tracing",
     "load_scene": "rtsim.tracing",
     "trace_scene": "rtsim.tracing",
     "write_trace": "rtsim.tracing",
@@ -43,27 +43,31 @@ _LAZY = {
     "SimConfig": "rtsim.config",
 }
 
+#: Public names defined under another name in their module.
+_RENAMED = {"trace_sections": "trace_section_table", "verify_trace": "verify_trace_file"}
+
 if TYPE_CHECKING:
-    from rtsim._core import (
-        Scene,
-        procedural_scene_names,
-        trace_rays,
-        trace_sections,
-        verify_trace,
-        write_procedural_scene,
-    )
+    from rtsim._core import Scene, procedural_scene_names
     from rtsim.config import SimConfig
     from rtsim.simulation import simulate
     from rtsim.stats import Stats
     from rtsim.trace_file import Trace, open_trace
-    from rtsim.tracing import load_scene, trace_scene, write_trace
+    from rtsim.trace_file import trace_section_table as trace_sections
+    from rtsim.trace_file import verify_trace_file as verify_trace
+    from rtsim.tracing import (
+        load_scene,
+        trace_rays,
+        trace_scene,
+        write_procedural_scene,
+        write_trace,
+    )
 
 
 def __getattr__(name: str) -> Any:
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'rtsim' has no attribute '{name}'")
-    value = getattr(importlib.import_module(module), name)
+    value = getattr(importlib.import_module(module), _RENAMED.get(name, name))
     globals()[name] = value
     return value
 

@@ -19,14 +19,18 @@ from __future__ import annotations
 import copy
 import dataclasses
 import json
+import math
+import numbers
 from dataclasses import field
 from importlib import resources
 from typing import Any, ClassVar, TypeVar
 
+from rtsim.errors import RtsimError
+
 T = TypeVar("T")
 
 
-class ConfigError(ValueError):
+class ConfigError(RtsimError, ValueError):
     """A config dict, key path or patch that does not fit the tree; the message names the key."""
 
 
@@ -144,21 +148,29 @@ def _join(prefix: str, name: str) -> str:
     return f"{prefix}.{name}" if prefix else name
 
 
+def _numpy_bool(value: Any) -> bool:
+    return type(value).__module__ == "numpy" and type(value).__name__ in ("bool", "bool_")
+
+
 def _check_value(f: dataclasses.Field[Any], value: Any, path: str) -> Any:
     kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", "")
+    # numpy scalars (np.int64, np.float32, np.bool_) count as the Python numbers they hold.
     if kind == "bool":
-        if not isinstance(value, bool):
+        if not isinstance(value, bool) and not _numpy_bool(value):
             raise ConfigError(f"config: '{path}' must be true or false, got {value!r}")
-        return value
+        return bool(value)
     if kind == "int":
-        if isinstance(value, float) and value.is_integer():
+        is_number = isinstance(value, numbers.Real) and not isinstance(value, bool)
+        if is_number and not isinstance(value, numbers.Integral) and float(value).is_integer():
             value = int(value)
-        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        if not is_number or not isinstance(value, numbers.Integral) or value < 0:
             raise ConfigError(f"config: '{path}' must be a non-negative integer, got {value!r}")
-        return value
+        return int(value)
     if kind == "float":
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise ConfigError(f"config: '{path}' must be a number, got {value!r}")
+        if not math.isfinite(float(value)):
+            raise ConfigError(f"config: '{path}' must be a finite number, got {value!r}")
         return float(value)
     if not isinstance(value, str):
         raise ConfigError(f"config: '{path}' must be a string, got {value!r}")
@@ -197,6 +209,8 @@ def unflatten(values: dict[str, Any]) -> dict[str, Any]:
     """{'l1.size_kib': 64} -> {'l1': {'size_kib': 64}}."""
     out: dict[str, Any] = {}
     for key, value in values.items():
+        if not isinstance(key, str):
+            raise ConfigError(f"config: keys are dotted names like 'l1.size_kib', got {key!r}")
         node = out
         *parents, leaf = key.split(".")
         for part in parents:

@@ -1,11 +1,28 @@
 """The exceptions rtsim raises for bad input, in pure Python so that catching them does not load
-the C++ extension. ``rtsim._core`` raises the same ``RtsimError`` class for C++ errors."""
+the C++ extension. ``rtsim._core`` raises the same ``RtsimError`` class for C++ errors.
+
+Every one is an ``RtsimError``; where Python's conventions call for a built-in type, it is also
+that type: a bad argument value is a ``ValueError``, an argument of the wrong type a
+``TypeError``, an index out of range an ``IndexError``.
+"""
 
 from __future__ import annotations
 
 
 class RtsimError(RuntimeError):
     """Bad input: a file, field, key or ray that rtsim cannot use; the message names it."""
+
+
+class ArgumentValueError(RtsimError, ValueError):
+    """An argument of a usable type whose value rtsim cannot use (width=0, timeout=-1)."""
+
+
+class ArgumentTypeError(RtsimError, TypeError):
+    """An argument of a type rtsim does not take (None for a path, a string for a size)."""
+
+
+class RtsimIndexError(RtsimError, IndexError):
+    """An index past the end of what it indexes (a frame the trace does not have)."""
 
 
 class UnknownSceneError(RtsimError, ValueError):

@@ -156,6 +156,9 @@ def run_sim(
     stderr line to on_message as it arrives. Raises OSError if the process cannot start
     (SimNotFoundError if there is no rtsim-sim); every outcome of a started process, crashes
     and timeouts included, is returned."""
+    from rtsim.args import timeout_arg
+
+    timeout = timeout_arg(timeout)
     exe = exe or find_sim()
     if job.out_dir.exists() and not job.out_dir.is_dir():
         raise NotADirectoryError(f"{job.out_dir}: the run folder is a file")

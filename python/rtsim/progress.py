@@ -11,6 +11,7 @@ from rich.progress import (
     Progress,
     ProgressColumn,
     Task,
+    TaskID,
     TextColumn,
     TimeElapsedColumn,
     TimeRemainingColumn,
@@ -32,7 +33,12 @@ class RateColumn(ProgressColumn):
 
 
 class TraceProgress:
-    """Context manager and callable ``(done, total, stage)``: one bar per tracer stage."""
+    """Context manager and callable ``(done, total, stage)``: one bar per tracer stage, the last
+    MAX_BARS of them shown. Older bars are dropped, so each refresh draws a bounded number of
+    rows and the display costs time linear in the stages (an animated trace of 1024 frames has
+    thousands of stages)."""
+
+    MAX_BARS = 6
 
     def __init__(self, console: Console | None = None, disable: bool = False) -> None:
         self._progress = Progress(
@@ -48,7 +54,9 @@ class TraceProgress:
             transient=False,
         )
         self._stage: str | None = None
-        self._task: int | None = None
+        self._task: TaskID | None = None
+        self._shown: list[TaskID] = []
+        self._total = 1
 
     def __enter__(self) -> TraceProgress:
         self._progress.start()
@@ -66,14 +74,16 @@ class TraceProgress:
 
     def _finish_stage(self) -> None:
         if self._task is not None:
-            task = self._progress.tasks[-1]
-            if task.total is not None:
-                self._progress.update(self._task, completed=task.total)
+            self._progress.update(self._task, completed=self._total)
 
     def __call__(self, done: int, total: int, stage: str) -> None:
         if stage != self._stage:
             self._finish_stage()
             self._stage = stage
             self._task = self._progress.add_task(stage, total=max(total, 1))
+            self._shown.append(self._task)
+            if len(self._shown) > self.MAX_BARS:
+                self._progress.remove_task(self._shown.pop(0))
         assert self._task is not None
-        self._progress.update(self._task, completed=done, total=max(total, done, 1))
+        self._total = max(total, done, 1)
+        self._progress.update(self._task, completed=done, total=self._total)

@@ -74,14 +74,29 @@ def list_scenes() -> list[SceneEntry]:
     return built_in + shared_scenes()
 
 
+def _scene_in_folder(folder: Path) -> str:
+    """The one .gltf/.glb file of a scene folder (a shared scene's folder given as a path)."""
+    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in SCENE_SUFFIXES)
+    if len(files) == 1:
+        return str(files[0])
+    found = ", ".join(p.name for p in files) if files else "none"
+    raise UnknownSceneError(
+        f"{folder}: is a folder; a scene folder holds exactly one .gltf or .glb file "
+        f"(found: {found}); give the file's path"
+    )
+
+
 def resolve_scene(name: str | os.PathLike[str]) -> str:
-    """A path for an existing file; a built-in name as is; a shared scene's folder or file name
-    (case-insensitive) as its glTF path; a path that does not exist unchanged (the loader names
-    it). A bare name that is none of these raises UnknownSceneError (a ValueError and an
-    RtsimError) saying where it looked."""
+    """A path for an existing file; a built-in name as is; a folder holding one .gltf/.glb (a
+    shared scene's folder) as that file; a shared scene's folder or file name (case-insensitive)
+    as its glTF path; a path that does not exist unchanged (the loader names it). A bare name
+    that is none of these raises UnknownSceneError (a ValueError and an RtsimError) saying where
+    it looked."""
     text = os.fspath(name)
     if Path(text).is_file() or text in procedural_scene_names():
         return text
+    if Path(text).is_dir():
+        return _scene_in_folder(Path(text))
     wanted = text.lower()
     for entry in shared_scenes():
         assert entry.path is not None

@@ -19,6 +19,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from rtsim.args import ArgumentTypeError, bool_arg, check_utf8_path, path_arg, timeout_arg
 from rtsim.config import ConfigError, SimConfig, apply_patch, compose
 from rtsim.errors import HitMismatchError, RtsimError
 from rtsim.launcher import EXIT_BAD_INPUT, EXIT_MISMATCH, EXIT_OK, SimJob, read_json, run_sim
@@ -40,16 +41,20 @@ def resolve_config(
         elif isinstance(config, SimConfig):
             base = config
         elif isinstance(config, Mapping):
+            if not all(isinstance(k, str) for k in config):
+                raise ArgumentTypeError(f"config: keys must be strings, got {list(config)!r}")
             # Nested sections first, then dotted keys over them: {"l1": {...}, "l1.ways": 8}.
             nested = {k: v for k, v in config.items() if "." not in k}
             dotted_keys = {k: v for k, v in config.items() if "." in k}
             base = apply_patch(SimConfig(), copy.deepcopy(nested)).with_values(dotted_keys)
-        elif isinstance(config, os.PathLike) or str(config).endswith(".json"):
+        elif isinstance(config, os.PathLike) or (
+            isinstance(config, str) and config.endswith(".json")
+        ):
             base = _config_file(Path(config))
         elif isinstance(config, str):
             base = compose(config)
         else:
-            raise RtsimError(
+            raise ArgumentTypeError(
                 f"config: expected a SimConfig, a dict, a preset name or a .json path, "
                 f"got {type(config).__name__}"
             )
@@ -58,13 +63,28 @@ def resolve_config(
         raise RtsimError(str(err)) from err
 
 
+#: Largest config file read (the defaults are about 6 KB): /dev/zero must not be read forever.
+MAX_CONFIG_BYTES = 64 << 20
+
+
 def _config_file(path: Path) -> SimConfig:
+    check_utf8_path(str(path), "config")
     try:
-        data = json.loads(path.read_text())
+        if path.is_dir():
+            raise RtsimError(f"{path}: is a folder, not a config JSON file")
+        if path.exists() and not path.is_file():
+            raise RtsimError(
+                f"{path}: is not a regular file (a FIFO, device or socket); give a config JSON file"
+            )
+        with path.open("rb") as f:
+            raw = f.read(MAX_CONFIG_BYTES + 1)
+        if len(raw) > MAX_CONFIG_BYTES:
+            raise RtsimError(f"{path}: more than {MAX_CONFIG_BYTES} bytes; not a config JSON file")
+        data = json.loads(raw.decode("utf-8"))
     except OSError as err:
         raise RtsimError(f"{path}: cannot read the config ({err.strerror or err})") from err
-    except json.JSONDecodeError as err:
-        raise RtsimError(f"{path}: not valid JSON ({err})") from err
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as err:
+        raise RtsimError(f"{path}: not valid JSON ({type(err).__name__}: {err})") from err
     try:
         return SimConfig.from_dict(data)
     except ConfigError as err:
@@ -75,7 +95,14 @@ def _config_file(path: Path) -> SimConfig:
 def _run_folder(out: str | os.PathLike[str] | None) -> Iterator[Path]:
     if out is not None:
         path = Path(out)
-        path.mkdir(parents=True, exist_ok=True)
+        if path.exists() and not path.is_dir():
+            raise RtsimError(f"{path}: is a file, not a folder (out: the run folder)")
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise RtsimError(
+                f"{path}: cannot create the run folder ({err.strerror or err})"
+            ) from err
         yield path
         return
     with tempfile.TemporaryDirectory(prefix="rtsim-run-") as tmp:
@@ -112,9 +139,15 @@ def simulate(
     Raises RtsimError naming the key, field or file for bad input (unknown key, wrong type, out
     of range, missing or corrupt trace), and for a crash or a timeout."""
     resolved = resolve_config(config, overrides)
+    timeout = timeout_arg(timeout)
+    timeline = bool_arg(timeline, "timeline")
+    check = bool_arg(check, "check")
+    progress = bool_arg(progress, "progress")
     if timeline and out is None:
         raise RtsimError("timeline=True needs out=RUN: a run folder to keep timeline.json in")
-    trace_path = Path(getattr(trace, "folder", trace))
+    trace_path = Path(path_arg(getattr(trace, "folder", trace), "trace"))
+    if out is not None:
+        out = path_arg(out, "out")
     with _run_folder(out) as run:
         (run / "config.json").write_text(resolved.to_json() + "\n")
         job = SimJob(trace_path, run, config=run / "config.json", timeline=timeline)

@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 
 from rtsim._core import RtsimError, section_layouts, trace_sections, verify_trace
+from rtsim.args import int_arg, path_arg
+from rtsim.errors import RtsimIndexError
 from rtsim.kinds import RAY_KINDS as RAY_KINDS  # RayKind values stored in RayRecord.kind
 
 TRACE_FILE = "trace.rtt"
@@ -74,6 +76,9 @@ class Trace:
         section = self.sections.get(name)
         if section is None:
             raise RtsimError(f"{self.path}: trace has no '{name}' section")
+        # Each record section's CRCs are checked on its first use (one streaming pass), as
+        # rtsim-sim checks them: a flipped byte raises RtsimError naming the section and chunk.
+        verify_trace(self.path, name.upper())
         dtype = SECTION_DTYPES[name]
         if section.record_count == 0:
             return np.zeros(0, dtype=dtype)
@@ -138,6 +143,7 @@ class Trace:
 
     def frame(self, f: int) -> slice:
         """The rays of frame f, as a slice of rays, hits and work."""
+        f = int_arg(f, "frame", 0, len(self.frames) - 1, RtsimIndexError)
         first, count = (int(x) for x in self.frames[f])
         return slice(first, first + count)
 
@@ -169,7 +175,9 @@ class Trace:
         return self.folder.name
 
     def verify(self) -> None:
-        """Checks the CRC32 of every chunk of every section (raises RtsimError)."""
+        """Checks the CRC32 of every chunk of every section now (raises RtsimError). Opening
+        checks the header, table, image regions and frame table; RAYS, HITS and WORK are
+        checked when first read."""
         verify_trace(self.path)
 
 
@@ -189,12 +197,15 @@ def open_trace(path: str | Path) -> Trace:
 
     Raises RtsimError naming the file if it is missing, truncated, corrupted or of another
     version, if a section's record size differs from the dtype this package expects, if its BVH
-    image is not a tree the traversal can walk (rtsim._core.trace_sections checks it), if a ray
-    has an unknown kind, or if manifest.json is not a JSON object.
+    image is not a tree the traversal can walk (rtsim._core.trace_sections checks it), if RAYS,
+    HITS and WORK differ in length or the frame table does not cover the rays, if a ray has an
+    unknown kind, or if manifest.json is not a JSON object. RAYS is CRC-checked here, HITS and
+    WORK when first read (``trace.hits``), each naming the section and chunk that failed.
     """
-    file, folder = _resolve(path)
+    file, folder = _resolve(path_arg(path, "path"))
     if not file.is_file():
-        raise RtsimError(f"{file}: no trace file (expected a trace folder or a .rtt file)")
+        what = "not a regular file" if file.exists() else "no trace file"
+        raise RtsimError(f"{file}: {what} (expected a trace folder or a .rtt file)")
     sections: dict[str, Section] = {}
     for info in trace_sections(file):
         name = _section_name(info)
@@ -247,3 +258,15 @@ def _check_ray_kinds(trace: Trace) -> None:
             f"{trace.path}: ray {first} has unknown ray kind {int(kinds[first])} "
             f"(known kinds: 0..{len(RAY_KINDS) - 1}); {bad.size} such rays"
         )
+
+
+def verify_trace_file(path: str | Path) -> None:
+    """Checks the CRC32 of every chunk of every section of a trace file (raises RtsimError
+    naming the section and chunk)."""
+    verify_trace(path_arg(path, "path"))
+
+
+def trace_section_table(path: str | Path) -> list[dict[str, Any]]:
+    """Validates a trace file's header, section table, structure image and frame table; returns
+    its sections (kind, record_bytes, record_count, offset, bytes, chunk_bytes, crc_offset)."""
+    return trace_sections(path_arg(path, "path"))

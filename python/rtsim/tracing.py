@@ -16,6 +16,16 @@ import os
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
+from rtsim.args import (
+    UINT32_MAX,
+    UINT64_MAX,
+    ArgumentTypeError,
+    ArgumentValueError,
+    bool_arg,
+    float_arg,
+    int_arg,
+    path_arg,
+)
 from rtsim.errors import RtsimError
 from rtsim.kinds import RAY_KINDS
 from rtsim.scenes import resolve_scene
@@ -36,13 +46,73 @@ def load_scene(
     by its name ("sponza"). hairball_triangles and seed shape the procedural scenes."""
     from rtsim import _core
 
-    return _core.load_scene(resolve_scene(scene), hairball_triangles=hairball_triangles, seed=seed)
+    return _core.load_scene(
+        resolve_scene(path_arg(scene, "scene")),
+        hairball_triangles=int_arg(hairball_triangles, "hairball_triangles", 1, UINT32_MAX),
+        seed=int_arg(seed, "seed", 0, UINT64_MAX),
+    )
 
 
 def _scene_arg(scene: SceneLike) -> Any:
     from rtsim import _core
 
-    return scene if isinstance(scene, _core.Scene) else resolve_scene(scene)
+    return scene if isinstance(scene, _core.Scene) else resolve_scene(path_arg(scene, "scene"))
+
+
+#: The tracer's limits (traces/tracer/tracer.cpp): pixels, frames of an animated trace, bounces.
+MAX_PIXELS = 1 << 28
+MAX_FRAMES = 1024
+MAX_BOUNCES = 64
+
+
+def _camera_arg(camera: Any) -> tuple[list[float], list[float], float] | None:
+    """(eye, target, fov) checked: 3 + 3 finite numbers, fov in (0, 180) degrees."""
+    if camera is None:
+        return None
+    if isinstance(camera, (str, bytes)) or not isinstance(camera, Sequence) or len(camera) != 3:
+        raise ArgumentTypeError(
+            f"camera: expected (eye, target, fov_degrees), e.g. ((0, 1, 5), (0, 1, 0), 60), "
+            f"got {camera!r}"
+        )
+    points = []
+    for name, point in (("eye", camera[0]), ("target", camera[1])):
+        if isinstance(point, (str, bytes)) or not isinstance(point, Sequence) or len(point) != 3:
+            try:
+                point = list(point)  # a numpy array
+            except TypeError:
+                point = None
+            if point is None or len(point) != 3:
+                raise ArgumentTypeError(f"camera {name}: expected 3 coordinates, got {camera!r}")
+        values = [float_arg(v, f"camera {name}", finite=False) for v in point]
+        if not all(math.isfinite(v) for v in values):
+            raise ArgumentValueError(
+                f"camera eye and target must be finite numbers (camera {name}: {values})"
+            )
+        points.append(values)
+    fov = float_arg(camera[2], "camera fov_degrees")
+    if not 0.0 < fov < 180.0:
+        raise ArgumentValueError(f"camera: field of view must be in (0, 180) degrees, got {fov:g}")
+    return points[0], points[1], fov
+
+
+def _workload_arg(workload: Sequence[str] | str | None) -> list[str] | None:
+    if workload is None:
+        return None
+    if isinstance(workload, str):
+        kinds = [k.strip() for k in workload.split(",") if k.strip()]
+    elif isinstance(workload, Sequence) and all(isinstance(k, str) for k in workload):
+        kinds = list(workload)
+    else:
+        raise ArgumentTypeError(
+            f"workload: expected ray kind names ('primary,diffuse' or a list), got {workload!r}"
+        )
+    unknown = sorted({k.lower() for k in kinds} - set(RAY_KINDS))
+    if unknown or not kinds:
+        raise ArgumentValueError(
+            f"workload: unknown ray kind(s) {unknown or '(none given)'}; "
+            f"choose from {', '.join(RAY_KINDS)} (None: what the scene calls for)"
+        )
+    return [k.lower() for k in kinds]
 
 
 def trace_defaults() -> dict[str, Any]:
@@ -83,27 +153,45 @@ def trace_scene(
     manifest["frames"] lists each frame's rays and TLAS build time."""
     from rtsim import _core
 
-    kinds = (
-        [k.strip() for k in workload.split(",") if k.strip()]
-        if isinstance(workload, str)
-        else workload
-    )
-    options = {
-        "workload": None if kinds is None else list(kinds),
-        "width": width,
-        "height": height,
-        "bounces": bounces,
-        "seed": seed,
-        "camera": camera,
-        "threads": threads,
-        "hairball_triangles": hairball_triangles,
-        "accel": accel,
-        "builder": builder,
-        "flatten": flatten,
-        "frames": frames,
+    checks: dict[str, Callable[[Any], Any]] = {
+        "workload": _workload_arg,
+        "width": lambda v: int_arg(v, "width", 1, MAX_PIXELS),
+        "height": lambda v: int_arg(v, "height", 1, MAX_PIXELS),
+        "bounces": lambda v: int_arg(v, "bounces", 0, MAX_BOUNCES),
+        "seed": lambda v: int_arg(v, "seed", 0, UINT64_MAX),
+        "camera": _camera_arg,
+        "threads": lambda v: int_arg(v, "threads", 0, UINT32_MAX),
+        "hairball_triangles": lambda v: int_arg(v, "hairball_triangles", 1, UINT32_MAX),
+        "accel": lambda v: _name_arg(v, "accel"),
+        "builder": lambda v: _name_arg(v, "builder"),
+        "flatten": lambda v: bool_arg(v, "flatten"),
+        "frames": lambda v: int_arg(v, "frames", 1, MAX_FRAMES),
     }
-    given = {k: v for k, v in options.items() if v is not None}
-    return _core.trace_scene(_scene_arg(scene), os.fspath(out_dir), progress=progress, **given)
+    values = {
+        "workload": workload, "width": width, "height": height, "bounces": bounces, "seed": seed,
+        "camera": camera, "threads": threads, "hairball_triangles": hairball_triangles,
+        "accel": accel, "builder": builder, "flatten": flatten, "frames": frames,
+    }  # fmt: skip
+    # Only the options given are passed: the others take the tracer's defaults (trace_defaults).
+    given = {k: checks[k](v) for k, v in values.items() if v is not None}
+    pixels = given.get("width", 1) * given.get("height", 1)
+    if "width" in given and "height" in given and pixels > MAX_PIXELS:
+        raise ArgumentValueError(
+            f"width x height: {given['width']}x{given['height']} is more than {MAX_PIXELS} pixels"
+        )
+    if progress is not None and not callable(progress):
+        raise ArgumentTypeError(
+            f"progress: expected a callable (done, total, stage), got {progress!r}"
+        )
+    return _core.trace_scene(
+        _scene_arg(scene), path_arg(out_dir, "out_dir"), progress=progress, **given
+    )
+
+
+def _name_arg(value: Any, name: str) -> str:
+    if not isinstance(value, str):
+        raise ArgumentTypeError(f"{name}: expected a name (str), got {type(value).__name__}")
+    return value
 
 
 def _kind_codes(kind: str | Sequence[str] | Any, n: int) -> np.ndarray:
@@ -158,12 +246,17 @@ def write_trace(
     from rtsim import _core
 
     loaded = scene if isinstance(scene, _core.Scene) else load_scene(scene)
+    out = path_arg(out, "out")
     n = int(np.shape(origins)[0]) if np.ndim(origins) >= 1 else 0
     kinds = _kind_codes(kind, n)
     if any_hit is None:
         flags = kinds == SHADOW
     else:
-        flags = np.asarray(any_hit, dtype=bool)
+        flags = np.asarray(any_hit)
+        if flags.dtype != bool:
+            raise ArgumentTypeError(
+                f"any_hit: expected True, False or one bool per ray, got {any_hit!r}"
+            )
         if flags.ndim == 0:
             flags = np.full(n, bool(flags))
     return _core.write_trace(
@@ -174,7 +267,43 @@ def write_trace(
         tmax,
         kinds,
         flags,
-        os.fspath(out),
-        threads=threads,
-        **{k: v for k, v in (("accel", accel), ("builder", builder)) if v is not None},
+        out,
+        threads=int_arg(threads, "threads", 0, UINT32_MAX),
+        **{k: _name_arg(v, k) for k, v in {"accel": accel, "builder": builder}.items() if v},
+    )
+
+
+def trace_rays(
+    scene: Scene,
+    origins: Any,
+    directions: Any,
+    tmin: Any = 0.0,
+    tmax: Any = math.inf,
+    any_hit: bool = False,
+) -> np.ndarray:
+    """Traces rays (origins and directions: (N, 3)) through the scene's reference BVH. Returns a
+    structured array: prim (-1: miss), inst, t, u, v, valid (False for rays rejected as invalid:
+    NaN, zero direction, tmin > tmax) and work, the traversal's work counts."""
+    from rtsim import _core
+
+    if not isinstance(scene, _core.Scene):
+        raise ArgumentTypeError(
+            f"scene: expected a Scene (rtsim.load_scene(...)), got {type(scene).__name__}"
+        )
+    return _core.trace_rays(
+        scene, origins, directions, tmin, tmax, any_hit=bool_arg(any_hit, "any_hit")
+    )
+
+
+def write_procedural_scene(
+    name: str, dir: str | os.PathLike[str], hairball_triangles: int = 200_000, seed: int = 1
+) -> str:
+    """Writes a built-in scene as DIR/NAME.gltf; returns the path."""
+    from rtsim import _core
+
+    return _core.write_procedural_scene(
+        _name_arg(name, "name"),
+        path_arg(dir, "dir"),
+        hairball_triangles=int_arg(hairball_triangles, "hairball_triangles", 1, UINT32_MAX),
+        seed=int_arg(seed, "seed", 0, UINT64_MAX),
     )

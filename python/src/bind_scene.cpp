@@ -14,6 +14,7 @@
 #include "python/src/bindings.h"
 #include "traces/bvh/builder.h"
 #include "traces/common/error.h"
+#include "traces/common/files.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
 
@@ -251,7 +252,7 @@ void bind_scene(py::module_& m) {
             opt.hairball_triangles = hairball_triangles;
             opt.seed = seed;
             py::gil_scoped_release release;
-            fs::create_directories(dir);
+            make_output_folder(dir.string(), "scene output");
             return write_procedural_scene(name, dir.string(), opt);
         },
         py::arg("name"), py::arg("dir"), py::arg("hairball_triangles") = 200000u,

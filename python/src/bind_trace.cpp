@@ -18,6 +18,7 @@
 #include "traces/accel/accel_io.h"
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/common/error.h"
+#include "traces/format/trace_checks.h"
 #include "traces/format/trace_reader.h"
 #include "traces/scene/procedural.h"
 #include "traces/tracer/ray_trace.h"
@@ -91,20 +92,20 @@ std::optional<CameraOverride> camera_from(const py::object& obj) {
     if (obj.is_none()) return std::nullopt;
     auto seq = obj.cast<py::sequence>();
     if (seq.size() != 3) {
-        throw py::value_error("camera: expected (eye, target, fov_degrees), got " +
+        throw ArgumentError("camera: expected (eye, target, fov_degrees), got " +
                               std::to_string(seq.size()) + " items");
     }
     auto eye = seq[0].cast<std::vector<float>>();
     auto target = seq[1].cast<std::vector<float>>();
     if (eye.size() != 3 || target.size() != 3) {
-        throw py::value_error("camera: eye and target must have 3 coordinates each");
+        throw ArgumentError("camera: eye and target must have 3 coordinates each");
     }
     CameraOverride cam;
     cam.eye = Vec3(eye[0], eye[1], eye[2]);
     cam.target = Vec3(target[0], target[1], target[2]);
     cam.yfov_degrees = seq[2].cast<float>();
     if (!(cam.yfov_degrees > 0.0f && cam.yfov_degrees < 180.0f)) {
-        throw py::value_error("camera: field of view must be in (0, 180) degrees, got " +
+        throw ArgumentError("camera: field of view must be in (0, 180) degrees, got " +
                               std::to_string(cam.yfov_degrees));
     }
     return cam;
@@ -139,7 +140,7 @@ struct KwargsApplier {
         py::object v;
         if (!take(name, &v)) return;
         const auto names = v.cast<std::vector<std::string>>();
-        if (names.empty()) throw py::value_error("workload: empty list (None: what the scene calls for)");
+        if (names.empty()) throw ArgumentError("workload: empty list (None: what the scene calls for)");
         for (const std::string& kind : names) kinds.push_back(parse_ray_kind(kind.c_str()));
     }
     void operator()(const char* name, std::optional<CameraOverride>& camera, const char*) {
@@ -166,7 +167,7 @@ py::object trace_scene_py(const py::object& scene, const fs::path& out_dir, cons
                 throw py::type_error("trace_scene: unknown option '" + item.first.cast<std::string>() +
                                      "' (options: " + py::str(py::list(known.out.attr("keys")())).cast<std::string>() + ")");
     }
-    if (opt.width == 0 || opt.height == 0) throw py::value_error("width and height must be positive");
+    if (opt.width == 0 || opt.height == 0) throw ArgumentError("width and height must be positive");
     opt.scene = scene_name(scene);
     opt.out_dir = out_dir.string();
     opt.procedural.seed = opt.seed;
@@ -196,14 +197,14 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
     const std::vector<Ray> rays = rays_from_arrays(origins, directions, tmin, tmax);
     const auto n = static_cast<py::ssize_t>(rays.size());
     if (kinds.ndim() != 1 || kinds.shape(0) != n)
-        throw py::value_error("kind: expected one ray kind per ray (" + std::to_string(n) + ")");
+        throw ArgumentError("kind: expected one ray kind per ray (" + std::to_string(n) + ")");
     if (any_hit.ndim() != 1 || any_hit.shape(0) != n)
-        throw py::value_error("any_hit: expected one flag per ray (" + std::to_string(n) + ")");
+        throw ArgumentError("any_hit: expected one flag per ray (" + std::to_string(n) + ")");
     std::vector<PendingRay> pending(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) {
         const uint8_t kind = kinds.data()[i];
         if (kind >= kRayKindCount)
-            throw py::value_error("kind: ray " + std::to_string(i) + " has kind " + std::to_string(kind) +
+            throw ArgumentError("kind: ray " + std::to_string(i) + " has kind " + std::to_string(kind) +
                                   " (0..4: primary, shadow, reflection, diffuse, refraction)");
         pending[i].ray = rays[i];
         pending[i].kind = RayKind(kind);
@@ -239,7 +240,12 @@ py::list trace_sections(const fs::path& path) {
         sections = reader.sections();
         // The structure's image must be one its traversal can walk, not just bytes with valid
         // CRCs: load_accel validates it structurally (docs/accel.md).
-        if (reader.has(SectionKind::accel)) load_accel(read_accel_image(reader), reader.path());
+        // And what rtsim-sim checks of the records: one HITS and WORK record per ray, a frame
+        // table that covers the rays (trace_checks.h). Payload CRCs: verify_trace, per section.
+        check_ray_sections(reader);
+        const uint32_t frames =
+            reader.has(SectionKind::accel) ? load_accel(read_accel_image(reader), reader.path())->frame_count() : 1;
+        read_frame_table(reader, frames);
     }
     py::list out;
     for (const SectionInfo& s : sections) {
@@ -343,12 +349,17 @@ void bind_trace(py::module_& m) {
           "Validates a trace file's header, section table and BVH image; returns its sections.");
     m.def(
         "verify_trace",
-        [](const fs::path& path) {
+        [](const fs::path& path, const std::optional<std::string>& section) {
             py::gil_scoped_release release;
             TraceReader reader(path.string());
-            reader.verify_all();
+            if (!section) return reader.verify_all();
+            for (const SectionInfo& s : reader.sections())
+                if (section_name(s.kind) == *section) return reader.verify_section(s.kind);
+            throw Error(path.string() + ": no section " + *section + " in this trace");
         },
-        py::arg("path"), "Checks every chunk's CRC32; raises RtsimError naming the first bad one.");
+        py::arg("path"), py::arg("section") = py::none(),
+        "Checks every chunk's CRC32 (of one section, named as trace_sections names it, if given);\n"
+        "raises RtsimError naming the section and the first bad chunk.");
 }
 
 }  // namespace rtsim::py_bind

@@ -3,6 +3,7 @@
 // functions that register each part of the module.
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 
 #include <pybind11/pybind11.h>
@@ -11,6 +12,12 @@
 #include "traces/scene/scene.h"
 
 namespace rtsim::py_bind {
+
+/// A bad argument value: raised in Python as rtsim.errors.ArgumentValueError (an RtsimError
+/// and a ValueError), with the message naming the argument.
+struct ArgumentError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
 
 /// A loaded scene as Python sees it. The hardware BVH is built on first use (trace_rays) and
 /// cached; the scene itself is immutable once loaded, so arrays handed out can alias it.

@@ -14,11 +14,15 @@ PYBIND11_MODULE(_core, m) {
     // Leaked on purpose: the translator may run until the interpreter exits.
     static py::handle rtsim_error =
         py::object(py::module_::import("rtsim.errors").attr("RtsimError")).release();
+    static py::handle argument_error =
+        py::object(py::module_::import("rtsim.errors").attr("ArgumentValueError")).release();
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const rtsim::Error& e) {
             PyErr_SetString(rtsim_error.ptr(), e.what());
+        } catch (const rtsim::py_bind::ArgumentError& e) {
+            PyErr_SetString(argument_error.ptr(), e.what());
         }
     });
     m.attr("RtsimError") = rtsim_error;

@@ -1,3 +1,4 @@
+#include "python/src/bindings.h"
 #include "python/src/ray_args.h"
 
 #include <string>
@@ -15,11 +16,11 @@ using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>
 /// (N, 3) float array or a ValueError naming the argument.
 FloatArray as_vectors(const py::handle& obj, const char* name) {
     FloatArray a = FloatArray::ensure(obj);
-    if (!a) throw py::value_error(std::string(name) + ": expected an array of floats");
+    if (!a) throw ArgumentError(std::string(name) + ": expected an array of floats");
     if (a.ndim() != 2 || a.shape(1) != 3) {
         std::string shape = "(";
         for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
-        throw py::value_error(std::string(name) + ": expected shape (N, 3), got " + shape +
+        throw ArgumentError(std::string(name) + ": expected shape (N, 3), got " + shape +
                               (a.ndim() == 1 ? ",)" : ")"));
     }
     return a;
@@ -28,11 +29,11 @@ FloatArray as_vectors(const py::handle& obj, const char* name) {
 /// A scalar (broadcast) or an (N,) array; returns the values and the stride (0 or 1).
 std::pair<FloatArray, py::ssize_t> as_limits(const py::handle& obj, py::ssize_t n, const char* name) {
     FloatArray a = FloatArray::ensure(obj);
-    if (!a) throw py::value_error(std::string(name) + ": expected a float or an array of floats");
+    if (!a) throw ArgumentError(std::string(name) + ": expected a float or an array of floats");
     if (a.ndim() == 0) return {a, 0};
     if (a.ndim() == 1 && a.shape(0) == n) return {a, 1};
     if (a.ndim() == 1 && a.shape(0) == 1) return {a, 0};
-    throw py::value_error(std::string(name) + ": expected a scalar or shape (" + std::to_string(n) +
+    throw ArgumentError(std::string(name) + ": expected a scalar or shape (" + std::to_string(n) +
                           ",), got an array with " + std::to_string(a.ndim()) + " dimensions and " +
                           std::to_string(a.size()) + " elements");
 }
@@ -45,7 +46,7 @@ std::vector<Ray> rays_from_arrays(const py::object& origins, const py::object& d
     FloatArray d = as_vectors(directions, "directions");
     const py::ssize_t n = o.shape(0);
     if (d.shape(0) != n) {
-        throw py::value_error("directions: expected " + std::to_string(n) +
+        throw ArgumentError("directions: expected " + std::to_string(n) +
                               " rays (as many as origins), got " + std::to_string(d.shape(0)));
     }
     auto [lo, lo_step] = as_limits(tmin, n, "tmin");

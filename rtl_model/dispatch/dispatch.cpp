@@ -111,9 +111,13 @@ void Dispatch::set_frames(std::vector<uint64_t> frame_rays, FrameEnd on_end, Fra
     m_frame_rays = std::move(frame_rays);
     m_on_end = std::move(on_end);
     m_on_begin = std::move(on_begin);
-    m_frame = 0;
-    stream().begin_frame(0);
-    if (m_on_begin) m_on_begin(0);
+    // Leading empty frames end at cycle 0: no ray of theirs will finish to end them.
+    for (m_frame = 0;; ++m_frame) {
+        stream().begin_frame(m_frame);
+        if (m_on_begin) m_on_begin(m_frame);
+        if (m_frame_rays[m_frame] != 0 || m_frame + 1 >= m_frame_rays.size()) break;
+        if (m_on_end) m_on_end(m_frame, 0);
+    }
 }
 
 bool Dispatch::next_ray(uint32_t unit, RayJob* job) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <vector>
@@ -19,8 +20,10 @@ std::string join_path(const std::string& prefix, const char* name) {
 }
 
 std::string format_number(double x) {
+    // Whole numbers in full (2147483648, not 2.14748e+09, which reads as inside [0, 2.14748e+09]).
+    if (std::isfinite(x) && std::trunc(x) == x && std::fabs(x) < 1e18) return std::to_string(int64_t(x));
     std::ostringstream out;
-    out << x;
+    out << std::setprecision(10) << x;
     return out.str();
 }
 

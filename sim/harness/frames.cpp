@@ -9,28 +9,6 @@ namespace rtsim {
 
 using nlohmann::json;
 
-std::vector<FrameRecord> read_frame_table(TraceReader& reader, uint32_t accel_frames) {
-    const std::string& path = reader.path();
-    const uint64_t rays = reader.section(SectionKind::rays).record_count;
-    std::vector<FrameRecord> frames;
-    if (reader.has(SectionKind::frames)) frames = reader.read_all<FrameRecord>(SectionKind::frames);
-    else frames.push_back(FrameRecord{0, rays});
-    require(frames.size() == accel_frames,
-            path + ": the trace has " + std::to_string(frames.size()) + " frame(s) (section FRMS) but its structure " +
-                std::to_string(accel_frames));
-    uint64_t next = 0;
-    for (size_t f = 0; f < frames.size(); ++f) {
-        require(frames[f].first_ray == next && frames[f].rays <= rays - next,
-                path + ": frame " + std::to_string(f) + " (rays [" + std::to_string(frames[f].first_ray) + ", +" +
-                    std::to_string(frames[f].rays) + ")) does not follow frame " + std::to_string(f) +
-                    " - 1 within the trace's " + std::to_string(rays) + " rays");
-        next += frames[f].rays;
-    }
-    require(next == rays, path + ": the frames hold " + std::to_string(next) + " of the trace's " +
-                              std::to_string(rays) + " rays");
-    return frames;
-}
-
 void check_frames_supported(const SimConfig& config, size_t frames, const std::string& trace) {
     if (frames <= 1) return;
     const std::string what = trace + ": an animated trace (" + std::to_string(frames) + " frames) ";

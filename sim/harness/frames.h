@@ -1,6 +1,6 @@
 #pragma once
-// Animated traces in the harness (docs/model.md, "Frames"): the frame table read and checked
-// against the structure, the ray stream cut at frame ends, and each frame's figures (cycles,
+// Animated traces in the harness (docs/model.md, "Frames"): the frame table (read and checked by
+// traces/format/trace_checks.h), the ray stream cut at frame ends, and each frame's figures (cycles,
 // Mrays/s, DRAM bytes per ray, cache hit rates) from the model's counters at the frame barrier.
 #include <cstdint>
 #include <string>
@@ -12,14 +12,10 @@
 #include "rtl_model/top/top.h"
 #include "sim/config/config.h"
 #include "sim/harness/trace_stream.h"
+#include "traces/format/trace_checks.h"  // read_frame_table
 #include "traces/format/trace_reader.h"
 
 namespace rtsim {
-
-/// The trace's frames: its FRMS records, or one frame of every ray when it has none. Throws
-/// rtsim::Error naming the trace unless the frames are back to back, cover every ray and match
-/// the structure's frame count (`accel_frames`).
-std::vector<FrameRecord> read_frame_table(TraceReader& reader, uint32_t accel_frames);
 
 /// Refuses (rtsim::Error naming the field) what does not replay frames yet: the analytic level,
 /// sampling and treelet scheduling.

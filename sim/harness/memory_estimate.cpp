@@ -16,6 +16,7 @@ namespace {
 constexpr double kBase = 16.0 * (1 << 20);
 constexpr double kPerUnit = 280.0 * 1024;
 constexpr double kPerContext = 1.1 * 1024;
+constexpr double kPerAnalyticContext = 1.35 * 1024;  // a stepper in a std::vector slot
 constexpr double kPerCacheLine = 24.0;
 constexpr double kGiB = double(1ull << 30);
 
@@ -47,12 +48,18 @@ MemoryEstimate estimate_sim_memory(const SimConfig& c, uint64_t image_bytes) {
         model = units * kPerUnit;
         context_bytes = contexts * kPerContext;
     }
+    // The analytic level's functional caches step every ray in a context of its own (a stepper
+    // and its stack, as a SystemC context holds), without the units' modules.
+    if (c.fidelity == Fidelity::analytic && c.analytic.caches == AnalyticCaches::functional)
+        context_bytes = contexts * kPerAnalyticContext;
     const double total = kBase + image + model + context_bytes + l1 + l2;
+    const double per_context = (context_bytes > 0 ? context_bytes / contexts : kPerContext) / 1024;
     char detail[256];
     std::snprintf(detail, sizeof detail,
-                  "%.0f ray contexts x 1.1 KiB = %.2f GiB, %.0f units = %.2f GiB, L1s %.2f GiB, L2 %.2f GiB, "
+                  "%.0f ray contexts x %.3g KiB = %.2f GiB, %.0f units = %.2f GiB, L1s %.2f GiB, L2 %.2f GiB, "
                   "structure image %.2f GiB",
-                  contexts, context_bytes / kGiB, units, model / kGiB, l1 / kGiB, l2 / kGiB, image / kGiB);
+                  contexts, per_context, context_bytes / kGiB, units, model / kGiB, l1 / kGiB, l2 / kGiB,
+                  image / kGiB);
     return MemoryEstimate{uint64_t(total), memory_limit_bytes(), detail};
 }
 

@@ -17,6 +17,7 @@
 #include "sim/analytic/estimate.h"
 #include "sim/report/energy_area.h"
 #include "sim/harness/hit_checker.h"
+#include "sim/harness/memory_estimate.h"
 #include "sim/report/roofline.h"
 #include "sim/harness/run_files.h"
 #include "sim/sampling/sampling.h"
@@ -150,6 +151,16 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     const json manifest = read_manifest(rtt);
     if (reader.has(SectionKind::frames))
         check_frames_supported(o.config, reader.section(SectionKind::frames).record_count, rtt);
+    uint64_t image_bytes = 0;  // the structure's sections: what load_accel will hold
+    for (const SectionInfo& s : reader.sections())
+        if (s.kind != SectionKind::rays && s.kind != SectionKind::hits && s.kind != SectionKind::work)
+            image_bytes += s.bytes;
+    const bool functional = o.config.analytic.caches == AnalyticCaches::functional;
+    check_sim_memory(o.config, image_bytes,
+                     std::string("config (fidelity=analytic, analytic.caches=") +
+                         (functional ? "functional" : "statistical") +
+                         ", traversal.units=" + std::to_string(o.config.traversal.units) +
+                         ", traversal.ray_contexts=" + std::to_string(o.config.traversal.ray_contexts) + ")");
     fs::create_directories(o.out_dir);
     write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(o.config));
     if (o.config.analytic.caches == AnalyticCaches::functional)

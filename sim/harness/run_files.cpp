@@ -39,6 +39,19 @@ json read_manifest(const std::string& rtt) {
     check(j, "scene", &json::is_object, "an object", "scene");
     check(j, "git", &json::is_string, "a string", "git");
     if (j.contains("scene")) check(j["scene"], "name", &json::is_string, "a string", "scene.name");
+    // An animated trace's per-frame figures, read at each frame's end (frames.h).
+    check(j, "frames", &json::is_object, "an object", "frames");
+    if (j.contains("frames")) {
+        check(j["frames"], "per_frame", &json::is_array, "an array", "frames.per_frame");
+        const json& per = j["frames"].value("per_frame", json::array());
+        for (size_t f = 0; f < per.size(); ++f) {
+            const std::string at = "frames.per_frame[" + std::to_string(f) + "]";
+            require(per[f].is_object(), m.string() + ": '" + at + "' must be an object");
+            for (const char* key : {"tlas_build_ms", "tlas_nodes"})
+                require(!per[f].contains(key) || per[f][key].is_number() || per[f][key].is_null(),
+                        m.string() + ": '" + at + "." + key + "' must be a number");
+        }
+    }
     return j;
 }
 

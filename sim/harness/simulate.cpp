@@ -92,7 +92,8 @@ SimOutcome run_simulation(const SimOptions& o) {
     const uint64_t total = workload["rays"];
     // Sampling (sim/sampling/sampling.h): only the sample's rays are simulated and checked.
     std::unique_ptr<SampledRun> sampled;
-    if (o.config.sampling.enabled()) sampled = std::make_unique<SampledRun>(reader, o.config, total);
+    if (o.config.sampling.enabled() && !sample_covers_trace(o.config, total))
+        sampled = std::make_unique<SampledRun>(reader, o.config, total);
     const uint64_t simulated = sampled ? sampled->plan.simulated_rays : total;
     // Spill areas belong to contexts, or to rays in treelet mode (they move between units).
     const TraversalConfig& tc = o.config.traversal;

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "traces/common/error.h"
+#include "traces/format/trace_checks.h"
 
 namespace rtsim {
 
@@ -32,9 +33,7 @@ size_t TraceRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
 
 ReferenceWindow::ReferenceWindow(TraceReader& reader, uint64_t chunk_rays)
     : m_reader(reader), m_chunk(chunk_rays), m_total(reader.section(SectionKind::hits).record_count) {
-    require(reader.section(SectionKind::work).record_count == m_total &&
-                reader.section(SectionKind::rays).record_count == m_total,
-            reader.path() + ": sections RAYS, HITS and WORK have different record counts");
+    check_ray_sections(reader);
 }
 
 ReferenceWindow::Chunk& ReferenceWindow::chunk_for(uint64_t id) {

@@ -5,6 +5,7 @@
 
 #include "traces/common/error.h"
 #include "traces/common/rng.h"
+#include "traces/format/trace_checks.h"
 
 namespace rtsim {
 
@@ -95,6 +96,21 @@ SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
     return plan;
 }
 
+bool sample_covers_trace(const SimConfig& c, uint64_t n) {
+    const SamplingConfig& s = c.sampling;
+    if (s.count > n) return false;  // more rays than the trace: plan_sample says so
+    const uint64_t budget = s.count ? s.count : uint64_t(std::llround(s.fraction * double(n)));
+    if (budget >= n) return true;
+    SimConfig all = c;  // the largest sample: every ray
+    all.sampling.count = uint32_t(std::min<uint64_t>(n, INT32_MAX));
+    try {
+        plan_sample(all, n);
+    } catch (const Error&) {
+        return true;  // no sample of this trace is possible
+    }
+    return false;
+}
+
 double student_t_975(uint64_t df) {
     // t_{0.975} for df = 1..30 (standard tables), then the Cornish-Fisher expansion in 1/df
     // around the normal quantile, accurate to 1e-4 beyond 30.
@@ -155,9 +171,7 @@ size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
 }
 
 SampledReference::SampledReference(TraceReader& reader, const SamplePlan& plan) : m_reader(reader), m_plan(plan) {
-    require(reader.section(SectionKind::hits).record_count == plan.trace_rays &&
-                reader.section(SectionKind::work).record_count == plan.trace_rays,
-            reader.path() + ": sections RAYS, HITS and WORK have different record counts");
+    check_ray_sections(reader);
 }
 
 SampledReference::Loaded& SampledReference::loaded_for(uint64_t id) {

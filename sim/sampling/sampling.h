@@ -55,6 +55,12 @@ struct SamplePlan {
 /// the trace is too small for the requested clusters and warm-up.
 SamplePlan plan_sample(const SimConfig& config, uint64_t trace_rays);
 
+/// True when sampling would simulate the whole trace anyway: the sample asked for is every ray
+/// (sampling.fraction = 1, a count of exactly the trace's rays), or the trace is smaller than
+/// the smallest sample (2 clusters of warm-up and measured rays). The run is then simply not
+/// sampled: exact. A count above the trace's rays stays an error (plan_sample).
+bool sample_covers_trace(const SimConfig& config, uint64_t trace_rays);
+
 /// The Student t quantile t_{0.975, df}: the half-width factor of a two-sided 95% interval.
 double student_t_975(uint64_t df);
 

@@ -1,7 +1,10 @@
 // libFuzzer target: the trace reader and the BVH image validation. The first byte picks a mode:
-//   even: the rest is a trace file: open, verify every CRC, read every section;
-//   odd:  the rest is a raw image (u16 node count, nodes, u16 triangle count, triangles, then
-//         rays), so mutations reach the validator without breaking CRCs first.
+//   0 mod 4: the rest is a trace file: open, verify every CRC, read every section;
+//   2 mod 4: the same, after every CRC (chunks, section table, header) is recomputed, so
+//            mutations of a section's content reach the record checks (counts, frames) and
+//            the structure's validation instead of stopping at a checksum;
+//   odd:     the rest is a raw image (u16 node count, nodes, u16 triangle count, triangles, then
+//            rays), so mutations reach the validator without breaking CRCs first.
 // Either way an image that the structure's validation accepts (load_accel for a trace, whatever
 // its kind; validate_bvh2 for a raw binary BVH) is traversed with up to 16 of the rays (the
 // fused loop and the stepper, both modes): the validation's contract is that this never crashes.
@@ -18,6 +21,8 @@
 #include "traces/accel/accel_io.h"
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/common/error.h"
+#include "traces/format/trace_checks.h"
+#include "traces/format/trace_layout.h"
 #include "traces/format/trace_reader.h"
 
 namespace {
@@ -82,11 +87,44 @@ void raw_image(const uint8_t* p, const uint8_t* end) {
     traverse_raw(nodes, tris, rays);
 }
 
-void trace_file(const uint8_t* data, size_t size) {
+/// Recomputes every CRC a trace holds where the bytes allow (what trace_forge.py does in tests):
+/// chunk CRCs of each in-bounds section, the section table's and the header's.
+void repair_crcs(std::vector<uint8_t>& f) {
+    namespace tl = trace_layout;
+    if (f.size() < tl::kHeaderBytes) return;
+    tl::FileHeader h = tl::decode_header(f.data());
+    if (h.section_count > 64 || h.table_offset > f.size() ||
+        tl::table_bytes_for(h.section_count) > f.size() - h.table_offset)
+        return;
+    for (uint32_t i = 0; i < h.section_count; ++i) {
+        const SectionInfo s = tl::decode_entry(&f[h.table_offset + size_t(i) * tl::kEntryBytes]);
+        const uint64_t chunks = tl::chunk_count(s.bytes, s.chunk_bytes);
+        if (s.offset > f.size() || s.bytes > f.size() - s.offset || s.crc_offset > f.size() ||
+            chunks > (f.size() - s.crc_offset) / 4)
+            continue;
+        for (uint64_t c = 0; c < chunks; ++c) {
+            const uint64_t b = c * s.chunk_bytes, n = std::min<uint64_t>(s.chunk_bytes, s.bytes - b);
+            const uint32_t crc = tl::crc32_bytes(&f[s.offset + b], size_t(n));
+            std::memcpy(&f[s.crc_offset + 4 * c], &crc, 4);
+        }
+    }
+    const size_t n = size_t(h.section_count) * tl::kEntryBytes;
+    const uint32_t crc = tl::crc32_bytes(&f[h.table_offset], n);
+    std::memcpy(&f[h.table_offset + n], &crc, 4);
+    uint8_t head[tl::kHeaderBytes];
+    tl::encode_header(h, head);  // the same fields, the magic and a fresh header CRC
+    std::memcpy(f.data(), head, tl::kHeaderBytes);
+}
+
+void trace_file(const uint8_t* data, size_t size, bool repair) {
     static const std::string path = "/tmp/rtsim_fuzz_trace_" + std::to_string(::getpid()) + ".rtt";
-    std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), std::streamsize(size));
+    std::vector<uint8_t> bytes(data, data + size);
+    if (repair) repair_crcs(bytes);
+    std::ofstream(path, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
     TraceReader reader(path);
     reader.verify_all();
+    check_ray_sections(reader);  // as rtsim-sim and open_trace check the records
     for (const SectionInfo& s : reader.sections())
         if (s.bytes <= (64u << 20)) {
             std::vector<uint8_t> buffer(size_t(s.bytes));
@@ -94,6 +132,7 @@ void trace_file(const uint8_t* data, size_t size) {
         }
     if (!reader.has(SectionKind::accel)) return;
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), "fuzz");
+    read_frame_table(reader, accel->frame_count());
     std::vector<RayRecord> rays;
     if (reader.has(SectionKind::rays)) {
         const uint64_t n = std::min<uint64_t>(16, reader.section(SectionKind::rays).record_count);
@@ -109,7 +148,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size == 0) return 0;
     try {
         if (data[0] & 1) raw_image(data + 1, data + size);
-        else trace_file(data + 1, size - 1);
+        else trace_file(data + 1, size - 1, (data[0] & 2) != 0);
     } catch (const rtsim::Error&) {
     }
     return 0;

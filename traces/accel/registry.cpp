@@ -181,11 +181,19 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
 }
 
 std::unique_ptr<Accel> load_accel(AccelImage image, const std::string& source) {
-    if (image.kind == "two_level") return std::make_unique<TwoLevelAccel>(std::move(image), source);
-    const Entry* e = find(image.kind);
-    require(e != nullptr, source + ": unknown acceleration structure '" + image.kind + "' (this build knows: " +
-                              known_kinds() + ")");
-    return e->load(std::move(image), source);
+    try {
+        if (image.kind == "two_level") return std::make_unique<TwoLevelAccel>(std::move(image), source);
+        const Entry* e = find(image.kind);
+        require(e != nullptr, source + ": unknown acceleration structure '" + image.kind + "' (this build knows: " +
+                                  known_kinds() + ")");
+        return e->load(std::move(image), source);
+    } catch (const Error& err) {
+        // Every refusal names the trace, also those raised below the structures' own checks
+        // (a region the image lacks).
+        const std::string what = err.what();
+        if (what.rfind(source, 0) == 0) throw;
+        throw Error(source + ": " + what);
+    }
 }
 
 }  // namespace rtsim

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "traces/common/error.h"
+#include "traces/common/files.h"
 #include "traces/format/trace_layout.h"
 
 namespace rtsim {
@@ -90,6 +91,7 @@ void check_entry(const std::string& path, const SectionInfo& s, uint64_t table_o
 }  // namespace
 
 TraceReader::TraceReader(const std::string& path) : m_path(path) {
+    require_regular_file(path, "trace file (trace.rtt)");  // a FIFO would block the open
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
     require(file != nullptr, path + ": cannot open trace: " + std::strerror(errno));
     std::FILE* f = file.get();
@@ -180,9 +182,14 @@ void TraceReader::verify_chunk(const SectionInfo& s, size_t section_index, uint6
 }
 
 void TraceReader::verify_all() {
-    for (size_t i = 0; i < m_sections.size(); ++i)
-        for (uint64_t c = 0; c < m_verified[i].size(); ++c)
-            if (!m_verified[i][c]) verify_chunk(m_sections[i], i, c);
+    for (const SectionInfo& s : m_sections) verify_section(s.kind);
+}
+
+void TraceReader::verify_section(SectionKind kind) {
+    const SectionInfo& s = section(kind);
+    const size_t i = static_cast<size_t>(&s - m_sections.data());
+    for (uint64_t c = 0; c < m_verified[i].size(); ++c)
+        if (!m_verified[i][c]) verify_chunk(s, i, c);
 }
 
 }  // namespace rtsim

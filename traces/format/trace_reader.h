@@ -46,6 +46,8 @@ public:
     }
     /// Verifies every chunk of every section; throws Error naming the first bad chunk.
     void verify_all();
+    /// Verifies every chunk of one section (once per reader); throws Error naming the bad chunk.
+    void verify_section(SectionKind kind);
 
 private:
     void verify_chunk(const SectionInfo& s, size_t section_index, uint64_t chunk);

@@ -63,10 +63,13 @@ constexpr size_t kMaxJsonDepth = 512;
 
 /// Refuses JSON text nested deeper than kMaxJsonDepth (one linear scan, before any parsing).
 void check_json_depth(const std::string& file, const unsigned char* text, size_t size);
-/// Checks what tinygltf lets through (gltf_json_checks.cpp): byteOffset, byteStride, byteLength
-/// and count must be non-negative integers (byteLength >= 1); texture, image and sampler
-/// indices in range. Text that is not a JSON object is left for tinygltf to report.
-void check_raw_document(const std::string& file, const unsigned char* text, size_t size);
+/// Checks every integer field of the glTF 2.0 schema by value (gltf_json_schema.cpp): an
+/// integer-valued number (3.0) is that integer, a fractional, non-numeric or out-of-range one
+/// is refused naming the element and key; every index is checked against its array, node
+/// transforms are arrays of finite numbers, bufferViews lie inside their buffers. Returns the
+/// document re-serialised when a number was rewritten (tinygltf drops 3.0 silently), else "".
+/// Text that is not a JSON object is left for tinygltf to report.
+std::string normalize_document(const std::string& file, const unsigned char* text, size_t size);
 
 /// The JSON chunk of a GLB file.
 struct GlbChunks {

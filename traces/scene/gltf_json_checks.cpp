@@ -1,89 +1,14 @@
-// Checks on the raw bytes and JSON of a glTF file, made before tinygltf sees them: tinygltf
-// recurses once per nesting level (a deep `extras` overflows the call stack), silently replaces
-// a negative byteOffset or byteStride by 0, reads any GLB version and never range-checks texture
-// indices. Each check names the file and the element.
-#include <cmath>
-
-#include <nlohmann/json.hpp>
-
+// Checks on the raw bytes of a glTF file, made before tinygltf sees them: tinygltf recurses once
+// per nesting level (a deep `extras` overflows the call stack) and reads any GLB version. The
+// document's numbers and indices are checked in gltf_json_schema.cpp. Each check names the file.
 #include "traces/scene/gltf_internal.h"
 
 namespace rtsim::gltf {
 
 namespace {
 
-using nlohmann::json;
-
 uint32_t le32(const unsigned char* p) {
     return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
-
-/// "bufferView 3 'name'" for element `i` of array `kind` of the document.
-std::string json_element(const json& doc, const char* array, const char* kind, size_t i) {
-    const json& e = doc[array][i];
-    auto name = e.is_object() ? e.find("name") : e.end();
-    return element(kind, i, name != e.end() && name->is_string() ? name->get<std::string>() : "");
-}
-
-/// Field `key` of `object`, if present, must be an integer >= minimum.
-void check_integer(const std::string& file, const json& object, const char* key, int64_t minimum,
-                   const std::string& where) {
-    auto it = object.find(key);
-    if (it == object.end()) return;
-    const bool integer = it->is_number_integer() ||
-                         (it->is_number_float() && std::isfinite(it->get<double>()) &&
-                          std::trunc(it->get<double>()) == it->get<double>());
-    if (!integer || it->get<double>() < double(minimum))
-        throw Error(file + ": " + where + ": " + key + " is " + it->dump() + " (must be an integer >= " +
-                    std::to_string(minimum) + ")");
-}
-
-/// A textureInfo object (anything with an "index" under a key ending in "Texture").
-void check_texture_info(const std::string& file, const json& info, size_t textures, const std::string& where) {
-    if (!info.is_object() || !info.contains("index")) return;
-    const json& index = info["index"];
-    if (!index.is_number_integer() || index.get<int64_t>() < 0 || uint64_t(index.get<int64_t>()) >= textures)
-        throw Error(file + ": " + where + ": texture index " + index.dump() + " out of range (" +
-                    std::to_string(textures) + " textures)");
-}
-
-/// Every textureInfo under `value` (core slots and extensions alike), depth-first.
-void check_textures_under(const std::string& file, const json& value, size_t textures, const std::string& where) {
-    if (!value.is_object()) return;
-    for (auto it = value.begin(); it != value.end(); ++it) {
-        const std::string& key = it.key();
-        std::string path = where + "." + key;
-        bool texture_key = key.size() >= 7 && key.compare(key.size() - 7, 7, "Texture") == 0;
-        if (texture_key) check_texture_info(file, it.value(), textures, path);
-        else if (key != "extras") check_textures_under(file, it.value(), textures, path);
-    }
-}
-
-void check_array_refs(const std::string& file, const json& doc) {
-    auto size_of = [&doc](const char* key) {
-        auto it = doc.find(key);
-        return it != doc.end() && it->is_array() ? it->size() : size_t(0);
-    };
-    const size_t textures = size_of("textures"), images = size_of("images"), samplers = size_of("samplers");
-    for (size_t i = 0; i < size_of("materials"); ++i)
-        check_textures_under(file, doc["materials"][i], textures, json_element(doc, "materials", "material", i));
-    for (size_t i = 0; i < textures; ++i) {
-        const json& t = doc["textures"][i];
-        if (!t.is_object()) continue;
-        std::string where = json_element(doc, "textures", "texture", i);
-        struct Ref {
-            const char* key;
-            size_t count;
-            const char* of;
-        };
-        for (const Ref& r : {Ref{"source", images, "images"}, Ref{"sampler", samplers, "samplers"}}) {
-            auto it = t.find(r.key);
-            if (it == t.end()) continue;
-            if (!it->is_number_integer() || it->get<int64_t>() < 0 || uint64_t(it->get<int64_t>()) >= r.count)
-                throw Error(file + ": " + where + ": " + r.key + " " + it->dump() + " out of range (" +
-                            std::to_string(r.count) + " " + r.of + ")");
-        }
-    }
 }
 
 }  // namespace
@@ -107,30 +32,6 @@ void check_json_depth(const std::string& file, const unsigned char* text, size_t
             --depth;
         }
     }
-}
-
-void check_raw_document(const std::string& file, const unsigned char* text, size_t size) {
-    json doc = json::parse(text, text + size, nullptr, false);
-    if (doc.is_discarded() || !doc.is_object()) return;  // tinygltf reports the parse error
-    auto each = [&](const char* array, const char* kind, auto&& check) {
-        auto it = doc.find(array);
-        if (it == doc.end() || !it->is_array()) return;
-        for (size_t i = 0; i < it->size(); ++i)
-            if ((*it)[i].is_object()) check((*it)[i], json_element(doc, array, kind, i));
-    };
-    each("buffers", "buffer", [&](const json& b, const std::string& where) {
-        check_integer(file, b, "byteLength", 1, where);  // glTF 2.0: minimum 1
-    });
-    each("bufferViews", "bufferView", [&](const json& v, const std::string& where) {
-        check_integer(file, v, "byteOffset", 0, where);
-        check_integer(file, v, "byteLength", 1, where);
-        check_integer(file, v, "byteStride", 0, where);
-    });
-    each("accessors", "accessor", [&](const json& a, const std::string& where) {
-        check_integer(file, a, "byteOffset", 0, where);
-        check_integer(file, a, "count", 0, where);
-    });
-    check_array_refs(file, doc);
 }
 
 GlbChunks check_glb(const std::string& file, const unsigned char* data, size_t size) {

@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "traces/common/files.h"
 #include "traces/scene/gltf_internal.h"
 
 namespace rtsim {
@@ -29,10 +30,9 @@ bool extension_supported(const std::string& name) {
     return kGeometry.count(name) || name.rfind("KHR_materials_", 0) == 0;
 }
 
-/// The whole file; a folder, an unreadable or a > 4 GiB file (tinygltf's limit) is refused.
+/// The whole file; a folder, a FIFO or device, an unreadable or a > 4 GiB file (tinygltf's limit) is refused.
 std::vector<unsigned char> read_file(const std::string& path) {
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) throw Error(path + ": is a folder, not a glTF file (.gltf or .glb)");
+    require_regular_file(path, "glTF file (.gltf or .glb)");
     std::ifstream in(path, std::ios::binary | std::ios::ate);
     if (!in) throw Error(path + ": cannot open file");
     const std::streamoff size = in.tellg();
@@ -53,16 +53,39 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
     return true;
 }
 
+/// The file's bytes with its JSON replaced by `text` (a new GLB container around the same
+/// binary chunk when the file is a GLB).
+std::vector<unsigned char> with_json(const std::vector<unsigned char>& bytes, bool binary,
+                                     const gltf::GlbChunks& old, std::string text) {
+    if (!binary) return std::vector<unsigned char>(text.begin(), text.end());
+    text.append((4 - text.size() % 4) % 4, ' ');
+    const size_t rest = size_t(old.json - bytes.data()) + old.json_bytes;  // the chunks after JSON
+    const size_t total = 20 + text.size() + (bytes.size() - rest);
+    if (total >= (uint64_t(1) << 32)) throw Error("GLB grows beyond 4 GiB");
+    std::vector<unsigned char> out(20);
+    auto put32 = [&out](size_t at, uint32_t v) {
+        for (int i = 0; i < 4; ++i) out[at + size_t(i)] = static_cast<unsigned char>(v >> (8 * i));
+    };
+    std::memcpy(out.data(), bytes.data(), 8);  // magic and version
+    put32(8, uint32_t(total));
+    put32(12, uint32_t(text.size()));
+    put32(16, 0x4E4F534Au);  // "JSON"
+    out.insert(out.end(), text.begin(), text.end());
+    out.insert(out.end(), bytes.begin() + std::ptrdiff_t(rest), bytes.end());
+    return out;
+}
+
 /// Loads the model (binary if the file starts with the GLB magic) or throws naming the file.
-/// The raw bytes are checked first (gltf_json_checks.cpp): nesting depth, GLB header, negative
-/// offsets and out-of-range texture indices, which tinygltf would crash on or let through.
+/// The raw bytes are checked first (gltf_json_checks.cpp, gltf_json_schema.cpp): nesting depth,
+/// GLB header, every integer and index by value, which tinygltf would crash on or drop.
 void load_model(const std::string& path, tinygltf::Model& model, Scene& scene) {
-    const std::vector<unsigned char> bytes = read_file(path);
+    std::vector<unsigned char> bytes = read_file(path);
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     gltf::GlbChunks json{bytes.data(), bytes.size()};
     if (binary) json = gltf::check_glb(path, bytes.data(), bytes.size());
     gltf::check_json_depth(path, json.json, json.json_bytes);
-    gltf::check_raw_document(path, json.json, json.json_bytes);
+    const std::string normalized = gltf::normalize_document(path, json.json, json.json_bytes);
+    if (!normalized.empty()) bytes = with_json(bytes, binary, json, normalized);
 
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(&skip_image, nullptr);
@@ -146,6 +169,16 @@ std::vector<glm::dmat4> gpu_instances(const Source& src, const tinygltf::Value& 
         if (!v.IsNumber()) src.fail(where + ": " + names[a] + " is not an accessor index");
         views[a] = gltf::view_accessor(src, gltf::as_index(v.GetNumberAsDouble()), where + " " + names[a]);
         if (views[a].components != sizes[a]) src.fail(where + ": " + names[a] + " has the wrong type");
+        // EXT_mesh_gpu_instancing: TRANSLATION and SCALE are floats; ROTATION floats or
+        // normalised signed bytes or shorts.
+        const int type = views[a].component_type;
+        const bool ok = type == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                        (a == 1 && views[a].normalized &&
+                         (type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT));
+        if (!ok)
+            src.fail(where + ": " + names[a] + " has componentType " + std::to_string(type) +
+                     (a == 1 ? " (must be 5126 float, or normalized 5120 byte or 5122 short)"
+                             : " (must be 5126 float)"));
         if (have_count && views[a].count != count) src.fail(where + ": attribute counts differ");
         count = views[a].count;
         have_count = present[a] = true;
@@ -279,6 +312,7 @@ Scene load_gltf_checked(const std::string& path, bool flatten) {
     for (int r : roots) walker.walk_root(r);
 
     if (scene.materials.empty()) scene.default_material();
+    check_instance_transforms(scene, false);
     if (flatten) scene.flatten();
     else scene.index_instances();
     if (scene.triangle_count() == 0)

@@ -94,6 +94,13 @@ uint64_t max_flat_triangles();
 /// when `triangles` exceeds max_flat_triangles(). Called before any flattening is allocated.
 void check_flat_size(const std::string& source, uint64_t triangles, const std::string& what);
 
+struct Scene;
+/// Refuses (rtsim::Error naming the file and the glTF node) an instance whose transform is not
+/// finite, and a scene whose every triangle collapses to zero area in world space (a node scaled
+/// by 0 or 1e-30, a matrix of zeros: no ray could hit anything). `invertible`: every transform
+/// must also invert in single precision (two-level structures trace rays in object space).
+void check_instance_transforms(const Scene& scene, bool invertible);
+
 struct Scene {
     std::string source;  ///< file the scene was read from
     std::vector<Mesh> meshes;

@@ -1,7 +1,10 @@
 // Scenes kept as instances (scene.h, index_instances()): primitive ids, bounds and per-primitive
 // lookups without a flattened triangle list, for two-level tracing.
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
@@ -69,6 +72,85 @@ uint32_t Scene::material_of(uint32_t prim) const {
     if (flattened()) return tri_material.at(prim);
     const Instance& inst = instances[instance_of(prim)];
     return meshes[inst.mesh].materials[prim - inst.prim_base];
+}
+
+
+namespace {
+
+/// "node 4" or "node 4 (EXT_mesh_gpu_instancing entry 2)" for instance i.
+std::string instance_name(const Scene& scene, size_t i) {
+    const int32_t node = scene.instances[i].node;
+    if (node < 0) return "instance " + std::to_string(i);
+    size_t entry = 0, entries = 0;
+    for (size_t k = 0; k < scene.instances.size(); ++k)
+        if (scene.instances[k].node == node) {
+            entry += k < i ? 1 : 0;
+            ++entries;
+        }
+    std::string name = "node " + std::to_string(node);
+    return entries > 1 ? name + " (EXT_mesh_gpu_instancing entry " + std::to_string(entry) + ")" : name;
+}
+
+/// A nonzero (or overflowing: huge, not collapsed) normal in single precision.
+bool has_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 n = glm::cross(b - a, c - a);
+    return n.x != 0.0f || n.y != 0.0f || n.z != 0.0f;
+}
+
+/// True if one of the first few triangles of the instance's mesh that have an area in object
+/// space keeps it in world space (rounded to float as flatten() rounds), or leaves the float
+/// range (not a collapse: flatten() names that triangle).
+bool keeps_area(const Scene& scene, const Instance& inst, bool* mesh_has_area) {
+    const Mesh& mesh = scene.meshes[inst.mesh];
+    int tried = 0;
+    for (size_t t = 0; t < mesh.triangle_count() && tried < 16; ++t) {
+        const Vec3* p = &mesh.positions[3 * t];
+        if (!has_area(p[0], p[1], p[2])) continue;
+        *mesh_has_area = true;
+        ++tried;
+        const Vec3 a = to_world(inst.object_to_world, p[0]), b = to_world(inst.object_to_world, p[1]),
+                   c = to_world(inst.object_to_world, p[2]);
+        if (!std::isfinite(a.x + a.y + a.z + b.x + b.y + b.z + c.x + c.y + c.z) || has_area(a, b, c)) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+void check_instance_transforms(const Scene& scene, bool invertible) {
+    int first_collapsed = -1;
+    bool area_anywhere = false;
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const glm::dmat4& m = scene.instances[i].object_to_world;
+        bool finite = true;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) finite = finite && std::isfinite(m[c][r]);
+        require(finite, scene.source + ": " + instance_name(scene, i) +
+                            " has a non-finite transform (NaN or infinite in its matrix, translation, "
+                            "rotation or scale, or in a parent's)");
+        if (invertible) {
+            const glm::dmat4 inv = glm::inverse(m);
+            bool ok = glm::determinant(glm::dmat3(m)) != 0.0;
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) ok = ok && std::isfinite(float(inv[c][r]));
+            require(ok, scene.source + ": " + instance_name(scene, i) +
+                            " has a singular transform (a scale of 0 or a degenerate matrix), which a "
+                            "two-level structure cannot invert; fix the node's scale or matrix, or trace "
+                            "with --flatten");
+        }
+        if (area_anywhere && !invertible) continue;
+        bool mesh_area = false;
+        if (keeps_area(scene, scene.instances[i], &mesh_area)) area_anywhere = true;
+        else if (mesh_area && first_collapsed < 0) first_collapsed = int(i);
+    }
+    if (area_anywhere || first_collapsed < 0) return;
+    const glm::dmat4& m = scene.instances[size_t(first_collapsed)].object_to_world;
+    char det[32];
+    std::snprintf(det, sizeof det, "%g", glm::determinant(glm::dmat3(m)));
+    throw Error(scene.source + ": every triangle collapses to zero area in world space (" +
+                instance_name(scene, size_t(first_collapsed)) + "'s transform has determinant " + det +
+                ": a scale of 0 or 1e-30, or a matrix of zeros); no ray could hit the scene. Fix the "
+                "nodes' scale or matrix");
 }
 
 }  // namespace rtsim

@@ -6,6 +6,7 @@
 #include "traces/accel/accel_io.h"
 #include "traces/common/build_info.h"
 #include "traces/common/error.h"
+#include "traces/common/files.h"
 
 namespace rtsim {
 
@@ -19,7 +20,8 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 std::string created(const std::string& out_dir) {
-    fs::create_directories(out_dir);
+    require_utf8_path(out_dir, "output folder");
+    make_output_folder(out_dir, "trace output");
     return out_dir;
 }
 

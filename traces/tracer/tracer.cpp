@@ -7,6 +7,7 @@
 
 #include "traces/accel/two_level/two_level.h"
 #include "traces/common/error.h"
+#include "traces/common/files.h"
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
 #include "traces/scene/gltf_loader.h"
@@ -80,6 +81,8 @@ std::string vec_text(const Vec3& v) {
 void validate(const TraceOptions& o) {
     require(!o.scene.empty(), "no scene given");
     require(!o.out_dir.empty(), "no output folder given");
+    require_utf8_path(o.scene, "scene");
+    require_utf8_path(o.out_dir, "output folder");
     require(o.width > 0 && o.height > 0 && uint64_t(o.width) * o.height <= (1ull << 28),
             "resolution " + std::to_string(o.width) + "x" + std::to_string(o.height) + " is out of range");
     require(o.bounces <= 64, "bounces " + std::to_string(o.bounces) + " is out of range (0..64)");
@@ -117,7 +120,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     auto report = [&](uint64_t done, uint64_t total, const std::string& stage) {
         if (progress) progress(done, total, stage);
     };
-    fs::create_directories(o.out_dir);
+    make_output_folder(o.out_dir, "trace output");
 
     report(0, 1, "load");
     bool procedural = false;
@@ -128,6 +131,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     AccelOptions accel_options = o.accel;
     accel_options.two_level = !o.flatten && shares_geometry(scene);
     check_frames(o.frames, o.flatten, accel_options.two_level, path);
+    if (accel_options.two_level) check_instance_transforms(scene, true);
     if (!accel_options.two_level) scene.flatten();
     double load_ms = ms_since(t_start);
     require(scene.triangle_count() > 0, path + ": the scene has no triangles");

@@ -37,9 +37,11 @@ def print_outcome(outcome: SweepOutcome, out: Path, console: Console) -> None:
 
 
 def cmd_sweep(args: argparse.Namespace, console: Console) -> int:
+    from rtsim.args import check_utf8_path
     from rtsim.sweep.runner import SweepOptions, run_sweep
     from rtsim.sweep.spec import SpecError, load_spec
 
+    check_utf8_path(args.output, "-o")  # every run's folder is under it, named in JSON
     try:
         spec = load_spec(Path(args.spec))
     except SpecError as err:

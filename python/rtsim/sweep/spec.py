@@ -18,8 +18,9 @@ import numpy as np
 import yaml
 
 from rtsim.config import ConfigError, SimConfig, apply_patch, compose, field_info, unflatten
+from rtsim.errors import RtsimError
 from rtsim.kinds import RAY_KINDS
-from rtsim.scenes import resolve_scene
+from rtsim.scenes import procedural_scene_names, resolve_scene
 from rtsim.sweep.accel_axis import (
     AccelSpec,
     default_accel,
@@ -48,9 +49,12 @@ ACCEL_KEY = "accel"
 #: Most runs one sweep may have (each is an rtsim-sim process and a row of the store); checked
 #: from the grid's and sample's sizes before any point is enumerated.
 MAX_RUNS = 100_000
+#: The tracer's limits (traces/tracer/tracer.cpp): pixels of a workload, bounces.
+MAX_PIXELS = 1 << 28
+MAX_BOUNCES = 64
 
 
-class SpecError(ValueError):
+class SpecError(RtsimError, ValueError):
     """A spec that cannot be run; the message names the file, line and key."""
 
 
@@ -251,12 +255,26 @@ class _Reader:
                 )
         return value
 
-    def number(self, parent: Any, key: Any, path: str, integer: bool, minimum: float = 0) -> Any:
+    def number(
+        self,
+        parent: Any,
+        key: Any,
+        path: str,
+        integer: bool,
+        minimum: float = 0,
+        maximum: float = math.inf,
+        above: bool = False,
+    ) -> Any:
+        """A number in [minimum, maximum] (above: > minimum); never NaN or infinite."""
         value = parent[key]
         ok = isinstance(value, int) if integer else isinstance(value, (int, float))
-        if isinstance(value, bool) or not ok or value < minimum:
-            what = "an integer" if integer else "a number"
-            raise self.fail(parent, key, path, f"expected {what} >= {minimum}, got {value!r}")
+        ok = ok and not isinstance(value, bool) and math.isfinite(value)
+        if not ok or value < minimum or value > maximum or (above and value == minimum):
+            what = "an integer" if integer else "a finite number"
+            bound = f"> {minimum}" if above else f">= {minimum}"
+            if maximum != math.inf:
+                bound += f" and <= {maximum}"
+            raise self.fail(parent, key, path, f"expected {what} {bound}, got {value!r}")
         return value
 
     def scene(self, items: LineList, i: int, base: Path | None) -> SceneSpec:
@@ -273,9 +291,12 @@ class _Reader:
             candidate = base / source
             source = str(candidate.resolve()) if candidate.exists() else source
         try:
-            resolve_scene(source)
+            resolved = resolve_scene(source)
         except ValueError as err:
             raise self.fail(d, "name", f"scenes[{i}].name", str(err)) from None
+        if resolved not in procedural_scene_names() and not Path(resolved).is_file():
+            what = "a folder without a .gltf/.glb" if Path(resolved).is_dir() else "no such file"
+            raise self.fail(d, "name", f"scenes[{i}].name", f"{resolved}: {what}")
         label = str(d.get("label") or Path(d["name"]).stem)
         tris = (
             self.number(d, "hairball_triangles", f"scenes[{i}].hairball_triangles", True, 1)
@@ -305,7 +326,15 @@ class _Reader:
         w, _, h = str(res).lower().partition("x")
         if not (w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
             raise self.fail(d, "resolution", f"{path}.resolution", f"expected WxH, got {res!r}")
-        bounces = self.number(d, "bounces", f"{path}.bounces", True) if "bounces" in d else 1
+        if int(w) * int(h) > MAX_PIXELS:
+            raise self.fail(
+                d, "resolution", f"{path}.resolution", f"{res}: more than {MAX_PIXELS} pixels"
+            )
+        bounces = (
+            self.number(d, "bounces", f"{path}.bounces", True, 0, MAX_BOUNCES)
+            if "bounces" in d
+            else 1
+        )
         seed = self.number(d, "seed", f"{path}.seed", True) if "seed" in d else 1
         label = str(d.get("name") or "-".join(rays) or "scene")
         return WorkloadSpec(label, tuple(rays), int(w), int(h), bounces, seed)
@@ -399,6 +428,8 @@ class _Reader:
     def range(self, parent: LineDict, key: str, path: str) -> dict[str, Any]:
         r = parent[key]
         if isinstance(r, dict) and set(r) == {"values"} and isinstance(r["values"], list):
+            if not r["values"]:
+                raise self.fail(parent, key, path, "values: an empty list (give one or more)")
             for v in r["values"]:
                 self.config_value(parent, key, path, key, v)
             return {"values": list(r["values"])}
@@ -412,6 +443,7 @@ class _Reader:
                 parent, key, path, f"expected [min, max] or {{values: [...]}}, got {r!r}"
             )
         self.config_value(parent, key, path, key, r[0])
+        self.config_value(parent, key, path, key, r[1])
         is_int = field_info(key).type in ("int", int)
         if is_int and not all(isinstance(x, int) for x in r):
             raise self.fail(parent, key, path, "an integer field needs integer bounds")
@@ -427,6 +459,10 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
         mark = getattr(err, "problem_mark", None)
         line = mark.line + 1 if mark is not None else 0
         raise SpecError(f"{source}:{line}: not valid YAML: {err}") from None
+    except RecursionError:
+        raise SpecError(
+            f"{source}: nested too deeply to parse (a spec needs a few levels)"
+        ) from None
     if not isinstance(doc, LineDict):
         raise SpecError(f"{source}:1: (root): expected a mapping with scenes, workloads, grid")
     holder = LineDict({"(root)": doc})
@@ -472,7 +508,7 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
             )
     _check_size(rd, doc, spec)
     if "timeout" in doc:
-        spec.timeout = float(rd.number(doc, "timeout", "timeout", False, 0))
+        spec.timeout = float(rd.number(doc, "timeout", "timeout", False, 0, above=True))
     if "baseline" in doc:
         spec.baseline = rd.baseline(doc, spec.grid)
     return spec
@@ -501,7 +537,11 @@ def _check_size(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
 def load_spec(path: Path) -> SweepSpec:
     """Reads and parses a spec file (relative scene paths are relative to it)."""
     try:
+        if Path(path).exists() and not Path(path).is_file():
+            raise SpecError(f"{path}: not a regular file (a folder, FIFO or device)")
         text = Path(path).read_text()
     except OSError as err:
         raise SpecError(f"{path}: cannot read the spec ({err.strerror})") from None
+    except UnicodeDecodeError as err:
+        raise SpecError(f"{path}: not UTF-8 text ({err})") from None
     return parse_spec(text, source=str(path), base=Path(path).resolve().parent)

@@ -17,13 +17,18 @@ Schema (version 1):
 
 from __future__ import annotations
 
+import functools
 import json
 import sqlite3
-from collections.abc import Iterator
-from contextlib import closing
+from collections.abc import Callable, Iterator
+from contextlib import closing, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
+
+from rtsim.errors import RtsimError
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 SCHEMA_VERSION = "1"
 STATUSES = ("ok", "mismatch", "failed")
@@ -103,6 +108,32 @@ class RunRecord:
         return str(self.params.get("accel", "bvh2"))
 
 
+class StoreError(RtsimError):
+    """A results store that SQLite cannot read (truncated, corrupt, not a database) or that is
+    not an rtsim results store; the message names the file."""
+
+
+@contextmanager
+def _store_errors(path: Path) -> Iterator[None]:
+    """SQLite's and JSON's errors on a damaged or foreign store, as StoreError naming it."""
+    try:
+        yield
+    except (sqlite3.DatabaseError, json.JSONDecodeError, KeyError, IndexError) as err:
+        raise StoreError(
+            f"{path}: not a readable rtsim results store ({type(err).__name__}: {err}); "
+            "move it away and re-run the sweep to rebuild it"
+        ) from err
+
+
+def _checked(method: F) -> F:
+    @functools.wraps(method)
+    def wrapper(self: ResultsStore, *args: Any, **kwargs: Any) -> Any:
+        with _store_errors(self.path):
+            return method(self, *args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
 def _quote(name: str) -> str:
     return '"' + name.replace('"', '""') + '"'
 
@@ -116,6 +147,26 @@ class ResultsStore:
             raise FileNotFoundError(f"{self.path}: no results store here (run `rtsim sweep`)")
         self.conn = sqlite3.connect(self.path, timeout=30, isolation_level=None)
         self.conn.row_factory = sqlite3.Row
+        try:
+            with _store_errors(self.path):
+                self._open(readonly)
+        except BaseException:
+            self.conn.close()
+            raise
+
+    def _open(self, readonly: bool) -> None:
+        # A store is this schema or empty: a foreign database is never written into.
+        tables = {r[0] for r in self.conn.execute("SELECT name FROM sqlite_master")}
+        if tables and not {"meta", "runs"} <= tables:
+            raise StoreError(
+                f"{self.path}: an SQLite database but not an rtsim results store (its tables: "
+                f"{', '.join(sorted(tables))}); give the sweep another folder"
+            )
+        if readonly and not tables:
+            raise StoreError(f"{self.path}: an empty results store (run `rtsim sweep`)")
+        check = self.conn.execute("PRAGMA quick_check").fetchone()[0]
+        if check != "ok":
+            raise sqlite3.DatabaseError(f"quick_check: {check}")
         if not readonly:
             self.conn.execute("PRAGMA journal_mode=WAL")
             self.conn.execute("PRAGMA synchronous=FULL")
@@ -140,6 +191,7 @@ class ResultsStore:
     def transaction(self) -> _Transaction:
         return _Transaction(self.conn)
 
+    @_checked
     def columns(self) -> list[str]:
         return [r["name"] for r in self.conn.execute("PRAGMA table_info(runs)")]
 
@@ -147,6 +199,7 @@ class ResultsStore:
         known = {*_FIXED, "attempts"}
         return [c for c in self.columns() if c not in known]
 
+    @_checked
     def ensure_columns(self, keys: list[str]) -> None:
         """Adds a column per swept key not seen before (a resumed spec may sweep more)."""
         missing = [k for k in keys if k not in set(self.columns())]
@@ -155,18 +208,22 @@ class ResultsStore:
                 for key in missing:
                     self.conn.execute(f"ALTER TABLE runs ADD COLUMN {_quote(key)}")
 
+    @_checked
     def set_meta(self, values: dict[str, str]) -> None:
         with self.transaction():
             for k, v in values.items():
                 self.conn.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (k, v))
 
+    @_checked
     def meta(self) -> dict[str, str]:
         return {r["key"]: r["value"] for r in self.conn.execute("SELECT key, value FROM meta")}
 
+    @_checked
     def statuses(self) -> dict[str, str]:
         """run_id -> status of every recorded run."""
         return {r[0]: r[1] for r in self.conn.execute("SELECT run_id, status FROM runs")}
 
+    @_checked
     def record(self, rec: RunRecord) -> None:
         """Writes one run atomically; a re-run of a recorded id replaces its row (attempts+1)."""
         if rec.status not in STATUSES:
@@ -206,10 +263,14 @@ class ResultsStore:
     def runs(self, status: str | None = None) -> Iterator[RunRecord]:
         query = "SELECT * FROM runs" + (" WHERE status = ?" if status else "")
         query += " ORDER BY scene, workload, rowid"
-        with closing(self.conn.execute(query, (status,) if status else ())) as cur:
+        with (
+            _store_errors(self.path),
+            closing(self.conn.execute(query, (status,) if status else ())) as cur,
+        ):
             for row in cur:
                 yield _from_row(row)
 
+    @_checked
     def count(self) -> dict[str, int]:
         rows = self.conn.execute("SELECT status, COUNT(*) FROM runs GROUP BY status")
         return {r[0]: r[1] for r in rows}

@@ -99,7 +99,7 @@ TEST(GltfRobustness, TextureIndicesInRange) {
     expect_error(b.write(dir, "tex_ext"), {"transmissionTexture", "texture index -1 out of range"});
     b.doc["materials"][0] = {{"normalTexture", {{"index", 0}}}};
     b.doc["textures"] = {{{"source", 3}}};
-    expect_error(b.write(dir, "tex_source"), {"texture 0", "source 3 out of range (0 images)"});
+    expect_error(b.write(dir, "tex_source"), {"texture 0", "source: image index 3 out of range (0 images)"});
 }
 
 TEST(GltfRobustness, ImagesAreNotDecoded) {

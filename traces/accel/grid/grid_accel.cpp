@@ -15,12 +15,23 @@ void validate_grid(const GridView& v, const std::string& source) {
              std::to_string(g.res[2]) + " needs " + std::to_string(g.cell_count()) + " cells, region 'cells' holds " +
              std::to_string(v.cell_count));
     if (v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) fail("more than 2^32 references or triangles");
+    // Lists back to back in record order, each reference in one list: the listed references
+    // total prim_refs' count, so a ray's work is bounded by the image (overlapping lists, every
+    // cell listing every reference, would cost cells x references per ray).
+    uint64_t next = 0;
     for (uint64_t c = 0; c < v.cell_count; ++c) {
         const GridCell& cell = v.cells[c];
         if (uint64_t(cell.first_ref) + cell.ref_count > v.ref_count)
             fail("cell " + std::to_string(c) + " lists prim_refs " + std::to_string(cell.first_ref) + ".." +
                  std::to_string(uint64_t(cell.first_ref) + cell.ref_count - 1) + " of " + std::to_string(v.ref_count));
+        if (cell.first_ref != next)
+            fail("cell " + std::to_string(c) + "'s list starts at prim_refs " + std::to_string(cell.first_ref) +
+                 ", not " + std::to_string(next) + " where the previous cell's ends (lists must be back to back "
+                 "in cell order, each reference in one list)");
+        next += cell.ref_count;
     }
+    if (next != v.ref_count)
+        fail("the cells list " + std::to_string(next) + " of prim_refs' " + std::to_string(v.ref_count) + " references");
     for (uint64_t r = 0; r < v.ref_count; ++r)
         if (v.refs[r] >= v.triangle_count)
             fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.refs[r]) + " of " +
