@@ -23,7 +23,7 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -34,6 +34,7 @@ from rtsim.errors import RtsimError
 from rtsim.kinds import RAY_KINDS
 from rtsim.sim_cli import add_parsers as add_simulate_parsers
 from rtsim.sweep.cli import add_parsers as add_sweep_parsers
+from rtsim.tracing import parse_setting_value
 
 # Start-up matters (`rtsim simulate` runs once per simulation): modules above import only the
 # standard library; rich, numpy, the C++ extension and Dask are imported by the commands.
@@ -69,6 +70,7 @@ class TraceJob:
     hairball_triangles: int = 200_000
     accel: str = "bvh2"
     builder: str = ""  # empty: the structure's default builder (its first)
+    build_settings: dict[str, Any] = field(default_factory=dict)  # --build-set overrides
     flatten: bool = False  # instanced scenes: one world-space structure instead of two levels
     frames: int = 1  # animated frames of an instanced scene (docs/accel.md, "Frames")
 
@@ -120,6 +122,15 @@ def parse_camera(text: str) -> tuple[tuple[float, float, float], tuple[float, fl
     return (ex, ey, ez), (tx, ty, tz), fov
 
 
+def parse_build_setting(text: str) -> tuple[str, Any]:
+    """KEY=VALUE of --build-set: the value as a number or true/false when it reads as one (the
+    builder checks the name, type and range, naming the setting)."""
+    key, sep, value = text.partition("=")
+    if not sep or not key.strip():
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got '{text}'")
+    return key.strip(), parse_setting_value(value.strip())
+
+
 def positive_int(text: str) -> int:
     if not text.isdigit():
         raise argparse.ArgumentTypeError(f"expected a non-negative integer, got '{text}'")
@@ -169,6 +180,7 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             progress=progress,
             accel=job.accel,
             builder=job.builder,
+            build_settings=job.build_settings,
             flatten=job.flatten,
             frames=job.frames,
         )
@@ -199,6 +211,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         hairball_triangles=args.hairball_triangles,
         accel=args.accel,
         builder=args.builder,
+        build_settings=dict(args.build_set or []),
         flatten=args.flatten,
         frames=args.frames,
     )
@@ -360,6 +373,15 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
             "builder (default: the structure's first); the structures take: "
             + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in accel_kinds())
         ),
+    )
+    p.add_argument(
+        "--build-set",
+        type=parse_build_setting,
+        action="append",
+        metavar="KEY=VALUE",
+        help="override one of the builder's documented settings, e.g. --build-set bins=32 "
+        "--build-set max_leaf_size=2 (repeatable; each structure's and builder's settings, defaults "
+        "and ranges: docs/accel.md, Builder settings); recorded in the manifest's accel.build_settings",
     )
     p.add_argument(
         "--flatten",

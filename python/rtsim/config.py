@@ -124,8 +124,30 @@ class TraversalConfig:
     stack_entries: int = _f(
         8, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64
     )
-    stack_entry_bytes: int = _f(8, "bytes", "Bytes per stack entry (spill traffic)", 4, 64)
+    stack_entry_bytes: int = _f(
+        0,
+        "bytes",
+        "Bytes per stack entry (on-chip stack and spill traffic); 0: the structure's own (a BVH's "
+        "8: node and entry distance; a kd-tree's or BIH's 12; an octree's 32), resolved from the "
+        "trace",
+        0,
+        64,
+    )
     issue_cycles: int = _f(1, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100)
+
+
+@dataclass
+class MailboxConfig:
+    """Mailboxes in the traversal units (docs/accel.md, "Mailboxes")."""
+
+    entries: int = _f(
+        0,
+        "entries",
+        "Mailbox entries per ray context (primitives tested, FIFO); retests of a listed primitive "
+        "are skipped in grids, kd-trees and octrees; 0: no mailbox",
+        0,
+        64,
+    )
 
 
 @dataclass
@@ -379,7 +401,7 @@ class SimConfig:
     ideal_memory: bool = _flag(
         False, "Every access hits in L1 at L1 latency: the upper bound on performance"
     )
-    # Sections: the box, triangle, any-hit, cell and transform pipelines and the two cache
+    # Sections: the box, triangle, any-hit, cell, transform and plane pipelines and the two cache
     # levels share a struct with per-section defaults, as in config.h.
     dispatch: DispatchConfig = field(default_factory=DispatchConfig)
     traversal: TraversalConfig = field(default_factory=TraversalConfig)
@@ -389,6 +411,9 @@ class SimConfig:
     cell: PipelineConfig = field(default_factory=lambda: PipelineConfig(4, 1, 1, "private", 4))
     # Instance transforms of two-level structures (docs/accel.md, "Two-level structures").
     transform: PipelineConfig = field(default_factory=lambda: PipelineConfig(8, 1, 1, "private", 4))
+    # Ray/split-plane tests of kd-trees, BIHs and octrees (docs/accel.md).
+    plane: PipelineConfig = field(default_factory=lambda: PipelineConfig(4, 1, 2, "private", 4))
+    mailbox: MailboxConfig = field(default_factory=MailboxConfig)
     # MSHRs: docs/presets.md, "How the defaults were chosen".
     l1: CacheConfig = field(default_factory=lambda: CacheConfig(16, 4, 64, 4, 16, 1, 1))
     l2: CacheConfig = field(default_factory=lambda: CacheConfig(1024, 16, 64, 20, 64, 8, 1))
@@ -406,6 +431,8 @@ class SimConfig:
         "anyhit",
         "cell",
         "transform",
+        "plane",
+        "mailbox",
         "l1",
         "l2",
         "dram",
@@ -447,9 +474,13 @@ class SimConfig:
         """On-chip SRAM of the accelerator: the L1s, the L2, the traversal stacks and, with
         treelet scheduling, the ray buffer."""
         t = self.traversal
-        stacks = t.units * t.ray_contexts * t.stack_entries * t.stack_entry_bytes
+        # stack_entry_bytes 0 is the structure's own, known only with a trace: a BVH's 8 here
+        # (stats.json "area" has the run's exact figure).
+        entry = t.stack_entry_bytes or 8
+        stacks = t.units * t.ray_contexts * t.stack_entries * entry
+        mailboxes = t.units * t.ray_contexts * self.mailbox.entries * 4
         ray_buffer = self.treelets.buffer_kib * 1024 if self.treelets.enabled else 0
-        return (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks + ray_buffer
+        return (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks + mailboxes + ray_buffer
 
 
 def _names(cls: type) -> dict[str, dataclasses.Field[Any]]:

@@ -111,6 +111,16 @@ TRIANGLE_DTYPE = np.dtype(
 #: grid GridCell (8 bytes): the cell's list in prim_refs (docs/accel.md, "grid").
 CELL_DTYPE = np.dtype([("first_ref", "<u4"), ("ref_count", "<u4")])
 
+#: kdtree KdNode (8 bytes; docs/accel.md, "kdtree"): word0 = split (f32 bits) or first ref;
+#: word1 = axis (bits 0-1, 3: leaf) | above child or ref count << 2.
+KDNODE_DTYPE = np.dtype([("word0", "<u4"), ("word1", "<u4")])
+#: bih BihNode (12 bytes; docs/accel.md, "bih"): word0 = axis (3: leaf) | left child or first
+#: triangle << 2; word1, word2 = the clip planes (f32 bits), or for a leaf the count and 0.
+BIHNODE_DTYPE = np.dtype([("word0", "<u4"), ("word1", "<u4"), ("word2", "<u4")])
+#: octree OctNode (16 bytes; docs/accel.md, "octree"): word0 = child mask (0: leaf) | first child
+#: << 8; interior: centre x, y, z; leaf: first ref, ref count, 0.
+OCTNODE_DTYPE = np.dtype([("word0", "<u4"), ("word1", "<u4"), ("word2", "<u4"), ("word3", "<u4")])
+
 #: two_level InstanceRecord (128 bytes; docs/accel.md, "Two-level structures").
 INSTANCE_DTYPE = np.dtype(
     [
@@ -149,6 +159,11 @@ REGION_DTYPES: dict[tuple[str, str], np.dtype] = {
     ("cwbvh8_octant", "nodes"): CWNODE8_DTYPE,
     ("grid", "cells"): CELL_DTYPE,
     ("grid", "prim_refs"): np.dtype("<u4"),
+    ("kdtree", "nodes"): KDNODE_DTYPE,
+    ("kdtree", "prim_refs"): np.dtype("<u4"),
+    ("bih", "nodes"): BIHNODE_DTYPE,
+    ("octree", "nodes"): OCTNODE_DTYPE,
+    ("octree", "prim_refs"): np.dtype("<u4"),
     ("two_level", "tlas_nodes"): NODE_DTYPE,
     ("two_level", "instances"): INSTANCE_DTYPE,
     ("two_level", "blas_triangles"): TRIANGLE_DTYPE,

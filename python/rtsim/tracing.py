@@ -11,6 +11,7 @@ Every trace folder holds trace.rtt and manifest.json, and ``rtsim.simulate`` rep
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -39,6 +40,20 @@ def load_scene(
     return _core.load_scene(resolve_scene(scene), hairball_triangles=hairball_triangles, seed=seed)
 
 
+def parse_setting_value(text: str) -> Any:
+    """A builder setting's value as given on the command line or in a spec: '32' -> 32,
+    '1e-5' -> 1e-05, 'true'/'false' -> a bool; other text stays text (the builder then names the
+    setting and what it takes)."""
+    lowered = text.strip().lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        value = json.loads(text)
+    except ValueError:
+        return text
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else text
+
+
 def _scene_arg(scene: SceneLike) -> Any:
     from rtsim import _core
 
@@ -61,6 +76,7 @@ def trace_scene(
     builder: str = "binned",
     flatten: bool = False,
     frames: int = 1,
+    build_settings: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. workload: ray kinds ("primary,diffuse" or a list);
@@ -95,6 +111,7 @@ def trace_scene(
         builder=builder,
         flatten=flatten,
         frames=frames,
+        build_settings=dict(build_settings or {}),
     )
 
 
@@ -134,6 +151,7 @@ def write_trace(
     threads: int = 0,
     accel: str = "bvh2",
     builder: str = "binned",
+    build_settings: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Traces your rays with the reference tracer and writes a trace folder (OUT/trace.rtt and
     manifest.json, exactly as trace_scene writes one) that rtsim.simulate replays.
@@ -141,8 +159,8 @@ def write_trace(
     origins, directions: (N, 3) arrays; tmin, tmax: scalars or (N,) arrays. kind: the ray kind
     of every ray ("primary", "shadow", "reflection", "diffuse", "refraction") or one per ray.
     any_hit: None makes shadow rays any-hit (occlusion) rays and the others closest-hit, as the
-    tracer does; or a bool for every ray, or one per ray. accel and builder choose the
-    acceleration structure, built as trace_scene builds it. Returns the manifest; rays are
+    tracer does; or a bool for every ray, or one per ray. accel, builder and build_settings
+    choose the acceleration structure, built as trace_scene builds it. Returns the manifest; rays are
     written in order, each with its index as `pixel`."""
     import numpy as np
 
@@ -169,4 +187,5 @@ def write_trace(
         threads=threads,
         accel=accel,
         builder=builder,
+        build_settings=dict(build_settings or {}),
     )

@@ -110,6 +110,17 @@ std::optional<CameraOverride> camera_from(const py::object& obj) {
     return cam;
 }
 
+/// Builder settings {name: value} (None: none) as the C++ side takes them (AccelOptions::settings).
+nlohmann::json settings_from(const py::object& settings) {
+    if (settings.is_none()) return nlohmann::json::object();
+    if (!py::isinstance<py::dict>(settings)) throw py::value_error("build_settings: expected a dict of name: value");
+    const std::string text = py::module_::import("json").attr("dumps")(settings).cast<std::string>();
+    return nlohmann::json::parse(text);
+}
+
+/// A JSON value as the Python object json.loads makes of it.
+py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
 /// The scene argument of trace_scene: a path, a procedural name, or a Scene (its source).
 std::string scene_name(const py::object& obj) {
     if (py::isinstance<PyScene>(obj)) return obj.cast<PyScene&>().scene().source;
@@ -121,10 +132,11 @@ py::object trace_scene_py(const py::object& scene, const fs::path& out_dir,
                           uint32_t height, uint32_t bounces, uint64_t seed,
                           const py::object& camera, unsigned threads, uint32_t hairball_triangles,
                           const py::object& progress, const std::string& accel, const std::string& builder,
-                          bool flatten, uint32_t frames) {
+                          bool flatten, uint32_t frames, const py::object& build_settings) {
     TraceOptions opt;
     opt.accel.kind = accel;
     opt.accel.builder = builder;
+    opt.accel.settings = settings_from(build_settings);
     opt.flatten = flatten;
     opt.frames = frames;
     opt.scene = scene_name(scene);
@@ -164,7 +176,7 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
                           const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& kinds,
                           const py::array_t<bool, py::array::c_style | py::array::forcecast>& any_hit,
                           const fs::path& out_dir, unsigned threads, const py::object& progress,
-                          const std::string& accel, const std::string& builder) {
+                          const std::string& accel, const std::string& builder, const py::object& build_settings) {
     const std::vector<Ray> rays = rays_from_arrays(origins, directions, tmin, tmax);
     const auto n = static_cast<py::ssize_t>(rays.size());
     if (kinds.ndim() != 1 || kinds.shape(0) != n)
@@ -185,6 +197,7 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
     AccelOptions accel_options;
     accel_options.kind = accel;
     accel_options.builder = builder;
+    accel_options.settings = settings_from(build_settings);
     validate_accel_options(accel_options);
     RayTraceOptions opt;
     opt.out_dir = out_dir.string();
@@ -250,18 +263,20 @@ void bind_trace(py::module_& m) {
           py::arg("camera") = py::none(), py::arg("threads") = 0u,
           py::arg("hairball_triangles") = 200000u, py::arg("progress") = py::none(),
           py::arg("accel") = "bvh2", py::arg("builder") = "", py::arg("flatten") = false,
-          py::arg("frames") = 1u,
+          py::arg("frames") = 1u, py::arg("build_settings") = py::none(),
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
           "returns the manifest. workload: ray kinds (None: every kind the scene calls for).\n"
           "progress(done, total, stage) is called now and then. accel and builder choose the\n"
-          "acceleration structure (accel_kinds()); instanced scenes get a BLAS of that kind per\n"
-          "mesh and a TLAS over the instances unless flatten is true. frames > 1 animates the\n"
-          "instances (docs/accel.md, Frames): BLASes once, a TLAS and the workload per frame.");
+          "acceleration structure (accel_kinds()); build_settings overrides its builder's\n"
+          "settings {name: value} (accel_kinds()[i]['settings'][builder] lists them). Instanced\n"
+          "scenes get a BLAS of that kind per mesh and a TLAS over the instances unless flatten\n"
+          "is true. frames > 1 animates the instances (docs/accel.md, Frames): BLASes once, a\n"
+          "TLAS and the workload per frame.");
     m.def("write_trace", &write_trace_py, py::arg("scene"), py::arg("origins"),
           py::arg("directions"), py::arg("tmin"), py::arg("tmax"), py::arg("kinds"),
           py::arg("any_hit"), py::arg("out_dir"), py::arg("threads") = 0u,
           py::arg("progress") = py::none(), py::arg("accel") = "bvh2",
-          py::arg("builder") = "binned",
+          py::arg("builder") = "binned", py::arg("build_settings") = py::none(),
           "Traces the given rays (kinds: RayKind per ray, any_hit: flag per ray) and writes\n"
           "OUT/trace.rtt and manifest.json exactly as trace_scene writes a workload; returns\n"
           "the manifest. Use rtsim.write_trace, which takes kind names and scene names.");
@@ -274,11 +289,15 @@ void bind_trace(py::module_& m) {
                 d["name"] = k.name;
                 d["description"] = k.description;
                 d["builders"] = k.builders;
+                py::dict settings;
+                for (const std::string& b : k.builders) settings[py::str(b)] = to_python(accel_settings_schema(k.name, b));
+                d["settings"] = settings;
                 out.append(d);
             }
             return out;
         },
-        "The acceleration structures this build knows: name, description, builders.");
+        "The acceleration structures this build knows: name, description, builders, and per builder\n"
+        "its settings {name: {type, default, unit, min, max, doc}} (docs/accel.md, Builder settings).");
     m.attr("trace_version") = kTraceVersion;  // the trace format this build writes and reads
     m.def("trace_sections", &trace_sections, py::arg("path"),
           "Validates a trace file's header, section table and BVH image; returns its sections.");

@@ -115,6 +115,11 @@ double pipeline_mm2(const EnergyConfig& c, const SimConfig& s, const PipelineCon
     return pipes * lanes * flops_um2(c, f) * 1e-6 * area_scale(c);
 }
 
+/// The mailboxes' SRAM, bytes: one table of mailbox.entries primitive ids per ray context.
+double mailbox_bytes(const SimConfig& s) {
+    return double(s.traversal.units) * s.traversal.ray_contexts * s.mailbox.entries * MailboxConfig::kEntryBytes;
+}
+
 bool instantiated(const json& list, const char* block) {
     for (const json& b : list)
         if (b.value("block", "") == block) return b.value("instantiated", false);
@@ -140,10 +145,15 @@ json area_json(const SimConfig& s, const json& stats) {
     mm2["anyhit"] = instantiated(stats.value("instantiated", json::array()), "anyhit")
                         ? pipeline_mm2(c, s, s.anyhit, kAnyhitFlops)
                         : 0.0;
+    // Blocks only some structures or configs have are listed only when built.
+    if (instantiated(stats.value("instantiated", json::array()), "plane"))
+        mm2["plane"] = pipeline_mm2(c, s, s.plane, kPlaneFlops);
+    if (s.mailbox.entries) mm2["mailbox"] = sram_mm2(c, mailbox_bytes(s));
     double total = 0, sram = 0;
     for (auto it = mm2.begin(); it != mm2.end(); ++it) {
         total += it->get<double>();
-        if (it.key() != "box" && it.key() != "triangle" && it.key() != "anyhit") sram += it->get<double>();
+        if (it.key() != "box" && it.key() != "triangle" && it.key() != "anyhit" && it.key() != "plane")
+            sram += it->get<double>();
     }
     return {{"mm2", mm2}, {"total_mm2", total}, {"sram_mm2", sram}, {"logic_mm2", total - sram}};
 }
@@ -208,6 +218,13 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     pj["transform"] = double(w.transforms) * op.transform;
     pj["cell"] = double(w.cell_steps) * op.cell;
     pj["plane"] = double(w.plane_tests) * op.plane;
+    if (s.mailbox.entries) {
+        // A lookup compares the reference with the ray's whole table (its entries read); a test
+        // run records its primitive (one id written).
+        const double table = double(t.ray_contexts) * s.mailbox.entries * MailboxConfig::kEntryBytes;
+        pj["mailbox"] = double(w.mailbox_lookups) * sram_access_pj(c, table, s.mailbox.entries * 32.0) +
+                        double(w.mailbox_lookups - w.mailbox_hits) * sram_access_pj(c, table, 32.0);
+    }
     // Traversal units: the ray's setup, and per step a read of the context's ray state and one
     // stack push or pop, each in the unit's SRAM of that kind.
     pj["traversal"] = double(rays) * op.ray_setup +

@@ -1,8 +1,9 @@
 #pragma once
 // The hit checker (docs/architecture.md, rule 2): every ray the model finishes is compared with the
 // trace's reference hit (primitive id and the bits of t) and reference work (every WorkCounts
-// field: steps, box, triangle, alpha and plane tests, transforms, cell steps, references). Mismatches are counted, the first ones listed, and make rtsim-sim exit
-// non-zero. It also keeps the per-ray latency histogram and reports progress.
+// field: steps, box, triangle, alpha and plane tests, transforms, cell steps, references; with a
+// mailbox, the tests it skipped counted back: WorkCounts::without_mailbox). Mismatches are
+// counted, the first ones listed, and make rtsim-sim exit non-zero. It also keeps the per-ray latency histogram and reports progress.
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -20,7 +21,7 @@ namespace rtsim {
 /// model (sim/harness/energy_area.h) prices these operations at every fidelity level.
 struct WorkTotals {
     uint64_t steps = 0, box_tests = 0, tri_tests = 0, anyhit_calls = 0, transforms = 0, cell_steps = 0,
-             plane_tests = 0, refs = 0;
+             plane_tests = 0, refs = 0, mailbox_lookups = 0, mailbox_hits = 0;
     void add(const WorkCounts& w) {
         steps += w.steps;
         box_tests += w.box_tests;
@@ -30,6 +31,8 @@ struct WorkTotals {
         cell_steps += w.cell_steps;
         plane_tests += w.plane_tests;
         refs += w.refs;
+        mailbox_lookups += w.mailbox_lookups;
+        mailbox_hits += w.mailbox_hits;
     }
 };
 

@@ -55,6 +55,12 @@ struct WorkCounts {
     uint32_t cell_steps = 0;   ///< 3D-DDA steps from cell to cell (grids)
     uint32_t plane_tests = 0;  ///< ray/split-plane tests (kd-trees, BIH)
     uint32_t refs = 0;         ///< primitive references fetched (structures with index lists)
+    /// The model's mailbox (docs/accel.md, "Mailboxes"; never in a trace: a trace's work is the
+    /// structure's without one): references looked up, and those found, whose triangle was then
+    /// neither fetched nor tested. With a mailbox tri_tests counts the tests run, and
+    /// tri_tests + mailbox_hits equals the triangle tests without one.
+    uint32_t mailbox_lookups = 0;
+    uint32_t mailbox_hits = 0;
 
     WorkCounts& operator+=(const WorkCounts& o) {
         steps += o.steps;
@@ -65,14 +71,25 @@ struct WorkCounts {
         cell_steps += o.cell_steps;
         plane_tests += o.plane_tests;
         refs += o.refs;
+        mailbox_lookups += o.mailbox_lookups;
+        mailbox_hits += o.mailbox_hits;
         return *this;
     }
     bool operator==(const WorkCounts& o) const {
         return steps == o.steps && box_tests == o.box_tests && tri_tests == o.tri_tests &&
                anyhit_calls == o.anyhit_calls && transforms == o.transforms &&
-               cell_steps == o.cell_steps && plane_tests == o.plane_tests && refs == o.refs;
+               cell_steps == o.cell_steps && plane_tests == o.plane_tests && refs == o.refs &&
+               mailbox_lookups == o.mailbox_lookups && mailbox_hits == o.mailbox_hits;
     }
     bool operator!=(const WorkCounts& o) const { return !(*this == o); }
+    /// The counts the same traversal has without a mailbox (what a trace records): the skipped
+    /// tests counted back, the mailbox's own counts dropped.
+    WorkCounts without_mailbox() const {
+        WorkCounts w = *this;
+        w.tri_tests += mailbox_hits;
+        w.mailbox_lookups = w.mailbox_hits = 0;
+        return w;
+    }
 };
 
 /// True when a ray may be traversed: finite origin and direction, non-zero direction,

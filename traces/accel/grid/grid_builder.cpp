@@ -135,7 +135,7 @@ AccelImage grid_image(const Scene& scene, const GridConfig& config) {
     image.bounds = bounds;
     image.params = g.to_json();
     GridCell* cells = image.add_region("cells", DataKind::cell, sizeof(GridCell), g.cell_count()).records<GridCell>();
-    uint32_t* refs = image.add_region("prim_refs", DataKind::prim_ref, kGridRefBytes, total).records<uint32_t>();
+    uint32_t* refs = image.add_region("prim_refs", DataKind::prim_ref, kRefBytes, total).records<uint32_t>();
     HwTriangle* tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), n).records<HwTriangle>();
     for (uint64_t c = 0; c < g.cell_count(); ++c) cells[c] = GridCell{uint32_t(count[c]), uint32_t(count[c + 1] - count[c])};
     for (size_t i = 0; i < n; ++i) {
