@@ -54,9 +54,15 @@ def render(kinds: list[dict[str, Any]]) -> str:
             continue
         lines += ["| setting | default | unit | range | what it does |", "|---|---|---|---|---|"]
         for name, f in schema.items():
-            bounds = "true, false" if f["type"] == "bool" else f"{number(f['min'])} to {number(f['max'])}"
+            bounds = (
+                "true, false"
+                if f["type"] == "bool"
+                else f"{number(f['min'])} to {number(f['max'])}"
+            )
             unit = f.get("unit", "")
-            lines.append(f"| `{name}` | `{number(f['default'])}` | {unit} | {bounds} | {f['doc']} |")
+            lines.append(
+                f"| `{name}` | `{number(f['default'])}` | {unit} | {bounds} | {f['doc']} |"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -64,7 +70,6 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--check", action="store_true", help="exit 1 if docs/accel.md is out of date")
     args = p.parse_args()
-    sys.path.insert(0, str(REPO / "python"))
     from rtsim.doc_markers import replace_between
 
     current = DOC.read_text()

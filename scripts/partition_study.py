@@ -46,7 +46,7 @@ from rtsim.launcher import find_sim
 from rtsim.scenes import resolve_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from accel_study import find_study, fmt, run  # noqa: E402  (one driver of rtsim-accel-study)
+from accel_study import find_study, fmt, run  # one driver of rtsim-accel-study
 
 REPO = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- partition-study:begin -->", "<!-- partition-study:end -->"
@@ -74,7 +74,9 @@ def build_figures(scene: str, args: argparse.Namespace) -> dict[str, Any]:
 
 def trace(scene: str, accel: str, workload: str, args: argparse.Namespace) -> Path:
     kind, _, builder = accel.partition(":")
-    folder = args.out / "traces" / f"{scene}-{kind}-{builder or 'default'}-{workload}-{args.resolution}"
+    folder = (
+        args.out / "traces" / f"{scene}-{kind}-{builder or 'default'}-{workload}-{args.resolution}"
+    )
     if (folder / "manifest.json").is_file() and not args.fresh:
         return folder
     shutil.rmtree(folder, ignore_errors=True)
@@ -123,29 +125,47 @@ def work_stats(folder: Path, workload: str) -> dict[str, Any]:
         v = work[f].astype(np.float64)
         out[f] = {"mean": float(v.mean()), "p99": float(np.percentile(v, 99))}
     manifest = json.loads((folder / "manifest.json").read_text())["accel"]
-    out["accel"] = {k: manifest.get(k) for k in ("footprint_bytes", "references_per_triangle", "sah_cost", "build_ms")}
+    out["accel"] = {
+        k: manifest.get(k)
+        for k in ("footprint_bytes", "references_per_triangle", "sah_cost", "build_ms")
+    }
     return out
 
 
 def one(scene: str, accel: str, workload: str, args: argparse.Namespace) -> dict[str, Any]:
     folder = trace(scene, accel, workload, args)
-    entry: dict[str, Any] = {"work": work_stats(folder, workload), "model": simulate(folder, "base", [], args)}
+    entry: dict[str, Any] = {
+        "work": work_stats(folder, workload),
+        "model": simulate(folder, "base", [], args),
+    }
     if accel.partition(":")[0] in MAILBOXED and args.mailbox:
-        entry["mailbox"] = simulate(folder, f"mb{args.mailbox}", [f"mailbox.entries={args.mailbox}"], args)
+        entry["mailbox"] = simulate(
+            folder, f"mb{args.mailbox}", [f"mailbox.entries={args.mailbox}"], args
+        )
     ref = np.asarray(rtsim.open_trace(trace(scene, "bvh2", workload, args)).hits)
     hits = np.asarray(rtsim.open_trace(folder).hits)
-    entry["hits_differ"] = int(((hits["prim"] != ref["prim"]) | (hits["t"].view(np.uint32) != ref["t"].view(np.uint32))).sum())
+    entry["hits_differ"] = int(
+        (
+            (hits["prim"] != ref["prim"]) | (hits["t"].view(np.uint32) != ref["t"].view(np.uint32))
+        ).sum()
+    )
     print(f"partition_study: {scene} {label(accel)} {workload} done", file=sys.stderr, flush=True)
     return entry
 
 
 def study(args: argparse.Namespace) -> dict[str, Any]:
     results: dict[str, Any] = {
-        "measured": {"host": platform.node(), "date": time.strftime("%Y-%m-%d"), "args": vars(args) | {"out": str(args.out)}}
+        "measured": {
+            "host": platform.node(),
+            "date": time.strftime("%Y-%m-%d"),
+            "args": vars(args) | {"out": str(args.out)},
+        }
     }
     for scene in args.scenes:
         results[scene] = {"build": build_figures(scene, args), "rays": {}}
-        for w in args.workloads:  # the bvh2 traces first: every structure's hits are compared with them
+        for (
+            w
+        ) in args.workloads:  # the bvh2 traces first: every structure's hits are compared with them
             trace(scene, "bvh2", w, args)
     jobs = [(s, a, w) for s in args.scenes for a in args.accels for w in args.workloads]
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
@@ -165,9 +185,12 @@ def build_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
         ref = st["bvh2"]["footprint_bytes"]
         for accel in args.accels:
             s = st[accel]
-            refs = results[scene]["rays"][accel][args.workloads[0]]["work"]["accel"].get("references_per_triangle")
+            refs = results[scene]["rays"][accel][args.workloads[0]]["work"]["accel"].get(
+                "references_per_triangle"
+            )
+            mib = s["footprint_bytes"] / 2**20
             lines.append(
-                f"| {scene} | {label(accel)} | {fmt(s['build_ms_cpu'], 0)} | {s['footprint_bytes'] / 2**20:.2f} | "
+                f"| {scene} | {label(accel)} | {fmt(s['build_ms_cpu'], 0)} | {mib:.2f} | "
                 f"{s['footprint_bytes'] / ref:.2f} | {fmt(refs, 2)} | {fmt(s.get('sah_cost'), 1)} |"
             )
     return lines
@@ -175,8 +198,9 @@ def build_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
 
 def ray_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
     lines = [
-        "| scene | rays | structure | steps | box | plane | tri tests | refs | hits vs bvh2 | Mrays/s | DRAM B/ray "
-        f"| mailbox {args.mailbox}: tri tests saved | Mrays/s | DRAM B/ray |",
+        "| scene | rays | structure | steps | box | plane | tri tests | refs | hits vs bvh2 "
+        f"| Mrays/s | DRAM B/ray | mailbox {args.mailbox}: tri tests saved | Mrays/s "
+        "| DRAM B/ray |",
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for scene in args.scenes:
@@ -186,10 +210,11 @@ def ray_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
                 w, m, mb = r["work"], r["model"], r.get("mailbox") or {}
                 cells = " | ".join(f"{w[f]['mean']:.1f} / {w[f]['p99']:.0f}" for f in WORK)
                 saved = mb.get("tri_tests_saved_fraction")
+                saved_text = "-" if saved is None else f"{saved:.1%}"
                 lines.append(
                     f"| {scene} | {workload} | {label(accel)} | {cells} | {r['hits_differ']} | "
-                    f"{fmt(m.get('mrays_per_second'), 1)} | {fmt(m.get('dram_bytes_per_ray'), 0)} | "
-                    f"{'-' if saved is None else f'{saved:.1%}'} | {fmt(mb.get('mrays_per_second'), 1)} | "
+                    f"{fmt(m.get('mrays_per_second'), 1)} | {fmt(m.get('dram_bytes_per_ray'), 0)} "
+                    f"| {saved_text} | {fmt(mb.get('mrays_per_second'), 1)} | "
                     f"{fmt(mb.get('dram_bytes_per_ray'), 0)} |"
                 )
     return lines
@@ -206,7 +231,10 @@ def frame_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
         base = None
         for accel in args.accels:
             build = results[scene]["build"]["structures"][accel]["build_ms_cpu"]
-            rates = [results[scene]["rays"][accel][w]["model"].get("mrays_per_second") for w in args.workloads]
+            rates = [
+                results[scene]["rays"][accel][w]["model"].get("mrays_per_second")
+                for w in args.workloads
+            ]
             rate = float(np.mean([x for x in rates if isinstance(x, (int, float))] or [np.nan]))
             if accel == "bvh2":
                 base = (build, rate)
@@ -233,31 +261,36 @@ def frame_table(results: dict[str, Any], args: argparse.Namespace) -> list[str]:
 
 def tables(results: dict[str, Any], args: argparse.Namespace) -> str:
     m = results["measured"]
-    tris = {s: results[s]["build"]["triangles"] for s in args.scenes}
+    tris = ", ".join(f"{s} {results[s]['build']['triangles']:,}" for s in args.scenes)
+    command = (
+        f"python scripts/partition_study.py --resolution {args.resolution} --repeats "
+        f"{args.repeats} --mailbox {args.mailbox} --scenes {','.join(args.scenes)} "
+        f"--accels {','.join(args.accels)}"
+    )
     return "\n".join(
         [
-            f"Measured on {m['host']} on {m['date']} with `python scripts/partition_study.py --resolution "
-            f"{args.resolution} --repeats {args.repeats} --mailbox {args.mailbox} --scenes {','.join(args.scenes)} "
-            f"--accels {','.join(args.accels)}` (triangles: " + ", ".join(f"{s} {n:,}" for s, n in tris.items()) + "). "
-            "Build: one thread, median CPU time of the builds, on a machine shared with other jobs; "
-            "footprint: every region (nodes, references, triangle records); refs/triangle: references "
-            "listed per scene triangle (leaf or cell lists; a BVH's triangle records per triangle); SAH "
-            "cost with C_t = C_i = 1 over each structure's cells or boxes (the grid has none).",
+            f"Measured on {m['host']} on {m['date']} with `{command}` (triangles: {tris}). "
+            "Build: one thread, median CPU time of the builds, on a machine shared with other "
+            "jobs; footprint: every region (nodes, references, triangle records); refs/triangle: "
+            "references listed per scene triangle (leaf or cell lists; a BVH's triangle records "
+            "per triangle); SAH cost with C_t = C_i = 1 over each structure's cells or boxes (the "
+            "grid has none).",
             "",
             *build_table(results, args),
             "",
-            "Per ray of each kind (mean / p99) from the reference traversal; *hits vs bvh2*: rays whose hit "
-            "(primitive and bits of t) differs from the binary BVH's; model at the default config (approx) "
-            f"on the whole trace, then with `mailbox.entries={args.mailbox}` (kd-tree, octree, grid): the "
-            "share of triangle tests it skipped and the model's figures with it. Every simulation replayed "
-            "its trace with 0 hit and 0 work mismatches (the script stops otherwise).",
+            "Per ray of each kind (mean / p99) from the reference traversal; *hits vs bvh2*: rays "
+            "whose hit (primitive and bits of t) differs from the binary BVH's; model at the "
+            "default config (approx) on the whole trace, then with "
+            f"`mailbox.entries={args.mailbox}` (kd-tree, octree, grid): the share of triangle "
+            "tests it skipped and the model's figures with it. Every simulation replayed its "
+            "trace with 0 hit and 0 work mismatches (the script stops otherwise).",
             "",
             *ray_table(results, args),
             "",
-            "Build plus trace per frame (ms): build time (host CPU, above) plus R rays at the model's mean "
-            "Mrays/s over the workloads; *beats bvh2 from*: the rays per frame from which the structure's "
-            "total is below the binned BVH's (its faster tracing pays back a slower build, or its faster "
-            "build outweighs slower tracing up to that many rays).",
+            "Build plus trace per frame (ms): build time (host CPU, above) plus R rays at the "
+            "model's mean Mrays/s over the workloads; *beats bvh2 from*: the rays per frame from "
+            "which the structure's total is below the binned BVH's (its faster tracing pays back "
+            "a slower build, or its faster build outweighs slower tracing up to that many rays).",
             "",
             *frame_table(results, args),
         ]
@@ -272,8 +305,12 @@ def main() -> int:
     p.add_argument("--workloads", default="primary,diffuse", type=lambda s: s.split(","))
     p.add_argument("--resolution", default="64x48")
     p.add_argument("--repeats", type=int, default=3, help="builds timed per structure (median)")
-    p.add_argument("--mailbox", type=int, default=8, help="mailbox entries of the second run (0: none)")
-    p.add_argument("--frame-rays", default="1e6,8e6", type=lambda s: [float(x) for x in s.split(",")])
+    p.add_argument(
+        "--mailbox", type=int, default=8, help="mailbox entries of the second run (0: none)"
+    )
+    p.add_argument(
+        "--frame-rays", default="1e6,8e6", type=lambda s: [float(x) for x in s.split(",")]
+    )
     p.add_argument("--hairball-triangles", type=int, default=200_000)
     p.add_argument("--jobs", type=int, default=2, help="traces and simulations at once")
     p.add_argument("--sim-timeout", type=float, default=1800.0, help="seconds per simulation")

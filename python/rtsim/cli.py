@@ -380,8 +380,9 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         action="append",
         metavar="KEY=VALUE",
         help="override one of the builder's documented settings, e.g. --build-set bins=32 "
-        "--build-set max_leaf_size=2 (repeatable; each structure's and builder's settings, defaults "
-        "and ranges: docs/accel.md, Builder settings); recorded in the manifest's accel.build_settings",
+        "--build-set max_leaf_size=2 (repeatable; each structure's and builder's settings, "
+        "defaults and ranges: docs/accel.md, Builder settings); recorded in the manifest's "
+        "accel.build_settings",
     )
     p.add_argument(
         "--flatten",

@@ -480,7 +480,9 @@ class SimConfig:
         stacks = t.units * t.ray_contexts * t.stack_entries * entry
         mailboxes = t.units * t.ray_contexts * self.mailbox.entries * 4
         ray_buffer = self.treelets.buffer_kib * 1024 if self.treelets.enabled else 0
-        return (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks + mailboxes + ray_buffer
+        return (
+            (self.l1.size_kib * t.units + self.l2.size_kib) * 1024 + stacks + mailboxes + ray_buffer
+        )
 
 
 def _names(cls: type) -> dict[str, dataclasses.Field[Any]]:

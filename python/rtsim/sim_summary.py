@@ -232,7 +232,9 @@ def mailbox_table(stats: dict[str, Any]) -> Table:
     """What the mailboxes saved (stats.json "mailbox", docs/accel.md, Mailboxes)."""
     m = stats.get("mailbox", {}) or {}
     per_ray = m.get("per_ray", {}) or {}
-    table = Table(title=f"mailboxes ({fmt_int(m.get('entries'))} entries per ray)", title_justify="left")
+    table = Table(
+        title=f"mailboxes ({fmt_int(m.get('entries'))} entries per ray)", title_justify="left"
+    )
     table.add_column("")
     table.add_column("value", justify="right")
     table.add_row("lookups / ray", fmt_float(per_ray.get("lookups"), 2))

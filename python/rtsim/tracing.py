@@ -160,8 +160,8 @@ def write_trace(
     of every ray ("primary", "shadow", "reflection", "diffuse", "refraction") or one per ray.
     any_hit: None makes shadow rays any-hit (occlusion) rays and the others closest-hit, as the
     tracer does; or a bool for every ray, or one per ray. accel, builder and build_settings
-    choose the acceleration structure, built as trace_scene builds it. Returns the manifest; rays are
-    written in order, each with its index as `pixel`."""
+    choose the acceleration structure, built as trace_scene builds it. Returns the manifest;
+    rays are written in order, each with its index as `pixel`."""
     import numpy as np
 
     from rtsim import _core

@@ -53,7 +53,12 @@ def test_accel_axis_sweeps_builder_settings() -> None:
         " {kind: bvh2, builder: lbvh, label: fast, build: {max_leaf_size: 2}}]\n",
         source="s.yaml",
     )
-    assert [a.label for a in s.accels] == ["bvh2", "kdtree empty_bonus=0", "kdtree empty_bonus=0.5", "fast"]
+    assert [a.label for a in s.accels] == [
+        "bvh2",
+        "kdtree empty_bonus=0",
+        "kdtree empty_bonus=0.5",
+        "fast",
+    ]
     traces = s.traces()
     assert len({t.trace_id for t in traces}) == 4
     kd = [t for t in traces if t.accel.kind == "kdtree"][1]
@@ -68,8 +73,14 @@ def test_accel_axis_sweeps_builder_settings() -> None:
 @pytest.mark.parametrize(
     ("entry", "message"),
     [
-        ("{kind: kdtree, build: {bins: 8}}", "setting 'bins': unknown setting; the builder takes: traversal_cost"),
-        ("{kind: bvh2, build: {max_leaf_size: [1, 0]}}", "'max_leaf_size': 0 is out of range [1, 64]"),
+        (
+            "{kind: kdtree, build: {bins: 8}}",
+            "setting 'bins': unknown setting; the builder takes: clip, empty_bonus",
+        ),
+        (
+            "{kind: bvh2, build: {max_leaf_size: [1, 0]}}",
+            "'max_leaf_size': 0 is out of range [1, 64]",
+        ),
         ("{kind: octree, build: {clip: 1}}", "expected true or false"),
         ("{kind: grid, build: 3}", "expected a mapping of setting"),
     ],

@@ -34,7 +34,11 @@ class AccelSpec:
     settings: tuple[tuple[str, Any], ...] = ()  # builder settings given (name, value), sorted
 
     def key(self, trace_version: int) -> dict[str, Any]:
-        key: dict[str, Any] = {"kind": self.kind, "builder": self.builder, "trace_version": trace_version}
+        key: dict[str, Any] = {
+            "kind": self.kind,
+            "builder": self.builder,
+            "trace_version": trace_version,
+        }
         if self.settings:  # (absent without settings: the keys of earlier sweeps stay valid)
             key["build"] = dict(self.settings)
         return key
@@ -101,7 +105,9 @@ def parse_accel_entries(
     elif isinstance(entry, dict):
         unknown = [k for k in entry if k not in ("kind", "builder", "label", "build")]
         if unknown:
-            raise fail(str(unknown[0]), "unknown key (expected one of: kind, builder, label, build)")
+            raise fail(
+                str(unknown[0]), "unknown key (expected one of: kind, builder, label, build)"
+            )
         kind = entry.get("kind")
         if not isinstance(kind, str) or not kind:
             raise fail("kind", "missing (a structure's name, e.g. bvh8)")
@@ -110,7 +116,9 @@ def parse_accel_entries(
             raise fail("builder", f"expected a builder name, got {builder!r}")
         build = entry.get("build") or {}
         if not isinstance(build, dict):
-            raise fail("build", f"expected a mapping of setting: value (or [values]), got {build!r}")
+            raise fail(
+                "build", f"expected a mapping of setting: value (or [values]), got {build!r}"
+            )
         label = str(entry.get("label") or (f"{kind}:{builder}" if builder else kind))
     else:
         raise fail("", f"expected KIND, KIND:BUILDER or a mapping with kind, got {entry!r}")
@@ -128,15 +136,15 @@ def parse_accel_entries(
     schema = registered_settings(kind, builder) if build else {}
     names = sorted(build)
     choices = [build[n] if isinstance(build[n], list) else [build[n]] for n in names]
-    for name, values in zip(names, choices):
+    for name, values in zip(names, choices, strict=True):
         for value in values or [None]:
             problem = check_setting(str(name), value, schema)
             if problem:
                 raise fail("build", f"{kind}:{builder} setting {name!r}: {problem}")
-    swept = [n for n, v in zip(names, choices) if isinstance(build[n], list)]
+    swept = [n for n in names if isinstance(build[n], list)]
     out = []
     for values in itertools.product(*choices):
-        settings = tuple(zip(names, values))
+        settings = tuple(zip(names, values, strict=True))
         # Labels name what differs: the swept settings, or all given when no label says it.
         named = [(n, v) for n, v in settings if n in swept or (not swept and not explicit_label)]
         suffix = " ".join(f"{n}={v}" for n, v in named)

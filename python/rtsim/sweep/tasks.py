@@ -69,7 +69,11 @@ class TraceTask:
             "--accel",
             self.accel,
             *(["--builder", self.builder] if self.builder else []),
-            *[a for k, v in self.build_settings.items() for a in ("--build-set", f"{k}={_text(v)}")],
+            *[
+                a
+                for k, v in self.build_settings.items()
+                for a in ("--build-set", f"{k}={_text(v)}")
+            ],
         ]
 
 
