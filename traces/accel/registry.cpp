@@ -138,7 +138,7 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
          loader<KdAccel>()},
         {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
-          {"wachter_keller", "binned", "lbvh"}},
+          {"binned", "wachter_keller", "lbvh"}},
          kBihStackEntryBytes,
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              if (builder == "wachter_keller") s.bih.visit(v);

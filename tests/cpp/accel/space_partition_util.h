@@ -15,7 +15,7 @@ namespace rtsim::test {
 
 /// The structures this tests sweep: KIND or KIND:BUILDER.
 inline const std::vector<std::string>& partition_kinds() {
-    static const std::vector<std::string> kinds = {"kdtree", "bih", "bih:binned", "bih:lbvh", "octree", "bvh2:lbvh"};
+    static const std::vector<std::string> kinds = {"kdtree", "bih", "bih:wachter_keller", "bih:lbvh", "octree", "bvh2:lbvh"};
     return kinds;
 }
 

@@ -25,7 +25,7 @@ TEST(SpacePartition, LayoutInvariantsOnRandomSoups) {
         const Scene scene = test::random_soup(seed, 1500);
         const auto kd = build_named(scene, "kdtree");
         EXPECT_NO_THROW(check_kdtree_invariants(static_cast<const KdAccel&>(*kd).view(), scene));
-        for (const char* name : {"bih", "bih:binned", "bih:lbvh"}) {
+        for (const char* name : {"bih", "bih:wachter_keller", "bih:lbvh"}) {
             const auto bih = build_named(scene, name);
             EXPECT_NO_THROW(check_bih_invariants(static_cast<const BihAccel&>(*bih).view(), scene)) << name;
         }
@@ -57,7 +57,7 @@ TEST(SpacePartition, HitsEqualBruteForceAndBvh2OnRandomSoups) {
                  {"kdtree", {{"traversal_cost", 1.0}, {"intersection_cost", 80.0}, {"clip", false}}},
                  {"octree", {{"max_leaf_size", 2}, {"max_depth", 10}}},
                  {"octree", {{"max_depth", 1}}},
-                 {"bih", {{"max_leaf_size", 1}}},
+                 {"bih:wachter_keller", {{"max_leaf_size", 1}}},
                  {"bvh2:lbvh", {{"morton_bits", 2}, {"max_leaf_size", 1}}}})
             expect_structure_correct(*build_named(scene, name, settings), scene, rays, name + " " + settings.dump());
     }
@@ -115,7 +115,7 @@ TEST(SpacePartitionHardCases, RaysInTheStructuresOwnPlanes) {
     for (const char* scene_name : {"soup", "cornell", "rotated_walls"}) {
         const Scene soup = test::random_soup(8, 800);
         const Scene& scene = std::string(scene_name) == "soup" ? soup : test::procedural(scene_name);
-        for (const char* name : {"kdtree", "bih", "bih:binned", "octree"}) {
+        for (const char* name : {"kdtree", "bih", "bih:wachter_keller", "octree"}) {
             const auto a = build_named(scene, name);
             const std::vector<std::pair<int, float>> planes = split_planes(*a);
             ASSERT_FALSE(planes.empty()) << name;

@@ -2,10 +2,10 @@
 // The bounding interval hierarchy behind the acceleration-structure seam (docs/accel.md, "bih"):
 // two clip planes per node on one axis, every triangle stored once (no references, no
 // duplication), front-to-back traversal of (node, tnear, tfar) with two ray/plane tests per
-// interior node on the `plane` pipeline. Builders: "wachter_keller" (the paper's global
-// heuristic: the middle of the current split box, objects by their box centres) and "binned" /
-// "lbvh" (a binary BVH build tree converted node by node: per node the axis and child order
-// whose clip planes leave the cheapest cells by the SAH).
+// interior node on the `plane` pipeline. Builders: "binned" (the default) and "lbvh" convert a
+// binary BVH build tree node by node (per node the axis and child order whose clip planes leave
+// the cheapest cells by the SAH); "wachter_keller" is the paper's global heuristic (the middle of
+// the current split box, triangles by their box centres).
 #include <memory>
 #include <string>
 #include <vector>

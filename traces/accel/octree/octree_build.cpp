@@ -107,14 +107,16 @@ void OctreeBuilder::build(uint32_t index, const Aabb& cell, std::vector<Ref>& re
         for (uint32_t c = 0; c < 8; ++c)
             if (!part[c].empty()) child[c].push_back(Ref{part[c], r.prim});
     }
-    // Subdividing must separate something; else this stays a leaf.
+    // A cut that lists every reference in every child it stores, with more than one stored,
+    // only multiplies references (large triangles covering the cell): it stays a leaf. A cut
+    // that leaves every reference in one child still shrinks the cell (empty space cut off).
     bool separates = false;
     uint32_t mask = 0, stored = 0;
     for (uint32_t c = 0; c < 8; ++c) {
         separates = separates || (!child[c].empty() && child[c].size() < refs.size());
         if (!child[c].empty()) mask |= 1u << c, ++stored;
     }
-    if (!separates) return leaf(index, cell, refs);
+    if (!separates && stored > 1) return leaf(index, cell, refs);
     std::vector<Ref>().swap(refs);
     const uint32_t first = uint32_t(nodes.size());
     require(first + stored <= OctNode::kMaxIndex, "octree: more than 2^24 nodes (lower max_depth or raise max_leaf_size)");
