@@ -73,7 +73,7 @@ def trace_scene(
     hairball_triangles: int = 200_000,
     progress: Callable[[int, int, str], None] | None = None,
     accel: str = "bvh2",
-    builder: str = "binned",
+    builder: str = "",
     flatten: bool = False,
     frames: int = 1,
     build_settings: dict[str, Any] | None = None,
@@ -82,12 +82,14 @@ def trace_scene(
     render.png, and returns the manifest. workload: ray kinds ("primary,diffuse" or a list);
     None (the default) traces every kind the scene calls for (manifest["workload"]["effects"]
     says which and why). camera: (eye, target, vertical field of view in degrees). accel and
-    builder choose the acceleration structure (rtsim._core.accel_kinds(), docs/accel.md);
-    instanced scenes are traced through two levels (a BLAS of that kind per mesh, a TLAS over
-    the instances) unless flatten is true. frames > 1 animates an instanced scene by the
-    documented motion (docs/accel.md, "Frames"): the BLASes are built once, a TLAS per frame, and
-    the workload is traced once per frame; manifest["frames"] lists each frame's rays and TLAS
-    build time."""
+    builder choose the acceleration structure (rtsim._core.accel_kinds(), docs/accel.md; ""
+    is the kind's default builder); build_settings overrides the builder's documented settings
+    ({"bins": 32}; docs/accel.md, "Builder settings"; manifest["accel"]["build_settings"]
+    records them all). Instanced scenes are traced through two levels (a BLAS of that kind per
+    mesh, a TLAS over the instances) unless flatten is true. frames > 1 animates an instanced
+    scene by the documented motion (docs/accel.md, "Frames"): the BLASes are built once, a TLAS
+    per frame, and the workload is traced once per frame; manifest["frames"] lists each frame's
+    rays and TLAS build time."""
     from rtsim import _core
 
     kinds = (
@@ -150,7 +152,7 @@ def write_trace(
     any_hit: bool | Sequence[bool] | Any | None = None,
     threads: int = 0,
     accel: str = "bvh2",
-    builder: str = "binned",
+    builder: str = "",
     build_settings: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Traces your rays with the reference tracer and writes a trace folder (OUT/trace.rtt and

@@ -276,7 +276,7 @@ void bind_trace(py::module_& m) {
           py::arg("directions"), py::arg("tmin"), py::arg("tmax"), py::arg("kinds"),
           py::arg("any_hit"), py::arg("out_dir"), py::arg("threads") = 0u,
           py::arg("progress") = py::none(), py::arg("accel") = "bvh2",
-          py::arg("builder") = "binned", py::arg("build_settings") = py::none(),
+          py::arg("builder") = "", py::arg("build_settings") = py::none(),
           "Traces the given rays (kinds: RayKind per ray, any_hit: flag per ray) and writes\n"
           "OUT/trace.rtt and manifest.json exactly as trace_scene writes a workload; returns\n"
           "the manifest. Use rtsim.write_trace, which takes kind names and scene names.");
