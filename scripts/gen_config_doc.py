@@ -47,6 +47,11 @@ SECTION_NOTES = {
     "anyhit": "The alpha-test stage; built only when the BVH has alpha-MASK triangles.",
     "cell": "The grid's cell-step (3D-DDA) pipeline: one operation per cell visited; built only "
     "for structures that issue cell steps (`grid`, docs/accel.md).",
+    "plane": "The ray/split-plane pipeline: one operation per split plane a node tests (a "
+    "kd-tree's 1, a BIH's 2, an octree's 3); built only for structures that issue plane tests "
+    "(docs/accel.md).",
+    "mailbox": "Mailboxes in the traversal units: a table per ray context of the primitives the "
+    "ray tested, so grids, kd-trees and octrees skip retests (docs/accel.md, Mailboxes).",
     "l1": "The private per-unit L1 caches (MSHRs modelled exactly).",
     "l2": "The shared banked L2 (MSHRs: occupancy bound at approx, exact at detailed).",
     "dram": "DRAM channels: banks and row buffers behind each channel's data bus "

@@ -34,6 +34,7 @@ from rtsim.errors import RtsimError
 from rtsim.kinds import RAY_KINDS
 from rtsim.sim_cli import add_parsers as add_simulate_parsers
 from rtsim.sweep.cli import add_parsers as add_sweep_parsers
+from rtsim.tracing import parse_setting_value
 
 # Start-up matters (`rtsim simulate` runs once per simulation): modules above import only the
 # standard library; rich, numpy, the C++ extension and Dask are imported by the commands.
@@ -77,6 +78,7 @@ class TraceJob:
     hairball_triangles: int | None = None
     accel: str | None = None
     builder: str | None = None  # None: the structure's default builder (its first)
+    build_settings: dict[str, Any] | None = None  # --build-set overrides
     flatten: bool | None = None  # instanced scenes: one world-space structure instead of two levels
     frames: int | None = None  # animated frames of an instanced scene (docs/accel.md, "Frames")
 
@@ -128,6 +130,15 @@ def parse_camera(text: str) -> tuple[tuple[float, float, float], tuple[float, fl
     return (ex, ey, ez), (tx, ty, tz), fov
 
 
+def parse_build_setting(text: str) -> tuple[str, Any]:
+    """KEY=VALUE of --build-set: the value as a number or true/false when it reads as one (the
+    builder checks the name, type and range, naming the setting)."""
+    key, sep, value = text.partition("=")
+    if not sep or not key.strip():
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got '{text}'")
+    return key.strip(), parse_setting_value(value.strip())
+
+
 def positive_int(text: str) -> int:
     if not text.isdigit():
         raise argparse.ArgumentTypeError(f"expected a non-negative integer, got '{text}'")
@@ -177,6 +188,7 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             progress=progress,
             accel=job.accel,
             builder=job.builder,
+            build_settings=job.build_settings,
             flatten=job.flatten,
             frames=job.frames,
         )
@@ -208,6 +220,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         hairball_triangles=args.hairball_triangles,
         accel=args.accel,
         builder=args.builder,
+        build_settings=dict(args.build_set) if args.build_set else None,
         flatten=args.flatten or None,
         frames=args.frames,
     )
@@ -383,6 +396,16 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
             "builder (default: the structure's first); the structures take: "
             + "; ".join(f"{k['name']}: {', '.join(k['builders'])}" for k in accel_kinds())
         ),
+    )
+    p.add_argument(
+        "--build-set",
+        type=parse_build_setting,
+        action="append",
+        metavar="KEY=VALUE",
+        help="override one of the builder's documented settings, e.g. --build-set bins=32 "
+        "--build-set max_leaf_size=2 (repeatable; each structure's and builder's settings, "
+        "defaults and ranges: docs/accel.md, Builder settings); recorded in the manifest's "
+        "accel.build_settings",
     )
     p.add_argument(
         "--flatten",

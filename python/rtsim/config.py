@@ -92,13 +92,17 @@ class _Root:
         return apply_patch(self, unflatten(values))  # type: ignore[arg-type]
 
     def sram_bytes(self) -> int:
-        """On-chip SRAM of the accelerator: the L1s, the L2, the traversal stacks and, with
-        treelet scheduling, the ray buffer."""
+        """On-chip SRAM of the accelerator: the L1s, the L2, the traversal stacks, the mailboxes
+        and, with treelet scheduling, the ray buffer."""
         c: Any = self
         t = c.traversal
-        stacks = t.units * t.ray_contexts * t.stack_entries * t.stack_entry_bytes
+        # stack_entry_bytes 0 is the structure's own, known only with a trace: a BVH's 8 here
+        # (stats.json "area" has the run's exact figure).
+        entry = t.stack_entry_bytes or 8
+        stacks = t.units * t.ray_contexts * t.stack_entries * entry
+        mailboxes = t.units * t.ray_contexts * c.mailbox.entries * 4
         ray_buffer = c.treelets.buffer_kib * 1024 if c.treelets.enabled else 0
-        return (c.l1.size_kib * t.units + c.l2.size_kib) * 1024 + stacks + ray_buffer
+        return (c.l1.size_kib * t.units + c.l2.size_kib) * 1024 + stacks + mailboxes + ray_buffer
 
 
 def _build_tree(schema: dict[str, Any]) -> tuple[type, dict[str, type]]:

@@ -228,6 +228,23 @@ def frames_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def mailbox_table(stats: dict[str, Any]) -> Table:
+    """What the mailboxes saved (stats.json "mailbox", docs/accel.md, Mailboxes)."""
+    m = stats.get("mailbox", {}) or {}
+    per_ray = m.get("per_ray", {}) or {}
+    table = Table(
+        title=f"mailboxes ({fmt_int(m.get('entries'))} entries per ray)", title_justify="left"
+    )
+    table.add_column("")
+    table.add_column("value", justify="right")
+    table.add_row("lookups / ray", fmt_float(per_ray.get("lookups"), 2))
+    table.add_row("hit rate", fmt_pct(m.get("hit_rate")))
+    table.add_row("triangle tests / ray", fmt_float(per_ray.get("tri_tests"), 2))
+    table.add_row("  without the mailbox", fmt_float(per_ray.get("tri_tests_without_mailbox"), 2))
+    table.add_row("tests and fetches saved", fmt_pct(m.get("tri_tests_saved_fraction")))
+    return table
+
+
 def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> None:
     """Prints the run's headline numbers, utilisation, latency and what was built and why."""
     console = console or Console()
@@ -240,6 +257,8 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
             console.print(why_slow_table(stats))
         console.print(latency_table(stats))
         console.print(instantiated_table(stats))
+    if stats.get("mailbox"):
+        console.print(mailbox_table(stats))
     if stats.get("energy"):
         console.print(energy_table(stats))
     if stats.get("effects"):

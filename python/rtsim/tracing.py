@@ -11,6 +11,7 @@ Every trace folder holds trace.rtt and manifest.json, and ``rtsim.simulate`` rep
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -51,6 +52,20 @@ def load_scene(
         hairball_triangles=int_arg(hairball_triangles, "hairball_triangles", 1, UINT32_MAX),
         seed=int_arg(seed, "seed", 0, UINT64_MAX),
     )
+
+
+def parse_setting_value(text: str) -> Any:
+    """A builder setting's value as given on the command line or in a spec: '32' -> 32,
+    '1e-5' -> 1e-05, 'true'/'false' -> a bool; other text stays text (the builder then names the
+    setting and what it takes)."""
+    lowered = text.strip().lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        value = json.loads(text)
+    except ValueError:
+        return text
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else text
 
 
 def _scene_arg(scene: SceneLike) -> Any:
@@ -139,6 +154,7 @@ def trace_scene(
     builder: str | None = None,
     flatten: bool | None = None,
     frames: int | None = None,
+    build_settings: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. Every option left None takes the tracer's default
@@ -146,8 +162,11 @@ def trace_scene(
     workload: ray kinds ("primary,diffuse" or a list); None traces every kind the scene calls
     for (manifest["workload"]["effects"] says which and why). camera: (eye, target, vertical
     field of view in degrees). accel and builder choose the acceleration structure
-    (rtsim._core.accel_kinds(), docs/accel.md); instanced scenes are traced through two levels
-    (a BLAS of that kind per mesh, a TLAS over the instances) unless flatten is true. frames > 1
+    (rtsim._core.accel_kinds(), docs/accel.md); build_settings overrides the builder's
+    documented settings ({"bins": 32}; docs/accel.md, "Builder settings";
+    manifest["accel"]["build_settings"] records them all). Instanced scenes are traced through
+    two levels (a BLAS of that kind per mesh, a TLAS over the instances) unless flatten is true.
+    frames > 1
     animates an instanced scene by the documented motion (docs/accel.md, "Frames"): the BLASes
     are built once, a TLAS per frame, and the workload is traced once per frame;
     manifest["frames"] lists each frame's rays and TLAS build time."""
@@ -166,11 +185,13 @@ def trace_scene(
         "builder": lambda v: _name_arg(v, "builder"),
         "flatten": lambda v: bool_arg(v, "flatten"),
         "frames": lambda v: int_arg(v, "frames", 1, MAX_FRAMES),
+        "build_settings": _settings_arg,
     }
     values = {
         "workload": workload, "width": width, "height": height, "bounces": bounces, "seed": seed,
         "camera": camera, "threads": threads, "hairball_triangles": hairball_triangles,
         "accel": accel, "builder": builder, "flatten": flatten, "frames": frames,
+        "build_settings": build_settings,
     }  # fmt: skip
     # Only the options given are passed: the others take the tracer's defaults (trace_defaults).
     given = {k: checks[k](v) for k, v in values.items() if v is not None}
@@ -186,6 +207,22 @@ def trace_scene(
     return _core.trace_scene(
         _scene_arg(scene), path_arg(out_dir, "out_dir"), progress=progress, **given
     )
+
+
+def _settings_arg(settings: dict[str, Any] | None) -> dict[str, Any] | None:
+    """Builder settings {name: number, bool or text}; the builder checks names and ranges."""
+    if settings is None:
+        return None
+    if not isinstance(settings, dict) or not all(isinstance(k, str) for k in settings):
+        raise ArgumentTypeError(
+            f"build_settings: expected a dict of setting name: value, got {settings!r}"
+        )
+    for name, value in settings.items():
+        if not isinstance(value, (bool, int, float, str)):
+            raise ArgumentTypeError(
+                f"build_settings: '{name}' must be a number, a bool or text, got {value!r}"
+            )
+    return dict(settings)
 
 
 def _name_arg(value: Any, name: str) -> str:
@@ -230,6 +267,7 @@ def write_trace(
     threads: int = 0,
     accel: str | None = None,
     builder: str | None = None,
+    build_settings: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Traces your rays with the reference tracer and writes a trace folder (OUT/trace.rtt and
     manifest.json, exactly as trace_scene writes one) that rtsim.simulate replays.
@@ -237,9 +275,9 @@ def write_trace(
     origins, directions: (N, 3) arrays; tmin, tmax: scalars or (N,) arrays. kind: the ray kind
     of every ray ("primary", "shadow", "reflection", "diffuse", "refraction") or one per ray.
     any_hit: None makes shadow rays any-hit (occlusion) rays and the others closest-hit, as the
-    tracer does; or a bool for every ray, or one per ray. accel and builder choose the
-    acceleration structure, built as trace_scene builds it (None: the tracer's defaults,
-    trace_defaults()). Returns the manifest; rays are
+    tracer does; or a bool for every ray, or one per ray. accel, builder and build_settings
+    choose the acceleration structure, built as trace_scene builds it (None: the tracer's
+    defaults, trace_defaults()). Returns the manifest; rays are
     written in order, each with its index as `pixel`."""
     import numpy as np
 
@@ -270,6 +308,7 @@ def write_trace(
         out,
         threads=int_arg(threads, "threads", 0, UINT32_MAX),
         **{k: _name_arg(v, k) for k, v in {"accel": accel, "builder": builder}.items() if v},
+        build_settings=_settings_arg(build_settings),
     )
 
 

@@ -111,6 +111,17 @@ std::optional<CameraOverride> camera_from(const py::object& obj) {
     return cam;
 }
 
+/// Builder settings {name: value} (None: none) as the C++ side takes them (AccelOptions::settings).
+nlohmann::json settings_from(const py::object& settings) {
+    if (settings.is_none()) return nlohmann::json::object();
+    if (!py::isinstance<py::dict>(settings)) throw ArgumentError("build_settings: expected a dict of name: value");
+    const std::string text = py::module_::import("json").attr("dumps")(settings).cast<std::string>();
+    return nlohmann::json::parse(text);
+}
+
+/// A JSON value as the Python object json.loads makes of it.
+py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
 /// The scene argument of trace_scene: a path, a procedural name, or a Scene (its source).
 std::string scene_name(const py::object& obj) {
     if (py::isinstance<PyScene>(obj)) return obj.cast<PyScene&>().scene().source;
@@ -122,6 +133,7 @@ struct DefaultsReader {
     py::dict out;
     void operator()(const char* name, const std::vector<RayKind>&, const char*) { out[name] = py::none(); }
     void operator()(const char* name, const std::optional<CameraOverride>&, const char*) { out[name] = py::none(); }
+    void operator()(const char* name, const nlohmann::json&, const char*) { out[name] = py::none(); }
     template <class T>
     void operator()(const char* name, const T& value, const char*) { out[name] = value; }
 };
@@ -146,6 +158,10 @@ struct KwargsApplier {
     void operator()(const char* name, std::optional<CameraOverride>& camera, const char*) {
         py::object v;
         if (take(name, &v)) camera = camera_from(v);
+    }
+    void operator()(const char* name, nlohmann::json& settings, const char*) {
+        py::object v;
+        if (take(name, &v)) settings = settings_from(v);
     }
     template <class T>
     void operator()(const char* name, T& value, const char*) {
@@ -193,7 +209,7 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
                           const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& kinds,
                           const py::array_t<bool, py::array::c_style | py::array::forcecast>& any_hit,
                           const fs::path& out_dir, unsigned threads, const py::object& progress,
-                          const std::string& accel, const std::string& builder) {
+                          const std::string& accel, const std::string& builder, const py::object& build_settings) {
     const std::vector<Ray> rays = rays_from_arrays(origins, directions, tmin, tmax);
     const auto n = static_cast<py::ssize_t>(rays.size());
     if (kinds.ndim() != 1 || kinds.shape(0) != n)
@@ -214,6 +230,7 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
     AccelOptions accel_options;
     accel_options.kind = accel;
     accel_options.builder = builder;
+    accel_options.settings = settings_from(build_settings);
     validate_accel_options(accel_options);
     RayTraceOptions opt;
     opt.out_dir = out_dir.string();
@@ -278,7 +295,7 @@ void bind_trace(py::module_& m) {
         [] {
             py::list out;
             for (const WorkFieldInfo& f : kWorkFields)
-                out.append(py::dict(py::arg("name") = f.name, py::arg("doc") = f.doc,
+                out.append(py::dict(py::arg("name") = f.name, py::arg("doc") = f.doc, py::arg("traced") = f.traced,
                                     py::arg("tests_of") = f.tests_of == kNoOpKind ? py::object(py::none())
                                                                                   : py::str(op_kind_name(f.tests_of))));
             return out;
@@ -311,8 +328,9 @@ void bind_trace(py::module_& m) {
           "Runs the reference tracer: writes OUT/trace.rtt, manifest.json and render.png and\n"
           "returns the manifest. Keyword options are trace_defaults()'s (None or absent: the\n"
           "default): workload (ray kinds; None: every kind the scene calls for), width, height,\n"
-          "bounces, seed, camera, accel and builder (accel_kinds()), flatten, hairball_triangles,\n"
-          "threads, frames. progress(done, total, stage) is called now and then.");
+          "bounces, seed, camera, accel and builder (accel_kinds()), build_settings ({name: value}\n"
+          "over the builder's settings: accel_kinds()[i]['settings'][builder]), flatten,\n"
+          "hairball_triangles, threads, frames. progress(done, total, stage) is called now and then.");
     m.def(
         "trace_defaults",
         [] {
@@ -326,7 +344,7 @@ void bind_trace(py::module_& m) {
           py::arg("directions"), py::arg("tmin"), py::arg("tmax"), py::arg("kinds"),
           py::arg("any_hit"), py::arg("out_dir"), py::arg("threads") = 0u,
           py::arg("progress") = py::none(), py::arg("accel") = AccelOptions{}.kind,
-          py::arg("builder") = AccelOptions{}.builder,
+          py::arg("builder") = AccelOptions{}.builder, py::arg("build_settings") = py::none(),
           "Traces the given rays (kinds: RayKind per ray, any_hit: flag per ray) and writes\n"
           "OUT/trace.rtt and manifest.json exactly as trace_scene writes a workload; returns\n"
           "the manifest. Use rtsim.write_trace, which takes kind names and scene names.");
@@ -339,11 +357,15 @@ void bind_trace(py::module_& m) {
                 d["name"] = k.name;
                 d["description"] = k.description;
                 d["builders"] = k.builders;
+                py::dict settings;
+                for (const std::string& b : k.builders) settings[py::str(b)] = to_python(accel_settings_schema(k.name, b));
+                d["settings"] = settings;
                 out.append(d);
             }
             return out;
         },
-        "The acceleration structures this build knows: name, description, builders.");
+        "The acceleration structures this build knows: name, description, builders, and per builder\n"
+        "its settings {name: {type, default, unit, min, max, doc}} (docs/accel.md, Builder settings).");
     m.attr("trace_version") = kTraceVersion;  // the trace format this build writes and reads
     m.def("trace_sections", &trace_sections, py::arg("path"),
           "Validates a trace file's header, section table and BVH image; returns its sections.");

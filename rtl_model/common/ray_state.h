@@ -39,9 +39,9 @@ private:
 };
 
 /// Bytes of ray-buffer SRAM one waiting ray occupies: origin, direction, tmin, tmax (32), hit so
-/// far (prim, t, u, v: 16), ray id and flags (8), and its on-chip stack entries.
-inline uint32_t ray_state_bytes(uint32_t stack_entries, uint32_t stack_entry_bytes) {
-    return 32 + 16 + 8 + stack_entries * stack_entry_bytes;
+/// far (prim, t, u, v: 16), ray id and flags (8), its on-chip stack entries and its mailbox.
+inline uint32_t ray_state_bytes(uint32_t stack_entries, uint32_t stack_entry_bytes, uint32_t mailbox_bytes = 0) {
+    return 32 + 16 + 8 + stack_entries * stack_entry_bytes + mailbox_bytes;
 }
 
 /// The ray buffer as the traversal units see it (treelet scheduling).

@@ -29,6 +29,7 @@ const PipelineConfig& ModelConfig::pipeline(OpKind kind) const {
         case OpKind::anyhit: return anyhit;
         case OpKind::cell: return cell;
         case OpKind::transform: return transform;
+        case OpKind::plane: return plane;
         default: break;
     }
     throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");

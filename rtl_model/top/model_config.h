@@ -14,6 +14,7 @@
 #include "rtl_model/mem/cache_config.h"
 #include "rtl_model/mem/dram_config.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
+#include "rtl_model/traversal/mailbox_config.h"
 #include "rtl_model/traversal/step_demand.h"
 #include "rtl_model/traversal/traversal_config.h"
 #include "traces/accel/step_plan.h"
@@ -40,6 +41,10 @@ struct ModelConfig {
     /// Instance transforms of two-level structures: a 3x4 matrix times the ray's origin and
     /// direction (18 multiply-adds), pipelined like a box test (Vulkan-Sim's instance transform).
     PipelineConfig transform{8, 1, 1, Sharing::per_unit, 4};
+    /// Ray/split-plane tests of kd-trees, BIHs and octrees: (plane - origin) x 1/d and two
+    /// compares, one slab of a box test; two per issue (a BIH node's pair).
+    PipelineConfig plane{4, 1, 2, Sharing::per_unit, 4};
+    MailboxConfig mailbox;
     // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
     // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
     CacheConfig l1{16, 4, 64, 4, 16, 1, 1};
@@ -69,6 +74,8 @@ struct ModelConfig {
         v.section("anyhit", anyhit);
         v.section("cell", cell);
         v.section("transform", transform);
+        v.section("plane", plane);
+        v.section("mailbox", mailbox);
         v.section("l1", l1);
         v.section("l2", l2);
         v.section("dram", dram);

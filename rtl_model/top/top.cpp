@@ -143,7 +143,8 @@ void Top::build_ray_buffer(const Accel& accel, const MemoryMap& map) {
     m_partition = accel.partition(uint64_t(t.treelet_kib) * 1024);
     const TraversalConfig& tc = m_config.traversal;
     m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", t, m_partition, map, m_steppers, tc.units, tc.ray_contexts,
-                                               ray_state_bytes(tc.stack_entries, tc.stack_entry_bytes),
+                                               ray_state_bytes(tc.stack_entries, tc.stack_entry_bytes,
+                                                               m_config.mailbox.entries * MailboxConfig::kEntryBytes),
                                                m_config.quantum_cycles);
     m_ray_buffer->rays(*m_dispatch);
     if (m_ideal) m_ray_buffer->mem(*m_ideal);

@@ -30,7 +30,7 @@ void work_totals(TraceReader& reader, AnalyticProfile* p) {
         reader.read(SectionKind::work, first, count, buf.data());
         WorkTotals sums;
         for (uint64_t i = 0; i < count; ++i) {
-            const WorkRecord& w = buf[i];
+            const WorkCounts w = buf[i].counts();
             sums.add(w);
             const double steps = plan_step_work(w);
             if (steps > p->longest_ray_steps) p->longest_ray_steps = steps, p->longest_ray_tests = w.tri_tests;

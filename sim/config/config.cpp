@@ -277,6 +277,11 @@ void validate(const SimConfig& config) {
     require(!config.treelets.enabled || config.fidelity != Fidelity::analytic,
             "config: 'treelets.enabled' is not supported at fidelity 'analytic' (its closed form models plain "
             "dispatch); use approx or detailed");
+    require(config.mailbox.entries == 0 || config.fidelity != Fidelity::analytic ||
+                config.analytic.caches == AnalyticCaches::functional,
+            "config: 'mailbox.entries' is not supported at fidelity 'analytic' with analytic.caches=statistical (its "
+            "per-trace analysis prices triangle tests from the trace's work records, which hold no mailbox); use "
+            "analytic.caches=functional, approx or detailed");
     require(config.sampling.fraction == 0 || config.sampling.count == 0,
             "config: set 'sampling.fraction' or 'sampling.count', not both");
     require(!config.sampling.enabled() || !config.treelets.enabled,

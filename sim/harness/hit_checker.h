@@ -1,7 +1,8 @@
 #pragma once
 // The hit checker (docs/architecture.md, rule 2): every ray the model finishes is compared with the
-// trace's reference hit (primitive id and the bits of t) and reference work (every field of
-// traces/common/work_counts.h). Mismatches are counted, the first ones listed, and make rtsim-sim
+// trace's reference hit (primitive id and the bits of t) and reference work (every traced field of
+// traces/common/work_counts.h; with a mailbox, the tests it skipped counted back:
+// WorkCounts::without_mailbox). Mismatches are counted, the first ones listed, and make rtsim-sim
 // exit non-zero. It also keeps the per-ray latency histogram and reports progress.
 #include <cstdint>
 #include <functional>

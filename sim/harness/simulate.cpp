@@ -1,4 +1,5 @@
 #include "sim/harness/simulate.h"
+#include "sim/harness/structure_defaults.h"
 
 #include <algorithm>
 #include <chrono>
@@ -14,6 +15,7 @@
 #include "sim/harness/hit_checker.h"
 #include "sim/report/roofline.h"
 #include "sim/harness/run_files.h"
+#include "sim/report/mailbox_stats.h"
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/model_errors.h"
 #include "sim/sampling/sampling.h"
@@ -65,7 +67,8 @@ json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, cons
 
 }  // namespace
 
-SimOutcome run_simulation(const SimOptions& o) {
+SimOutcome run_simulation(const SimOptions& options) {
+    const SimOptions o = with_structure_defaults(options);  // the structure's stack entry size
     // The analytic level works from a per-trace analysis and a closed form (sim/analytic/analytic.h).
     if (o.config.fidelity == Fidelity::analytic) return run_analytic_simulation(o);
     auto t0 = std::chrono::steady_clock::now();
@@ -76,6 +79,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     const json manifest = read_manifest(rtt);
     // The acceleration structure, whichever it is, validated structurally (load_accel).
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
+    apply_mailbox(*accel, o.config);
     // Animated traces (frames.h): replayed frame after frame, caches warm, one barrier between.
     const std::vector<FrameRecord> frames = read_frame_table(reader, accel->frame_count());
     check_frames_supported(o.config, frames.size(), rtt);
@@ -202,6 +206,7 @@ SimOutcome run_simulation(const SimOptions& o) {
     }
     // Energy and area from the run's counts and config (docs/energy_area.md); the timed model
     // never sees them.
+    add_mailbox_stats(out.stats, o.config, checker.work_totals(), checker.checked());
     add_energy_area(out.stats, o.config, checker.work_totals(), checker.checked());
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);
     json verdict = nullptr;

@@ -123,6 +123,11 @@ double pipeline_mm2(const EnergyConfig& c, const SimConfig& s, const PipelineCon
     return pipes * lanes * flops_um2(c, f) * 1e-6 * area_scale(c);
 }
 
+/// The mailboxes' SRAM, bytes: one table of mailbox.entries primitive ids per ray context.
+double mailbox_bytes(const SimConfig& s) {
+    return double(s.traversal.units) * s.traversal.ray_contexts * s.mailbox.entries * MailboxConfig::kEntryBytes;
+}
+
 bool instantiated(const json& list, const char* block) {
     for (const json& b : list)
         if (b.value("block", "") == block) return b.value("instantiated", false);
@@ -148,10 +153,15 @@ json area_json(const SimConfig& s, const json& stats) {
     mm2["anyhit"] = instantiated(stats.value("instantiated", json::array()), "anyhit")
                         ? pipeline_mm2(c, s, s.anyhit, kAnyhitFlops)
                         : 0.0;
+    // Blocks only some structures or configs have are listed only when built.
+    if (instantiated(stats.value("instantiated", json::array()), "plane"))
+        mm2["plane"] = pipeline_mm2(c, s, s.plane, kPlaneFlops);
+    if (s.mailbox.entries) mm2["mailbox"] = sram_mm2(c, mailbox_bytes(s));
     double total = 0, sram = 0;
     for (auto it = mm2.begin(); it != mm2.end(); ++it) {
         total += it->get<double>();
-        if (it.key() != "box" && it.key() != "triangle" && it.key() != "anyhit") sram += it->get<double>();
+        if (it.key() != "box" && it.key() != "triangle" && it.key() != "anyhit" && it.key() != "plane")
+            sram += it->get<double>();
     }
     return {{"mm2", mm2}, {"total_mm2", total}, {"sram_mm2", sram}, {"logic_mm2", total - sram}};
 }
@@ -213,6 +223,14 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     json pj = json::object();
     for (int k = 0; k < kOpKindCount; ++k)
         pj[op_kind_name(OpKind(k))] = double(w[work_field_of(OpKind(k))]) * op[OpKind(k)];
+    if (s.mailbox.entries) {
+        // A lookup compares the reference with the ray's whole table (its entries read); a test
+        // run records its primitive (one id written).
+        const double table = double(t.ray_contexts) * s.mailbox.entries * MailboxConfig::kEntryBytes;
+        const double lookups = double(w[WorkField::mailbox_lookups]), hits = double(w[WorkField::mailbox_hits]);
+        pj["mailbox"] = lookups * sram_access_pj(c, table, s.mailbox.entries * 32.0) +
+                        (lookups - hits) * sram_access_pj(c, table, 32.0);
+    }
     // Traversal units: the ray's setup, and per step a read of the context's ray state and one
     // stack push or pop, each in the unit's SRAM of that kind.
     pj["traversal"] = double(rays) * op.ray_setup +
@@ -305,7 +323,7 @@ const StatBlock& energy_stats() {
             {"dram_pj_per_bit", "pJ/bit", "its energy per bit (or the override)"},
             {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`) and one `ray_setup` at the node"},
             {"rays", "rays", "rays the energy is divided by: the rays checked (a sampled run's simulated rays, warm-up included)"},
-            {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
+            {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `mailbox` (only with `mailbox.entries > 0`: lookups and recorded tests in the mailbox SRAM), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
             {"dynamic_nj", "nJ", "dynamic energy of the blocks with counts, summed over the rays"},
             {"leakage_w", "W", "`area.total_mm2 x energy.leakage_mw_per_mm2`"},
             {"power_w", "W", "as `summary.power_w`"},
@@ -320,7 +338,7 @@ const StatBlock& area_stats() {
     static const StatBlock block{
         "area",
         {
-            {"mm2", "mm^2", "`{block: mm^2}`: `l1` (all units, tags in), `l2` (tags in), `ray_buffer` (treelets on), `stacks`, `ray_contexts`, and each pipeline kind built"},
+            {"mm2", "mm^2", "`{block: mm^2}`: `l1` (all units, tags in), `l2` (tags in), `ray_buffer` (treelets on), `stacks`, `ray_contexts`, each pipeline kind built, and `mailbox` (only with `mailbox.entries > 0`)"},
             {"total_mm2", "mm^2", "all blocks"},
             {"sram_mm2", "mm^2", "the SRAM blocks"},
             {"logic_mm2", "mm^2", "the pipelines"},

@@ -11,6 +11,7 @@
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/run_files.h"
 #include "sim/report/energy_area.h"
+#include "sim/report/mailbox_stats.h"
 #include "sim/report/roofline.h"
 #include "sim/report/summary_schema.h"
 #include "sim/report/verdict.h"
@@ -25,7 +26,7 @@ std::vector<const StatBlock*> stats_blocks() {
             &validation_stats(), &latency_stats(),      &workload_stats(),   &model_stats(),
             &dispatch_stats(),   &ray_buffer_stats(),   &unit_stats(),       &pipeline_stats(),
             &cache_stats(),      &dram_stats(),         &cycle_accounting_stats(), &utilization_stats(),
-            &analytic_stats(),   &ideal_memory_stats(), &provenance_stats()};
+            &analytic_stats(),   &ideal_memory_stats(), &provenance_stats(), &mailbox_stats()};
 }
 
 void check_run_stats(const nlohmann::json& stats, bool sampled) {
@@ -39,6 +40,7 @@ void check_run_stats(const nlohmann::json& stats, bool sampled) {
     if (!stats.at("roofline").is_null()) roofline_stats().check(stats.at("roofline"));
     if (stats.contains("frames"))
         for (const nlohmann::json& f : stats.at("frames")) frame_stats().check(f);
+    if (stats.contains("mailbox")) mailbox_stats().check(stats.at("mailbox"));
     validation_stats().check(stats.at("validation"));
     latency_stats().check(stats.at("latency"));
     workload_stats().check(stats.at("workload"));

@@ -82,6 +82,9 @@ const StatBlock& summary_stats() {
         {"rays_per_second_ci95", "rays/s",
          "sampled runs only: `[lo, hi]`, the same interval for `rays_per_second`",
          false, true},
+        {"mailbox_hits_per_ray", "tests/ray",
+         "triangle tests (and 48-byte triangle fetches) the mailbox skipped per ray (stats.json `mailbox`, [accel.md](accel.md#mailboxes)); `null` without one (`mailbox.entries = 0`)",
+         false, false},
         {"energy_per_ray_nj", "nJ/ray",
          "`energy.per_ray_nj.total`: dynamic energy of every block plus leakage, per ray ([energy_area.md](energy_area.md)); `null` at functional",
          true, false},
@@ -123,6 +126,7 @@ const StatBlock& run_stats() {
             {"area", "", "chip area by block, mm^2, from the same model (below)"},
             {"verdict", "", "why the run is slow: the binding resource, its evidence and the knob that relaxes it (below); `null` at functional or with `--no-verdict`"},
             {"roofline", "", "the run against its throughput ceilings (below); `null` at functional"},
+            {"mailbox", "", "only when `mailbox.entries > 0`: the mailboxes' lookups, hits and the triangle tests and fetches they saved (below)", false, true},
             {"frames", "list", "one entry per frame of the trace (below): a single entry for a trace without frames; absent at the analytic level (it does not replay frames)", false, true},
         }};
     return block;

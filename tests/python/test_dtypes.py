@@ -27,8 +27,12 @@ def test_section_records_match_the_documented_layouts() -> None:
     }  # fmt: skip
     assert RAY_DTYPE["origin"].shape == (3,)
     assert offsets(HIT_DTYPE) == {"prim": 0, "inst": 4, "t": 8, "u": 12, "v": 16}
-    # WORK holds the work counters in declaration order, 4 bytes each.
-    names = [f["name"] for f in rtsim._core.work_fields()]
+    # WORK holds the traced work counters in declaration order, 4 bytes each; the model's own
+    # (the mailbox's) come after them and are never in a trace.
+    fields = rtsim._core.work_fields()
+    names = [f["name"] for f in fields if f["traced"]]
+    assert [f["name"] for f in fields if not f["traced"]] == ["mailbox_lookups", "mailbox_hits"]
+    assert [f["name"] for f in fields][: len(names)] == names
     assert list(WORK_DTYPE.names or ()) == names
     assert WORK_DTYPE.itemsize == 4 * len(names)
     assert offsets(SECTION_DTYPES["frms"]) == {"first_ray": 0, "rays": 8}

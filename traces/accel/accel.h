@@ -20,6 +20,9 @@ namespace rtsim {
 
 struct Scene;
 
+/// Bytes of a BVH's traversal stack entry in hardware: a node reference and its entry distance.
+constexpr uint32_t kBvhStackEntryBytes = 8;
+
 /// Contract: an Accel owns a validated image. make_stepper() steppers and trace() agree on every
 /// ray (hits bit for bit, work counts exactly); both read only the image.
 class Accel {
@@ -42,6 +45,17 @@ public:
     virtual std::vector<OpKind> op_kinds() const = 0;
     /// Deepest traversal stack a ray can need (sizes the model's stack spill area).
     virtual uint32_t max_stack_entries() const = 0;
+    /// Bytes of one traversal stack entry in this structure's hardware: what a spill moves and
+    /// what the on-chip stack holds per entry (a BVH's 8: node and entry distance; a kd-tree's
+    /// 12: node, tnear, tfar; an octree's 32: node, tnear and the cell's six plane distances).
+    virtual uint32_t stack_entry_bytes() const { return kBvhStackEntryBytes; }
+    /// True when the structure lists primitive references that can repeat along a ray (grid,
+    /// kd-tree, octree): its steppers then honour a mailbox (mailbox.h).
+    virtual bool uses_mailbox() const { return false; }
+    /// Mailbox entries per ray for the steppers and trace() from now on (0: none, the default;
+    /// docs/accel.md, "Mailboxes"). Hits never change; see WorkCounts for the counts.
+    void set_mailbox(uint32_t entries) { m_mailbox_entries = entries; }
+    uint32_t mailbox_entries() const { return m_mailbox_entries; }
     /// True when some triangle is alpha-MASKed (the any-hit stage is then needed).
     bool has_anyhit_triangles() const;
     /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
@@ -54,6 +68,7 @@ public:
 
 protected:
     AccelImage m_image;
+    uint32_t m_mailbox_entries = 0;
 };
 
 /// How to build a structure: which kind, which builder for its tree, and the builder's config.
@@ -61,6 +76,10 @@ struct AccelOptions {
     std::string kind = "bvh2";        ///< accel_kinds() name
     std::string builder;              ///< empty: the kind's default (its first); accel_kinds() lists each kind's builders
     BuildConfig build;
+    /// Overrides of the kind's and builder's documented settings, {name: value} (docs/accel.md,
+    /// "Builder settings"; accel_kinds() lists each builder's): applied over `build` and the other
+    /// Configs' defaults; unknown names are refused.
+    nlohmann::json settings = nlohmann::json::object();
     /// Two levels (docs/accel.md, "Two-level structures"): a BLAS of `kind` per mesh in object
     /// space and a binary TLAS over the instances; the image's kind is then "two_level".
     bool two_level = false;
@@ -71,6 +90,10 @@ struct AccelKindInfo {
     std::string description;
     std::vector<std::string> builders;  ///< builders this kind accepts (first: default)
 };
+
+/// The settings a kind's builder takes, as a schema {name: {type, default, unit, min, max, doc}}.
+/// Throws rtsim::Error if the kind or builder is unknown.
+nlohmann::json accel_settings_schema(const std::string& kind, const std::string& builder = "");
 
 /// Every registered structure, in a stable order.
 const std::vector<AccelKindInfo>& accel_kinds();

@@ -19,7 +19,7 @@ void write_accel_image(TraceWriter& writer, const AccelImage& image) {
     }
 }
 
-AccelImage read_accel_image(TraceReader& reader) {
+nlohmann::json read_accel_descriptor(TraceReader& reader) {
     const std::string& path = reader.path();
     const SectionInfo& info = reader.section(SectionKind::accel);
     require(info.record_count <= (64u << 20), path + ": section ACCL is larger than 64 MiB");
@@ -32,9 +32,14 @@ AccelImage read_accel_image(TraceReader& reader) {
         else if (c == '}' || c == ']') --depth;
     }
     require(max_depth <= 32, path + ": section ACCL: descriptor nested deeper than 32 levels");
-    const json d = json::parse(text, nullptr, false);
+    json d = json::parse(text, nullptr, false);
     require(!d.is_discarded(), path + ": section ACCL: the descriptor is not valid JSON");
-    AccelImage image = AccelImage::from_descriptor(d, path);
+    return d;
+}
+
+AccelImage read_accel_image(TraceReader& reader) {
+    const std::string& path = reader.path();
+    AccelImage image = AccelImage::from_descriptor(read_accel_descriptor(reader), path);
     require(image.regions.size() <= kMaxRegionSections, path + ": section ACCL: more than 100 regions");
     for (size_t i = 0; i < image.regions.size(); ++i) {
         Region& r = image.regions[i];

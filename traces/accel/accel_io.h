@@ -9,6 +9,9 @@ namespace rtsim {
 
 void write_accel_image(TraceWriter& writer, const AccelImage& image);
 
+/// Reads the descriptor alone (kind, params, stats, bounds, the regions' shapes): the JSON of
+/// AccelImage::descriptor(). Throws rtsim::Error naming the file when it is missing or malformed.
+nlohmann::json read_accel_descriptor(TraceReader& reader);
 /// Reads the descriptor and every region (each chunk's CRC checked). Throws rtsim::Error naming
 /// the file and the section or field when something is missing, malformed or inconsistent.
 AccelImage read_accel_image(TraceReader& reader);

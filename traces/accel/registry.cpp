@@ -1,17 +1,23 @@
-// The registry of acceleration structures: each kind's builder and loader by name. Adding a
-// structure adds its folder and one entry here (docs/accel.md, "Adding a structure").
+// The registry of acceleration structures: each kind's builders, their settings, its build and
+// load functions by name. Adding a structure adds its folder and one entry here (docs/accel.md,
+// "Adding a structure").
 #include <algorithm>
 #include <chrono>
 #include <functional>
 
 #include "traces/accel/accel.h"
+#include "traces/accel/bih/bih.h"
+#include "traces/accel/build_settings.h"
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/accel/cwbvh/cwbvh.h"
 #include "traces/accel/grid/grid.h"
+#include "traces/accel/kdtree/kdtree.h"
+#include "traces/accel/octree/octree.h"
 #include "traces/accel/two_level/two_level.h"
 #include "traces/accel/wide/wide.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/builder.h"
+#include "traces/bvh/lbvh_builder.h"
 #include "traces/bvh/sbvh_builder.h"
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
@@ -20,63 +26,106 @@ namespace rtsim {
 
 namespace {
 
-using BuildFn = std::function<AccelImage(const Scene&, const AccelOptions&)>;
+/// Every builder's documented Config: what the settings overrides apply to.
+struct BuildSettings {
+    BuildConfig bvh;
+    SbvhConfig sbvh;
+    LbvhConfig lbvh;
+    GridConfig grid;
+    KdConfig kd;
+    BihConfig bih;
+    OctreeConfig octree;
+};
+
+using SettingsFn = std::function<void(const std::string& builder, BuildSettings&, SettingsVisitor&)>;
+using BuildFn = std::function<AccelImage(const Scene&, const AccelOptions&, const BuildSettings&)>;
 using LoadFn = std::function<std::unique_ptr<Accel>(AccelImage, const std::string&)>;
 
 struct Entry {
     AccelKindInfo info;
+    uint32_t stack_entry_bytes;  ///< the kind's Accel::stack_entry_bytes(), recorded in the manifest
+    SettingsFn settings;
     BuildFn build;
     LoadFn load;
 };
 
-BuildTree build_binned(const Scene& scene, const AccelOptions& o, nlohmann::json*) {
-    return build_binned_sah(scene.triangles, o.build);
+/// Binned SAH (Wald 2007).
+BuildTree build_binned(const Scene& scene, const BuildSettings& s, nlohmann::json*) {
+    return build_binned_sah(scene.triangles, s.bvh);
+}
+
+/// Morton codes (Lauterbach et al. 2009).
+BuildTree build_morton(const Scene& scene, const BuildSettings& s, nlohmann::json*) {
+    return build_lbvh(scene.triangles, s.bvh, s.lbvh);
 }
 
 /// Spatial splits (Stich et al. 2009): prim_ids may repeat a primitive; its statistics go to
 /// the structure's stats.
-BuildTree build_spatial_splits(const Scene& scene, const AccelOptions& o, nlohmann::json* stats) {
-    const SbvhConfig c;
-    SbvhStats s;
-    BuildTree tree = build_sbvh(scene.triangles, o.build, c, &s);
+BuildTree build_spatial_splits(const Scene& scene, const BuildSettings& s, nlohmann::json* stats) {
+    const SbvhConfig& c = s.sbvh;
+    SbvhStats st;
+    BuildTree tree = build_sbvh(scene.triangles, s.bvh, c, &st);
     (*stats)["sbvh"] = {{"config",
                          {{"alpha", c.alpha},
                           {"spatial_bins", c.spatial_bins},
                           {"reference_budget", c.reference_budget},
                           {"unsplit", c.unsplit}}},
-                        {"references", s.references},
-                        {"duplication", double(s.references) / double(scene.triangles.size())},
-                        {"object_splits", s.object_splits},
-                        {"spatial_splits", s.spatial_splits},
-                        {"median_splits", s.median_splits},
-                        {"unsplit_references", s.unsplit}};
+                        {"references", st.references},
+                        {"duplication", double(st.references) / double(scene.triangles.size())},
+                        {"object_splits", st.object_splits},
+                        {"spatial_splits", st.spatial_splits},
+                        {"median_splits", st.median_splits},
+                        {"unsplit_references", st.unsplit}};
     return tree;
 }
 
-using TreeBuilder = BuildTree (*)(const Scene&, const AccelOptions&, nlohmann::json*);
+/// One builder of binary build trees (the tree every BVH kind, and BIH's tree builders, start from).
+struct TreeBuilder {
+    const char* name;
+    BuildTree (*build)(const Scene&, const BuildSettings&, nlohmann::json* stats);
+    void (*settings)(BuildSettings&, SettingsVisitor&);  ///< its own settings beyond the SAH leaf rules
+    bool sah_costs;                                     ///< it reads the SAH bins and costs
+};
 
-/// The builders of binary build trees (the tree every BVH kind starts from), by name: a kind's
-/// builders list names from here, and adding one is a line here.
-const std::vector<std::pair<std::string, TreeBuilder>>& tree_builders() {
-    static const std::vector<std::pair<std::string, TreeBuilder>> b = {
-        {"binned", build_binned},          // binned SAH
-        {"sbvh", build_spatial_splits},    // SAH with spatial splits
+/// The tree builders by name: a kind's builders list names from here, and adding one is a line here.
+const std::vector<TreeBuilder>& tree_builders() {
+    static const std::vector<TreeBuilder> b = {
+        {"binned", build_binned, [](BuildSettings&, SettingsVisitor&) {}, true},
+        {"sbvh", build_spatial_splits, [](BuildSettings& s, SettingsVisitor& v) { s.sbvh.visit(v); }, true},
+        {"lbvh", build_morton, [](BuildSettings& s, SettingsVisitor& v) { s.lbvh.visit(v); }, false},
     };
     return b;
 }
 
-/// The binary build tree of the chosen builder; what the builder reports beyond the tree's own
-/// statistics goes to `stats`.
-BuildTree build_tree(const Scene& scene, const AccelOptions& o, nlohmann::json* stats) {
-    for (const auto& [name, build] : tree_builders())
-        if (name == o.builder) return build(scene, o, stats);
-    throw Error("accel: no tree builder '" + o.builder + "'");
+const TreeBuilder& tree_builder(const std::string& name) {
+    for (const TreeBuilder& b : tree_builders())
+        if (name == b.name) return b;
+    throw Error("accel: no tree builder '" + name + "'");
 }
 
-AccelImage build_bvh2(const Scene& scene, const AccelOptions& o) {
+std::vector<std::string> tree_builder_names() {
+    std::vector<std::string> names;
+    for (const TreeBuilder& b : tree_builders()) names.push_back(b.name);
+    return names;
+}
+
+/// The settings of the chosen tree builder.
+void tree_settings(const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
+    const TreeBuilder& b = tree_builder(builder);
+    s.bvh.visit(v, b.sah_costs);
+    b.settings(s, v);
+}
+
+/// The binary build tree of the chosen builder; what the builder reports beyond the tree's own
+/// statistics goes to `stats`.
+BuildTree build_tree(const Scene& scene, const std::string& builder, const BuildSettings& s, nlohmann::json* stats) {
+    return tree_builder(builder).build(scene, s, stats);
+}
+
+AccelImage build_bvh2(const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
     nlohmann::json extra = nlohmann::json::object();
-    const BuildTree tree = build_tree(scene, o, &extra);
-    AccelImage image = bvh2_image(flatten_bvh(tree, scene, o.build), o.build, o.builder);
+    const BuildTree tree = build_tree(scene, o.builder, s, &extra);
+    AccelImage image = bvh2_image(flatten_bvh(tree, scene, s.bvh), s.bvh, o.builder);
     image.stats.update(extra);
     return image;
 }
@@ -84,27 +133,29 @@ AccelImage build_bvh2(const Scene& scene, const AccelOptions& o) {
 /// A wide BVH kind: the binary tree collapsed to `width` (wide.h), stored fp32 or compressed.
 Entry wide_entry(const std::string& name, const std::string& description, int width, bool compressed,
                  ChildOrder order) {
-    BuildFn build = [=](const Scene& scene, const AccelOptions& o) {
+    BuildFn build = [=](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
         nlohmann::json extra = nlohmann::json::object();
-        const WideBuildTree wide = make_wide_tree(build_tree(scene, o, &extra), scene, width, o.build, order);
+        const WideBuildTree wide = make_wide_tree(build_tree(scene, o.builder, s, &extra), scene, width, s.bvh, order);
         AccelImage image = compressed ? cwbvh_image(wide, scene, name, order) : wide_image(wide, scene, name, order);
-        image.stats = wide_stats(wide, o.build, o.builder, image.region("nodes").record_bytes, order);
+        image.stats = wide_stats(wide, s.bvh, o.builder, image.region("nodes").record_bytes, order);
         image.stats.update(extra);
         return image;
     };
     LoadFn load = [=](AccelImage image, const std::string& source) {
         return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
     };
-    return {{name, description, {"binned", "sbvh"}}, build, load};
+    return {{name, description, tree_builder_names()}, kBvhStackEntryBytes, tree_settings, build, load};
+}
+
+template <class A>
+LoadFn loader() {
+    return [](AccelImage image, const std::string& source) { return std::make_unique<A>(std::move(image), source); };
 }
 
 const std::vector<Entry>& registry() {
     static const std::vector<Entry> entries = {
-        {{"bvh2", "binary BVH, 64-byte nodes holding both child boxes (docs/bvh_layout.md)", {"binned", "sbvh"}},
-         build_bvh2,
-         [](AccelImage image, const std::string& source) {
-             return std::make_unique<Bvh2Accel>(std::move(image), source);
-         }},
+        {{"bvh2", "binary BVH, 64-byte nodes holding both child boxes (docs/bvh_layout.md)", tree_builder_names()},
+         kBvhStackEntryBytes, tree_settings, build_bvh2, loader<Bvh2Accel>()},
         wide_entry("bvh4", "4-wide BVH, 128-byte fp32 nodes, SAH-optimal collapse of the binary tree (docs/accel.md)", 4,
                    false, ChildOrder::distance),
         wide_entry("bvh6", "6-wide BVH, 192-byte fp32 nodes, SAH-optimal collapse", 6, false, ChildOrder::distance),
@@ -119,10 +170,34 @@ const std::vector<Entry>& registry() {
                    true, ChildOrder::octant),
         {{"grid", "uniform grid, cells of lambda x N by density, 3D-DDA traversal, no stack (docs/accel.md)",
           {"uniform"}},
-         [](const Scene& scene, const AccelOptions&) { return grid_image(scene); },
-         [](AccelImage image, const std::string& source) {
-             return std::make_unique<GridAccel>(std::move(image), source);
-         }},
+         kBvhStackEntryBytes,  // no stack: the machine's entry size is moot
+         [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.grid.visit(v); },
+         [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return grid_image(scene, s.grid); },
+         loader<GridAccel>()},
+        {{"kdtree", "kd-tree, SAH in O(N log N) with perfect splits (Wald & Havran 2006), 8-byte nodes, plane tests",
+          {"sah"}},
+         kKdStackEntryBytes,
+         [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.kd.visit(v); },
+         [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
+         loader<KdAccel>()},
+        {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
+          {"binned", "wachter_keller", "lbvh"}},
+         kBihStackEntryBytes,
+         [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
+             if (builder == "wachter_keller") s.bih.visit(v);
+             else tree_settings(builder, s, v);
+         },
+         [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
+             if (o.builder == "wachter_keller") return bih_image(build_bih(scene, s.bih), scene, o.builder);
+             nlohmann::json unused;
+             return bih_image(bih_from_build_tree(build_tree(scene, o.builder, s, &unused)), scene, o.builder);
+         },
+         loader<BihAccel>()},
+        {{"octree", "adaptive octree, 16-byte nodes, parametric traversal (Revelles et al. 2000)", {"adaptive"}},
+         kOctStackEntryBytes,
+         [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.octree.visit(v); },
+         [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return octree_image(scene, s.octree); },
+         loader<OctreeAccel>()},
     };
     return entries;
 }
@@ -139,6 +214,24 @@ std::string known_kinds() {
     return s;
 }
 
+/// The entry and resolved builder of valid options.
+const Entry& entry_of(const AccelOptions& o, std::string* builder) {
+    validate_accel_options(o);
+    const Entry& e = *find(o.kind);
+    *builder = o.builder.empty() ? e.info.builders.front() : o.builder;  // empty: the kind's default
+    return e;
+}
+
+/// The settings of (kind, builder) over `o.build`, with o.settings applied.
+BuildSettings resolve_settings(const Entry& e, const std::string& builder, const AccelOptions& o, nlohmann::json* values) {
+    BuildSettings s;
+    s.bvh = o.build;
+    const SettingsVisit visit = [&](SettingsVisitor& v) { e.settings(builder, s, v); };
+    apply_settings(visit, o.settings, "accel " + o.kind + " (builder " + builder + ")");
+    if (values) *values = settings_values(visit);
+    return s;
+}
+
 }  // namespace
 
 const std::vector<AccelKindInfo>& accel_kinds() {
@@ -148,6 +241,16 @@ const std::vector<AccelKindInfo>& accel_kinds() {
         return v;
     }();
     return kinds;
+}
+
+nlohmann::json accel_settings_schema(const std::string& kind, const std::string& builder) {
+    AccelOptions o;
+    o.kind = kind;
+    o.builder = builder;
+    std::string b;
+    const Entry& e = entry_of(o, &b);
+    BuildSettings s;
+    return settings_schema([&](SettingsVisitor& v) { e.settings(b, s, v); });
 }
 
 void validate_accel_options(const AccelOptions& o) {
@@ -161,23 +264,28 @@ void validate_accel_options(const AccelOptions& o) {
 }
 
 AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
-    validate_accel_options(options);
     AccelOptions o = options;
-    if (o.builder.empty()) o.builder = find(o.kind)->info.builders.front();  // the kind's default
+    const Entry& e = entry_of(options, &o.builder);
+    nlohmann::json values;
+    const BuildSettings s = resolve_settings(e, o.builder, o, &values);  // refuses bad settings before any work
     const auto start = std::chrono::steady_clock::now();
-    if (o.two_level) {
-        AccelImage image = build_two_level(scene, o);
+    auto finish = [&](AccelImage image) {
         image.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         image.stats["footprint_bytes"] = image.footprint_bytes();
+        // The TLAS's entries and the BLAS kind's share one stack: the larger size (two_level.h).
+        image.stats["stack_entry_bytes"] = o.two_level ? std::max(kBvhStackEntryBytes, e.stack_entry_bytes)
+                                                       : e.stack_entry_bytes;
+        image.stats["build_settings"] = values;
+        image.stats["build_set"] = o.settings;
         return image;
-    }
+    };
+    if (o.two_level) return finish(build_two_level(scene, o));
     require(!scene.triangles.empty(), "scene has no triangles");
     require(scene.tri_material.size() == scene.triangles.size() && scene.tri_instance.size() == scene.triangles.size(),
             "build_accel: scene is not flattened (call Scene::flatten())");
-    AccelImage image = find(o.kind)->build(scene, o);
-    image.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    image.stats["footprint_bytes"] = image.footprint_bytes();
-    return image;
+    AccelOptions resolved = o;
+    resolved.build = s.bvh;
+    return finish(e.build(scene, resolved, s));
 }
 
 std::unique_ptr<Accel> load_accel(AccelImage image, const std::string& source) {

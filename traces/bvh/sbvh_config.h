@@ -26,6 +26,15 @@ struct SbvhConfig {
     /// reference goes whole to one side when that is cheaper by the SAH than duplicating it.
     /// Costs one SAH evaluation per straddling reference; saves references and usually SAH cost.
     bool unsplit = true;
+
+    /// The settings as data (traces/accel/build_settings.h).
+    template <class V>
+    void visit(V& v) {
+        v.field("alpha", alpha, "x root area", "Spatial splits are tried where the best object split's children overlap by more than alpha x the root's area", 0, 1e6);
+        v.field("spatial_bins", spatial_bins, "bins", "Spatial-split bin planes per axis", 2, 1024);
+        v.field("reference_budget", reference_budget, "x N", "Extra references the build may create, as a fraction of the triangles (48 bytes each)", 0, 16);
+        v.flag("unsplit", unsplit, "Reference unsplitting: a straddler goes whole to one side when the SAH says that is cheaper");
+    }
 };
 
 /// What a spatial-split build did (written to the manifest's accel stats).

@@ -6,6 +6,7 @@
 // record, the hit checker's totals and messages, the analytic level's sums, the energy model's
 // prices, the Python bindings and the trace dtypes all iterate it, so adding a counter is one
 // line here plus the code that counts it (and a trace-format version bump: WORK records grow).
+// Counters of the model alone (never in a trace) are declared in RTSIM_MODEL_WORK_FIELDS.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -26,21 +27,32 @@
     X(plane_tests, OpKind::plane, false, "ray/split-plane tests (kd-trees, BIH)")                  \
     X(refs, kNoOpKind, false, "primitive references fetched (structures with index lists)")
 
+// The mailbox's counts (docs/accel.md, "Mailboxes"): never in a trace (a trace's work is the
+// structure's without one). With a mailbox tri_tests counts the tests run, and
+// tri_tests + mailbox_hits equals the triangle tests without one.
+#define RTSIM_MODEL_WORK_FIELDS(X)                                                                  \
+    X(mailbox_lookups, kNoOpKind, false, "primitive references looked up in the ray's mailbox")    \
+    X(mailbox_hits, kNoOpKind, false, "references found there: triangle neither fetched nor tested")
+
+#define RTSIM_ALL_WORK_FIELDS(X) RTSIM_WORK_FIELDS(X) RTSIM_MODEL_WORK_FIELDS(X)
+
 namespace rtsim {
 
-/// The work fields by position (WORK record order).
+/// The work fields by position (WORK record order, then the model's own).
 enum class WorkField : uint8_t {
 #define RTSIM_WORK_ENUM(name, tests_of, plan_step, doc) name,
-    RTSIM_WORK_FIELDS(RTSIM_WORK_ENUM)
+    RTSIM_ALL_WORK_FIELDS(RTSIM_WORK_ENUM)
 #undef RTSIM_WORK_ENUM
 };
 #define RTSIM_WORK_ONE(name, tests_of, plan_step, doc) +1
-constexpr int kWorkFieldCount = 0 RTSIM_WORK_FIELDS(RTSIM_WORK_ONE);
+constexpr int kWorkFieldCount = 0 RTSIM_ALL_WORK_FIELDS(RTSIM_WORK_ONE);
+/// The fields a trace records (the first ones).
+constexpr int kTracedWorkFieldCount = 0 RTSIM_WORK_FIELDS(RTSIM_WORK_ONE);
 #undef RTSIM_WORK_ONE
 
 struct WorkCounts {
 #define RTSIM_WORK_MEMBER(name, tests_of, plan_step, doc) uint32_t name = 0;
-    RTSIM_WORK_FIELDS(RTSIM_WORK_MEMBER)
+    RTSIM_ALL_WORK_FIELDS(RTSIM_WORK_MEMBER)
 #undef RTSIM_WORK_MEMBER
 
     uint32_t& operator[](WorkField f);
@@ -48,6 +60,14 @@ struct WorkCounts {
     WorkCounts& operator+=(const WorkCounts& o);
     bool operator==(const WorkCounts& o) const;
     bool operator!=(const WorkCounts& o) const { return !(*this == o); }
+    /// The counts the same traversal has without a mailbox (what a trace records): the skipped
+    /// tests counted back, the mailbox's own counts dropped.
+    WorkCounts without_mailbox() const {
+        WorkCounts w = *this;
+        w.tri_tests += mailbox_hits;
+        w.mailbox_lookups = w.mailbox_hits = 0;
+        return w;
+    }
 };
 
 /// One field's declaration.
@@ -57,10 +77,14 @@ struct WorkFieldInfo {
     OpKind tests_of;  ///< kNoOpKind: the field counts no pipeline's tests
     bool plan_step;
     const char* doc;
+    bool traced;  ///< in a trace's WORK record (false: the model's own count)
 };
 inline constexpr std::array<WorkFieldInfo, kWorkFieldCount> kWorkFields{{
-#define RTSIM_WORK_INFO(name, tests_of, plan_step, doc) {#name, &WorkCounts::name, tests_of, plan_step, doc},
+#define RTSIM_WORK_INFO(name, tests_of, plan_step, doc) {#name, &WorkCounts::name, tests_of, plan_step, doc, true},
     RTSIM_WORK_FIELDS(RTSIM_WORK_INFO)
+#undef RTSIM_WORK_INFO
+#define RTSIM_WORK_INFO(name, tests_of, plan_step, doc) {#name, &WorkCounts::name, tests_of, plan_step, doc, false},
+    RTSIM_MODEL_WORK_FIELDS(RTSIM_WORK_INFO)
 #undef RTSIM_WORK_INFO
 }};
 

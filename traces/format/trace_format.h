@@ -60,9 +60,30 @@ struct HitRecord {
     float u;              // 12
     float v;              // 16
 };
-/// Work the reference traversal did for the ray at the same index: WorkCounts itself (4 bytes
-/// per field of traces/common/work_counts.h, in declaration order, no padding).
-using WorkRecord = WorkCounts;
+/// Work the reference traversal did for the ray at the same index: WorkCounts' traced fields (4
+/// bytes per field of RTSIM_WORK_FIELDS in traces/common/work_counts.h, in order, no padding).
+struct WorkRecord {
+#define RTSIM_WORK_MEMBER(name, tests_of, plan_step, doc) uint32_t name = 0;
+    RTSIM_WORK_FIELDS(RTSIM_WORK_MEMBER)
+#undef RTSIM_WORK_MEMBER
+
+    /// The record of `w` (which must have no mailbox counts: a trace's work has none).
+    static WorkRecord of(const WorkCounts& w) {
+        WorkRecord r;
+#define RTSIM_WORK_COPY(name, tests_of, plan_step, doc) r.name = w.name;
+        RTSIM_WORK_FIELDS(RTSIM_WORK_COPY)
+#undef RTSIM_WORK_COPY
+        return r;
+    }
+    /// The counts this record holds (the model's own counts zero).
+    WorkCounts counts() const {
+        WorkCounts w;
+#define RTSIM_WORK_COPY(name, tests_of, plan_step, doc) w.name = name;
+        RTSIM_WORK_FIELDS(RTSIM_WORK_COPY)
+#undef RTSIM_WORK_COPY
+        return w;
+    }
+};
 /// One frame of an animated trace (16 bytes): its rays are RAYS[first_ray, first_ray + rays),
 /// traced against the structure's frame of the same index (Accel::bind_frame).
 struct FrameRecord {
@@ -73,7 +94,7 @@ struct FrameRecord {
 static_assert(sizeof(FrameRecord) == 16, "FrameRecord layout");
 static_assert(sizeof(RayRecord) == 40, "RayRecord layout");
 static_assert(sizeof(HitRecord) == 20, "HitRecord layout");
-static_assert(sizeof(WorkRecord) == kWorkFieldCount * sizeof(uint32_t), "WorkRecord layout");
+static_assert(sizeof(WorkRecord) == kTracedWorkFieldCount * sizeof(uint32_t), "WorkRecord layout");
 
 /// The records' layouts (numpy reads the sections with them: python/rtsim/trace_file.py).
 inline RecordLayout layout_of(const RayRecord*) {

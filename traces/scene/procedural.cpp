@@ -18,6 +18,7 @@ const Entry kScenes[] = {
     {"hairball", write_hairball},
     {"teapot_stadium", write_teapot_stadium},
     {"rotated_walls", write_rotated_walls},
+    {"aligned_walls", write_aligned_walls},
 };
 
 /// Instanced scenes: not in procedural_scene_names(), which the per-structure tests sweep

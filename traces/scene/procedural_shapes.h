@@ -32,6 +32,7 @@ std::string write_cornell(const std::string& dir, const ProceduralOptions& optio
 std::string write_hairball(const std::string& dir, const ProceduralOptions& options);
 std::string write_teapot_stadium(const std::string& dir, const ProceduralOptions& options);
 std::string write_rotated_walls(const std::string& dir, const ProceduralOptions& options);
+std::string write_aligned_walls(const std::string& dir, const ProceduralOptions& options);
 std::string write_forest(const std::string& dir, const ProceduralOptions& options);
 std::string write_grove(const std::string& dir, const ProceduralOptions& options);
 

@@ -47,7 +47,7 @@ void TraceFolderWriter::add_wavefront(const WorkloadPlan& plan, const std::vecto
         if (!written) continue;
         ray_rec.push_back(to_record(r.ray, r.kind, r.pixel, r.depth, r.any_hit));
         hit_rec.push_back(to_record(res.hits[i]));
-        work_rec.push_back(res.work[i]);
+        work_rec.push_back(WorkRecord::of(res.work[i]));
     }
     m_rays_written += ray_rec.size();
     m_writer.append(SectionKind::rays, ray_rec);

@@ -62,6 +62,7 @@ struct TraceOptions {
         v("camera", camera, "(eye, target, vertical field of view in degrees); none: the scene's camera or a framing");
         v("accel", accel.kind, "acceleration structure (accel_kinds())");
         v("builder", accel.builder, "its builder; empty: the structure's default");
+        v("build_settings", accel.settings, "{name: value} over the builder's documented settings (accel_kinds())");
         v("flatten", flatten, "instanced scenes: one world-space structure instead of two levels");
         v("hairball_triangles", procedural.hairball_triangles, "triangles of the built-in hairball");
         v("threads", threads, "tracing threads, 0 for all cores (the trace is the same for any)");

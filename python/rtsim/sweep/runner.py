@@ -84,6 +84,7 @@ def trace_task(plan: TracePlan, out: Path) -> TraceTask:
         hairball_triangles=plan.scene.hairball_triangles,
         accel=plan.accel.kind,
         builder=plan.accel.builder,
+        build_settings=dict(plan.accel.settings),
     )
 
 

@@ -25,7 +25,7 @@ from rtsim.sweep.accel_axis import (
     AccelSpec,
     default_accel,
     folder_label,
-    parse_accel_entry,
+    parse_accel_entries,
     registered_kinds,
     trace_format_version,
 )
@@ -341,7 +341,8 @@ class _Reader:
 
     def accels(self, doc: LineDict) -> list[AccelSpec]:
         """The `accel` axis: a list (or one entry) of KIND, KIND:BUILDER or {kind, builder,
-        label}, checked against the structures this build registers."""
+        label, build}, checked against the structures this build registers; lists in `build`
+        expand into one structure per value (builder settings as an axis)."""
         items = doc["accel"]
         if isinstance(items, (str, dict)):
             items = LineList([items])
@@ -359,7 +360,7 @@ class _Reader:
                     return self.fail(where, key, f"accel[{i}].{sub}", message)
                 return self.fail(items, i, f"accel[{i}]", message)
 
-            out.append(parse_accel_entry(entry, kinds, fail))
+            out.extend(parse_accel_entries(entry, kinds, fail))
         labels = [a.label for a in out]
         dup = next((x for x in labels if labels.count(x) > 1), None)
         if dup:

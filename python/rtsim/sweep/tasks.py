@@ -14,7 +14,7 @@ import socket
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -45,6 +45,7 @@ class TraceTask:
     hairball_triangles: int
     accel: str = "bvh2"  # the structure (rtsim trace --accel)
     builder: str = ""  # its builder; empty: the structure's default
+    build_settings: dict[str, Any] = field(default_factory=dict)  # rtsim trace --build-set
 
     def command(self, out: str) -> list[str]:
         workload = ["--workload", ",".join(self.rays)] if self.rays else []
@@ -68,7 +69,17 @@ class TraceTask:
             "--accel",
             self.accel,
             *(["--builder", self.builder] if self.builder else []),
+            *[
+                a
+                for k, v in self.build_settings.items()
+                for a in ("--build-set", f"{k}={_text(v)}")
+            ],
         ]
+
+
+def _text(value: Any) -> str:
+    """A setting's value as --build-set takes it (true/false, numbers as JSON writes them)."""
+    return json.dumps(value)
 
 
 def trace_ready(trace_dir: Path) -> bool:

@@ -193,7 +193,7 @@ TEST(GridLocality, BricksCoverEveryCellOnceWithinTheBudget) {
             EXPECT_EQ(p.group_of[p.treelets[t].root], t);
             bytes += p.treelets[t].bytes;
         }
-        EXPECT_EQ(bytes, v.cell_count * sizeof(GridCell) + v.ref_count * (kGridRefBytes + sizeof(HwTriangle)));
+        EXPECT_EQ(bytes, v.cell_count * sizeof(GridCell) + v.ref_count * (kRefBytes + sizeof(HwTriangle)));
         EXPECT_GE(p.treelets.size(), previous);  // a smaller budget never makes fewer bricks
         previous = p.treelets.size();
     }

@@ -104,7 +104,20 @@ TEST(TraceRecords, WorkRecordIsTheDeclaredFieldsInOrder) {
         EXPECT_EQ(w.*kWorkFields[i].member, 10 + i) << kWorkFields[i].name;
     }
     EXPECT_EQ(w.steps, 10u);
-    EXPECT_EQ(w.refs, 10u + kWorkFields.size() - 1);
+    EXPECT_EQ(w.mailbox_hits, 10u + kWorkFields.size() - 1);
+    // The record holds the traced fields, in order; the model's own (the mailbox's) follow them
+    // in WorkCounts and never reach a trace.
+    EXPECT_EQ(sizeof(WorkRecord), kTracedWorkFieldCount * sizeof(uint32_t));
+    const WorkRecord r = WorkRecord::of(w);
+    const auto* record_words = reinterpret_cast<const uint32_t*>(&r);
+    for (int i = 0; i < kTracedWorkFieldCount; ++i) EXPECT_TRUE(kWorkFields[size_t(i)].traced);
+    for (int i = kTracedWorkFieldCount; i < kWorkFieldCount; ++i) EXPECT_FALSE(kWorkFields[size_t(i)].traced);
+    for (int i = 0; i < kTracedWorkFieldCount; ++i) EXPECT_EQ(record_words[i], 10u + uint32_t(i));
+    EXPECT_EQ(r.refs, 10u + uint32_t(kTracedWorkFieldCount) - 1);
+    const WorkCounts back = r.counts();
+    EXPECT_EQ(back.refs, w.refs);
+    EXPECT_EQ(back.mailbox_lookups, 0u);
+    EXPECT_EQ(back.mailbox_hits, 0u);
     EXPECT_EQ(work_field_of(OpKind::plane), WorkField::plane_tests);
     EXPECT_EQ(work_field_of(OpKind::box), WorkField::box_tests);
     WorkCounts twice = w;

@@ -27,7 +27,7 @@ bool has_material(const Scene& s, float metallic, float roughness_below) {
 }
 
 TEST(Procedural, NamesAndUnknownName) {
-    EXPECT_EQ(procedural_scene_names().size(), 4u);
+    EXPECT_EQ(procedural_scene_names().size(), 5u);
     EXPECT_TRUE(is_procedural_scene("hairball"));
     EXPECT_FALSE(is_procedural_scene("sponza"));
     try {
@@ -134,6 +134,19 @@ TEST(Procedural, RotatedWalls) {
     }
     EXPECT_GT(oblique, s.triangle_count() / 2);
     EXPECT_GT(s.bounds.extent().x, 20.0f);
+}
+
+TEST(Procedural, AlignedWallsAreTheRotatedWallsTwin) {
+    Scene aligned = load_gltf(write_procedural_scene("aligned_walls", test::test_dir()));
+    Scene rotated = load_gltf(write_procedural_scene("rotated_walls", test::test_dir()));
+    // The same maze, so the same triangles, with every face on the axes.
+    EXPECT_EQ(aligned.triangle_count(), rotated.triangle_count());
+    for (const Triangle& t : aligned.triangles) {
+        Vec3 n = glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
+        EXPECT_GT(std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)}), 0.9999f);
+    }
+    EXPECT_TRUE(has_material(aligned, 1.0f, 0.1f));
+    EXPECT_EQ(aligned.lights.size(), 1u);
 }
 
 }  // namespace

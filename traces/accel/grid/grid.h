@@ -43,6 +43,7 @@ public:
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return 0; }  // no stack
+    bool uses_mailbox() const override { return true; }
     const GridView& view() const { return m_view; }
 
 private:

@@ -33,8 +33,8 @@ void validate_grid(const GridView& v, const std::string& source) {
     if (next != v.ref_count)
         fail("the cells list " + std::to_string(next) + " of prim_refs' " + std::to_string(v.ref_count) + " references");
     for (uint64_t r = 0; r < v.ref_count; ++r)
-        if (v.refs[r] >= v.triangle_count)
-            fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.refs[r]) + " of " +
+        if (v.list.refs[r] >= v.triangle_count)
+            fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.list.refs[r]) + " of " +
                  std::to_string(v.triangle_count));
 }
 
@@ -42,28 +42,27 @@ GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::m
     const Region& cells = m_image.region("cells");
     const Region& refs = m_image.region("prim_refs");
     const Region& tris = m_image.region("triangles");
-    require(cells.record_bytes == sizeof(GridCell) && refs.record_bytes == kGridRefBytes &&
+    require(cells.record_bytes == sizeof(GridCell) && refs.record_bytes == kRefBytes &&
                 tris.record_bytes == sizeof(HwTriangle),
             source + ": grid regions must hold 8-byte cells, 4-byte references and 48-byte triangles");
     require(cells.kind == DataKind::cell && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
             source + ": grid regions must be of data kinds cell, prim_ref and triangle");
     m_view.geometry = GridGeometry::from_json(m_image.params, source);
     m_view.cells = cells.records<GridCell>();
-    m_view.refs = refs.records<uint32_t>();
-    m_view.triangles = tris.records<HwTriangle>();
+    m_view.list = RefListView{refs.records<uint32_t>(), tris.records<HwTriangle>(), refs.base, tris.base};
     m_view.cell_count = cells.count;
     m_view.ref_count = refs.count;
     m_view.triangle_count = tris.count;
     m_view.cell_base = cells.base;
-    m_view.ref_base = refs.base;
-    m_view.triangle_base = tris.base;
     validate_grid(m_view, source);
 }
 
-std::unique_ptr<Stepper> GridAccel::make_stepper() const { return std::make_unique<GridStepper>(m_view); }
+std::unique_ptr<Stepper> GridAccel::make_stepper() const {
+    return std::make_unique<GridStepper>(m_view, m_mailbox_entries);
+}
 
 Hit GridAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
-    GridStepper stepper(m_view);
+    GridStepper stepper(m_view, m_mailbox_entries);
     stepper.begin(ray, mode);
     while (!stepper.done()) stepper.execute();
     if (work) *work = stepper.work();

@@ -22,7 +22,7 @@ void check_grid_invariants(const GridView& v, const Scene& scene) {
     uint64_t expected = 0;
     for (uint64_t i = 0; i < v.triangle_count; ++i) {
         const HwTriangle want = make_hw_triangle(scene, uint32_t(i));
-        if (std::memcmp(&want, &v.triangles[i], sizeof(HwTriangle)) != 0)
+        if (std::memcmp(&want, &v.list.triangles[i], sizeof(HwTriangle)) != 0)
             fail("triangle " + std::to_string(i) + " differs from the scene's primitive " + std::to_string(i));
         const Triangle& t = scene.triangles[i];
         Aabb box;
@@ -49,8 +49,8 @@ void check_grid_invariants(const GridView& v, const Scene& scene) {
                 if (next > v.ref_count) fail("cell " + std::to_string(c) + "'s list runs past prim_refs");
                 const uint32_t xyz[3] = {x, y, z};
                 for (uint32_t k = 0; k < cell.ref_count; ++k) {
-                    const uint32_t t = v.refs[cell.first_ref + k];
-                    if (k > 0 && t <= v.refs[cell.first_ref + k - 1])
+                    const uint32_t t = v.list.refs[cell.first_ref + k];
+                    if (k > 0 && t <= v.list.refs[cell.first_ref + k - 1])
                         fail("cell " + std::to_string(c) + "'s list is not in increasing triangle order");
                     if (t >= v.triangle_count) fail("cell " + std::to_string(c) + " lists a triangle out of range");
                     for (int a = 0; a < 3; ++a)
@@ -68,7 +68,7 @@ void check_grid_invariants(const GridView& v, const Scene& scene) {
 namespace {
 
 /// Bytes a cell brings to its brick: itself, its list and one triangle per entry.
-uint64_t cell_bytes(const GridCell& c) { return sizeof(GridCell) + uint64_t(c.ref_count) * (kGridRefBytes + sizeof(HwTriangle)); }
+uint64_t cell_bytes(const GridCell& c) { return sizeof(GridCell) + uint64_t(c.ref_count) * (kRefBytes + sizeof(HwTriangle)); }
 
 /// Per-brick bytes for bricks of b^3 cells (x fastest over bricks).
 std::vector<uint64_t> brick_bytes(const GridView& v, uint32_t b, uint32_t dims[3]) {

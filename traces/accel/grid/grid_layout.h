@@ -2,7 +2,7 @@
 // The uniform grid's hardware layout (docs/accel.md, "grid"), documented byte by byte:
 //
 //   region "cells"      GridCell, 8 bytes, x fastest: cell (x, y, z) at x + nx * (y + ny * z)
-//   region "prim_refs"  uint32_t, 4 bytes: an index into "triangles"; each cell's list is
+//   region "prim_refs"  uint32_t, 4 bytes (kRefBytes, ref_list.h): an index into "triangles"; each cell's list is
 //                       contiguous, in increasing triangle order
 //   region "triangles"  HwTriangle, 48 bytes, each scene triangle once, in scene order (prim = index)
 //
@@ -27,9 +27,6 @@ static_assert(sizeof(GridCell) == 8, "GridCell must be 8 bytes");
 inline RecordLayout layout_of(const GridCell*) {
     return {RTSIM_FIELD(GridCell, first_ref), RTSIM_FIELD(GridCell, ref_count)};
 }
-
-/// Bytes of one prim_refs entry.
-constexpr uint32_t kGridRefBytes = 4;
 
 struct GridGeometry {
     uint32_t res[3] = {1, 1, 1};       ///< cells per axis
@@ -62,6 +59,14 @@ struct GridConfig {
     uint32_t max_resolution = 1024;
     /// Most cells in all (the cell region is 8 bytes per cell); lambda N is scaled down to fit.
     uint64_t max_cells = 1ull << 25;
+
+    /// The settings as data (traces/accel/build_settings.h).
+    template <class V>
+    void visit(V& v) {
+        v.field("density", density, "cells/triangle", "lambda: about lambda x N cells, cubic where the scene is", 1e-6, 1e6);
+        v.field("max_resolution", max_resolution, "cells", "Largest resolution along one axis", 1, 65536);
+        v.field("max_cells", max_cells, "cells", "Most cells in all (8 bytes each); lambda N is scaled down to fit", 1, 4294967296.0);
+    }
 };
 
 }  // namespace rtsim

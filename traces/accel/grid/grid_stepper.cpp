@@ -2,8 +2,6 @@
 // the definition the SystemC model matches (docs/accel.md, "grid").
 #include "traces/accel/grid/grid_stepper.h"
 
-#include <algorithm>
-
 #include "traces/isect/leaf_kernel.h"
 #include "traces/isect/ray_box_kernel.h"
 
@@ -15,6 +13,7 @@ void GridStepper::begin(const Ray& ray, TraversalMode mode) {
     m_hit = Hit{};
     m_work = WorkCounts{};
     m_stack_size = 0;
+    m_mailbox.clear();
     if (!ray_is_valid(ray) || m_view.cell_count == 0) {
         finish();
         return;
@@ -44,23 +43,28 @@ StepOutcome GridStepper::execute() {
                 next_cell();
                 break;
             }
-            m_first = c.first_ref;
-            m_count = c.ref_count;
-            m_tested = 0;
             m_phase = Phase::refs;
-            m_plan.reset(kNoLocality);  // the list belongs to its cell's brick
-            m_plan.add_fetch(m_view.ref_base + uint64_t(m_first) * kGridRefBytes, m_count * kGridRefBytes,
-                             DataKind::prim_ref);
+            m_list.plan_list(m_view.list, c.first_ref, c.ref_count, m_plan);  // belongs to its cell's brick
             break;
         }
         case Phase::refs:
-            m_work.refs += m_count;
+            m_list.list_fetched(m_work);
             m_phase = Phase::triangles;
-            plan_triangles();
+            next_batch();
             break;
-        case Phase::triangles:
-            out.add_op(OpKind::anyhit, test_triangles());
+        case Phase::triangles: {
+            bool done = false;
+            const uint32_t alpha =
+                m_mode == TraversalMode::any_hit
+                    ? m_list.test_batch<true>(m_view.list, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox,
+                                              m_work, &done)
+                    : m_list.test_batch<false>(m_view.list, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox,
+                                               m_work, &done);
+            out.add_op(OpKind::anyhit, alpha);
+            if (done) finish();
+            else next_batch();
             break;
+        }
     }
     return out;
 }
@@ -83,35 +87,8 @@ void GridStepper::next_cell() {
     m_plan.add_op(OpKind::cell, 1);
 }
 
-void GridStepper::plan_triangles() {
-    const uint32_t n = std::min(kBatch, m_count - m_tested);
-    m_plan.reset(kNoLocality);
-    for (uint32_t i = 0; i < n; ++i) {
-        const uint32_t tri = m_view.refs[m_first + m_tested + i];
-        m_plan.add_fetch(m_view.triangle_base + uint64_t(tri) * sizeof(HwTriangle), sizeof(HwTriangle),
-                         DataKind::triangle);
-    }
-    m_plan.add_op(OpKind::triangle, n);
-}
-
-uint32_t GridStepper::test_triangles() {
-    const uint32_t n = std::min(kBatch, m_count - m_tested), alpha_before = m_work.anyhit_calls;
-    m_work.tri_tests += n;
-    const uint32_t* refs = m_view.refs + m_first + m_tested;
-    bool done = false;
-    for (uint32_t i = 0; i < n && !done; ++i) {
-        const HwTriangle& tri = m_view.triangles[refs[i]];
-        done = m_mode == TraversalMode::any_hit
-                   ? detail::triangle_step<true>(m_tri, m_ray.tmin, m_ray.tmax, tri, m_hit, m_cull_t, m_work.anyhit_calls)
-                   : (detail::triangle_step<false>(m_tri, m_ray.tmin, m_ray.tmax, tri, m_hit, m_cull_t,
-                                                   m_work.anyhit_calls),
-                      false);
-    }
-    m_tested += n;
-    if (done) finish();
-    else if (m_tested < m_count) plan_triangles();
-    else next_cell();
-    return m_work.anyhit_calls - alpha_before;
+void GridStepper::next_batch() {
+    if (!m_list.plan_batch(m_view.list, m_mailbox, m_work, m_plan)) next_cell();
 }
 
 void GridStepper::finish() {

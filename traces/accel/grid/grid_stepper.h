@@ -6,10 +6,11 @@
 //              the cell. An empty cell goes on to the next cell.
 //   refs       fetches the cell's prim_refs list (one contiguous read); no operation
 //   triangles  gathers up to 8 of the listed triangles (one 48-byte fetch each); one triangle
-//              test each; a longer list takes several such steps
+//              test each; a longer list takes several such steps (ref_list.h)
 //
 // Each triangle is tested against the ray's own [tmin, tmax] and the best hit is the closest
-// by (t, prim) (traces/isect/leaf_kernel.h), so a triangle listed in several cells is harmless.
+// by (t, prim) (traces/isect/leaf_kernel.h), so a triangle listed in several cells is harmless;
+// with a mailbox (mailbox.h) its retests are skipped.
 // The DDA hands out cells in order of entry distance and stops at the first whose entry exceeds
 // the cull distance of the best hit: every cell that can hold a closer hit has been tested, so
 // the first hit found that way is the closest, bit for bit the binary BVH's. Any hit stops at
@@ -17,6 +18,8 @@
 #include <cstdint>
 
 #include "traces/accel/grid/grid_dda.h"
+#include "traces/accel/mailbox.h"
+#include "traces/accel/ref_list.h"
 #include "traces/accel/stepper.h"
 #include "traces/common/hw_triangle.h"
 #include "traces/isect/ray_box.h"
@@ -28,18 +31,14 @@ namespace rtsim {
 struct GridView {
     GridGeometry geometry;
     const GridCell* cells = nullptr;
-    const uint32_t* refs = nullptr;
-    const HwTriangle* triangles = nullptr;
+    RefListView list;  ///< the cells' lists and the triangles they index
     uint64_t cell_count = 0, ref_count = 0, triangle_count = 0;
-    uint64_t cell_base = 0, ref_base = 0, triangle_base = 0;  ///< addresses of record 0
+    uint64_t cell_base = 0;  ///< address of cell 0
 };
 
 class GridStepper final : public Stepper {
 public:
-    /// Triangles gathered per step at most (StepPlan::kMaxFetches).
-    static constexpr uint32_t kBatch = StepPlan::kMaxFetches;
-
-    explicit GridStepper(const GridView& view) : m_view(view) {}
+    GridStepper(const GridView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
@@ -48,8 +47,7 @@ private:
     enum class Phase : uint8_t { clip, cell, refs, triangles };
     void clip();
     void next_cell();        ///< the DDA's next cell, or the end
-    void plan_triangles();
-    uint32_t test_triangles();  ///< returns the alpha tests run
+    void next_batch();       ///< the list's next triangles, or the next cell
     void finish();
 
     GridView m_view;
@@ -59,8 +57,8 @@ private:
     float m_cull_t = 0.0f;  ///< cells entered beyond this are not visited: best t widened
     Phase m_phase = Phase::clip;
     uint32_t m_cell = 0;    ///< the current cell
-    uint32_t m_first = 0, m_count = 0;  ///< its list in prim_refs
-    uint32_t m_tested = 0;  ///< entries of the list tested so far
+    Mailbox m_mailbox;
+    RefListWalk m_list;     ///< the current cell's list
 };
 
 }  // namespace rtsim

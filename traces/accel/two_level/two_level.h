@@ -59,6 +59,8 @@ public:
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override;
+    /// The larger of the TLAS's 8-byte entries and the BLAS kind's (the stack holds both).
+    uint32_t stack_entry_bytes() const override;
 
     uint32_t frame_count() const override { return uint32_t(m_frames.size()); }
     void bind_frame(uint32_t f) override;

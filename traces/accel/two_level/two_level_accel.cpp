@@ -201,4 +201,10 @@ uint32_t TwoLevelAccel::max_stack_entries() const {
     return kTraversalStackSize + deepest;
 }
 
+uint32_t TwoLevelAccel::stack_entry_bytes() const {
+    uint32_t bytes = Accel::stack_entry_bytes();
+    for (const auto& b : m_blases) bytes = std::max(bytes, b->stack_entry_bytes());
+    return bytes;
+}
+
 }  // namespace rtsim

@@ -1,0 +1,24 @@
+#include "sim/harness/structure_defaults.h"
+
+#include "sim/harness/run_files.h"
+#include "traces/accel/accel_io.h"
+#include "traces/common/error.h"
+#include "traces/format/trace_reader.h"
+
+namespace rtsim {
+
+SimOptions with_structure_defaults(const SimOptions& options) {
+    SimOptions o = options;
+    if (o.config.traversal.stack_entry_bytes != 0) return o;
+    TraceReader reader(trace_file(o.trace));
+    const nlohmann::json d = read_accel_descriptor(reader);
+    const nlohmann::json stats = d.is_object() ? d.value("stats", nlohmann::json::object()) : nlohmann::json::object();
+    const nlohmann::json bytes = stats.is_object() ? stats.value("stack_entry_bytes", nlohmann::json(kBvhStackEntryBytes))
+                                                   : nlohmann::json(kBvhStackEntryBytes);
+    require(bytes.is_number_unsigned() && bytes.get<uint64_t>() >= 1 && bytes.get<uint64_t>() <= 64,
+            reader.path() + ": section ACCL: stats 'stack_entry_bytes' must be an integer in 1..64, got " + bytes.dump());
+    o.config.traversal.stack_entry_bytes = bytes.get<uint32_t>();
+    return o;
+}
+
+}  // namespace rtsim

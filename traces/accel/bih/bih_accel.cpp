@@ -1,0 +1,137 @@
+// The BIH's validation, Accel, locality tree and invariants (bih.h).
+#include <cmath>
+#include <limits>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "traces/accel/bih/bih.h"
+#include "traces/accel/spatial_params.h"
+#include "traces/common/error.h"
+#include "traces/scene/scene.h"
+
+namespace rtsim {
+
+uint32_t validate_bih(const BihView& v, const std::string& source) {
+    // Messages are built only on failure: this pass runs over every node of every trace opened.
+    auto fail = [&](const std::string& what) { throw Error(source + ": BIH: " + what); };
+    auto node_name = [](uint64_t i) { return "node " + std::to_string(i); };
+    if (v.node_count == 0) fail("no nodes");
+    if (v.node_count > BihNode::kMaxIndex || v.triangle_count > BihNode::kMaxIndex)
+        fail("more than 2^30 nodes or triangles");
+    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0), covered(v.triangle_count, 0);
+    seen[0] = 1;
+    uint32_t deepest = 0;
+    for (uint64_t i = 0; i < v.node_count; ++i) {
+        const BihNode& n = v.nodes[i];
+        if (!seen[i]) fail(node_name(i) + " is not reachable from the root");
+        deepest = std::max<uint32_t>(deepest, depth[i]);
+        if (n.leaf()) {
+            if (uint64_t(n.first()) + n.count() > v.triangle_count)
+                fail(node_name(i) + " holds triangles " + std::to_string(n.first()) + ".." +
+                     std::to_string(uint64_t(n.first()) + n.count() - 1) + " of " + std::to_string(v.triangle_count));
+            for (uint64_t k = n.first(); k < uint64_t(n.first()) + n.count(); ++k) {
+                if (covered[k]) fail("triangle " + std::to_string(k) + " is in two leaves");
+                covered[k] = 1;
+            }
+            continue;
+        }
+        if (std::isnan(n.clip(0)) || std::isnan(n.clip(1))) fail(node_name(i) + " has a NaN clip plane");
+        for (uint64_t k : {uint64_t(n.left()), uint64_t(n.left()) + 1}) {
+            if (k <= i || k >= v.node_count)
+                fail(node_name(i) + " names child " + std::to_string(k) + (k < v.node_count ? " (not after it)" : " (out of range)"));
+            if (seen[k]) fail(node_name(k) + " has two parents");
+            if (depth[i] + 1u >= kBihMaxDepth) fail("deeper than the traversal stack (" + std::to_string(kBihMaxDepth) + ")");
+            seen[k] = 1;
+            depth[k] = uint8_t(depth[i] + 1);
+        }
+    }
+    for (uint64_t k = 0; k < v.triangle_count; ++k)
+        if (!covered[k]) fail("triangle " + std::to_string(k) + " is in no leaf (unreachable)");
+    return deepest;
+}
+
+void check_bih_invariants(const BihView& v, const Scene& scene) {
+    auto fail = [](const std::string& what) { throw Error("BIH invariant: " + what); };
+    std::vector<uint8_t> seen(scene.triangles.size(), 0);
+    for (uint64_t k = 0; k < v.triangle_count; ++k) {
+        const uint32_t prim = v.triangles[k].prim;
+        if (prim >= seen.size() || seen[prim]++) fail("triangle records are not a permutation of the scene's");
+        const HwTriangle want = make_hw_triangle(scene, prim);
+        if (std::memcmp(&want, &v.triangles[k], sizeof want) != 0) fail("record " + std::to_string(k) + " is not the scene's");
+    }
+    // Every triangle lies in its leaf's cell: the root box cut by its ancestors' clip planes.
+    std::vector<Aabb> cell(v.node_count);
+    cell[0] = v.bounds;
+    for (uint64_t i = 0; i < v.node_count; ++i) {
+        const BihNode& n = v.nodes[i];
+        if (n.leaf()) {
+            for (uint32_t k = n.first(); k < n.first() + n.count(); ++k) {
+                Aabb box;
+                const HwTriangle& t = v.triangles[k];
+                for (const float* p : {t.v0, t.v1, t.v2}) box.grow(Vec3(p[0], p[1], p[2]));
+                if (!cell[i].contains(box)) fail("triangle record " + std::to_string(k) + " lies outside the cell of leaf " + std::to_string(i));
+            }
+            continue;
+        }
+        cell[n.left()] = cell[n.left() + 1] = cell[i];
+        cell[n.left()].hi[n.axis()] = std::min(cell[i].hi[n.axis()], n.clip(0));
+        cell[n.left() + 1].lo[n.axis()] = std::max(cell[i].lo[n.axis()], n.clip(1));
+    }
+}
+
+BihAccel::BihAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
+    const Region& nodes = m_image.region("nodes");
+    const Region& tris = m_image.region("triangles");
+    require(nodes.record_bytes == sizeof(BihNode) && tris.record_bytes == sizeof(HwTriangle),
+            source + ": bih regions must hold 12-byte nodes and 48-byte triangles");
+    require(nodes.kind == DataKind::node && tris.kind == DataKind::triangle,
+            source + ": bih regions must be of data kinds node and triangle");
+    m_view.nodes = nodes.records<BihNode>();
+    m_view.node_count = nodes.count;
+    m_view.node_base = nodes.base;
+    m_view.triangles = tris.records<HwTriangle>();
+    m_view.triangle_count = tris.count;
+    m_view.triangle_base = tris.base;
+    m_view.bounds = root_cell_from_json(m_image.params, source + ": bih params");
+    m_depth = validate_bih(m_view, source);
+}
+
+std::unique_ptr<Stepper> BihAccel::make_stepper() const { return std::make_unique<BihStepper>(m_view); }
+
+Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
+    BihStepper stepper(m_view);  // on the stack: no allocation, no virtual calls
+    stepper.begin(ray, mode);
+    while (!stepper.done()) stepper.execute();
+    if (work) *work = stepper.work();
+    return stepper.hit();
+}
+
+LocalityPartition BihAccel::partition(uint64_t budget_bytes) const {
+    require(budget_bytes >= sizeof(BihNode), "treelet budget must be at least one node (12 bytes)");
+    LocalityTree t;
+    std::vector<Aabb> cell(m_view.node_count);
+    cell[0] = m_view.bounds;
+    for (uint64_t i = 0; i < m_view.node_count; ++i) {
+        const BihNode& n = m_view.nodes[i];
+        t.add_node(sizeof(BihNode) + (n.leaf() ? uint64_t(n.count()) * sizeof(HwTriangle) : 0),
+                   i == 0 ? std::numeric_limits<float>::infinity() : cell[i].half_area());
+        if (n.leaf()) continue;
+        const uint32_t l = n.left();
+        cell[l] = cell[l + 1] = cell[i];
+        cell[l].hi[n.axis()] = std::min(cell[i].hi[n.axis()], n.clip(0));
+        cell[l + 1].lo[n.axis()] = std::max(cell[i].lo[n.axis()], n.clip(1));
+        t.add_child(l);
+        t.add_child(l + 1);
+    }
+    t.finish();
+    return partition_tree(t, budget_bytes);
+}
+
+std::vector<OpKind> BihAccel::op_kinds() const {
+    std::vector<OpKind> kinds{OpKind::box, OpKind::plane, OpKind::triangle};
+    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
+    return kinds;
+}
+
+}  // namespace rtsim

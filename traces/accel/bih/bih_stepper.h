@@ -1,0 +1,65 @@
+#pragma once
+// The BIH's stepper (docs/accel.md, "bih"). Steps:
+//
+//   clip       no fetch; 1 box test: the ray against the root cell
+//   node       fetches the 12-byte BihNode (locality key: the node); an interior node runs 2 plane
+//              tests (its clip planes' distances) and goes on to the near child, pushing the far
+//              one with its interval when the ray enters both; a leaf goes on to its triangles
+//   leaf       fetches the leaf's triangles (contiguous) and runs one triangle test each
+//
+// As in the kd-tree (kd_stepper.h), a child's interval is its parent's cut at its clip plane,
+// exactly the robust box test of the child's cell (traces/isect/slab_interval.h); pending cells
+// entered beyond the best hit's cull distance are dropped without a fetch. Children may overlap
+// (clip[0] > clip[1]), so a hit in the near child does not end the ray by itself: the cull rule
+// decides, and the closest hit by (t, prim) is the binary BVH's bit for bit.
+#include <cstdint>
+
+#include "traces/accel/bih/bih_layout.h"
+#include "traces/accel/stepper.h"
+#include "traces/common/aabb.h"
+#include "traces/common/hw_triangle.h"
+#include "traces/isect/ray_triangle.h"
+#include "traces/isect/slab_interval.h"
+
+namespace rtsim {
+
+/// Where a BIH's data lives: arrays and their addresses in the memory image.
+struct BihView {
+    const BihNode* nodes = nullptr;
+    const HwTriangle* triangles = nullptr;
+    uint64_t node_count = 0, triangle_count = 0;
+    uint64_t node_base = 0, triangle_base = 0;  ///< addresses of record 0
+    Aabb bounds;                                ///< the root cell
+};
+
+class BihStepper final : public Stepper {
+public:
+    explicit BihStepper(const BihView& view) : m_view(view) {}
+
+    void begin(const Ray& ray, TraversalMode mode) override;
+    StepOutcome execute() override;
+
+private:
+    enum class Phase : uint8_t { clip, node, leaf };
+    struct Entry {
+        uint32_t node;
+        detail::SlabInterval cell;
+    };
+    void clip();
+    void visit(uint32_t node, const detail::SlabInterval& cell);
+    void interior(const BihNode& node);
+    uint32_t leaf();  ///< returns the alpha tests run
+    void pop_next();
+    void finish();
+
+    BihView m_view;
+    RayBoxPre m_box;
+    RayTrianglePre m_tri;
+    float m_cull_t = 0.0f;
+    Phase m_phase = Phase::clip;
+    uint32_t m_node = 0;
+    detail::SlabInterval m_cell;
+    Entry m_stack[kBihMaxDepth];
+};
+
+}  // namespace rtsim

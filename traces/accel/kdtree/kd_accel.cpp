@@ -1,0 +1,140 @@
+// The kd-tree's image, validation, Accel and locality tree (kdtree.h).
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "traces/accel/kdtree/kdtree.h"
+#include "traces/accel/spatial_params.h"
+#include "traces/bvh/build_tree.h"
+#include "traces/common/error.h"
+#include "traces/scene/scene.h"
+
+namespace rtsim {
+
+AccelImage kdtree_image(const Scene& scene, const KdConfig& config) {
+    KdTreeBuild kd = build_kdtree(scene, config);
+    AccelImage image;
+    image.kind = "kdtree";
+    image.bounds = kd.bounds;
+    image.params = root_cell_json(kd.bounds);
+    Region& nodes = image.add_region<KdNode>("nodes", DataKind::node, kd.nodes.size());
+    std::copy(kd.nodes.begin(), kd.nodes.end(), nodes.records<KdNode>());
+    Region& refs = image.add_region<uint32_t>("prim_refs", DataKind::prim_ref, kd.refs.size());
+    std::copy(kd.refs.begin(), kd.refs.end(), refs.records<uint32_t>());
+    const size_t n = scene.triangles.size();
+    HwTriangle* tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, n).records<HwTriangle>();
+    for (size_t i = 0; i < n; ++i) tris[i] = make_hw_triangle(scene, uint32_t(i));
+    image.place_regions();
+    image.stats = std::move(kd.stats);
+    return image;
+}
+
+uint32_t validate_kdtree(const KdView& v, const std::string& source) {
+    // Messages are built only on failure: this pass runs over every node of every trace opened.
+    auto fail = [&](const std::string& what) { throw Error(source + ": kd-tree: " + what); };
+    auto node_name = [](uint64_t i) { return "node " + std::to_string(i); };
+    if (v.node_count == 0) fail("no nodes");
+    if (v.node_count > KdNode::kMaxIndex || v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32))
+        fail("more than 2^30 nodes or 2^32 references or triangles");
+    // Depth first: children come after their parent, so one forward pass checks reachability and
+    // depth, and carries each node's cell to check that its split lies inside it.
+    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0);
+    std::vector<Aabb> cell(v.node_count);
+    seen[0] = 1;
+    cell[0] = v.bounds;
+    uint32_t deepest = 0;
+    for (uint64_t i = 0; i < v.node_count; ++i) {
+        const KdNode& n = v.nodes[i];
+        if (!seen[i]) fail(node_name(i) + " is not reachable from the root");
+        deepest = std::max<uint32_t>(deepest, depth[i]);
+        if (n.leaf()) {
+            if (uint64_t(n.first_ref()) + n.ref_count() > v.ref_count)
+                fail(node_name(i) + " lists prim_refs " + std::to_string(n.first_ref()) + ".." +
+                     std::to_string(uint64_t(n.first_ref()) + n.ref_count() - 1) + " of " + std::to_string(v.ref_count));
+            continue;
+        }
+        const int a = n.axis();
+        const float p = n.split();
+        if (!(std::isfinite(p) && p >= cell[i].lo[a] && p <= cell[i].hi[a]))
+            fail(node_name(i) + " splits axis " + std::to_string(a) + " at " + std::to_string(p) + " outside its cell");
+        const uint64_t kids[2] = {i + 1, n.above()};
+        for (int c = 0; c < 2; ++c) {
+            const uint64_t k = kids[c];
+            if (k <= i || k >= v.node_count)
+                fail(node_name(i) + " names child " + std::to_string(k) + (k < v.node_count ? " (not after it)" : " (out of range)"));
+            if (seen[k]) fail(node_name(k) + " has two parents");
+            if (depth[i] + 1u >= kKdMaxDepth) fail("deeper than the traversal stack (" + std::to_string(kKdMaxDepth) + ")");
+            seen[k] = 1;
+            depth[k] = uint8_t(depth[i] + 1);
+            cell[k] = cell[i];
+            (c == 0 ? cell[k].hi[a] : cell[k].lo[a]) = p;
+        }
+    }
+    for (uint64_t r = 0; r < v.ref_count; ++r)
+        if (v.list.refs[r] >= v.triangle_count)
+            fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.list.refs[r]) + " of " +
+                 std::to_string(v.triangle_count));
+    return deepest;
+}
+
+KdAccel::KdAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
+    const Region& nodes = m_image.region("nodes");
+    const Region& refs = m_image.region("prim_refs");
+    const Region& tris = m_image.region("triangles");
+    require(nodes.record_bytes == sizeof(KdNode) && refs.record_bytes == kRefBytes &&
+                tris.record_bytes == sizeof(HwTriangle),
+            source + ": kdtree regions must hold 8-byte nodes, 4-byte references and 48-byte triangles");
+    require(nodes.kind == DataKind::node && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
+            source + ": kdtree regions must be of data kinds node, prim_ref and triangle");
+    m_view.nodes = nodes.records<KdNode>();
+    m_view.node_count = nodes.count;
+    m_view.node_base = nodes.base;
+    m_view.list = RefListView{refs.records<uint32_t>(), tris.records<HwTriangle>(), refs.base, tris.base};
+    m_view.ref_count = refs.count;
+    m_view.triangle_count = tris.count;
+    m_view.bounds = root_cell_from_json(m_image.params, source + ": kdtree params");
+    m_depth = validate_kdtree(m_view, source);
+}
+
+std::unique_ptr<Stepper> KdAccel::make_stepper() const {
+    return std::make_unique<KdStepper>(m_view, m_mailbox_entries);
+}
+
+Hit KdAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
+    KdStepper stepper(m_view, m_mailbox_entries);  // on the stack: no allocation, no virtual calls
+    stepper.begin(ray, mode);
+    while (!stepper.done()) stepper.execute();
+    if (work) *work = stepper.work();
+    return stepper.hit();
+}
+
+LocalityPartition KdAccel::partition(uint64_t budget_bytes) const {
+    require(budget_bytes >= sizeof(KdNode), "treelet budget must be at least one node (8 bytes)");
+    // A node brings itself and, for a leaf, its list and one triangle per reference; its
+    // probability is its cell's surface area.
+    LocalityTree t;
+    std::vector<Aabb> cell(m_view.node_count);
+    cell[0] = m_view.bounds;
+    for (uint64_t i = 0; i < m_view.node_count; ++i) {
+        const KdNode& n = m_view.nodes[i];
+        uint64_t bytes = sizeof(KdNode);
+        if (n.leaf()) bytes += uint64_t(n.ref_count()) * (kRefBytes + sizeof(HwTriangle));
+        t.add_node(bytes, i == 0 ? std::numeric_limits<float>::infinity() : cell[i].half_area());
+        if (n.leaf()) continue;
+        cell[i + 1] = cell[n.above()] = cell[i];
+        cell[i + 1].hi[n.axis()] = cell[n.above()].lo[n.axis()] = n.split();
+        t.add_child(uint32_t(i + 1));
+        t.add_child(n.above());
+    }
+    t.finish();
+    return partition_tree(t, budget_bytes);
+}
+
+std::vector<OpKind> KdAccel::op_kinds() const {
+    std::vector<OpKind> kinds{OpKind::box, OpKind::plane, OpKind::triangle};
+    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
+    return kinds;
+}
+
+}  // namespace rtsim

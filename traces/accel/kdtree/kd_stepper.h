@@ -1,0 +1,72 @@
+#pragma once
+// The kd-tree's stepper (docs/accel.md, "kdtree"). Steps:
+//
+//   clip       no fetch; 1 box test: the ray against the root cell (its interval [tnear, tfar])
+//   node       fetches the 8-byte KdNode (locality key: the node); an interior node runs 1 plane
+//              test (the split plane's distance) and goes on to the near child, pushing the far
+//              one with its interval when the ray enters both; a leaf goes on to its list
+//   refs       fetches the leaf's prim_refs list (one contiguous read); no operation
+//   triangles  gathers up to 8 listed triangles, one triangle test each (ref_list.h)
+//
+// Front to back: a child's interval is its parent's cut at the split plane, computed as the
+// robust box test computes the child cell's box (traces/isect/slab_interval.h), so the cells
+// visited are exactly those the box test accepts. After a leaf the next entry is popped; an entry
+// entered beyond the best hit's cull distance is dropped without a fetch, and since pending cells
+// lie behind the current one, a hit inside the current leaf ends the ray ("stop at the first hit
+// in the current leaf"), while a hit that lies beyond the leaf (its triangle extends into later
+// cells) or on its far boundary lets the cells up to it be visited, so the closest hit by
+// (t, prim) is the binary BVH's bit for bit. Any hit stops at the first accepted hit.
+#include <cstdint>
+
+#include "traces/accel/kdtree/kd_layout.h"
+#include "traces/accel/mailbox.h"
+#include "traces/accel/ref_list.h"
+#include "traces/accel/stepper.h"
+#include "traces/common/aabb.h"
+#include "traces/isect/ray_triangle.h"
+#include "traces/isect/slab_interval.h"
+
+namespace rtsim {
+
+/// Where a kd-tree's data lives: arrays and their addresses in the memory image.
+struct KdView {
+    const KdNode* nodes = nullptr;
+    RefListView list;
+    uint64_t node_count = 0, ref_count = 0, triangle_count = 0;
+    uint64_t node_base = 0;  ///< address of node 0
+    Aabb bounds;             ///< the root cell
+};
+
+class KdStepper final : public Stepper {
+public:
+    KdStepper(const KdView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
+
+    void begin(const Ray& ray, TraversalMode mode) override;
+    StepOutcome execute() override;
+
+private:
+    enum class Phase : uint8_t { clip, node, refs, triangles };
+    struct Entry {
+        uint32_t node;
+        detail::SlabInterval cell;
+    };
+    void clip();
+    void visit(uint32_t node, const detail::SlabInterval& cell);
+    void interior(const KdNode& node);
+    void next_batch();  ///< the leaf's next triangles, or the next cell
+    void pop_next();
+    void finish();
+
+    KdView m_view;
+    RayBoxPre m_box;
+    RayTrianglePre m_tri;
+    Mailbox m_mailbox;
+    RefListWalk m_list;
+    float m_cull_t = 0.0f;
+    Phase m_phase = Phase::clip;
+    uint32_t m_node = 0;
+    detail::SlabInterval m_cell;
+    Entry m_stack[kKdMaxDepth];
+};
+
+}  // namespace rtsim

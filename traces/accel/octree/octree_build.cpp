@@ -1,0 +1,185 @@
+// The adaptive octree's builder (octree.h): top down, a cell listing more than max_leaf_size
+// references is cut at its centre and each reference (the part of a triangle inside the cell) is
+// clipped into the children it reaches (conservatively, in double: traces/bvh/sbvh_clip.h).
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "traces/accel/octree/octree.h"
+#include "traces/accel/ref_list.h"
+#include "traces/accel/spatial_params.h"
+#include "traces/bvh/build_tree.h"
+#include "traces/bvh/sbvh_clip.h"
+#include "traces/common/error.h"
+#include "traces/scene/scene.h"
+
+namespace rtsim {
+namespace {
+
+struct Ref {
+    Aabb box;  ///< the triangle's part in the cell (conservative)
+    uint32_t prim;
+};
+
+double half_area(const Aabb& b) {
+    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+    return x * y + y * z + z * x;
+}
+
+class OctreeBuilder {
+public:
+    OctreeBuilder(const Scene& scene, const OctreeConfig& c) : m_scene(scene), m_c(c) {}
+
+    void build(uint32_t index, const Aabb& cell, std::vector<Ref>& refs, uint32_t depth);
+    std::vector<OctNode> nodes;
+    std::vector<uint32_t> list;
+    double root_area = 1.0, sah = 0.0;
+    uint64_t leaves = 0, max_leaf = 0, deepest = 0;
+
+private:
+    void leaf(uint32_t index, const Aabb& cell, const std::vector<Ref>& refs);
+    /// The parts of `r` on either side of `plane` of `axis` (empty boxes where it does not reach).
+    void split(const Ref& r, int axis, float plane, Aabb* lower, Aabb* upper) const;
+
+    const Scene& m_scene;
+    OctreeConfig m_c;
+};
+
+void OctreeBuilder::split(const Ref& r, int axis, float plane, Aabb* lower, Aabb* upper) const {
+    if (r.box.hi[axis] <= plane && !(r.box.lo[axis] == plane)) {  // wholly below (touching allowed)
+        *lower = r.box, *upper = Aabb{};
+        return;
+    }
+    if (r.box.lo[axis] >= plane && !(r.box.hi[axis] == plane)) {
+        *lower = Aabb{}, *upper = r.box;
+        return;
+    }
+    if (r.box.lo[axis] == plane && r.box.hi[axis] == plane) {  // flat in the plane: the lower side
+        *lower = r.box, *upper = Aabb{};
+        return;
+    }
+    if (m_c.clip) {
+        ClippedTriangle(m_scene.triangles[r.prim], r.box).split(axis, plane, lower, upper);
+    } else {
+        *lower = *upper = r.box;
+        lower->hi[axis] = upper->lo[axis] = plane;
+    }
+}
+
+void OctreeBuilder::leaf(uint32_t index, const Aabb& cell, const std::vector<Ref>& refs) {
+    std::vector<uint32_t> prims;
+    for (const Ref& r : refs) prims.push_back(r.prim);
+    std::sort(prims.begin(), prims.end());
+    require(list.size() + prims.size() < (1ull << 32), "octree: more than 2^32 references");
+    nodes[index] = OctNode::make_leaf(uint32_t(list.size()), uint32_t(prims.size()));
+    list.insert(list.end(), prims.begin(), prims.end());
+    sah += half_area(cell) / root_area * double(prims.size());
+    leaves += 1;
+    max_leaf = std::max<uint64_t>(max_leaf, prims.size());
+}
+
+void OctreeBuilder::build(uint32_t index, const Aabb& cell, std::vector<Ref>& refs, uint32_t depth) {
+    deepest = std::max<uint64_t>(deepest, depth);
+    // The centre: each axis with extent is halved; one without keeps its upper bound (not cut).
+    float centre[3];
+    bool cut_any = false;
+    for (int a = 0; a < 3; ++a) {
+        const float lo = cell.lo[a], hi = cell.hi[a], mid = lo + (hi - lo) * 0.5f;
+        const bool cut = mid > lo && mid < hi;
+        centre[a] = cut ? mid : hi;
+        cut_any = cut_any || cut;
+    }
+    if (refs.size() <= m_c.max_leaf_size || depth >= m_c.max_depth || !cut_any) return leaf(index, cell, refs);
+    // Each reference clipped into the children it reaches: one axis at a time.
+    std::vector<Ref> child[8];
+    for (const Ref& r : refs) {
+        Aabb part[8];
+        part[0] = r.box;
+        for (int a = 0; a < 3; ++a) {
+            if (!(centre[a] < cell.hi[a])) continue;  // axis not cut: everything on the lower side
+            for (uint32_t c = 0; c < 8; ++c) {
+                if ((c >> a & 1u) || part[c].empty()) continue;
+                Ref piece{part[c], r.prim};
+                split(piece, a, centre[a], &part[c], &part[c | 1u << a]);
+            }
+        }
+        for (uint32_t c = 0; c < 8; ++c)
+            if (!part[c].empty()) child[c].push_back(Ref{part[c], r.prim});
+    }
+    // A cut that lists every reference in every child it stores, with more than one stored,
+    // only multiplies references (large triangles covering the cell): it stays a leaf. A cut
+    // that leaves every reference in one child still shrinks the cell (empty space cut off).
+    bool separates = false;
+    uint32_t mask = 0, stored = 0;
+    for (uint32_t c = 0; c < 8; ++c) {
+        separates = separates || (!child[c].empty() && child[c].size() < refs.size());
+        if (!child[c].empty()) mask |= 1u << c, ++stored;
+    }
+    if (!separates && stored > 1) return leaf(index, cell, refs);
+    std::vector<Ref>().swap(refs);
+    const uint32_t first = uint32_t(nodes.size());
+    require(first + stored <= OctNode::kMaxIndex, "octree: more than 2^24 nodes (lower max_depth or raise max_leaf_size)");
+    nodes[index] = OctNode::interior(mask, first, centre);
+    nodes.resize(nodes.size() + stored);
+    sah += half_area(cell) / root_area;
+    uint32_t k = first;
+    for (uint32_t c = 0; c < 8; ++c) {
+        if (child[c].empty()) continue;
+        build(k++, octree_child_cell(cell, centre, c), child[c], depth + 1);
+        std::vector<Ref>().swap(child[c]);
+    }
+}
+
+}  // namespace
+
+AccelImage octree_image(const Scene& scene, const OctreeConfig& config) {
+    const size_t n = scene.triangles.size();
+    require(n > 0, "octree: the scene has no triangles");
+    require(n < (size_t(1) << 31), "octree: too many triangles (>= 2^31)");
+    require(config.max_depth >= 1 && config.max_depth <= kOctMaxDepth && config.max_leaf_size >= 1,
+            "OctreeConfig: max_depth must be in 1.." + std::to_string(kOctMaxDepth) + " and max_leaf_size >= 1");
+    std::vector<Ref> refs(n);
+    Aabb bounds;
+    for (size_t i = 0; i < n; ++i) {
+        for (const Vec3& v : {scene.triangles[i].v0, scene.triangles[i].v1, scene.triangles[i].v2}) {
+            require(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z),
+                    "octree: triangle " + std::to_string(i) + " has a non-finite vertex");
+            refs[i].box.grow(v);
+        }
+        refs[i].prim = uint32_t(i);
+        bounds.grow(refs[i].box);
+    }
+    OctreeBuilder b(scene, config);
+    b.root_area = std::max(half_area(bounds), 1e-300);
+    b.nodes.resize(1);
+    b.build(0, bounds, refs, 0);
+
+    AccelImage image;
+    image.kind = "octree";
+    image.bounds = bounds;
+    image.params = root_cell_json(bounds);
+    Region& nodes = image.add_region<OctNode>("nodes", DataKind::node, b.nodes.size());
+    std::copy(b.nodes.begin(), b.nodes.end(), nodes.records<OctNode>());
+    Region& list = image.add_region<uint32_t>("prim_refs", DataKind::prim_ref, b.list.size());
+    std::copy(b.list.begin(), b.list.end(), list.records<uint32_t>());
+    HwTriangle* tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, n).records<HwTriangle>();
+    for (size_t i = 0; i < n; ++i) tris[i] = make_hw_triangle(scene, uint32_t(i));
+    image.place_regions();
+    const double total = double(b.list.size());
+    image.stats = {{"builder", "adaptive"},
+                   {"width", 8},
+                   {"node_bytes", sizeof(OctNode)},
+                   {"triangle_bytes", sizeof(HwTriangle)},
+                   {"nodes", b.nodes.size()},
+                   {"leaves", b.leaves},
+                   {"max_depth", b.deepest},
+                   {"references", b.list.size()},
+                   {"references_per_triangle", total / double(n)},
+                   {"avg_leaf_size", b.leaves ? total / double(b.leaves) : 0.0},
+                   {"max_leaf_size", b.max_leaf},
+                   {"sah_cost", b.sah}};
+    return image;
+}
+
+}  // namespace rtsim
