@@ -8,14 +8,15 @@ namespace rtsim {
 
 using nlohmann::json;
 
-Region& AccelImage::add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count) {
+Region& AccelImage::add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count,
+                               bool zero) {
     require(!has_region(name), "accel image '" + this->kind + "': region '" + name + "' added twice");
     Region r;
     r.name = name;
     r.kind = kind;
     r.record_bytes = record_bytes;
     r.count = count;
-    r.bytes.resize(count * record_bytes);
+    r.bytes.resize(count * record_bytes, zero);
     regions.push_back(std::move(r));
     return regions.back();
 }

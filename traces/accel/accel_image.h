@@ -44,8 +44,10 @@ struct AccelImage {
     Aabb bounds;                               ///< of the whole scene
     std::vector<Region> regions;
 
-    /// Adds a zero-filled region; addresses are assigned by place_regions().
-    Region& add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count);
+    /// Adds a zero-filled region (zero = false: uninitialised, for a caller that writes every
+    /// byte of every record); addresses are assigned by place_regions().
+    Region& add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count,
+                       bool zero = true);
     /// The region called `name`; throws rtsim::Error naming it (and the image's kind) if absent.
     const Region& region(const std::string& name) const;
     Region& region(const std::string& name);

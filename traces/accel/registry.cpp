@@ -54,7 +54,7 @@ BuildTree build_tree(const Scene& scene, const AccelOptions& o, nlohmann::json* 
 AccelImage build_bvh2(const Scene& scene, const AccelOptions& o) {
     nlohmann::json extra = nlohmann::json::object();
     const BuildTree tree = build_tree(scene, o, &extra);
-    AccelImage image = bvh2_image(flatten_bvh(tree, scene, o.build), o.build, o.builder);
+    AccelImage image = bvh2_image(tree, scene, o.build, o.builder);
     image.stats.update(extra);
     return image;
 }

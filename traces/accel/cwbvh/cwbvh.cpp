@@ -42,7 +42,8 @@ void write_node(const WideBuildTree& tree, const WideOrder& o, uint32_t b, Node&
         if (child_at[s] < 0) continue;
         const WideBuildChild& c = n.child[child_at[s]];
         if (c.is_leaf()) {
-            require(c.count <= kWideLeafMax, "cwbvh: leaf of " + std::to_string(c.count) + " triangles (at most 3)");
+            if (c.count > kWideLeafMax)
+                throw Error("cwbvh: leaf of " + std::to_string(c.count) + " triangles (at most 3)");
             const uint32_t offset = o.leaf_first[size_t(b) * kMaxWideWidth + uint32_t(child_at[s])] - base_tri;
             out.meta[s] = meta_leaf(c.count, offset);
         } else {
@@ -76,7 +77,7 @@ AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std:
     }
     Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
-    for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
+    HwTriangleWriter(scene).write(o.prims.data(), o.prims.size(), t);
     image.place_regions();
     return image;
 }

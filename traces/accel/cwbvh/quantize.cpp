@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "traces/common/error.h"
 
@@ -26,10 +27,21 @@ QuantFrame make_quant_frame(const Aabb& box) {
     return f;
 }
 
+namespace {
+
+/// (x - p) / scale in double, clamped to [0, 255]: exact before the clamp (scale is a power of
+/// two, so its inverse is exact too), a starting point the walks below correct by a step or two.
+double steps_from_origin(const QuantFrame& f, int a, float x) {
+    const uint64_t bits = uint64_t(1023 + 127 - int(f.e[a])) << 52;  // 2^(127 - e) as a double
+    double inv_scale;
+    std::memcpy(&inv_scale, &bits, sizeof inv_scale);
+    return std::clamp((double(x) - double(f.p[a])) * inv_scale, 0.0, 255.0);
+}
+
+}  // namespace
+
 uint8_t quantize_lo(const QuantFrame& f, int a, float lo) {
-    const float s = quant_scale(f.e[a]);
-    double guess = std::floor((double(lo) - double(f.p[a])) / double(s));
-    int q = int(std::clamp(guess, 0.0, 255.0));
+    int q = int(steps_from_origin(f, a, lo));  // truncation: the floor of a value >= 0
     // decode is monotone in q: walk to the largest q that still decodes at or below lo.
     while (q > 0 && quant_decode(f.p[a], f.e[a], uint32_t(q)) > lo) --q;
     while (q < 255 && quant_decode(f.p[a], f.e[a], uint32_t(q + 1)) <= lo) ++q;
@@ -38,9 +50,9 @@ uint8_t quantize_lo(const QuantFrame& f, int a, float lo) {
 }
 
 uint8_t quantize_hi(const QuantFrame& f, int a, float hi) {
-    const float s = quant_scale(f.e[a]);
-    double guess = std::ceil((double(hi) - double(f.p[a])) / double(s));
-    int q = int(std::clamp(guess, 0.0, 255.0));
+    const double steps = steps_from_origin(f, a, hi);
+    int q = int(steps);
+    q += double(q) < steps;  // the ceiling
     while (q < 255 && quant_decode(f.p[a], f.e[a], uint32_t(q)) < hi) ++q;
     while (q > 0 && quant_decode(f.p[a], f.e[a], uint32_t(q - 1)) >= hi) --q;
     require(quant_decode(f.p[a], f.e[a], uint32_t(q)) >= hi, "quantize_hi: bound beyond the frame");

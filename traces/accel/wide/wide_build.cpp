@@ -76,7 +76,7 @@ AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::
     }
     Region& tris = image.add_region("triangles", DataKind::triangle, sizeof(HwTriangle), o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
-    for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
+    HwTriangleWriter(scene).write(o.prims.data(), o.prims.size(), t);
     image.place_regions();
     return image;
 }
