@@ -33,7 +33,7 @@ struct Entry {
 /// (binned SAH) or "sbvh" (spatial splits; prim_ids may repeat a primitive). What the builder
 /// reports beyond the tree's own statistics goes to `stats`.
 BuildTree build_tree(const Scene& scene, const AccelOptions& o, nlohmann::json* stats) {
-    if (o.builder != "sbvh") return build_binned_sah(scene.triangles, o.build);
+    if (o.builder != "sbvh") return build_binned_sah(scene.triangles, o.build, std::max(1u, o.build_threads));
     const SbvhConfig c;
     SbvhStats s;
     BuildTree tree = build_sbvh(scene.triangles, o.build, c, &s);

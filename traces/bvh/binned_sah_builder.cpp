@@ -214,18 +214,20 @@ void NodeSplitter::group_by_bins(uint32_t begin, uint32_t end, const BinMapper& 
 // would have grown. Branch-free (ranks by counting, runs by selects): the order is data.
 void NodeSplitter::group_small(uint32_t begin, uint32_t end, const BinMapper& map, const bool* usable) {
     const uint32_t n = end - begin;
-    Int4 index[kSmallNode];
-    for (uint32_t k = 0; k < n; ++k) index[k] = map(m_refs[begin + k]);
+    // Keys bin * 16 + position (distinct; in bin, then range order) and their ranks, for the
+    // three axes at once in the lanes.
+    Int4 key[kSmallNode], rank[kSmallNode];
+    for (uint32_t k = 0; k < n; ++k) {
+        key[k] = map(m_refs[begin + k]) * 16 + int32_t(k);
+        rank[k] = Int4{0, 0, 0, 0};
+    }
+    for (uint32_t k = 0; k < n; ++k)
+        for (uint32_t j = 0; j < n; ++j) rank[k] += key[j] < key[k];  // a true lane is -1
     for (uint32_t a = 0; a < 3; ++a) {
         m_groups[a] = 0;
         if (!usable[a]) continue;
-        uint32_t key[kSmallNode], sorted[kSmallNode];  // bin * 16 + position: distinct, in bin then range order
-        for (uint32_t k = 0; k < n; ++k) key[k] = uint32_t(index[k][a]) * 16 + k;
-        for (uint32_t k = 0; k < n; ++k) {
-            uint32_t rank = 0;
-            for (uint32_t j = 0; j < n; ++j) rank += uint32_t(key[j] < key[k]);
-            sorted[rank] = key[k];
-        }
+        uint32_t sorted[kSmallNode];
+        for (uint32_t k = 0; k < n; ++k) sorted[-rank[k][a]] = uint32_t(key[k][a]);
         const size_t base = a * size_t(m_stride);
         Box run;
         uint32_t g = 0, run_count = 0, prev = ~0u;
@@ -247,6 +249,31 @@ void NodeSplitter::group_small(uint32_t begin, uint32_t end, const BinMapper& ma
     }
 }
 
+// A node of two references, the commonest (half the nodes split): where their bins differ on a
+// usable axis there are two groups and one boundary, the same on every such axis, so the sweep's
+// answer is the first such axis, priced as the sweep prices it.
+Split NodeSplitter::split_pair(uint32_t begin, const BinMapper& map, const bool* usable) {
+    const PrimRef* r = m_refs + begin;
+    const Int4 bin[2] = {map(r[0]), map(r[1])};
+    m_groups[0] = m_groups[1] = m_groups[2] = 0;
+    for (int a = 0; a < 3; ++a) {
+        if (!usable[a] || bin[0][a] == bin[1][a]) continue;
+        const int low = bin[0][a] < bin[1][a] ? 0 : 1;
+        const size_t base = a * size_t(m_stride);
+        for (int g = 0; g < 2; ++g) {
+            const PrimRef& p = r[g == 0 ? low : 1 - low];
+            m_group_box[base + g] = Box{};
+            m_group_box[base + g].grow(p.lo3(), p.hi);
+            m_group_count[base + g] = 1;
+            m_group_bin[base + g] = uint32_t(bin[g == 0 ? low : 1 - low][a]);
+        }
+        m_groups[a] = 2;
+        const float right = m_group_box[base + 1].half_area_nonempty();
+        return Split{a, m_group_bin[base] + 1, m_group_box[base].half_area_nonempty() * 1.0f + right * 1.0f};
+    }
+    return Split{};
+}
+
 // Groups the range's references by bin (the filled bins: their boxes, counts and indices), then
 // sweeps each axis right-to-left and left-to-right to price every bin boundary (Wald 2007,
 // section 3). Only boundaries that follow a filled bin are priced: one that follows an empty bin
@@ -254,6 +281,7 @@ void NodeSplitter::group_small(uint32_t begin, uint32_t end, const BinMapper& ma
 // keeps. The boxes are grown in the same order as over all bins (an empty box changes no bit of
 // a min or max), so every cost is bit for bit the one the sweep over all bins computes.
 Split NodeSplitter::find_sah_split(uint32_t begin, uint32_t end, const BinMapper& map, const bool* usable) {
+    if (end - begin == 2) return split_pair(begin, map, usable);
     if (end - begin <= kSmallNode) group_small(begin, end, map, usable);
     else group_by_bins(begin, end, map);
     Split best;

@@ -106,6 +106,7 @@ private:
     Split find_sah_split(uint32_t begin, uint32_t end, const BinMapper& map, const bool* usable);
     void group_by_bins(uint32_t begin, uint32_t end, const BinMapper& map);
     void group_small(uint32_t begin, uint32_t end, const BinMapper& map, const bool* usable);
+    Split split_pair(uint32_t begin, const BinMapper& map, const bool* usable);
     uint32_t partition_bins(const WorkItem& item, const Split& split, const BinMapper& map, Box& left_c,
                             Box& right_c);
     uint32_t partition_median(const WorkItem& item, Box& left, Box& right, Box& left_c, Box& right_c);
