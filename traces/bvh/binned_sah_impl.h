@@ -1,6 +1,7 @@
 #pragma once
 // Internals of the binned SAH builder (build_tree.h, build_binned_sah), shared by
-// binned_sah_builder.cpp (references, the node split, the single-threaded build) and
+// binned_sah_builder.cpp (references, the node split, the single-threaded build),
+// binned_sah_groups.cpp (a node's references grouped by bin for the SAH sweep) and
 // binned_sah_parallel.cpp (the multi-threaded build, which splits the same nodes the same way).
 #include <cstdint>
 #include <cstring>

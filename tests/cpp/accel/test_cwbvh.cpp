@@ -76,6 +76,45 @@ TEST(Quantize, DecodedBoxesContainTheExactOnesAndAreTight) {
     EXPECT_GT(loose_steps, 0);
 }
 
+TEST(Quantize, BoundsOfANodeQuantiseLikeTheScalarRule) {
+    // quantize_bounds (several bounds per SIMD operation, the node builder's) against
+    // quantize_lo / quantize_hi, on frames of every magnitude and bounds on and near their ends.
+    Rng rng(77);
+    long compared = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        Aabb node;
+        for (int a = 0; a < 3; ++a) {
+            float x = random_coordinate(rng), y = random_coordinate(rng);
+            if (rng.next() < 0.1f) y = std::nextafter(x, INFINITY);
+            node.lo[a] = std::min(x, y);
+            node.hi[a] = std::max(x, y);
+        }
+        const QuantFrame f = make_quant_frame(node);
+        const uint32_t count = 1 + uint32_t(rng.next() * 8.0f) % 8;
+        for (int a = 0; a < 3; ++a) {
+            float lo[8], hi[8];
+            for (uint32_t i = 0; i < count; ++i) {
+                auto inside = [&] {
+                    const float t = rng.next();
+                    if (t < 0.15f) return node.lo[a];
+                    if (t < 0.3f) return node.hi[a];
+                    const double v = double(node.lo[a]) + double(t) * (double(node.hi[a]) - double(node.lo[a]));
+                    return std::min(std::max(float(v), node.lo[a]), node.hi[a]);
+                };
+                lo[i] = inside(), hi[i] = inside();
+                if (lo[i] > hi[i]) std::swap(lo[i], hi[i]);
+            }
+            uint8_t q_lo[8], q_hi[8];
+            quantize_bounds(f, a, lo, hi, count, q_lo, q_hi);
+            for (uint32_t i = 0; i < count; ++i, ++compared) {
+                ASSERT_EQ(q_lo[i], quantize_lo(f, a, lo[i])) << "lo " << lo[i] << " trial " << trial;
+                ASSERT_EQ(q_hi[i], quantize_hi(f, a, hi[i])) << "hi " << hi[i] << " trial " << trial;
+            }
+        }
+    }
+    EXPECT_GT(compared, 200000);
+}
+
 TEST(Cwbvh, SameTopologyAsTheFp32TwinAndNeverLessWorkOnMisses) {
     const Scene scene = test::random_soup(41, 4000);
     for (const auto& [fp32, cw] : {std::pair<std::string, std::string>{"bvh8", "cwbvh8"}, {"bvh6", "cwbvh6"}}) {

@@ -29,16 +29,18 @@ uint32_t splits_needed(uint32_t count, uint32_t leaf_max) {
 }  // namespace
 
 BuildTree split_large_leaves(const BuildTree& in, const std::vector<Triangle>& triangles, uint32_t leaf_max) {
+    return split_large_leaves(BuildTree(in), triangles, leaf_max);
+}
+
+BuildTree split_large_leaves(BuildTree&& in, const std::vector<Triangle>& triangles, uint32_t leaf_max) {
     require(leaf_max >= 1, "split_large_leaves: leaf_max must be at least 1");
     // Nodes the splits add (two per split; a piece is split again while too large), so the
-    // node array is allocated once.
+    // node array grows once.
     size_t added = 0;
     for (const BuildNode& b : in.nodes)
         if (b.is_leaf()) added += 2 * size_t(splits_needed(b.count, leaf_max));
-    BuildTree out;
-    out.prim_ids = in.prim_ids;
-    out.nodes.reserve(in.nodes.size() + added);
-    out.nodes = in.nodes;
+    BuildTree out = std::move(in);
+    out.nodes.reserve(out.nodes.size() + added);
     // Nodes appended while splitting are visited too: a piece may still be too large.
     for (size_t n = 0; n < out.nodes.size(); ++n) {
         const BuildNode leaf = out.nodes[n];
