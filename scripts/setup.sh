@@ -3,7 +3,9 @@
 #   system packages (compiler, CMake, Ninja, SystemC, GLM, tinygltf, Embree, ...),
 #   then `pip install .` (the C++ libraries, the C++ tests and the Python package with rtsim._core).
 # Idempotent: re-running skips installed packages and rebuilds incrementally in build/py.
-# Env: PYTHON (default: python), CMAKE_BUILD_PARALLEL_LEVEL (default: number of cores).
+# Env: PYTHON (default: python), CMAKE_BUILD_PARALLEL_LEVEL (default: number of cores),
+#      RTSIM_LTO (default ON: link-time optimisation of the Release build; CI sets OFF, whose
+#      links take minutes on two cores, and tests the same code without it).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -44,7 +46,11 @@ echo "setup: installing Python build and test tools"
 
 export CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)}"
 echo "setup: building and installing rtsim (C++ and Python; -j${CMAKE_BUILD_PARALLEL_LEVEL})"
-"$PYTHON" -m pip install -q --no-build-isolation ".[test]"
+lto_args=()
+if [ "${RTSIM_LTO:-ON}" = "OFF" ]; then
+  lto_args=(-C cmake.define.CMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF)
+fi
+"$PYTHON" -m pip install -q --no-build-isolation "${lto_args[@]}" ".[test]"
 
 # pyenv only creates the `rtsim` shim on a rehash (`python -m pip` does not trigger one).
 if command -v pyenv >/dev/null 2>&1; then

@@ -303,6 +303,8 @@ def cmd_bench(args: argparse.Namespace, console: Console) -> int:
         cmd += ["--hairball-triangles", str(args.hairball_triangles)]
     if args.accel:
         cmd += ["--accel", args.accel]
+    if args.build_threads:
+        cmd += ["--build-threads", str(args.build_threads)]
     return subprocess.run(cmd, check=False).returncode
 
 
@@ -525,7 +527,16 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         "--accel",
         default=None,
         metavar="KIND,...",
-        help="structures to benchmark; the first is 'rtsim' in the summary (default: bvh8,bvh2)",
+        help="structures to benchmark, KIND or KIND:BUILDER (bvh8:sbvh); the first is 'rtsim' in "
+        "the summary (default: bvh8,bvh2)",
+    )
+    p.add_argument(
+        "--build-threads",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="also time each structure's build on N threads: wall time and speed-up over one "
+        "thread in the same run (default: one thread only)",
     )
     p.add_argument(
         "--model",

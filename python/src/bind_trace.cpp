@@ -1,10 +1,12 @@
 // Tracing bindings: trace_rays (numpy rays through the reference traversal), trace_scene (the
 // whole tracer, with a progress callback) and the trace file reader (sections, verification).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <pybind11/functional.h>
@@ -231,6 +233,7 @@ py::object write_trace_py(PyScene& scene, const py::object& origins, const py::o
     accel_options.kind = accel;
     accel_options.builder = builder;
     accel_options.settings = settings_from(build_settings);
+    accel_options.build_threads = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
     validate_accel_options(accel_options);
     RayTraceOptions opt;
     opt.out_dir = out_dir.string();

@@ -26,6 +26,8 @@ TOP_LEVEL = (
     "light_note",
     "build",
     "rays",
+    "date",
+    "host",
 )
 RAY_KINDS = {"primary": "closest_hit", "diffuse": "closest_hit", "shadow": "any_hit"}
 TIMES = ("wall_ms", "cpu_ms")
@@ -38,8 +40,9 @@ def bench_json(tmp_path_factory: pytest.TempPathFactory) -> dict:
         pytest.skip("rtsim-bench is not built (no Embree)")
     out = tmp_path_factory.mktemp("bench") / "bench.json"
     result = run_rtsim(
-        "bench", "cornell", "--repeat", "1", "--resolution", "32x24", "--json", str(out)
-    )
+        "bench", "cornell", "--repeat", "1", "--resolution", "32x24", "--json", str(out),
+        "--accel", "bvh8,bvh2:sbvh,cwbvh8", "--build-threads", "2",
+    )  # fmt: skip
     assert result.returncode == 0, result.stderr
     assert "rtsim/Embree" in result.stdout
     return json.loads(out.read_text())
@@ -55,6 +58,41 @@ def test_bench_json_keys(bench_json: dict) -> None:
         for key in TIMES:
             assert bench_json["build"][tracer][key] >= 0.0
     assert set(bench_json["rays"]) == set(RAY_KINDS)
+    assert set(bench_json["build"]["structures"]) == {"bvh8", "bvh2:sbvh", "cwbvh8"}
+    # The host and its load: what the figures of a shared machine need to be read.
+    assert bench_json["host"]["cpu"]
+    assert bench_json["host"]["load_average_start"] >= 0
+    assert bench_json["host"]["load_average_end"] >= 0
+    assert len(bench_json["date"]) == 20 and bench_json["date"].endswith("Z")
+
+
+def test_bench_parallel_build(bench_json: dict) -> None:
+    parallel = bench_json["build"]["parallel"]
+    assert parallel["threads"] == 2
+    assert set(parallel["structures"]) == {"bvh8", "bvh2:sbvh", "cwbvh8"}
+    for figures in parallel["structures"].values():
+        assert figures["wall_ms"] > 0 and figures["process_cpu_ms"] > 0
+        assert figures["speedup_wall"] > 0
+
+
+def test_bench_on_the_command_line() -> None:
+    """docs/benchmarks.md runs `rtsim-bench` directly: it is installed beside rtsim-sim."""
+    from rtsim.launcher import find_sim
+
+    if find_bench() is None:
+        pytest.skip("rtsim-bench is not built (no Embree)")
+    sim = find_sim()
+    if "build" in sim.parts:
+        pytest.skip("rtsim-sim runs from the build tree: the package is not installed")
+    assert (sim.parent / "rtsim-bench").is_file()
+
+
+def test_bench_refuses_an_unknown_builder(tmp_path: Path) -> None:
+    if find_bench() is None:
+        pytest.skip("rtsim-bench is not built (no Embree)")
+    result = run_rtsim("bench", "cornell", "--accel", "bvh8:median", "--repeat", "1")
+    assert result.returncode == 2
+    assert "bvh8:median" in result.stderr and "no builder 'median'" in result.stderr
 
 
 @pytest.mark.parametrize("kind", list(RAY_KINDS))
@@ -68,6 +106,8 @@ def test_bench_ray_figures(bench_json: dict, kind: str) -> None:
         assert figures[tracer]["mrays_per_s_cpu"] > 0
     # Both tracers trace the same rays; on the cornell box they agree on the hit count.
     assert figures["rtsim"]["hits"] == figures["embree"]["hits"]
+    for name, structure in figures["structures"].items():
+        assert structure["rtsim"]["hits"] == figures["embree"]["hits"], name
     assert figures["ratio_cpu"] > 0 and figures["ratio_wall"] > 0
 
 

@@ -83,6 +83,9 @@ struct AccelOptions {
     /// Two levels (docs/accel.md, "Two-level structures"): a BLAS of `kind` per mesh in object
     /// space and a binary TLAS over the instances; the image's kind is then "two_level".
     bool two_level = false;
+    /// Threads the build may use where its builder can ("binned": the binary build tree). The
+    /// image is the same, byte for byte, for any count; 1 builds on the calling thread only.
+    unsigned build_threads = 1;
 };
 
 struct AccelKindInfo {

@@ -9,7 +9,7 @@ namespace rtsim {
 using nlohmann::json;
 
 Region& AccelImage::add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count,
-                               RecordLayout layout) {
+                               RecordLayout layout, bool zero) {
     require(!has_region(name), "accel image '" + this->kind + "': region '" + name + "' added twice");
     Region r;
     r.name = name;
@@ -17,7 +17,7 @@ Region& AccelImage::add_region(const std::string& name, DataKind kind, uint32_t 
     r.record_bytes = record_bytes;
     r.count = count;
     r.layout = std::move(layout);
-    r.bytes.resize(count * record_bytes);
+    r.bytes.resize(count * record_bytes, zero);
     regions.push_back(std::move(r));
     return regions.back();
 }

@@ -46,14 +46,15 @@ struct AccelImage {
     Aabb bounds;                               ///< of the whole scene
     std::vector<Region> regions;
 
-    /// Adds a zero-filled region of `count` records of `record_bytes` in `layout`; addresses are
+    /// Adds a region of `count` records of `record_bytes` in `layout`, zero-filled (zero = false:
+    /// uninitialised, for a caller that writes every byte of every record); addresses are
     /// assigned by place_regions().
     Region& add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count,
-                       RecordLayout layout = {});
+                       RecordLayout layout = {}, bool zero = true);
     /// Adds a region of records of type T, in T's declared layout (layout_of(const T*)).
     template <class T>
-    Region& add_region(const std::string& name, DataKind kind, uint64_t count) {
-        return add_region(name, kind, uint32_t(sizeof(T)), count, layout_of(static_cast<const T*>(nullptr)));
+    Region& add_region(const std::string& name, DataKind kind, uint64_t count, bool zero = true) {
+        return add_region(name, kind, uint32_t(sizeof(T)), count, layout_of(static_cast<const T*>(nullptr)), zero);
     }
     /// The region called `name`; throws rtsim::Error naming it (and the image's kind) if absent.
     const Region& region(const std::string& name) const;

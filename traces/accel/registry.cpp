@@ -50,18 +50,18 @@ struct Entry {
 };
 
 /// Binned SAH (Wald 2007).
-BuildTree build_binned(const Scene& scene, const BuildSettings& s, nlohmann::json*) {
-    return build_binned_sah(scene.triangles, s.bvh);
+BuildTree build_binned(const Scene& scene, const BuildSettings& s, unsigned threads, nlohmann::json*) {
+    return build_binned_sah(scene.triangles, s.bvh, std::max(1u, threads));
 }
 
 /// Morton codes (Lauterbach et al. 2009).
-BuildTree build_morton(const Scene& scene, const BuildSettings& s, nlohmann::json*) {
+BuildTree build_morton(const Scene& scene, const BuildSettings& s, unsigned, nlohmann::json*) {
     return build_lbvh(scene.triangles, s.bvh, s.lbvh);
 }
 
 /// Spatial splits (Stich et al. 2009): prim_ids may repeat a primitive; its statistics go to
 /// the structure's stats.
-BuildTree build_spatial_splits(const Scene& scene, const BuildSettings& s, nlohmann::json* stats) {
+BuildTree build_spatial_splits(const Scene& scene, const BuildSettings& s, unsigned, nlohmann::json* stats) {
     const SbvhConfig& c = s.sbvh;
     SbvhStats st;
     BuildTree tree = build_sbvh(scene.triangles, s.bvh, c, &st);
@@ -82,7 +82,8 @@ BuildTree build_spatial_splits(const Scene& scene, const BuildSettings& s, nlohm
 /// One builder of binary build trees (the tree every BVH kind, and BIH's tree builders, start from).
 struct TreeBuilder {
     const char* name;
-    BuildTree (*build)(const Scene&, const BuildSettings&, nlohmann::json* stats);
+    /// threads: the build's worker threads where the builder has them (the tree does not depend on them)
+    BuildTree (*build)(const Scene&, const BuildSettings&, unsigned threads, nlohmann::json* stats);
     void (*settings)(BuildSettings&, SettingsVisitor&);  ///< its own settings beyond the SAH leaf rules
     bool sah_costs;                                     ///< it reads the SAH bins and costs
 };
@@ -116,16 +117,16 @@ void tree_settings(const std::string& builder, BuildSettings& s, SettingsVisitor
     b.settings(s, v);
 }
 
-/// The binary build tree of the chosen builder; what the builder reports beyond the tree's own
-/// statistics goes to `stats`.
-BuildTree build_tree(const Scene& scene, const std::string& builder, const BuildSettings& s, nlohmann::json* stats) {
-    return tree_builder(builder).build(scene, s, stats);
+/// The binary build tree of the chosen builder (on o.build_threads); what the builder reports
+/// beyond the tree's own statistics goes to `stats`.
+BuildTree build_tree(const Scene& scene, const AccelOptions& o, const BuildSettings& s, nlohmann::json* stats) {
+    return tree_builder(o.builder).build(scene, s, o.build_threads, stats);
 }
 
 AccelImage build_bvh2(const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
     nlohmann::json extra = nlohmann::json::object();
-    const BuildTree tree = build_tree(scene, o.builder, s, &extra);
-    AccelImage image = bvh2_image(flatten_bvh(tree, scene, s.bvh), s.bvh, o.builder);
+    const BuildTree tree = build_tree(scene, o, s, &extra);
+    AccelImage image = bvh2_image(tree, scene, s.bvh, o.builder);
     image.stats.update(extra);
     return image;
 }
@@ -135,7 +136,7 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
                  ChildOrder order) {
     BuildFn build = [=](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
         nlohmann::json extra = nlohmann::json::object();
-        const WideBuildTree wide = make_wide_tree(build_tree(scene, o.builder, s, &extra), scene, width, s.bvh, order);
+        const WideBuildTree wide = make_wide_tree(build_tree(scene, o, s, &extra), scene, width, s.bvh, order);
         AccelImage image = compressed ? cwbvh_image(wide, scene, name, order) : wide_image(wide, scene, name, order);
         image.stats = wide_stats(wide, s.bvh, o.builder, image.region("nodes").record_bytes, order);
         image.stats.update(extra);
@@ -190,7 +191,7 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
              if (o.builder == "wachter_keller") return bih_image(build_bih(scene, s.bih), scene, o.builder);
              nlohmann::json unused;
-             return bih_image(bih_from_build_tree(build_tree(scene, o.builder, s, &unused)), scene, o.builder);
+             return bih_image(bih_from_build_tree(build_tree(scene, o, s, &unused)), scene, o.builder);
          },
          loader<BihAccel>()},
         {{"octree", "adaptive octree, 16-byte nodes, parametric traversal (Revelles et al. 2000)", {"adaptive"}},

@@ -29,17 +29,38 @@ struct BuildTree {
 };
 
 /// Binned SAH build (Wald 2007, "On fast construction of SAH-based bounding volume
-/// hierarchies") over the triangles. Throws rtsim::Error on a non-finite vertex or when
+/// hierarchies") over the triangles, on `threads` threads (1: this one; the tree is the same,
+/// node for node, for any count). Throws rtsim::Error on a non-finite vertex or when
 /// config.max_depth cannot hold the tree.
-BuildTree build_binned_sah(const std::vector<Triangle>& triangles, const BuildConfig& config);
+BuildTree build_binned_sah(const std::vector<Triangle>& triangles, const BuildConfig& config, unsigned threads = 1);
 
 /// Flattens a build tree into the hardware layout (node 0 an interior root, depth-first order,
 /// triangles in leaf order) and fills the stats other than build_ms.
 HwBvh flatten_bvh(const BuildTree& tree, const Scene& scene, const BuildConfig& config);
 
+/// HwNodes of the flattened tree: its interior nodes, or 1 when the root is a leaf.
+size_t flat_node_count(const BuildTree& tree);
+/// flatten_bvh into arrays the caller provides (flat_node_count(tree) nodes and
+/// tree.prim_ids.size() triangles, e.g. an image's regions); returns the stats.
+BvhStats flatten_bvh_into(const BuildTree& tree, const Scene& scene, const BuildConfig& config, HwNode* nodes,
+                          HwTriangle* triangles);
+
 /// The hardware triangle record of scene primitive `prim` (vertices, ids, alpha and material
 /// flags). Throws rtsim::Error if its material index does not fit the layout.
 HwTriangle make_hw_triangle(const Scene& scene, uint32_t prim);
+
+/// make_hw_triangle for many primitives of one scene: each material's flags are worked out once.
+class HwTriangleWriter {
+public:
+    explicit HwTriangleWriter(const Scene& scene);
+    HwTriangle operator()(uint32_t prim) const;
+    /// out[i] = the record of prims[i], i < count.
+    void write(const uint32_t* prims, size_t count, HwTriangle* out) const;
+
+private:
+    const Scene& m_scene;
+    std::vector<uint32_t> m_flags;  ///< per material (at most the 65,536 the layout holds)
+};
 
 /// Levels of object-median splits needed below a node of `count` primitives before every leaf
 /// holds at most max_leaf_size: ceil(log2(ceil(count / max_leaf_size))).

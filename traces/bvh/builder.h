@@ -20,5 +20,7 @@ void check_bvh_invariants(const HwBvh& bvh, const Scene& scene, bool spatial_spl
 
 /// SAH cost of a flattened tree (same formula the builder minimises, relative to root area).
 double sah_cost(const HwBvh& bvh, const BuildConfig& config);
+/// The same over `count` nodes of a flattened tree (node 0 the root).
+double sah_cost(const HwNode* nodes, size_t count, const BuildConfig& config);
 
 }  // namespace rtsim

@@ -159,13 +159,17 @@ void check_bvh_invariants(const HwBvh& bvh, const Scene& scene, bool spatial_spl
 // and every leaf intersection_cost per triangle, each weighted by its area over the root's.
 // A zero-area root (all triangles on one point or line) weighs everything 1.
 double sah_cost(const HwBvh& bvh, const BuildConfig& config) {
-    auto node_box = [&bvh](size_t i) {
+    return sah_cost(bvh.nodes.data(), bvh.nodes.size(), config);
+}
+
+double sah_cost(const HwNode* nodes, size_t count, const BuildConfig& config) {
+    auto node_box = [nodes](size_t i) {
         Aabb box;
         for (int slot = 0; slot < 2; ++slot)
-            if (bvh.nodes[i].child_count[slot] != kEmptyChild) box.grow(slot_box(bvh.nodes[i], slot));
+            if (nodes[i].child_count[slot] != kEmptyChild) box.grow(slot_box(nodes[i], slot));
         return box;
     };
-    if (bvh.nodes.empty()) return 0.0;
+    if (count == 0) return 0.0;
     // Areas in double: float products overflow for boxes beyond about 1e19.
     auto area = [](const Aabb& box) {
         if (box.empty()) return 0.0;
@@ -177,13 +181,13 @@ double sah_cost(const HwBvh& bvh, const BuildConfig& config) {
         return root_area > 0.0 ? area(box) / root_area : 1.0;
     };
     double cost = 0.0;
-    for (size_t i = 0; i < bvh.nodes.size(); ++i) {
-        const HwNode& node = bvh.nodes[i];
+    for (size_t i = 0; i < count; ++i) {
+        const HwNode& node = nodes[i];
         cost += config.traversal_cost * weight(node_box(i));
         for (int slot = 0; slot < 2; ++slot) {
-            uint32_t count = node.child_count[slot];
-            if (count != 0 && count != kEmptyChild)
-                cost += double(config.intersection_cost) * count * weight(slot_box(node, slot));
+            uint32_t n = node.child_count[slot];
+            if (n != 0 && n != kEmptyChild)
+                cost += double(config.intersection_cost) * n * weight(slot_box(node, slot));
         }
     }
     return cost;

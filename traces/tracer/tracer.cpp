@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <thread>
 
 #include "traces/accel/two_level/two_level.h"
 #include "traces/common/error.h"
@@ -130,6 +131,8 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     Scene scene = load_gltf(path, false);
     AccelOptions accel_options = o.accel;
     accel_options.two_level = !o.flatten && shares_geometry(scene);
+    // The build may use the tracing threads too: its image does not depend on their number.
+    accel_options.build_threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
     check_frames(o.frames, o.flatten, accel_options.two_level, path);
     if (accel_options.two_level) check_instance_transforms(scene, true);
     if (!accel_options.two_level) scene.flatten();

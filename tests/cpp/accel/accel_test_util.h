@@ -11,6 +11,7 @@
 #include "tests/cpp/error_of.h"
 #include "../isect/isect_test_util.h"
 #include "traces/accel/accel.h"
+#include "traces/accel/cwbvh/cwbvh.h"
 #include "traces/accel/wide/wide_accel.h"
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
@@ -63,8 +64,9 @@ inline bool same_hit(const Hit& a, const Hit& b) {
            float_bits(a.u) == float_bits(b.u) && float_bits(a.v) == float_bits(b.v);
 }
 
-/// The SSE2 fused loop of an fp32 kind in distance order (Accel::trace runs the best the CPU has:
-/// AVX for 8-wide nodes where present), or nothing for other kinds.
+/// The SSE2 fused loop of an fp32 kind or of cwbvh8 in distance order (Accel::trace runs the best
+/// the CPU has: AVX for 8-wide nodes, AVX2 for compressed ones, where present), or nothing for
+/// other kinds.
 inline Hit trace_sse2(const Accel& accel, const Ray& r, TraversalMode mode, WorkCounts* work, bool* ran) {
     *ran = true;
     if (auto* a = dynamic_cast<const WideAccel<Fp32Codec<4>>*>(&accel))
@@ -73,6 +75,8 @@ inline Hit trace_sse2(const Accel& accel, const Ray& r, TraversalMode mode, Work
         return trace_wide_fused<6>(a->view(), r, mode, work, WideSimd::sse2);
     auto* a = dynamic_cast<const WideAccel<Fp32Codec<8>>*>(&accel);
     if (a && a->view().order == ChildOrder::distance) return trace_wide_fused<8>(a->view(), r, mode, work, WideSimd::sse2);
+    auto* c = dynamic_cast<const WideAccel<Cw8Codec>*>(&accel);
+    if (c && c->view().order == ChildOrder::distance) return trace_cwbvh8_fused(c->view(), r, mode, work, WideSimd::sse2);
     *ran = false;
     return Hit{};
 }

@@ -76,6 +76,45 @@ TEST(Quantize, DecodedBoxesContainTheExactOnesAndAreTight) {
     EXPECT_GT(loose_steps, 0);
 }
 
+TEST(Quantize, BoundsOfANodeQuantiseLikeTheScalarRule) {
+    // quantize_bounds (several bounds per SIMD operation, the node builder's) against
+    // quantize_lo / quantize_hi, on frames of every magnitude and bounds on and near their ends.
+    Rng rng(77);
+    long compared = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        Aabb node;
+        for (int a = 0; a < 3; ++a) {
+            float x = random_coordinate(rng), y = random_coordinate(rng);
+            if (rng.next() < 0.1f) y = std::nextafter(x, INFINITY);
+            node.lo[a] = std::min(x, y);
+            node.hi[a] = std::max(x, y);
+        }
+        const QuantFrame f = make_quant_frame(node);
+        const uint32_t count = 1 + uint32_t(rng.next() * 8.0f) % 8;
+        for (int a = 0; a < 3; ++a) {
+            float lo[8], hi[8];
+            for (uint32_t i = 0; i < count; ++i) {
+                auto inside = [&] {
+                    const float t = rng.next();
+                    if (t < 0.15f) return node.lo[a];
+                    if (t < 0.3f) return node.hi[a];
+                    const double v = double(node.lo[a]) + double(t) * (double(node.hi[a]) - double(node.lo[a]));
+                    return std::min(std::max(float(v), node.lo[a]), node.hi[a]);
+                };
+                lo[i] = inside(), hi[i] = inside();
+                if (lo[i] > hi[i]) std::swap(lo[i], hi[i]);
+            }
+            uint8_t q_lo[8], q_hi[8];
+            quantize_bounds(f, a, lo, hi, count, q_lo, q_hi);
+            for (uint32_t i = 0; i < count; ++i, ++compared) {
+                ASSERT_EQ(q_lo[i], quantize_lo(f, a, lo[i])) << "lo " << lo[i] << " trial " << trial;
+                ASSERT_EQ(q_hi[i], quantize_hi(f, a, hi[i])) << "hi " << hi[i] << " trial " << trial;
+            }
+        }
+    }
+    EXPECT_GT(compared, 200000);
+}
+
 TEST(Cwbvh, SameTopologyAsTheFp32TwinAndNeverLessWorkOnMisses) {
     const Scene scene = test::random_soup(41, 4000);
     for (const auto& [fp32, cw] : {std::pair<std::string, std::string>{"bvh8", "cwbvh8"}, {"bvh6", "cwbvh6"}}) {
@@ -137,6 +176,44 @@ TEST(Cwbvh, ExtremeCoordinatesTraceLikeTheBinaryBvh) {
             EXPECT_GT(hits, 300) << kind << " scale " << scale;
         }
     }
+}
+
+TEST(Cwbvh, FusedLoopDecodesFramesNearTheFloatRangeLikeTheStepper) {
+    // Nodes whose frame step is 2^121 or more (exponent byte >= 248): there 255 * scale can
+    // overflow, so the fused loop decodes them without a fused multiply-add. A scene spanning
+    // +-1.8e38 has such nodes near the root, and small clusters give the ordinary frames below.
+    std::vector<Vec3> soup = {Vec3(-1.8e38f, -1.0f, 0.0f), Vec3(1.8e38f, -1.0f, 0.0f), Vec3(0.0f, 1.7e38f, 1.0f)};
+    for (const Vec3& v : test::icosphere(1)) soup.push_back(v + Vec3(2.0f, 0.0f, 5.0f));
+    for (const Vec3& v : test::tessellated_cube(2)) soup.push_back(v * 1e30f + Vec3(1e31f, 0.0f, 0.0f));
+    const Scene scene = test::make_scene(soup);
+    const auto cw = test::build_kind(scene, "cwbvh8");
+    const Region& nodes = cw->image().region("nodes");
+    uint32_t largest = 0;
+    for (uint64_t i = 0; i < nodes.count; ++i)
+        for (uint8_t e : nodes.records<CwNode8>()[i].e) largest = std::max<uint32_t>(largest, e);
+    ASSERT_GE(largest, 248u);
+    // Rays from around the small clusters (random_ray over the whole scene's box would overflow).
+    Rng rng(11);
+    std::unique_ptr<Stepper> stepper = cw->make_stepper();
+    uint64_t steps = 0, hits = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const Region& t = test::triangles_of(*cw);
+        const Aabb around = i % 2 ? Aabb{Vec3(-10.0f), Vec3(10.0f)} : Aabb{Vec3(-3e31f), Vec3(3e31f)};
+        const Ray r = test::random_ray(rng, around, t.records<HwTriangle>(), t.count);
+        for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+            WorkCounts fused_work, step_work, sse_work;
+            const Hit fused = cw->trace(r, mode, &fused_work);
+            const Hit stepped = trace_with_stepper(*stepper, r, mode, &step_work);
+            ASSERT_TRUE(test::same_hit(fused, stepped) && fused_work == step_work) << "ray " << i;
+            bool ran = false;
+            const Hit sse = test::trace_sse2(*cw, r, mode, &sse_work, &ran);
+            ASSERT_TRUE(ran && test::same_hit(sse, stepped) && sse_work == step_work) << "SSE2 ray " << i;
+            steps += step_work.steps;
+            hits += stepped.valid();
+        }
+    }
+    EXPECT_GT(steps, 3000u * 4);
+    EXPECT_GT(hits, 200u);
 }
 
 template <class Node>

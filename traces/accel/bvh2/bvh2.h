@@ -8,6 +8,7 @@
 
 #include "traces/accel/accel.h"
 #include "traces/accel/bvh2/bvh2_stepper.h"
+#include "traces/bvh/build_tree.h"
 #include "traces/bvh/hw_layout.h"
 
 namespace rtsim {
@@ -28,6 +29,9 @@ Hit trace_ray_brute_force(const HwBvh& bvh, const Ray& ray, TraversalMode mode);
 
 /// The image of a flattened binary BVH; stats from its BvhStats and the builder's config.
 AccelImage bvh2_image(const HwBvh& bvh, const BuildConfig& config, const std::string& builder);
+/// The same image, the build tree flattened straight into its regions (no HwBvh in between).
+AccelImage bvh2_image(const BuildTree& tree, const Scene& scene, const BuildConfig& config,
+                      const std::string& builder);
 
 /// The locality tree of binary BVH nodes (a node brings itself and its leaf children's triangles).
 LocalityTree bvh2_locality_tree(const HwNode* nodes, uint64_t count);

@@ -28,6 +28,29 @@ Hit trace_ray_brute_force(const HwBvh& bvh, const Ray& ray, TraversalMode mode) 
     return trace_ray_brute_force(bvh.triangles.data(), bvh.triangles.size(), ray, mode);
 }
 
+namespace {
+
+nlohmann::json bvh2_stats(const BvhStats& s, const BuildConfig& c, const std::string& builder) {
+    return {{"builder", builder},
+            {"config",
+             {{"bins", c.bins},
+              {"traversal_cost", c.traversal_cost},
+              {"intersection_cost", c.intersection_cost},
+              {"max_leaf_size", c.max_leaf_size},
+              {"max_depth", c.max_depth}}},
+            {"width", 2},
+            {"node_bytes", sizeof(HwNode)},
+            {"triangle_bytes", sizeof(HwTriangle)},
+            {"nodes", s.nodes},
+            {"leaves", s.leaves},
+            {"max_depth", s.max_depth},
+            {"avg_leaf_size", s.avg_leaf_size},
+            {"max_leaf_size", s.max_leaf_size},
+            {"sah_cost", s.sah_cost}};
+}
+
+}  // namespace
+
 AccelImage bvh2_image(const HwBvh& bvh, const BuildConfig& c, const std::string& builder) {
     AccelImage image;
     image.kind = "bvh2";
@@ -37,23 +60,19 @@ AccelImage bvh2_image(const HwBvh& bvh, const BuildConfig& c, const std::string&
     Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, bvh.triangles.size());
     std::copy(bvh.triangles.begin(), bvh.triangles.end(), tris.records<HwTriangle>());
     image.place_regions();
-    const BvhStats& s = bvh.stats;
-    image.stats = {{"builder", builder},
-                   {"config",
-                    {{"bins", c.bins},
-                     {"traversal_cost", c.traversal_cost},
-                     {"intersection_cost", c.intersection_cost},
-                     {"max_leaf_size", c.max_leaf_size},
-                     {"max_depth", c.max_depth}}},
-                   {"width", 2},
-                   {"node_bytes", sizeof(HwNode)},
-                   {"triangle_bytes", sizeof(HwTriangle)},
-                   {"nodes", s.nodes},
-                   {"leaves", s.leaves},
-                   {"max_depth", s.max_depth},
-                   {"avg_leaf_size", s.avg_leaf_size},
-                   {"max_leaf_size", s.max_leaf_size},
-                   {"sah_cost", s.sah_cost}};
+    image.stats = bvh2_stats(bvh.stats, c, builder);
+    return image;
+}
+
+AccelImage bvh2_image(const BuildTree& tree, const Scene& scene, const BuildConfig& c, const std::string& builder) {
+    AccelImage image;
+    image.kind = "bvh2";
+    image.bounds = tree.nodes[0].box;
+    Region& nodes = image.add_region<HwNode>("nodes", DataKind::node, flat_node_count(tree), false);
+    Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, tree.prim_ids.size(), false);
+    const BvhStats s = flatten_bvh_into(tree, scene, c, nodes.records<HwNode>(), tris.records<HwTriangle>());
+    image.place_regions();
+    image.stats = bvh2_stats(s, c, builder);
     return image;
 }
 

@@ -38,20 +38,32 @@ void write_node(const WideBuildTree& tree, const WideOrder& o, uint32_t b, Node&
         if (c.is_leaf() && !have_tri) base_tri = o.leaf_first[size_t(b) * kMaxWideWidth + uint32_t(child_at[s])], have_tri = true;
     }
     set_bases(out, base_node, base_tri);
+    // The children's bounds, slot by slot, quantised an axis at a time.
+    int slot_of[W];
+    uint32_t used = 0;
+    float lo[3][W], hi[3][W];
+    for (int s = 0; s < W; ++s) {
+        if (child_at[s] < 0) continue;
+        const WideBuildChild& c = n.child[child_at[s]];
+        for (int a = 0; a < 3; ++a) lo[a][used] = c.box.lo[a], hi[a][used] = c.box.hi[a];
+        slot_of[used++] = s;
+    }
+    for (int a = 0; a < 3; ++a) {
+        uint8_t q_lo[W], q_hi[W];
+        quantize_bounds(f, a, lo[a], hi[a], used, q_lo, q_hi);
+        for (uint32_t k = 0; k < used; ++k) out.qlo[a][slot_of[k]] = q_lo[k], out.qhi[a][slot_of[k]] = q_hi[k];
+    }
     for (int s = 0; s < W; ++s) {
         if (child_at[s] < 0) continue;
         const WideBuildChild& c = n.child[child_at[s]];
         if (c.is_leaf()) {
-            require(c.count <= kWideLeafMax, "cwbvh: leaf of " + std::to_string(c.count) + " triangles (at most 3)");
+            if (c.count > kWideLeafMax)
+                throw Error("cwbvh: leaf of " + std::to_string(c.count) + " triangles (at most 3)");
             const uint32_t offset = o.leaf_first[size_t(b) * kMaxWideWidth + uint32_t(child_at[s])] - base_tri;
             out.meta[s] = meta_leaf(c.count, offset);
         } else {
             out.meta[s] = meta_interior(s);
             if constexpr (std::is_same_v<Node, CwNode8>) out.imask |= uint8_t(1u << s);
-        }
-        for (int a = 0; a < 3; ++a) {
-            out.qlo[a][s] = quantize_lo(f, a, c.box.lo[a]);
-            out.qhi[a][s] = quantize_hi(f, a, c.box.hi[a]);
         }
     }
 }
@@ -76,7 +88,7 @@ AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std:
     }
     Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
-    for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
+    HwTriangleWriter(scene).write(o.prims.data(), o.prims.size(), t);
     image.place_regions();
     return image;
 }

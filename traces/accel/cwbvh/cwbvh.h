@@ -22,7 +22,9 @@ struct CwCodec {
     using Node = N;
     static constexpr int kWidth = W;
     static constexpr uint32_t kBytes = sizeof(N);
-    static constexpr bool kFused = false;
+    /// CwNode8 has a fused SIMD reference loop (cwbvh_trace.cpp); CwNode6, the stepper.
+    static constexpr bool kFused = W == 8;
+    static Hit fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work);
 
     static uint32_t valid_mask(const Node& n) {
         uint32_t m = 0;
@@ -81,6 +83,13 @@ using Cw6Codec = CwCodec<CwNode6, 6>;
 /// Throws rtsim::Error if the tree has leaves of more than 3 triangles or, for CwNode6, more
 /// than 2^28 nodes or triangles.
 AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std::string& kind, ChildOrder order);
+
+/// The fused reference loop of cwbvh8 images in distance order (cwbvh_trace.cpp): SIMD decoding
+/// of each node's child boxes, the hits and work of WideStepper<Cw8Codec>. Needs view.valid.
+Hit trace_cwbvh8_fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work,
+                       WideSimd simd = WideSimd::best);
+template <>
+Hit Cw8Codec::fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work);
 
 /// The Accel of a compressed image of width 8 or 6.
 std::unique_ptr<Accel> load_cwbvh(AccelImage image, int width, const std::string& source);

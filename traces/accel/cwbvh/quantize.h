@@ -39,5 +39,9 @@ QuantFrame make_quant_frame(const Aabb& node_box);
 uint8_t quantize_lo(const QuantFrame& f, int axis, float lo);
 /// Smallest q with quant_decode(q) >= hi (hi must be within the frame's box).
 uint8_t quantize_hi(const QuantFrame& f, int axis, float hi);
+/// quantize_lo and quantize_hi of `count` (at most 8) bounds on one axis: q_lo[i] of lo[i],
+/// q_hi[i] of hi[i]. The same bytes, several bounds per SIMD operation (a node's children).
+void quantize_bounds(const QuantFrame& f, int axis, const float* lo, const float* hi, uint32_t count, uint8_t* q_lo,
+                     uint8_t* q_hi);
 
 }  // namespace rtsim

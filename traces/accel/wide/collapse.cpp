@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "traces/accel/wide/wide_tree.h"
@@ -22,15 +23,34 @@ double area_of(const Aabb& box) {
     return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-/// Post-order of the binary tree (children before parents) without assuming an index order.
-std::vector<uint32_t> post_order(const BuildTree& tree) {
-    std::vector<uint32_t> order, stack{0};
-    order.reserve(tree.nodes.size());
+/// An order of the binary tree's reachable nodes with every child before its parent. Builders
+/// allocate children after their parent, so decreasing index order usually is one and reads the
+/// nodes sequentially; otherwise (or if some node is unreachable) a reversed pre-order.
+std::vector<uint32_t> children_first(const BuildTree& tree) {
+    const size_t n = tree.nodes.size();
+    std::vector<uint8_t> reached(n, 0);
+    reached[0] = 1;
+    bool by_index = true;
+    for (size_t i = 0; i < n && by_index; ++i) {
+        const BuildNode& b = tree.nodes[i];
+        if (!reached[i]) by_index = false;
+        else if (!b.is_leaf()) {
+            if (b.first <= i || size_t(b.first) + 1 >= n) by_index = false;
+            else reached[b.first] = reached[b.first + 1] = 1;
+        }
+    }
+    std::vector<uint32_t> order;
+    order.reserve(n);
+    if (by_index) {
+        for (size_t i = n; i-- > 0;) order.push_back(uint32_t(i));
+        return order;
+    }
+    std::vector<uint32_t> stack{0};
     while (!stack.empty()) {
-        const uint32_t n = stack.back();
+        const uint32_t i = stack.back();
         stack.pop_back();
-        order.push_back(n);
-        const BuildNode& b = tree.nodes[n];
+        order.push_back(i);
+        const BuildNode& b = tree.nodes[i];
         if (!b.is_leaf()) stack.insert(stack.end(), {b.first, b.first + 1});
     }
     std::reverse(order.begin(), order.end());  // reversed pre-order: every child before its parent
@@ -60,7 +80,8 @@ protected:
         WideBuildChild c;
         c.box = box_of(n);
         c.first = uint32_t(m_out.prims.size());
-        std::vector<uint32_t> stack{n};
+        std::vector<uint32_t>& stack = m_leaf_stack;
+        stack.assign(1, n);
         while (!stack.empty()) {
             const BuildNode& b = m_in.nodes[stack.back()];
             stack.pop_back();
@@ -88,6 +109,7 @@ protected:
     const BuildTree& m_in;
     const CollapseConfig& m_c;
     WideBuildTree m_out;
+    std::vector<uint32_t> m_leaf_stack;  ///< leaf_of's scratch
 };
 
 /// Ylitie et al. 2017, section 3.1. cost(n, i) is the SAH cost of representing binary subtree n
@@ -102,11 +124,12 @@ public:
 
     void run() {
         const size_t w = size_t(m_c.width);
-        m_cost.assign(m_in.nodes.size() * w, kInfCost);
-        m_choice.assign(m_in.nodes.size() * w, 0);
+        // solve() writes every entry before it is read: no initial fill of these large arrays.
+        m_cost.reset(new double[m_in.nodes.size() * w]);
+        m_choice.reset(new uint8_t[m_in.nodes.size() * w]);
         m_dist_k.assign(m_in.nodes.size(), 0);
         m_tris.assign(m_in.nodes.size(), 0);
-        for (uint32_t n : post_order(m_in)) solve(n);
+        for (uint32_t n : children_first(m_in)) solve(n);
         const uint32_t root = new_node();
         if (m_in.nodes[0].is_leaf()) add_child(root, leaf_of(0));
         else fill(root, 0);
@@ -121,10 +144,14 @@ private:
         const uint32_t width = uint32_t(m_c.width);
         const double area = area_of(box_of(n));
         if (b.is_leaf()) {
-            require(b.count <= m_c.leaf_max, "collapse: binary leaf of " + std::to_string(b.count) +
-                                                 " triangles above the wide leaf limit (split it first)");
+            if (b.count > m_c.leaf_max)
+                throw Error("collapse: binary leaf of " + std::to_string(b.count) +
+                            " triangles above the wide leaf limit (split it first)");
             m_tris[n] = b.count;
-            for (uint32_t i = 1; i <= width; ++i) cost(n, i) = area * m_c.intersection_cost * b.count;
+            for (uint32_t i = 1; i <= width; ++i) {
+                cost(n, i) = area * m_c.intersection_cost * b.count;
+                choice(n, i) = 0;  // a leaf, whatever the slots
+            }
             return;
         }
         const uint32_t l = b.first, r = b.first + 1;
@@ -179,8 +206,8 @@ private:
         add_child(node, c);
     }
 
-    std::vector<double> m_cost;
-    std::vector<uint8_t> m_choice;
+    std::unique_ptr<double[]> m_cost;
+    std::unique_ptr<uint8_t[]> m_choice;
     std::vector<uint8_t> m_dist_k;
     std::vector<uint32_t> m_tris;
 };
@@ -239,8 +266,9 @@ WideBuildTree collapse_tree(const BuildTree& tree, const CollapseConfig& c) {
     require(!tree.nodes.empty(), "collapse: empty build tree");
     if (c.method == Collapse::greedy) {
         for (const BuildNode& b : tree.nodes)
-            require(!b.is_leaf() || b.count <= c.leaf_max, "collapse: binary leaf of " + std::to_string(b.count) +
-                                                               " triangles above the wide leaf limit (split it first)");
+            if (b.is_leaf() && b.count > c.leaf_max)
+                throw Error("collapse: binary leaf of " + std::to_string(b.count) +
+                            " triangles above the wide leaf limit (split it first)");
         GreedyCollapser g(tree, c);
         g.run();
         return g.take();

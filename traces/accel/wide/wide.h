@@ -17,6 +17,9 @@ namespace rtsim {
 /// (SAH-optimal DP unless told otherwise), octant slots when `order` is octant.
 WideBuildTree make_wide_tree(const BuildTree& tree, const Scene& scene, int width, const BuildConfig& config,
                              ChildOrder order, Collapse method = Collapse::dp);
+/// The same from a tree the caller no longer needs (its leaves are split in place).
+WideBuildTree make_wide_tree(BuildTree&& tree, const Scene& scene, int width, const BuildConfig& config,
+                             ChildOrder order, Collapse method = Collapse::dp);
 
 /// The fp32 image (kind `kind`, e.g. "bvh8") of a wide tree of width N = tree.width.
 AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::string& kind, ChildOrder order);

@@ -24,6 +24,8 @@ namespace rtsim {
 enum class WideSimd : uint8_t { best = 0, sse2 = 1 };
 /// True when the fused 8-wide loop runs its AVX node test on this CPU.
 bool wide_simd_has_avx();
+/// True when the CPU has `feature` ("avx", "avx2", "fma", "popcnt") and RTSIM_SIMD is not "sse2".
+bool wide_simd_has(const char* feature);
 
 /// The fused reference loop of the fp32 layouts (wide_trace.cpp): SIMD node tests with the same
 /// per-lane arithmetic, and the same order and work as WideStepper<Fp32Codec<N>> in distance
@@ -143,7 +145,7 @@ public:
     std::unique_ptr<Stepper> make_stepper() const override { return std::make_unique<WideStepper<Codec>>(m_view); }
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override {
         if constexpr (Codec::kFused) {
-            if (m_view.order == ChildOrder::distance) return trace_wide_fused<Codec::kWidth>(m_view, ray, mode, work);
+            if (m_view.order == ChildOrder::distance) return Codec::fused(m_view, ray, mode, work);
         }
         return Accel::trace(ray, mode, work);
     }

@@ -18,13 +18,18 @@ ChildOrder child_order_param(const AccelImage& image, const std::string& source)
 
 WideBuildTree make_wide_tree(const BuildTree& tree, const Scene& scene, int width, const BuildConfig& config,
                              ChildOrder order, Collapse method) {
+    return make_wide_tree(BuildTree(tree), scene, width, config, order, method);
+}
+
+WideBuildTree make_wide_tree(BuildTree&& tree, const Scene& scene, int width, const BuildConfig& config,
+                             ChildOrder order, Collapse method) {
     CollapseConfig c;
     c.width = width;
     c.leaf_max = std::max(1u, std::min(kWideLeafMax, config.max_leaf_size));
     c.method = method;
     c.traversal_cost = config.traversal_cost;
     c.intersection_cost = config.intersection_cost;
-    WideBuildTree wide = collapse_tree(split_large_leaves(tree, scene.triangles, c.leaf_max), c);
+    WideBuildTree wide = collapse_tree(split_large_leaves(std::move(tree), scene.triangles, c.leaf_max), c);
     if (order == ChildOrder::octant) assign_octant_slots(wide);
     return wide;
 }
@@ -81,7 +86,7 @@ AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::
     }
     Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
-    for (size_t i = 0; i < o.prims.size(); ++i) t[i] = make_hw_triangle(scene, o.prims[i]);
+    HwTriangleWriter(scene).write(o.prims.data(), o.prims.size(), t);
     image.place_regions();
     return image;
 }

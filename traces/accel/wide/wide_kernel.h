@@ -14,6 +14,8 @@
 
 namespace rtsim {
 
+struct WideView;
+
 /// A wide node decoded to floats: what every wide layout's node step tests.
 struct DecodedNode {
     uint32_t valid = 0;  ///< bit s: slot s holds a child
@@ -46,6 +48,8 @@ struct Fp32Codec {
     static constexpr int kWidth = N;
     static constexpr uint32_t kBytes = sizeof(Node);
     static constexpr bool kFused = true;  ///< has a fused SIMD reference loop (wide_trace.cpp)
+    /// The fused loop (distance order only): trace_wide_fused<N> (wide_accel.h).
+    static Hit fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work);
 
     /// Encoding checks beyond the generic ones: none (any count and box is well-formed).
     template <class Fail>

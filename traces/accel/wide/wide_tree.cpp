@@ -21,11 +21,26 @@ Aabb triangle_box(const Triangle& t) {
 
 Aabb clip(const Aabb& a, const Aabb& b) { return Aabb{glm::max(a.lo, b.lo), glm::min(a.hi, b.hi)}; }
 
+/// Splits split_large_leaves makes in a leaf of `count` triangles (halving until <= leaf_max).
+uint32_t splits_needed(uint32_t count, uint32_t leaf_max) {
+    return count <= leaf_max ? 0 : 1 + splits_needed(count / 2, leaf_max) + splits_needed(count - count / 2, leaf_max);
+}
+
 }  // namespace
 
 BuildTree split_large_leaves(const BuildTree& in, const std::vector<Triangle>& triangles, uint32_t leaf_max) {
+    return split_large_leaves(BuildTree(in), triangles, leaf_max);
+}
+
+BuildTree split_large_leaves(BuildTree&& in, const std::vector<Triangle>& triangles, uint32_t leaf_max) {
     require(leaf_max >= 1, "split_large_leaves: leaf_max must be at least 1");
-    BuildTree out = in;
+    // Nodes the splits add (two per split; a piece is split again while too large), so the
+    // node array grows once.
+    size_t added = 0;
+    for (const BuildNode& b : in.nodes)
+        if (b.is_leaf()) added += 2 * size_t(splits_needed(b.count, leaf_max));
+    BuildTree out = std::move(in);
+    out.nodes.reserve(out.nodes.size() + added);
     // Nodes appended while splitting are visited too: a piece may still be too large.
     for (size_t n = 0; n < out.nodes.size(); ++n) {
         const BuildNode leaf = out.nodes[n];

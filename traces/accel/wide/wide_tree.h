@@ -67,6 +67,8 @@ struct CollapseConfig {
 /// of the triangle centroids on the leaf's widest centroid axis, each piece's box being its
 /// triangles' bounds clipped to the leaf's box (a spatial-split leaf stays inside its box).
 BuildTree split_large_leaves(const BuildTree& tree, const std::vector<Triangle>& triangles, uint32_t leaf_max);
+/// The same, reusing a tree the caller no longer needs (no copy of its arrays).
+BuildTree split_large_leaves(BuildTree&& tree, const std::vector<Triangle>& triangles, uint32_t leaf_max);
 
 /// Collapses a binary build tree (leaves of at most config.leaf_max triangles: call
 /// split_large_leaves first) into a wide tree. Deterministic.
