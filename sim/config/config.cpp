@@ -277,6 +277,10 @@ void validate(const SimConfig& config) {
     require(!config.treelets.enabled || config.fidelity != Fidelity::analytic,
             "config: 'treelets.enabled' is not supported at fidelity 'analytic' (its closed form models plain "
             "dispatch); use approx or detailed");
+    require(config.traversal.model == UnitModel::mimd || config.fidelity != Fidelity::analytic,
+            "config: 'traversal.model' " + std::string(kUnitModelChoices.name(config.traversal.model)) +
+                " is not supported at fidelity 'analytic' (its closed form costs each ray context on its own, "
+                "with no lock-step warps); use approx or detailed, or traversal.model mimd");
     require(config.sampling.fraction == 0 || config.sampling.count == 0,
             "config: set 'sampling.fraction' or 'sampling.count', not both");
     require(!config.sampling.enabled() || !config.treelets.enabled,
