@@ -13,8 +13,9 @@ every ray's work checked), and writes:
   efficiency per scene and ray kind.
 
 All runs share one machine: 8 units x 64 ray contexts (MIMD: 64 independent contexts; SIMT:
-64 / lanes warps), the default pipelines, caches and DRAM; only traversal.model, traversal.lanes
-and dispatch.sort change.
+64 / lanes warps), rays dealt to units 64 at a time (dispatch.block_rays), the default
+pipelines, caches and DRAM; only the traversal.model, lanes, SIMT policies and dispatch.sort
+change.
 
     python scripts/execution_models_study.py --out out/execution_models \\
         [--resolution 64x48] [--doc docs/execution_models.md] [--figure docs/execution_models.png]
@@ -44,11 +45,15 @@ SCENES = [
 ]
 KINDS = ["primary", "diffuse"]
 CONTEXTS = 64
-#: (model, lanes, sort)
-CONFIGS = [("mimd", 0, "none")] + [
-    ("simt", lanes, sort) for sort in ("none", "origin_direction") for lanes in (8, 16, 32)
+BLOCK = 64
+#: (model, lanes, sort, SIMT policy, refill)
+CONFIGS = [("mimd", 0, "none", "", ""), ("mimd", 0, "origin_direction", "", "")]
+CONFIGS += [
+    ("simt", lanes, sort, "while_while", "lane")
+    for sort in ("none", "origin_direction")
+    for lanes in (8, 16, 32)
 ]
-CONFIGS.insert(1, ("mimd", 0, "origin_direction"))
+CONFIGS += [("simt", 32, "none", "if_if", "lane"), ("simt", 32, "none", "while_while", "warp")]
 
 
 def trace(label: str, scene: str, extra: list[str], kind: str, args: argparse.Namespace) -> Path:
@@ -62,17 +67,14 @@ def trace(label: str, scene: str, extra: list[str], kind: str, args: argparse.Na
     return folder
 
 
-def run(
-    folder: Path, model: str, lanes: int, sort: str, args: argparse.Namespace
-) -> dict[str, Any]:
-    name = f"{folder.name}_{model}{lanes or ''}_{sort}"
-    sets = [
-        f"traversal.model={model}",
-        f"traversal.ray_contexts={CONTEXTS}",
-        f"dispatch.sort={sort}",
-    ]
+def run(folder: Path, config: tuple, args: argparse.Namespace) -> dict[str, Any]:
+    model, lanes, sort, policy, refill = config
+    name = f"{folder.name}_{model}{lanes or ''}_{sort}_{policy}_{refill}"
+    sets = [f"traversal.model={model}", f"traversal.ray_contexts={CONTEXTS}",
+            f"dispatch.sort={sort}", f"dispatch.block_rays={BLOCK}"]  # fmt: skip
     if lanes:
-        sets.append(f"traversal.lanes={lanes}")
+        sets += [f"traversal.lanes={lanes}", f"traversal.simt_policy={policy}",
+                 f"traversal.simt_refill={refill}"]  # fmt: skip
     result = run_sim(SimJob(trace=folder, out_dir=args.out / "runs" / name, sets=sets))
     if result.returncode != 0 or result.stats is None:
         raise SystemExit(f"{name}: rtsim-sim exit {result.returncode}: {result.stderr[-600:]}")
@@ -84,6 +86,8 @@ def run(
         "model": model,
         "lanes": lanes,
         "sort": sort,
+        "policy": policy,
+        "refill": refill,
         "rays": s["rays"],
         "mrays_per_second": s["mrays_per_second"],
         "dram_bytes_per_ray": s["dram_bytes_per_ray"],
@@ -100,6 +104,10 @@ def run(
 
 def config_label(row: dict[str, Any]) -> str:
     base = "MIMD" if row["model"] == "mimd" else f"SIMT {row['lanes']}"
+    if row["policy"] == "if_if":
+        base += " if-if"
+    if row["refill"] == "warp":
+        base += " warp refill"
     return base + (" + sort" if row["sort"] != "none" else "")
 
 
@@ -110,7 +118,9 @@ def table(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
         f"Measured {today} on {platform.node()} ({os.cpu_count()} cores) by `python "
         f"scripts/execution_models_study.py --resolution {args.resolution}`: one `rtsim-sim` run "
         "per row at the approx level (deterministic: one run, no medians needed), 8 units x "
-        f"{CONTEXTS} ray contexts, defaults otherwise; sort = `dispatch.sort=origin_direction`. "
+        f"{CONTEXTS} ray contexts, `dispatch.block_rays={BLOCK}` (a warp gets neighbouring rays), "
+        "defaults otherwise; SIMT while-while with lane refill unless named; sort = "
+        "`dispatch.sort=origin_direction`. "
         f"{len(rows)} runs, {mismatches} hit and work mismatches in all. Speed-up: Mrays/s "
         "against MIMD without sorting on the same trace.",
         "",
@@ -128,6 +138,43 @@ def table(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
             f"{speed:.2f}x | {r['dram_bytes_per_ray']:.0f} | {simd} | {coal} | "
             f"{r['l1_hit_rate']:.3f} | {r['bottleneck'] or '-'} |"
         )
+    return "\n".join(lines) + "\n"
+
+
+def trends(rows: list[dict[str, Any]]) -> str:
+    """Our figures beside the published trends, per scene."""
+    by = {(r["trace"], config_label(r)): r for r in rows}
+    scenes = list(dict.fromkeys(r["trace"].rsplit("_", 1)[0] for r in rows))
+
+    def eff(trace: str, cfg: str) -> str:
+        return f"{by[(trace, cfg)]['simd_efficiency']:.2f}"
+
+    def speed(trace: str, cfg: str, base: str) -> str:
+        a, b = by[(trace, cfg)], by[(trace, base)]
+        return f"{a['mrays_per_second'] / b['mrays_per_second']:.2f}x"
+
+    lines = [
+        "| scene | SIMD eff. SIMT 32, primary -> diffuse | SIMT 32 / MIMD, primary -> diffuse "
+        "| sorting, MIMD diffuse | sorting, SIMT 32 diffuse | SIMD eff. SIMT 32 diffuse, "
+        "sorted |",
+        "|---|---|---|---:|---:|---:|",
+    ]
+    for sc in scenes:
+        p, d = f"{sc}_primary", f"{sc}_diffuse"
+        if (p, "MIMD") not in by or (d, "MIMD") not in by:
+            continue
+        lines.append(
+            f"| {sc} | {eff(p, 'SIMT 32')} -> {eff(d, 'SIMT 32')} | "
+            f"{speed(p, 'SIMT 32', 'MIMD')} -> {speed(d, 'SIMT 32', 'MIMD')} | "
+            f"{speed(d, 'MIMD + sort', 'MIMD')} | {speed(d, 'SIMT 32 + sort', 'SIMT 32')} | "
+            f"{eff(d, 'SIMT 32 + sort')} |"
+        )
+    lines.append(
+        "| published | Aila & Laine 2009: high on primary rays, falling on diffuse | "
+        "SIMT GPUs hide divergence with many more warps per core than here | "
+        "Boulos et al. 2008, packet reordering: about 1.5x on diffuse paths | "
+        "Meister et al. 2020, sorting: 1.3-2.0x on incoherent rays | |"
+    )
     return "\n".join(lines) + "\n"
 
 
@@ -158,7 +205,8 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     top.axhline(1.0, color="black", linewidth=0.8)
     top.set_ylabel("Mrays/s / MIMD's")
     top.set_title("Execution models: throughput against MIMD (8 units x 64 ray contexts)")
-    top.legend(ncol=4, fontsize=8, loc="upper right")
+    top.set_ylim(0, 1.45)  # room for the legend above the bars
+    top.legend(ncol=5, fontsize=8, loc="upper center")
     bottom.set_ylabel("SIMD efficiency")
     bottom.set_ylim(0, 1)
     bottom.set_xticks(range(len(traces)))
@@ -177,7 +225,13 @@ def main(argv: list[str] | None = None) -> int:
         "--doc", type=Path, help="write the table into this file's execution-models markers"
     )
     p.add_argument("--figure", type=Path, help="write the figure here (PNG)")
+    p.add_argument("--replot", action="store_true", help="redraw from OUT/execution_models.json")
     args = p.parse_args(argv)
+    if args.replot:
+        rows = json.loads((args.out / "execution_models.json").read_text())
+        if args.figure:
+            plot(rows, args.figure)
+        return 0
     args.out.mkdir(parents=True, exist_ok=True)
     scenes_dir = Path(os.environ.get("RTSIM_SCENES", ""))
     rows = []
@@ -187,14 +241,17 @@ def main(argv: list[str] | None = None) -> int:
             continue
         for kind in KINDS:
             folder = trace(label, scene, extra, kind, args)
-            for model, lanes, sort in CONFIGS:
-                rows.append(run(folder, model, lanes, sort, args))
+            for config in CONFIGS:
+                rows.append(run(folder, config, args))
                 print(json.dumps(rows[-1]), file=sys.stderr)
     (args.out / "execution_models.json").write_text(json.dumps(rows, indent=2))
     text = table(rows, args)
     print(text)
+    trend_text = trends(rows)
+    print(trend_text)
     if args.doc:
         write_between(args.doc, "execution-models", text)
+        write_between(args.doc, "execution-models-trends", trend_text)
     if args.figure:
         plot(rows, args.figure)
     return 0

@@ -143,3 +143,36 @@ def test_bad_settings_are_named(
     result = simulate(sim_exe, coherent_and_not / "trace.rtt", tmp_path / "run", *sets)
     assert result.returncode == 2, result.stderr
     assert named in result.stderr
+
+
+@pytest.mark.parametrize("accel", ["bvh4", "cwbvh8", "grid"])
+def test_simt_on_every_structure_kind(sim_exe: Path, tmp_path: Path, accel: str) -> None:
+    """Lanes drive any structure's steppers (wide nodes, compressed nodes, grid cells)."""
+    trace = tmp_path / "trace"
+    kinds = "primary,diffuse"
+    rtsim.trace_scene("cornell", trace, workload=kinds, width=24, height=16, accel=accel)
+    stats = sim_stats(sim_exe, trace / "trace.rtt", tmp_path / "run", *SIMT, "traversal.lanes=16")
+    s = stats["summary"]
+    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0 and s["rays"] > 0
+    assert 0.0 < s["simd_efficiency"] <= 1.0
+
+
+def test_simt_two_level_with_frames(sim_exe: Path, tmp_path: Path) -> None:
+    """Instance transforms are one more operation kind; frames hold warps at the barrier."""
+    trace = tmp_path / "trace"
+    rtsim.trace_scene("grove", trace, workload="primary", width=24, height=16, frames=3)
+    stats = sim_stats(sim_exe, trace / "trace.rtt", tmp_path / "run", *SIMT)
+    s = stats["summary"]
+    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+    assert 0.0 < s["simd_efficiency"] <= 1.0
+    assert len(stats["frames"]) == 3
+
+
+def test_simt_sampled(sim_exe: Path, coherent_and_not: Path, tmp_path: Path) -> None:
+    small = ("traversal.model=simt", "traversal.units=2", "traversal.ray_contexts=16")
+    stats = sim_stats(
+        sim_exe, coherent_and_not / "trace.rtt", tmp_path / "run", *small, "sampling.fraction=0.3"
+    )
+    s = stats["summary"]
+    assert s["sampled"] is True and s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+    assert 0.0 < s["simd_efficiency"] <= 1.0
