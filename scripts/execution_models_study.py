@@ -56,25 +56,35 @@ CONFIGS += [
 CONFIGS += [("simt", 32, "none", "if_if", "lane"), ("simt", 32, "none", "while_while", "warp")]
 
 
-def trace(label: str, scene: str, extra: list[str], kind: str, args: argparse.Namespace) -> Path:
-    folder = args.out / "traces" / f"{label}_{kind}"
+def trace(
+    label: str, scene: str, extra: list[str], kind: str, args: argparse.Namespace, res: str = ""
+) -> Path:
+    res = res or args.resolution
+    folder = (
+        args.out / "traces" / f"{label}_{kind}"
+        if res == args.resolution
+        else (args.out / "traces" / f"{label}_{kind}_{res}")
+    )
     if (folder / "trace.rtt").exists():
         return folder
     shutil.rmtree(folder, ignore_errors=True)
     cmd = [sys.executable, "-m", "rtsim", "trace", scene, "-o", str(folder),
-           "--workload", kind, "--resolution", args.resolution, *extra]  # fmt: skip
+           "--workload", kind, "--resolution", res, *extra]  # fmt: skip
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
     return folder
 
 
-def run(folder: Path, config: tuple, args: argparse.Namespace) -> dict[str, Any]:
+def run(
+    folder: Path, config: tuple, args: argparse.Namespace, extra: tuple[str, ...] = ()
+) -> dict[str, Any]:
     model, lanes, sort, policy, refill = config
-    name = f"{folder.name}_{model}{lanes or ''}_{sort}_{policy}_{refill}"
+    name = f"{folder.name}_{model}{lanes or ''}_{sort}_{policy}_{refill}" + "_".join(extra)
     sets = [f"traversal.model={model}", f"traversal.ray_contexts={CONTEXTS}",
             f"dispatch.sort={sort}", f"dispatch.block_rays={BLOCK}"]  # fmt: skip
     if lanes:
         sets += [f"traversal.lanes={lanes}", f"traversal.simt_policy={policy}",
                  f"traversal.simt_refill={refill}"]  # fmt: skip
+    sets += list(extra)
     result = run_sim(SimJob(trace=folder, out_dir=args.out / "runs" / name, sets=sets))
     if result.returncode != 0 or result.stats is None:
         raise SystemExit(f"{name}: rtsim-sim exit {result.returncode}: {result.stderr[-600:]}")
@@ -138,6 +148,42 @@ def table(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
             f"{speed:.2f}x | {r['dram_bytes_per_ray']:.0f} | {simd} | {coal} | "
             f"{r['l1_hit_rate']:.3f} | {r['bottleneck'] or '-'} |"
         )
+    return "\n".join(lines) + "\n"
+
+
+#: The sorting study: one larger trace, windows up to the whole trace.
+SORT_WINDOWS = [4096, 65536]
+
+
+def sorting_study(args: argparse.Namespace) -> str:
+    """Sorting on a larger batch (Sponza diffuse): does a bigger window buy coherence?"""
+    folder = trace("sponza", "sponza", [], "diffuse", args, args.sort_resolution)
+    lines = [
+        f"Sponza diffuse at {args.sort_resolution}, same machine and method as above; "
+        "`dispatch.sort_window` as given (4,096 is the default; `dispatch.chunk_rays` at least "
+        "as large, since the stage sorts within a chunk).",
+        "",
+        "| config | window | rays | Mrays/s | speed-up from sorting | DRAM B/ray | SIMD eff. "
+        "| mismatches |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for model, lanes in (("mimd", 0), ("simt", 32)):
+        config = (model, lanes, "none", "while_while" if lanes else "", "lane" if lanes else "")
+        base = run(folder, config, args)
+        rows = [(base, "-")]
+        for window in SORT_WINDOWS:
+            sorted_config = (*config[:2], "origin_direction", *config[3:])
+            # The stage sorts within a chunk: the chunk at least as large as the window.
+            sets = (f"dispatch.sort_window={window}", f"dispatch.chunk_rays={max(16384, window)}")
+            rows.append((run(folder, sorted_config, args, sets), window))
+        for r, window in rows:
+            simd = f"{r['simd_efficiency']:.2f}" if r["simd_efficiency"] is not None else "-"
+            lines.append(
+                f"| {config_label(r)} | {window} | {r['rays']:,} | {r['mrays_per_second']:.1f} | "
+                f"{r['mrays_per_second'] / base['mrays_per_second']:.2f}x | "
+                f"{r['dram_bytes_per_ray']:.0f} | {simd} | "
+                f"{r['hit_mismatches'] + r['work_mismatches']} |"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -226,6 +272,8 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--figure", type=Path, help="write the figure here (PNG)")
     p.add_argument("--replot", action="store_true", help="redraw from OUT/execution_models.json")
+    p.add_argument("--sort-resolution", default="256x192", help="the sorting study's trace")
+    p.add_argument("--no-sort-study", action="store_true")
     args = p.parse_args(argv)
     if args.replot:
         rows = json.loads((args.out / "execution_models.json").read_text())
@@ -252,6 +300,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.doc:
         write_between(args.doc, "execution-models", text)
         write_between(args.doc, "execution-models-trends", trend_text)
+    if not args.no_sort_study and (scenes_dir / "sponza").is_dir():
+        sort_text = sorting_study(args)
+        print(sort_text)
+        if args.doc:
+            write_between(args.doc, "execution-models-sorting", sort_text)
     if args.figure:
         plot(rows, args.figure)
     return 0

@@ -102,6 +102,7 @@ bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
     lane.ray.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_rejected;
     lane.ray.ray_id = job.id;
+    lane.kind = job.kind;
     lane.ray.start = start;
     lane.ray.stack = StackSplit{};
     account_until(m_account, lane.accounted, CycleUse::starved, start);  // no ray until now
@@ -117,16 +118,14 @@ void SimtUnit::fetch_rays(uint32_t w, Cycle t) {
     // already had rays wait for it.
     AccessInfo slowest;
     const Cycle ready = issue_reads(m_fetch_at, &slowest);
-    uint32_t active = 0;
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
         Lane& lane = m_lanes[l];
         if (!lane.stepping) continue;
-        ++active;
         account_until(m_account, lane.accounted, CycleUse::dispatch, m_fetch_at);
         account_read_until(m_account, lane.accounted, ready, slowest);
     }
     account_idle(w, ready);
-    count_warp_step(active);
+    count_warp_step(w, t);
     ++m_fetch_steps;
     m_warps[w].phase = Phase::step;
     m_events.schedule(w, std::max(ready, t));
@@ -158,12 +157,10 @@ void SimtUnit::step(uint32_t w, Cycle t) {
     warp.last_class = cls;
     // The lanes whose next step runs the warp's kind step (costed and run with the one
     // arithmetic as their fetches issue); their fetches are coalesced per line.
-    uint32_t active = 0;
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
         Lane& lane = m_lanes[l];
         lane.stepping = lane.has_ray && step_class(lane.ray.stepper->plan()) == cls;
         if (!lane.stepping) continue;
-        ++active;
         account_until(m_account, lane.accounted, CycleUse::issue, t);
         take_step(*lane.ray.stepper, lane.ray.stack, m_costs, lane.demand);
         for (int i = 0; i < lane.demand.read_count; ++i)
@@ -174,8 +171,7 @@ void SimtUnit::step(uint32_t w, Cycle t) {
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l)
         if (m_lanes[l].stepping) account_read_until(m_account, m_lanes[l].accounted, ready, slowest);
     account_idle(w, ready);
-    count_warp_step(active);
-    warp.active = active;
+    count_warp_step(w, t);
     warp.phase = Phase::ops;
     m_events.schedule(w, ready);
 }
@@ -241,10 +237,38 @@ void SimtUnit::account_idle(uint32_t w, Cycle until) {
     }
 }
 
-void SimtUnit::count_warp_step(uint32_t active) {
+void SimtUnit::count_warp_step(uint32_t w, Cycle t) {
+    uint32_t active = 0;
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+        const Lane& lane = m_lanes[l];
+        if (!lane.has_ray) continue;
+        ++m_kind_present[size_t(lane.kind)];
+        if (lane.stepping) ++active, ++m_kind_active[size_t(lane.kind)];
+    }
     ++m_warp_steps;
     m_lane_steps += active;
     ++m_active_histogram[active];
+    m_slot_use.add(t, m_config.lanes);
+    m_active_use.add(t, active);
+}
+
+nlohmann::json SimtUnit::efficiency_by_kind() const {
+    nlohmann::json out = nlohmann::json::object();
+    for (int k = 0; k < kRayKindCount; ++k)
+        if (m_kind_present[size_t(k)])
+            out[ray_kind_name(RayKind(k))] = double(m_kind_active[size_t(k)]) / double(m_kind_present[size_t(k)]);
+    return out;
+}
+
+nlohmann::json SimtUnit::efficiency_over_time() const {
+    // Active lanes / lane slots per point, the points as UsageSeries::to_json groups them.
+    const nlohmann::json slots = m_slot_use.to_json(1.0), active = m_active_use.to_json(1.0);
+    nlohmann::json out = nlohmann::json::array();
+    for (size_t i = 0; i < slots.size() && i < active.size(); ++i) {
+        const double s = slots[i]["value"].get<double>();
+        out.push_back({{"cycle", slots[i]["cycle"]}, {"value", s > 0 ? active[i]["value"].get<double>() / s : 0.0}});
+    }
+    return out;
 }
 
 void SimtUnit::finish_lane(uint32_t l, Cycle t) {
@@ -288,6 +312,8 @@ nlohmann::json SimtUnit::stats_json(Cycle total_cycles) const {
         .set("active_lanes", m_lane_steps)
         .set("simd_efficiency", slots ? double(m_lane_steps) / double(slots) : 0.0)
         .set("active_lane_histogram", m_active_histogram)
+        .set("simd_efficiency_by_kind", efficiency_by_kind())
+        .set("simd_efficiency_over_time", efficiency_over_time())
         .set("lane_requests", m_coalescer.lane_requests())
         .set("coalesced_requests", m_coalescer.requests())
         .done();

@@ -19,9 +19,11 @@
 // takes a new ray then (traversal.simt_refill = lane, persistent threads) or once its whole warp
 // has finished (warp); new rays' records are fetched in a warp step of their own (the lanes that
 // fetch are its active lanes: refilling few lanes costs a mostly idle step, as on a GPU).
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "rtl_model/common/usage_series.h"
 #include "rtl_model/traversal/context_queue.h"
 #include "rtl_model/traversal/simt/coalescer.h"
 #include "rtl_model/traversal/traversal_unit.h"
@@ -48,6 +50,7 @@ private:
     struct Lane {
         RayState ray;
         StepDemand demand;      ///< its step in the warp step in flight
+        RayKind kind = RayKind::primary;
         bool has_ray = false;
         bool stepping = false;  ///< active in the warp step in flight
         Cycle accounted = 0;
@@ -55,7 +58,6 @@ private:
     struct Warp {
         Phase phase = Phase::step;
         uint32_t last_class = 0;  ///< the step class it ran last
-        uint32_t active = 0;      ///< lanes stepping in the warp step in flight
     };
 
     void run();
@@ -71,7 +73,10 @@ private:
     void finish_lane(uint32_t l, Cycle t);
     /// The step class the warp runs next (simt_policy), or kClasses when no lane has a ray.
     uint32_t choose_class(uint32_t w) const;
-    void count_warp_step(uint32_t active);
+    /// Counts a warp step of warp w (its lanes' `stepping` flags set) at cycle t.
+    void count_warp_step(uint32_t w, Cycle t);
+    nlohmann::json efficiency_by_kind() const;
+    nlohmann::json efficiency_over_time() const;
     /// Lanes of warp w with a ray but not stepping (and, with warp refill, lanes waiting for the
     /// warp) spent up to `until` idle.
     void account_idle(uint32_t w, Cycle until);
@@ -99,6 +104,9 @@ private:
     uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0;
     uint64_t m_warp_steps = 0, m_lane_steps = 0, m_fetch_steps = 0;
     std::vector<uint64_t> m_active_histogram;  ///< warp steps by active lanes (0 .. lanes)
+    /// Per ray kind: lane-steps of lanes holding a ray of that kind, and those that stepped.
+    std::array<uint64_t, kRayKindCount> m_kind_present{}, m_kind_active{};
+    UsageSeries m_slot_use, m_active_use;  ///< lane slots and active lanes over time
     CycleAccount m_account;
 };
 

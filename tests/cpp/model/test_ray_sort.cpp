@@ -83,7 +83,9 @@ TEST(RaySort, WindowsComeOutInStableKeyOrderAndWaitForTheStage) {
             const uint32_t a = ray_sort_key(jobs[i - 1].ray, config.sort, Vec3(0), Vec3(0));
             const uint32_t b = ray_sort_key(jobs[i].ray, config.sort, Vec3(0), Vec3(0));
             EXPECT_LE(a, b) << "ray " << i;
-            if (a == b) EXPECT_LT(jobs[i - 1].id, jobs[i].id) << "stable at " << i;  // trace order within a key
+            if (a == b) {
+                EXPECT_LT(jobs[i - 1].id, jobs[i].id) << "stable at " << i;  // trace order within a key
+            }
         }
     }
 }
