@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import sim_stats, simulate
+from conftest import REPO, sim_stats, simulate
 
 SIMT = ("traversal.model=simt", "traversal.ray_contexts=32")
 
@@ -202,3 +202,11 @@ def test_simt_alpha_instances_and_shadow_rays(
             assert built["anyhit"] and built["instance_transform"]
         else:
             assert stats["workload"]["occlusion_rays"] > 0
+
+
+def test_execution_models_sweep_spec_parses() -> None:
+    """The knobs are sweep axes: the shipped spec crosses model, lanes and sort."""
+    from rtsim.sweep.spec import load_spec
+
+    spec = load_spec(REPO / "python" / "rtsim" / "specs" / "execution_models.yaml")
+    assert len(spec.points()) == 2 * 3 * 2
