@@ -106,6 +106,7 @@ def run(
             sum(u["coalesced_requests"] for u in units) / lane_req if lane_req else None
         ),
         "l1_hit_rate": s["l1_hit_rate"],
+        "energy_per_ray_nj": s.get("energy_per_ray_nj"),
         "hit_mismatches": s["hit_mismatches"],
         "work_mismatches": s["work_mismatches"],
         "bottleneck": s.get("bottleneck"),
@@ -134,18 +135,19 @@ def table(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
         f"{len(rows)} runs, {mismatches} hit and work mismatches in all. Speed-up: Mrays/s "
         "against MIMD without sorting on the same trace.",
         "",
-        "| trace | rays | config | Mrays/s | speed-up | DRAM B/ray | SIMD eff. "
+        "| trace | rays | config | Mrays/s | speed-up | DRAM B/ray | nJ/ray | SIMD eff. "
         "| requests after coalescing | L1 hit | bottleneck |",
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---|",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|",
     ]
     base = {r["trace"]: r for r in rows if r["model"] == "mimd" and r["sort"] == "none"}
     for r in rows:
         simd = f"{r['simd_efficiency']:.2f}" if r["simd_efficiency"] is not None else "-"
         coal = f"{r['coalesced_fraction']:.2f}" if r["coalesced_fraction"] is not None else "-"
         speed = r["mrays_per_second"] / base[r["trace"]]["mrays_per_second"]
+        nj = f"{r['energy_per_ray_nj']:.1f}" if r["energy_per_ray_nj"] is not None else "-"
         lines.append(
             f"| {r['trace']} | {r['rays']:,} | {config_label(r)} | {r['mrays_per_second']:.1f} | "
-            f"{speed:.2f}x | {r['dram_bytes_per_ray']:.0f} | {simd} | {coal} | "
+            f"{speed:.2f}x | {r['dram_bytes_per_ray']:.0f} | {nj} | {simd} | {coal} | "
             f"{r['l1_hit_rate']:.3f} | {r['bottleneck'] or '-'} |"
         )
     return "\n".join(lines) + "\n"

@@ -210,3 +210,13 @@ def test_execution_models_sweep_spec_parses() -> None:
 
     spec = load_spec(REPO / "python" / "rtsim" / "specs" / "execution_models.yaml")
     assert len(spec.points()) == 2 * 3 * 2
+
+
+def test_simt_is_deterministic(sim_exe: Path, coherent_and_not: Path, tmp_path: Path) -> None:
+    """Same trace and config: the same model figures, run after run (rule 9)."""
+    sets = (*SIMT, "dispatch.sort=morton", "traversal.simt_policy=if_if")
+    trace = coherent_and_not / "trace.rtt"
+    runs = [sim_stats(sim_exe, trace, tmp_path / f"r{i}", *sets) for i in range(2)]
+    assert runs[0]["model"] == runs[1]["model"]
+    assert runs[0]["summary"]["cycles"] == runs[1]["summary"]["cycles"]
+    assert runs[0]["summary"]["simd_efficiency"] == runs[1]["summary"]["simd_efficiency"]
