@@ -86,6 +86,10 @@ def utilisation_table(stats: dict[str, Any]) -> Table:
     model = stats.get("model", {}) or {}
     table = _two_column("utilisation and memory")
     table.add_row("traversal units busy", fmt_pct(s.get("unit_busy_fraction")))
+    if s.get("simd_efficiency") is not None:
+        table.add_row(
+            "SIMD efficiency (active lanes / lane slots)", fmt_pct(s.get("simd_efficiency"))
+        )
     table.add_row("box pipelines", fmt_pct(s.get("box_utilization")))
     table.add_row("triangle pipelines", fmt_pct(s.get("triangle_utilization")))
     anyhit = model.get("anyhit")

@@ -55,6 +55,7 @@ struct RayJob {
     Ray ray;
     bool any_hit = false;
     Cycle not_before = 0;  ///< the ray may not start earlier (a frame barrier's release cycle)
+    RayKind kind = RayKind::primary;  ///< what the ray is for (stats by kind)
 };
 
 /// Contract: hands out each ray of the workload exactly once; false when none are left now.

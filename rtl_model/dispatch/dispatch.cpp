@@ -5,7 +5,7 @@
 namespace rtsim {
 
 RayDealer::RayDealer(const DispatchConfig& config, uint32_t units, RayStream& stream)
-    : m_config(config), m_stream(stream), m_queues(std::max(1u, units)) {}
+    : m_config(config), m_stream(stream), m_sorter(config), m_queues(std::max(1u, units)) {}
 
 bool RayDealer::next_ray(uint32_t unit, RayJob* job) {
     bool ok = m_config.policy == DispatchPolicy::on_demand ? next_on_demand(job) : next_interleaved(unit, job);
@@ -21,6 +21,7 @@ bool RayDealer::next_on_demand(RayJob* job) {
             m_stream_done = true;
             return next_segment() && next_on_demand(job);
         }
+        sort_chunk(m_buffer);
         ++m_chunks;
     }
     *job = m_buffer[m_next++];
@@ -34,6 +35,7 @@ bool RayDealer::deal_chunk() {
         m_stream_done = true;
         return false;
     }
+    sort_chunk(chunk);
     ++m_chunks;
     for (size_t i = 0; i < chunk.size(); i += m_config.block_rays) {
         size_t end = std::min(chunk.size(), i + m_config.block_rays);
@@ -88,19 +90,26 @@ const StatBlock& dispatch_stats() {
             {"chunk_rays", "rays", "the configured chunk size (`dispatch.chunk_rays`)"},
             {"policy", "", "`interleaved` (rays dealt to units in turn) or `on_demand` (`dispatch.policy`)"},
             {"steals", "rays", "rays an idle unit took from another unit's queue (interleaved, at the end of the trace)"},
+            {"sort", "", "with `dispatch.sort` only: the sorting stage's key", false, true},
+            {"sorted_rays", "rays", "with `dispatch.sort` only: rays through the sorting stage", false, true},
+            {"sort_ready_cycle", "cycle", "with `dispatch.sort` only: when its last window was ready (rays may not start earlier)", false, true},
         }};
     return block;
 }
 
 nlohmann::json RayDealer::stats_json() const {
     nlohmann::json j;
-    StatsWriter(dispatch_stats(), j)
-        .set("rays", m_dispatched)
+    StatsWriter w(dispatch_stats(), j);
+    w.set("rays", m_dispatched)
         .set("chunks", m_chunks)
         .set("chunk_rays", m_config.chunk_rays)
         .set("policy", kDispatchPolicyChoices.name(m_config.policy))
-        .set("steals", m_steals)
-        .done();
+        .set("steals", m_steals);
+    if (m_config.sort != RaySort::none)
+        w.set("sort", kRaySortChoices.name(m_config.sort))
+            .set("sorted_rays", m_sorter.sorted())
+            .set("sort_ready_cycle", m_sorter.ready());
+    w.done();
     return j;
 }
 
@@ -122,7 +131,7 @@ void Dispatch::set_frames(std::vector<uint64_t> frame_rays, FrameEnd on_end, Fra
 
 bool Dispatch::next_ray(uint32_t unit, RayJob* job) {
     if (!RayDealer::next_ray(unit, job)) return false;
-    job->not_before = m_release;
+    job->not_before = std::max(job->not_before, m_release);  // sorted rays wait for their window
     return true;
 }
 

@@ -6,7 +6,8 @@
 // rays at a time; a unit whose queue is empty steals from the back of the longest queue. The
 // assignment is the hardware's policy and does not depend on how far units run ahead of each
 // other (quantum_cycles), so the approx and detailed levels give rays to the same units.
-// on_demand: the next ray in trace order goes to whichever unit asks first. With temporal
+// on_demand: the next ray in trace order goes to whichever unit asks first. With dispatch.sort,
+// each chunk passes a sorting stage first (ray_sort.h) and "trace order" is its sorted order. With temporal
 // decoupling a unit running ahead then takes runs of neighbouring rays, which flatters its L1.
 #include <cstdint>
 #include <deque>
@@ -19,6 +20,7 @@
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/stats.h"
 #include "rtl_model/dispatch/dispatch_config.h"
+#include "rtl_model/dispatch/ray_sort.h"
 
 namespace rtsim {
 
@@ -69,8 +71,14 @@ private:
     /// next segment (false at the stream's end).
     bool next_segment();
 
+    /// A chunk just read from the stream goes through the sorting stage (dispatch.sort).
+    void sort_chunk(std::vector<RayJob>& chunk) {
+        if (m_config.sort != RaySort::none) m_sorter.sort(chunk);
+    }
+
     DispatchConfig m_config;
     RayStream& m_stream;
+    RaySorter m_sorter;
     std::vector<RayJob> m_buffer;  ///< on_demand: the current chunk
     size_t m_next = 0;
     std::vector<std::deque<RayJob>> m_queues;  ///< interleaved: per-unit queues

@@ -20,6 +20,25 @@ void validate_cache(const CacheConfig& c, const char* name) {
     require(power_of_two(lines / c.ways), p + ".size_kib' / (ways x line_bytes) must be a power of two (sets)");
 }
 
+/// The execution model's cross-field rules.
+void validate_traversal_model(const ModelConfig& config) {
+    const TraversalConfig& t = config.traversal;
+    require(config.dispatch.sort == RaySort::none || !config.treelets.enabled,
+            "config: 'dispatch.sort' needs treelets.enabled false: the ray buffer takes rays from dispatch in its own "
+            "order and reorders them by treelet itself");
+    require(t.model != UnitModel::packet,
+            "config: 'traversal.model' packet is not built yet (rays sharing one traversal stack need a packet "
+            "kernel in the reference tracer); use mimd or simt");
+    if (t.model != UnitModel::simt) return;
+    require(t.ray_contexts % t.lanes == 0,
+            "config: 'traversal.ray_contexts' (" + std::to_string(t.ray_contexts) + ") must be a multiple of "
+            "'traversal.lanes' (" + std::to_string(t.lanes) + ") with traversal.model simt: a unit's ray contexts "
+            "are its warps' lanes");
+    require(!config.treelets.enabled,
+            "config: 'treelets.enabled' is not supported with traversal.model simt (a warp's lanes would leave "
+            "for different treelets' queues); use traversal.model mimd");
+}
+
 }  // namespace
 
 const PipelineConfig& ModelConfig::pipeline(OpKind kind) const {
@@ -50,6 +69,7 @@ void validate_model(const ModelConfig& config) {
             "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas with dram.model banks (it is the "
             "latency of an access to a closed bank); raise dram.latency, lower dram.t_rcd/dram.t_cas, or set "
             "dram.model=bandwidth");
+    validate_traversal_model(config);
 }
 
 }  // namespace rtsim

@@ -34,6 +34,7 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
       m_config(config),
       m_unit_context{config.quantum_cycles, config.dispatch.latency, config.treelets.idle_poll_cycles},
       m_steppers(accel) {
+    m_unit_context.line_bytes = config.l1.line_bytes;
     m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, config.traversal.units, rays);
     build_memory();
     build_pipelines(accel);

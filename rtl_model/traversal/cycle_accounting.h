@@ -26,6 +26,7 @@ enum class CycleUse : uint8_t {
     ray_buffer,     ///< treelet mode: waiting for a ray's state from the ray buffer
     starved,        ///< no ray to run while the workload still has rays for later
     tail,           ///< no ray to run: the workload has run out (the end of the run)
+    idle_lane,      ///< SIMT: a lane with a ray (or waiting for its warp) masked off by divergence
     pipe_first,     ///< first of kOpKindCount uses: waiting for the pipeline of each operation kind
 };
 constexpr int kCycleUseCount = int(CycleUse::pipe_first) + kOpKindCount;
@@ -41,7 +42,8 @@ public:
     uint64_t operator[](CycleUse use) const { return m_cycles[size_t(use)]; }
     uint64_t total() const;
     CycleAccount& operator+=(const CycleAccount& o);
-    /// {use: cycles} for the uses that occurred (every non-pipeline use always appears).
+    /// {use: cycles} for the uses that occurred (every non-pipeline use but idle_lane always appears;
+/// idle_lane and the pipelines' uses appear when they occurred).
     nlohmann::json to_json() const;
 
 private:

@@ -7,8 +7,21 @@
 namespace rtsim {
 
 /// Execution models of traversal units (rtl_model/traversal/unit_registry.cpp builds each).
-enum class UnitModel : uint8_t { mimd = 0 };
-inline constexpr Choices<UnitModel, 1> kUnitModelChoices{{"mimd"}};
+enum class UnitModel : uint8_t { mimd = 0, simt = 1, packet = 2 };
+inline constexpr Choices<UnitModel, 3> kUnitModelChoices{{"mimd", "simt", "packet"}};
+
+/// Which operation kind a SIMT warp runs next (Aila & Laine 2009, "Understanding the efficiency
+/// of ray traversal on GPUs", section 2): while_while keeps the kind it ran while any lane still
+/// needs it (the inner loops of while-while traversal), if_if takes the next kind any lane needs
+/// in turn each warp step (one step of each branch per loop iteration).
+enum class SimtPolicy : uint8_t { while_while = 0, if_if = 1 };
+inline constexpr Choices<SimtPolicy, 2> kSimtPolicyChoices{{"while_while", "if_if"}};
+
+/// When a SIMT lane whose ray finished gets a new one: at its warp's next step (lane: persistent
+/// threads that fetch work as they finish), or only once every lane of its warp has finished
+/// (warp: the whole warp retires and is relaunched).
+enum class SimtRefill : uint8_t { lane = 0, warp = 1 };
+inline constexpr Choices<SimtRefill, 2> kSimtRefillChoices{{"lane", "warp"}};
 
 struct TraversalConfig {
     UnitModel model = UnitModel::mimd;  ///< how a unit runs its rays (unit_registry.h)
@@ -17,15 +30,24 @@ struct TraversalConfig {
     uint32_t stack_entries = 8;      ///< on-chip traversal stack entries per ray; deeper entries spill
     uint32_t stack_entry_bytes = 0;  ///< bytes per stack entry; 0: the structure's (8 for a BVH, 12 for a kd-tree, ...)
     uint32_t issue_cycles = 1;       ///< cycles the unit's scheduler needs per traversal step
+    uint32_t lanes = 8;              ///< simt: rays per warp, stepping in lock-step
+    SimtPolicy simt_policy = SimtPolicy::while_while;  ///< simt: which operation kind a warp runs next
+    SimtRefill simt_refill = SimtRefill::lane;         ///< simt: when a finished lane takes a new ray
+
+    /// simt: warps per unit (its ray contexts grouped `lanes` at a time).
+    uint32_t warps() const { return lanes ? ray_contexts / lanes : 0; }
 
     template <class V>
     void visit(V& v) {
-        v.choice("model", model, kUnitModelChoices, "Execution model of the traversal units: mimd (each ray context steps on its own, TRaX/STRaTA-style)");
+        v.choice("model", model, kUnitModelChoices, "Execution model of the traversal units: mimd (each ray context steps on its own, TRaX/STRaTA-style), simt (warps of `lanes` ray contexts in lock-step, GPU-style), packet (not built yet: refused)");
         v.field("units", units, "units", "Traversal units", 1, 4096);
         v.field("ray_contexts", ray_contexts, "rays", "Ray contexts per unit (rays in flight)", 1, 4096);
         v.field("stack_entries", stack_entries, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64);
         v.field("stack_entry_bytes", stack_entry_bytes, "bytes", "Bytes per stack entry (on-chip stack and spill traffic); 0: the structure's own (a BVH's 8: node and entry distance; a kd-tree's or BIH's 12; an octree's 32), resolved from the trace", 0, 64);
         v.field("issue_cycles", issue_cycles, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100);
+        v.field("lanes", lanes, "rays", "simt: rays per warp in lock-step; ray_contexts must be a multiple (warps = ray_contexts / lanes)", 4, 64);
+        v.choice("simt_policy", simt_policy, kSimtPolicyChoices, "simt: while_while (a warp keeps its operation kind while any lane needs it) or if_if (kinds in turn each warp step), Aila & Laine 2009");
+        v.choice("simt_refill", simt_refill, kSimtRefillChoices, "simt: lane (a finished lane takes a new ray at its warp's next step) or warp (only when every lane of the warp has finished)");
     }
 };
 

@@ -32,6 +32,7 @@ struct UnitContext {
     /// does not synchronise with SystemC time first (the detailed level with private pipelines:
     /// shared blocks still see every request in time order, at half the synchronisations).
     bool sync_private_steps = true;
+    uint32_t line_bytes = 64;  ///< the L1's line size: a SIMT warp coalesces its reads per line
 };
 
 /// Everything a unit is built from (one per machine; every unit of it shares it).

@@ -1,8 +1,11 @@
 #include "rtl_model/traversal/unit_registry.h"
 
 #include <array>
+#include <string>
 
 #include "rtl_model/traversal/mimd/mimd_unit.h"
+#include "rtl_model/traversal/simt/simt_unit.h"
+#include "traces/common/error.h"
 
 namespace rtsim {
 
@@ -18,13 +21,18 @@ std::unique_ptr<TraversalUnit> make(sc_core::sc_module_name name, const UnitSetu
 /// One line per unit kind, in UnitModel order.
 constexpr std::array<UnitFactory, kUnitModelChoices.names.size()> kFactories{{
     make<MimdUnit>,  // mimd
+    make<SimtUnit>,  // simt
+    nullptr,         // packet: refused by validate_model (not built yet)
 }};
 
 }  // namespace
 
 std::unique_ptr<TraversalUnit> make_traversal_unit(sc_core::sc_module_name name, const UnitSetup& setup,
                                                    uint32_t index) {
-    return kFactories[size_t(setup.config.model)](name, setup, index);
+    const UnitFactory make_unit = kFactories[size_t(setup.config.model)];
+    require(make_unit != nullptr, std::string("model: traversal.model '") + kUnitModelChoices.name(setup.config.model) +
+                                      "' has no unit built");
+    return make_unit(name, setup, index);
 }
 
 }  // namespace rtsim

@@ -19,6 +19,16 @@ const StatBlock& unit_stats() {
             {"rays_taken", "rays", "treelet scheduling only: rays it took from the ray buffer", false, true},
             {"rays_parked", "rays", "treelet scheduling only: rays it parked in another treelet's queue", false, true},
             {"idle_polls", "count", "treelet scheduling only: times it found no ray and looked again after `treelets.idle_poll_cycles`", false, true},
+            {"warp_steps", "steps", "simt only: warp steps (one operation kind for the warp, or the new rays' record fetch)", false, true},
+            {"ray_fetch_steps", "steps", "simt only: warp steps that fetched new rays' records", false, true},
+            {"lane_slots", "lane-steps", "simt only: `warp_steps x traversal.lanes`", false, true},
+            {"active_lanes", "lane-steps", "simt only: lanes that stepped, summed over warp steps", false, true},
+            {"simd_efficiency", "fraction", "simt only: `active_lanes / lane_slots` (Aila & Laine 2009's SIMD efficiency)", false, true},
+            {"active_lane_histogram", "steps", "simt only: warp steps by active lanes, index 0 .. `traversal.lanes`", false, true},
+            {"simd_efficiency_by_kind", "fraction", "simt only: `{ray kind: lanes of that kind that stepped / lanes holding a ray of that kind}` over warp steps (empty lanes are in no kind)", false, true},
+            {"simd_efficiency_over_time", "fraction", "simt only: `[{cycle, value}]`, active lanes / lane slots of the warp steps issued in each interval (at most 256 points)", false, true},
+            {"lane_requests", "requests", "simt only: reads the stepping lanes asked for (a MIMD unit's requests for the same steps)", false, true},
+            {"coalesced_requests", "requests", "simt only: read requests after coalescing a warp step's reads per L1 line", false, true},
         }};
     return block;
 }

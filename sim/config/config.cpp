@@ -282,6 +282,10 @@ void validate(const SimConfig& config) {
             "config: 'mailbox.entries' is not supported at fidelity 'analytic' with analytic.caches=statistical (its "
             "per-trace analysis prices triangle tests from the trace's work records, which hold no mailbox); use "
             "analytic.caches=functional, approx or detailed");
+    require(config.traversal.model == UnitModel::mimd || config.fidelity != Fidelity::analytic,
+            "config: 'traversal.model' " + std::string(kUnitModelChoices.name(config.traversal.model)) +
+                " is not supported at fidelity 'analytic' (its closed form costs each ray context on its own, "
+                "with no lock-step warps); use approx or detailed, or traversal.model mimd");
     require(config.sampling.fraction == 0 || config.sampling.count == 0,
             "config: set 'sampling.fraction' or 'sampling.count', not both");
     require(!config.sampling.enabled() || !config.treelets.enabled,

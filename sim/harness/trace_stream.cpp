@@ -19,6 +19,8 @@ void read_ray_jobs(TraceReader& reader, uint64_t first, size_t n, std::vector<Ra
         job.id = first + i;
         job.ray = ray_from_record((*buffer)[i]);
         job.any_hit = (*buffer)[i].flags & kRayFlagAnyHit;
+        const uint8_t kind = (*buffer)[i].kind;
+        job.kind = kind < kRayKindCount ? RayKind(kind) : RayKind::primary;
         out->push_back(job);
     }
 }

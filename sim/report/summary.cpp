@@ -49,6 +49,21 @@ json mean_of(const json& group, const StatBlock& block, const char* key) {
     return n > 0 ? json(sum / n) : json(nullptr);
 }
 
+/// Active lanes / lane slots over the units' warp steps; null when no unit runs warps.
+json simd_efficiency(const json& units) {
+    double active = 0, slots = 0;
+    bool simt = false;
+    for (const json& u : units) {
+        const StatsReader r(unit_stats(), u);
+        if (!u.contains("lane_slots")) continue;
+        simt = true;
+        active += r["active_lanes"].get<double>();
+        slots += r["lane_slots"].get<double>();
+    }
+    if (!simt) return nullptr;
+    return slots > 0 ? active / slots : 0.0;
+}
+
 /// Peak resident memory of this process's address space (VmHWM). getrusage's ru_maxrss would
 /// also count the parent's pages a forked child held before exec (a Python caller's, say).
 double peak_memory_mib() {
@@ -85,6 +100,8 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
     s["mrays_per_second"] = seconds > 0 ? double(rays) / seconds / 1e6 : 0.0;
     s["avg_ray_latency_cycles"] = checker.latency().mean();
     s["unit_busy_fraction"] = mean_of(model.value("units", json::object()), unit_stats(), "busy_fraction");
+    if (const json simd = simd_efficiency(model.value("units", json::object())); !simd.is_null())
+        s["simd_efficiency"] = simd;
     s["box_utilization"] = mean_of(model.value("box", json::object()), pipeline_stats(), "utilization");
     s["triangle_utilization"] = mean_of(model.value("triangle", json::object()), pipeline_stats(), "utilization");
     s["l1_hit_rate"] = model.contains("l1") ? hit_rate(model["l1"]) : json(nullptr);

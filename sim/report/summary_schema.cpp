@@ -1,6 +1,8 @@
 // The summary keys (summary_schema.h). Add a key here first; docs/stats.md follows from it.
 #include "sim/report/summary_schema.h"
 
+#include <string>
+
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -46,6 +48,9 @@ const StatBlock& summary_stats() {
         {"unit_busy_fraction", "fraction",
          "mean over units of `model.units.<unit>.busy_fraction`",
          true, false},
+        {"simd_efficiency", "fraction",
+         "`traversal.model` simt only: active lanes / lane slots over every unit's warp steps (`model.units.<unit>.simd_efficiency`, Aila & Laine 2009)",
+         false, true},
         {"box_utilization", "fraction",
          "mean over box pipeline blocks of `utilization`",
          true, false},
@@ -148,10 +153,14 @@ const StatBlock& provenance_stats() {
     return block;
 }
 
+/// The summary's optional keys are a sampled run's estimate, except the one a traversal unit kind
+/// writes (simd_efficiency: runs of SIMT units only).
+static bool sampled_only(const StatDecl& d) { return d.optional && std::string(d.key) != "simd_efficiency"; }
+
 void check_summary(const nlohmann::json& summary, bool sampled) {
     summary_stats().check(summary);
     for (const StatDecl& d : summary_stats().stats)
-        require(!d.optional || !sampled || summary.contains(d.key),
+        require(!sampled_only(d) || !sampled || summary.contains(d.key),
                 std::string("stats: 'summary.") + d.key + "' is declared for sampled runs but was not written");
 }
 

@@ -42,6 +42,7 @@ const std::vector<ResourceInfo>& resource_table() {
         {"stack", "stack spills (spilled entries read back)", "", "traversal.stack_entries"},
         {"ray_buffer", "the ray buffer SRAM", "", "treelets.bytes_per_cycle"},
         {"workload", "the workload: too few rays to keep the machine busy (contexts idle)", "", ""},
+        {"divergence", "SIMT divergence (warp lanes masked off while others step)", "", ""},
     };
     return r;
 }
@@ -80,7 +81,7 @@ std::string waiting_for(const std::string& use) {
         {"l1_hit", "data from its L1"},      {"issue", "its unit's scheduler"},
         {"stack", "spilled stack entries"},  {"ray_buffer", "the ray buffer"},
         {"dispatch", "dispatch"},            {"starved", "a ray (starved)"},
-        {"tail", "nothing: the workload had run out"}};
+        {"tail", "nothing: the workload had run out"}, {"idle_lane", "their warp (lanes masked off)"}};
     auto it = w.find(use);
     if (it != w.end()) return it->second;
     return "the " + use.substr(5) + " pipeline";  // pipe_<kind>
@@ -105,6 +106,7 @@ std::string resource_of_use(const std::string& use, const json& model, std::stri
     if (use == "issue") return "scheduler";
     if (use == "stack" || use == "ray_buffer") return use;
     if (use == "starved" || use == "tail") return "workload";
+    if (use == "idle_lane") return "divergence";
     if (use.rfind("pipe_", 0) == 0) {
         const std::string kind = use.substr(5);
         return saturated(use.c_str(), kind.c_str());
@@ -167,6 +169,9 @@ SimConfig analytic_config(SimConfig config) {
     config.fidelity = Fidelity::analytic;
     config.treelets.enabled = false;
     config.sampling = SamplingConfig{};
+    // The closed form times each ray context on its own: a SIMT machine's relaxations are
+    // estimated for the MIMD machine with the same contexts (divergence is not in it).
+    config.traversal.model = UnitModel::mimd;
     return config;
 }
 
@@ -254,6 +259,7 @@ Relaxation relaxation_for(const std::string& resource, const SimConfig& c) {
         if (p.initiation_interval > 1) return halved(c, base + "initiation_interval");
         return doubled(c, base + "width");
     }
+    if (resource == "divergence") return halved(c, "traversal.lanes");  // narrower warps diverge less
     if (resource == "scheduler")
         return c.traversal.issue_cycles > 1 ? halved(c, "traversal.issue_cycles") : doubled(c, "traversal.units");
     const ResourceInfo* r = find_resource(resource);
@@ -335,7 +341,7 @@ const StatBlock& verdict_stats() {
     static const StatBlock block{
         "verdict",
         {
-            {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l2`, `l1_banks`, `pipe_<kind>`, `scheduler`, `stack`, `ray_buffer`, `dispatch`, `latency`"},
+            {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l2`, `l1_banks`, `pipe_<kind>`, `scheduler`, `stack`, `ray_buffer`, `dispatch`, `latency`, `divergence` (SIMT lanes idle)"},
             {"label", "", "the same in words (e.g. \"DRAM bandwidth\")"},
             {"text", "", "one sentence: label, evidence and the best relaxation with its estimated speed-up"},
             {"evidence", "", "`use` (the cycle-accounting use that points at it), `context_fraction` (that use's share of context cycles), `utilization.<resource>` (the utilisations that confirm it), `text` (the evidence in words)"},

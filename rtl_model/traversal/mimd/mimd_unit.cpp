@@ -13,7 +13,8 @@ MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
       m_costs(setup.costs),
       m_index(index),
       m_contexts(setup.config.ray_contexts),
-      m_events(setup.config.ray_contexts) {
+      m_events(setup.config.ray_contexts),
+      m_sync(setup.context.quantum_cycles) {
     SC_THREAD(run);
 }
 
@@ -39,7 +40,7 @@ void MimdUnit::run() {
             if (ray_buffer->done()) break;
             now += m_ctx.idle_poll_cycles;
             ++m_idle_polls;
-            sync(now);
+            m_sync(now);
             fill_idle_contexts(now);
             continue;
         }
@@ -51,25 +52,16 @@ void MimdUnit::run() {
         now = t;
         // An operations phase on private pipelines touches nothing shared (stack spills sync
         // themselves in stack_traffic()), so it may run ahead of SystemC time.
-        if (m_ctx.sync_private_steps || m_contexts[c].phase != Phase::ops) sync(t);
+        if (m_ctx.sync_private_steps || m_contexts[c].phase != Phase::ops) m_sync(t);
         advance(c, t);
         m_events.finish_pop();
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
         if (!m_treelet_mode && rays->frame() != m_frame) {  // a frame was released: fill every context
-            if (!m_ctx.sync_private_steps) sync(t);  // dispatch is shared: in time order at detailed
+            if (!m_ctx.sync_private_steps) m_sync(t);  // dispatch is shared: in time order at detailed
             m_frame = rays->frame();
             fill_idle_contexts(t);
         }
     }
-}
-
-void MimdUnit::sync(Cycle t) {
-    // Temporal decoupling: run ahead of SystemC time by at most a quantum, then let others catch up.
-    if (t < m_synced + m_ctx.quantum_cycles) return;
-    uint64_t now = sc_core::sc_time_stamp().value();
-    if (t > now) wait(sc_core::sc_time::from_value(t - now));
-    m_synced = t;
-    ++m_syncs;
 }
 
 void MimdUnit::fill_idle_contexts(Cycle t) {
@@ -79,17 +71,11 @@ void MimdUnit::fill_idle_contexts(Cycle t) {
 }
 
 void MimdUnit::account(uint32_t c, CycleUse use, Cycle until) {
-    Context& ctx = m_contexts[c];
-    if (until <= ctx.accounted) return;
-    m_account.add(use, until - ctx.accounted);
-    ctx.accounted = until;
+    account_until(m_account, m_contexts[c].accounted, use, until);
 }
 
 void MimdUnit::account_read(uint32_t c, Cycle ready, const AccessInfo& info) {
-    Context& ctx = m_contexts[c];
-    if (ready <= ctx.accounted) return;
-    account_memory(m_account, ctx.accounted, ready, info);
-    ctx.accounted = ready;
+    account_read_until(m_account, m_contexts[c].accounted, ready, info);
 }
 
 void MimdUnit::activate(uint32_t c, Cycle t) {
@@ -204,17 +190,10 @@ Cycle MimdUnit::stack_traffic(uint32_t c, Cycle t, Cycle ready) {
     // Spill slots belong to the context (reused ray after ray); with treelets they belong to the
     // ray (its id), since the ray moves between contexts and units through the ray buffer.
     const uint64_t owner = m_treelet_mode ? ray.ray_id : uint64_t(m_index) * m_contexts.size() + c;
-    d.for_each_spill([&](uint32_t slot) {  // full on-chip stack: the oldest entry goes to memory (posted)
-        if (!m_ctx.sync_private_steps) sync(t);  // the write goes on to the shared L2
-        mem->access({m_map.stack(owner, slot, bytes), bytes, true, DataKind::stack, t});
-        ++m_spill_writes;
+    // The write goes on to the shared L2 and a read may miss to it: in time order at detailed.
+    return issue_stack_traffic(*mem[0], m_map, d, owner, bytes, t, ready, &m_spill_writes, &m_spill_reads, [&] {
+        if (!m_ctx.sync_private_steps) m_sync(t);
     });
-    d.for_each_fill([&](uint32_t slot) {  // on-chip stack empty but entries in memory: read one back first
-        if (!m_ctx.sync_private_steps) sync(t);  // may miss to the shared L2
-        ++m_spill_reads;
-        ready = std::max(ready, mem->access({m_map.stack(owner, slot, bytes), bytes, false, DataKind::stack, t}));
-    });
-    return ready;
 }
 
 void MimdUnit::finish_ray(uint32_t c, Cycle t) {
@@ -248,7 +227,7 @@ nlohmann::json MimdUnit::stats_json(Cycle total_cycles) const {
         .set("stack_spill_writes", m_spill_writes)
         .set("stack_spill_reads", m_spill_reads)
         .set("rejected_rays", m_rejected)
-        .set("quantum_syncs", m_syncs)
+        .set("quantum_syncs", m_sync.syncs())
         .set("finish_cycle", m_finish)
         .set("cycle_accounting", cycle_account(total_cycles).to_json());
     if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);

@@ -23,6 +23,7 @@
 
 #include "rtl_model/traversal/context_queue.h"
 #include "rtl_model/traversal/traversal_unit.h"
+#include "rtl_model/traversal/unit_parts.h"
 
 namespace rtsim {
 
@@ -48,7 +49,6 @@ private:
     };
 
     void run();
-    void sync(Cycle t);
     bool start_ray(uint32_t c, Cycle t);
     bool take_parked_ray(uint32_t c, Cycle t);
     void park_ray(uint32_t c, uint32_t treelet, Cycle t);
@@ -74,12 +74,12 @@ private:
     uint32_t m_index;
     std::vector<Context> m_contexts;
     ContextQueue m_events;  ///< each context's next phase, earliest first
+    QuantumSync m_sync;
     Cycle m_sched_free = 0;
-    Cycle m_synced = 0;
     Cycle m_finish = 0;
     uint32_t m_active = 0;
     Cycle m_busy_since = 0, m_busy_cycles = 0;
-    uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0, m_syncs = 0;
+    uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0;
     bool m_treelet_mode = false;
     uint32_t m_frame = 0;  ///< the dispatch frame this unit last filled its contexts from
     Cycle m_next_fill = 0;

@@ -1,0 +1,323 @@
+#include "rtl_model/traversal/simt/simt_unit.h"
+
+#include <algorithm>
+#include <array>
+
+namespace rtsim {
+
+SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
+    : TraversalUnit(name),
+      m_config(setup.config),
+      m_ctx(setup.context),
+      m_map(setup.map),
+      m_steppers(setup.steppers),
+      m_costs(setup.costs),
+      m_index(index),
+      m_lanes(setup.config.warps() * setup.config.lanes),
+      m_warps(setup.config.warps()),
+      m_events(setup.config.warps()),
+      m_sync(setup.context.quantum_cycles),
+      m_coalescer(setup.context.line_bytes),
+      m_active_histogram(setup.config.lanes + 1, 0) {
+    SC_THREAD(run);
+}
+
+void SimtUnit::run() {
+    for (Lane& lane : m_lanes) lane.ray.stepper = m_steppers.acquire();
+    Cycle now = 0;
+    fill_idle_warps(0);
+    for (;;) {
+        if (m_events.empty()) {
+            // No warp has a ray. Done, unless dispatch holds the next frame's rays until this
+            // frame's last ray finishes (docs/model.md, "Frames"): wait for them.
+            const sc_core::sc_event* released = rays->released();
+            if (rays->exhausted() || !released) break;
+            if (rays->frame() == m_frame) wait(*released);
+            m_frame = rays->frame();
+            fill_idle_warps(now);
+            continue;
+        }
+        const Cycle ready = m_events.top_time();
+        const uint32_t w = m_events.begin_pop();
+        // The scheduler issues one warp phase per issue_cycles.
+        const Cycle t = std::max(ready, m_sched_free);
+        m_sched_free = t + m_config.issue_cycles;
+        now = t;
+        m_sync(t);
+        advance(w, t);
+        m_events.finish_pop();
+        if (rays->frame() != m_frame) {  // a frame was released: fill the idle warps
+            m_frame = rays->frame();
+            fill_idle_warps(t);
+        }
+    }
+}
+
+bool SimtUnit::warp_has_ray(uint32_t w) const {
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l)
+        if (m_lanes[l].has_ray) return true;
+    return false;
+}
+
+void SimtUnit::fill_idle_warps(Cycle t) {
+    for (uint32_t w = 0; w < m_warps.size(); ++w) {
+        if (warp_has_ray(w)) continue;  // in flight: it refills itself
+        if (!retire_and_refill(w, t)) break;  // dispatch has nothing now
+        fetch_rays(w, t);
+    }
+}
+
+void SimtUnit::advance(uint32_t w, Cycle t) {
+    ++m_steps;
+    if (m_warps[w].phase == Phase::ops) run_ops(w, t);
+    else step(w, t);
+}
+
+bool SimtUnit::retire_and_refill(uint32_t w, Cycle t) {
+    m_coalescer.clear();
+    const uint32_t end = first_lane(w) + m_config.lanes;
+    bool any_ray = false;
+    for (uint32_t l = first_lane(w); l < end; ++l) {
+        m_lanes[l].stepping = false;
+        if (m_lanes[l].has_ray && m_lanes[l].ray.stepper->plan().done) finish_lane(l, t);
+        any_ray = any_ray || m_lanes[l].has_ray;
+    }
+    if (m_config.simt_refill == SimtRefill::warp && any_ray) return false;  // the warp has not retired
+    Cycle fetch = 0;
+    bool taken = false;
+    for (uint32_t l = first_lane(w); l < end; ++l)
+        if (!m_lanes[l].has_ray) {
+            if (!start_lane(l, t, &fetch)) break;
+            taken = true;
+        }
+    m_fetch_at = fetch;
+    return taken;
+}
+
+bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
+    RayJob job;
+    if (!rays->next_ray(m_index, &job)) return false;
+    const Cycle start = std::max(t, job.not_before);  // a frame's rays start when the previous frame is done
+    Lane& lane = m_lanes[l];
+    lane.ray.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+    if (!ray_is_valid(job.ray)) ++m_rejected;
+    lane.ray.ray_id = job.id;
+    lane.kind = job.kind;
+    lane.ray.start = start;
+    lane.ray.stack = StackSplit{};
+    account_until(m_account, lane.accounted, CycleUse::starved, start);  // no ray until now
+    lane.has_ray = lane.stepping = true;
+    if (m_active_lanes++ == 0) m_busy_since = start;
+    *fetch = std::max(*fetch, start + m_ctx.dispatch_latency);
+    m_coalescer.add(m_map.ray(job.id), sizeof(RayRecord), DataKind::ray);
+    return true;
+}
+
+void SimtUnit::fetch_rays(uint32_t w, Cycle t) {
+    // The new rays' records are read (coalesced) in a warp step of their own; the lanes that
+    // already had rays wait for it.
+    AccessInfo slowest;
+    const Cycle ready = issue_reads(m_fetch_at, &slowest);
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+        Lane& lane = m_lanes[l];
+        if (!lane.stepping) continue;
+        account_until(m_account, lane.accounted, CycleUse::dispatch, m_fetch_at);
+        account_read_until(m_account, lane.accounted, ready, slowest);
+    }
+    account_idle(w, ready);
+    count_warp_step(w, t);
+    ++m_fetch_steps;
+    m_warps[w].phase = Phase::step;
+    m_events.schedule(w, std::max(ready, t));
+}
+
+uint32_t SimtUnit::choose_class(uint32_t w) const {
+    std::array<uint32_t, kClasses> want{};
+    bool any = false;
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l)
+        if (m_lanes[l].has_ray) {
+            ++want[step_class(m_lanes[l].ray.stepper->plan())];
+            any = true;
+        }
+    if (!any) return kClasses;
+    const uint32_t last = m_warps[w].last_class;
+    // while-while stays in its inner loop while any lane needs it; both policies then take the
+    // next kind in program order that some lane needs.
+    if (m_config.simt_policy == SimtPolicy::while_while && want[last]) return last;
+    for (uint32_t i = 1; i <= kClasses; ++i)
+        if (want[(last + i) % kClasses]) return (last + i) % kClasses;
+    return last;
+}
+
+void SimtUnit::step(uint32_t w, Cycle t) {
+    if (retire_and_refill(w, t)) return fetch_rays(w, t);
+    const uint32_t cls = choose_class(w);
+    if (cls == kClasses) return;  // every lane finished and dispatch is empty: the warp idles
+    Warp& warp = m_warps[w];
+    warp.last_class = cls;
+    // The lanes whose next step runs the warp's kind step (costed and run with the one
+    // arithmetic as their fetches issue); their fetches are coalesced per line.
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+        Lane& lane = m_lanes[l];
+        lane.stepping = lane.has_ray && step_class(lane.ray.stepper->plan()) == cls;
+        if (!lane.stepping) continue;
+        account_until(m_account, lane.accounted, CycleUse::issue, t);
+        take_step(*lane.ray.stepper, lane.ray.stack, m_costs, lane.demand);
+        for (int i = 0; i < lane.demand.read_count; ++i)
+            m_coalescer.add(lane.demand.reads[i].addr, lane.demand.reads[i].bytes, lane.demand.reads[i].kind);
+    }
+    AccessInfo slowest;
+    const Cycle ready = issue_reads(t, &slowest);
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l)
+        if (m_lanes[l].stepping) account_read_until(m_account, m_lanes[l].accounted, ready, slowest);
+    account_idle(w, ready);
+    count_warp_step(w, t);
+    warp.phase = Phase::ops;
+    m_events.schedule(w, ready);
+}
+
+void SimtUnit::run_ops(uint32_t w, Cycle t) {
+    // Each kind's issues of all stepping lanes go to its pipeline, kinds in the order the lanes'
+    // demands list them; then each lane's stack traffic. The warp waits for the slowest.
+    std::array<uint32_t, kOpKindCount> issues{}, tests{};
+    std::array<bool, kOpKindCount> seen{};
+    std::array<OpKind, kOpKindCount> order{};
+    uint32_t kinds = 0;
+    const uint32_t begin = first_lane(w), end = begin + m_config.lanes;
+    for (uint32_t l = begin; l < end; ++l) {
+        if (!m_lanes[l].stepping) continue;
+        account_until(m_account, m_lanes[l].accounted, CycleUse::issue, t);
+        const StepDemand& d = m_lanes[l].demand;
+        for (int i = 0; i < d.issue_count; ++i) {
+            const size_t k = size_t(d.issues[i].kind);
+            if (!seen[k]) seen[k] = true, order[kinds++] = d.issues[i].kind;
+            issues[k] += d.issues[i].issues;
+            tests[k] += d.issues[i].tests;
+        }
+    }
+    Cycle ready = t;
+    for (uint32_t i = 0; i < kinds; ++i) {
+        const size_t k = size_t(order[i]);
+        ready = pipes[k]->issue(ready, issues[k], tests[k]);
+        for (uint32_t l = begin; l < end; ++l)
+            if (m_lanes[l].stepping) account_until(m_account, m_lanes[l].accounted, pipe_use(order[i]), ready);
+    }
+    const Cycle ops_done = ready;
+    for (uint32_t l = begin; l < end; ++l) {
+        if (!m_lanes[l].stepping) continue;
+        const uint64_t owner = uint64_t(m_index) * m_lanes.size() + l;  // spill slots belong to the lane
+        ready = std::max(ready, issue_stack_traffic(*mem[0], m_map, m_lanes[l].demand, owner, m_costs.stack_entry_bytes, t,
+                                                    ops_done, &m_spill_writes, &m_spill_reads, [] {}));
+    }
+    for (uint32_t l = begin; l < end; ++l)
+        if (m_lanes[l].stepping) account_until(m_account, m_lanes[l].accounted, CycleUse::stack, ready);
+    account_idle(w, ready);
+    m_warps[w].phase = Phase::step;
+    m_events.schedule(w, ready);
+}
+
+Cycle SimtUnit::issue_reads(Cycle t, AccessInfo* slowest) {
+    Cycle ready = t;
+    bool first = true;
+    AccessInfo info;
+    m_coalescer.issue([&](uint64_t addr, uint32_t bytes, DataKind kind) {
+        const Cycle done = mem->access({addr, bytes, false, kind, t, &info});
+        if (done > ready || first) *slowest = info;
+        first = false;
+        ready = std::max(ready, done);
+    });
+    return ready;
+}
+
+void SimtUnit::account_idle(uint32_t w, Cycle until) {
+    const bool waiting = m_config.simt_refill == SimtRefill::warp && warp_has_ray(w);
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+        Lane& lane = m_lanes[l];
+        if (!lane.stepping && (lane.has_ray || waiting)) account_until(m_account, lane.accounted, CycleUse::idle_lane, until);
+    }
+}
+
+void SimtUnit::count_warp_step(uint32_t w, Cycle t) {
+    uint32_t active = 0;
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+        const Lane& lane = m_lanes[l];
+        if (!lane.has_ray) continue;
+        ++m_kind_present[size_t(lane.kind)];
+        if (lane.stepping) ++active, ++m_kind_active[size_t(lane.kind)];
+    }
+    ++m_warp_steps;
+    m_lane_steps += active;
+    ++m_active_histogram[active];
+    m_slot_use.add(t, m_config.lanes);
+    m_active_use.add(t, active);
+}
+
+nlohmann::json SimtUnit::efficiency_by_kind() const {
+    nlohmann::json out = nlohmann::json::object();
+    for (int k = 0; k < kRayKindCount; ++k)
+        if (m_kind_present[size_t(k)])
+            out[ray_kind_name(RayKind(k))] = double(m_kind_active[size_t(k)]) / double(m_kind_present[size_t(k)]);
+    return out;
+}
+
+nlohmann::json SimtUnit::efficiency_over_time() const {
+    // Active lanes / lane slots per point, the points as UsageSeries::to_json groups them.
+    const nlohmann::json slots = m_slot_use.to_json(1.0), active = m_active_use.to_json(1.0);
+    nlohmann::json out = nlohmann::json::array();
+    for (size_t i = 0; i < slots.size() && i < active.size(); ++i) {
+        const double s = slots[i]["value"].get<double>();
+        out.push_back({{"cycle", slots[i]["cycle"]}, {"value", s > 0 ? active[i]["value"].get<double>() / s : 0.0}});
+    }
+    return out;
+}
+
+void SimtUnit::finish_lane(uint32_t l, Cycle t) {
+    Lane& lane = m_lanes[l];
+    account_until(m_account, lane.accounted, CycleUse::issue, t);  // done, waiting for its warp's step
+    // The hit record is written back (posted).
+    mem->access({m_map.hit(lane.ray.ray_id), sizeof(HitRecord), true, DataKind::hit, t});
+    const Stepper& s = *lane.ray.stepper;
+    sink->ray_done(RayResult{lane.ray.ray_id, s.hit(), s.work(), lane.ray.start, t, m_index, l});
+    rays->ray_finished(t);
+    ++m_rays;
+    m_finish = std::max(m_finish, t);
+    lane.has_ray = false;
+    if (--m_active_lanes == 0) m_busy_cycles += t - m_busy_since;
+}
+
+CycleAccount SimtUnit::cycle_account(Cycle total_cycles) const {
+    CycleAccount a = m_account;
+    for (const Lane& lane : m_lanes)
+        if (total_cycles > lane.accounted) a.add(CycleUse::tail, total_cycles - lane.accounted);
+    return a;
+}
+
+nlohmann::json SimtUnit::stats_json(Cycle total_cycles) const {
+    nlohmann::json j;
+    const uint64_t slots = m_warp_steps * m_config.lanes;
+    StatsWriter(unit_stats(), j)
+        .set("rays", m_rays)
+        .set("steps", m_steps)
+        .set("busy_cycles", m_busy_cycles)
+        .set("busy_fraction", total_cycles ? double(m_busy_cycles) / double(total_cycles) : 0.0)
+        .set("stack_spill_writes", m_spill_writes)
+        .set("stack_spill_reads", m_spill_reads)
+        .set("rejected_rays", m_rejected)
+        .set("quantum_syncs", m_sync.syncs())
+        .set("finish_cycle", m_finish)
+        .set("cycle_accounting", cycle_account(total_cycles).to_json())
+        .set("warp_steps", m_warp_steps)
+        .set("ray_fetch_steps", m_fetch_steps)
+        .set("lane_slots", slots)
+        .set("active_lanes", m_lane_steps)
+        .set("simd_efficiency", slots ? double(m_lane_steps) / double(slots) : 0.0)
+        .set("active_lane_histogram", m_active_histogram)
+        .set("simd_efficiency_by_kind", efficiency_by_kind())
+        .set("simd_efficiency_over_time", efficiency_over_time())
+        .set("lane_requests", m_coalescer.lane_requests())
+        .set("coalesced_requests", m_coalescer.requests())
+        .done();
+    return j;
+}
+
+}  // namespace rtsim

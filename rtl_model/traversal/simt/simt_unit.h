@@ -1,0 +1,113 @@
+#pragma once
+// The SIMT traversal unit, traversal.model = "simt": the unit's ray contexts are the lanes of
+// `ray_contexts / lanes` warps, and a warp's lanes step in lock-step, as GPU ray tracing runs one
+// ray per SIMD lane (Aila & Laine 2009; Vulkan-Sim's RT unit). Each lane drives its own stepper
+// (its own stack) and costs its step with the step-demand function (../step_demand.h); the warp
+// merges its lanes' demands:
+//
+//   warp step:  one operation kind for the warp (traversal.simt_policy: while-while or if-if, as
+//               Aila & Laine define them); the lanes whose next step runs that kind step, the others
+//               idle (counted: lane slots, idle_lane cycles)
+//   fetches:    the stepping lanes' fetches coalesced per L1 line: one request per distinct line
+//   operations: each kind's issues of all stepping lanes, to the kind's pipeline at its width
+//               (a lane's tests never share an issue with another lane's: each issue tests one ray)
+//   stack:      each lane's spills and fills, to its own spill slots
+//
+// Like the MIMD unit, a warp step is two scheduler phases (fetches, then operations) so requests
+// to the private L1 and pipelines come in time order, and the unit runs ahead of SystemC time by
+// at most quantum_cycles. A lane whose ray finished writes its hit at the warp's next step and
+// takes a new ray then (traversal.simt_refill = lane, persistent threads) or once its whole warp
+// has finished (warp); new rays' records are fetched in a warp step of their own (the lanes that
+// fetch are its active lanes: refilling few lanes costs a mostly idle step, as on a GPU).
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "rtl_model/common/usage_series.h"
+#include "rtl_model/traversal/context_queue.h"
+#include "rtl_model/traversal/simt/coalescer.h"
+#include "rtl_model/traversal/traversal_unit.h"
+#include "rtl_model/traversal/unit_parts.h"
+
+namespace rtsim {
+
+class SimtUnit : public TraversalUnit {
+public:
+    SC_HAS_PROCESS(SimtUnit);
+    SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index);
+
+    Cycle finish_cycle() const override { return m_finish; }
+    uint64_t rays_done() const override { return m_rays; }
+    CycleAccount cycle_account(Cycle total_cycles) const override;
+    nlohmann::json stats_json(Cycle total_cycles) const override;
+
+    /// The step class of a plan: its first operation's kind, or kOpKindCount for a step with none.
+    static uint32_t step_class(const StepPlan& plan) { return plan.op_count ? uint32_t(plan.op[0].kind) : kOpKindCount; }
+
+private:
+    static constexpr uint32_t kClasses = kOpKindCount + 1;
+    enum class Phase : uint8_t { step, ops };
+    struct Lane {
+        RayState ray;
+        StepDemand demand;      ///< its step in the warp step in flight
+        RayKind kind = RayKind::primary;
+        bool has_ray = false;
+        bool stepping = false;  ///< active in the warp step in flight
+        Cycle accounted = 0;
+    };
+    struct Warp {
+        Phase phase = Phase::step;
+        uint32_t last_class = 0;  ///< the step class it ran last
+    };
+
+    void run();
+    void fill_idle_warps(Cycle t);
+    void advance(uint32_t w, Cycle t);
+    void step(uint32_t w, Cycle t);
+    void run_ops(uint32_t w, Cycle t);
+    /// Finishes the lanes whose rays are done and refills lanes per simt_refill; true when rays
+    /// were taken (the warp step then fetches their records).
+    bool retire_and_refill(uint32_t w, Cycle t);
+    void fetch_rays(uint32_t w, Cycle t);
+    bool start_lane(uint32_t l, Cycle t, Cycle* fetch);
+    void finish_lane(uint32_t l, Cycle t);
+    /// The step class the warp runs next (simt_policy), or kClasses when no lane has a ray.
+    uint32_t choose_class(uint32_t w) const;
+    /// Counts a warp step of warp w (its lanes' `stepping` flags set) at cycle t.
+    void count_warp_step(uint32_t w, Cycle t);
+    nlohmann::json efficiency_by_kind() const;
+    nlohmann::json efficiency_over_time() const;
+    /// Lanes of warp w with a ray but not stepping (and, with warp refill, lanes waiting for the
+    /// warp) spent up to `until` idle.
+    void account_idle(uint32_t w, Cycle until);
+    Cycle issue_reads(Cycle t, AccessInfo* slowest);
+    bool warp_has_ray(uint32_t w) const;
+    uint32_t first_lane(uint32_t w) const { return w * m_config.lanes; }
+
+    const TraversalConfig& m_config;
+    UnitContext m_ctx;
+    const MemoryMap& m_map;
+    StepperPool& m_steppers;
+    const StepCosts m_costs;
+    uint32_t m_index;
+    std::vector<Lane> m_lanes;
+    std::vector<Warp> m_warps;
+    ContextQueue m_events;  ///< each warp's next phase, earliest first
+    QuantumSync m_sync;
+    LineCoalescer m_coalescer;
+    Cycle m_fetch_at = 0;  ///< when the rays retire_and_refill() took may fetch their records
+    Cycle m_sched_free = 0;
+    Cycle m_finish = 0;
+    uint32_t m_frame = 0;
+    uint32_t m_active_lanes = 0;  ///< lanes with a ray (busy while > 0)
+    Cycle m_busy_since = 0, m_busy_cycles = 0;
+    uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0;
+    uint64_t m_warp_steps = 0, m_lane_steps = 0, m_fetch_steps = 0;
+    std::vector<uint64_t> m_active_histogram;  ///< warp steps by active lanes (0 .. lanes)
+    /// Per ray kind: lane-steps of lanes holding a ray of that kind, and those that stepped.
+    std::array<uint64_t, kRayKindCount> m_kind_present{}, m_kind_active{};
+    UsageSeries m_slot_use, m_active_use;  ///< lane slots and active lanes over time
+    CycleAccount m_account;
+};
+
+}  // namespace rtsim
