@@ -69,6 +69,11 @@ DESIGNS = [
     Design("4 ray contexts", "sponza", ("traversal.ray_contexts=4",)),
     Design("32 units, 1 channel", "sponza", ("traversal.units=32", "dram.channels=1")),
     Design("treelets", "sponza", ("treelets.enabled=true",)),
+    Design(
+        "treelets, 2 admission reads",
+        "sponza",
+        ("treelets.enabled=true", "treelets.admit_outstanding=2"),
+    ),
     Design("rtx2060 preset", "sponza", (), "rtx2060"),
     Design("other structure", "sponza-alt"),
 ]
@@ -127,11 +132,13 @@ def slug(text: str) -> str:
 
 
 def knobs_to_measure(verdict: dict[str, Any]) -> list[str]:
-    """The verdict's top five candidates and the core knobs, as `key=to`."""
+    """The verdict's top five candidates and the core knobs, as `key=to`, and its first
+    co-limit (both knobs, joined by a space)."""
     cands = verdict.get("candidates") or []
-    chosen = [c for c in cands[:5]]
+    chosen = list(cands[:5])
     chosen += [c for c in cands if any(c["key"].startswith(k) for k in CORE) and c not in chosen]
-    return [f"{c['key']}={c['to']}" for c in chosen]
+    out = [f"{c['key']}={c['to']}" for c in chosen]
+    return out + [" ".join(co["sets"]) for co in (verdict.get("co_limits") or [])[:1]]
 
 
 def rays_per_second(stats: dict[str, Any]) -> float:
@@ -157,7 +164,7 @@ def study(
         o, knob = job
         d = o.design
         run = out / "runs" / slug(d.name) / slug(knob)
-        sets = [*d.sets, knob]
+        sets = [*d.sets, *knob.split(" ")]
         stats = simulate(traces[d.trace], run, configs[d.name], sets, False, args.fresh)
         return rays_per_second(stats) / rays_per_second(o.base)
 
@@ -179,31 +186,46 @@ def named_knob(verdict: dict[str, Any]) -> tuple[str, float | None]:
 def table(outcomes: list[Outcome]) -> tuple[str, dict[str, Any]]:
     rows = [
         "| design | rays | verdict names | estimated | measured | best single knob (measured) "
-        "| within 10% | co-limit (estimated jointly) |",
-        "|---|---:|---|---:|---:|---|:-:|---|",
+        "| within 10% (speed-up / gain) | best of the top three (--check-verdict) "
+        "| co-limit (estimated jointly, measured) |",
+        "|---|---:|---|---:|---:|---|:-:|---|---|",
     ]
-    hits, errors = 0, []
+    hits, gain_hits, checked_hits, errors = 0, 0, 0, []
     for o in outcomes:
         v = o.base["verdict"]
         knob, est = named_knob(v)
         meas = o.measured.get(knob)
-        best_knob, best = max(o.measured.items(), key=lambda kv: kv[1])
+        singles = {k: g for k, g in o.measured.items() if " " not in k}
+        best_knob, best = max(singles.items(), key=lambda kv: kv[1])
         within = meas is not None and meas >= best / 1.10
+        within_gain = meas is not None and meas - 1 >= 0.9 * (best - 1)
         hits += within
+        gain_hits += within_gain
+        # What --check-verdict gives: the best measured of the top three.
+        top3 = [f"{k['key']}={k['to']}" for k in (v.get("top") or [])[:3]]
+        checked_knob, checked = max(
+            ((k, o.measured[k]) for k in top3 if k in o.measured), key=lambda kv: kv[1]
+        )
+        checked_hits += checked - 1 >= 0.9 * (best - 1)
         if est is not None and meas:
             errors.append(abs(est - meas) / meas)
         co = "; ".join(
-            f"{' + '.join(c['sets'])}: {c['joint']:.2f}x" for c in (v.get("co_limits") or [])[:1]
+            f"{' + '.join(c['sets'])}: {c['joint']:.2f}x, measured "
+            f"{o.measured.get(' '.join(c['sets']), float('nan')):.2f}x"
+            for c in (v.get("co_limits") or [])[:1]
         )
         rows.append(
             f"| {o.design.name} | {o.base['summary']['rays']:,} | `{knob}` | "
             f"{f'{est:.2f}x' if est is not None else 'not estimated'} | "
             f"{f'{meas:.2f}x' if meas is not None else '-'} | `{best_knob}` {best:.2f}x | "
-            f"{'yes' if within else 'no'} | {co or '-'} |"
+            f"{'yes' if within else 'no'} / {'yes' if within_gain else 'no'} | "
+            f"`{checked_knob}` {checked:.2f}x | {co or '-'} |"
         )
     figures = {
         "designs": len(outcomes),
         "within_10pct": hits,
+        "within_10pct_of_gain": gain_hits,
+        "checked_within_10pct_of_gain": checked_hits,
         "median_estimate_error": statistics.median(errors) if errors else None,
         "estimated": len(errors),
     }
@@ -215,7 +237,7 @@ def main() -> None:
     p.add_argument("--out", type=Path, default=REPO / "out" / "verdict_study")
     p.add_argument("--resolution", default="128x96")
     p.add_argument(
-        "--alt-accel", default="bvh2", help="the structure of the 'other structure' design"
+        "--alt-accel", default="cwbvh8", help="the structure of the 'other structure' design"
     )
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--docs", type=Path, default=REPO / "docs")
@@ -235,7 +257,11 @@ def main() -> None:
     med = figures["median_estimate_error"]
     text += (
         f"\nThe named knob is within 10% of the best measured single knob (its speed-up at least "
-        f"the best's / 1.10) in **{figures['within_10pct']} of {figures['designs']}** designs; "
+        f"the best's / 1.10) in **{figures['within_10pct']} of {figures['designs']}** designs, "
+        f"and its gain within 10% of the best gain (gain at least 0.9 x the best's) in "
+        f"**{figures['within_10pct_of_gain']} of {figures['designs']}**; the best measured of "
+        f"its top three (what `--check-verdict` shows) is within 10% of the best gain in "
+        f"**{figures['checked_within_10pct_of_gain']} of {figures['designs']}**; "
         f"median error of the {figures['estimated']} estimates against their measured gain: "
         f"**{100 * med:.1f}%**.\n"
         if med is not None

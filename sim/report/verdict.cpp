@@ -131,6 +131,13 @@ std::vector<std::pair<std::string, double>> uses_by_size(const json& model) {
     return uses;
 }
 
+/// Whether each unit has its own `resource` (so more units relax it).
+bool per_unit(const SimConfig& c, const std::string& resource) {
+    OpKind kind;
+    if (op_kind_of(resource, &kind)) return !c.pipeline(kind).shared();
+    return resource == "latency" || resource == "scheduler" || resource == "l1_mshrs" || resource == "l1_banks";
+}
+
 /// What the evidence says of each resource: the share of context cycles that points at it, and
 /// the largest use that does.
 struct Evidence {
@@ -159,7 +166,9 @@ Evidence timed_evidence(const SimConfig& c, const json& model) {
             e.add("dram", use, fraction);
         if (use == "dram" || use == "l2_mshr_full") e.add("l2_capacity", use, fraction / 2);
         if (use == "l2" || use == "l1_mshr_full") e.add("l1_capacity", use, fraction / 2);
-        if (use == "issue") e.add("units", use, fraction);
+        // More units relax every per-unit resource at once: contexts (latency hiding), the
+        // scheduler, unshared pipelines, the L1's MSHRs and banks.
+        if (per_unit(c, r)) e.add("units", use, fraction);
         if (use == "ray_buffer") e.add("treelet_scheduling", use, fraction / 2);
     }
     return e;
@@ -225,6 +234,13 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
     } else {
         text += "; try " + knob_text(relax);
     }
+    // Estimates this close are within the analytic level's error of each other: say so.
+    const json& top = weighed["top"];
+    if (top.size() > 1 && top[0]["speedup"].is_number() && top[1]["speedup"].is_number() &&
+        top[0]["speedup"].get<double>() > 1.02 &&
+        top[1]["speedup"].get<double>() >= top[0]["speedup"].get<double>() - 0.03)
+        text += " (as good as " + top[1]["key"].get<std::string>() + " within the estimate's error: "
+                "measure both with --check-verdict)";
     std::string next;
     for (const json& k : weighed["top"])
         if (relax.is_null() || k["key"] != relax["key"]) next += (next.empty() ? "" : ", ") + knob_text(k);
