@@ -28,8 +28,10 @@ def test_structure_kinds_are_not_dropped() -> None:
 def test_log_axes_get_several_ticks() -> None:
     from rtsim.report.figures import log_ticks
 
-    # Wide spans: 1-2-5 steps; a span inside one decade (40 to 90) still gets several ticks.
-    assert log_ticks(1.0, 1000.0)[:4] == [1.0, 2.0, 5.0, 10.0]
+    # Wide spans: powers of ten; two decades: 1-2-5 steps; a span inside one decade (40 to
+    # 90) or narrower still gets several ticks.
+    assert log_ticks(1.0, 1000.0) == [1.0, 10.0, 100.0, 1000.0]
+    assert log_ticks(3.0, 120.0) == [5.0, 10.0, 20.0, 50.0, 100.0]
     for lo, hi in ((40.0, 90.0), (1500.0, 2600.0), (0.031, 0.047), (61.0, 64.0)):
         ticks = log_ticks(lo, hi)
         assert len(ticks) >= 2, (lo, hi, ticks)

@@ -461,8 +461,9 @@ def _cost_axis(ax: Any, xs: list[float], unit: str) -> None:
 def roofline(data: SweepData) -> Figure | None:
     """The roofline per scene and workload: every run a point at (DRAM bytes per ray, Mrays/s);
     the DRAM ceilings (peak bandwidth over bytes per ray: one line per distinct peak in the
-    sweep) and, above each point, the lowest ceiling of its pipelines and scheduler (stats
-    `roofline.ceilings`). A point on a line is bound by that resource; a point far below both is
+    sweep) and, above each point, the lowest of its own config's other ceilings: pipelines,
+    scheduler, L1 and L2 MSHRs by Little's law, L2 bandwidth (stats `roofline.ceilings`).
+    A point on a line is bound by that resource; a point far below both is
     latency- or queue-bound (the verdict says which)."""
     groups = [g for g in data.groups() if any(_roof(r) for r in g.ok)][:4]
     if not groups:
@@ -495,7 +496,7 @@ def roofline(data: SweepData) -> Figure | None:
             marker="_",
             s=160,
             color="#555555",
-            label="pipeline / scheduler ceiling",
+            label="its own lowest other ceiling (pipelines, scheduler, MSHRs, L2)",
         )
         ax.scatter(xs, [mrays(r) for r in runs], color="#C44E52", zorder=3, label="run")
         ax.set_xscale("log")
