@@ -37,3 +37,41 @@ def test_log_axes_get_several_ticks() -> None:
         assert len(ticks) >= 2, (lo, hi, ticks)
         assert all(lo <= t <= hi for t in ticks), (lo, hi, ticks)
     assert log_ticks(0.0, 1.0) == []
+
+
+def test_heatmap_colour_bar_label_fits_and_says_per_pixel() -> None:
+    import numpy as np
+
+    from rtsim.heatmaps import PixelWork, heatmap_figure
+
+    rng = np.random.default_rng(1)
+    data = rng.integers(0, 200, size=(96, 128)).astype(float)
+    data[0, 0] = 5000.0  # an extreme pixel: the scale is clipped and says so
+    work = PixelWork("steps", data / 3, data, 100, 200)
+    label = "traversal steps (nodes or cells visited)"
+    fig = heatmap_figure(work, label, "Sponza")
+    fig.canvas.draw()
+    box = fig.bbox
+    texts = [t for ax in fig.axes for t in (ax.yaxis.label, ax.title) if t.get_text()]
+    assert any("clipped" in t.get_text() for t in texts)
+    for t in texts:
+        extent = t.get_window_extent()
+        assert extent.x0 >= box.x0 - 1 and extent.x1 <= box.x1 + 1, t.get_text()
+        assert extent.y0 >= box.y0 - 1 and extent.y1 <= box.y1 + 1, t.get_text()
+    titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
+    assert titles and all("per pixel" in t and "per ray" not in t for t in titles)
+
+
+def test_figure_legend_names_every_panels_lines() -> None:
+    import matplotlib.pyplot as plt
+
+    from rtsim.report.figures import _fig_legend
+
+    fig, (a, b) = plt.subplots(1, 2)
+    a.plot([1, 2], [1, 2], label="diffuse")
+    b.plot([1, 2], [2, 1], label="diffuse")
+    b.plot([1, 2], [3, 3], label="diffuse · treelets on")  # only the second panel has it
+    _fig_legend(fig)
+    [legend] = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == ["diffuse", "diffuse · treelets on"]
+    plt.close(fig)

@@ -311,7 +311,7 @@ def rays_per_second(data: SweepData) -> Figure | None:
             ax.set_ylabel("simulated Mrays/s")
             ax.set_ylim(bottom=0)
             ax.set_title(f"{scene}: rays/s against {key}", fontsize=11)
-    _fig_legend(fig, axes[0][0])
+    _fig_legend(fig)
     fig.suptitle(
         "Performance against each swept key (line: median over the other keys; band: min to max)",
         y=1.0,
@@ -320,8 +320,17 @@ def rays_per_second(data: SweepData) -> Figure | None:
     return fig
 
 
-def _fig_legend(fig: Figure, ax: Any) -> None:
-    handles, names = ax.get_legend_handles_labels()
+def _fig_legend(fig: Figure) -> None:
+    """One legend for the figure: every labelled line of every panel, each name once (a line
+    only some panels draw, a category or a workload of another scene's row, is named too)."""
+    handles, names = [], []
+    for a in fig.axes:
+        for h, n in zip(*a.get_legend_handles_labels(), strict=True):
+            if n not in names:
+                handles.append(h)
+                names.append(n)
+    if not names:
+        return
     fig.legend(
         handles,
         names,
@@ -350,7 +359,7 @@ def hit_rates(data: SweepData) -> Figure | None:
             ax.set_ylim(0, 102)
             ax.set_ylabel(f"{level.upper()} hit rate (%)")
             ax.set_title(f"{level.upper()} hit rate against {key}", fontsize=11)
-    _fig_legend(fig, axes[0][0])
+    _fig_legend(fig)
     fig.suptitle("Cache hit rates per level (reads served, including merged misses)", y=1.0)
     fig.tight_layout(rect=(0, 0, 1, 0.94))
     return fig
