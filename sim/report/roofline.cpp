@@ -112,7 +112,7 @@ const StatBlock& roofline_stats() {
             {"bound_rays_per_second", "rays/s", "the lowest ceiling; the run can never be faster (tested)"},
             {"dram_bytes_per_ray", "bytes/ray", "as `summary.dram_bytes_per_ray`"},
             {"peak_dram_bytes_per_second", "B/s", "`channels x bytes_per_cycle x clock`"},
-            {"mshr_little", "", "timed levels: `{l1, l2}` each `{rays_per_second, mshrs (all units' at the L1), line_bytes, mean_hold_cycles (loaded: a miss's MSHR time), bytes_per_second (mshrs x line_bytes / mean_hold_cycles x clock), miss_bytes_per_ray}`; empty when the level kept no MSHR time"},
+            {"mshr_little", "", "timed levels: `l1` and `l2`, each with `rays_per_second` (the ceiling), `mshrs` (all units' at the L1), `line_bytes`, `mean_hold_cycles` (loaded: a miss's MSHR time), `bytes_per_second` (`mshrs x line_bytes / mean_hold_cycles x clock`) and `miss_bytes_per_ray`; empty when no level kept MSHR time"},
         }};
     return block;
 }
