@@ -90,7 +90,8 @@ json check_verdict(const SimOptions& o, const json& verdict, double base_rays_pe
         const double rps = code == 0 ? rays_per_second_of(run) : 0;
         json c = {{"sets", sets}, {"estimated", estimated}, {"run", run.string()}};
         c["measured"] = rps > 0 && base_rays_per_second > 0 ? json(rps / base_rays_per_second) : json(nullptr);
-        if (code != 0) c["error"] = "rtsim-sim exited with " + std::to_string(code) + " (see " + (run / "log.txt").string() + ")";
+        if (code != 0)
+            c["error"] = "rtsim-sim exited with " + std::to_string(code) + " (see " + (run / "log.txt").string() + ")";
         out.push_back(c);
     }
     std::stable_sort(out.begin(), out.end(), [](const json& a, const json& b) {
@@ -107,9 +108,9 @@ std::string checked_text(const json& verdict) {
     for (const json& c : verdict["check"]) {
         std::string sets;
         for (const json& s : c["sets"]) sets += (sets.empty() ? "" : " + ") + s.get<std::string>();
-        text += std::string(first ? " " : ", ") + sets + " measured " +
-                (c["measured"].is_number() ? gain(c["measured"].get<double>()) : std::string("(failed)")) +
-                " (estimated " + (c["estimated"].is_number() ? gain(c["estimated"].get<double>()) : std::string("-")) + ")";
+        const std::string measured = c["measured"].is_number() ? gain(c["measured"].get<double>()) : "(failed)";
+        const std::string estimated = c["estimated"].is_number() ? gain(c["estimated"].get<double>()) : "-";
+        text += std::string(first ? " " : ", ") + sets + " measured " + measured + " (estimated " + estimated + ")";
         first = false;
     }
     return text;

@@ -309,6 +309,15 @@ json judge(const VerdictContext& c) {
                {{"method", estimator.method()},
                 {"base_cycles", base_cycles},
                 {"wall_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}}}};
+    // Two resources binding together: name both when relaxing the pair beats any single knob.
+    const json& co = weighed["co_limits"].empty() ? json(nullptr) : weighed["co_limits"][0];
+    const bool co_beats = !co.is_null() && best_pays && best["speedup"].is_number() &&
+                          co["joint"].get<double>() > best["speedup"].get<double>();
+    if (co_beats &&
+        (co["resources"][0] == binding || co["resources"][1] == binding)) {
+        const std::string other = co["resources"][co["resources"][0] == binding ? 1 : 0];
+        v["label"] = label_of(binding) + " together with " + label_of(other) + " (a co-limit)";
+    }
     v["text"] = verdict_text(v, weighed, not_covered);
     return v;
 }

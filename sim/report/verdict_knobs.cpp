@@ -87,7 +87,8 @@ json co_limits(const WeighInputs& in, const json& knobs) {
             if (pool[i]["key"] == pool[j]["key"]) continue;
             double joint;
             try {
-                joint = in.base_cycles / in.cycles(relaxed_config(in.config, {relaxation_of(pool[i]), relaxation_of(pool[j])}));
+                const SimConfig both = relaxed_config(in.config, {relaxation_of(pool[i]), relaxation_of(pool[j])});
+                joint = in.base_cycles / in.cycles(both);
             } catch (const Error&) {
                 continue;
             }
@@ -153,7 +154,8 @@ json weigh_knobs(const WeighInputs& in) {
     std::vector<OpKind> ops;
     for (const json& b : in.instantiated)
         for (int k = 0; k < kOpKindCount; ++k)
-            if (b.value("block", "") == op_kind_name(OpKind(k)) && b.value("instantiated", false)) ops.push_back(OpKind(k));
+            if (b.value("block", "") == op_kind_name(OpKind(k)) && b.value("instantiated", false))
+                ops.push_back(OpKind(k));
     const double base_mm2 = area_total_mm2(in.config, in.instantiated);
     json knobs = json::array();
     for (const Knob& k : every_knob(in.config, ops)) {
@@ -166,8 +168,8 @@ json weigh_knobs(const WeighInputs& in) {
             const double added = area_total_mm2(relaxed, in.instantiated) - base_mm2;
             j["added_mm2"] = added;
             if (!k.estimable || !in.not_covered.empty() || !in.cycles) {
-                j["why_not"] = k.estimable && !in.not_covered.empty() ? in.not_covered
-                                                                      : "the analytic level does not model it: measure it";
+                const bool machine = k.estimable && !in.not_covered.empty();
+                j["why_not"] = machine ? in.not_covered : "the analytic level does not model it: measure it";
             } else {
                 const double speedup = in.base_cycles / in.cycles(relaxed);
                 j["speedup"] = speedup;
