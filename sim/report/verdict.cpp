@@ -19,33 +19,31 @@ namespace {
 constexpr double kSaturated = 0.7;
 
 /// The resources the verdict can name besides the pipelines: the name the analytic bounds and
-/// stats use, what a person calls it, the utilisation that shows it busy (model.utilization;
-/// "" if none) and the config knob that relaxes it, doubled ("" if none, or a rule below).
+/// stats use, what a person calls it and the utilisation that shows it busy (model.utilization;
+/// "" if none). The knobs that relax them are declared once, in verdict_knobs.cpp.
 struct ResourceInfo {
     const char* name;
     const char* label;
     const char* busy;
-    const char* knob;
 };
 
 const std::vector<ResourceInfo>& resource_table() {
     static const std::vector<ResourceInfo> r = {
-        {"l1_mshrs", "L1 MSHRs", "l1_mshrs", "l1.mshrs"},
-        {"l2_mshrs", "L2 MSHRs", "l2_mshrs", "l2.mshrs"},
-        {"dram", "DRAM bandwidth", "dram_bandwidth", "dram.channels"},
-        {"l1_banks", "L1 banks", "l1_banks", "l1.banks"},
-        {"l2_banks", "L2 banks", "l2_banks", "l2.banks"},
-        {"latency", "latency not hidden (memory and pipeline latency over too few ray contexts)", "",
-         "traversal.ray_contexts"},
-        {"scheduler", "the traversal units' schedulers (one step per issue_cycles)", "", ""},
-        {"stack", "stack spills (spilled entries read back)", "", "traversal.stack_entries"},
-        {"ray_buffer", "the ray buffer SRAM", "", "treelets.bytes_per_cycle"},
-        {"workload", "the workload: too few rays to keep the machine busy (contexts idle)", "", ""},
-        {"units", "too few traversal units", "", "traversal.units"},
-        {"l1_capacity", "L1 capacity (misses to the L2)", "", "l1.size_kib"},
-        {"l2_capacity", "L2 capacity (misses to DRAM)", "", "l2.size_kib"},
-        {"admission", "treelet admission (rays admitted into the ray buffer)", "", "treelets.admit_outstanding"},
-        {"treelet_scheduling", "treelet scheduling (which queue a free unit runs)", "", ""},
+        {"l1_mshrs", "L1 MSHRs", "l1_mshrs"},
+        {"l2_mshrs", "L2 MSHRs", "l2_mshrs"},
+        {"dram", "DRAM bandwidth", "dram_bandwidth"},
+        {"l1_banks", "L1 banks", "l1_banks"},
+        {"l2_banks", "L2 banks", "l2_banks"},
+        {"latency", "latency not hidden (memory and pipeline latency over too few ray contexts)", ""},
+        {"scheduler", "the traversal units' schedulers (one step per issue_cycles)", ""},
+        {"stack", "stack spills (spilled entries read back)", ""},
+        {"ray_buffer", "the ray buffer SRAM", ""},
+        {"workload", "the workload: too few rays to keep the machine busy (contexts idle)", ""},
+        {"units", "too few traversal units", ""},
+        {"l1_capacity", "L1 capacity (misses to the L2)", ""},
+        {"l2_capacity", "L2 capacity (misses to DRAM)", ""},
+        {"admission", "treelet admission (rays admitted into the ray buffer)", ""},
+        {"treelet_scheduling", "treelet scheduling (which queue a free unit runs)", ""},
     };
     return r;
 }
