@@ -68,8 +68,13 @@ def gltf_corpus(out: Path, work: Path) -> None:
         if not m.valid:
             write_gltf(bad / f"mut_{m.name.replace('/', '_')}.gltf", m.doc, binary)
     text = (seed / "rich.gltf").read_bytes()
-    for i, edits in enumerate([b"", struct.pack("<HBB6s", 5, 0, 0, b"\0" * 6) * 3,
-                               struct.pack("<HBB6s", 40, 5, 0, b"\1" * 6)]):
+    for i, edits in enumerate(
+        [
+            b"",
+            struct.pack("<HBB6s", 5, 0, 0, b"\0" * 6) * 3,
+            struct.pack("<HBB6s", 40, 5, 0, b"\1" * 6),
+        ]
+    ):
         (seed / f"structured_{i}.bin").write_bytes(
             b"RTSIMNUM" + struct.pack("<I", len(text)) + text + edits
         )
@@ -112,8 +117,18 @@ def trace_corpus(out: Path, work: Path) -> None:
         (bad / f"{case}.trace").write_bytes(b"\x00" + path.read_bytes())
         (bad / f"{case}.image").write_bytes(raw_image(path))
     # CRC-repaired section edits: record counts, a region renamed, frame tables.
-    rtsim("trace", "grove", "-o", str(work / "grove"), "--resolution", "4x3", "--frames", "3",
-          "--workload", "primary")
+    rtsim(
+        "trace",
+        "grove",
+        "-o",
+        str(work / "grove"),
+        "--resolution",
+        "4x3",
+        "--frames",
+        "3",
+        "--workload",
+        "primary",
+    )
     for source, edits in (("soup", COUNT_EDITS), ("grove", FRAME_EDITS)):
         for edit in edits:
             sections = read_sections(work / source / "trace.rtt")

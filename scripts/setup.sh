@@ -42,7 +42,7 @@ fi
 # (build/py) keeps the paths of these tools, so rebuilds are incremental and reliable.
 echo "setup: installing Python build and test tools"
 "$PYTHON" -m pip install -q \
-  "scikit-build-core>=0.10" "pybind11>=2.12" pytest hypothesis ruff
+  "scikit-build-core>=0.10" "pybind11>=2.12" pytest pytest-xdist hypothesis ruff
 
 export CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)}"
 echo "setup: building and installing rtsim (C++ and Python; -j${CMAKE_BUILD_PARALLEL_LEVEL})"

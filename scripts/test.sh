@@ -18,7 +18,12 @@ status=0
 echo "== C++ tests (ctest)"
 ctest --test-dir build/py --output-on-failure -j2 || status=1
 echo "== Python tests (pytest)"
-"$PYTHON" -m pytest tests/python -q || status=1
+# One pytest worker per core (pytest-xdist, installed by setup.sh): the suite is CPU-bound.
+xdist=()
+if "$PYTHON" -c "import xdist" 2>/dev/null; then
+  xdist=(-n "${PYTEST_WORKERS:-auto}")
+fi
+"$PYTHON" -m pytest tests/python -q "${xdist[@]}" || status=1
 
 if [ "$status" -ne 0 ]; then
   echo "test: FAILED" >&2

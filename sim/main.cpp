@@ -53,7 +53,7 @@ int sc_main(int argc, char** argv) {
     std::string trace, config_path, out_dir;
     std::vector<std::string> sets;
     bool timeline = false, progress = false, dump_defaults = false, dump_schema = false, dump_stats_schema = false,
-         no_verdict = false;
+         no_verdict = false, check_verdict = false;
     app.add_option("trace", trace, "Trace folder (from rtsim trace) or .rtt file");
     app.add_option("--config", config_path, "Config JSON (defaults for missing keys)");
     app.add_option("--set", sets, "Override a config key: key.path=value (repeatable)");
@@ -61,6 +61,9 @@ int sc_main(int argc, char** argv) {
     app.add_flag("--timeline", timeline, "Also write timeline.json (Chrome/Perfetto trace events)");
     app.add_flag("--progress", progress, "Print JSON progress lines on stderr");
     app.add_flag("--no-verdict", no_verdict, "Skip the bottleneck verdict (its analytic estimates on a sample of the trace)");
+    app.add_flag("--check-verdict", check_verdict,
+                 "Re-run the verdict's top three knobs and its co-limit, each in its own process (RUN/check/N), "
+                 "and report measured against estimated gains");
     app.add_flag("--dump-defaults", dump_defaults, "Print the default config as JSON and exit");
     app.add_flag("--dump-schema", dump_schema, "Print every config field with default, unit, range, doc");
     app.add_flag("--dump-stats-schema", dump_stats_schema, "Print every stats.json block's declared keys with unit and meaning");
@@ -87,6 +90,7 @@ int sc_main(int argc, char** argv) {
         o.timeline = timeline;
         o.progress = progress;
         o.verdict = !no_verdict;
+        o.check_verdict = check_verdict && !no_verdict;
         for (int i = 0; i < argc; ++i) o.command_line += (i ? " " : "") + std::string(argv[i]);
         rtsim::SimOutcome r = rtsim::run_simulation(o);
         const auto& s = r.stats["summary"];

@@ -252,6 +252,24 @@ def field_info(key: str) -> dataclasses.Field[Any]:
     return fields[leaf]
 
 
+#: Sections whose every other field has no effect while the switch is off: (prefix, switch).
+INACTIVE_UNLESS: tuple[tuple[str, str], ...] = (("treelets.", "treelets.enabled"),)
+
+
+def effective_dict(config: SimConfig) -> dict[str, Any]:
+    """The config as the simulator sees it: fields of a switched-off section (a ray-buffer size
+    with treelets off) at their defaults, so two configs that differ only there compare equal
+    (a sweep simulates them once)."""
+    data = config.to_dict()
+    flat, default = flatten(data), flatten(SimConfig().to_dict())
+    for prefix, switch in INACTIVE_UNLESS:
+        if flat.get(switch) is False:
+            for key in flat:
+                if key.startswith(prefix) and key != switch:
+                    flat[key] = default[key]
+    return unflatten(flat)
+
+
 def config_keys() -> list[str]:
     """Every dotted field key, in tree order."""
     return list(flatten(SimConfig().to_dict()))

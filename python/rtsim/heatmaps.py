@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -80,6 +81,13 @@ def color_limit(data: np.ndarray) -> float:
 
 
 def _draw(work: PixelWork, label: str, scene: str, path: Path) -> None:
+    heatmap_figure(work, label, scene).savefig(path, dpi=110)
+
+
+def heatmap_figure(work: PixelWork, label: str, scene: str) -> Any:
+    """The heatmap panels as a matplotlib Figure. Each pixel sums the work of every ray traced
+    from it (a primary ray and its bounces), so figures are per pixel, not per ray; the long
+    label stays in the title, the colour bar says only its unit so it is never cut."""
     # The object-oriented API: no pyplot global state, safe without a display.
     from matplotlib.figure import Figure
 
@@ -90,7 +98,9 @@ def _draw(work: PixelWork, label: str, scene: str, path: Path) -> None:
         # Each panel on its own scale: primary work is a fraction of the total.
         vmax = color_limit(data)
         image = ax.imshow(data, cmap="inferno", vmin=0.0, vmax=vmax, interpolation="nearest")
-        ax.set_title(f"{which}: mean {data.mean():.1f}, max {data.max(initial=0.0):.0f}")
+        ax.set_title(
+            f"{which}: {data.mean():.1f} per pixel on average, max {data.max(initial=0.0):.0f}"
+        )
         ax.set_axis_off()
         clipped = float(data.max(initial=0.0)) > vmax
         fig.colorbar(
@@ -98,10 +108,10 @@ def _draw(work: PixelWork, label: str, scene: str, path: Path) -> None:
             ax=ax,
             shrink=0.85,
             extend="max" if clipped else "neither",
-            label=f"{label} per pixel" + (f" (clipped at p{CLIP_PERCENTILE:g})" if clipped else ""),
+            label="per pixel" + (f" (clipped at p{CLIP_PERCENTILE:g})" if clipped else ""),
         )
     fig.suptitle(f"{scene}: {label} per pixel")
-    fig.savefig(path, dpi=110)
+    return fig
 
 
 def write_heatmaps(

@@ -70,6 +70,7 @@ class SimJob:
     timeline: bool = False  # also write RUN/timeline.json
     progress: bool = False  # JSON progress lines on stderr
     verdict: bool = True  # False: --no-verdict (no bottleneck estimates after the run)
+    check_verdict: bool = False  # --check-verdict: re-run the verdict's top knobs (RUN/check/N)
 
     def command(self, exe: Path) -> list[str]:
         """The command line; sweeps record it in RUN/command.txt (keep the order stable)."""
@@ -85,6 +86,8 @@ class SimJob:
             cmd.append("--progress")
         if not self.verdict:
             cmd.append("--no-verdict")
+        elif self.check_verdict:
+            cmd.append("--check-verdict")
         return cmd
 
 

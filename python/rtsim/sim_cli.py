@@ -2,6 +2,7 @@
 drive a progress bar from its JSON progress lines and print the run's summary.
 
 rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline] [--timeout S]
+               [--check-verdict]
 rtsim config --defaults | --schema
 
 Kept light at import time (no numpy, no C++ extension): a short simulation should not wait for
@@ -107,13 +108,39 @@ def run_and_report(
     return result.returncode
 
 
+def config_file(config: str | None, out_dir: Path) -> Path | None:
+    """--config as rtsim-sim takes it: a JSON file as given; a preset name ('rtx2060',
+    'base+tu16', as Python's configs take them) composed and written to RUN/config.preset.json.
+    An unknown name raises ConfigError listing the presets (exit 2)."""
+    if config is None:
+        return None
+    path = Path(config)
+    if path.exists() or config.endswith(".json") or "/" in config:
+        return path
+    from rtsim.config import compose
+
+    composed = compose(config)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    preset = out_dir / "config.preset.json"
+    preset.write_text(composed.to_json())
+    return preset
+
+
 def cmd_simulate(args: argparse.Namespace, console: Any) -> int:
+    from rtsim.errors import RtsimError
+
+    try:
+        config = config_file(args.config, Path(args.output))
+    except RtsimError as err:
+        print(f"rtsim: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     job = SimJob(
         trace=Path(args.trace),
         out_dir=Path(args.output),
-        config=Path(args.config) if args.config else None,
+        config=config,
         sets=list(args.set or []),
         timeline=args.timeline,
+        check_verdict=args.check_verdict,
     )
     return run_and_report(job, console, show_progress=not args.no_progress, timeout=args.timeout)
 
@@ -145,7 +172,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         "--config",
         metavar="CFG.json",
         default=None,
-        help="config JSON over the defaults (default: the defaults, rtsim config --defaults)",
+        help="config JSON over the defaults, or a preset name such as rtx2060 or base+tu16 "
+        "(default: the defaults, rtsim config --defaults)",
     )
     p.add_argument(
         "--set",
@@ -165,6 +193,12 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         default=None,
         metavar="SECONDS",
         help="kill rtsim-sim after this many seconds and exit with status 4 (default: no limit)",
+    )
+    p.add_argument(
+        "--check-verdict",
+        action="store_true",
+        help="after the run, re-run the verdict's top three knobs and its co-limit (each one "
+        "rtsim-sim process, RUN/check/N) and print measured against estimated gains",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_simulate)

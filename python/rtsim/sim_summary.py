@@ -140,6 +140,56 @@ def energy_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def _gain(x: Any) -> str:
+    return f"{x:.2f}x" if _is_num(x) else "-"
+
+
+def _knob(k: dict[str, Any]) -> str:
+    return f"--set {k.get('key')}={k.get('to')} (now {k.get('from')})"
+
+
+def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
+    """The verdict's top three knobs (estimated, or to be measured), the best gains per mm^2,
+    co-limits, what the estimator does not cover and, with --check-verdict, what re-runs
+    measured."""
+    rows: list[tuple[str, str]] = []
+    for i, k in enumerate(verdict.get("top") or []):
+        est = (
+            f"{_gain(k.get('speedup'))} estimated"
+            if _is_num(k.get("speedup"))
+            else f"not estimated ({k.get('why_not', '?')})"
+        )
+        rows.append(("  try" if i == 0 else "", f"{_knob(k)}: {est}"))
+    for i, k in enumerate(verdict.get("top_per_mm2") or []):
+        rows.append(
+            (
+                "  per mm^2" if i == 0 else "",
+                f"{_knob(k)}: {_gain(k.get('speedup'))} for {k.get('added_mm2', 0):.3f} mm^2",
+            )
+        )
+    for co in verdict.get("co_limits") or []:
+        alone = ", ".join(_gain(a) for a in co.get("alone", []))
+        rows.append(
+            (
+                "  co-limit",
+                f"{' + '.join(co.get('sets', []))}: {_gain(co.get('joint'))} jointly "
+                f"(alone {alone})",
+            )
+        )
+    coverage = verdict.get("coverage") or {}
+    if coverage.get("why_not"):
+        rows.append(("  caveat", str(coverage["why_not"])))
+    for i, c in enumerate(verdict.get("check") or []):
+        rows.append(
+            (
+                "  re-run" if i == 0 else "",
+                f"{' + '.join(c.get('sets', []))}: measured {_gain(c.get('measured'))}, "
+                f"estimated {_gain(c.get('estimated'))}",
+            )
+        )
+    return rows
+
+
 def why_slow_table(stats: dict[str, Any]) -> Table:
     """The verdict, where context time went, and the roofline (docs/stats.md, `verdict`,
     `model.cycle_accounting`, `roofline`)."""
@@ -150,13 +200,8 @@ def why_slow_table(stats: dict[str, Any]) -> Table:
         evidence = (verdict.get("evidence") or {}).get("text")
         if evidence:
             table.add_row("  evidence", str(evidence))
-        relax = verdict.get("relax") or {}
-        if relax and _is_num(relax.get("speedup")):
-            table.add_row(
-                "  try",
-                f"--set {relax.get('key')}={relax.get('to')} (now {relax.get('from')}): "
-                f"{relax['speedup']:.2f}x estimated",
-            )
+        for row, text in verdict_rows(verdict):
+            table.add_row(row, text)
     fractions = _get(stats, "model.cycle_accounting.fractions") or {}
     top = sorted(
         ((k, v) for k, v in fractions.items() if _is_num(v) and v >= 0.01), key=lambda kv: -kv[1]

@@ -30,6 +30,19 @@ public:
             t = stop;
         }
     }
+    /// Spreads `amount` over the cycles from `start` at `per_cycle` a cycle (a transfer of
+    /// `amount` bytes over a bus of `per_cycle` bytes a cycle), so a transfer straddling a
+    /// bucket's end is split between the buckets and no bucket holds more than its cycles allow.
+    void add_spread(Cycle start, uint64_t amount, uint64_t per_cycle) {
+        per_cycle = per_cycle ? per_cycle : amount;
+        for (Cycle t = start; amount > 0;) {
+            const Cycle bucket_end = (t / kBucketCycles + 1) * kBucketCycles;
+            const uint64_t part = std::min<uint64_t>(amount, (bucket_end - t) * per_cycle);
+            add(t, part);
+            amount -= part;
+            t = bucket_end;
+        }
+    }
     const std::vector<uint64_t>& buckets() const { return m_buckets; }
     uint64_t total() const {
         uint64_t sum = 0;

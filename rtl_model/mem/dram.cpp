@@ -33,11 +33,12 @@ Cycle Dram::access(const MemRequest& req) {
         ++c.read_hits;  // DRAM serves every read
         c.read_bytes += req.bytes;
     }
-    Cycle start, ready;
+    Cycle start, ready, data;  // data: the first cycle the bytes are on the bus
     if (m_banks) {
         // Bank, row buffer and data bus timing; the rest of `latency` is a fixed front end.
         const DramBanks::Timing t = m_banks->access(req.addr, req.bytes, req.time);
         start = t.start;
+        data = t.done - std::min<Cycle>(t.done, (req.bytes + m_config.bytes_per_cycle - 1) / m_config.bytes_per_cycle);
         const Cycle bank_part = Cycle(m_config.t_rcd) + m_config.t_cas;
         ready = t.done + (m_config.latency > bank_part ? m_config.latency - bank_part : 0);
     } else {
@@ -45,10 +46,14 @@ Cycle Dram::access(const MemRequest& req) {
         start = channel.reserve(req.time, req.bytes);
         Cycle transfer = m_transfer.div(req.bytes + m_config.bytes_per_cycle - 1);
         ready = start + m_config.latency + transfer;
+        data = start;
     }
     m_queue_cycles += start - req.time;
     if (req.info) req.info->level = ServedBy::dram;
-    m_bytes_use.add(start, req.bytes);
+    // Bytes are counted when they move on the channel, at its rate (with the bank model, on the
+    // data bus after the column command, not when the bank started): a transfer straddling a
+    // bucket's end is split, so bandwidth over time does not show a bucket above the peak.
+    m_bytes_use.add_spread(data, req.bytes, m_config.bytes_per_cycle);
     return ready;
 }
 

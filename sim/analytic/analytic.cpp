@@ -109,8 +109,8 @@ AnalyticOutcome outcome_of(const SimConfig& config, const AnalyticProfile& profi
 
 }  // namespace
 
-AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
-                             RaySinkIf& sink) {
+const AnalyticProfile& analyze_stream(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                                      RayStream& rays, RaySinkIf& sink) {
     std::vector<RayJob> jobs;
     while (rays.read_chunk(65536, &jobs)) {
     }
@@ -119,7 +119,7 @@ AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const 
     auto it = cache.find(key);
     if (it != cache.end()) {
         for (const RayResult& r : it->second.results) sink.ray_done(r);
-        return outcome_of(config, it->second.profile);
+        return it->second.profile;
     }
     Memo m;
     AnalyticProfile& p = m.profile;
@@ -140,9 +140,12 @@ AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const 
     }
     m.results = std::move(recording.results);
     if (cache.size() >= 8) cache.erase(cache.begin());
-    const AnalyticOutcome out = outcome_of(config, p);
-    cache.emplace(key, std::move(m));
-    return out;
+    return cache.emplace(key, std::move(m)).first->second.profile;
+}
+
+AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
+                             RaySinkIf& sink) {
+    return outcome_of(config, analyze_stream(config, accel, map, rays, sink));
 }
 
 SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig& config) {

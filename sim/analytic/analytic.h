@@ -43,6 +43,12 @@ struct AnalyticOutcome {
 AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
                              RaySinkIf& sink);
 
+/// The analysis run_analytic evaluates: the stream stepped once per process and key (later calls
+/// with the same rays and key return the kept analysis, replaying the results to `sink`). The
+/// reference stays valid until the next call (a handful of analyses are kept).
+const AnalyticProfile& analyze_stream(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                                      RayStream& rays, RaySinkIf& sink);
+
 /// The exact variant: every ray stepped, every access through functional
 /// caches on unloaded clocks (exact.cpp); for tests and comparisons.
 AnalyticOutcome run_analytic_exact(const SimConfig& config, const Accel& accel, const MemoryMap& map,

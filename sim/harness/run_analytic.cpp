@@ -28,6 +28,7 @@
 #include "sim/harness/structure_defaults.h"
 #include "sim/harness/trace_stream.h"
 #include "sim/report/verdict.h"
+#include "sim/harness/verdict_check.h"
 #include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
 
@@ -99,7 +100,11 @@ SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json
     add_mailbox_stats(out.stats, o.config, r.work, r.rays);
     add_energy_area(out.stats, o.config, r.work, r.rays);
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], r.model);
-    const json verdict = o.verdict && out.stats["summary"].value("rays", 0) > 0 ? verdict_of(r.model) : json(nullptr);
+    json verdict = o.verdict && out.stats["summary"].value("rays", 0) > 0 ? verdict_of(r.model) : json(nullptr);
+    if (o.check_verdict && !verdict.is_null()) {
+        verdict["check"] = check_verdict(o, verdict, out.stats["summary"].value("rays_per_second", 0.0));
+        verdict["text"] = checked_text(verdict);
+    }
     out.stats["verdict"] = verdict;
     out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
     out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
@@ -139,8 +144,12 @@ SimOutcome run_functional_caches(const SimOptions& o, TraceReader& reader, const
     r.bad = checker.hit_mismatches() || checker.work_mismatches();
     r.work = checker.work_totals();
     r.rays = checker.checked();
+    const json instantiated = r.instantiated;
     return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
-        return judge(VerdictContext{o.config, model, accel.get(), &map, &reader});
+        VerdictContext v{o.config, model, accel.get(), &map, &reader};
+        v.trace_path = rtt;
+        v.instantiated = instantiated;
+        return judge(v);
     });
 }
 
@@ -212,9 +221,11 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
     r.instantiated = std::move(e.instantiated);
     r.model = std::move(e.model);
     r.bad = p.validation.value("hit_mismatches", 0) || p.validation.value("work_mismatches", 0);
+    const json instantiated = r.instantiated;
     return write_outputs(o, rtt, manifest, started, std::move(r), [&](const json& model) {
         // The verdict's analytic estimates come from this run's own analysis (no second pass).
         VerdictContext v{o.config, model, nullptr, nullptr, nullptr};
+        v.instantiated = instantiated;
         v.estimate = [&p](const SimConfig& c) {
             const AnalyticEstimate x = estimate_analytic(c, p);
             return std::make_pair(x.form.cycles, x.form.binding);

@@ -26,6 +26,7 @@
 #include "sim/report/timeline.h"
 #include "sim/harness/trace_stream.h"
 #include "sim/report/verdict.h"
+#include "sim/harness/verdict_check.h"
 #include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
 
@@ -210,9 +211,24 @@ SimOutcome run_simulation(const SimOptions& options) {
     add_energy_area(out.stats, o.config, checker.work_totals(), checker.checked());
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);
     json verdict = nullptr;
-    // The verdict's estimates trace a sample of rays against one bound structure: not across frames.
-    if (o.verdict && o.config.fidelity != Fidelity::functional && total > 0 && frames.size() == 1)
-        verdict = judge(VerdictContext{o.config, model, accel.get(), &map, &reader});
+    if (o.verdict && o.config.fidelity != Fidelity::functional && total > 0) {
+        // The estimates trace a sample of rays against one bound structure: an animated trace's
+        // first frame, its rays against its structure.
+        VerdictContext v{o.config, model, accel.get(), &map, &reader};
+        v.trace_path = rtt;
+        v.instantiated = instantiated;
+        v.frames = frames.size();
+        if (frames.size() > 1) {
+            accel->bind_frame(0);
+            v.first_ray = frames[0].first_ray;
+            v.frame_rays = frames[0].rays;
+        }
+        verdict = judge(v);
+        if (o.check_verdict) {
+            verdict["check"] = check_verdict(o, verdict, out.stats["summary"].value("rays_per_second", 0.0));
+            verdict["text"] = checked_text(verdict);
+        }
+    }
     out.stats["verdict"] = verdict;
     out.stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
     out.stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];

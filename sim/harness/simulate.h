@@ -18,6 +18,8 @@ struct SimOptions {
     bool timeline = false;
     bool progress = false;  ///< JSON progress lines on stderr: {"progress": done, "total": n}
     bool verdict = true;    ///< name the bottleneck and estimate what relaxing it buys (sim/report/verdict.h)
+    /// Re-run the verdict's top knobs and co-limit, each in its own process (verdict_check.h)
+    bool check_verdict = false;
     std::string command_line;
 };
 

@@ -168,6 +168,10 @@ json area_json(const SimConfig& s, const json& stats) {
 
 }  // namespace
 
+double area_total_mm2(const SimConfig& config, const json& instantiated) {
+    return area_json(config, json{{"instantiated", instantiated}})["total_mm2"].get<double>();
+}
+
 double supply_voltage(const EnergyConfig& c) {
     return c.vdd > 0 ? c.vdd : across_nodes(c.node_nm, [](const Node& n) { return n.nominal_vdd; });
 }

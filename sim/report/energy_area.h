@@ -43,6 +43,10 @@ double sram_mm2(const EnergyConfig& c, double bytes);
 /// stats["summary"] (rays_per_second: the estimate of a sampled run) and stats["instantiated"].
 void add_energy_area(nlohmann::json& stats, const SimConfig& config, const WorkTotals& work, uint64_t rays);
 
+/// The area model's total for a config, mm^2 (`area.total_mm2`; `instantiated` as in stats.json:
+/// it says whether the any-hit pipelines are built). The verdict prices each knob with it.
+double area_total_mm2(const SimConfig& config, const nlohmann::json& instantiated);
+
 /// stats.json "energy" and "area", declared once.
 const StatBlock& energy_stats();
 const StatBlock& area_stats();

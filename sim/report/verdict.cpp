@@ -6,8 +6,7 @@
 #include <cstdio>
 #include <map>
 
-#include "sim/analytic/analytic.h"
-#include "sim/harness/trace_stream.h"
+#include "sim/report/verdict_estimator.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -20,29 +19,32 @@ namespace {
 constexpr double kSaturated = 0.7;
 
 /// The resources the verdict can name besides the pipelines: the name the analytic bounds and
-/// stats use, what a person calls it, the utilisation that shows it busy (model.utilization;
-/// "" if none) and the config knob that relaxes it, doubled ("" if none, or a rule below).
+/// stats use, what a person calls it and the utilisation that shows it busy (model.utilization;
+/// "" if none). The knobs that relax them are declared once, in verdict_knobs.cpp.
 struct ResourceInfo {
     const char* name;
     const char* label;
     const char* busy;
-    const char* knob;
 };
 
 const std::vector<ResourceInfo>& resource_table() {
     static const std::vector<ResourceInfo> r = {
-        {"l1_mshrs", "L1 MSHRs", "l1_mshrs", "l1.mshrs"},
-        {"l2_mshrs", "L2 MSHRs", "l2_mshrs", "l2.mshrs"},
-        {"dram", "DRAM bandwidth", "dram_bandwidth", "dram.channels"},
-        {"l1_banks", "L1 banks", "l1_banks", "l1.banks"},
-        {"l2_banks", "L2 banks", "l2_banks", "l2.banks"},
-        {"latency", "latency not hidden (memory and pipeline latency over too few ray contexts)", "",
-         "traversal.ray_contexts"},
-        {"scheduler", "the traversal units' schedulers (one step per issue_cycles)", "", ""},
-        {"stack", "stack spills (spilled entries read back)", "", "traversal.stack_entries"},
-        {"ray_buffer", "the ray buffer SRAM", "", "treelets.bytes_per_cycle"},
-        {"workload", "the workload: too few rays to keep the machine busy (contexts idle)", "", ""},
-        {"divergence", "SIMT divergence (warp lanes masked off while others step)", "", ""},
+        {"l1_mshrs", "L1 MSHRs", "l1_mshrs"},
+        {"l2_mshrs", "L2 MSHRs", "l2_mshrs"},
+        {"dram", "DRAM bandwidth", "dram_bandwidth"},
+        {"l1_banks", "L1 banks", "l1_banks"},
+        {"l2_banks", "L2 banks", "l2_banks"},
+        {"latency", "latency not hidden (memory and pipeline latency over too few ray contexts)", ""},
+        {"scheduler", "the traversal units' schedulers (one step per issue_cycles)", ""},
+        {"stack", "stack spills (spilled entries read back)", ""},
+        {"ray_buffer", "the ray buffer SRAM", ""},
+        {"workload", "the workload: too few rays to keep the machine busy (contexts idle)", ""},
+        {"units", "too few traversal units", ""},
+        {"l1_capacity", "L1 capacity (misses to the L2)", ""},
+        {"l2_capacity", "L2 capacity (misses to DRAM)", ""},
+        {"admission", "treelet admission (rays admitted into the ray buffer)", ""},
+        {"treelet_scheduling", "treelet scheduling (which queue a free unit runs)", ""},
+        {"divergence", "SIMT divergence (warp lanes masked off while others step)", ""},
     };
     return r;
 }
@@ -120,78 +122,6 @@ std::string percent(double x) {
     return buf;
 }
 
-/// Evenly spread blocks of the trace's rays: a cheap sample for the analytic estimates.
-class SampleStream : public RayStream {
-public:
-    SampleStream(TraceReader& reader, uint64_t sample) : m_reader(reader) {
-        const uint64_t total = reader.section(SectionKind::rays).record_count;
-        const uint64_t blocks = total <= sample ? 1 : 16, block = total <= sample ? total : sample / blocks;
-        for (uint64_t b = 0; b < blocks; ++b) m_blocks.push_back({b * (total / blocks), block});
-        m_total = blocks * block;
-    }
-    size_t read_chunk(size_t max, std::vector<RayJob>* out) override {
-        if (m_next == m_blocks.size()) return 0;
-        auto& [first, left] = m_blocks[m_next];
-        const size_t n = size_t(std::min<uint64_t>(max, left));
-        read_ray_jobs(m_reader, first, n, &m_buffer, out);
-        first += n;
-        left -= n;
-        if (left == 0) ++m_next;
-        return n;
-    }
-    uint64_t total_rays() const override { return m_total; }
-
-private:
-    TraceReader& m_reader;
-    std::vector<std::pair<uint64_t, uint64_t>> m_blocks;  ///< first ray, rays left
-    size_t m_next = 0;
-    uint64_t m_total = 0;
-    std::vector<RayRecord> m_buffer;
-};
-
-class DiscardSink : public RaySinkIf {
-public:
-    void ray_done(const RayResult&) override {}
-};
-
-/// The analytic level on the sample: its cycles and its binding bound.
-std::pair<double, std::string> analytic_on_sample(const VerdictContext& c, const SimConfig& config) {
-    if (c.estimate) return c.estimate(config);
-    SampleStream stream(*c.reader, c.sample_rays);
-    DiscardSink sink;
-    const AnalyticOutcome a = run_analytic(config, *c.accel, *c.map, stream, sink);
-    return {double(a.cycles), a.model["analytic"].value("binding", "")};
-}
-
-/// The config the analytic level can run: no treelets (its closed form models plain dispatch)
-/// and no sampling (it runs on its own sample).
-SimConfig analytic_config(SimConfig config) {
-    config.fidelity = Fidelity::analytic;
-    config.treelets.enabled = false;
-    config.sampling = SamplingConfig{};
-    // The closed form times each ray context on its own: a SIMT machine's relaxations are
-    // estimated for the MIMD machine with the same contexts (divergence is not in it).
-    config.traversal.model = UnitModel::mimd;
-    return config;
-}
-
-/// The speed-up the analytic level estimates on the sample for one relaxation (null if the
-/// relaxed config is invalid, with why_not).
-json estimate(const VerdictContext& c, const SimConfig& base, double base_cycles, const Relaxation& relax) {
-    json out = {{"key", relax.key}, {"from", relax.from}, {"to", relax.to}};
-    SimConfig relaxed = base;
-    try {
-        config_set(relaxed, relax.key + "=" + relax.to.dump());
-        validate(relaxed);
-        const double cycles = analytic_on_sample(c, relaxed).first;
-        out["speedup"] = cycles > 0 ? base_cycles / cycles : 1.0;
-    } catch (const Error& e) {
-        out["speedup"] = nullptr;
-        out["why_not"] = e.what();
-    }
-    return out;
-}
-
 /// Cycle uses of a timed run, largest first.
 std::vector<std::pair<std::string, double>> uses_by_size(const json& model) {
     std::vector<std::pair<std::string, double>> uses;
@@ -201,139 +131,197 @@ std::vector<std::pair<std::string, double>> uses_by_size(const json& model) {
     return uses;
 }
 
-/// Resources that may bind a timed run: those behind its largest cycle uses, and downstream of a
-/// full MSHR file the saturated resources its misses wait on (an L1 whose MSHRs are full because
-/// its misses queue at the L2's MSHRs is bound by the L2's, not its own).
-std::vector<std::string> timed_candidates(const json& model, json* evidence) {
-    const auto uses = uses_by_size(model);
-    std::vector<std::string> out;
-    auto add = [&](const std::string& r) {
-        if (std::find(out.begin(), out.end(), r) == out.end()) out.push_back(r);
-    };
-    double covered = 0;
-    for (size_t i = 0; i < uses.size() && i < 3 && covered < 0.8; ++i) {
-        const auto& [use, fraction] = uses[i];
-        std::string busy;
-        add(resource_of_use(use, model, &busy));
-        if (use == "l1_mshr_full" && utilization(model, "l2_mshrs") >= kSaturated) add("l2_mshrs");
-        if ((use == "l1_mshr_full" || use == "l2_mshr_full") && utilization(model, "dram_bandwidth") >= kSaturated)
-            add("dram");
-        if (i == 0) {
-            std::string text = "contexts waited for " + waiting_for(use) + " " + percent(fraction) + " of their cycles";
-            *evidence = {{"use", use}, {"context_fraction", fraction}};
-            if (!busy.empty()) {
-                (*evidence)["utilization"] = {{busy, utilization(model, busy)}};
-                text += " (" + busy + " " + percent(utilization(model, busy)) + " busy)";
-            }
-            (*evidence)["text"] = text;
-        }
-        covered += fraction;
+/// Whether each unit has its own `resource` (so more units relax it).
+bool per_unit(const SimConfig& c, const std::string& resource) {
+    OpKind kind;
+    if (op_kind_of(resource, &kind)) return !c.pipeline(kind).shared();
+    return resource == "latency" || resource == "scheduler" || resource == "l1_mshrs" || resource == "l1_banks";
+}
+
+/// What the evidence says of each resource: the share of context cycles that points at it, and
+/// the largest use that does.
+struct Evidence {
+    std::map<std::string, double> share;
+    std::map<std::string, std::string> use;
+    std::string largest;  ///< the resource behind the largest use
+    void add(const std::string& resource, const std::string& by, double fraction) {
+        if (!use.count(resource)) use[resource] = by;
+        share[resource] += fraction;
     }
+};
+
+/// The resources a timed run's cycle uses point at: each use's own (resource_of_use) and the
+/// ones whose relaxation would shorten it (downstream of a full MSHR file, the saturated
+/// resources its misses wait on; a bigger L2 for DRAM waits; more admission for starved
+/// contexts in treelet mode; more units for a busy scheduler).
+Evidence timed_evidence(const SimConfig& c, const json& model) {
+    Evidence e;
+    for (const auto& [use, fraction] : uses_by_size(model)) {
+        std::string busy;
+        const std::string r = resource_of_use(use, model, &busy);
+        if (e.largest.empty()) e.largest = r;
+        e.add(r == "workload" && use == "starved" && c.treelets.enabled ? "admission" : r, use, fraction);
+        if (use == "l1_mshr_full" && utilization(model, "l2_mshrs") >= kSaturated) e.add("l2_mshrs", use, fraction);
+        if ((use == "l1_mshr_full" || use == "l2_mshr_full") && utilization(model, "dram_bandwidth") >= kSaturated)
+            e.add("dram", use, fraction);
+        if (use == "dram" || use == "l2_mshr_full") e.add("l2_capacity", use, fraction / 2);
+        if (use == "l2" || use == "l1_mshr_full") e.add("l1_capacity", use, fraction / 2);
+        // More units relax every per-unit resource at once: contexts (latency hiding), the
+        // scheduler, unshared pipelines, the L1's MSHRs and banks.
+        if (per_unit(c, r)) e.add("units", use, fraction);
+        if (use == "ray_buffer") e.add("treelet_scheduling", use, fraction / 2);
+    }
+    return e;
+}
+
+/// At the analytic level, the evidence is its own bounds: each bound's share of the largest.
+Evidence analytic_evidence(const json& model, const std::string& binding) {
+    Evidence e;
+    e.largest = binding;
+    const json& bounds = model.value("analytic", json::object()).value("bounds", json::object());
+    double top = 0;
+    for (auto it = bounds.begin(); it != bounds.end(); ++it)
+        if (it->is_number()) top = std::max(top, it->get<double>());
+    for (auto it = bounds.begin(); it != bounds.end(); ++it)
+        if (it->is_number() && top > 0) e.add(it.key(), "bound", it->get<double>() / top);
+    return e;
+}
+
+/// The evidence for `resource` in words: the use that points at it and the utilisation that
+/// confirms it.
+json evidence_for(const std::string& resource, const Evidence& e, const json& model, bool timed) {
+    if (!timed) return {{"text", "the analytic level's binding bound is " + e.largest}};
+    const auto it = e.use.find(resource);
+    const std::string use = it != e.use.end() ? it->second : uses_by_size(model).front().first;
+    const double fraction = model["cycle_accounting"]["fractions"].value(use, 0.0);
+    json out = {{"use", use}, {"context_fraction", fraction}};
+    // The largest use first, so a knob named for a smaller use does not hide where time went.
+    const auto [top_use, top_fraction] = uses_by_size(model).front();
+    std::string text = "contexts waited for " + waiting_for(top_use) + " " + percent(top_fraction) + " of their cycles";
+    if (top_use != use) text += ", for " + waiting_for(use) + " " + percent(fraction);
+    std::string busy;
+    resource_of_use(use, model, &busy);
+    if (busy.empty()) busy = busy_of(resource);
+    if (!busy.empty() && model.contains("utilization")) {
+        out["utilization"] = {{busy, utilization(model, busy)}};
+        text += " (" + busy + " " + percent(utilization(model, busy)) + " busy)";
+    }
+    out["text"] = text;
     return out;
+}
+
+std::string gain(double speedup) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%+.0f%%", 100.0 * (speedup - 1.0));
+    return buf;
+}
+
+std::string knob_text(const json& k) {
+    std::string t = k["key"].get<std::string>() + " " + k["from"].dump() + " -> " + k["to"].dump();
+    return k["speedup"].is_number() ? t + " " + gain(k["speedup"].get<double>()) : t;
+}
+
+/// The verdict's sentence: label, evidence, the best knob, the next two, co-limits, coverage.
+std::string verdict_text(const json& v, const json& weighed, const std::string& not_covered) {
+    std::string text = v["label"].get<std::string>() + ": " + v["evidence"].value("text", std::string());
+    const json& relax = v["relax"];
+    if (relax.is_null()) {
+        text += "; no hardware knob relaxes it";
+    } else if (relax["speedup"].is_number()) {
+        text += "; " + knob_text(relax) + " estimated by the analytic level";
+    } else if (not_covered.empty()) {
+        text += "; " + knob_text(relax) + ": not estimated (" + relax.value("why_not", std::string("?")) + ")";
+    } else {
+        text += "; try " + knob_text(relax);
+    }
+    // Estimates this close are within the analytic level's error of each other: say so.
+    const json& top = weighed["top"];
+    if (top.size() > 1 && top[0]["speedup"].is_number() && top[1]["speedup"].is_number() &&
+        top[0]["speedup"].get<double>() > 1.02 &&
+        top[1]["speedup"].get<double>() >= top[0]["speedup"].get<double>() - 0.03)
+        text += " (as good as " + top[1]["key"].get<std::string>() + " within the estimate's error: "
+                "measure both with --check-verdict)";
+    std::string next;
+    for (const json& k : weighed["top"])
+        if (relax.is_null() || k["key"] != relax["key"]) next += (next.empty() ? "" : ", ") + knob_text(k);
+    if (!next.empty()) text += "; next: " + next;
+    for (const json& co : weighed["co_limits"])
+        text += "; co-limit: " + co["keys"][0].get<std::string>() + " and " + co["keys"][1].get<std::string>() +
+                " together " + gain(co["joint"].get<double>()) + " (alone " + gain(co["alone"][0].get<double>()) +
+                ", " + gain(co["alone"][1].get<double>()) + ")";
+    if (!not_covered.empty()) text += "; " + not_covered;
+    return text + " (analytic binding bound: " + v["analytic_binding"].get<std::string>() + ")";
+}
+
+/// Why the estimates do not describe this machine ("" when they do).
+std::string coverage_gap(const SimConfig& c) {
+    if (c.treelets.enabled)
+        return "not estimated: the analytic level does not model treelet admission and queues, so the knobs "
+               "are ranked by the cycle accounting; measure them with --check-verdict";
+    if (c.traversal.model != UnitModel::mimd)
+        return "estimated for the MIMD machine with the same ray contexts (the analytic level has no "
+               "lock-step warps: divergence is not in the estimates); measure them with --check-verdict";
+    return "";
 }
 
 }  // namespace
 
-/// The knob `key` doubled, within the range its config field declares; none past the range.
-Relaxation doubled(const SimConfig& c, const std::string& key) {
-    const ConfigField f = config_field(c, key);
-    const double value = f.value.get<double>();
-    if (value * 2 > f.max) return {};
-    return {key, f.value, json(f.value.get<uint64_t>() * 2)};
-}
-
-/// The knob `key` halved (a cost per operation, at least its declared minimum).
-Relaxation halved(const SimConfig& c, const std::string& key) {
-    const ConfigField f = config_field(c, key);
-    const uint64_t value = f.value.get<uint64_t>();
-    if (value / 2 < f.min || value < 2) return {};
-    return {key, f.value, json(value / 2)};
-}
-
 Relaxation relaxation_for(const std::string& resource, const SimConfig& c) {
     OpKind kind;
-    if (op_kind_of(resource, &kind)) {
-        const PipelineConfig& p = c.pipeline(kind);
-        const std::string base = resource + ".";
-        if (p.shared()) return doubled(c, base + "shared_count");
-        if (p.initiation_interval > 1) return halved(c, base + "initiation_interval");
-        return doubled(c, base + "width");
-    }
-    if (resource == "divergence") return halved(c, "traversal.lanes");  // narrower warps diverge less
-    if (resource == "scheduler")
-        return c.traversal.issue_cycles > 1 ? halved(c, "traversal.issue_cycles") : doubled(c, "traversal.units");
-    const ResourceInfo* r = find_resource(resource);
-    return r && *r->knob ? doubled(c, r->knob) : Relaxation{};  // the workload: no hardware knob
+    const bool pipeline = op_kind_of(resource, &kind);
+    for (const Knob& k : every_knob(c, pipeline ? std::vector<OpKind>{kind} : std::vector<OpKind>{}))
+        if (k.resource == resource && (resource != "scheduler" || c.traversal.issue_cycles > 1)) return k.relax;
+    if (resource == "scheduler") return doubled(c, "traversal.units");
+    return {};  // the workload: no hardware knob
 }
 
 json judge(const VerdictContext& c) {
     if (c.config.fidelity == Fidelity::functional) return nullptr;
     const auto start = std::chrono::steady_clock::now();
-    const SimConfig base = analytic_config(c.config);
-    const auto [base_cycles, analytic_binding] = analytic_on_sample(c, base);
-    json evidence;
-    std::vector<std::string> candidates;
-    if (c.config.fidelity == Fidelity::analytic) {
-        evidence = {{"text", "the analytic level's binding bound is " + analytic_binding}};
-    } else {
-        candidates = timed_candidates(c.model, &evidence);
-    }
-    if (std::find(candidates.begin(), candidates.end(), analytic_binding) == candidates.end())
-        candidates.push_back(analytic_binding);
-    // Each candidate's relaxation, estimated; the binding resource is the one whose relaxation
-    // buys the most (when none buys 2%, the largest cycle use stands).
-    json tried = json::array();
-    std::string binding = candidates.front();
-    double best = 1.02;
-    for (const std::string& r : candidates) {
-        const Relaxation relax = relaxation_for(r, c.config);
-        json t = relax.key.empty() ? json{{"key", nullptr}, {"speedup", nullptr}} : estimate(c, base, base_cycles, relax);
-        t["resource"] = r;
-        if (t["speedup"].is_number() && t["speedup"].get<double>() > best) {
-            best = t["speedup"].get<double>();
-            binding = r;
-        }
-        tried.push_back(t);
-    }
-    json chosen = nullptr;
-    for (const json& t : tried)
-        if (t["resource"] == binding) chosen = t;
+    const VerdictEstimator estimator(c);
+    const auto [base_cycles, analytic_binding] = estimator(c.config);
+    const bool timed = c.config.fidelity != Fidelity::analytic;
+    const Evidence evidence = timed ? timed_evidence(c.config, c.model) : analytic_evidence(c.model, analytic_binding);
+    const std::string not_covered = coverage_gap(c.config);
+    WeighInputs in{c.config, c.instantiated, [&](const SimConfig& x) { return estimator(x).first; }, base_cycles,
+                   not_covered, evidence.share};
+    const json weighed = weigh_knobs(in);
+    // The binding resource: the best knob's when it buys 2% (or, unestimated, when the
+    // evidence points at it); else the largest cycle use's.
+    const json& best = weighed["knobs"].empty() ? json(nullptr) : weighed["knobs"][0];
+    const bool best_pays = !best.is_null() && (best["speedup"].is_number() ? best["speedup"].get<double>() >= 1.02
+                                                                             : best["evidence"].get<double>() > 0);
+    const std::string binding = best_pays ? best["resource"].get<std::string>() : evidence.largest;
+    json relax = best_pays ? best : json(nullptr);
+    if (!best_pays)
+        for (const json& k : weighed["knobs"])
+            if (relax.is_null() && k["resource"] == binding) relax = k;
     json v = {{"binding", binding},
               {"label", label_of(binding)},
-              {"evidence", evidence},
-              {"relax", chosen["key"].is_null() ? json(nullptr) : chosen},
-              {"candidates", tried},
+              {"evidence", evidence_for(binding, evidence, c.model, timed)},
+              {"relax", relax},
+              {"candidates", weighed["knobs"]},
+              {"top", weighed["top"]},
+              {"top_per_mm2", weighed["top_per_mm2"]},
+              {"co_limits", weighed["co_limits"]},
+              {"coverage", {{"estimated", not_covered.empty()},
+                            {"why_not", not_covered.empty() ? json(nullptr) : json(not_covered)},
+                            {"frames", c.frames}}},
               {"analytic_binding", analytic_binding},
               {"estimate",
-               {{"method", c.estimate ? c.estimate_method
-                                      : "analytic level on " +
-                                            std::to_string(SampleStream(*c.reader, c.sample_rays).total_rays()) +
-                                            " sampled rays" + (c.config.treelets.enabled ? " (treelets off)" : "")},
+               {{"method", estimator.method()},
                 {"base_cycles", base_cycles},
-                {"wall_seconds",
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}}}};
-    std::string text = v["label"].get<std::string>() + ": " + evidence.value("text", std::string());
-    const std::string busy = busy_of(binding);
-    if (!busy.empty() && busy.rfind("pipe_", 0) != 0 &&
-        !evidence.value("utilization", json::object()).contains(busy) && c.model.contains("utilization")) {
-        const double u = utilization(c.model, busy);
-        v["evidence"]["utilization"][busy] = u;
-        text += "; " + busy + " " + percent(u) + " busy";
+                {"wall_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}}}};
+    // Two resources binding together: name both when relaxing the pair beats any single knob.
+    const json& co = weighed["co_limits"].empty() ? json(nullptr) : weighed["co_limits"][0];
+    const bool co_beats = !co.is_null() && best_pays && best["speedup"].is_number() &&
+                          co["joint"].get<double>() > best["speedup"].get<double>();
+    if (co_beats &&
+        (co["resources"][0] == binding || co["resources"][1] == binding)) {
+        const std::string other = co["resources"][co["resources"][0] == binding ? 1 : 0];
+        v["label"] = label_of(binding) + " together with " + label_of(other) + " (a co-limit)";
     }
-    if (chosen["key"].is_null()) {
-        text += "; no hardware knob relaxes it";
-    } else {
-        text += "; " + chosen["key"].get<std::string>() + " " + chosen["from"].dump() + " -> " + chosen["to"].dump() + ": ";
-        if (chosen["speedup"].is_number()) {
-            char buf[64];
-            std::snprintf(buf, sizeof buf, "%+.0f%%", 100.0 * (chosen["speedup"].get<double>() - 1.0));
-            text += std::string(buf) + " estimated by the analytic level";
-        } else {
-            text += "no estimate (" + chosen.value("why_not", std::string("?")) + ")";
-        }
-    }
-    text += " (analytic binding bound: " + analytic_binding + ")";
-    v["text"] = text;
+    v["text"] = verdict_text(v, weighed, not_covered);
     return v;
 }
 
@@ -341,13 +329,18 @@ const StatBlock& verdict_stats() {
     static const StatBlock block{
         "verdict",
         {
-            {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l2`, `l1_banks`, `pipe_<kind>`, `scheduler`, `stack`, `ray_buffer`, `dispatch`, `latency`, `divergence` (SIMT lanes idle)"},
+            {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l1_banks`, `l2_banks`, `l1_capacity`, `l2_capacity`, `units`, `<kind>` (a pipeline kind), `scheduler`, `stack`, `ray_buffer`, `admission`, `treelet_scheduling`, `latency`, `workload`, `divergence` (SIMT lanes idle)"},
             {"label", "", "the same in words (e.g. \"DRAM bandwidth\")"},
             {"text", "", "one sentence: label, evidence and the best relaxation with its estimated speed-up"},
             {"evidence", "", "`use` (the cycle-accounting use that points at it), `context_fraction` (that use's share of context cycles), `utilization.<resource>` (the utilisations that confirm it), `text` (the evidence in words)"},
-            {"candidates", "list", "best first, each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to)) and, without an estimate, `why_not`"},
+            {"candidates", "list", "every knob, best first (by estimated gain; unestimated ones by `evidence`), each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to); `null` without one, with `why_not`), `added_mm2` (the area model's added area), `gain_per_mm2` (`(speedup - 1) / added_mm2`; `null` for knobs the area model does not price: MSHRs, banks, channels, costs), `evidence` (the share of context cycles that points at the resource)"},
+            {"top", "list", "the first three `candidates`: what to try, printed by `rtsim simulate`"},
+            {"top_per_mm2", "list", "the three best `gain_per_mm2`"},
+            {"co_limits", "list", "pairs of estimated knobs whose joint relaxation gains much more than either alone (joint gain >= 1.5 x the better single gain + 5 points): `keys`, `sets` (`key=value` each), `resources`, `joint` (estimated speed-up of both), `alone` (each's)"},
+            {"coverage", "", "`estimated` (false where the analytic level does not model the machine: treelets), `why_not`, `frames` (an animated trace's estimates are the first frame's)"},
+            {"check", "list", "with `--check-verdict`: each top candidate and co-limit re-run at the run's level: `sets`, `estimated`, `measured` (rays/s relaxed over the run's), `run` (its folder); best measured first", false, true},
             {"relax", "", "the best candidate, with the same fields; `null` when no knob relaxes the binding resource"},
-            {"estimate", "", "`method` (the analytic level on N sampled rays), `base_cycles` (its cycles for the run's own config on that sample), `wall_seconds` (the host time the estimates took)"},
+            {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `base_cycles` (its cycles for the run's own config), `wall_seconds` (the host time the estimates took)"},
             {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
         }};
     return block;

@@ -1,19 +1,21 @@
 #pragma once
 // Why is this design slow? (docs/stats.md, "verdict"). After a run, the verdict names the
-// binding resource with its evidence and what relaxing it would buy:
+// binding resource with its evidence, what relaxing each resource would buy, and what to try:
 //
-//   1. candidates: at the timed levels, the resources behind the largest uses of the ray
-//      contexts' cycles (cycle accounting: e.g. waiting for a free L1 MSHR), refined by
-//      utilisation (DRAM data waits with the channels near peak are bandwidth, otherwise
-//      latency), plus the saturated resources downstream of a full MSHR file (an L1 whose
-//      misses queue at a saturated L2 MSHR file), plus the analytic level's binding bound.
-//   2. relaxation: for each candidate, the config knob that relaxes it, doubled (l2.mshrs
-//      32 -> 64, dram.channels 2 -> 4, ...), from one table (relaxation_for).
-//   3. estimate: the analytic level run on a sample of the trace with the base config and with
-//      each relaxed one; a speed-up is the ratio of their cycles. The binding resource is the
-//      candidate whose relaxation buys the most (the largest cycle use when none buys 2%).
-//      First order: the analytic level has its own error (docs/fidelity.md); an estimate of
-//      direction and size, not a promise.
+//   1. evidence: at the timed levels, the shares of the ray contexts' cycles that point at each
+//      resource (cycle accounting: e.g. waiting for a free L1 MSHR), refined by utilisation (DRAM
+//      data waits with the channels near peak are bandwidth, otherwise latency; an L1 whose
+//      misses queue at a saturated L2 MSHR file points at the L2's MSHRs too).
+//   2. every knob (verdict_knobs.h): each resource's config field relaxed one step (doubled,
+//      or a cost halved), estimated by the analytic level on the run's analysis
+//      (verdict_estimator.h), priced by the area model; ranked by gain and by gain per mm^2;
+//      pairs that gain much more together than alone are co-limits.
+//   3. the binding resource: the best knob's, when it buys 2% or more; else the largest
+//      cycle use's. Where the analytic level does not model the machine (treelet admission and
+//      queues), nothing is estimated: the knobs are ranked by evidence and the verdict says to
+//      measure (verdict_check.h, `--check-verdict`), never a confident wrong answer.
+//   First order: the analytic level has its own error (docs/fidelity.md); an estimate of
+//   direction and size, not a promise; `--check-verdict` measures the top candidates.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -26,14 +28,9 @@
 #include "sim/config/config.h"
 #include "traces/accel/accel.h"
 #include "traces/format/trace_reader.h"
+#include "sim/report/verdict_knobs.h"
 
 namespace rtsim {
-
-/// A config change that relaxes one resource: "key" from "from" to "to".
-struct Relaxation {
-    std::string key;
-    nlohmann::json from, to;
-};
 
 /// The knob that relaxes a resource (names of the analytic bounds: "l2_mshrs", "dram", "box",
 /// "scheduler", "latency", ...), doubled; an empty key when no knob does.
@@ -50,9 +47,14 @@ struct VerdictContext {
     /// analytic level passes its own per-trace analysis, so it needs no second pass over rays.
     std::function<std::pair<double, std::string>(const SimConfig&)> estimate = {};
     std::string estimate_method = {};  ///< how `estimate` estimates, for the verdict's text
+    std::string trace_path = {};       ///< the .rtt: a per-trace analysis stored beside it is reused
+    size_t frames = 1;                 ///< an animated trace's frames: the sample is the first frame's
+    uint64_t first_ray = 0, frame_rays = 0;  ///< that frame's rays (0: the whole trace)
+    nlohmann::json instantiated = nlohmann::json::array();  ///< the run's blocks (the area model's input)
 };
 
-/// {binding, label, evidence, relax, estimate, analytic_binding, text}; null for the functional level.
+/// {binding, label, evidence, relax, candidates, top, top_per_mm2, co_limits, coverage, estimate,
+/// analytic_binding, text}; null for the functional level.
 nlohmann::json judge(const VerdictContext& context);
 
 /// stats.json "verdict", declared once.

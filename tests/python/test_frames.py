@@ -75,6 +75,11 @@ def test_replay_checks_every_hit_of_every_frame(
     if level == "functional":
         assert all(f["cycles"] is None for f in frames)
         return
+    # Every timed run has a verdict, its estimates on the first frame (said so).
+    v = stats["verdict"]
+    assert v is not None and len(v["top"]) == 3, v
+    assert v["coverage"]["frames"] == FRAMES and "first frame" in v["estimate"]["method"]
+    assert v["top"][0]["speedup"] is not None
     # Frames follow one another: each starts when the previous one's last ray finished.
     assert frames[0]["start_cycle"] == 0
     for a, b in itertools.pairwise(frames):

@@ -136,3 +136,28 @@ def test_preset_grid_key() -> None:
     runs = parse_spec(text, "s.yaml").runs()
     assert [r.config.traversal.units for r in runs] == [8, 16]
     assert [r.preset for r in runs] == ["base", "base+tu16"]
+
+
+def test_switched_off_sections_are_simulated_once() -> None:
+    # Ray-buffer sizes with treelets off are one machine: one run, not one per size.
+    text = """\
+    name: t
+    scenes: [cornell]
+    workloads:
+      - {name: primary, rays: [primary], resolution: 32x24}
+    grid:
+      treelets.enabled: [false, true]
+      treelets.buffer_kib: [128, 512, 2048]
+    """
+    runs = parse_spec(textwrap.dedent(text), "s.yaml").runs()
+    off = [r for r in runs if not r.config.treelets.enabled]
+    on = [r for r in runs if r.config.treelets.enabled]
+    assert len(off) == 1 and len(on) == 3
+    assert len({r.run_id for r in runs}) == 4
+    # A treelets-off run with default treelet fields keeps the id it always had.
+    from rtsim.sweep.spec import stable_hash
+
+    plain = parse_spec(textwrap.dedent(text).replace("[128, 512, 2048]", "[512]"), "s.yaml")
+    [base] = [r for r in plain.runs() if not r.config.treelets.enabled]
+    expected = {"trace": base.trace.trace_id, "config": base.config.to_dict()}
+    assert base.run_id == stable_hash(expected)

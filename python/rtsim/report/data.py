@@ -10,7 +10,7 @@ from typing import Any
 
 import yaml
 
-from rtsim.config import ConfigError, field_info, flatten
+from rtsim.config import INACTIVE_UNLESS, ConfigError, field_info, flatten
 from rtsim.sweep.results import sram_bytes
 from rtsim.sweep.store import RunRecord, open_store
 
@@ -31,7 +31,6 @@ SHORT_KEYS: dict[str, tuple[str, str]] = {
 FLAG_KEYS: dict[str, str] = {"treelets.enabled": "treelets", "ideal_memory": "ideal mem"}
 # Keys that do nothing unless a switch is on: (key prefix, switch). A treelets-off run is not
 # labelled with a ray-buffer size.
-INACTIVE_UNLESS: tuple[tuple[str, str], ...] = (("treelets.", "treelets.enabled"),)
 
 
 def key_active(key: str, config: dict[str, Any]) -> bool:

@@ -35,6 +35,8 @@ KIND_COLORS = {
     "hit": "#C44E52",
     "stack": "#8172B3",
     "ray_buffer": "#937860",
+    "cell": "#DA8BC3",
+    "prim_ref": "#8C8C8C",
 }
 KIND_NAMES = {
     "node": "BVH nodes",
@@ -43,7 +45,29 @@ KIND_NAMES = {
     "hit": "hits",
     "stack": "stack spills",
     "ray_buffer": "ray-buffer spills",
+    "cell": "grid cells",
+    "prim_ref": "primitive references",
 }
+#: Colours for kinds a structure adds that are not named above (never dropped from a chart).
+EXTRA_KIND_COLORS = ("#CCB974", "#64B5CD", "#2F4B7C", "#A05195")
+
+
+def kinds_present(breakdowns: list[dict[str, float]]) -> list[str]:
+    """Every data kind with traffic in any breakdown: the known kinds in their order, then any
+    other (a structure's own regions, e.g. a grid's cells and primitive references) by name.
+    A kind left out would make the stacked bars short of the run's total."""
+    moved = {k for kinds in breakdowns for k, v in kinds.items() if v}
+    known = [k for k in (*DATA_KINDS, *KIND_COLORS) if k in moved]
+    known = list(dict.fromkeys(known))
+    return known + sorted(moved - set(known))
+
+
+def kind_style(kind: str, index: int) -> tuple[str, str]:
+    """(colour, legend name) of a data kind."""
+    color = KIND_COLORS.get(kind, EXTRA_KIND_COLORS[index % len(EXTRA_KIND_COLORS)])
+    return color, KIND_NAMES.get(kind, kind.replace("_", " "))
+
+
 MAX_BARS = 24
 
 plt.rcParams.update(
@@ -102,13 +126,14 @@ def bytes_per_ray(data: SweepData) -> Figure | None:
     bars = [b for g in data.groups() if g.ok for b in _breakdown_clusters(data, g)]
     if not bars:
         return None
-    present = [k for k in DATA_KINDS if any(kinds.get(k) for _, kinds in bars)]
+    present = kinds_present([kinds for _, kinds in bars])
     fig, ax = plt.subplots(figsize=(12, 0.42 * len(bars) + 1.8))
     labels = [label for label, _ in bars][::-1]
     left = [0.0] * len(bars)
-    for kind in present:
+    for i, kind in enumerate(present):
         vals = [kinds.get(kind, 0.0) for _, kinds in bars][::-1]
-        ax.barh(labels, vals, left=left, color=KIND_COLORS[kind], label=KIND_NAMES[kind])
+        color, name = kind_style(kind, i)
+        ax.barh(labels, vals, left=left, color=color, label=name)
         left = [a + b for a, b in zip(left, vals, strict=True)]
     for y, total in enumerate(left):
         ax.annotate(
@@ -286,7 +311,7 @@ def rays_per_second(data: SweepData) -> Figure | None:
             ax.set_ylabel("simulated Mrays/s")
             ax.set_ylim(bottom=0)
             ax.set_title(f"{scene}: rays/s against {key}", fontsize=11)
-    _fig_legend(fig, axes[0][0])
+    _fig_legend(fig)
     fig.suptitle(
         "Performance against each swept key (line: median over the other keys; band: min to max)",
         y=1.0,
@@ -295,8 +320,17 @@ def rays_per_second(data: SweepData) -> Figure | None:
     return fig
 
 
-def _fig_legend(fig: Figure, ax: Any) -> None:
-    handles, names = ax.get_legend_handles_labels()
+def _fig_legend(fig: Figure) -> None:
+    """One legend for the figure: every labelled line of every panel, each name once (a line
+    only some panels draw, a category or a workload of another scene's row, is named too)."""
+    handles, names = [], []
+    for a in fig.axes:
+        for h, n in zip(*a.get_legend_handles_labels(), strict=True):
+            if n not in names:
+                handles.append(h)
+                names.append(n)
+    if not names:
+        return
     fig.legend(
         handles,
         names,
@@ -325,7 +359,7 @@ def hit_rates(data: SweepData) -> Figure | None:
             ax.set_ylim(0, 102)
             ax.set_ylabel(f"{level.upper()} hit rate (%)")
             ax.set_title(f"{level.upper()} hit rate against {key}", fontsize=11)
-    _fig_legend(fig, axes[0][0])
+    _fig_legend(fig)
     fig.suptitle("Cache hit rates per level (reads served, including merged misses)", y=1.0)
     fig.tight_layout(rect=(0, 0, 1, 0.94))
     return fig
@@ -436,8 +470,9 @@ def _cost_axis(ax: Any, xs: list[float], unit: str) -> None:
 def roofline(data: SweepData) -> Figure | None:
     """The roofline per scene and workload: every run a point at (DRAM bytes per ray, Mrays/s);
     the DRAM ceilings (peak bandwidth over bytes per ray: one line per distinct peak in the
-    sweep) and, above each point, the lowest ceiling of its pipelines and scheduler (stats
-    `roofline.ceilings`). A point on a line is bound by that resource; a point far below both is
+    sweep) and, above each point, the lowest of its own config's other ceilings: pipelines,
+    scheduler, L1 and L2 MSHRs by Little's law, L2 bandwidth (stats `roofline.ceilings`).
+    A point on a line is bound by that resource; a point far below both is
     latency- or queue-bound (the verdict says which)."""
     groups = [g for g in data.groups() if any(_roof(r) for r in g.ok)][:4]
     if not groups:
@@ -470,14 +505,17 @@ def roofline(data: SweepData) -> Figure | None:
             marker="_",
             s=160,
             color="#555555",
-            label="pipeline / scheduler ceiling",
+            label="its own lowest other ceiling (pipelines, scheduler, MSHRs, L2)",
         )
         ax.scatter(xs, [mrays(r) for r in runs], color="#C44E52", zorder=3, label="run")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlim(lo, hi)
-        plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:,.0f}" if v >= 1 else f"{v:g}")
-        for axis in (ax.xaxis, ax.yaxis):
+        plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:,.0f}" if v >= 1 else f"{v:.3g}")
+        for axis, limits in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+            # A log axis spanning less than a decade gets one power-of-ten tick or none:
+            # 1-2-5 steps (finer when the span is narrower) give it several.
+            axis.set_major_locator(matplotlib.ticker.FixedLocator(log_ticks(*limits)))
             axis.set_major_formatter(plain)
             axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel("DRAM bytes per ray")
@@ -486,6 +524,24 @@ def roofline(data: SweepData) -> Figure | None:
         ax.legend(loc="lower left", fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def log_ticks(lo: float, hi: float, least: int = 3) -> list[float]:
+    """Ticks for a log axis over [lo, hi]: 1-2-5 steps of each decade, finer steps (1, 1.5, 2,
+    3, 4, 5, 7) when that leaves fewer than `least` inside, every tick inside the range."""
+    if not (lo > 0 and hi > lo):
+        return []
+    ticks: list[float] = []
+    for steps in ((1.0,), (1.0, 2.0, 5.0), (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 7.0)):
+        first, last = math.floor(math.log10(lo)), math.ceil(math.log10(hi))
+        ticks = [s * 10.0**d for d in range(first, last + 1) for s in steps]
+        ticks = [t for t in ticks if lo <= t <= hi]
+        if len(ticks) >= least:
+            return ticks
+    if len(ticks) < 2:  # narrower than one 1.5x step: the ends and the geometric middle
+        ticks = [float(f"{t:.2g}") for t in (lo, math.sqrt(lo * hi), hi)]
+        ticks = [t for t in ticks if lo <= t <= hi] or [lo, hi]
+    return ticks
 
 
 def _roof(rec: RunRecord) -> dict[str, Any]:

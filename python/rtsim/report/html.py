@@ -392,7 +392,8 @@ def render_report(data: SweepData) -> str:
             "roofline: rays per second against DRAM bytes per ray",
             "Every run a point: simulated Mrays/s against DRAM bytes per ray. Dashed: the DRAM "
             "ceiling of each peak bandwidth in the sweep (peak / bytes per ray); grey bars: each "
-            "run's lowest pipeline or scheduler ceiling (stats <code>roofline.ceilings</code>). "
+            "run's lowest other ceiling of its own config: pipelines, scheduler, L1 and L2 "
+            "MSHRs (Little's law), L2 bandwidth (stats <code>roofline.ceilings</code>). "
             "A point on a line is bound by it; a point far below both is latency- or queue-bound, "
             "and its verdict above says by what.",
         ),

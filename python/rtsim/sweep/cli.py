@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from rtsim.cli_help import HelpFormatter
 
@@ -79,8 +79,15 @@ def cmd_results(args: argparse.Namespace, console: Console) -> int:
     keys = list(dict.fromkeys(k for r in records for k in r.params))
     table = Table(title=f"{args.sweep}: {len(records)} runs")
     for col in ("scene", "workload", *keys, "status", "Mrays/s", "DRAM B/ray", "wall s"):
-        table.add_column(col, justify="left" if col in ("scene", "workload", "status") else "right")
-    for r in records:
+        # Headers are never cut: a column is at least as wide as its name (the table wraps the
+        # cells, not the key names a reader needs to tell the columns apart).
+        table.add_column(
+            col,
+            justify="left" if col in ("scene", "workload", "status") else "right",
+            min_width=len(col),
+            no_wrap=True,
+        )
+    for r in results_order(records, keys):
         s = r.summary
         table.add_row(
             r.scene,
@@ -91,8 +98,30 @@ def cmd_results(args: argparse.Namespace, console: Console) -> int:
             f"{s['dram_bytes_per_ray']:.0f}" if s.get("dram_bytes_per_ray") is not None else "-",
             f"{r.wall_seconds:.2f}" if r.wall_seconds is not None else "-",
         )
-    console.print(table)
+    # Wider than the terminal: print the table whole (the terminal wraps long lines) rather
+    # than cutting its headers or its last columns.
+    columns = ("scene", "workload", *keys, "status", "Mrays/s", "DRAM B/ray", "wall s")
+    wide = sum(len(c) + 3 for c in columns) + 1
+    console.print(table, width=max(console.width, wide), crop=False)
     return 0
+
+
+def results_order(records: list[RunRecord], keys: list[str]) -> list[RunRecord]:
+    """Runs in a stable, readable order: by scene, workload, then each swept key's value
+    (numbers by value, 2 before 16; text by name), never the order they happened to finish."""
+    from rtsim.sweep.results import key_value
+
+    def rank(value: Any) -> tuple[int, float, str]:
+        if isinstance(value, bool) or value is None:
+            return (2, 0.0, str(value))
+        if isinstance(value, int | float):
+            return (0, float(value), "")
+        return (1, 0.0, str(value))
+
+    return sorted(
+        records,
+        key=lambda r: (r.scene, r.workload, *(rank(key_value(r, k)[0]) for k in keys)),
+    )
 
 
 def _key_cell(rec: RunRecord, key: str) -> str:

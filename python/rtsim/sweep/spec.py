@@ -17,7 +17,15 @@ from typing import Any
 import numpy as np
 import yaml
 
-from rtsim.config import ConfigError, SimConfig, apply_patch, compose, field_info, unflatten
+from rtsim.config import (
+    ConfigError,
+    SimConfig,
+    apply_patch,
+    compose,
+    effective_dict,
+    field_info,
+    unflatten,
+)
 from rtsim.errors import RtsimError
 from rtsim.kinds import RAY_KINDS
 from rtsim.scenes import procedural_scene_names, resolve_scene
@@ -134,7 +142,9 @@ class RunPlan:
 
     @property
     def run_id(self) -> str:
-        return stable_hash({"trace": self.trace.trace_id, "config": self.config.to_dict()})
+        # The effective config: points that differ only in a switched-off section's fields
+        # (ray-buffer sizes with treelets off) are one simulation.
+        return stable_hash({"trace": self.trace.trace_id, "config": effective_dict(self.config)})
 
 
 @dataclass

@@ -61,6 +61,22 @@ TEST(Dram, SaturatesAtConfiguredBandwidthWhenAllRequestsArriveAtOnce) {
     EXPECT_GT(j["avg_queue_cycles"].get<double>(), 1000.0);
 }
 
+TEST(Dram, BandwidthOverTimeNeverExceedsThePeakWhenTransfersStraddleBuckets) {
+    TestKernel kernel;
+    DramConfig c = two_channels();
+    c.channels = 1;  // 16 B/cycle; 48-byte transfers take 3 cycles, and 1024 is no multiple of 3
+    Dram dram("dram", c);
+    for (uint64_t i = 0; i < 3000; ++i) dram.access({i * 64, 48, false, DataKind::node, 0});
+    uint64_t total = 0;
+    const auto& buckets = dram.bytes_over_time();
+    for (size_t b = 0; b < buckets.size(); ++b) {
+        EXPECT_LE(buckets[b], 16u * Dram::bucket_cycles()) << "bucket " << b;
+        total += buckets[b];
+    }
+    EXPECT_EQ(total, 3000u * 48);
+    EXPECT_GE(buckets[1], 15u * Dram::bucket_cycles());  // saturated: close to the peak
+}
+
 TEST(Dram, SaturatesAtConfiguredBandwidthUnderOverload) {
     TestKernel kernel;
     Dram dram("dram", two_channels());

@@ -1,0 +1,119 @@
+#include "sim/harness/verdict_check.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "traces/common/error.h"
+
+extern char** environ;
+
+namespace rtsim {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+/// The candidates to measure: the top three knobs (one `key=value` each) and the best
+/// co-limit (both at once), without repeats.
+std::vector<std::pair<std::vector<std::string>, json>> to_measure(const json& verdict) {
+    std::vector<std::pair<std::vector<std::string>, json>> out;
+    auto add = [&](std::vector<std::string> sets, const json& estimated) {
+        for (const auto& o : out)
+            if (o.first == sets) return;
+        out.push_back({std::move(sets), estimated});
+    };
+    for (const json& k : verdict.value("top", json::array())) {
+        const std::string to = k["to"].is_string() ? k["to"].get<std::string>() : k["to"].dump();
+        add({k["key"].get<std::string>() + "=" + to}, k["speedup"]);
+    }
+    for (const json& co : verdict.value("co_limits", json::array())) {
+        add(co["sets"].get<std::vector<std::string>>(), co["joint"]);
+        break;
+    }
+    return out;
+}
+
+/// Runs `argv` with stdout and stderr into `log`; its exit code (-1 when it could not start or died).
+int run_process(const std::vector<std::string>& argv, const std::string& log) {
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    posix_spawn_file_actions_addopen(&files, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&files, 1, 2);
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    pid_t pid = 0;
+    const int err = posix_spawn(&pid, args[0], &files, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&files);
+    if (err != 0) return -1;
+    int status = 0;
+    if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
+}
+
+double rays_per_second_of(const fs::path& run) {
+    std::ifstream in(run / "stats.json");
+    const json stats = json::parse(in, nullptr, false);
+    if (stats.is_discarded()) return 0;
+    const json& r = stats.value("summary", json::object()).value("rays_per_second", json(nullptr));
+    return r.is_number() ? r.get<double>() : 0;
+}
+
+std::string gain(double speedup) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%+.0f%%", 100.0 * (speedup - 1.0));
+    return buf;
+}
+
+}  // namespace
+
+json check_verdict(const SimOptions& o, const json& verdict, double base_rays_per_second) {
+    std::error_code ec;
+    const std::string exe = fs::read_symlink("/proc/self/exe", ec).string();
+    require(!ec && !exe.empty(), "--check-verdict: cannot find this rtsim-sim executable (/proc/self/exe)");
+    const fs::path config = fs::path(o.out_dir) / "config.resolved.json";
+    json out = json::array();
+    int n = 0;
+    for (const auto& [sets, estimated] : to_measure(verdict)) {
+        const fs::path run = fs::path(o.out_dir) / "check" / std::to_string(++n);
+        fs::create_directories(run);
+        std::vector<std::string> argv = {exe, o.trace, "--config", config.string(), "--no-verdict", "-o", run.string()};
+        for (const std::string& s : sets) argv.insert(argv.end(), {"--set", s});
+        const int code = run_process(argv, (run / "log.txt").string());
+        const double rps = code == 0 ? rays_per_second_of(run) : 0;
+        json c = {{"sets", sets}, {"estimated", estimated}, {"run", run.string()}};
+        c["measured"] = rps > 0 && base_rays_per_second > 0 ? json(rps / base_rays_per_second) : json(nullptr);
+        if (code != 0)
+            c["error"] = "rtsim-sim exited with " + std::to_string(code) + " (see " + (run / "log.txt").string() + ")";
+        out.push_back(c);
+    }
+    std::stable_sort(out.begin(), out.end(), [](const json& a, const json& b) {
+        const double x = a["measured"].is_number() ? a["measured"].get<double>() : 0;
+        const double y = b["measured"].is_number() ? b["measured"].get<double>() : 0;
+        return x > y;
+    });
+    return out;
+}
+
+std::string checked_text(const json& verdict) {
+    std::string text = verdict["text"].get<std::string>() + "; re-run:";
+    bool first = true;
+    for (const json& c : verdict["check"]) {
+        std::string sets;
+        for (const json& s : c["sets"]) sets += (sets.empty() ? "" : " + ") + s.get<std::string>();
+        const std::string measured = c["measured"].is_number() ? gain(c["measured"].get<double>()) : "(failed)";
+        const std::string estimated = c["estimated"].is_number() ? gain(c["estimated"].get<double>()) : "-";
+        text += std::string(first ? " " : ", ") + sets + " measured " + measured + " (estimated " + estimated + ")";
+        first = false;
+    }
+    return text;
+}
+
+}  // namespace rtsim

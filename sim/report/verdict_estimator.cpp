@@ -1,0 +1,93 @@
+#include "sim/report/verdict_estimator.h"
+
+#include <algorithm>
+
+#include "sim/analytic/analysis_cache.h"
+#include "sim/analytic/analytic.h"
+#include "sim/analytic/estimate.h"
+#include "sim/harness/trace_stream.h"
+#include "sim/report/verdict.h"
+
+namespace rtsim {
+
+namespace {
+
+/// Evenly spread blocks of rays [first, first + count): a cheap sample for the estimates.
+class SampleStream : public RayStream {
+public:
+    SampleStream(TraceReader& reader, uint64_t first, uint64_t total, uint64_t sample) : m_reader(reader) {
+        const uint64_t blocks = total <= sample ? 1 : 16, block = total <= sample ? total : sample / blocks;
+        for (uint64_t b = 0; b < blocks; ++b) m_blocks.push_back({first + b * (total / blocks), block});
+        m_total = blocks * block;
+    }
+    size_t read_chunk(size_t max, std::vector<RayJob>* out) override {
+        if (m_next == m_blocks.size()) return 0;
+        auto& [first, left] = m_blocks[m_next];
+        const size_t n = size_t(std::min<uint64_t>(max, left));
+        read_ray_jobs(m_reader, first, n, &m_buffer, out);
+        first += n;
+        left -= n;
+        if (left == 0) ++m_next;
+        return n;
+    }
+    uint64_t total_rays() const override { return m_total; }
+
+private:
+    TraceReader& m_reader;
+    std::vector<std::pair<uint64_t, uint64_t>> m_blocks;  ///< first ray, rays left
+    size_t m_next = 0;
+    uint64_t m_total = 0;
+    std::vector<RayRecord> m_buffer;
+};
+
+class DiscardSink : public RaySinkIf {
+public:
+    void ray_done(const RayResult&) override {}
+};
+
+}  // namespace
+
+SimConfig analytic_config(SimConfig config) {
+    config.fidelity = Fidelity::analytic;
+    config.treelets.enabled = false;
+    config.sampling = SamplingConfig{};
+    // The closed form times each ray context on its own: a SIMT machine's relaxations are
+    // estimated for the MIMD machine with the same contexts (divergence is not in it).
+    config.traversal.model = UnitModel::mimd;
+    return config;
+}
+
+VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
+    if (c.estimate) {
+        m_method = c.estimate_method;
+        return;
+    }
+    const SimConfig base = analytic_config(c.config);
+    // The analysis stored beside the trace for this key, if a run at the analytic level made it.
+    if (c.frames == 1 && !c.trace_path.empty()) {
+        const nlohmann::json key = analysis_key(base, base.analytic, trace_identity(*c.reader));
+        if (auto stored = load_analysis(analysis_path(c.trace_path, key), key)) {
+            m_loaded = std::make_unique<AnalyticProfile>(std::move(*stored));
+            m_profile = m_loaded.get();
+            m_method = "the analytic level on the per-trace analysis stored beside the trace (" +
+                       std::to_string(uint64_t(m_profile->stepped_rays)) + " stepped rays)";
+            return;
+        }
+    }
+    const uint64_t total = c.reader->section(SectionKind::rays).record_count;
+    const uint64_t rays = c.frame_rays ? c.frame_rays : total;
+    SampleStream stream(*c.reader, c.first_ray, rays, c.sample_rays);
+    DiscardSink sink;
+    m_profile = &analyze_stream(base, *c.accel, *c.map, stream, sink);
+    m_method = "analytic level on " + std::to_string(stream.total_rays()) + " sampled rays" +
+               (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " (treelets off)" : "");
+}
+
+std::pair<double, std::string> VerdictEstimator::operator()(const SimConfig& config) const {
+    const SimConfig a = analytic_config(config);
+    if (m_context.estimate) return m_context.estimate(a);
+    const AnalyticEstimate e = estimate_analytic(a, *m_profile);
+    return {e.form.cycles, e.form.binding};
+}
+
+}  // namespace rtsim

@@ -1,0 +1,192 @@
+#include "sim/report/verdict_knobs.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/report/energy_area.h"
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// A pair is a co-limit when its joint gain is much more than either alone: at least 1.5x the
+/// better single gain plus five points (2.06x jointly against 1.07x and 1.12x alone is one).
+constexpr double kCoLimitFactor = 1.5, kCoLimitMargin = 0.05;
+/// Knobs whose pairs are tried: the best this many by estimated gain (every estimable knob of a
+/// default config: a co-limit's knobs gain little alone, so a short list by gain would miss it).
+constexpr size_t kPairPool = 24;
+
+void add(std::vector<Knob>* out, Relaxation r, const std::string& resource, bool estimable = true) {
+    if (!r.key.empty()) out->push_back({std::move(r), resource, estimable});
+}
+
+/// A pipeline kind's relaxation: more shared pipelines, a shorter initiation interval, or wider.
+Relaxation pipeline_relaxation(const SimConfig& c, OpKind kind) {
+    const PipelineConfig& p = c.pipeline(kind);
+    const std::string base = std::string(op_kind_name(kind)) + ".";
+    if (p.shared()) return doubled(c, base + "shared_count");
+    if (p.initiation_interval > 1) return halved(c, base + "initiation_interval");
+    return doubled(c, base + "width");
+}
+
+void treelet_knobs(const SimConfig& c, std::vector<Knob>* out) {
+    // The analytic level has no ray buffer: these are measured, never estimated.
+    add(out, doubled(c, "treelets.admit_outstanding"), "admission", false);
+    if (c.treelets.max_rays_in_flight > 0) add(out, doubled(c, "treelets.max_rays_in_flight"), "admission", false);
+    add(out, doubled(c, "treelets.buffer_kib"), "ray_buffer", false);
+    add(out, doubled(c, "treelets.bytes_per_cycle"), "ray_buffer", false);
+    for (size_t i = 0; i < kTreeletPolicyChoices.names.size(); ++i)
+        if (TreeletPolicy(i) != c.treelets.policy)
+            add(out, {"treelets.policy", kTreeletPolicyChoices.name(c.treelets.policy), kTreeletPolicyChoices.names[i]},
+                "treelet_scheduling", false);
+}
+
+double num_or(const json& j, double fallback) { return j.is_number() ? j.get<double>() : fallback; }
+
+/// Best first: by estimated gain where there is one, else by the share of context cycles that
+/// point at the knob's resource.
+void rank(json& knobs) {
+    std::stable_sort(knobs.begin(), knobs.end(), [](const json& a, const json& b) {
+        const bool ea = a["speedup"].is_number(), eb = b["speedup"].is_number();
+        if (ea != eb) return ea;
+        if (ea && a["speedup"] != b["speedup"]) return a["speedup"].get<double>() > b["speedup"].get<double>();
+        return a["evidence"].get<double>() > b["evidence"].get<double>();
+    });
+}
+
+json first(const json& list, size_t n) {
+    json out = json::array();
+    for (size_t i = 0; i < list.size() && i < n; ++i) out.push_back(list[i]);
+    return out;
+}
+
+/// The three best gains per added mm^2 (knobs the area model prices, that gain at all).
+json per_area(const json& knobs) {
+    json out = json::array();
+    for (const json& k : knobs)
+        if (k["gain_per_mm2"].is_number() && num_or(k["speedup"], 1.0) > 1.005) out.push_back(k);
+    std::stable_sort(out.begin(), out.end(), [](const json& a, const json& b) {
+        return a["gain_per_mm2"].get<double>() > b["gain_per_mm2"].get<double>();
+    });
+    return first(out, 3);
+}
+
+Relaxation relaxation_of(const json& k) { return {k["key"].get<std::string>(), k["from"], k["to"]}; }
+
+/// Pairs of the best estimated knobs whose joint gain is much more than either alone.
+json co_limits(const WeighInputs& in, const json& knobs) {
+    std::vector<json> pool;
+    for (const json& k : knobs)
+        if (k["speedup"].is_number() && pool.size() < kPairPool) pool.push_back(k);
+    json out = json::array();
+    for (size_t i = 0; i < pool.size(); ++i)
+        for (size_t j = i + 1; j < pool.size(); ++j) {
+            if (pool[i]["key"] == pool[j]["key"]) continue;
+            double joint;
+            try {
+                const SimConfig both = relaxed_config(in.config, {relaxation_of(pool[i]), relaxation_of(pool[j])});
+                joint = in.base_cycles / in.cycles(both);
+            } catch (const Error&) {
+                continue;
+            }
+            const double a = pool[i]["speedup"].get<double>(), b = pool[j]["speedup"].get<double>();
+            if (joint - 1.0 < kCoLimitFactor * (std::max(a, b) - 1.0) + kCoLimitMargin) continue;
+            out.push_back({{"keys", {pool[i]["key"], pool[j]["key"]}},
+                           {"sets", {pool[i]["key"].get<std::string>() + "=" + pool[i]["to"].dump(),
+                                     pool[j]["key"].get<std::string>() + "=" + pool[j]["to"].dump()}},
+                           {"resources", {pool[i]["resource"], pool[j]["resource"]}},
+                           {"joint", joint},
+                           {"alone", {a, b}}});
+        }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const json& a, const json& b) { return a["joint"].get<double>() > b["joint"].get<double>(); });
+    return first(out, 3);
+}
+
+}  // namespace
+
+Relaxation doubled(const SimConfig& c, const std::string& key) {
+    const ConfigField f = config_field(c, key);
+    const double value = f.value.get<double>();
+    if (value <= 0 || value * 2 > f.max) return {};
+    return {key, f.value, json(f.value.get<uint64_t>() * 2)};
+}
+
+Relaxation halved(const SimConfig& c, const std::string& key) {
+    const ConfigField f = config_field(c, key);
+    const uint64_t value = f.value.get<uint64_t>();
+    if (value / 2 < f.min || value < 2) return {};
+    return {key, f.value, json(value / 2)};
+}
+
+std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops) {
+    std::vector<Knob> out;
+    add(&out, doubled(c, "traversal.units"), "units");
+    add(&out, doubled(c, "traversal.ray_contexts"), "latency");
+    for (OpKind kind : ops) add(&out, pipeline_relaxation(c, kind), op_kind_name(kind));
+    add(&out, halved(c, "traversal.issue_cycles"), "scheduler");
+    if (!c.ideal_memory) {
+        add(&out, doubled(c, "l1.size_kib"), "l1_capacity");
+        add(&out, doubled(c, "l2.size_kib"), "l2_capacity");
+        add(&out, doubled(c, "l1.banks"), "l1_banks");
+        add(&out, doubled(c, "l2.banks"), "l2_banks");
+        add(&out, doubled(c, "l1.mshrs"), "l1_mshrs");
+        add(&out, doubled(c, "l2.mshrs"), "l2_mshrs");
+        add(&out, doubled(c, "dram.channels"), "dram");
+    }
+    add(&out, doubled(c, "traversal.stack_entries"), "stack");
+    // Narrower warps diverge less; the analytic level has no warps, so only a re-run measures it.
+    if (c.traversal.model == UnitModel::simt) add(&out, halved(c, "traversal.lanes"), "divergence", false);
+    if (c.treelets.enabled) treelet_knobs(c, &out);
+    return out;
+}
+
+SimConfig relaxed_config(const SimConfig& config, const std::vector<Relaxation>& knobs) {
+    SimConfig c = config;
+    for (const Relaxation& r : knobs)
+        config_set(c, r.key + "=" + (r.to.is_string() ? r.to.get<std::string>() : r.to.dump()));
+    validate(c);
+    return c;
+}
+
+json weigh_knobs(const WeighInputs& in) {
+    std::vector<OpKind> ops;
+    for (const json& b : in.instantiated)
+        for (int k = 0; k < kOpKindCount; ++k)
+            if (b.value("block", "") == op_kind_name(OpKind(k)) && b.value("instantiated", false))
+                ops.push_back(OpKind(k));
+    const double base_mm2 = area_total_mm2(in.config, in.instantiated);
+    json knobs = json::array();
+    for (const Knob& k : every_knob(in.config, ops)) {
+        json j = {{"key", k.relax.key}, {"resource", k.resource}, {"from", k.relax.from}, {"to", k.relax.to},
+                  {"speedup", nullptr}, {"added_mm2", nullptr}, {"gain_per_mm2", nullptr}};
+        const auto e = in.evidence.find(k.resource);
+        j["evidence"] = e == in.evidence.end() ? 0.0 : e->second;
+        try {
+            const SimConfig relaxed = relaxed_config(in.config, {k.relax});
+            const double added = area_total_mm2(relaxed, in.instantiated) - base_mm2;
+            j["added_mm2"] = added;
+            if (!k.estimable || !in.not_covered.empty() || !in.cycles) {
+                const bool machine = k.estimable && !in.not_covered.empty();
+                j["why_not"] = machine ? in.not_covered : "the analytic level does not model it: measure it";
+            } else {
+                const double speedup = in.base_cycles / in.cycles(relaxed);
+                j["speedup"] = speedup;
+                if (added > 1e-9) j["gain_per_mm2"] = (speedup - 1.0) / added;
+            }
+        } catch (const Error& e) {
+            j["why_not"] = e.what();
+        }
+        knobs.push_back(j);
+    }
+    rank(knobs);
+    return {{"knobs", knobs},
+            {"top", first(knobs, 3)},
+            {"top_per_mm2", per_area(knobs)},
+            {"co_limits", in.cycles && in.not_covered.empty() ? co_limits(in, knobs) : json::array()}};
+}
+
+}  // namespace rtsim

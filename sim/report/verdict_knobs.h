@@ -1,0 +1,65 @@
+#pragma once
+// Every knob weighed (docs/stats.md, "verdict"): each resource the model has is a candidate,
+// relaxed by one step of the config field that sizes it (doubled within its declared range, or a
+// cost per operation halved), estimated, priced by the area model, ranked by gain and by gain per
+// added mm^2; pairs whose joint relaxation gains much more than either alone are co-limits.
+//
+// A co-limit is what a single-knob verdict misses: with DRAM channels and L2 MSHRs both near
+// their bound, doubling either leaves the other binding (a few percent), doubling both moves the
+// machine to its next bound. The analytic level's closed form (sim/analytic/closed_form.h) is a
+// max over bounds plus mean value analysis, so evaluating the pair shows it directly.
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sim/config/config.h"
+
+namespace rtsim {
+
+/// A config change that relaxes one resource: "key" from "from" to "to".
+struct Relaxation {
+    std::string key;
+    nlohmann::json from, to;
+};
+
+/// The knob `key` doubled, within the range its config field declares; an empty key past it.
+Relaxation doubled(const SimConfig& config, const std::string& key);
+/// The knob `key` halved (a cost per operation), not below its declared minimum.
+Relaxation halved(const SimConfig& config, const std::string& key);
+
+/// One knob: the relaxation and the resource it relaxes (the names the verdict's `binding`
+/// uses: `l2_mshrs`, `dram`, `box`, `l2_capacity`, `admission`, ...).
+struct Knob {
+    Relaxation relax;
+    std::string resource;
+    bool estimable = true;  ///< the analytic level models what the knob changes
+};
+
+/// Every knob of this config that relaxes a resource: units, ray contexts, the pipelines of the
+/// operation kinds in `ops`, the scheduler, L1 and L2 capacity, banks and MSHRs, DRAM channels,
+/// the on-chip stack and, with treelets on, the ray buffer, admission and scheduling.
+std::vector<Knob> every_knob(const SimConfig& config, const std::vector<OpKind>& ops);
+
+/// The cycles the estimator gives for a config; throws rtsim::Error for a config it refuses.
+using CycleEstimate = std::function<double(const SimConfig&)>;
+
+struct WeighInputs {
+    const SimConfig& config;
+    nlohmann::json instantiated;          ///< stats.json "instantiated" (the area model's input)
+    CycleEstimate cycles;                 ///< unset when nothing can be estimated
+    double base_cycles = 0;               ///< the estimator's cycles for `config`
+    std::string not_covered;              ///< why the estimates do not describe this machine ("" if they do)
+    std::map<std::string, double> evidence;  ///< resource -> share of context cycles pointing at it
+};
+
+/// {knobs (best first), top (three), top_per_mm2 (three), co_limits}; each knob {key, resource,
+/// from, to, speedup (null without an estimate), added_mm2, gain_per_mm2, evidence, why_not}.
+nlohmann::json weigh_knobs(const WeighInputs& in);
+
+/// The relaxed config: `config` with every `key=to` of `knobs` set (validated); throws rtsim::Error.
+SimConfig relaxed_config(const SimConfig& config, const std::vector<Relaxation>& knobs);
+
+}  // namespace rtsim
