@@ -41,12 +41,14 @@ class AccelRow:
     manifest: dict[str, Any]
 
     def work_per_ray(self, what: str) -> float | None:
-        """Mean of a work count per ray over every ray kind of the trace."""
+        """Mean of a work count per ray over the rays the trace holds (and the model simulated):
+        each kind weighted by its written rays, so the primary rays a diffuse workload traces
+        only to find its bounces do not count."""
         kinds = self.manifest.get("counts", {}).get("by_kind", {})
-        rays = sum(k.get("traced", 0) for k in kinds.values())
+        rays = sum(k.get("written", 0) for k in kinds.values())
         if not rays:
             return None
-        total = sum(k.get(f"{what}_per_ray", 0.0) * k.get("traced", 0) for k in kinds.values())
+        total = sum(k.get(f"{what}_per_ray", 0.0) * k.get("written", 0) for k in kinds.values())
         return total / rays
 
 
