@@ -68,9 +68,11 @@ AccelImage bvh2_image(const BuildTree& tree, const Scene& scene, const BuildConf
     AccelImage image;
     image.kind = "bvh2";
     image.bounds = tree.nodes[0].box;
-    Region& nodes = image.add_region<HwNode>("nodes", DataKind::node, flat_node_count(tree), false);
-    Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, tree.prim_ids.size(), false);
-    const BvhStats s = flatten_bvh_into(tree, scene, c, nodes.records<HwNode>(), tris.records<HwTriangle>());
+    image.add_region<HwNode>("nodes", DataKind::node, flat_node_count(tree), false);
+    image.add_region<HwTriangle>("triangles", DataKind::triangle, tree.prim_ids.size(), false);
+    // The regions' records are taken once both exist: adding a region may move the others.
+    const BvhStats s = flatten_bvh_into(tree, scene, c, image.region("nodes").records<HwNode>(),
+                                        image.region("triangles").records<HwTriangle>());
     image.place_regions();
     image.stats = bvh2_stats(s, c, builder);
     return image;
