@@ -45,11 +45,12 @@ class AccelRow:
         each kind weighted by its written rays, so the primary rays a diffuse workload traces
         only to find its bounces do not count."""
         kinds = self.manifest.get("counts", {}).get("by_kind", {})
-        rays = sum(k.get("written", 0) for k in kinds.values())
+        # Manifests written before kinds recorded "written" traced exactly what they wrote.
+        weights = [(k, k.get("written", k.get("traced", 0))) for k in kinds.values()]
+        rays = sum(w for _, w in weights)
         if not rays:
             return None
-        total = sum(k.get(f"{what}_per_ray", 0.0) * k.get("written", 0) for k in kinds.values())
-        return total / rays
+        return sum(k.get(f"{what}_per_ray", 0.0) * w for k, w in weights) / rays
 
 
 def has_accel_axis(data: SweepData) -> bool:
