@@ -8,7 +8,7 @@ rtsim simulate TRACE [--config CFG] [--set k=v ...] -o RUN [--timeline]  replay 
 rtsim config --defaults | --schema                                   the simulator's config
 rtsim accuracy SCENE... [-o DIR] [--fractions 0.01,0.05]            fidelity: time against error
 rtsim bench [SCENE] [--json FILE] [--repeat N]                       rtsim against Embree
-rtsim bench --model TRACE [--levels L,...] [--repeat N] [--json FILE] the simulator's own speed
+rtsim bench --model TRACE [--levels L,...] [--verdict] [--json FILE] the simulator's own speed
 rtsim sweep SPEC.yaml -o SWEEP [--scheduler tcp://HOST:PORT]        a design-space sweep
 rtsim results SWEEP [--csv [FILE]]                                  its tidy table
 rtsim report SWEEP [-o report.html]                                 its HTML report
@@ -280,6 +280,7 @@ def cmd_bench(args: argparse.Namespace, console: Console) -> int:
             Path(args.json) if args.json else None,
             console,
             Path(args.against) if args.against else None,
+            verdict=args.verdict,
         )
     exe = find_bench()
     if exe is None or not exe.is_file():
@@ -566,6 +567,12 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         default=None,
         help="with --model: also run this other rtsim-sim binary after every run (same settings) "
         "and report its CPU time, the speed-up and whether the cycles agree (default: none)",
+    )
+    p.add_argument(
+        "--verdict",
+        action="store_true",
+        help="with --model: time default runs, the bottleneck verdict included (default: every "
+        "run has --no-verdict, the simulation alone; the report says which)",
     )
     p.set_defaults(func=cmd_bench)
 

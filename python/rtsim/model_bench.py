@@ -1,10 +1,12 @@
 """`rtsim bench --model TRACE`: how fast the simulator itself runs, per fidelity level.
 
 For each trace and level, runs `rtsim-sim TRACE --no-verdict --set fidelity=LEVEL` `repeat` times
-(one process each, start-up included) and reports the median wall time, the median CPU time of
-the process (user + system, from the OS's accounting of the finished child: less sensitive to a
-shared machine than wall time), simulated rays per wall- and CPU-second, and the ratios the
-simulator's speed targets are stated in (docs/benchmarks.md):
+(one process each, start-up included; with `verdict=True` without `--no-verdict`, so each run is
+what a default run costs, the bottleneck verdict included; the report says which) and reports
+the median wall time, the median CPU time of the process (user + system, from the OS's
+accounting of the finished child: less sensitive to a shared machine than wall time),
+simulated rays per wall- and CPU-second, and the ratios the simulator's speed targets are
+stated in (docs/benchmarks.md):
 
     approx/functional, detailed/approx, treelets/approx, approx/analytic
 
@@ -23,9 +25,11 @@ from __future__ import annotations
 
 import json
 import os
+import platform
 import statistics
 import tempfile
 from dataclasses import asdict, dataclass, field
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +67,7 @@ class LevelTiming:
     against_cpu_seconds: list[float] = field(default_factory=list)  # --against: the other binary
     against_cycles: int | None = None
     against_error: str | None = None
+    git: str | None = None  # the binary's commit (stats.json provenance)
 
     def median_wall(self) -> float | None:
         return statistics.median(self.wall_seconds) if self.wall_seconds else None
@@ -88,10 +93,11 @@ class LevelTiming:
 
 
 def run_once(
-    exe: Path, trace: Path, settings: list[str], out: Path
-) -> tuple[float, float, int, int | None]:
-    """One rtsim-sim process: (wall s, CPU s of the child, simulated rays, simulated cycles)."""
-    result = run_sim(SimJob(trace=trace, out_dir=out, sets=settings, verdict=False), exe=exe)
+    exe: Path, trace: Path, settings: list[str], out: Path, verdict: bool = False
+) -> tuple[float, float, int, int | None, str | None]:
+    """One rtsim-sim process: (wall s, CPU s of the child, simulated rays, simulated cycles,
+    the binary's git commit)."""
+    result = run_sim(SimJob(trace=trace, out_dir=out, sets=settings, verdict=verdict), exe=exe)
     if result.returncode not in (0, 3) or result.stats is None:
         lines = result.messages
         raise RuntimeError(lines[-1] if lines else result.describe_failure())
@@ -99,7 +105,8 @@ def run_once(
     rays = int(stats["summary"].get("rays") or stats["workload"]["rays"])
     cycles = stats["summary"].get("cycles")
     simulated = int(cycles) if cycles is not None else None
-    return result.wall_seconds, result.cpu_seconds, rays, simulated
+    git = stats.get("provenance", {}).get("git")
+    return result.wall_seconds, result.cpu_seconds, rays, simulated, git
 
 
 def bench_trace(
@@ -110,6 +117,7 @@ def bench_trace(
     extra: list[str],
     console: Console,
     against: Path | None = None,
+    verdict: bool = False,
 ) -> dict[str, LevelTiming]:
     timings: dict[str, LevelTiming] = {}
     with tempfile.TemporaryDirectory(prefix="rtsim-bench-model-") as tmp:
@@ -120,8 +128,8 @@ def bench_trace(
                 if t.error or (level != "analytic" and round_ >= repeat):
                     continue
                 try:
-                    wall, cpu, rays, t.cycles = run_once(
-                        exe, trace, LEVELS[level] + extra, Path(tmp)
+                    wall, cpu, rays, t.cycles, t.git = run_once(
+                        exe, trace, LEVELS[level] + extra, Path(tmp), verdict
                     )
                 except RuntimeError as err:
                     t.error = str(err)
@@ -136,8 +144,8 @@ def bench_trace(
                 line = f"  {trace.name:<28} {level:<11} {wall:8.3f} s wall {cpu:8.3f} s cpu"
                 if against and not t.against_error:
                     try:
-                        _, other_cpu, _, t.against_cycles = run_once(
-                            against, trace, LEVELS[level] + extra, Path(tmp)
+                        _, other_cpu, _, t.against_cycles, _ = run_once(
+                            against, trace, LEVELS[level] + extra, Path(tmp), verdict
                         )
                         t.against_cpu_seconds.append(other_cpu)
                         line += f"   against: {other_cpu:8.3f} s cpu"
@@ -156,6 +164,37 @@ def ratios(timings: dict[str, LevelTiming]) -> dict[str, float | None]:
         ca, cb = (a.median_cpu() if a else None), (b.median_cpu() if b else None)
         out[f"{slow}/{fast}"] = ca / cb if ca and cb else None
     return out
+
+
+def verdict_note(verdict: bool) -> str:
+    """What the timed runs include, said with every report."""
+    if verdict:
+        return (
+            "Each run is a default run: the bottleneck verdict is included (its analysis is "
+            "stepped by the first run of a trace and key, stored beside the trace, loaded by later "
+            "runs)."
+        )
+    return (
+        "The verdict is not included: every run has --no-verdict (the simulation alone; "
+        "--verdict times default runs, verdict included)."
+    )
+
+
+def host_info() -> dict[str, Any]:
+    """CPU model and load average, as rtsim-bench records them."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    try:
+        load = os.getloadavg()[0]
+    except OSError:
+        load = None
+    return {"cpu": cpu, "hardware_threads": os.cpu_count(), "load_average": load}
 
 
 def markdown(report: list[dict[str, Any]]) -> str:
@@ -203,6 +242,7 @@ def run_model_bench(
     json_path: Path | None,
     console: Console,
     against: Path | None = None,
+    verdict: bool = False,
 ) -> int:
     unknown = [lvl for lvl in levels if lvl not in LEVELS]
     if unknown:
@@ -213,12 +253,13 @@ def run_model_bench(
     if against is not None and not against.is_file():
         console.print(f"rtsim: error: --against: {against}: no such binary")
         return 2
+    started, host_start = datetime.now(timezone.utc), host_info()
     report = []
     for trace in traces:
         if not trace.exists():
             console.print(f"rtsim: error: {trace}: no such trace")
             return 2
-        timings = bench_trace(exe, trace, levels, repeat, extra, console, against)
+        timings = bench_trace(exe, trace, levels, repeat, extra, console, against, verdict)
         report.append(
             {
                 "trace": str(trace),
@@ -227,13 +268,26 @@ def run_model_bench(
             }
         )
     console.print(markdown(report), highlight=False, markup=False)
+    console.print(verdict_note(verdict), highlight=False, markup=False)
     if json_path:
+        host_end = host_info()
+        gits = [s["git"] for t in report for s in t["levels"].values() if s.get("git")]
         meta = {
             "sim": str(exe),
+            "git": gits[0] if gits else None,
             "against": str(against) if against else None,
             "repeat": repeat,
             "set": extra,
+            "verdict": verdict,
             "cpu_count": os.cpu_count(),
+            "date_start": started.isoformat(timespec="seconds"),
+            "date_end": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "host": {
+                "cpu": host_start["cpu"],
+                "hardware_threads": host_start["hardware_threads"],
+                "load_average_start": host_start["load_average"],
+                "load_average_end": host_end["load_average"],
+            },
         }
         json_path.write_text(json.dumps({**meta, "traces": report}, indent=2))
     return 1 if any(s["error"] for t in report for s in t["levels"].values()) else 0

@@ -39,6 +39,11 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
 Cycle Cache::access(const MemRequest& req) {
     uint64_t first = req.addr >> m_line_shift;
     uint64_t last = (req.addr + (req.bytes ? req.bytes : 1) - 1) >> m_line_shift;
+    // One line (most node and triangle fetches): where its time went is the line's own.
+    if (first == last) {
+        if (req.info) *req.info = AccessInfo{};
+        return std::max(req.time, access_line(first, req, req.info));
+    }
     Cycle done = req.time;
     if (!req.info) {
         for (uint64_t line = first; line <= last; ++line) done = std::max(done, access_line(line, req, nullptr));
@@ -54,6 +59,17 @@ Cycle Cache::access(const MemRequest& req) {
         }
     }
     return done;
+}
+
+Cycle Cache::forward(const MemRequest& down) {
+    if (!m_next_resolved) {
+        m_next_cache = dynamic_cast<Cache*>(next.get_interface());
+        m_next_dram = dynamic_cast<Dram*>(next.get_interface());
+        m_next_resolved = true;
+    }
+    if (m_next_cache) return m_next_cache->access(down);
+    if (m_next_dram) return m_next_dram->access(down);
+    return next->access(down);
 }
 
 Cycle Cache::bank_start(uint64_t line, Cycle time) {
@@ -80,7 +96,7 @@ Cycle Cache::access_line(uint64_t line, const MemRequest& req, AccessInfo* info)
         down.bytes = bytes;
         down.time = tag_done + m_next_latency;
         down.info = nullptr;
-        next->access(down);
+        forward(down);
         return tag_done;
     }
     ++c.reads;
@@ -122,7 +138,7 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     if (info) info->mshr_wait[size_t(m_level)] += issue - tag_done;
     AccessInfo below;
     MemRequest down{line << m_line_shift, m_config.line_bytes, false, req.kind, issue + m_next_latency, &below};
-    Cycle fill = next->access(down) + m_next_latency;
+    Cycle fill = forward(down) + m_next_latency;
     if (info) {
         info->level = below.level;
         for (int k = 0; k < 2; ++k) info->mshr_wait[k] += below.mshr_wait[k];

@@ -24,6 +24,7 @@
 #include "rtl_model/common/usage_series.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/mem/cache_config.h"
+#include "rtl_model/mem/dram.h"
 
 namespace rtsim {
 
@@ -36,7 +37,7 @@ public:
     Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs_enabled, Cycle next_latency,
           bool exact = false, ServedBy level = ServedBy::l1);
 
-    Cycle access(const MemRequest& req) override;
+    Cycle access(const MemRequest& req) final;
     /// Functional warming (sampling, SMARTS): makes the lines of [addr, addr + bytes) present and
     /// most recently used, as a read would, with no time, no stats and no traffic below.
     /// Returns true when every line was already present (a hit: the level below would not see it).
@@ -64,6 +65,9 @@ private:
         ServedBy filled_from = ServedBy::l1;  ///< where its fill came from (for merged reads)
     };
     static constexpr uint64_t kInvalid = ~0ull;  ///< tag of an empty line
+    /// A request to the next level: a direct call when it is a Cache or the Dram (the usual
+    /// L1 -> L2 -> DRAM chain, resolved on first use), else through the port.
+    Cycle forward(const MemRequest& down);
     Cycle access_line(uint64_t line_addr, const MemRequest& req, AccessInfo* info);
     Cycle miss(uint64_t line_addr, const MemRequest& req, Cycle tag_done, AccessInfo* info);
     Cycle bank_start(uint64_t line_addr, Cycle time);
@@ -71,6 +75,9 @@ private:
 
     CacheConfig m_config;
     ServedBy m_level;
+    bool m_next_resolved = false;
+    Cache* m_next_cache = nullptr;
+    Dram* m_next_dram = nullptr;
     bool m_mshrs_enabled;
     Cycle m_next_latency;
     uint32_t m_line_shift;

@@ -23,7 +23,7 @@ class Dram : public sc_core::sc_module, public MemIf {
 public:
     Dram(sc_core::sc_module_name name, const DramConfig& config);
 
-    Cycle access(const MemRequest& req) override;
+    Cycle access(const MemRequest& req) final;
 
     const MemStats& stats() const { return m_stats; }
     /// Bytes moved per bucket of `bucket_cycles()` cycles, from cycle 0.

@@ -20,9 +20,7 @@ void add_issue(const Op& op, const StepCosts& costs, StepDemand& d) {
 void plan_demand(const StepPlan& plan, const StepCosts& costs, StepDemand& d) {
     d.read_count = plan.fetch_count;
     std::copy(plan.fetch, plan.fetch + plan.fetch_count, d.reads);
-    d.issue_count = 0;
-    for (int i = 0; i < plan.op_count; ++i) add_issue(plan.op[i], costs, d);
-    d.scheduler_slots = kSchedulerSlotsPerStep;
+    step_parts::plan_issues(plan, costs, d);
 }
 
 void outcome_demand(const StepOutcome& outcome, const StepCosts& costs, StepDemand& d) {
@@ -58,9 +56,23 @@ StepDemand step_demand(const StepPlan& plan, const StepOutcome& outcome, int sta
 
 void take_step(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& d) {
     plan_demand(stepper.plan(), costs, d);  // execute() plans the next step over this one
+    step_parts::run_and_cost(stepper, stack, costs, d);
+}
+
+namespace step_parts {
+
+void plan_issues(const StepPlan& plan, const StepCosts& costs, StepDemand& d) {
+    d.issue_count = 0;
+    for (int i = 0; i < plan.op_count; ++i) add_issue(plan.op[i], costs, d);
+    d.scheduler_slots = kSchedulerSlotsPerStep;
+}
+
+void run_and_cost(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& d) {
     const int before = stepper.stack_size();
     outcome_demand(stepper.execute(), costs, d);
     stack_demand(before, stepper.stack_size(), stack, costs, d);
 }
+
+}  // namespace step_parts
 
 }  // namespace rtsim

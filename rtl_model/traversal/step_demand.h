@@ -95,6 +95,25 @@ StepDemand step_demand(const StepPlan& plan, const StepOutcome& outcome, int sta
 /// step-demand function, without copying the plan): what every consumer of plans calls.
 void take_step(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& demand);
 
+namespace step_parts {
+/// The issues of the plan's operations (take_step's first part, after the reads).
+void plan_issues(const StepPlan& plan, const StepCosts& costs, StepDemand& demand);
+/// Runs the planned step, then costs the operations its results called for and its stack.
+void run_and_cost(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& demand);
+}  // namespace step_parts
+
+/// take_step with the plan's fetches handed to `read(const Fetch&)` in order, in place, before
+/// the step runs (demand.reads is left empty, read_count 0): a traversal unit issues them to
+/// its memory as they are, instead of copying them first. The demand is otherwise take_step's.
+template <class Read>
+void take_step_reading(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& demand, Read&& read) {
+    const StepPlan& plan = stepper.plan();
+    for (int i = 0; i < plan.fetch_count; ++i) read(plan.fetch[i]);
+    demand.read_count = 0;
+    step_parts::plan_issues(plan, costs, demand);
+    step_parts::run_and_cost(stepper, stack, costs, demand);
+}
+
 /// Calls f(line, bytes in it) for each line (of 1 << line_shift bytes) that [addr, addr + bytes)
 /// touches (a zero-byte access touches the line of addr), as the caches split a request.
 template <class F>

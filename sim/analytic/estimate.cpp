@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <deque>
 
 #include "rtl_model/dispatch/dispatch.h"
 #include "rtl_model/mem/mem_stats.h"
@@ -13,42 +14,70 @@ namespace rtsim {
 
 using nlohmann::json;
 
-namespace {
-
-/// Miss probabilities per reuse bin for one configuration's L1 and L2, computed on first use.
-class MissTables {
+/// Miss probabilities per reuse bin of one cache shape (lines, ways) on one stream's curve,
+/// each computed on first use.
+class LevelMisses {
 public:
-    MissTables(const SimConfig& c, const AnalyticProfile& p)
-        : m_unit(p.unit_events, p.unit_censored),
-          m_global(p.global_events, p.global_censored),
-          m_c(c),
-          m_cold(p.whole_trace),
-          m_m1(2 * DistanceBins::kBins, -1.0),
-          m_m2(2 * DistanceBins::kBins, -1.0) {}
-    /// P(L1 miss) and P(L1 miss and L2 miss) of an access in a joint cell.
-    std::pair<double, double> cell(uint32_t key) const {
-        if (m_c.ideal_memory) return {0.0, 0.0};
-        int ub, gb;
-        bool uc, gc;
-        JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
-        const double p1 = lookup(m_m1, m_unit, ub, uc, m_c.l1, m_cold);
-        return {p1, p1 * lookup(m_m2, m_global, gb, gc, m_c.l2, m_cold)};
+    LevelMisses(const ReuseCurve& curve, double lines, uint32_t ways, bool cold)
+        : m_curve(curve), m_lines(lines), m_ways(ways), m_cold(cold), m_table(2 * DistanceBins::kBins, -1.0) {}
+    bool is(double lines, uint32_t ways) const { return lines == m_lines && ways == m_ways; }
+    double operator()(int b, bool censored) {
+        double& m = m_table[size_t(2 * b + censored)];
+        if (m < 0) m = bin_miss_probability(m_curve, b, censored, m_lines, m_ways, m_cold);
+        return m;
     }
 
 private:
-    static double lookup(std::vector<double>& table, const ReuseCurve& curve, int b, bool censored,
-                         const CacheConfig& cache, bool cold) {
-        double& m = table[size_t(2 * b + censored)];
-        if (m < 0) {
-            const double lines = double(cache.size_kib) * 1024.0 / cache.line_bytes;
-            m = bin_miss_probability(curve, b, censored, lines, cache.ways, cold);
-        }
-        return m;
+    const ReuseCurve& m_curve;
+    double m_lines;
+    uint32_t m_ways;
+    bool m_cold;  ///< censored accesses are compulsory misses (whole-trace analysis)
+    std::vector<double> m_table;
+};
+
+/// A profile's reuse curves and the miss tables of every cache shape asked for so far: one
+/// configuration's evaluation computes its L1's and L2's tables; evaluating many against one
+/// profile (the verdict's knobs and pairs) reuses them wherever the cache shape is unchanged.
+class MissModel {
+public:
+    explicit MissModel(const AnalyticProfile& p)
+        : m_unit(p.unit_events, p.unit_censored), m_global(p.global_events, p.global_censored), m_cold(p.whole_trace) {}
+    LevelMisses& l1(const CacheConfig& c) { return table(m_l1, m_unit, c); }
+    LevelMisses& l2(const CacheConfig& c) { return table(m_l2, m_global, c); }
+
+private:
+    LevelMisses& table(std::deque<LevelMisses>& tables, const ReuseCurve& curve, const CacheConfig& c) {
+        const double lines = double(c.size_kib) * 1024.0 / c.line_bytes;
+        for (LevelMisses& t : tables)
+            if (t.is(lines, c.ways)) return t;
+        return tables.emplace_back(curve, lines, c.ways, m_cold);
     }
     ReuseCurve m_unit, m_global;
-    const SimConfig& m_c;
-    bool m_cold;  ///< censored accesses are compulsory misses (whole-trace analysis)
-    mutable std::vector<double> m_m1, m_m2;
+    bool m_cold;
+    std::deque<LevelMisses> m_l1, m_l2;  ///< a deque: references stay valid as tables are added
+};
+
+namespace {
+
+/// Miss probabilities per reuse bin for one configuration's L1 and L2.
+class MissTables {
+public:
+    MissTables(const SimConfig& c, MissModel& model)
+        : m_ideal(c.ideal_memory), m_l1(model.l1(c.l1)), m_l2(model.l2(c.l2)) {}
+    /// P(L1 miss) and P(L1 miss and L2 miss) of an access in a joint cell.
+    std::pair<double, double> cell(uint32_t key) const {
+        if (m_ideal) return {0.0, 0.0};
+        int ub, gb;
+        bool uc, gc;
+        JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
+        const double p1 = m_l1(ub, uc);
+        return {p1, p1 * m_l2(gb, gc)};
+    }
+
+private:
+    bool m_ideal;
+    LevelMisses& m_l1;
+    LevelMisses& m_l2;
 };
 
 /// Whole-trace counts of one data kind.
@@ -64,7 +93,7 @@ json counters_json(double reads, double writes, double hits, double read_bytes, 
 
 class Estimator {
 public:
-    Estimator(const SimConfig& c, const AnalyticProfile& p) : m_c(c), m_p(p), m_miss(c, p) {
+    Estimator(const SimConfig& c, const AnalyticProfile& p, MissModel& misses) : m_c(c), m_p(p), m_miss(c, misses) {
         const double line = c.l1.line_bytes;
         const double ic = c.interconnect_latency;
         m_lat_l1 = c.l1.latency;
@@ -72,6 +101,9 @@ public:
         m_dram = double(c.dram.latency) + std::ceil(line / c.dram.bytes_per_cycle);
         m_lat_dram = m_lat_l2 + m_dram;
     }
+    /// The demands and the closed form (all the verdict needs).
+    ClosedForm form();
+    /// The form and the model's stats as the SystemC model writes them.
     AnalyticEstimate run();
     PredictedRates rates();
 
@@ -156,7 +188,7 @@ void Estimator::ops(double* op_latency) {
     }
 }
 
-AnalyticEstimate Estimator::run() {
+ClosedForm Estimator::form() {
     count_kinds();
     double op_latency = 0;
     ops(&op_latency);
@@ -178,10 +210,14 @@ AnalyticEstimate Estimator::run() {
     const double per_step = steps > 0 ? (steps * fetch + op_latency) / steps : 0.0;
     const double longest = m_p.plan_steps_per[0] * m_p.longest_ray_steps + m_p.plan_steps_per[1] * m_p.longest_ray_tests;
     m_d.latency_max = ray_start + longest * per_step;
+    return closed_form(m_c, m_p.op_kinds, m_d);
+}
 
+AnalyticEstimate Estimator::run() {
     AnalyticEstimate e;
+    e.form = form();
     e.demands = m_d;
-    e.form = closed_form(m_c, m_p.op_kinds, m_d);
+    const double rays = m_d.rays;
     e.mean_latency = rays > 0 ? m_d.latency_sum / rays : 0.0;
     const double units = m_c.traversal.units;
     const std::vector<double> none(kOpKindCount, 0.0);
@@ -284,11 +320,22 @@ PredictedRates Estimator::rates() {
 }  // namespace
 
 AnalyticEstimate estimate_analytic(const SimConfig& config, const AnalyticProfile& profile) {
-    return Estimator(config, profile).run();
+    MissModel misses(profile);
+    return Estimator(config, profile, misses).run();
 }
 
 PredictedRates predicted_rates(const SimConfig& config, const AnalyticProfile& profile) {
-    return Estimator(config, profile).rates();
+    MissModel misses(profile);
+    return Estimator(config, profile, misses).rates();
+}
+
+FormEstimator::FormEstimator(const AnalyticProfile& profile)
+    : m_profile(profile), m_misses(std::make_unique<MissModel>(profile)) {}
+
+FormEstimator::~FormEstimator() = default;
+
+ClosedForm FormEstimator::operator()(const SimConfig& config) const {
+    return Estimator(config, m_profile, *m_misses).form();
 }
 
 }  // namespace rtsim

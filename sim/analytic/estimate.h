@@ -4,6 +4,8 @@
 // traffic and unloaded latencies scaled to the whole trace by its work counts, then the closed
 // form (closed_form.h). Costs microseconds to milliseconds per configuration; no ray is
 // stepped, so a sweep evaluates every configuration against one analysis.
+#include <memory>
+
 #include <nlohmann/json.hpp>
 
 #include "sim/config/config.h"
@@ -24,6 +26,23 @@ struct AnalyticEstimate {
 /// (analysis_cache.h); when it does not (the verdict trying twice the ray contexts), the
 /// estimate keeps the profile's hit rates: first order.
 AnalyticEstimate estimate_analytic(const SimConfig& config, const AnalyticProfile& profile);
+
+class MissModel;
+
+/// The closed form of many configurations against one profile (the verdict's every knob and
+/// pair): the reuse curves are built once, each cache shape's miss probabilities are kept
+/// (computed once per L1 or L2 size and ways) and no model stats are written. Its form equals
+/// estimate_analytic's for the same configuration and profile, which must outlive it.
+class FormEstimator {
+public:
+    explicit FormEstimator(const AnalyticProfile& profile);
+    ~FormEstimator();
+    ClosedForm operator()(const SimConfig& config) const;
+
+private:
+    const AnalyticProfile& m_profile;
+    std::unique_ptr<MissModel> m_misses;
+};
 
 /// Hit rates the profile predicts for one cache level: {l1: {kind: rate}, l2: ...} (tests).
 struct PredictedRates {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <optional>
 
 #include "sim/harness/frames.h"
@@ -226,9 +227,9 @@ SimOutcome run_analytic_simulation(const SimOptions& o) {
         // The verdict's analytic estimates come from this run's own analysis (no second pass).
         VerdictContext v{o.config, model, nullptr, nullptr, nullptr};
         v.instantiated = instantiated;
-        v.estimate = [&p](const SimConfig& c) {
-            const AnalyticEstimate x = estimate_analytic(c, p);
-            return std::make_pair(x.form.cycles, x.form.binding);
+        v.estimate = [form = std::make_shared<FormEstimator>(p)](const SimConfig& c) {
+            const ClosedForm x = (*form)(c);
+            return std::make_pair(x.cycles, x.binding);
         };
         v.estimate_method = "the analytic level's per-trace analysis (" + std::to_string(p.stepped_rays) +
                             " stepped rays)";

@@ -310,6 +310,7 @@ json judge(const VerdictContext& c) {
               {"analytic_binding", analytic_binding},
               {"estimate",
                {{"method", estimator.method()},
+                {"reused", estimator.reused()},
                 {"base_cycles", base_cycles},
                 {"wall_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}}}};
     // Two resources binding together: name both when relaxing the pair beats any single knob.
@@ -340,7 +341,7 @@ const StatBlock& verdict_stats() {
             {"coverage", "", "`estimated` (false where the analytic level does not model the machine: treelets), `why_not`, `frames` (an animated trace's estimates are the first frame's)"},
             {"check", "list", "with `--check-verdict`: each top candidate and co-limit re-run at the run's level: `sets`, `estimated`, `measured` (rays/s relaxed over the run's), `run` (its folder); best measured first", false, true},
             {"relax", "", "the best candidate, with the same fields; `null` when no knob relaxes the binding resource"},
-            {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `base_cycles` (its cycles for the run's own config), `wall_seconds` (the host time the estimates took)"},
+            {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `reused` (the analysis was loaded from beside the trace, stored there by an earlier run, instead of stepped by this one), `base_cycles` (its cycles for the run's own config), `wall_seconds` (the host time the estimates took)"},
             {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
         }};
     return block;

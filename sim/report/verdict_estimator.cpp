@@ -1,6 +1,7 @@
 #include "sim/report/verdict_estimator.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "sim/analytic/analysis_cache.h"
 #include "sim/analytic/analytic.h"
@@ -57,37 +58,78 @@ SimConfig analytic_config(SimConfig config) {
     return config;
 }
 
+namespace {
+
+/// The key of the verdict's own sample analysis stored beside the trace: the per-trace key's
+/// trace and machine fields (what the access streams depend on) and the sample's rays instead
+/// of the analytic level's sample parameters.
+nlohmann::json verdict_sample_key(const SimConfig& base, const std::string& identity, uint64_t first_ray,
+                                  uint64_t rays, uint64_t sample_rays) {
+    nlohmann::json key = analysis_key(base, base.analytic, identity);
+    key.erase("sample");
+    key["verdict_sample"] = {{"first_ray", first_ray}, {"rays", rays}, {"sample_rays", sample_rays}};
+    return key;
+}
+
+}  // namespace
+
 VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
     if (c.estimate) {
         m_method = c.estimate_method;
         return;
     }
     const SimConfig base = analytic_config(c.config);
+    const std::string identity = c.trace_path.empty() ? std::string() : trace_identity(*c.reader);
     // The analysis stored beside the trace for this key, if a run at the analytic level made it.
     if (c.frames == 1 && !c.trace_path.empty()) {
-        const nlohmann::json key = analysis_key(base, base.analytic, trace_identity(*c.reader));
+        const nlohmann::json key = analysis_key(base, base.analytic, identity);
         if (auto stored = load_analysis(analysis_path(c.trace_path, key), key)) {
             m_loaded = std::make_unique<AnalyticProfile>(std::move(*stored));
             m_profile = m_loaded.get();
             m_method = "the analytic level on the per-trace analysis stored beside the trace (" +
                        std::to_string(uint64_t(m_profile->stepped_rays)) + " stepped rays)";
+            m_form = std::make_unique<FormEstimator>(*m_profile);
+            m_reused = true;
             return;
         }
     }
     const uint64_t total = c.reader->section(SectionKind::rays).record_count;
     const uint64_t rays = c.frame_rays ? c.frame_rays : total;
     SampleStream stream(*c.reader, c.first_ray, rays, c.sample_rays);
-    DiscardSink sink;
-    m_profile = &analyze_stream(base, *c.accel, *c.map, stream, sink);
     m_method = "analytic level on " + std::to_string(stream.total_rays()) + " sampled rays" +
                (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " (treelets off)" : "");
+    // Else the verdict's own sample analysis: stored beside the trace by the first run that
+    // needs it (under a lock, as a sweep's processes share it), loaded by every later one.
+    const nlohmann::json key =
+        identity.empty() ? nlohmann::json() : verdict_sample_key(base, identity, c.first_ray, rays, c.sample_rays);
+    const std::string path = identity.empty() ? std::string() : analysis_path(c.trace_path, key);
+    std::optional<AnalyticProfile> stored = load_analysis(path, key);
+    if (!stored) {
+        AnalysisLock lock(path);
+        stored = load_analysis(path, key);
+        if (!stored) {
+            DiscardSink sink;
+            m_profile = &analyze_stream(base, *c.accel, *c.map, stream, sink);
+            if (!path.empty()) {
+                AnalyticProfile keyed = *m_profile;
+                keyed.key = key;
+                store_analysis(path, keyed);
+            }
+            m_form = std::make_unique<FormEstimator>(*m_profile);
+            return;
+        }
+    }
+    m_loaded = std::make_unique<AnalyticProfile>(std::move(*stored));
+    m_profile = m_loaded.get();
+    m_form = std::make_unique<FormEstimator>(*m_profile);
+    m_reused = true;
 }
 
 std::pair<double, std::string> VerdictEstimator::operator()(const SimConfig& config) const {
     const SimConfig a = analytic_config(config);
     if (m_context.estimate) return m_context.estimate(a);
-    const AnalyticEstimate e = estimate_analytic(a, *m_profile);
-    return {e.form.cycles, e.form.binding};
+    const ClosedForm form = (*m_form)(a);
+    return {form.cycles, form.binding};
 }
 
 }  // namespace rtsim

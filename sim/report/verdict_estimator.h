@@ -3,12 +3,15 @@
 // any config against one per-trace analysis, so weighing every knob and pair costs
 // milliseconds, not a pass over rays per knob. The analysis is, in order of preference: the one
 // the analytic level itself computed (its run passes it), the per-trace analysis stored beside
-// the trace for this config's key (analysis_cache.h), or one pass over a sample of the trace's
-// rays (evenly spread blocks, of the first frame in an animated trace).
+// the trace for this config's key (analysis_cache.h), or the verdict's own analysis of a sample
+// of the trace's rays (evenly spread blocks, of the first frame in an animated trace), which the
+// first run that needs it steps and stores beside the trace, so every later run of the trace
+// with the same key (a sweep's, a re-run's) loads it instead of stepping rays.
 #include <memory>
 #include <string>
 #include <utility>
 
+#include "sim/analytic/estimate.h"
 #include "sim/analytic/profile.h"
 #include "sim/config/config.h"
 
@@ -27,12 +30,16 @@ public:
     std::pair<double, std::string> operator()(const SimConfig& config) const;
     /// How the estimates are made, for the verdict's text.
     const std::string& method() const { return m_method; }
+    /// True when the analysis was loaded from beside the trace (not stepped by this run).
+    bool reused() const { return m_reused; }
 
 private:
     const VerdictContext& m_context;
     std::unique_ptr<AnalyticProfile> m_loaded;  ///< a stored per-trace analysis, when one was found
     const AnalyticProfile* m_profile = nullptr;
+    std::unique_ptr<FormEstimator> m_form;  ///< the closed form of each config against m_profile
     std::string m_method;
+    bool m_reused = false;
 };
 
 }  // namespace rtsim

@@ -71,3 +71,45 @@ def test_bench_model_against_a_missing_binary_is_refused(tmp_path: Path) -> None
     result = run_rtsim("bench", "--model", str(tmp_path), "--against", str(tmp_path / "nope"))
     assert result.returncode == 2
     assert "nope" in result.stdout + result.stderr
+
+
+def test_bench_model_says_whether_it_times_the_verdict(tmp_path: Path) -> None:
+    trace = tmp_path / "trace"
+    made = run_rtsim("trace", "cornell", "-o", str(trace), "--resolution", "16x12")
+    assert made.returncode == 0, made.stderr
+    for flag, included in (((), False), (("--verdict",), True)):
+        out = tmp_path / f"bench-{included}.json"
+        result = run_rtsim("bench", "--model", str(trace), "--repeat", "1", "--json", str(out),
+                           "--levels", "approx", *flag)  # fmt: skip
+        assert result.returncode == 0, result.stdout + result.stderr
+        report = json.loads(out.read_text())
+        assert report["verdict"] is included
+        said = "the bottleneck verdict is included" if included else "verdict is not included"
+        assert said in " ".join(result.stdout.split())
+        # Where and when: the doc generator (scripts/bench_doc.py --model) quotes these.
+        assert report["host"]["cpu"] and report["host"]["hardware_threads"] >= 1
+        assert report["host"]["load_average_start"] is not None
+        assert report["date_start"] <= report["date_end"] and report["git"]
+
+
+def test_bench_doc_renders_the_model_tables(tmp_path: Path) -> None:
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "bench_doc.py"
+    spec = importlib.util.spec_from_file_location("bench_doc", path)
+    assert spec and spec.loader
+    bench_doc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench_doc)
+    level = {"level": "approx", "rays": 1000, "error": None, "median_wall_seconds": 2.0,
+             "median_cpu_seconds": 1.0, "rays_per_wall_second": 500.0,
+             "rays_per_cpu_second": 1000.0, "against_cpu_seconds": []}  # fmt: skip
+    bench = {"date_start": "2026-01-02T03:04:05+00:00", "date_end": "2026-01-02T03:09:00+00:00",
+             "host": {"cpu": "Test CPU", "hardware_threads": 2, "load_average_start": 1.5,
+                      "load_average_end": 2.0},
+             "git": "abc123", "against": None, "repeat": 3, "set": [], "verdict": False,
+             "traces": [{"trace": "/x/cornell", "levels": {"approx": level},
+                         "ratios": {"approx/functional": None}}]}  # fmt: skip
+    text = bench_doc.render_model(bench)
+    assert "2026-01-02, 03:04-03:09 UTC, on Test CPU (2 hardware threads)" in text
+    assert "load average 1.5" in text and "`abc123`" in text and "verdict is not included" in text
+    assert "| cornell | approx | 1,000 |" in text and "/x/" not in text

@@ -153,16 +153,17 @@ void MimdUnit::step(uint32_t c, Cycle t) {
     }
     // The step is costed (and run, with the one arithmetic) as its fetches issue; its
     // operations phase issues what the demand says once the data has arrived.
-    StepDemand& d = ctx.demand;
-    take_step(*ctx.ray.stepper, ctx.ray.stack, m_costs, d);
+    // The plan's reads go to memory as the plan holds them, before the step runs.
     Cycle ready = t;
     AccessInfo slowest, info;
-    for (int i = 0; i < d.read_count; ++i) {
-        const Fetch& f = d.reads[i];
-        const Cycle done = mem->access({f.addr, f.bytes, false, f.kind, t, &info});
-        if (done > ready || i == 0) slowest = info;
+    bool first = true;
+    MemIf& memory = *mem[0];
+    take_step_reading(*ctx.ray.stepper, ctx.ray.stack, m_costs, ctx.demand, [&](const Fetch& f) {
+        const Cycle done = memory.access({f.addr, f.bytes, false, f.kind, t, &info});
+        if (done > ready || first) slowest = info;
         ready = std::max(ready, done);
-    }
+        first = false;
+    });
     account_read(c, ready, slowest);
     ctx.phase = Phase::ops;
     schedule(c, ready);

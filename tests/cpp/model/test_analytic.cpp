@@ -197,6 +197,31 @@ TEST(AnalyticLevel, StatisticalHitRatesTrackTheFunctionalCaches) {
             }
 }
 
+TEST(AnalyticLevel, FormEstimatorEqualsTheFullEstimate) {
+    // The verdict evaluates every knob through FormEstimator (miss tables kept per cache shape,
+    // no stats written): its forms must be the full estimate's, bit for bit, whatever order the
+    // cache shapes come in.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    RayList rays(w.jobs);
+    Discard sink;
+    const AnalyticProfile& p = analyze_stream(c, *w.accel, w.map(c), rays, sink);
+    const FormEstimator form(p);
+    const std::vector<std::vector<std::string>> configs = {
+        {}, {"l1.size_kib=64"}, {"l2.size_kib=512"}, {"l1.size_kib=64", "l2.ways=4"}, {"dram.channels=1"},
+        {"ideal_memory=true"}, {"l1.ways=1"}, {}};
+    for (const auto& sets : configs) {
+        SimConfig x = small_machine();
+        for (const std::string& s : sets) config_set(x, s);
+        const ClosedForm fast = form(x);
+        const AnalyticEstimate full = estimate_analytic(x, p);
+        EXPECT_EQ(fast.cycles, full.form.cycles) << testing::PrintToString(sets);
+        EXPECT_EQ(fast.queueing, full.form.queueing) << testing::PrintToString(sets);
+        EXPECT_EQ(fast.binding, full.form.binding) << testing::PrintToString(sets);
+        EXPECT_EQ(fast.bounds, full.form.bounds) << testing::PrintToString(sets);
+    }
+}
+
 TEST(AnalyticLevel, NeverPredictsFasterThanItsRoofline) {
     const Workload& w = workload();
     const std::vector<std::vector<std::string>> configs = {
