@@ -20,6 +20,7 @@ MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
 
 void MimdUnit::run() {
     m_treelet_mode = ray_buffer.size() > 0;
+    if (m_treelet_mode) m_prefetcher.attach(ray_buffer->footprints());
     if (!m_treelet_mode)
         for (Context& ctx : m_contexts) ctx.ray.stepper = m_steppers.acquire();
     Cycle now = 0;
@@ -55,6 +56,7 @@ void MimdUnit::run() {
         if (m_ctx.sync_private_steps || m_contexts[c].phase != Phase::ops) m_sync(t);
         advance(c, t);
         m_events.finish_pop();
+        if (m_prefetcher.on()) m_prefetcher.drain(*mem[0], t);
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
         if (!m_treelet_mode && rays->frame() != m_frame) {  // a frame was released: fill every context
             if (!m_ctx.sync_private_steps) m_sync(t);  // dispatch is shared: in time order at detailed
@@ -122,6 +124,7 @@ bool MimdUnit::take_parked_ray(uint32_t c, Cycle t) {
     const Stepper& s = *ctx.ray.stepper;
     if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_rejected;
     ++m_takes;
+    if (m_prefetcher.on()) m_prefetcher.enter(ctx.treelet, t);
     activate(c, t);
     account(c, CycleUse::ray_buffer, ready);
     ctx.phase = Phase::step;
@@ -155,6 +158,7 @@ void MimdUnit::step(uint32_t c, Cycle t) {
     // operations phase issues what the demand says once the data has arrived.
     StepDemand& d = ctx.demand;
     take_step(*ctx.ray.stepper, ctx.ray.stack, m_costs, d);
+    if (m_prefetcher.on()) m_prefetcher.learn(ctx.treelet, d);
     Cycle ready = t;
     AccessInfo slowest, info;
     for (int i = 0; i < d.read_count; ++i) {
@@ -231,6 +235,7 @@ nlohmann::json MimdUnit::stats_json(Cycle total_cycles) const {
         .set("finish_cycle", m_finish)
         .set("cycle_accounting", cycle_account(total_cycles).to_json());
     if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
+    if (m_prefetcher.on()) w.set("prefetch", m_prefetcher.stats_json());
     w.done();
     return j;
 }
