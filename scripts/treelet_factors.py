@@ -75,11 +75,16 @@ POINTS = [
     tl("prefetch into L1", "prefetching", "treelets (defaults)", treelets__prefetch="true"),
     tl("prefetch into L2", "prefetching", "treelets (defaults)", treelets__prefetch="true",
        treelets__prefetch_into="l2"),
+    tl("prefetch 32 lines into L1", "prefetching", "treelets (defaults)",
+       treelets__prefetch="true", treelets__prefetch_lines="32"),
+    tl("prefetch 32 lines into L2", "prefetching", "treelets (defaults)",
+       treelets__prefetch="true", treelets__prefetch_lines="32", treelets__prefetch_into="l2"),
     tl("32 KiB treelets, 8 MiB buffer", "combined", treelets__treelet_kib="32",
        treelets__buffer_kib="8192"),
     tl("32 KiB treelets, 8 MiB buffer, L2 256 KiB", "combined", "baseline, L2 256 KiB",
        treelets__treelet_kib="32", treelets__buffer_kib="8192", l2__size_kib="256"),
-    tl("32 KiB treelets, 8 MiB buffer, prefetch into L1", "combined", treelets__treelet_kib="32",
+    tl("32 KiB treelets, 8 MiB buffer, prefetch into L1", "combined",
+       "32 KiB treelets, 8 MiB buffer", treelets__treelet_kib="32",
        treelets__buffer_kib="8192", treelets__prefetch="true"),
 ]  # fmt: skip
 QUICK = ["baseline", "treelets (defaults)", "buffer 2 MiB", "prefetch into L1", "prefetch into L2"]
