@@ -113,7 +113,7 @@ def prefetch_totals(stats: dict[str, Any]) -> dict[str, int]:
         for k, v in cache.get("prefetch", {}).items():
             total[k] = total.get(k, 0) + v
     if total:
-        total["dram_bytes"] = model["l2"]["prefetch"]["below_bytes"]
+        total["dram_bytes"] = model["l2"].get("prefetch", {}).get("below_bytes", 0)
     return total
 
 

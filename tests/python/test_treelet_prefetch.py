@@ -91,3 +91,13 @@ def test_bad_prefetch_fields_are_named(
     result = simulate(sim_or_fail(), hairball_diffuse, tmp_path / "bad", *TREELETS, setting)
     assert result.returncode == 2
     assert field.split(".")[-1] in result.stderr, result.stderr
+
+
+def test_prefetch_fields_are_sweep_axes() -> None:
+    from rtsim.sweep.spec import load_spec
+
+    spec_file = Path(__file__).resolve().parents[2] / "python/rtsim/specs/treelet_prefetch.yaml"
+    spec = load_spec(spec_file)
+    assert spec.grid["treelets.prefetch"] == [False, True]
+    assert spec.grid["treelets.prefetch_into"] == ["l1", "l2"]
+    assert len(list(spec.points())) == 8
