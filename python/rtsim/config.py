@@ -380,6 +380,8 @@ MODIFIERS: dict[str, dict[str, Any]] = {
     "rb-4m": {"treelets": {"buffer_kib": 4096}},
     "treelet-8k": {"treelets": {"treelet_kib": 8}},
     "treelet-32k": {"treelets": {"treelet_kib": 32}},
+    "prefetch": {"treelets": {"prefetch": True}},
+    "prefetch-l2": {"treelets": {"prefetch": True, "prefetch_into": "l2"}},
     "sample-1pct": {"sampling": {"fraction": 0.01}},
     "sample-5pct": {"sampling": {"fraction": 0.05}},
     "sample-10pct": {"sampling": {"fraction": 0.1}},

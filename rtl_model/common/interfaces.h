@@ -32,9 +32,15 @@ struct MemRequest {
     DataKind kind = DataKind::node;
     Cycle time = 0;              ///< cycle the request is issued
     AccessInfo* info = nullptr;  ///< optional: filled with where a read's time went
+    /// A prefetch (a read nobody waits for) filling the cache of level `prefetch_into`; the levels
+    /// above it pass it down, the levels below serve its miss as a read (counted as prefetch traffic).
+    bool prefetch = false;
+    ServedBy prefetch_into = ServedBy::l1;
 };
 
 /// Contract: returns the cycle the data is available (reads) or accepted (writes), >= req.time.
+/// A prefetch at its target level returns req.time when it was taken (or was not needed: the line
+/// is there) and, when no MSHR is free, the cycle one frees: the prefetcher retries then.
 /// Requests from one issuer arrive in non-decreasing time; different issuers may be out of order
 /// by up to a quantum.
 class MemIf : public virtual sc_core::sc_interface {

@@ -8,6 +8,7 @@
 
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/stack_split.h"
+#include "rtl_model/common/treelet_footprint.h"
 #include "traces/accel/accel.h"
 
 namespace rtsim {
@@ -60,6 +61,8 @@ public:
     virtual bool done() const = 0;
     /// Treelet of a step's locality key (StepPlan::locality; never kNoLocality).
     virtual uint32_t treelet_of(uint32_t locality) const = 0;
+    /// The treelets' lines for prefetching (treelets.prefetch), or null when prefetching is off.
+    virtual TreeletFootprints* footprints() { return nullptr; }
 };
 
 }  // namespace rtsim

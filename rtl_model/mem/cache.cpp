@@ -37,6 +37,7 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
 }
 
 Cycle Cache::access(const MemRequest& req) {
+    if (req.prefetch && uint8_t(m_level) <= uint8_t(req.prefetch_into)) return prefetch(req);
     uint64_t first = req.addr >> m_line_shift;
     uint64_t last = (req.addr + (req.bytes ? req.bytes : 1) - 1) >> m_line_shift;
     // One line (most node and triangle fetches): where its time went is the line's own.
@@ -107,6 +108,7 @@ Cycle Cache::access_line(uint64_t line, const MemRequest& req, AccessInfo* info)
         if (tags[w] != line) continue;
         m_last_use[set + w] = ++m_use_clock;
         const LineFill& fill = m_fills[set + w];
+        if (!m_prefetched.empty() && m_prefetched[set + w]) prefetch_used(set + w, fill.ready > tag_done);
         if (fill.ready > tag_done) {
             ++c.merged;
             if (info) info->level = fill.filled_from;  // waits for a fill in flight
@@ -137,7 +139,8 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     }
     if (info) info->mshr_wait[size_t(m_level)] += issue - tag_done;
     AccessInfo below;
-    MemRequest down{line << m_line_shift, m_config.line_bytes, false, req.kind, issue + m_next_latency, &below};
+    MemRequest down{line << m_line_shift, m_config.line_bytes, false, req.kind, issue + m_next_latency, &below,
+                    req.prefetch, req.prefetch_into};
     Cycle fill = forward(down) + m_next_latency;
     if (info) {
         info->level = below.level;
@@ -154,6 +157,14 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     // LRU victim (invalid lines have last_use 0 and go first).
     const size_t victim = lru_way(size_t(line & m_set_mask) * m_config.ways);
     if (m_tags[victim] != kInvalid) ++m_evictions;
+    if (req.prefetch) {
+        m_prefetch_seen = true;
+        m_prefetch.below_bytes += m_config.line_bytes;  // traffic below this level caused by prefetching
+    }
+    if (!m_prefetched.empty()) {
+        if (m_prefetched[victim]) ++m_prefetch.useless;  // evicted before any read used it
+        m_prefetched[victim] = req.prefetch && req.prefetch_into == m_level;
+    }
     m_tags[victim] = line;
     m_fills[victim] = {fill, below.level};
     m_last_use[victim] = ++m_use_clock;
@@ -210,6 +221,7 @@ nlohmann::json Cache::stats_json(Cycle total_cycles, bool series) const {
     }
     const uint32_t mshrs = (m_mshrs_enabled || m_mshr_occupancy) ? m_config.mshrs : 0u;
     w.set("config", cache_config_json(m_config, mshrs));
+    if (m_prefetch_seen) w.set("prefetch", prefetch_json());
     w.done();
     return j;
 }

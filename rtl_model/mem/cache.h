@@ -12,6 +12,8 @@
 // At the detailed level (exact = true) units synchronise every cycle, so the shared L2 sees
 // requests in time order and models its MSHRs too; banks are then per-cycle slot calendars
 // (one access per bank_cycles, arrival order at equal cycles) instead of 16-access windows.
+// Prefetches (treelet prefetching, cache_prefetch.cpp) allocate a line without a waiter, only
+// into a free MSHR, and are counted until a read uses the line or it is evicted unused.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -59,6 +61,15 @@ public:
     uint32_t mshrs() const { return m_config.mshrs; }
 
 private:
+    /// Prefetch counters (cache_prefetch.cpp): issued = useful + useless + still resident.
+    struct PrefetchCounters {
+        uint64_t issued = 0, redundant = 0, blocked = 0, useful = 0, late = 0, useless = 0, below_bytes = 0;
+    };
+    /// A prefetch reaching this level: passed down above its target, allocated at it.
+    Cycle prefetch(const MemRequest& req);
+    /// A read found a prefetched line (way) not used before: the prefetch was useful.
+    void prefetch_used(size_t way, bool late);
+    nlohmann::json prefetch_json() const;
     /// A line's state besides its tag and LRU stamp (read only on a hit or a fill).
     struct LineFill {
         Cycle ready = 0;                      ///< cycle the fill completes
@@ -100,6 +111,10 @@ private:
     uint64_t m_mshr_busy_cycles = 0;   ///< MSHR-cycles held by misses
     UsageSeries m_bank_use;            ///< line accesses over time
     UsageSeries m_mshr_use;            ///< MSHR-cycles held over time
+    std::vector<uint8_t> m_prefetched;  ///< per way: filled by a prefetch, not yet read (sized at the first prefetch)
+    PrefetchCounters m_prefetch;
+    std::unique_ptr<MinTree> m_prefetch_mshrs;  ///< fill cycle of each MSHR prefetches may hold (half of them)
+    bool m_prefetch_seen = false;       ///< a prefetch (or a miss for one above) reached this level
 };
 
 }  // namespace rtsim

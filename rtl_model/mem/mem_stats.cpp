@@ -49,6 +49,7 @@ const StatBlock& cache_stats() {
                  {"bank_utilization", "fraction", "bank accesses x `bank_cycles` / (`banks` x `summary.cycles`); timed levels only", false, true},
                  {"mshr_utilization_over_time", "list", "the L2's `[{cycle, value}]` per bucket, at most 256 points (the L1s' are merged in `model.utilization`)", false, true},
                  {"bank_utilization_over_time", "list", "the L2's bank utilisation the same way", false, true},
+                 {"prefetch", "", "treelet prefetching (`treelets.prefetch`; written only where a prefetch reached this level): `issued` lines this level fetched for prefetches it is the target of; `redundant` prefetches of lines already present; `blocked` prefetches that found no free MSHR and were retried later; `useful` prefetched lines a read then used (`late`: of those, read while still being filled); `useless` evicted before any read; `resident` still unused at the end (`issued = useful + useless + resident`, tested); `below_bytes` bytes this level read from the level below for prefetches (at the L2: the DRAM traffic prefetching caused)", false, true},
                  {"config", "", "`size_kib`, `ways`, `line_bytes`, `latency`, `banks`: the cache's configuration; `mshrs`: MSHRs modelled (exact free-list in the L1s and, at `detailed`, the L2; an occupancy bound in the L2 at `approx`; `null` at analytic)"},
              })};
     return block;

@@ -60,6 +60,10 @@ void RayBuffer::push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time) 
     index(treelet);
 }
 
+void RayBuffer::enable_prefetch(uint32_t line_bytes, ServedBy into) {
+    m_footprints = std::make_unique<TreeletFootprints>(uint32_t(m_queues.size()), line_bytes, m_config.prefetch_lines, into);
+}
+
 bool RayBuffer::has_room() const {
     // By default (no explicit limit) admission also waits for SRAM room, so it never overflows.
     // It leaves one entry free: a unit parks a ray and takes the next in one step, so the SRAM
@@ -240,6 +244,7 @@ const StatBlock& ray_buffer_stats() {
             {"picks", "picks", "times a unit chose a new treelet queue"},
             {"drain_picks", "picks", "picks where no queue reached `treelets.threshold` (the policy's best queue ran anyway)"},
             {"avg_queue_rays_at_pick", "rays", "mean length of the chosen queue: how many rays share a treelet's load"},
+            {"prefetch", "", "treelet prefetching's table (`treelets.prefetch`): `treelets_learnt` treelets rays have read lines in, `lines_learnt` their lines, `mean_lines` per such treelet (docs/treelets.md, \"Prefetching\")", false, true},
             {"treelets", "", "the partition: `count` treelets, `budget_bytes`, `mean_bytes` and `max_bytes` of a treelet, `max_depth` (deepest treelet level)"},
         }};
     return block;
@@ -273,8 +278,13 @@ nlohmann::json RayBuffer::stats_json() const {
                                         {"budget_bytes", m_partition.budget_bytes},
                                         {"mean_bytes", t.empty() ? 0.0 : double(sum_bytes) / double(t.size())},
                                         {"max_bytes", max_bytes},
-                                        {"max_depth", max_depth}})
-        .done();
+                                        {"max_depth", max_depth}});
+    if (m_footprints) {
+        const uint64_t learnt = m_footprints->treelets_learnt(), lines = m_footprints->lines_learnt();
+        j["prefetch"] = {{"treelets_learnt", learnt}, {"lines_learnt", lines},
+                         {"mean_lines", learnt ? double(lines) / double(learnt) : 0.0}};
+    }
+    ray_buffer_stats().check(j);
     return j;
 }
 

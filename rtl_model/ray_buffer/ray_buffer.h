@@ -20,6 +20,7 @@
 // before it exists.
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <set>
 #include <vector>
 
@@ -61,6 +62,9 @@ public:
     void finished(Cycle time) override;
     bool done() const override { return m_dispatch_empty && m_in_machine == 0; }
     uint32_t treelet_of(uint32_t locality) const override { return m_partition.group_of[locality]; }
+    /// Treelet prefetching on (treelets.prefetch): the units learn and prefetch through the table.
+    void enable_prefetch(uint32_t line_bytes, ServedBy into);
+    TreeletFootprints* footprints() override { return m_footprints.get(); }
 
     uint64_t capacity_rays() const { return m_capacity; }
     uint64_t max_occupancy() const { return m_max_occupancy; }
@@ -118,6 +122,7 @@ private:
     uint64_t m_occupancy = 0, m_max_occupancy = 0, m_in_machine = 0;
     uint64_t m_admitted = 0, m_parked = 0, m_taken = 0, m_overflows = 0, m_overflow_reads = 0;
     uint64_t m_picks = 0, m_drain_picks = 0, m_picked_queue_rays = 0;
+    std::unique_ptr<TreeletFootprints> m_footprints;  ///< treelet prefetching only
 };
 
 }  // namespace rtsim

@@ -9,6 +9,9 @@ namespace rtsim {
 
 enum class TreeletPolicy : uint8_t { largest = 0, oldest = 1, round_robin = 2 };
 inline constexpr Choices<TreeletPolicy, 3> kTreeletPolicyChoices{{"largest", "oldest", "round_robin"}};
+/// Which cache treelet prefetches fill (Chou, Nowicki & Aamodt 2023 prefetch into the RT unit's L1).
+enum class PrefetchInto : uint8_t { l1 = 0, l2 = 1 };
+inline constexpr Choices<PrefetchInto, 2> kPrefetchIntoChoices{{"l1", "l2"}};
 
 struct TreeletConfig {
     bool enabled = false;             ///< queue rays per treelet in the ray buffer
@@ -22,6 +25,9 @@ struct TreeletConfig {
     uint32_t max_rays_in_flight = 0;  ///< rays admitted at once (0: what the SRAM and contexts hold)
     uint32_t admit_outstanding = 16;  ///< ray-record reads in flight while admitting rays
     uint32_t quantum_cycles = 16;     ///< approx with treelets: the units' quantum is at most this
+    bool prefetch = false;            ///< request a treelet's lines when a unit enters it (Chou et al. 2023)
+    uint32_t prefetch_lines = 0;      ///< lines requested per treelet entry, root first (0: the whole treelet)
+    PrefetchInto prefetch_into = PrefetchInto::l1;  ///< the cache prefetched lines are filled into
 
     template <class V>
     void visit(V& v) {
@@ -36,6 +42,9 @@ struct TreeletConfig {
         v.field("max_rays_in_flight", max_rays_in_flight, "rays", "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to DRAM (0: SRAM capacity plus the ray contexts, never overflows)", 0, 1u << 30);
         v.field("admit_outstanding", admit_outstanding, "reads", "Ray-record reads the ray buffer keeps in flight while admitting new rays (a streaming engine, one read issued per cycle)", 1, 4096);
         v.field("quantum_cycles", quantum_cycles, "cycles", "At the approx level with treelets, the units (and the admission engine) run ahead of each other by at most this many cycles (the smaller of this and quantum_cycles): treelet queues' dynamics depend on the order of parks and takes, and longer quanta made approx up to 37% off detailed (docs/fidelity.md)", 1, 1u << 20);
+        v.flag("prefetch", prefetch, "Treelet prefetching (Chou, Nowicki & Aamodt 2023): when a unit starts a treelet's queue, the treelet's lines are requested ahead of its rays (needs treelets.enabled; docs/treelets.md)");
+        v.field("prefetch_lines", prefetch_lines, "lines", "Lines prefetched per treelet entry, in the order rays first read them (the treelet's root first); 0: the whole treelet", 0, 1u << 16);
+        v.choice("prefetch_into", prefetch_into, kPrefetchIntoChoices, "Cache the prefetched lines are filled into: the unit's l1 or the shared l2");
     }
 };
 

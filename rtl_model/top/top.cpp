@@ -11,6 +11,7 @@ class IdealMemory : public sc_core::sc_module, public MemIf {
 public:
     IdealMemory(sc_core::sc_module_name name, Cycle latency) : sc_core::sc_module(name), m_latency(latency) {}
     Cycle access(const MemRequest& req) override {
+        if (req.prefetch) return req.time;  // nothing to prefetch into: every access hits
         MemCounters& c = m_stats[req.kind];
         (req.write ? c.writes : c.reads) += 1;
         (req.write ? c.write_bytes : c.read_bytes) += req.bytes;
@@ -148,13 +149,19 @@ void Top::build_ray_buffer(const Accel& accel, const MemoryMap& map) {
                                                                m_config.mailbox.entries * MailboxConfig::kEntryBytes),
                                                m_config.quantum_cycles);
     m_ray_buffer->rays(*m_dispatch);
+    if (t.prefetch && !m_ideal)
+        m_ray_buffer->enable_prefetch(m_config.l1.line_bytes,
+                                      t.prefetch_into == PrefetchInto::l1 ? ServedBy::l1 : ServedBy::l2);
     if (m_ideal) m_ray_buffer->mem(*m_ideal);
     else m_ray_buffer->mem(*m_l2);
     m_instantiated.push_back({{"block", "ray_buffer"}, {"instantiated", true},
                               {"why", std::to_string(m_partition.treelets.size()) + " treelets of at most " +
                                           std::to_string(t.treelet_kib) + " KiB, " + std::to_string(t.buffer_kib) +
                                           " KiB ray buffer (" + std::to_string(m_ray_buffer->capacity_rays()) +
-                                          " rays), policy " + kTreeletPolicyChoices.name(t.policy)}});
+                                          " rays), policy " + kTreeletPolicyChoices.name(t.policy) +
+                                          (t.prefetch && !m_ideal ? std::string(", treelet prefetch into ") +
+                                                                        kPrefetchIntoChoices.name(t.prefetch_into)
+                                                                  : std::string())}});
 }
 
 void Top::warm(uint32_t unit, uint64_t addr, uint32_t bytes) {

@@ -19,6 +19,7 @@ const StatBlock& unit_stats() {
             {"rays_taken", "rays", "treelet scheduling only: rays it took from the ray buffer", false, true},
             {"rays_parked", "rays", "treelet scheduling only: rays it parked in another treelet's queue", false, true},
             {"idle_polls", "count", "treelet scheduling only: times it found no ray and looked again after `treelets.idle_poll_cycles`", false, true},
+            {"prefetch", "", "treelet prefetching only (`treelets.prefetch`): `entries` treelets the unit started and prefetched, `queued` lines queued for them, `sent` lines sent to the cache, `cancelled` lines dropped unsent when the unit moved to another treelet, `waits` times the target had no free MSHR and the engine waited", false, true},
             {"warp_steps", "steps", "simt only: warp steps (one operation kind for the warp, or the new rays' record fetch)", false, true},
             {"ray_fetch_steps", "steps", "simt only: warp steps that fetched new rays' records", false, true},
             {"lane_slots", "lane-steps", "simt only: `warp_steps x traversal.lanes`", false, true},

@@ -20,6 +20,7 @@ MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
 
 void MimdUnit::run() {
     m_treelet_mode = ray_buffer.size() > 0;
+    if (m_treelet_mode) m_prefetcher.attach(ray_buffer->footprints());
     if (!m_treelet_mode)
         for (Context& ctx : m_contexts) ctx.ray.stepper = m_steppers.acquire();
     Cycle now = 0;
@@ -55,6 +56,7 @@ void MimdUnit::run() {
         if (m_ctx.sync_private_steps || m_contexts[c].phase != Phase::ops) m_sync(t);
         advance(c, t);
         m_events.finish_pop();
+        if (m_prefetcher.on()) m_prefetcher.drain(*mem[0], t);
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
         if (!m_treelet_mode && rays->frame() != m_frame) {  // a frame was released: fill every context
             if (!m_ctx.sync_private_steps) m_sync(t);  // dispatch is shared: in time order at detailed
@@ -122,6 +124,7 @@ bool MimdUnit::take_parked_ray(uint32_t c, Cycle t) {
     const Stepper& s = *ctx.ray.stepper;
     if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_rejected;
     ++m_takes;
+    if (m_prefetcher.on()) m_prefetcher.enter(ctx.treelet, t);
     activate(c, t);
     account(c, CycleUse::ray_buffer, ready);
     ctx.phase = Phase::step;
@@ -153,12 +156,15 @@ void MimdUnit::step(uint32_t c, Cycle t) {
     }
     // The step is costed (and run, with the one arithmetic) as its fetches issue; its
     // operations phase issues what the demand says once the data has arrived.
-    // The plan's reads go to memory as the plan holds them, before the step runs.
+    // The plan's reads go to memory as the plan holds them, before the step runs; a treelet
+    // prefetcher learns the treelet's lines from them.
     Cycle ready = t;
     AccessInfo slowest, info;
     bool first = true;
     MemIf& memory = *mem[0];
+    const bool learning = m_prefetcher.on();
     take_step_reading(*ctx.ray.stepper, ctx.ray.stack, m_costs, ctx.demand, [&](const Fetch& f) {
+        if (learning) m_prefetcher.learn(ctx.treelet, f);
         const Cycle done = memory.access({f.addr, f.bytes, false, f.kind, t, &info});
         if (done > ready || first) slowest = info;
         ready = std::max(ready, done);
@@ -232,6 +238,7 @@ nlohmann::json MimdUnit::stats_json(Cycle total_cycles) const {
         .set("finish_cycle", m_finish)
         .set("cycle_accounting", cycle_account(total_cycles).to_json());
     if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
+    if (m_prefetcher.on()) w.set("prefetch", m_prefetcher.stats_json());
     w.done();
     return j;
 }

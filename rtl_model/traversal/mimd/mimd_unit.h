@@ -18,11 +18,14 @@
 // unit's current treelet instead of from dispatch; a ray whose next step lies in another treelet
 // is parked in that treelet's queue and the context takes the next ray. Traversal order, hits and
 // work counts do not change: the stepper is the same, the ray only waits in between.
+// With treelet prefetching, the unit's steps teach the footprint table and a treelet the unit
+// starts is prefetched (../treelet_prefetcher.h).
 #include <cstdint>
 #include <vector>
 
 #include "rtl_model/traversal/context_queue.h"
 #include "rtl_model/traversal/traversal_unit.h"
+#include "rtl_model/traversal/treelet_prefetcher.h"
 #include "rtl_model/traversal/unit_parts.h"
 
 namespace rtsim {
@@ -85,6 +88,7 @@ private:
     Cycle m_next_fill = 0;
     uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
     CycleAccount m_account;
+    TreeletPrefetcher m_prefetcher;
 };
 
 }  // namespace rtsim
