@@ -75,7 +75,8 @@ def test_accel_axis_sweeps_builder_settings() -> None:
     [
         (
             "{kind: kdtree, build: {bins: 8}}",
-            "setting 'bins': unknown setting; the builder takes: clip, empty_bonus",
+            "setting 'bins': unknown setting; the builder takes: clip, compressed_leaves, "
+            "empty_bonus",
         ),
         (
             "{kind: bvh2, build: {max_leaf_size: [1, 0]}}",

@@ -20,8 +20,10 @@ Hit Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
 bool Accel::has_anyhit_triangles() const {
     for (const Region& r : m_image.regions) {
         if (r.kind != DataKind::triangle) continue;
-        const HwTriangle* t = r.records<HwTriangle>();
-        for (uint64_t i = 0; i < r.count; ++i)
+        const bool blocks = r.name == kLeafBlocksRegion;  // compressed: read the decoded triangles
+        const HwTriangle* t = blocks ? m_triangles.triangles() : r.records<HwTriangle>();
+        const uint64_t n = blocks ? m_triangles.count() : r.count;
+        for (uint64_t i = 0; i < n; ++i)
             if (t[i].flags & kTriAnyHit) return true;
     }
     return false;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "traces/accel/accel_image.h"
+#include "traces/accel/leaf_blocks.h"
 #include "traces/accel/locality.h"
 #include "traces/accel/stepper.h"
 #include "traces/bvh/config.h"
@@ -68,6 +69,9 @@ public:
 
 protected:
     AccelImage m_image;
+    /// The triangles the steppers read, plain or decoded from compressed leaves (leaf_blocks.h);
+    /// opened by structures that have a triangle region.
+    TriangleStore m_triangles;
     uint32_t m_mailbox_entries = 0;
 };
 

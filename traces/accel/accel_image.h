@@ -5,6 +5,7 @@
 // the trace; the model's memory map is derived from it (docs/architecture.md, rule 3: one memory
 // image, the addresses the caches and DRAM see).
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -44,11 +45,16 @@ struct AccelImage {
     nlohmann::json params = nlohmann::json::object();  ///< kind-specific, read by its stepper
     nlohmann::json stats = nlohmann::json::object();   ///< build statistics (manifest "accel")
     Aabb bounds;                               ///< of the whole scene
-    std::vector<Region> regions;
+    /// A deque: a Region& from add_region() stays valid when later regions are added.
+    std::deque<Region> regions;
+    /// Build time only (not in the trace): the first triangle of every leaf, ascending, for
+    /// structures whose leaves are contiguous runs of "triangles" (compressed leaves start a
+    /// block at each; leaf_blocks.h). Empty for structures that fetch single triangles.
+    std::vector<uint32_t> leaf_starts;
 
     /// Adds a region of `count` records of `record_bytes` in `layout`, zero-filled (zero = false:
     /// uninitialised, for a caller that writes every byte of every record); addresses are
-    /// assigned by place_regions().
+    /// assigned by place_regions(). The reference stays valid when more regions are added.
     Region& add_region(const std::string& name, DataKind kind, uint32_t record_bytes, uint64_t count,
                        RecordLayout layout = {}, bool zero = true);
     /// Adds a region of records of type T, in T's declared layout (layout_of(const T*)).

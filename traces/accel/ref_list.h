@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "traces/accel/leaf_blocks.h"
 #include "traces/accel/mailbox.h"
 #include "traces/accel/step_plan.h"
 #include "traces/common/hw_triangle.h"
@@ -19,7 +20,8 @@ namespace rtsim {
 struct RefListView {
     const uint32_t* refs = nullptr;
     const HwTriangle* triangles = nullptr;
-    uint64_t ref_base = 0, triangle_base = 0;  ///< addresses of record 0
+    uint64_t ref_base = 0;     ///< address of reference 0
+    TriangleAddressing tri_at; ///< where triangles' bytes are (plain or compressed leaves)
 };
 
 /// Bytes of one reference (a uint32 triangle index).
@@ -63,9 +65,10 @@ public:
         }
         if (m_batch_size == 0) return false;
         plan.reset(kNoLocality);
-        for (uint32_t i = 0; i < m_batch_size; ++i)
-            plan.add_fetch(v.triangle_base + uint64_t(m_batch[i]) * sizeof(HwTriangle), sizeof(HwTriangle),
-                           DataKind::triangle);
+        for (uint32_t i = 0; i < m_batch_size; ++i) {
+            const TriangleAddressing::Span s = v.tri_at.span(m_batch[i], 1);
+            plan.add_fetch(s.address, s.bytes, DataKind::triangle);
+        }
         plan.add_op(OpKind::triangle, m_batch_size);
         return true;
     }

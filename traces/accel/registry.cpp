@@ -12,6 +12,7 @@
 #include "traces/accel/cwbvh/cwbvh.h"
 #include "traces/accel/grid/grid.h"
 #include "traces/accel/kdtree/kdtree.h"
+#include "traces/accel/leaf_blocks.h"
 #include "traces/accel/octree/octree.h"
 #include "traces/accel/two_level/two_level.h"
 #include "traces/accel/wide/wide.h"
@@ -35,6 +36,7 @@ struct BuildSettings {
     KdConfig kd;
     BihConfig bih;
     OctreeConfig octree;
+    LeafConfig leaves;  ///< every kind's leaf layout (plain or compressed)
 };
 
 using SettingsFn = std::function<void(const std::string& builder, BuildSettings&, SettingsVisitor&)>;
@@ -215,6 +217,12 @@ std::string known_kinds() {
     return s;
 }
 
+/// The settings one (kind, builder) takes: its builder's, then the leaf layout every kind shares.
+void kind_settings(const Entry& e, const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
+    e.settings(builder, s, v);
+    s.leaves.visit(v);
+}
+
 /// The entry and resolved builder of valid options.
 const Entry& entry_of(const AccelOptions& o, std::string* builder) {
     validate_accel_options(o);
@@ -227,7 +235,7 @@ const Entry& entry_of(const AccelOptions& o, std::string* builder) {
 BuildSettings resolve_settings(const Entry& e, const std::string& builder, const AccelOptions& o, nlohmann::json* values) {
     BuildSettings s;
     s.bvh = o.build;
-    const SettingsVisit visit = [&](SettingsVisitor& v) { e.settings(builder, s, v); };
+    const SettingsVisit visit = [&](SettingsVisitor& v) { kind_settings(e, builder, s, v); };
     apply_settings(visit, o.settings, "accel " + o.kind + " (builder " + builder + ")");
     if (values) *values = settings_values(visit);
     return s;
@@ -251,7 +259,7 @@ nlohmann::json accel_settings_schema(const std::string& kind, const std::string&
     std::string b;
     const Entry& e = entry_of(o, &b);
     BuildSettings s;
-    return settings_schema([&](SettingsVisitor& v) { e.settings(b, s, v); });
+    return settings_schema([&](SettingsVisitor& v) { kind_settings(e, b, s, v); });
 }
 
 void validate_accel_options(const AccelOptions& o) {
@@ -271,6 +279,8 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
     const BuildSettings s = resolve_settings(e, o.builder, o, &values);  // refuses bad settings before any work
     const auto start = std::chrono::steady_clock::now();
     auto finish = [&](AccelImage image) {
+        if (s.leaves.compressed) compress_leaves(image, image.leaf_starts, s.leaves);
+        image.leaf_starts.clear();
         image.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         image.stats["footprint_bytes"] = image.footprint_bytes();
         // The TLAS's entries and the BLAS kind's share one stack: the larger size (two_level.h).
@@ -280,6 +290,8 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
         image.stats["build_set"] = o.settings;
         return image;
     };
+    require(!(o.two_level && s.leaves.compressed),
+            "accel: compressed_leaves is not available with two levels (the BLASes' triangles are slices of one region)");
     if (o.two_level) return finish(build_two_level(scene, o));
     require(!scene.triangles.empty(), "scene has no triangles");
     require(scene.tri_material.size() == scene.triangles.size() && scene.tri_instance.size() == scene.triangles.size(),

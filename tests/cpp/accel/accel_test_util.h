@@ -25,9 +25,24 @@ inline const std::vector<std::string>& wide_kinds() {
     return kinds;
 }
 
+/// Suffix of a kind name that builds it with compressed leaves ("cwbvh8+cl"; leaf_blocks.h).
+inline const std::string kCompressedLeaves = "+cl";
+
+/// The kinds, each also with compressed leaves.
+inline std::vector<std::string> with_compressed_leaves(const std::vector<std::string>& kinds) {
+    std::vector<std::string> out = kinds;
+    for (const std::string& k : kinds) out.push_back(k + kCompressedLeaves);
+    return out;
+}
+
 inline std::unique_ptr<Accel> build_kind(const Scene& scene, const std::string& kind, uint32_t max_leaf_size = 4) {
     AccelOptions o;
     o.kind = kind;
+    const size_t cl = kind.size() >= kCompressedLeaves.size() ? kind.size() - kCompressedLeaves.size() : 0;
+    if (kind.compare(cl, std::string::npos, kCompressedLeaves) == 0) {
+        o.kind = kind.substr(0, cl);
+        o.settings["compressed_leaves"] = true;
+    }
     o.build.max_leaf_size = max_leaf_size;
     return load_accel(build_accel(scene, o), kind);
 }

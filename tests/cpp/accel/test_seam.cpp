@@ -48,6 +48,17 @@ TEST(AccelImage, RegionsArePlacedOnGranules) {
     EXPECT_NE(error_of([&] { (void)image.region("zzz"); }).find("no region 'zzz'"), std::string::npos);
 }
 
+TEST(AccelImage, RegionReferencesSurviveLaterRegions) {
+    // A builder may hold the first region's records while it adds the next ones.
+    AccelImage image;
+    Region& first = image.add_region("first", DataKind::node, 64, 4);
+    const uint8_t* bytes = first.bytes.data();
+    for (int i = 0; i < 64; ++i) image.add_region("r" + std::to_string(i), DataKind::triangle, 48, 1);
+    EXPECT_EQ(&first, &image.region("first"));
+    EXPECT_EQ(first.bytes.data(), bytes);
+    EXPECT_EQ(first.count, 4u);
+}
+
 TEST(AccelImage, ImageRoundTripsThroughATrace) {
     const AccelImage built = small_bvh2();
     const std::string path = temp_file("roundtrip.rtt");

@@ -1,7 +1,8 @@
-// The numerical hard cases through every wide and compressed BVH, with no false miss: rays from
-// inside closed meshes (random, and aimed exactly at shared vertices and edge midpoints) never
-// escape; axis-parallel rays with signed zeros exactly along shared edges hit at t = 1; rays
-// through shared vertices from many origins give the brute-force hit bit for bit.
+// The numerical hard cases through every wide and compressed BVH, with plain and compressed leaves,
+// with no false miss: rays from inside closed meshes (random, and aimed exactly at shared
+// vertices and edge midpoints) never escape; axis-parallel rays with signed zeros exactly along
+// shared edges hit at t = 1; rays through shared vertices from many origins give the brute-force
+// hit bit for bit.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -55,7 +56,7 @@ long escapes(const Accel& accel, const std::vector<Vec3>& soup, float inner, int
 TEST(WideHardCases, ClosedMeshesNeverLeak) {
     const std::vector<Vec3> cube = test::tessellated_cube(8), sphere = test::icosphere(3);
     const Scene cube_scene = test::make_scene(cube), sphere_scene = test::make_scene(sphere);
-    for (const std::string& kind : test::wide_kinds()) {
+    for (const std::string& kind : test::with_compressed_leaves(test::wide_kinds())) {
         const long e = escapes(*test::build_kind(cube_scene, kind, 2), cube, 0.99f, 50000, 17) +
                        escapes(*test::build_kind(sphere_scene, kind, 2), sphere, 0.9f, 50000, 23);
         std::printf("[ watertight ] %s: %ld escapes\n", kind.c_str(), e);
@@ -65,7 +66,7 @@ TEST(WideHardCases, ClosedMeshesNeverLeak) {
 
 TEST(WideHardCases, AxisRaysAlongSharedEdgesWithSignedZeros) {
     const Scene scene = test::make_scene(test::tessellated_cube(4));
-    for (const std::string& kind : test::wide_kinds()) {
+    for (const std::string& kind : test::with_compressed_leaves(test::wide_kinds())) {
         const auto accel = test::build_kind(scene, kind, 1);
         int rays = 0, misses = 0;
         for (int axis = 0; axis < 3; ++axis)
@@ -94,9 +95,9 @@ TEST(WideHardCases, AxisRaysAlongSharedEdgesWithSignedZeros) {
 TEST(WideHardCases, SharedVerticesFromManyOriginsMatchBruteForce) {
     const std::vector<Vec3> soup = test::tessellated_cube(6);
     const Scene scene = test::make_scene(soup);
-    for (const std::string& kind : test::wide_kinds()) {
+    for (const std::string& kind : test::with_compressed_leaves(test::wide_kinds())) {
         const auto accel = test::build_kind(scene, kind, 2);
-        const Region& tris = test::triangles_of(*accel);
+        const TriangleStore tris = TriangleStore::open(accel->image(), kind);  // plain or decoded
         Rng rng(77);
         int diffs = 0;
         for (size_t k = 0; k < soup.size(); ++k)
@@ -104,7 +105,7 @@ TEST(WideHardCases, SharedVerticesFromManyOriginsMatchBruteForce) {
                 const Vec3 o = j == 0 ? Vec3(0.0f) : test::random_point(rng, Vec3(-3), Vec3(3));
                 const Ray r = make_ray(o, soup[k] - o);
                 const Hit a = trace(*accel, r, TraversalMode::closest_hit);
-                const Hit b = trace_ray_brute_force(tris.records<HwTriangle>(), tris.count, r, TraversalMode::closest_hit);
+                const Hit b = trace_ray_brute_force(tris.triangles(), tris.count(), r, TraversalMode::closest_hit);
                 diffs += !test::same_hit(a, b);
             }
         EXPECT_EQ(diffs, 0) << kind;

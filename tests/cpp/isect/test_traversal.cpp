@@ -77,7 +77,7 @@ TEST(Traversal, StepsAndWorkOnAHandMadeTree) {
     // Through both leaves' boxes: x = 0 lies on both boxes' shared face.
     Bvh2View view = bvh2_view(bvh);
     view.node_base = 0x1000;
-    view.triangle_base = 0x8000;
+    view.tri_at.base = 0x8000;
     Bvh2Stepper tr(view);
     tr.begin(make_ray(Vec3(0, 0, 0), Vec3(0, 0, 1)), TraversalMode::closest_hit);
     // The root: one 64-byte node fetch at its address, two box tests, locality key node 0.

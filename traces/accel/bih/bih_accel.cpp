@@ -82,17 +82,18 @@ void check_bih_invariants(const BihView& v, const Scene& scene) {
 
 BihAccel::BihAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
     const Region& nodes = m_image.region("nodes");
-    const Region& tris = m_image.region("triangles");
-    require(nodes.record_bytes == sizeof(BihNode) && tris.record_bytes == sizeof(HwTriangle),
+    const Region& tris = triangle_region(m_image);
+    require(nodes.record_bytes == sizeof(BihNode) && triangle_records_ok(tris),
             source + ": bih regions must hold 12-byte nodes and 48-byte triangles");
     require(nodes.kind == DataKind::node && tris.kind == DataKind::triangle,
             source + ": bih regions must be of data kinds node and triangle");
     m_view.nodes = nodes.records<BihNode>();
     m_view.node_count = nodes.count;
     m_view.node_base = nodes.base;
-    m_view.triangles = tris.records<HwTriangle>();
-    m_view.triangle_count = tris.count;
-    m_view.triangle_base = tris.base;
+    m_triangles = TriangleStore::open(m_image, source);
+    m_view.triangles = m_triangles.triangles();
+    m_view.triangle_count = m_triangles.count();
+    m_view.tri_at = m_triangles.addressing();
     m_view.bounds = root_cell_from_json(m_image.params, source + ": bih params");
     m_depth = validate_bih(m_view, source);
 }

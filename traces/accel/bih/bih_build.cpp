@@ -172,6 +172,8 @@ AccelImage bih_image(const BihTree& tree, const Scene& scene, const std::string&
     std::copy(tree.nodes.begin(), tree.nodes.end(), nodes.records<BihNode>());
     Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, tree.prim_ids.size());
     for (size_t k = 0; k < tree.prim_ids.size(); ++k) tris.records<HwTriangle>()[k] = make_hw_triangle(scene, tree.prim_ids[k]);
+    for (const BihNode& n : tree.nodes)
+        if (n.leaf() && n.count()) image.leaf_starts.push_back(n.first());
     image.place_regions();
     // Statistics over the cells, top down (SAH with C_t = C_i = 1, as the BVHs report it).
     std::vector<Aabb> cell(tree.nodes.size());

@@ -40,8 +40,8 @@ StepOutcome BihStepper::execute() {
             } else {
                 m_phase = Phase::leaf;
                 m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
-                m_plan.add_fetch(m_view.triangle_base + uint64_t(n.first()) * sizeof(HwTriangle),
-                                 n.count() * uint32_t(sizeof(HwTriangle)), DataKind::triangle);
+                const TriangleAddressing::Span s = m_view.tri_at.span(n.first(), n.count());
+                m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
                 m_plan.add_op(OpKind::triangle, n.count());
             }
             break;

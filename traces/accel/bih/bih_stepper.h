@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "traces/accel/bih/bih_layout.h"
+#include "traces/accel/leaf_blocks.h"
 #include "traces/accel/stepper.h"
 #include "traces/common/aabb.h"
 #include "traces/common/hw_triangle.h"
@@ -28,7 +29,8 @@ struct BihView {
     const BihNode* nodes = nullptr;
     const HwTriangle* triangles = nullptr;
     uint64_t node_count = 0, triangle_count = 0;
-    uint64_t node_base = 0, triangle_base = 0;  ///< addresses of record 0
+    uint64_t node_base = 0;                     ///< address of node 0
+    TriangleAddressing tri_at;                  ///< where triangles' bytes are (plain or compressed leaves)
     Aabb bounds;                                ///< the root cell
 };
 

@@ -1,9 +1,11 @@
 // The binary BVH's image, Accel and locality tree (bvh2.h).
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "traces/accel/bvh2/bvh2.h"
+#include "traces/accel/bvh_image_stats.h"
 #include "traces/bvh/builder.h"
 #include "traces/common/error.h"
 #include "traces/isect/brute_force.h"
@@ -31,25 +33,21 @@ Hit trace_ray_brute_force(const HwBvh& bvh, const Ray& ray, TraversalMode mode) 
 namespace {
 
 nlohmann::json bvh2_stats(const BvhStats& s, const BuildConfig& c, const std::string& builder) {
-    return {{"builder", builder},
-            {"config",
-             {{"bins", c.bins},
-              {"traversal_cost", c.traversal_cost},
-              {"intersection_cost", c.intersection_cost},
-              {"max_leaf_size", c.max_leaf_size},
-              {"max_depth", c.max_depth}}},
-            {"width", 2},
-            {"node_bytes", sizeof(HwNode)},
-            {"triangle_bytes", sizeof(HwTriangle)},
-            {"nodes", s.nodes},
-            {"leaves", s.leaves},
-            {"max_depth", s.max_depth},
-            {"avg_leaf_size", s.avg_leaf_size},
-            {"max_leaf_size", s.max_leaf_size},
-            {"sah_cost", s.sah_cost}};
+    return bvh_image_stats(s, c, builder, 2, sizeof(HwNode));
 }
 
 }  // namespace
+
+/// The first triangle of every leaf child (compressed leaves start a block at each).
+std::vector<uint32_t> bvh2_leaf_starts(const Region& nodes) {
+    std::vector<uint32_t> starts;
+    const HwNode* n = nodes.records<HwNode>();
+    for (uint64_t i = 0; i < nodes.count; ++i)
+        for (int c = 0; c < 2; ++c)
+            if (n[i].child_count[c] != 0 && n[i].child_count[c] != kEmptyChild) starts.push_back(n[i].child_ref[c]);
+    std::sort(starts.begin(), starts.end());
+    return starts;
+}
 
 AccelImage bvh2_image(const HwBvh& bvh, const BuildConfig& c, const std::string& builder) {
     AccelImage image;
@@ -59,6 +57,7 @@ AccelImage bvh2_image(const HwBvh& bvh, const BuildConfig& c, const std::string&
     std::copy(bvh.nodes.begin(), bvh.nodes.end(), nodes.records<HwNode>());
     Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, bvh.triangles.size());
     std::copy(bvh.triangles.begin(), bvh.triangles.end(), tris.records<HwTriangle>());
+    image.leaf_starts = bvh2_leaf_starts(image.region("nodes"));
     image.place_regions();
     image.stats = bvh2_stats(bvh.stats, c, builder);
     return image;
@@ -73,6 +72,7 @@ AccelImage bvh2_image(const BuildTree& tree, const Scene& scene, const BuildConf
     // The regions' records are taken once both exist: adding a region may move the others.
     const BvhStats s = flatten_bvh_into(tree, scene, c, image.region("nodes").records<HwNode>(),
                                         image.region("triangles").records<HwTriangle>());
+    image.leaf_starts = bvh2_leaf_starts(image.region("nodes"));
     image.place_regions();
     image.stats = bvh2_stats(s, c, builder);
     return image;
@@ -163,15 +163,16 @@ void validate_bvh2(const Bvh2View& v, const std::string& source) {
 
 Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
     const Region& nodes = m_image.region("nodes");
-    const Region& tris = m_image.region("triangles");
-    require(nodes.record_bytes == sizeof(HwNode) && tris.record_bytes == sizeof(HwTriangle),
+    const Region& tris = triangle_region(m_image);
+    require(nodes.record_bytes == sizeof(HwNode) && triangle_records_ok(tris),
             source + ": bvh2 regions must hold 64-byte nodes and 48-byte triangles");
     m_view.nodes = nodes.records<HwNode>();
     m_view.node_count = nodes.count;
     m_view.node_base = nodes.base;
-    m_view.triangles = tris.records<HwTriangle>();
-    m_view.triangle_count = tris.count;
-    m_view.triangle_base = tris.base;
+    m_triangles = TriangleStore::open(m_image, source);
+    m_view.triangles = m_triangles.triangles();
+    m_view.triangle_count = m_triangles.count();
+    m_view.tri_at = m_triangles.addressing();
     validate_bvh2(m_view, source);
 }
 

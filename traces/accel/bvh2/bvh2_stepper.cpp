@@ -53,8 +53,8 @@ void Bvh2Stepper::plan_next() {
     } else {
         prefetch_range(m_view.triangles + m_ref, sizeof(HwTriangle) * m_count);
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
-        m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
-                         uint32_t(sizeof(HwTriangle) * m_count), DataKind::triangle);
+        const TriangleAddressing::Span s = m_view.tri_at.span(m_ref, m_count);
+        m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
         m_plan.add_op(OpKind::triangle, m_count);
     }
 }

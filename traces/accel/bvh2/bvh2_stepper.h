@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
+#include "traces/accel/leaf_blocks.h"
 #include "traces/accel/stepper.h"
 #include "traces/bvh/hw_layout.h"
 #include "traces/isect/ray_box.h"
@@ -25,7 +26,7 @@ struct Bvh2View {
     uint64_t node_count = 0;
     uint64_t triangle_count = 0;
     uint64_t node_base = 0;      ///< address of node 0
-    uint64_t triangle_base = 0;  ///< address of triangle 0
+    TriangleAddressing tri_at;   ///< where triangles' bytes are (plain or compressed leaves)
 };
 
 class Bvh2Stepper final : public Stepper {

@@ -89,6 +89,7 @@ AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std:
     Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
     HwTriangleWriter(scene).write(o.prims.data(), o.prims.size(), t);
+    image.leaf_starts = o.leaf_starts;
     image.place_regions();
     return image;
 }

@@ -41,18 +41,19 @@ void validate_grid(const GridView& v, const std::string& source) {
 GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
     const Region& cells = m_image.region("cells");
     const Region& refs = m_image.region("prim_refs");
-    const Region& tris = m_image.region("triangles");
+    const Region& tris = triangle_region(m_image);
     require(cells.record_bytes == sizeof(GridCell) && refs.record_bytes == kRefBytes &&
-                tris.record_bytes == sizeof(HwTriangle),
+                triangle_records_ok(tris),
             source + ": grid regions must hold 8-byte cells, 4-byte references and 48-byte triangles");
     require(cells.kind == DataKind::cell && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
             source + ": grid regions must be of data kinds cell, prim_ref and triangle");
     m_view.geometry = GridGeometry::from_json(m_image.params, source);
     m_view.cells = cells.records<GridCell>();
-    m_view.list = RefListView{refs.records<uint32_t>(), tris.records<HwTriangle>(), refs.base, tris.base};
+    m_triangles = TriangleStore::open(m_image, source);
+    m_view.list = RefListView{refs.records<uint32_t>(), m_triangles.triangles(), refs.base, m_triangles.addressing()};
     m_view.cell_count = cells.count;
     m_view.ref_count = refs.count;
-    m_view.triangle_count = tris.count;
+    m_view.triangle_count = m_triangles.count();
     m_view.cell_base = cells.base;
     validate_grid(m_view, source);
 }

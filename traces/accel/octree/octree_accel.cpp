@@ -132,18 +132,19 @@ void check_octree_invariants(const OctView& v, const Scene& scene) {
 OctreeAccel::OctreeAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
     const Region& nodes = m_image.region("nodes");
     const Region& refs = m_image.region("prim_refs");
-    const Region& tris = m_image.region("triangles");
+    const Region& tris = triangle_region(m_image);
     require(nodes.record_bytes == sizeof(OctNode) && refs.record_bytes == kRefBytes &&
-                tris.record_bytes == sizeof(HwTriangle),
+                triangle_records_ok(tris),
             source + ": octree regions must hold 16-byte nodes, 4-byte references and 48-byte triangles");
     require(nodes.kind == DataKind::node && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
             source + ": octree regions must be of data kinds node, prim_ref and triangle");
     m_view.nodes = nodes.records<OctNode>();
     m_view.node_count = nodes.count;
     m_view.node_base = nodes.base;
-    m_view.list = RefListView{refs.records<uint32_t>(), tris.records<HwTriangle>(), refs.base, tris.base};
+    m_triangles = TriangleStore::open(m_image, source);
+    m_view.list = RefListView{refs.records<uint32_t>(), m_triangles.triangles(), refs.base, m_triangles.addressing()};
     m_view.ref_count = refs.count;
-    m_view.triangle_count = tris.count;
+    m_view.triangle_count = m_triangles.count();
     m_view.bounds = root_cell_from_json(m_image.params, source + ": octree params");
     m_depth = validate_octree(m_view, source);
 }

@@ -123,7 +123,7 @@ void TwoLevelAccel::add_frame(const json& slice, const std::string& where) {
     fr.tlas.node_count = node_count;
     fr.tlas.node_base = nodes.address(node_first);
     fr.tlas.triangle_count = record_count;  // a TLAS leaf's "triangles" are instance records
-    fr.tlas.triangle_base = records.address(record_first);
+    fr.tlas.tri_at.base = records.address(record_first);
     fr.instances = {records.records<InstanceRecord>() + record_first, record_count, records.address(record_first)};
     fr.key_base = uint32_t(node_first);
     validate_bvh2(fr.tlas, where + " TLAS");

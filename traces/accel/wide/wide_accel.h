@@ -123,16 +123,17 @@ class WideAccel final : public Accel {
 public:
     WideAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
         const Region& nodes = m_image.region("nodes");
-        const Region& tris = m_image.region("triangles");
-        require(nodes.record_bytes == Codec::kBytes && tris.record_bytes == sizeof(HwTriangle),
+        const Region& tris = triangle_region(m_image);
+        require(nodes.record_bytes == Codec::kBytes && triangle_records_ok(tris),
                 source + ": " + m_image.kind + " regions must hold " + std::to_string(Codec::kBytes) +
                     "-byte nodes and 48-byte triangles");
         m_view.nodes = nodes.bytes.data();
         m_view.node_count = nodes.count;
         m_view.node_base = nodes.base;
-        m_view.triangles = tris.records<HwTriangle>();
-        m_view.triangle_count = tris.count;
-        m_view.triangle_base = tris.base;
+        m_triangles = TriangleStore::open(m_image, source);
+        m_view.triangles = m_triangles.triangles();
+        m_view.triangle_count = m_triangles.count();
+        m_view.tri_at = m_triangles.addressing();
         m_view.order = child_order_param(m_image, source);
         m_view.max_stack = validate_wide<Codec>(m_view, source, m_image.kind);
         m_valid.resize(m_view.node_count);

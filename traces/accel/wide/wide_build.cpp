@@ -1,6 +1,7 @@
 // Building the fp32 wide images (wide.h): wide tree, node and triangle order (WideOrder), records.
 #include <algorithm>
 
+#include "traces/accel/bvh_image_stats.h"
 #include "traces/accel/wide/wide.h"
 #include "traces/common/error.h"
 
@@ -87,6 +88,7 @@ AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::
     Region& tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, o.prims.size());
     HwTriangle* t = tris.records<HwTriangle>();
     HwTriangleWriter(scene).write(o.prims.data(), o.prims.size(), t);
+    image.leaf_starts = o.leaf_starts;
     image.place_regions();
     return image;
 }
@@ -94,26 +96,19 @@ AccelImage wide_image(const WideBuildTree& tree, const Scene& scene, const std::
 nlohmann::json wide_stats(const WideBuildTree& tree, const BuildConfig& c, const std::string& builder,
                           uint32_t node_bytes, ChildOrder order) {
     const WideShape s = wide_shape(tree);
-    return {{"builder", builder},
-            {"config",
-             {{"bins", c.bins},
-              {"traversal_cost", c.traversal_cost},
-              {"intersection_cost", c.intersection_cost},
-              {"max_leaf_size", c.max_leaf_size},
-              {"max_depth", c.max_depth}}},
-            {"width", tree.width},
-            {"node_bytes", node_bytes},
-            {"triangle_bytes", sizeof(HwTriangle)},
-            {"nodes", tree.nodes.size()},
-            {"leaves", s.leaves},
-            {"max_depth", s.max_depth},
-            {"avg_leaf_size", s.avg_leaf_size},
-            {"max_leaf_size", s.max_leaf_size},
-            {"avg_children", s.avg_children},
-            {"triangle_refs", tree.prims.size()},
-            {"collapse", "dp"},
-            {"order", child_order_name(order)},
-            {"sah_cost", wide_sah_cost(tree, c.traversal_cost, c.intersection_cost)}};
+    BvhStats b;
+    b.nodes = uint32_t(tree.nodes.size());
+    b.leaves = s.leaves;
+    b.max_depth = s.max_depth;
+    b.avg_leaf_size = s.avg_leaf_size;
+    b.max_leaf_size = s.max_leaf_size;
+    b.sah_cost = wide_sah_cost(tree, c.traversal_cost, c.intersection_cost);
+    nlohmann::json j = bvh_image_stats(b, c, builder, tree.width, node_bytes);
+    j.update(nlohmann::json{{"avg_children", s.avg_children},
+              {"triangle_refs", tree.prims.size()},
+              {"collapse", "dp"},
+              {"order", child_order_name(order)}});
+    return j;
 }
 
 std::unique_ptr<Accel> load_wide_fp32(AccelImage image, int width, const std::string& source) {

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "traces/accel/leaf_blocks.h"
 #include "traces/accel/stepper.h"
 #include "traces/accel/wide/wide_kernel.h"
 #include "traces/common/error.h"
@@ -29,7 +30,7 @@ struct WideView {
     uint64_t node_count = 0;
     uint64_t triangle_count = 0;
     uint64_t node_base = 0;      ///< address of node 0
-    uint64_t triangle_base = 0;  ///< address of triangle 0
+    TriangleAddressing tri_at;   ///< where triangles' bytes are (plain or compressed leaves)
     ChildOrder order = ChildOrder::distance;
     uint32_t max_stack = 1;  ///< deepest stack a ray can need (from validation)
     /// Host-side copy of each node's slot mask, derived from the image when it is loaded (not
@@ -80,8 +81,8 @@ private:
             m_plan.add_op(OpKind::box, detail::popcount8(Codec::valid_mask(node(m_ref))));
         } else {
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
-            m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
-                             uint32_t(sizeof(HwTriangle) * m_count), DataKind::triangle);
+            const TriangleAddressing::Span s = m_view.tri_at.span(m_ref, m_count);
+            m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
             m_plan.add_op(OpKind::triangle, m_count);
         }
     }

@@ -126,6 +126,7 @@ WideOrder wide_order(const WideBuildTree& tree) {
             const WideBuildChild& c = n.child[slots[k]];
             if (c.is_leaf()) {
                 o.leaf_first[size_t(b) * kMaxWideWidth + slots[k]] = uint32_t(o.prims.size());
+                o.leaf_starts.push_back(uint32_t(o.prims.size()));
                 o.prims.insert(o.prims.end(), tree.prims.begin() + c.first, tree.prims.begin() + c.first + c.count);
             } else {
                 o.index[c.node] = uint32_t(o.stored.size());

@@ -93,6 +93,7 @@ struct WideOrder {
     std::vector<uint32_t> index;       ///< stored index of each build node
     std::vector<uint32_t> leaf_first;  ///< per build node * 8 + child: first stored triangle of a leaf
     std::vector<uint32_t> prims;       ///< scene primitive of each stored triangle
+    std::vector<uint32_t> leaf_starts; ///< first stored triangle of every leaf, in storage order
 };
 WideOrder wide_order(const WideBuildTree& tree);
 

@@ -1,0 +1,271 @@
+"""Compressed structures against their papers: rows of docs/papers.md, and the compressed-leaves
+table of docs/accel.md.
+
+`rows(out_dir, quick)` traces Sponza's diffuse bounce with the binary BVH (`bvh2`), the
+compressed 8-wide BVH (`cwbvh8`) and `cwbvh8` with compressed leaves (`--build-set
+compressed_leaves=true`, traces/accel/leaf_blocks.h), simulates each at the default configuration
+and on the `rtx2060` preset, and returns one dict per published figure:
+{"technique", "paper", "published", "setup", "ours", "why"}. quick=True keeps it under a minute
+(a 32x24 camera); quick=False uses 96x72.
+
+Run as a script it also writes the compressed-leaves table into docs/accel.md (between the
+`compressed-leaves` markers) and prints the rows:
+
+    python scripts/papers/leaves_rows.py --out out/leaves [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+SCENE = "sponza"
+#: (label, --accel, --build-set compressed_leaves)
+STRUCTURES = [
+    ("bvh2", "bvh2", False),
+    ("bvh2 + compressed leaves", "bvh2", True),
+    ("bvh8", "bvh8", False),
+    ("cwbvh8", "cwbvh8", False),
+    ("cwbvh8 + compressed leaves", "cwbvh8", True),
+]
+PRESETS = ("default", "rtx2060")
+
+
+def _trace(out: Path, kind: str, compressed: bool, resolution: str) -> dict[str, Any]:
+    """Traces Sponza's diffuse bounce into out (reused when its manifest exists)."""
+    manifest = out / "manifest.json"
+    if not manifest.exists():
+        cmd = [sys.executable, "-m", "rtsim", "trace", SCENE, "-o", str(out), "--accel", kind,
+               "--workload", "diffuse", "--bounces", "1", "--resolution", resolution]  # fmt: skip
+        if compressed:
+            cmd += ["--build-set", "compressed_leaves=true"]
+        subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return json.loads(manifest.read_text())
+
+
+def _simulate(trace: Path, out: Path, preset: str) -> dict[str, Any]:
+    """rtsim-sim on the trace at `preset` (default: no --config); its stats.json."""
+    from rtsim.launcher import SimJob, find_sim
+    from rtsim.sim_cli import config_file
+
+    stats = out / "stats.json"
+    if not stats.exists():
+        config = None if preset == "default" else config_file(preset, out)
+        cmd = SimJob(trace=trace, out_dir=out, config=config, verdict=False).command(find_sim())
+        subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return json.loads(stats.read_text())
+
+
+def _dram_kind_bytes(stats: dict[str, Any], kind: str) -> float:
+    by_kind = stats["model"]["dram"].get("by_kind", {})
+    rays = max(stats["summary"]["rays"], 1)
+    c = by_kind.get(kind, {})
+    return (c.get("read_bytes", 0) + c.get("write_bytes", 0)) / rays
+
+
+def measure(out_dir: Path, quick: bool) -> dict[str, Any]:
+    """Every structure's footprint and, per preset, its run's figures."""
+    resolution = "32x24" if quick else "96x72"
+    results: dict[str, Any] = {"resolution": resolution, "structures": {}}
+    for label, kind, compressed in STRUCTURES:
+        if quick and label.startswith(("bvh2 +", "bvh8")):
+            continue  # the papers' rows need bvh2, cwbvh8 and cwbvh8 with compressed leaves only
+        slug = label.replace(" + compressed leaves", "-cl")
+        manifest = _trace(out_dir / slug / "trace", kind, compressed, resolution)
+        accel = manifest["accel"]
+        row: dict[str, Any] = {
+            "footprint": accel["footprint_bytes"],
+            "node_bytes": accel["nodes"] * accel["node_bytes"],
+            "leaf_blocks": accel.get("leaf_blocks"),
+        }
+        for preset in PRESETS:
+            s = _simulate(out_dir / slug / "trace", out_dir / slug / preset, preset)
+            summary = s["summary"]
+            if summary["hit_mismatches"] or summary["work_mismatches"]:
+                raise RuntimeError(f"{slug} {preset}: mismatches")
+            row[preset] = {
+                "mrays": summary["mrays_per_second"],
+                "dram_per_ray": summary["dram_bytes_per_ray"],
+                "tri_dram_per_ray": _dram_kind_bytes(s, "triangle"),
+                "node_dram_per_ray": _dram_kind_bytes(s, "node"),
+                "energy_nj": summary.get("energy_per_ray_nj"),
+                "area_mm2": summary.get("area_mm2"),
+                "rays": summary["rays"],
+            }
+        results["structures"][label] = row
+    return results
+
+
+def _ratio(a: float | None, b: float | None) -> float | None:
+    return None if a is None or b is None or b == 0 else a / b
+
+
+def _fmt(x: float | None, spec: str = ".2f", suffix: str = "x") -> str:
+    return "n/a" if x is None else f"{format(x, spec)}{suffix}"
+
+
+def _speed_why(ratio: float | None) -> str:
+    """Why our cwbvh8 speed-up differs from (or meets) Ylitie's 1.9-2.1x."""
+    where = (
+        "within their range" if ratio is not None and 1.9 <= ratio <= 2.1 else "outside their range"
+    )
+    return (
+        f"{where}, from another baseline: theirs is a software GPU kernel (Aila et al. 2012) "
+        "whose time is memory traffic on SIMT cores, with a compressed traversal stack too; ours "
+        "is a binary BVH on the same MIMD RT units, where cwbvh8 gains from fewer node steps and "
+        "less node traffic (a small frame: partly cold caches)"
+    )
+
+
+def rows_from(r: dict[str, Any]) -> list[dict[str, str]]:
+    s = r["structures"]
+    b2, cw, cl = s["bvh2"], s["cwbvh8"], s["cwbvh8 + compressed leaves"]
+    setup = (
+        f"Sponza, diffuse bounce, {r['resolution']} camera; whole image = nodes + "
+        "triangles as the model addresses them"
+    )
+    d, x = "default", "rtx2060"
+    return [
+        {
+            "technique": "compressed 8-wide BVH (memory)",
+            "paper": "Ylitie, Karras & Laine 2017",
+            "published": "hierarchy memory 35-60% of a typical uncompressed BVH",
+            "setup": setup,
+            "ours": (
+                f"cwbvh8 / bvh2: whole image {_fmt(_ratio(cw['footprint'], b2['footprint']))}, "
+                f"nodes only {_fmt(_ratio(cw['node_bytes'], b2['node_bytes']))}; with "
+                f"compressed leaves {_fmt(_ratio(cl['footprint'], b2['footprint']))}"
+            ),
+            "why": (
+                "their nodes compress like ours (80-byte nodes); the whole image is dominated by "
+                "48-byte triangles, which their layout keeps too: only compressed leaves bring "
+                "the whole image into their range"
+            ),
+        },
+        {
+            "technique": "compressed 8-wide BVH (speed)",
+            "paper": "Ylitie, Karras & Laine 2017",
+            "published": "1.9-2.1x incoherent ray traversal over Aila et al. 2012 on a GPU",
+            "setup": setup + "; default model config",
+            "ours": (
+                f"cwbvh8 / bvh2 Mrays/s {_fmt(_ratio(cw[d]['mrays'], b2[d]['mrays']))}, "
+                f"with compressed leaves {_fmt(_ratio(cl[d]['mrays'], b2[d]['mrays']))}; "
+                f"DRAM B/ray {_fmt(_ratio(cw[d]['dram_per_ray'], b2[d]['dram_per_ray']))}"
+            ),
+            "why": _speed_why(_ratio(cw[d]["mrays"], b2[d]["mrays"])),
+        },
+        {
+            "technique": "compressed, quantised wide BVH on an RT unit",
+            "paper": "AQB8 (ISCA 2025)",
+            "published": (
+                "-70% DRAM accesses, -49% energy, -27% area, 1.82x speed (Vulkan-Sim RT unit)"
+            ),
+            "setup": setup + "; rtx2060 preset; cwbvh8 with compressed leaves against bvh2",
+            "ours": (
+                f"DRAM B/ray {_fmt(_ratio(cl[x]['dram_per_ray'], b2[x]['dram_per_ray']))}, "
+                f"energy/ray {_fmt(_ratio(cl[x]['energy_nj'], b2[x]['energy_nj']))}, "
+                f"area {_fmt(_ratio(cl[x]['area_mm2'], b2[x]['area_mm2']))}, "
+                f"speed {_fmt(_ratio(cl[x]['mrays'], b2[x]['mrays']))}"
+            ),
+            "why": (
+                "our area model prices units, pipelines and SRAM, not the node format, and our "
+                "box pipeline stays fp32 (AQB8 also narrows the arithmetic, hence its area); "
+                "its baseline is the Vulkan-Sim RT unit's own BVH, ours the binary BVH"
+            ),
+        },
+        {
+            "technique": "reduced-precision box tests",
+            "paper": "Keely 2014",
+            "published": (
+                "compact reduced-precision traversal unit; 3.4 Grays/s path tracing (simulated GPU)"
+            ),
+            "setup": "-",
+            "ours": "not measured: the reduced-precision box pipeline is not built on this branch",
+            "why": "not built yet",
+        },
+        {
+            "technique": "compressed leaves, lossless",
+            "paper": "Benthin, Wald, Woop & Afra 2018",
+            "published": (
+                "about the memory savings of Embree's compressed BVH, with almost the "
+                "speed of its fastest uncompressed BVH"
+            ),
+            "setup": setup + "; default model config; cwbvh8 with and without compressed leaves",
+            "ours": (
+                f"whole image {_fmt(_ratio(cl['footprint'], cw['footprint']))}, triangle DRAM "
+                f"B/ray {_fmt(_ratio(cl[d]['tri_dram_per_ray'], cw[d]['tri_dram_per_ray']))}, "
+                f"Mrays/s {_fmt(_ratio(cl[d]['mrays'], cw[d]['mrays']))}"
+            ),
+            "why": (
+                "ours is only the lossless part (vertices shared within a leaf, byte indices, "
+                "no quantised leaf boxes), so it saves less memory than their quantised "
+                "multi-leaf nodes; decoding is a byte gather the model does not charge"
+            ),
+        },
+    ]
+
+
+def rows(out_dir: str | os.PathLike[str], quick: bool = True) -> list[dict[str, str]]:
+    """The papers page's rows for compressed structures, measured into out_dir."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return rows_from(measure(out, quick))
+
+
+def accel_table(r: dict[str, Any], host: str, date: str) -> str:
+    """The docs/accel.md table: every structure's bytes and its run's traffic and speed."""
+    lines = [
+        f"Measured with `python scripts/papers/leaves_rows.py` on {host}, {date}: Sponza, diffuse "
+        f"bounce, {r['resolution']} camera, default model config (one run each; the machine was "
+        "shared). DRAM bytes per ray by kind are the model's; 0 mismatches in every run.",
+        "",
+        "| structure | image MiB | triangle bytes MiB | vs bvh2 image | Mrays/s | DRAM B/ray "
+        "| triangle DRAM B/ray | node DRAM B/ray |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    base = r["structures"]["bvh2"]["footprint"]
+    for label, row in r["structures"].items():
+        d = row["default"]
+        tri = row["footprint"] - row["node_bytes"]
+        lines.append(
+            f"| {label} | {row['footprint'] / 2**20:.1f} | {tri / 2**20:.1f} | "
+            f"{row['footprint'] / base:.2f}x | {d['mrays']:.1f} | {d['dram_per_ray']:.0f} | "
+            f"{d['tri_dram_per_ray']:.0f} | {d['node_dram_per_ray']:.0f} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument("--out", type=Path, default=Path("out/leaves"))
+    ap.add_argument("--quick", action="store_true", help="a 32x24 camera, papers' structures only")
+    ap.add_argument(
+        "--doc", type=Path, default=Path(__file__).resolve().parents[2] / "docs" / "accel.md"
+    )
+    args = ap.parse_args()
+    os.environ.setdefault("RTSIM_SCENES", "/work/shared/scenes")
+    args.out.mkdir(parents=True, exist_ok=True)
+    r = measure(args.out, args.quick)
+    (args.out / "leaves.json").write_text(json.dumps(r, indent=1))
+    if not args.quick:
+        from rtsim.doc_markers import write_between
+
+        write_between(
+            args.doc,
+            "compressed-leaves",
+            accel_table(r, os.uname().nodename, time.strftime("%Y-%m-%d")),
+        )
+    for row in rows_from(r):
+        print(json.dumps(row))
+
+
+if __name__ == "__main__":
+    main()
