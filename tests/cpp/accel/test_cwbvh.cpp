@@ -265,5 +265,19 @@ TEST(Cwbvh, CorruptImagesAreRefusedByName) {
     expect(test::error_of([&] { load_accel(std::move(wrong_size), "w.rtt"); }), "w.rtt: bvh4 regions must hold 128-byte nodes");
 }
 
+// The compressed images' SAH cost is computed from the boxes the node step tests (dequantised
+// outward): above the fp32 twin's, which uses the exact boxes of the same tree, and the exact
+// figure is kept beside it.
+TEST(Cwbvh, SahCostCountsTheQuantisedBoxes) {
+    const Scene scene = test::random_soup(4, 3000);
+    for (const auto& [fp32, compressed] : {std::pair{"bvh8", "cwbvh8"}, std::pair{"bvh6", "cwbvh6"}}) {
+        const auto a = test::build_kind(scene, fp32), b = test::build_kind(scene, compressed);
+        const double exact = a->image().stats["sah_cost"], quantised = b->image().stats["sah_cost"];
+        EXPECT_DOUBLE_EQ(double(b->image().stats["sah_cost_exact_boxes"]), exact) << compressed;
+        EXPECT_GT(quantised, exact * 1.001) << compressed;
+        EXPECT_LT(quantised, exact * 2.0) << compressed;
+    }
+}
+
 }  // namespace
 }  // namespace rtsim
