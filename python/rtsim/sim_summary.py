@@ -294,6 +294,25 @@ def mailbox_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def short_stack_table(stats: dict[str, Any]) -> Table:
+    """A short stack's restarts and re-traversal (stats.json "short_stack", docs/accel.md)."""
+    m = stats.get("short_stack", {}) or {}
+    per_ray = m.get("per_ray", {}) or {}
+    table = Table(
+        title=f"short stack ({fmt_int(m.get('entries'))} entries per ray, restart trail)",
+        title_justify="left",
+    )
+    table.add_column("")
+    table.add_column("value", justify="right")
+    table.add_row("entries dropped / ray", fmt_float(per_ray.get("stack_drops"), 2))
+    table.add_row("restarts / ray", fmt_float(per_ray.get("restarts"), 3))
+    table.add_row("nodes revisited / ray", fmt_float(per_ray.get("restart_steps"), 2))
+    table.add_row("extra node steps", fmt_pct(m.get("extra_steps_fraction")))
+    table.add_row("extra box tests", fmt_pct(m.get("extra_box_tests_fraction")))
+    table.add_row("spill bytes avoided", fmt_int(m.get("spill_bytes_avoided")))
+    return table
+
+
 def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> None:
     """Prints the run's headline numbers, utilisation, latency and what was built and why."""
     console = console or Console()
@@ -308,6 +327,8 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         console.print(instantiated_table(stats))
     if stats.get("mailbox"):
         console.print(mailbox_table(stats))
+    if stats.get("short_stack"):
+        console.print(short_stack_table(stats))
     if stats.get("energy"):
         console.print(energy_table(stats))
     if stats.get("effects"):

@@ -48,7 +48,8 @@ struct StepCosts {
     template <class PipelineOf, class Kinds>
     static StepCosts of(const TraversalConfig& traversal, const Kinds& kinds, PipelineOf&& pipeline) {
         StepCosts c;
-        c.stack_entries = traversal.stack_entries;
+        // A short stack drops entries instead of spilling them: no stack traffic, restart steps instead.
+        c.stack_entries = traversal.stack_overflow == StackOverflow::spill ? traversal.stack_entries : UINT32_MAX;
         c.stack_entry_bytes = traversal.stack_entry_bytes;
         for (OpKind k : kinds) c.width[size_t(k)] = pipeline(k).width;
         return c;

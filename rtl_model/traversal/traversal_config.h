@@ -23,12 +23,22 @@ inline constexpr Choices<SimtPolicy, 2> kSimtPolicyChoices{{"while_while", "if_i
 enum class SimtRefill : uint8_t { lane = 0, warp = 1 };
 inline constexpr Choices<SimtRefill, 2> kSimtRefillChoices{{"lane", "warp"}};
 
+/// What a push onto a full on-chip stack does: spill (the oldest entry is written to memory and
+/// read back when needed) or restart_trail (a short stack: the oldest entry is dropped, and an
+/// empty stack with dropped entries restarts at the root, guided by a restart trail; Laine 2010,
+/// Vaidyanathan, Woop & Benthin 2019; traces/accel/short_stack.h). A restart without a trail is
+/// not offered: a BVH's boxes overlap, so a restart from the root with only the current t_max
+/// would visit finished leaves again (it is sound for kd-trees, Foley & Sugerman 2005).
+enum class StackOverflow : uint8_t { spill = 0, restart_trail = 1 };
+inline constexpr Choices<StackOverflow, 2> kStackOverflowChoices{{"spill", "restart_trail"}};
+
 struct TraversalConfig {
     UnitModel model = UnitModel::mimd;  ///< how a unit runs its rays (unit_registry.h)
     uint32_t units = 8;              ///< traversal units
     uint32_t ray_contexts = 16;      ///< rays in flight per unit, each advancing independently
     uint32_t stack_entries = 8;      ///< on-chip traversal stack entries per ray; deeper entries spill
     uint32_t stack_entry_bytes = 0;  ///< bytes per stack entry; 0: the structure's (8 for a BVH, 12 for a kd-tree, ...)
+    StackOverflow stack_overflow = StackOverflow::spill;  ///< a push onto a full on-chip stack: spill or drop and restart
     uint32_t issue_cycles = 1;       ///< cycles the unit's scheduler needs per traversal step
     uint32_t lanes = 8;              ///< simt: rays per warp, stepping in lock-step
     SimtPolicy simt_policy = SimtPolicy::while_while;  ///< simt: which operation kind a warp runs next
@@ -44,6 +54,7 @@ struct TraversalConfig {
         v.field("ray_contexts", ray_contexts, "rays", "Ray contexts per unit (rays in flight)", 1, 4096);
         v.field("stack_entries", stack_entries, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64);
         v.field("stack_entry_bytes", stack_entry_bytes, "bytes", "Bytes per stack entry (on-chip stack and spill traffic); 0: the structure's own (a BVH's 8: node and entry distance; a kd-tree's or BIH's 12; an octree's 32), resolved from the trace", 0, 64);
+        v.choice("stack_overflow", stack_overflow, kStackOverflowChoices, "A push onto a full on-chip stack: spill (the oldest entry goes to memory and is read back) or restart_trail (a short stack: the oldest entry is dropped; an empty stack with dropped entries restarts at the root along a restart trail, Laine 2010; single-level BVH traces: bvh2, the wide and compressed BVHs)");
         v.field("issue_cycles", issue_cycles, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100);
         v.field("lanes", lanes, "rays", "simt: rays per warp in lock-step; ray_contexts must be a multiple (warps = ray_contexts / lanes)", 4, 64);
         v.choice("simt_policy", simt_policy, kSimtPolicyChoices, "simt: while_while (a warp keeps its operation kind while any lane needs it) or if_if (kinds in turn each warp step), Aila & Laine 2009");

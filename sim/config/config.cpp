@@ -282,6 +282,11 @@ void validate(const SimConfig& config) {
             "config: 'mailbox.entries' is not supported at fidelity 'analytic' with analytic.caches=statistical (its "
             "per-trace analysis prices triangle tests from the trace's work records, which hold no mailbox); use "
             "analytic.caches=functional, approx or detailed");
+    require(config.traversal.stack_overflow == StackOverflow::spill || config.fidelity != Fidelity::analytic ||
+                config.analytic.caches == AnalyticCaches::functional,
+            "config: 'traversal.stack_overflow' restart_trail is not supported at fidelity 'analytic' with "
+            "analytic.caches=statistical (its per-trace analysis prices steps from the trace's work records, which "
+            "hold no restarts); use analytic.caches=functional, approx or detailed");
     require(config.traversal.model == UnitModel::mimd || config.fidelity != Fidelity::analytic,
             "config: 'traversal.model' " + std::string(kUnitModelChoices.name(config.traversal.model)) +
                 " is not supported at fidelity 'analytic' (its closed form costs each ray context on its own, "

@@ -16,7 +16,7 @@ uint32_t bits(float f) {
 
 std::string compare_with_reference(const RayResult& r, const HitRecord& h, const WorkRecord& w, bool* hit_differs) {
     *hit_differs = r.hit.prim != h.prim || (h.prim >= 0 && bits(r.hit.t) != bits(h.t));
-    const WorkCounts m = r.work.without_mailbox();  // a trace's work has no mailbox
+    const WorkCounts m = r.work.traced();  // a trace's work has no mailbox and no restarts
     const WorkCounts ref = w.counts();
     if (!*hit_differs && m == ref) return std::string();  // every ray comes here: no text unless needed
     std::ostringstream out;

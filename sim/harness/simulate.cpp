@@ -16,6 +16,8 @@
 #include "sim/report/roofline.h"
 #include "sim/harness/run_files.h"
 #include "sim/report/mailbox_stats.h"
+#include "sim/report/short_stack_stats.h"
+#include "sim/report/two_level_stats.h"
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/model_errors.h"
 #include "sim/sampling/sampling.h"
@@ -46,6 +48,8 @@ json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, cons
     const std::string& path = reader.path();
     TraceRayStream stream(reader);
     std::vector<RayJob> jobs;
+    // A short stack's restarts are counted by the steppers; the fused reference loops walk a full one.
+    const std::unique_ptr<Stepper> stepper = accel.short_stack_entries() ? accel.make_stepper() : nullptr;
     uint32_t frame = 0;
     accel.bind_frame(0);
     while (stream.read_chunk(65536, &jobs)) {
@@ -54,7 +58,8 @@ json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, cons
             RayResult r;
             r.id = job.id;
             try {
-                r.hit = accel.trace(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit, &r.work);
+                const TraversalMode mode = job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
+                r.hit = stepper ? trace_with_stepper(*stepper, job.ray, mode, &r.work) : accel.trace(job.ray, mode, &r.work);
             } catch (const Error& e) {
                 throw Error(path + ": ray " + std::to_string(job.id) + ": " + e.what());
             }
@@ -81,6 +86,7 @@ SimOutcome run_simulation(const SimOptions& options) {
     // The acceleration structure, whichever it is, validated structurally (load_accel).
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
     apply_mailbox(*accel, o.config);
+    apply_short_stack(*accel, o.config);
     // Animated traces (frames.h): replayed frame after frame, caches warm, one barrier between.
     const std::vector<FrameRecord> frames = read_frame_table(reader, accel->frame_count());
     check_frames_supported(o.config, frames.size(), rtt);
@@ -208,6 +214,8 @@ SimOutcome run_simulation(const SimOptions& options) {
     // Energy and area from the run's counts and config (docs/energy_area.md); the timed model
     // never sees them.
     add_mailbox_stats(out.stats, o.config, checker.work_totals(), checker.checked());
+    add_short_stack_stats(out.stats, o.config, checker.work_totals(), checker.checked());
+    if (accel->kind() == "two_level") add_two_level_stats(out.stats, checker.work_totals(), checker.checked());
     add_energy_area(out.stats, o.config, checker.work_totals(), checker.checked());
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);
     json verdict = nullptr;

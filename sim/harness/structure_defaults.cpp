@@ -21,4 +21,13 @@ SimOptions with_structure_defaults(const SimOptions& options) {
     return o;
 }
 
+void apply_short_stack(Accel& accel, const SimConfig& config) {
+    const TraversalConfig& t = config.traversal;
+    if (t.stack_overflow == StackOverflow::spill) return accel.set_short_stack(0);
+    require(accel.supports_short_stack(),
+            "config: 'traversal.stack_overflow' restart_trail needs a single-level BVH trace (bvh2, or a wide or "
+            "compressed BVH); this trace's structure is '" + accel.kind() + "'; use traversal.stack_overflow spill");
+    accel.set_short_stack(t.stack_entries);
+}
+
 }  // namespace rtsim

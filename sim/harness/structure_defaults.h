@@ -16,4 +16,9 @@ SimOptions with_structure_defaults(const SimOptions& options);
 /// Gives the structure's steppers the configured mailbox (mailbox.entries per ray).
 inline void apply_mailbox(Accel& accel, const SimConfig& config) { accel.set_mailbox(config.mailbox.entries); }
 
+/// Gives the structure's steppers the configured short stack (traversal.stack_overflow =
+/// restart_trail: traversal.stack_entries entries). Throws rtsim::Error naming the field when the
+/// trace's structure has no short-stack walk.
+void apply_short_stack(Accel& accel, const SimConfig& config);
+
 }  // namespace rtsim

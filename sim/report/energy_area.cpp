@@ -227,6 +227,9 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     json pj = json::object();
     for (int k = 0; k < kOpKindCount; ++k)
         pj[op_kind_name(OpKind(k))] = double(w[work_field_of(OpKind(k))]) * op[OpKind(k)];
+    // A short stack's restarts re-test the boxes of the nodes they revisit.
+    if (w[WorkField::restart_box_tests])
+        pj["box"] = pj["box"].get<double>() + double(w[WorkField::restart_box_tests]) * op[OpKind::box];
     if (s.mailbox.entries) {
         // A lookup compares the reference with the ray's whole table (its entries read); a test
         // run records its primitive (one id written).

@@ -13,6 +13,8 @@
 #include "sim/report/energy_area.h"
 #include "sim/report/mailbox_stats.h"
 #include "sim/report/roofline.h"
+#include "sim/report/short_stack_stats.h"
+#include "sim/report/two_level_stats.h"
 #include "sim/report/summary_schema.h"
 #include "sim/report/verdict.h"
 #include "sim/sampling/sampling.h"
@@ -26,7 +28,8 @@ std::vector<const StatBlock*> stats_blocks() {
             &validation_stats(), &latency_stats(),      &workload_stats(),   &model_stats(),
             &dispatch_stats(),   &ray_buffer_stats(),   &unit_stats(),       &pipeline_stats(),
             &cache_stats(),      &dram_stats(),         &cycle_accounting_stats(), &utilization_stats(),
-            &analytic_stats(),   &ideal_memory_stats(), &provenance_stats(), &mailbox_stats()};
+            &analytic_stats(),   &ideal_memory_stats(), &provenance_stats(), &mailbox_stats(),
+            &short_stack_stats(), &two_level_stats()};
 }
 
 void check_run_stats(const nlohmann::json& stats, bool sampled) {
@@ -41,6 +44,8 @@ void check_run_stats(const nlohmann::json& stats, bool sampled) {
     if (stats.contains("frames"))
         for (const nlohmann::json& f : stats.at("frames")) frame_stats().check(f);
     if (stats.contains("mailbox")) mailbox_stats().check(stats.at("mailbox"));
+    if (stats.contains("short_stack")) short_stack_stats().check(stats.at("short_stack"));
+    if (stats.contains("two_level")) two_level_stats().check(stats.at("two_level"));
     validation_stats().check(stats.at("validation"));
     latency_stats().check(stats.at("latency"));
     workload_stats().check(stats.at("workload"));

@@ -132,6 +132,8 @@ const StatBlock& run_stats() {
             {"verdict", "", "why the run is slow: the binding resource, its evidence and the knob that relaxes it (below); `null` at functional or with `--no-verdict`"},
             {"roofline", "", "the run against its throughput ceilings (below); `null` at functional"},
             {"mailbox", "", "only when `mailbox.entries > 0`: the mailboxes' lookups, hits and the triangle tests and fetches they saved (below)", false, true},
+            {"short_stack", "", "only when `traversal.stack_overflow = restart_trail`: entries dropped, restarts and the re-traversal they cost (below)", false, true},
+            {"two_level", "", "only for two-level traces, at the levels that step every ray: the TLAS's and the BLASes' steps and box tests (below)", false, true},
             {"frames", "list", "one entry per frame of the trace (below): a single entry for a trace without frames; absent at the analytic level (it does not replay frames)", false, true},
         }};
     return block;

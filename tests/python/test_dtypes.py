@@ -28,10 +28,13 @@ def test_section_records_match_the_documented_layouts() -> None:
     assert RAY_DTYPE["origin"].shape == (3,)
     assert offsets(HIT_DTYPE) == {"prim": 0, "inst": 4, "t": 8, "u": 12, "v": 16}
     # WORK holds the traced work counters in declaration order, 4 bytes each; the model's own
-    # (the mailbox's) come after them and are never in a trace.
+    # (the mailbox's, a short stack's) come after them and are never in a trace.
     fields = rtsim._core.work_fields()
     names = [f["name"] for f in fields if f["traced"]]
-    assert [f["name"] for f in fields if not f["traced"]] == ["mailbox_lookups", "mailbox_hits"]
+    assert [f["name"] for f in fields if not f["traced"]] == [
+        "mailbox_lookups", "mailbox_hits", "stack_drops", "restarts", "restart_steps",
+        "restart_box_tests", "tlas_steps", "tlas_box_tests",
+    ]  # fmt: skip
     assert [f["name"] for f in fields][: len(names)] == names
     assert list(WORK_DTYPE.names or ()) == names
     assert WORK_DTYPE.itemsize == 4 * len(names)

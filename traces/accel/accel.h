@@ -57,6 +57,13 @@ public:
     /// docs/accel.md, "Mailboxes"). Hits never change; see WorkCounts for the counts.
     void set_mailbox(uint32_t entries) { m_mailbox_entries = entries; }
     uint32_t mailbox_entries() const { return m_mailbox_entries; }
+    /// True when the steppers can shadow a short stack with a restart trail (short_stack.h).
+    virtual bool supports_short_stack() const { return false; }
+    /// Short-stack entries per ray for the steppers from now on (0: a full stack, the default;
+    /// docs/accel.md, "Short stacks"). Hits and the reference work never change; the restarts'
+    /// work is counted in the model-only work fields. trace() always walks a full stack.
+    void set_short_stack(uint32_t entries) { m_short_stack_entries = entries; }
+    uint32_t short_stack_entries() const { return m_short_stack_entries; }
     /// True when some triangle is alpha-MASKed (the any-hit stage is then needed).
     bool has_anyhit_triangles() const;
     /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
@@ -73,6 +80,7 @@ protected:
     /// opened by structures that have a triangle region.
     TriangleStore m_triangles;
     uint32_t m_mailbox_entries = 0;
+    uint32_t m_short_stack_entries = 0;
 };
 
 /// How to build a structure: which kind, which builder for its tree, and the builder's config.

@@ -30,9 +30,18 @@
 // The mailbox's counts (docs/accel.md, "Mailboxes"): never in a trace (a trace's work is the
 // structure's without one). With a mailbox tri_tests counts the tests run, and
 // tri_tests + mailbox_hits equals the triangle tests without one.
+// A short stack's counts (docs/accel.md, "Short stacks"): the work its restarts add on top of
+// the full stack's, which the reference fields keep counting unchanged. The TLAS's share of a
+// two-level walk's steps and box tests (docs/accel.md, "Two-level structures").
 #define RTSIM_MODEL_WORK_FIELDS(X)                                                                  \
     X(mailbox_lookups, kNoOpKind, false, "primitive references looked up in the ray's mailbox")    \
-    X(mailbox_hits, kNoOpKind, false, "references found there: triangle neither fetched nor tested")
+    X(mailbox_hits, kNoOpKind, false, "references found there: triangle neither fetched nor tested") \
+    X(stack_drops, kNoOpKind, false, "short stack: oldest entries dropped by a push onto a full one") \
+    X(restarts, kNoOpKind, false, "short stack: restarts from the root (empty, entries dropped)")  \
+    X(restart_steps, kNoOpKind, true, "short stack: node steps a restart's re-descent revisited")  \
+    X(restart_box_tests, kNoOpKind, false, "short stack: box tests of those revisits")           \
+    X(tlas_steps, kNoOpKind, false, "two-level: the steps that walked the TLAS (also in steps)")    \
+    X(tlas_box_tests, kNoOpKind, false, "two-level: their box tests (also in box_tests)")
 
 #define RTSIM_ALL_WORK_FIELDS(X) RTSIM_WORK_FIELDS(X) RTSIM_MODEL_WORK_FIELDS(X)
 
@@ -66,6 +75,14 @@ struct WorkCounts {
         WorkCounts w = *this;
         w.tri_tests += mailbox_hits;
         w.mailbox_lookups = w.mailbox_hits = 0;
+        return w;
+    }
+    /// What a trace records for the same traversal: without the mailbox, without a short
+    /// stack's restarts (their work is on top of the full stack's) and the TLAS's share.
+    WorkCounts traced() const {
+        WorkCounts w = without_mailbox();
+        w.stack_drops = w.restarts = w.restart_steps = w.restart_box_tests = 0;
+        w.tlas_steps = w.tlas_box_tests = 0;
         return w;
     }
 };

@@ -57,7 +57,35 @@ def cmd_sweep(args: argparse.Namespace, console: Console) -> int:
     )
     outcome = run_sweep(spec, opts, console)
     print_outcome(outcome, opts.out_dir, console)
+    if args.check_front:
+        print_front_check(opts.out_dir, args, console)
     return 0 if outcome.failed == 0 and outcome.mismatch == 0 else 1
+
+
+def print_front_check(out: Path, args: argparse.Namespace, console: Console) -> None:
+    """Re-runs the front designs' verdicts and prints estimated against measured gains."""
+    import os
+
+    from rich.table import Table
+
+    from rtsim.sweep.front_check import check_front, pct
+
+    workers = args.workers or os.cpu_count() or 1
+    rows = check_front(out, workers=workers, timeout=args.timeout)
+    table = Table(title="Pareto front: the verdict's knob, estimated against measured")
+    for col in ("design", "named knob", "estimated", "measured", "best measured"):
+        table.add_column(col)
+    for r in rows:
+        design = f"{r['scene']} {r['workload']} {r['accel']} " + " ".join(
+            f"{k}={v}" for k, v in r["params"].items() if k != "accel"
+        )
+        if "error" in r:
+            table.add_row(design, r["error"], "", "", "")
+            continue
+        best = f"{r['best']} {pct(r['best_measured'])}"
+        table.add_row(design, r["named"], pct(r["estimated"]), pct(r["measured"]), best)
+    console.print(table)
+    console.print(f"front check: {len(rows)} designs -> {out / 'front_check.json'}")
 
 
 def cmd_results(args: argparse.Namespace, console: Console) -> int:
@@ -177,6 +205,13 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
     )
     p.add_argument("--retry-failed", action="store_true", help="re-run runs recorded as failed")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--check-front",
+        action="store_true",
+        help="then re-run each Pareto-front design's verdict (rtsim-sim --check-verdict): the "
+        "named knob's estimated against measured gain, and the best measured one "
+        "(SWEEP/front_check.json)",
+    )
     p.set_defaults(func=cmd_sweep)
 
     p = sub.add_parser(

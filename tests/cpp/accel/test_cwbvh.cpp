@@ -124,7 +124,9 @@ TEST(Cwbvh, SameTopologyAsTheFp32TwinAndNeverLessWorkOnMisses) {
         const Region &ta = test::triangles_of(*a), &tb = test::triangles_of(*b);
         ASSERT_EQ(ta.size_bytes(), tb.size_bytes());
         EXPECT_EQ(std::memcmp(ta.bytes.data(), tb.bytes.data(), ta.size_bytes()), 0);
-        EXPECT_EQ(a->image().stats["sah_cost"], b->image().stats["sah_cost"]);
+        // The same tree's cost with exact boxes; the quantised boxes cost more (SahCostCounts...).
+        EXPECT_EQ(a->image().stats["sah_cost"], b->image().stats["sah_cost_exact_boxes"]);
+        EXPECT_GT(double(b->image().stats["sah_cost"]), double(a->image().stats["sah_cost"]));
         Rng rng(7);
         uint64_t misses = 0, steps[2] = {}, tris[2] = {}, all_steps[2] = {}, all_tris[2] = {};
         for (int i = 0; i < 20000; ++i) {
@@ -263,6 +265,20 @@ TEST(Cwbvh, CorruptImagesAreRefusedByName) {
     AccelImage wrong_size = good4;
     wrong_size.region("nodes").record_bytes = 64;
     expect(test::error_of([&] { load_accel(std::move(wrong_size), "w.rtt"); }), "w.rtt: bvh4 regions must hold 128-byte nodes");
+}
+
+// The compressed images' SAH cost is computed from the boxes the node step tests (dequantised
+// outward): above the fp32 twin's, which uses the exact boxes of the same tree, and the exact
+// figure is kept beside it.
+TEST(Cwbvh, SahCostCountsTheQuantisedBoxes) {
+    const Scene scene = test::random_soup(4, 3000);
+    for (const auto& [fp32, compressed] : {std::pair{"bvh8", "cwbvh8"}, std::pair{"bvh6", "cwbvh6"}}) {
+        const auto a = test::build_kind(scene, fp32), b = test::build_kind(scene, compressed);
+        const double exact = a->image().stats["sah_cost"], quantised = b->image().stats["sah_cost"];
+        EXPECT_DOUBLE_EQ(double(b->image().stats["sah_cost_exact_boxes"]), exact) << compressed;
+        EXPECT_GT(quantised, exact * 1.001) << compressed;
+        EXPECT_LT(quantised, exact * 2.0) << compressed;
+    }
 }
 
 }  // namespace

@@ -104,7 +104,8 @@ TEST(TraceRecords, WorkRecordIsTheDeclaredFieldsInOrder) {
         EXPECT_EQ(w.*kWorkFields[i].member, 10 + i) << kWorkFields[i].name;
     }
     EXPECT_EQ(w.steps, 10u);
-    EXPECT_EQ(w.mailbox_hits, 10u + kWorkFields.size() - 1);
+    EXPECT_EQ(w.mailbox_hits, 10u + uint32_t(WorkField::mailbox_hits));
+    EXPECT_EQ(w.*kWorkFields.back().member, 10u + kWorkFields.size() - 1);
     // The record holds the traced fields, in order; the model's own (the mailbox's) follow them
     // in WorkCounts and never reach a trace.
     EXPECT_EQ(sizeof(WorkRecord), kTracedWorkFieldCount * sizeof(uint32_t));

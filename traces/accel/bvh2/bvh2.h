@@ -50,6 +50,7 @@ public:
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return kTraversalStackSize; }
+    bool supports_short_stack() const override { return true; }
     const Bvh2View& view() const { return m_view; }
 
 private:

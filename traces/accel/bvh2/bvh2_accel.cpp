@@ -176,7 +176,9 @@ Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::m
     validate_bvh2(m_view, source);
 }
 
-std::unique_ptr<Stepper> Bvh2Accel::make_stepper() const { return std::make_unique<Bvh2Stepper>(m_view); }
+std::unique_ptr<Stepper> Bvh2Accel::make_stepper() const {
+    return std::make_unique<Bvh2Stepper>(m_view, m_short_stack_entries);
+}
 
 Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
     return trace_bvh2(m_view, ray, mode, work);

@@ -28,6 +28,8 @@ void Bvh2Stepper::begin(const Ray& ray, TraversalMode mode) {
     m_hit = Hit{};
     m_work = WorkCounts{};
     m_stack_size = 0;
+    m_depth = 0;
+    m_short.begin();
     if (!ray_is_valid(ray) || m_view.node_count == 0) {
         finish();
         return;
@@ -62,7 +64,9 @@ void Bvh2Stepper::plan_next() {
 StepOutcome Bvh2Stepper::execute() {
     StepOutcome out;
     if (m_plan.done) return out;
-    if (m_count == 0) {
+    if (m_short.replaying()) {
+        replay_step();
+    } else if (m_count == 0) {
         visit_node(m_view.nodes[m_ref]);
     } else {
         out.add_op(OpKind::anyhit, visit_leaf(m_view.triangles + m_ref));
@@ -72,8 +76,17 @@ StepOutcome Bvh2Stepper::execute() {
 
 void Bvh2Stepper::visit_node(const HwNode& node) {
     // Nearer child next (child 0 on equal entry distances); the farther one pushed.
+    const int before = m_stack_size;
+    if (m_short.enabled()) m_short.visit(m_ref, m_depth);
     if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count))
         return pop_next();
+    if (m_short.enabled()) {
+        if (m_stack_size > before) {
+            m_entry_depth[m_stack_size - 1] = m_depth + 1;
+            if (m_short.push()) m_work.stack_drops += 1;
+        }
+        m_depth += 1;
+    }
     plan_next();
 }
 
@@ -92,16 +105,46 @@ uint32_t Bvh2Stepper::visit_leaf(const HwTriangle* triangles) {
 }
 
 void Bvh2Stepper::pop_next() {
-    // Entries entered beyond the (widened) best hit are dropped without a fetch.
+    // Entries entered beyond the (widened) best hit are dropped without a fetch. With a short
+    // stack, reaching an entry it dropped means a restart (short_stack.h).
+    bool restart = false;
     while (m_stack_size > 0) {
         const detail::Bvh2StackEntry& e = m_stack[--m_stack_size];
+        if (m_short.enabled()) restart |= m_short.pop();
         if (e.tnear > m_cull_t) continue;
         m_ref = e.ref;
         m_count = e.count;
+        if (m_short.enabled()) m_depth = m_entry_depth[m_stack_size];
+        if (restart) return begin_restart(m_depth, true);
         plan_next();
         return;
     }
+    if (restart) return begin_restart(0, false);
     finish();
+}
+
+void Bvh2Stepper::begin_restart(uint32_t depth, bool resume) {
+    m_work.restarts += 1;
+    m_short.restart(depth, uint32_t(m_stack_size));
+    m_resume = resume;
+    plan_replay();
+}
+
+void Bvh2Stepper::plan_replay() {
+    const uint32_t node = m_short.replay_node();
+    m_plan.reset(node);
+    m_plan.add_fetch(m_view.node_base + uint64_t(node) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+    m_plan.add_op(OpKind::box, 2);
+}
+
+void Bvh2Stepper::replay_step() {
+    // A revisit re-tests the node's child boxes to follow the trail; the walk's state is unchanged.
+    m_work.restart_steps += 1;
+    m_work.restart_box_tests += 2;
+    m_short.replay_advance();
+    if (m_short.replaying()) plan_replay();
+    else if (m_resume) plan_next();
+    else finish();
 }
 
 void Bvh2Stepper::finish() {

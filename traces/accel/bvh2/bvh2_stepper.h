@@ -8,10 +8,14 @@
 // Steps: a node step fetches one 64-byte HwNode and runs 2 box tests (locality key: the node);
 // a leaf step fetches its HwTriangles (contiguous) and runs one triangle test each, plus an
 // alpha test for each MASK triangle hit (reported by execute()).
+//
+// With a short stack (set by the Accel; traces/accel/short_stack.h) a restart's re-descent adds
+// node steps of the same shape, counted in the model-only restart fields.
 #include <cstdint>
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
 #include "traces/accel/leaf_blocks.h"
+#include "traces/accel/short_stack.h"
 #include "traces/accel/stepper.h"
 #include "traces/bvh/hw_layout.h"
 #include "traces/isect/ray_box.h"
@@ -31,7 +35,9 @@ struct Bvh2View {
 
 class Bvh2Stepper final : public Stepper {
 public:
-    explicit Bvh2Stepper(const Bvh2View& view) : m_view(view) {}
+    explicit Bvh2Stepper(const Bvh2View& view, uint32_t short_stack_entries = 0) : m_view(view) {
+        m_short.configure(short_stack_entries);
+    }
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
@@ -41,6 +47,9 @@ private:
     uint32_t visit_leaf(const HwTriangle* triangles);
     void pop_next();
     void plan_next();
+    void begin_restart(uint32_t depth, bool resume);
+    void plan_replay();  ///< the next node a short stack's restart revisits
+    void replay_step();
     void finish();  ///< the plan is done; a ray without a hit reports Hit{} (t = +inf)
 
     Bvh2View m_view;
@@ -50,6 +59,11 @@ private:
     uint32_t m_ref = 0;     ///< node index, or first triangle of a leaf
     uint32_t m_count = 0;   ///< 0: m_ref is a node; else the leaf's triangle count
     detail::Bvh2StackEntry m_stack[kTraversalStackSize];
+    // Short stack only: the current node's depth, each entry's depth, and the shadow.
+    uint32_t m_depth = 0;
+    bool m_resume = false;  ///< after the re-descent: m_ref/m_count (true) or the end (false)
+    uint32_t m_entry_depth[kTraversalStackSize];
+    ShortStack m_short;
 };
 
 }  // namespace rtsim

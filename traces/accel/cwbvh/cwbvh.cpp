@@ -68,7 +68,37 @@ void write_node(const WideBuildTree& tree, const WideOrder& o, uint32_t b, Node&
     }
 }
 
+/// Half the surface area of decoded slot s, in double.
+double slot_area(const DecodedNode& d, int s) {
+    const double x = double(d.hi[0][s]) - d.lo[0][s], y = double(d.hi[1][s]) - d.lo[1][s],
+                 z = double(d.hi[2][s]) - d.lo[2][s];
+    return x * y + y * z + z * x;
+}
+
+template <class Codec>
+double sah_of_nodes(const Region& nodes, const Aabb& root, float ct, float ci) {
+    const glm::dvec3 e = glm::dvec3(root.hi) - glm::dvec3(root.lo);
+    const double root_area = e.x * e.y + e.y * e.z + e.z * e.x;
+    auto weight = [&](double a) { return root_area > 0.0 ? a / root_area : 1.0; };
+    double cost = nodes.count ? double(ct) : 0.0;  // the root, always visited
+    DecodedNode d;
+    for (uint64_t i = 0; i < nodes.count; ++i) {
+        Codec::decode(nodes.records<typename Codec::Node>()[i], d);
+        for (int s = 0; s < Codec::kWidth; ++s)
+            if (d.valid >> s & 1u)
+                cost += (d.count[s] ? double(ci) * d.count[s] : double(ct)) * weight(slot_area(d, s));
+    }
+    return cost;
+}
+
 }  // namespace
+
+double cwbvh_sah_cost(const AccelImage& image, float traversal_cost, float intersection_cost) {
+    const Region& nodes = image.region("nodes");
+    if (nodes.record_bytes == sizeof(CwNode8))
+        return sah_of_nodes<Cw8Codec>(nodes, image.bounds, traversal_cost, intersection_cost);
+    return sah_of_nodes<Cw6Codec>(nodes, image.bounds, traversal_cost, intersection_cost);
+}
 
 AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std::string& kind, ChildOrder order) {
     require(tree.width == 8 || tree.width == 6, "cwbvh: no compressed layout of width " + std::to_string(tree.width));

@@ -84,6 +84,12 @@ using Cw6Codec = CwCodec<CwNode6, 6>;
 /// than 2^28 nodes or triangles.
 AccelImage cwbvh_image(const WideBuildTree& tree, const Scene& scene, const std::string& kind, ChildOrder order);
 
+/// SAH cost of a compressed image (from cwbvh_image) as the hardware sees it: C_t per node and
+/// C_i per triangle, each weighted by the area of the box its parent stores for it, dequantised
+/// outward as the node step tests it (relative to the root's area). The wide tree's
+/// wide_sah_cost() uses the exact boxes; the quantised ones are larger, so this is higher.
+double cwbvh_sah_cost(const AccelImage& image, float traversal_cost, float intersection_cost);
+
 /// The fused reference loop of cwbvh8 images in distance order (cwbvh_trace.cpp): SIMD decoding
 /// of each node's child boxes, the hits and work of WideStepper<Cw8Codec>. Needs view.valid.
 Hit trace_cwbvh8_fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work,

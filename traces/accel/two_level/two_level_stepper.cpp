@@ -62,6 +62,8 @@ StepOutcome TwoLevelStepper::execute() {
 
 void TwoLevelStepper::visit_node(const HwNode& node) {
     // The binary BVH's node step (bvh2_kernel.h): nearer child next, the farther pushed.
+    m_work.tlas_steps += 1;  // the TLAS's share of steps and box tests (descend counts both)
+    m_work.tlas_box_tests += 2;
     if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_tlas_size, &m_ref, &m_count))
         return pop_next();
     plan_tlas();

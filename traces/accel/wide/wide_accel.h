@@ -143,7 +143,10 @@ public:
         m_view.valid = m_valid.data();
     }
 
-    std::unique_ptr<Stepper> make_stepper() const override { return std::make_unique<WideStepper<Codec>>(m_view); }
+    std::unique_ptr<Stepper> make_stepper() const override {
+        return std::make_unique<WideStepper<Codec>>(m_view, m_short_stack_entries);
+    }
+    bool supports_short_stack() const override { return true; }
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override {
         if constexpr (Codec::kFused) {
             if (m_view.order == ChildOrder::distance) return Codec::fused(m_view, ray, mode, work);

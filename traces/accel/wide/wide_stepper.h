@@ -9,11 +9,14 @@
 // fetches the leaf's triangles (contiguous) and runs one triangle test each, plus an alpha test
 // for each MASK triangle hit. Popped entries entered beyond the best hit are dropped unfetched.
 // Hit rules, cull distance and any-hit termination are every structure's (leaf_kernel.h).
+// With a short stack (set by the Accel; traces/accel/short_stack.h) a restart's re-descent adds
+// node steps of the same shape, counted in the model-only restart fields.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "traces/accel/leaf_blocks.h"
+#include "traces/accel/short_stack.h"
 #include "traces/accel/stepper.h"
 #include "traces/accel/wide/wide_kernel.h"
 #include "traces/common/error.h"
@@ -41,7 +44,11 @@ struct WideView {
 template <class Codec>
 class WideStepper final : public Stepper {
 public:
-    explicit WideStepper(const WideView& view) : m_view(view), m_stack(std::max<uint32_t>(1, view.max_stack)) {}
+    explicit WideStepper(const WideView& view, uint32_t short_stack_entries = 0)
+        : m_view(view), m_stack(std::max<uint32_t>(1, view.max_stack)) {
+        m_short.configure(short_stack_entries);
+        if (m_short.enabled()) m_entry_depth.resize(m_stack.size());
+    }
 
     void begin(const Ray& ray, TraversalMode mode) override {
         m_ray = ray;
@@ -49,6 +56,8 @@ public:
         m_hit = Hit{};
         m_work = WorkCounts{};
         m_stack_size = 0;
+        m_depth = 0;
+        m_short.begin();
         if (!ray_is_valid(ray) || m_view.node_count == 0) return finish();
         m_box = ray_box_precompute(ray);
         m_tri = ray_triangle_precompute(ray);
@@ -63,7 +72,8 @@ public:
     StepOutcome execute() override {
         StepOutcome out;
         if (m_plan.done) return out;
-        if (m_count == 0) visit_node(node(m_ref));
+        if (m_short.replaying()) replay_step();
+        else if (m_count == 0) visit_node(node(m_ref));
         else out.add_op(OpKind::anyhit, visit_leaf());
         return out;
     }
@@ -74,11 +84,15 @@ private:
         return *reinterpret_cast<const Node*>(m_view.nodes + uint64_t(i) * Codec::kBytes);
     }
 
+    void plan_node(uint32_t i) {
+        m_plan.reset(i);
+        m_plan.add_fetch(m_view.node_base + uint64_t(i) * Codec::kBytes, Codec::kBytes, DataKind::node);
+        m_plan.add_op(OpKind::box, detail::popcount8(Codec::valid_mask(node(i))));
+    }
+
     void plan_next() {
         if (m_count == 0) {
-            m_plan.reset(m_ref);
-            m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * Codec::kBytes, Codec::kBytes, DataKind::node);
-            m_plan.add_op(OpKind::box, detail::popcount8(Codec::valid_mask(node(m_ref))));
+            plan_node(m_ref);
         } else {
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
             const TriangleAddressing::Span s = m_view.tri_at.span(m_ref, m_count);
@@ -96,12 +110,18 @@ private:
         const uint32_t mask = detail::wide_box_tests(m_box, d, m_ray.tmin, m_cull_t, tnear);
         uint8_t order[kMaxWideWidth];
         const int hits = detail::order_children(mask, tnear, m_view.order, m_octant, order);
+        if (m_short.enabled()) m_short.visit(m_ref, m_depth);
         if (hits == 0) return pop_next();
         for (int i = hits - 1; i >= 1; --i) {
             if (uint32_t(m_stack_size) >= m_stack.size())
                 throw Error("wide BVH: traversal stack overflow (" + std::to_string(m_stack.size()) + " entries)");
+            if (m_short.enabled()) {
+                m_entry_depth[size_t(m_stack_size)] = m_depth + 1;
+                if (m_short.push()) m_work.stack_drops += 1;
+            }
             m_stack[size_t(m_stack_size++)] = {d.ref[order[i]], d.count[order[i]], tnear[order[i]]};
         }
+        m_depth += 1;
         m_ref = d.ref[order[0]];
         m_count = d.count[order[0]];
         plan_next();
@@ -122,14 +142,37 @@ private:
     }
 
     void pop_next() {
+        // With a short stack, reaching an entry it dropped means a restart (short_stack.h).
+        bool restart = false;
         while (m_stack_size > 0) {
             const WideStackEntry& e = m_stack[size_t(--m_stack_size)];
+            if (m_short.enabled()) restart |= m_short.pop();
             if (e.tnear > m_cull_t) continue;
             m_ref = e.ref;
             m_count = e.count;
+            if (m_short.enabled()) m_depth = m_entry_depth[size_t(m_stack_size)];
+            if (restart) return begin_restart(m_depth, true);
             return plan_next();
         }
+        if (restart) return begin_restart(0, false);
         finish();
+    }
+
+    void begin_restart(uint32_t depth, bool resume) {
+        m_work.restarts += 1;
+        m_short.restart(depth, uint32_t(m_stack_size));
+        m_resume = resume;
+        plan_node(m_short.replay_node());
+    }
+
+    void replay_step() {
+        // A revisit re-tests the node's child boxes to follow the trail; the walk is unchanged.
+        m_work.restart_steps += 1;
+        m_work.restart_box_tests += detail::popcount8(Codec::valid_mask(node(m_short.replay_node())));
+        m_short.replay_advance();
+        if (m_short.replaying()) plan_node(m_short.replay_node());
+        else if (m_resume) plan_next();
+        else finish();
     }
 
     void finish() {
@@ -145,6 +188,11 @@ private:
     uint32_t m_ref = 0;    ///< node index, or first triangle of a leaf
     uint32_t m_count = 0;  ///< 0: m_ref is a node; else the leaf's triangle count
     std::vector<WideStackEntry> m_stack;
+    // Short stack only: the current node's depth, each entry's depth, and the shadow.
+    uint32_t m_depth = 0;
+    bool m_resume = false;  ///< after the re-descent: m_ref/m_count (true) or the end (false)
+    std::vector<uint32_t> m_entry_depth;
+    ShortStack m_short;
 };
 
 }  // namespace rtsim

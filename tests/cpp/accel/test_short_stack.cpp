@@ -1,0 +1,81 @@
+// Short stacks with a restart trail (traces/accel/short_stack.h): on every BVH kind and any stack
+// size, every ray keeps its hit bit for bit and its reference work exactly (the restarts' work is
+// counted only in the model's own fields), the plans ask for exactly the work counted (revisits
+// included), a stack as deep as the structure can need never restarts, and a short stack on a
+// deep scene does restart.
+#include <gtest/gtest.h>
+
+#include "accel_test_util.h"
+#include "structure_test_util.h"
+
+namespace rtsim {
+namespace {
+
+struct Totals {
+    uint64_t drops = 0, restarts = 0, restart_steps = 0, steps = 0;
+};
+
+/// Checks every ray of `rays` (both modes) against the full stack; returns the restarts' totals.
+Totals check_short_stack(Accel& accel, uint32_t entries, const std::vector<Ray>& rays, const std::string& what) {
+    accel.set_short_stack(0);
+    std::unique_ptr<Stepper> full = accel.make_stepper();
+    accel.set_short_stack(entries);
+    std::unique_ptr<Stepper> shortened = accel.make_stepper();
+    accel.set_short_stack(0);
+    Totals t;
+    int diffs = 0;
+    for (const Ray& r : rays)
+        for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+            WorkCounts want, got;
+            const Hit hw = trace_with_stepper(*full, r, mode, &want);
+            const WorkCounts planned = test::tally_plans(*shortened, r, mode);
+            got = shortened->work();
+            const Hit hg = shortened->hit();
+            // The plans show revisits as node steps with box tests.
+            WorkCounts folded = got;
+            folded.steps += got.restart_steps;
+            folded.box_tests += got.restart_box_tests;
+            const bool ok = test::same_hit(hg, hw, TraversalMode::closest_hit) && got.traced() == want &&
+                            planned == folded.traced() && got.restart_steps >= got.restarts;
+            if (!ok && ++diffs <= 3)
+                ADD_FAILURE() << what << ": mode " << int(mode) << " hit " << hg.prim << "/" << hw.prim << " steps "
+                              << got.steps << "/" << want.steps << " restarts " << got.restarts;
+            t.drops += got.stack_drops;
+            t.restarts += got.restarts;
+            t.restart_steps += got.restart_steps;
+            t.steps += got.steps;
+        }
+    EXPECT_EQ(diffs, 0) << what;
+    return t;
+}
+
+TEST(ShortStack, ChangesNoHitNorReferenceWorkAndRestartsOnlyWhenShort) {
+    const Scene soup = test::random_soup(5, 3000);
+    for (const char* scene_name : {"soup", "hairball"}) {
+        const Scene& scene = std::string(scene_name) == "soup" ? soup : test::procedural(scene_name);
+        const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 7, 1500);
+        for (const std::string kind : {"bvh2", "bvh4", "bvh8", "cwbvh8"}) {
+            const auto accel = test::build_kind(scene, kind);
+            ASSERT_TRUE(accel->supports_short_stack()) << kind;
+            const std::string what = std::string(scene_name) + " " + kind;
+            const Totals one = check_short_stack(*accel, 1, rays, what + " 1 entry");
+            const Totals four = check_short_stack(*accel, 4, rays, what + " 4 entries");
+            const Totals deep = check_short_stack(*accel, accel->max_stack_entries(), rays, what + " deepest");
+            EXPECT_GT(one.restarts, 0u) << what;
+            EXPECT_GT(one.drops, 0u) << what;
+            EXPECT_GE(one.restart_steps, four.restart_steps) << what;
+            EXPECT_EQ(deep.restarts, 0u) << what;
+            EXPECT_EQ(deep.drops, 0u) << what;
+            EXPECT_EQ(deep.restart_steps, 0u) << what;
+        }
+    }
+}
+
+TEST(ShortStack, OtherStructuresDoNotOfferIt) {
+    const Scene scene = test::random_soup(3, 500);
+    for (const std::string kind : {"grid", "kdtree", "octree", "bih"})
+        EXPECT_FALSE(test::build_kind(scene, kind)->supports_short_stack()) << kind;
+}
+
+}  // namespace
+}  // namespace rtsim
