@@ -14,7 +14,8 @@ reference packet loop) and writes:
 - a figure (--figure, e.g. docs/execution_models_packets.png).
 
     python scripts/execution_models_packets.py --out out/execution_models \\
-        [--resolution 96x72] [--doc docs/execution_models.md] [--figure docs/execution_models_packets.png]
+        [--resolution 96x72] [--doc docs/execution_models.md] \\
+        [--figure docs/execution_models_packets.png] [--replot]
 """
 
 from __future__ import annotations
@@ -29,10 +30,10 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from execution_models_study import BLOCK, CONTEXTS, KINDS, SCENES, trace  # noqa: E402
+from execution_models_study import BLOCK, CONTEXTS, KINDS, SCENES, trace
 
-from rtsim.doc_markers import write_between  # noqa: E402
-from rtsim.launcher import SimJob, run_sim  # noqa: E402
+from rtsim.doc_markers import write_between
+from rtsim.launcher import SimJob, run_sim
 
 SORT = "origin_direction"
 #: (label, accel, model, lanes, split_below, sort)
@@ -61,7 +62,9 @@ def run(folder: Path, config: tuple, args: argparse.Namespace) -> dict[str, Any]
     st = result.stats
     s = st["summary"]
     units = list(st["model"]["units"].values())
-    tests = {k: sum(p["tests"] for p in st["model"].get(k, {}).values()) for k in ("box", "triangle")}
+    tests = {
+        k: sum(p["tests"] for p in st["model"].get(k, {}).values()) for k in ("box", "triangle")
+    }
     packets = sum(u.get("packets", 0) for u in units)
     return {
         "trace": folder.name.replace("_bvh8", ""),
@@ -83,7 +86,9 @@ def run(folder: Path, config: tuple, args: argparse.Namespace) -> dict[str, Any]
         "node_fetches_per_packet": (
             sum(u["packet_node_fetches"] for u in units) / packets if packets else None
         ),
-        "split_packets": sum(u.get("packet_splits", 0) for u in units) / packets if packets else None,
+        "split_packets": sum(u.get("packet_splits", 0) for u in units) / packets
+        if packets
+        else None,
         "box_tests_per_ray": tests["box"] / s["rays"],
         "tri_tests_per_ray": tests["triangle"] / s["rays"],
         "hit_mismatches": s["hit_mismatches"],
@@ -102,8 +107,9 @@ def table(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
         f"Measured {datetime.date.today().isoformat()} on {platform.node()} ({os.cpu_count()} "
         f"cores) by `python scripts/execution_models_packets.py --resolution {args.resolution}`: "
         "one `rtsim-sim` run per row at the approx level (deterministic), the machine above (8 "
-        f"units x {CONTEXTS} ray contexts: {CONTEXTS} // lanes packets per unit), binary BVH unless "
-        "named; hybrid 16 splits below 0.5 of the packet's rays, hybrid 64 below 0.25; sort = "
+        f"units x {CONTEXTS} ray contexts: {CONTEXTS} // lanes packets per unit), binary BVH "
+        "unless named; hybrid 16 splits below 0.5 of the packet's rays, hybrid 64 below 0.25; "
+        "sort = "
         f"`dispatch.sort={SORT}`. {len(rows)} runs, {mismatches} hit and work mismatches in all "
         "(packet work checked against the reference packet loop). Speed-up: against MIMD on the "
         "binary BVH, same trace. Occupancy: active rays per packet step (SIMD eff. = occupancy / "
@@ -134,7 +140,9 @@ def trends(rows: list[dict[str, Any]]) -> str:
     def speed(trace: str, cfg: str, base: str = "MIMD") -> str:
         if (trace, cfg) not in by or (trace, base) not in by:
             return "-"
-        return f"{by[(trace, cfg)]['mrays_per_second'] / by[(trace, base)]['mrays_per_second']:.2f}x"
+        return (
+            f"{by[(trace, cfg)]['mrays_per_second'] / by[(trace, base)]['mrays_per_second']:.2f}x"
+        )
 
     def eff(trace: str, cfg: str) -> str:
         return fmt(by[(trace, cfg)]["simd_efficiency"], ".2f") if (trace, cfg) in by else "-"
@@ -177,7 +185,13 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     for i, cfg in enumerate(configs):
         xs = [t + (i - (len(configs) - 1) / 2) * width for t in range(len(traces))]
         by = {r["trace"]: r for r in rows if r["config"] == cfg}
-        top.bar(xs, [by[t]["mrays_per_second"] / base[t] for t in traces], width, label=cfg, color=colors(i))
+        top.bar(
+            xs,
+            [by[t]["mrays_per_second"] / base[t] for t in traces],
+            width,
+            label=cfg,
+            color=colors(i),
+        )
         if by[traces[0]]["simd_efficiency"] is not None:
             bottom.bar(xs, [by[t]["simd_efficiency"] for t in traces], width, color=colors(i))
     top.axhline(1.0, color="black", linewidth=0.8)
@@ -202,13 +216,27 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--resolution", default="64x48")
     p.add_argument("--doc", type=Path, help="write the tables into this file's markers")
     p.add_argument("--figure", type=Path, help="write the figure here (PNG)")
-    p.add_argument("--replot", action="store_true", help="redraw from OUT/execution_models_packets.json")
+    p.add_argument(
+        "--replot",
+        action="store_true",
+        help="tables and figure from OUT/execution_models_packets.json",
+    )
     args = p.parse_args(argv)
     data = args.out / "execution_models_packets.json"
-    if args.replot:
-        if args.figure:
-            plot(json.loads(data.read_text()), args.figure)
-        return 0
+    rows = json.loads(data.read_text()) if args.replot else measure(args)
+    text, trend_text = table(rows, args), trends(rows)
+    print(text)
+    print(trend_text)
+    if args.doc:
+        write_between(args.doc, "execution-models-packets", text)
+        write_between(args.doc, "execution-models-packet-trends", trend_text)
+    if args.figure:
+        plot(rows, args.figure)
+    return 0
+
+
+def measure(args: argparse.Namespace) -> list[dict[str, Any]]:
+    """Every configuration on every trace; the rows also go to OUT/execution_models_packets.json."""
     args.out.mkdir(parents=True, exist_ok=True)
     scenes_dir = Path(os.environ.get("RTSIM_SCENES", ""))
     rows = []
@@ -226,16 +254,8 @@ def main(argv: list[str] | None = None) -> int:
                 row["trace"] = f"{label}_{kind}"
                 rows.append(row)
                 print(json.dumps(rows[-1]), file=sys.stderr)
-    data.write_text(json.dumps(rows, indent=2))
-    text, trend_text = table(rows, args), trends(rows)
-    print(text)
-    print(trend_text)
-    if args.doc:
-        write_between(args.doc, "execution-models-packets", text)
-        write_between(args.doc, "execution-models-packet-trends", trend_text)
-    if args.figure:
-        plot(rows, args.figure)
-    return 0
+    (args.out / "execution_models_packets.json").write_text(json.dumps(rows, indent=2))
+    return rows
 
 
 if __name__ == "__main__":

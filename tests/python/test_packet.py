@@ -1,8 +1,8 @@
 """Packets (traversal.model=packet, Wald et al. 2001): every hit identical to single-ray
 traversal and every ray's work equal to the reference packet loop's, at every timed level and
-functional, with and without sorting and with the hybrid's split into single rays; occupancy exactly 1 when every ray of a packet is the same
-ray; one node fetch serves a packet; lanes' cycles accounted; structures without a packet kernel
-and bad settings refused, naming the field."""
+functional, with and without sorting and with the hybrid's split into single rays; occupancy
+exactly 1 when every ray of a packet is the same ray; one node fetch serves a packet; lanes'
+cycles accounted; structures without a packet kernel and bad settings refused, naming the field."""
 
 from __future__ import annotations
 
@@ -76,7 +76,9 @@ def test_packet_hits_and_work_match_the_reference(
         assert u["packet_active_histogram"][0] == 0  # a step always has a ray in it
         assert u["packet_occupancy"] == pytest.approx(u["active_lanes"] / u["packet_steps"])
         assert u["packets"] * lanes >= u["rays"] > (u["packets"] - 1) * 1
-        assert u["node_fetches_per_packet"] == pytest.approx(u["packet_node_fetches"] / u["packets"])
+        assert u["node_fetches_per_packet"] == pytest.approx(
+            u["packet_node_fetches"] / u["packets"]
+        )
         if "traversal.stack_entries=2" in sets:
             assert u["stack_spill_writes"] > 0
         split = any(x.startswith("traversal.packet_split_below") for x in sets)
@@ -90,11 +92,16 @@ def test_packet_hits_and_work_match_the_reference(
 
 def test_packets_share_node_fetches(sim_exe: Path, cornell_trace: Path, tmp_path: Path) -> None:
     """A packet's node step is one fetch: far fewer node reads than single rays make."""
-    mimd = sim_stats(sim_exe, cornell_trace / "trace.rtt", tmp_path / "mimd", "traversal.ray_contexts=64")
-    pk = sim_stats(sim_exe, cornell_trace / "trace.rtt", tmp_path / "pk", *PACKET, "traversal.lanes=16")
-    node_reads = lambda st: sum(u["packet_node_fetches"] for u in st["model"]["units"].values())  # noqa: E731
-    single_steps = sum(u["steps"] for u in mimd["model"]["units"].values())  # 2 per step + 1 per ray
-    assert node_reads(pk) < single_steps / 2 / 4
+    mimd = sim_stats(
+        sim_exe, cornell_trace / "trace.rtt", tmp_path / "mimd", "traversal.ray_contexts=64"
+    )
+    pk = sim_stats(
+        sim_exe, cornell_trace / "trace.rtt", tmp_path / "pk", *PACKET, "traversal.lanes=16"
+    )
+    node_reads = sum(u["packet_node_fetches"] for u in pk["model"]["units"].values())
+    # A MIMD unit's scheduler steps: 2 per traversal step and 1 per ray.
+    single_steps = sum(u["steps"] for u in mimd["model"]["units"].values())
+    assert node_reads < single_steps / 2 / 4
     # Each ray's box tests are its own: packets never test fewer boxes than single rays.
     assert pk["summary"]["work_mismatches"] == 0
 
@@ -136,9 +143,15 @@ def test_packet_needs_a_packet_kernel(sim_exe: Path, tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("sets", "named"),
     [
-        (("traversal.model=packet", "traversal.packet_split_below=1.5"), "traversal.packet_split_below"),
+        (
+            ("traversal.model=packet", "traversal.packet_split_below=1.5"),
+            "traversal.packet_split_below",
+        ),
         (("traversal.model=packet", "traversal.lanes=2"), "traversal.lanes"),
-        (("traversal.model=packet", "traversal.ray_contexts=20", "traversal.lanes=16"), "traversal.ray_contexts"),
+        (
+            ("traversal.model=packet", "traversal.ray_contexts=20", "traversal.lanes=16"),
+            "traversal.ray_contexts",
+        ),
     ],
 )
 def test_bad_packet_settings_are_named(
