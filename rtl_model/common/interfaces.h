@@ -99,6 +99,12 @@ struct RayResult {
 class RaySinkIf : public virtual sc_core::sc_interface {
 public:
     virtual void ray_done(const RayResult& result) = 0;
+    /// A packet's rays finished together (traversal.model packet): results[i] is the ray traced
+    /// from rays[i] in modes[i]. The default hands each result to ray_done().
+    virtual void packet_done(const RayResult* results, const Ray* rays, const TraversalMode* modes, uint32_t n) {
+        (void)rays, (void)modes;
+        for (uint32_t i = 0; i < n; ++i) ray_done(results[i]);
+    }
 };
 
 }  // namespace rtsim

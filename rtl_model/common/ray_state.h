@@ -33,6 +33,8 @@ public:
     void release(std::unique_ptr<Stepper> s) {
         if (s) m_free.push_back(std::move(s));
     }
+    /// The structure the steppers walk (a packet unit makes packet steppers from it).
+    const Accel& accel() const { return m_accel; }
 
 private:
     const Accel& m_accel;

@@ -26,17 +26,16 @@ void validate_traversal_model(const ModelConfig& config) {
     require(config.dispatch.sort == RaySort::none || !config.treelets.enabled,
             "config: 'dispatch.sort' needs treelets.enabled false: the ray buffer takes rays from dispatch in its own "
             "order and reorders them by treelet itself");
-    require(t.model != UnitModel::packet,
-            "config: 'traversal.model' packet is not built yet (rays sharing one traversal stack need a packet "
-            "kernel in the reference tracer); use mimd or simt");
-    if (t.model != UnitModel::simt) return;
+    if (t.model == UnitModel::mimd) return;
+    const std::string model = kUnitModelChoices.name(t.model);
+    const char* group = t.model == UnitModel::simt ? "warps' lanes" : "packets' rays";
     require(t.ray_contexts % t.lanes == 0,
             "config: 'traversal.ray_contexts' (" + std::to_string(t.ray_contexts) + ") must be a multiple of "
-            "'traversal.lanes' (" + std::to_string(t.lanes) + ") with traversal.model simt: a unit's ray contexts "
-            "are its warps' lanes");
+            "'traversal.lanes' (" + std::to_string(t.lanes) + ") with traversal.model " + model +
+                ": a unit's ray contexts are its " + group);
     require(!config.treelets.enabled,
-            "config: 'treelets.enabled' is not supported with traversal.model simt (a warp's lanes would leave "
-            "for different treelets' queues); use traversal.model mimd");
+            "config: 'treelets.enabled' is not supported with traversal.model " + model + " (a group's rays would "
+            "leave for different treelets' queues); use traversal.model mimd");
 }
 
 }  // namespace

@@ -1,12 +1,15 @@
 #pragma once
 // Pieces every traversal unit kind shares, so no kind re-types them: temporal decoupling against
-// SystemC time, and moving a ray context's (or SIMT lane's) accounted cycles forward by use.
+// SystemC time, moving a ray context's (or SIMT lane's, or packet's) accounted cycles forward by
+// use and folding the rest of the run in as tail, the busy time, finishing a ray, and the stats
+// every kind writes alike.
 #include <algorithm>
 #include <cstdint>
 
 #include <systemc>
 
 #include "rtl_model/common/memory_map.h"
+#include "rtl_model/common/stats.h"
 #include "rtl_model/traversal/cycle_accounting.h"
 #include "rtl_model/traversal/step_demand.h"
 
@@ -45,6 +48,61 @@ inline void account_read_until(CycleAccount& account, Cycle& accounted, Cycle re
     account_memory(account, accounted, ready, info);
     accounted = ready;
 }
+
+/// The unit's account at the end of a run of `total` cycles: `account` plus, for each context
+/// (anything with an `accounted` cycle), its cycles after that as tail, `weight` ray contexts each
+/// (a packet holds `lanes`).
+template <class Contexts>
+CycleAccount with_tail(CycleAccount account, const Contexts& contexts, Cycle total, uint64_t weight = 1) {
+    for (const auto& c : contexts)
+        if (total > c.accounted) account.add(CycleUse::tail, (total - c.accounted) * weight);
+    return account;
+}
+
+/// Cycles with at least one ray in the unit: enter() when a context takes a ray, leave() when
+/// it gives it up.
+class BusyTime {
+public:
+    void enter(Cycle t) {
+        if (m_in++ == 0) m_since = t;
+    }
+    void leave(Cycle t) {
+        if (--m_in == 0) m_cycles += t - m_since;  // a busy interval ends (may restart now)
+    }
+    Cycle cycles() const { return m_cycles; }
+
+private:
+    uint64_t m_in = 0;
+    Cycle m_since = 0, m_cycles = 0;
+};
+
+/// What every unit kind counts alike, and the stats it writes from them.
+struct UnitTally {
+    uint64_t rays = 0, steps = 0, spill_writes = 0, spill_reads = 0, rejected = 0;
+    Cycle finish = 0;  ///< cycle the unit finished its last ray
+    BusyTime busy;
+
+    /// Ray `r` is done at r.end: its hit record is written back (posted) and it is counted. The
+    /// caller hands the result to the sink and tells the ray's source.
+    void finish_ray(MemIf& mem, const MemoryMap& map, const RayResult& r) {
+        mem.access({map.hit(r.id), sizeof(HitRecord), true, DataKind::hit, r.end});
+        ++rays;
+        finish = std::max(finish, r.end);
+    }
+    /// The keys every kind writes (unit_stats()).
+    void write(StatsWriter& w, const QuantumSync& sync, const CycleAccount& account, Cycle total_cycles) const {
+        w.set("rays", rays)
+            .set("steps", steps)
+            .set("busy_cycles", busy.cycles())
+            .set("busy_fraction", total_cycles ? double(busy.cycles()) / double(total_cycles) : 0.0)
+            .set("stack_spill_writes", spill_writes)
+            .set("stack_spill_reads", spill_reads)
+            .set("rejected_rays", rejected)
+            .set("quantum_syncs", sync.syncs())
+            .set("finish_cycle", finish)
+            .set("cycle_accounting", account.to_json());
+    }
+};
 
 /// A step's stack traffic (docs/model.md, "Traversal stack") for the spill slots of `owner`:
 /// entries beyond the on-chip stack written to memory (posted), spilled entries read back (the

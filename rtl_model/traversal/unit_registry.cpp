@@ -4,6 +4,7 @@
 #include <string>
 
 #include "rtl_model/traversal/mimd/mimd_unit.h"
+#include "rtl_model/traversal/packet/packet_unit.h"
 #include "rtl_model/traversal/simt/simt_unit.h"
 #include "traces/common/error.h"
 
@@ -22,7 +23,7 @@ std::unique_ptr<TraversalUnit> make(sc_core::sc_module_name name, const UnitSetu
 constexpr std::array<UnitFactory, kUnitModelChoices.names.size()> kFactories{{
     make<MimdUnit>,  // mimd
     make<SimtUnit>,  // simt
-    nullptr,         // packet: refused by validate_model (not built yet)
+    make<PacketUnit>,  // packet
 }};
 
 }  // namespace

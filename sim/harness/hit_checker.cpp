@@ -33,9 +33,27 @@ std::string compare_with_reference(const RayResult& r, const HitRecord& h, const
 HitChecker::HitChecker(sc_core::sc_module_name name, ReferenceSource& reference, uint64_t total, Progress progress)
     : sc_core::sc_module(name), m_reference(reference), m_total(total), m_progress(std::move(progress)) {}
 
-void HitChecker::ray_done(const RayResult& r) {
+void HitChecker::ray_done(const RayResult& r) { check(r, m_reference.hit(r.id), m_reference.work(r.id)); }
+
+void HitChecker::packet_done(const RayResult* results, const Ray* rays, const TraversalMode* modes, uint32_t n) {
+    if (!m_packet_reference) return RaySinkIf::packet_done(results, rays, modes, n);
+    std::vector<Hit> hits(n);
+    std::vector<WorkCounts> work(n);
+    m_packet_reference(rays, modes, n, hits.data(), work.data());
+    for (uint32_t i = 0; i < n; ++i) {
+        HitRecord want = m_reference.hit(results[i].id);
+        // An any-hit ray that agrees with the trace on occlusion must have the packet loop's hit.
+        if (modes[i] == TraversalMode::any_hit && (want.prim >= 0) == hits[i].valid()) {
+            want.prim = hits[i].prim;
+            want.t = hits[i].t;
+        }
+        check(results[i], want, WorkRecord::of(work[i]));
+    }
+}
+
+void HitChecker::check(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work) {
     bool hit_differs = false;
-    std::string diff = compare_with_reference(r, m_reference.hit(r.id), m_reference.work(r.id), &hit_differs);
+    std::string diff = compare_with_reference(r, ref_hit, ref_work, &hit_differs);
     if (!diff.empty()) {
         if (hit_differs) ++m_hit_mismatches;
         else ++m_work_mismatches;

@@ -24,6 +24,16 @@ public:
     HitChecker(sc_core::sc_module_name name, ReferenceSource& reference, uint64_t total, Progress progress = {});
 
     void ray_done(const RayResult& r) override;
+    /// With a packet reference, a packet's work is checked against the structure's reference packet
+    /// loop over the same rays (hits against the trace as ever; see set_packet_reference).
+    void packet_done(const RayResult* results, const Ray* rays, const TraversalMode* modes, uint32_t n) override;
+
+    /// The reference packet loop (Accel::trace_packet): each ray's hit and work when traced in
+    /// one packet with the others. Packets change the work a ray does, never its closest hit;
+    /// an any-hit ray may stop at another occluder than alone (visit order), so it is checked for
+    /// occlusion against the trace and for its primitive against the packet loop.
+    using PacketReference = std::function<void(const Ray*, const TraversalMode*, uint32_t, Hit*, WorkCounts*)>;
+    void set_packet_reference(PacketReference reference) { m_packet_reference = std::move(reference); }
 
     uint64_t checked() const { return m_checked; }
     uint64_t hit_mismatches() const { return m_hit_mismatches; }
@@ -36,6 +46,9 @@ public:
     std::function<void(const RayResult&)> on_ray;
 
 private:
+    void check(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work);
+
+    PacketReference m_packet_reference;
     ReferenceSource& m_reference;
     uint64_t m_total;
     Progress m_progress;

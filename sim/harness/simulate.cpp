@@ -43,8 +43,43 @@ void report_progress(uint64_t done, uint64_t total) {
     std::cerr << "{\"progress\": " << done << ", \"total\": " << total << "}" << std::endl;
 }
 
+/// Rays traced as one packet by the reference packet loop (functional level, traversal.model packet).
+class FunctionalPackets {
+public:
+    FunctionalPackets(const Accel& accel, HitChecker& checker, uint32_t lanes, float split_below)
+        : m_accel(accel), m_checker(checker), m_lanes(lanes), m_split_below(split_below) {}
+    void add(const RayJob& job) {
+        m_results.push_back(RayResult{});
+        m_results.back().id = job.id;
+        m_rays.push_back(job.ray);
+        m_modes.push_back(job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+        if (m_rays.size() == m_lanes) flush();
+    }
+    void flush() {
+        const uint32_t n = uint32_t(m_rays.size());
+        if (n == 0) return;
+        std::vector<Hit> hits(n);
+        std::vector<WorkCounts> work(n);
+        m_accel.trace_packet(m_rays.data(), m_modes.data(), n, hits.data(), work.data(), nullptr, m_split_below);
+        for (uint32_t i = 0; i < n; ++i) m_results[i].hit = hits[i], m_results[i].work = work[i];
+        m_checker.packet_done(m_results.data(), m_rays.data(), m_modes.data(), n);
+        m_results.clear(), m_rays.clear(), m_modes.clear();
+    }
+
+private:
+    const Accel& m_accel;
+    HitChecker& m_checker;
+    uint32_t m_lanes;
+    float m_split_below;
+    std::vector<RayResult> m_results;
+    std::vector<Ray> m_rays;
+    std::vector<TraversalMode> m_modes;
+};
+
 /// Functional level: the reference traversal in a loop, no time. Counts and the hit check only.
-json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, const std::vector<FrameRecord>& frames) {
+/// With packets (`packets` not null), rays in trace order `lanes` at a time, never across frames.
+json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, const std::vector<FrameRecord>& frames,
+                    FunctionalPackets* packets) {
     const std::string& path = reader.path();
     TraceRayStream stream(reader);
     std::vector<RayJob> jobs;
@@ -54,10 +89,17 @@ json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, cons
     accel.bind_frame(0);
     while (stream.read_chunk(65536, &jobs)) {
         for (const RayJob& job : jobs) {
-            while (job.id >= frames[frame].first_ray + frames[frame].rays) accel.bind_frame(++frame);
+            while (job.id >= frames[frame].first_ray + frames[frame].rays) {
+                if (packets) packets->flush();
+                accel.bind_frame(++frame);
+            }
             RayResult r;
             r.id = job.id;
             try {
+                if (packets) {
+                    packets->add(job);
+                    continue;
+                }
                 const TraversalMode mode = job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
                 r.hit = stepper ? trace_with_stepper(*stepper, job.ray, mode, &r.work) : accel.trace(job.ray, mode, &r.work);
             } catch (const Error& e) {
@@ -67,6 +109,7 @@ json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, cons
         }
         jobs.clear();
     }
+    if (packets) packets->flush();
     return json::object();
 }
 
@@ -130,8 +173,19 @@ SimOutcome run_simulation(const SimOptions& options) {
     // Approx with treelets: a shorter quantum (treelets.quantum_cycles; docs/fidelity.md).
     else if (o.config.treelets.enabled)
         timed_config.quantum_cycles = std::min(timed_config.quantum_cycles, o.config.treelets.quantum_cycles);
+    std::unique_ptr<FunctionalPackets> packets;
+    if (tc.model == UnitModel::packet) {
+        // Packets change each ray's work: it is checked against the reference packet loop.
+        require(accel->make_packet_stepper() != nullptr,
+                "config: 'traversal.model' packet needs a structure with a packet kernel (bvh2); this trace's "
+                "structure is '" + accel->kind() + "'");
+        const float split = float(tc.packet_split_below);
+        checker.set_packet_reference([&accel, split](const Ray* r, const TraversalMode* m, uint32_t n, Hit* h,
+                                                     WorkCounts* w) { accel->trace_packet(r, m, n, h, w, nullptr, split); });
+        packets = std::make_unique<FunctionalPackets>(*accel, checker, tc.lanes, split);
+    }
     if (o.config.fidelity == Fidelity::functional) {
-        run_functional(*accel, reader, checker, frames);
+        run_functional(*accel, reader, checker, frames, packets.get());
         frame_figures.untimed();
     } else {
         FrameRayStream stream(reader, frames);

@@ -49,7 +49,7 @@ const StatBlock& summary_stats() {
          "mean over units of `model.units.<unit>.busy_fraction`",
          true, false},
         {"simd_efficiency", "fraction",
-         "`traversal.model` simt only: active lanes / lane slots over every unit's warp steps (`model.units.<unit>.simd_efficiency`, Aila & Laine 2009)",
+         "`traversal.model` simt and packet: active lanes / lane slots over every unit's warp (or packet) steps (`model.units.<unit>.simd_efficiency`, Aila & Laine 2009)",
          false, true},
         {"box_utilization", "fraction",
          "mean over box pipeline blocks of `utilization`",

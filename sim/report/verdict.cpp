@@ -44,7 +44,7 @@ const std::vector<ResourceInfo>& resource_table() {
         {"l2_capacity", "L2 capacity (misses to DRAM)", ""},
         {"admission", "treelet admission (rays admitted into the ray buffer)", ""},
         {"treelet_scheduling", "treelet scheduling (which queue a free unit runs)", ""},
-        {"divergence", "SIMT divergence (warp lanes masked off while others step)", ""},
+        {"divergence", "divergence (SIMT warp lanes, or packet rays, masked off while others step)", ""},
     };
     return r;
 }

@@ -138,8 +138,8 @@ std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops)
         add(&out, doubled(c, "dram.channels"), "dram");
     }
     add(&out, doubled(c, "traversal.stack_entries"), "stack");
-    // Narrower warps diverge less; the analytic level has no warps, so only a re-run measures it.
-    if (c.traversal.model == UnitModel::simt) add(&out, halved(c, "traversal.lanes"), "divergence", false);
+    // Narrower warps (or packets) diverge less; the analytic level has neither, so only a re-run measures it.
+    if (c.traversal.model != UnitModel::mimd) add(&out, halved(c, "traversal.lanes"), "divergence", false);
     if (c.treelets.enabled) treelet_knobs(c, &out);
     return out;
 }

@@ -17,6 +17,20 @@ Hit Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
     return trace_with_stepper(*s, ray, mode, work);
 }
 
+void Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
+                         PacketCounts* counts, float split_below) const {
+    const std::unique_ptr<PacketStepper> s = make_packet_stepper();
+    require(s != nullptr, "structure '" + kind() + "' has no packet traversal");
+    s->set_split_below(split_below);
+    s->begin_packet(rays, modes, n);
+    while (!s->done()) s->execute();
+    for (uint32_t i = 0; i < n; ++i) {
+        if (hits) hits[i] = s->lane_hit(i);
+        if (work) work[i] = s->lane_work(i);
+    }
+    if (counts) *counts = s->counts();
+}
+
 bool Accel::has_anyhit_triangles() const {
     for (const Region& r : m_image.regions) {
         if (r.kind != DataKind::triangle) continue;

@@ -14,6 +14,7 @@
 #include "traces/accel/accel_image.h"
 #include "traces/accel/leaf_blocks.h"
 #include "traces/accel/locality.h"
+#include "traces/accel/packet_stepper.h"
 #include "traces/accel/stepper.h"
 #include "traces/bvh/config.h"
 
@@ -40,6 +41,14 @@ public:
     /// The reference loop: the stepper's steps, fused for speed where a kind provides one
     /// (the default drives a stepper).
     virtual Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const;
+    /// A packet stepper (rays sharing one traversal stack, packet_stepper.h), or null where the
+    /// kind has no packet kernel (the model's packet unit then refuses the structure).
+    virtual std::unique_ptr<PacketStepper> make_packet_stepper() const { return nullptr; }
+    /// The reference packet loop: rays[0, n) traced as one packet, each ray's hit and work and the
+    /// packet's counts (any output may be null); `split_below` as PacketStepper::set_split_below.
+    /// The default drives make_packet_stepper(); throws rtsim::Error where the kind has none.
+    virtual void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
+                              PacketCounts* counts, float split_below = 0.0f) const;
     /// Treelets (or cell blocks) of at most `budget_bytes`, keyed by StepPlan::locality.
     virtual LocalityPartition partition(uint64_t budget_bytes) const = 0;
     /// Operation kinds the steppers issue (the model instantiates a pipeline for each).

@@ -83,12 +83,12 @@ void MimdUnit::account_read(uint32_t c, Cycle ready, const AccessInfo& info) {
 void MimdUnit::activate(uint32_t c, Cycle t) {
     account(c, CycleUse::starved, t);  // idle until now, while rays were still to come
     m_contexts[c].active = true;
-    if (m_active++ == 0) m_busy_since = t;
+    m_tally.busy.enter(t);
 }
 
 void MimdUnit::deactivate(uint32_t c, Cycle t) {
     m_contexts[c].active = false;
-    if (--m_active == 0) m_busy_cycles += t - m_busy_since;  // a busy interval ends (may restart now)
+    m_tally.busy.leave(t);
 }
 
 bool MimdUnit::start_ray(uint32_t c, Cycle t) {
@@ -98,7 +98,7 @@ bool MimdUnit::start_ray(uint32_t c, Cycle t) {
     t = std::max(t, job.not_before);  // a frame's rays start when the previous frame is done
     Context& ctx = m_contexts[c];
     ctx.ray.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
-    if (!ray_is_valid(job.ray)) ++m_rejected;
+    if (!ray_is_valid(job.ray)) ++m_tally.rejected;
     ctx.ray.ray_id = job.id;
     ctx.ray.start = t;
     ctx.ray.stack = StackSplit{};
@@ -122,7 +122,7 @@ bool MimdUnit::take_parked_ray(uint32_t c, Cycle t) {
     m_steppers.release(std::move(ctx.ray.stepper));  // the finished ray's stepper is free again
     ctx.ray = std::move(taken);
     const Stepper& s = *ctx.ray.stepper;
-    if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_rejected;
+    if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_tally.rejected;
     ++m_takes;
     if (m_prefetcher.on()) m_prefetcher.enter(ctx.treelet, t);
     activate(c, t);
@@ -140,7 +140,7 @@ void MimdUnit::park_ray(uint32_t c, uint32_t treelet, Cycle t) {
 }
 
 void MimdUnit::advance(uint32_t c, Cycle t) {
-    ++m_steps;
+    ++m_tally.steps;
     account(c, CycleUse::issue, t);  // ready since its event, waiting for the scheduler
     if (m_contexts[c].phase == Phase::ops) run_ops(c, t);
     else step(c, t);
@@ -198,45 +198,31 @@ Cycle MimdUnit::stack_traffic(uint32_t c, Cycle t, Cycle ready) {
     // ray (its id), since the ray moves between contexts and units through the ray buffer.
     const uint64_t owner = m_treelet_mode ? ray.ray_id : uint64_t(m_index) * m_contexts.size() + c;
     // The write goes on to the shared L2 and a read may miss to it: in time order at detailed.
-    return issue_stack_traffic(*mem[0], m_map, d, owner, bytes, t, ready, &m_spill_writes, &m_spill_reads, [&] {
+    return issue_stack_traffic(*mem[0], m_map, d, owner, bytes, t, ready, &m_tally.spill_writes, &m_tally.spill_reads, [&] {
         if (!m_ctx.sync_private_steps) m_sync(t);
     });
 }
 
 void MimdUnit::finish_ray(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
-    // The hit record is written back (posted).
-    mem->access({m_map.hit(ctx.ray.ray_id), sizeof(HitRecord), true, DataKind::hit, t});
     const Stepper& s = *ctx.ray.stepper;
-    sink->ray_done(RayResult{ctx.ray.ray_id, s.hit(), s.work(), ctx.ray.start, t, m_index, c});
+    const RayResult r{ctx.ray.ray_id, s.hit(), s.work(), ctx.ray.start, t, m_index, c};
+    m_tally.finish_ray(*mem[0], m_map, r);
+    sink->ray_done(r);
     if (m_treelet_mode) ray_buffer->finished(t);
     else rays->ray_finished(t);
-    ++m_rays;
-    m_finish = std::max(m_finish, t);
     deactivate(c, t);
     start_ray(c, t);
 }
 
 CycleAccount MimdUnit::cycle_account(Cycle total_cycles) const {
-    CycleAccount a = m_account;
-    for (const Context& ctx : m_contexts)
-        if (total_cycles > ctx.accounted) a.add(CycleUse::tail, total_cycles - ctx.accounted);
-    return a;
+    return with_tail(m_account, m_contexts, total_cycles);
 }
 
 nlohmann::json MimdUnit::stats_json(Cycle total_cycles) const {
     nlohmann::json j;
     StatsWriter w(unit_stats(), j);
-    w.set("rays", m_rays)
-        .set("steps", m_steps)
-        .set("busy_cycles", m_busy_cycles)
-        .set("busy_fraction", total_cycles ? double(m_busy_cycles) / double(total_cycles) : 0.0)
-        .set("stack_spill_writes", m_spill_writes)
-        .set("stack_spill_reads", m_spill_reads)
-        .set("rejected_rays", m_rejected)
-        .set("quantum_syncs", m_sync.syncs())
-        .set("finish_cycle", m_finish)
-        .set("cycle_accounting", cycle_account(total_cycles).to_json());
+    m_tally.write(w, m_sync, cycle_account(total_cycles), total_cycles);
     if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
     if (m_prefetcher.on()) w.set("prefetch", m_prefetcher.stats_json());
     w.done();

@@ -35,8 +35,8 @@ public:
     SC_HAS_PROCESS(MimdUnit);
     MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index);
 
-    Cycle finish_cycle() const override { return m_finish; }
-    uint64_t rays_done() const override { return m_rays; }
+    Cycle finish_cycle() const override { return m_tally.finish; }
+    uint64_t rays_done() const override { return m_tally.rays; }
     CycleAccount cycle_account(Cycle total_cycles) const override;
     nlohmann::json stats_json(Cycle total_cycles) const override;
 
@@ -79,10 +79,7 @@ private:
     ContextQueue m_events;  ///< each context's next phase, earliest first
     QuantumSync m_sync;
     Cycle m_sched_free = 0;
-    Cycle m_finish = 0;
-    uint32_t m_active = 0;
-    Cycle m_busy_since = 0, m_busy_cycles = 0;
-    uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0;
+    UnitTally m_tally;
     bool m_treelet_mode = false;
     uint32_t m_frame = 0;  ///< the dispatch frame this unit last filled its contexts from
     Cycle m_next_fill = 0;

@@ -68,7 +68,7 @@ void SimtUnit::fill_idle_warps(Cycle t) {
 }
 
 void SimtUnit::advance(uint32_t w, Cycle t) {
-    ++m_steps;
+    ++m_tally.steps;
     if (m_warps[w].phase == Phase::ops) run_ops(w, t);
     else step(w, t);
 }
@@ -100,14 +100,14 @@ bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
     const Cycle start = std::max(t, job.not_before);  // a frame's rays start when the previous frame is done
     Lane& lane = m_lanes[l];
     lane.ray.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
-    if (!ray_is_valid(job.ray)) ++m_rejected;
+    if (!ray_is_valid(job.ray)) ++m_tally.rejected;
     lane.ray.ray_id = job.id;
     lane.kind = job.kind;
     lane.ray.start = start;
     lane.ray.stack = StackSplit{};
     account_until(m_account, lane.accounted, CycleUse::starved, start);  // no ray until now
     lane.has_ray = lane.stepping = true;
-    if (m_active_lanes++ == 0) m_busy_since = start;
+    m_tally.busy.enter(start);
     *fetch = std::max(*fetch, start + m_ctx.dispatch_latency);
     m_coalescer.add(m_map.ray(job.id), sizeof(RayRecord), DataKind::ray);
     return true;
@@ -207,7 +207,7 @@ void SimtUnit::run_ops(uint32_t w, Cycle t) {
         if (!m_lanes[l].stepping) continue;
         const uint64_t owner = uint64_t(m_index) * m_lanes.size() + l;  // spill slots belong to the lane
         ready = std::max(ready, issue_stack_traffic(*mem[0], m_map, m_lanes[l].demand, owner, m_costs.stack_entry_bytes, t,
-                                                    ops_done, &m_spill_writes, &m_spill_reads, [] {}));
+                                                    ops_done, &m_tally.spill_writes, &m_tally.spill_reads, [] {}));
     }
     for (uint32_t l = begin; l < end; ++l)
         if (m_lanes[l].stepping) account_until(m_account, m_lanes[l].accounted, CycleUse::stack, ready);
@@ -274,39 +274,25 @@ nlohmann::json SimtUnit::efficiency_over_time() const {
 void SimtUnit::finish_lane(uint32_t l, Cycle t) {
     Lane& lane = m_lanes[l];
     account_until(m_account, lane.accounted, CycleUse::issue, t);  // done, waiting for its warp's step
-    // The hit record is written back (posted).
-    mem->access({m_map.hit(lane.ray.ray_id), sizeof(HitRecord), true, DataKind::hit, t});
     const Stepper& s = *lane.ray.stepper;
-    sink->ray_done(RayResult{lane.ray.ray_id, s.hit(), s.work(), lane.ray.start, t, m_index, l});
+    const RayResult r{lane.ray.ray_id, s.hit(), s.work(), lane.ray.start, t, m_index, l};
+    m_tally.finish_ray(*mem[0], m_map, r);
+    sink->ray_done(r);
     rays->ray_finished(t);
-    ++m_rays;
-    m_finish = std::max(m_finish, t);
     lane.has_ray = false;
-    if (--m_active_lanes == 0) m_busy_cycles += t - m_busy_since;
+    m_tally.busy.leave(t);
 }
 
 CycleAccount SimtUnit::cycle_account(Cycle total_cycles) const {
-    CycleAccount a = m_account;
-    for (const Lane& lane : m_lanes)
-        if (total_cycles > lane.accounted) a.add(CycleUse::tail, total_cycles - lane.accounted);
-    return a;
+    return with_tail(m_account, m_lanes, total_cycles);
 }
 
 nlohmann::json SimtUnit::stats_json(Cycle total_cycles) const {
     nlohmann::json j;
     const uint64_t slots = m_warp_steps * m_config.lanes;
-    StatsWriter(unit_stats(), j)
-        .set("rays", m_rays)
-        .set("steps", m_steps)
-        .set("busy_cycles", m_busy_cycles)
-        .set("busy_fraction", total_cycles ? double(m_busy_cycles) / double(total_cycles) : 0.0)
-        .set("stack_spill_writes", m_spill_writes)
-        .set("stack_spill_reads", m_spill_reads)
-        .set("rejected_rays", m_rejected)
-        .set("quantum_syncs", m_sync.syncs())
-        .set("finish_cycle", m_finish)
-        .set("cycle_accounting", cycle_account(total_cycles).to_json())
-        .set("warp_steps", m_warp_steps)
+    StatsWriter w(unit_stats(), j);
+    m_tally.write(w, m_sync, cycle_account(total_cycles), total_cycles);
+    w.set("warp_steps", m_warp_steps)
         .set("ray_fetch_steps", m_fetch_steps)
         .set("lane_slots", slots)
         .set("active_lanes", m_lane_steps)

@@ -36,8 +36,8 @@ public:
     SC_HAS_PROCESS(SimtUnit);
     SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index);
 
-    Cycle finish_cycle() const override { return m_finish; }
-    uint64_t rays_done() const override { return m_rays; }
+    Cycle finish_cycle() const override { return m_tally.finish; }
+    uint64_t rays_done() const override { return m_tally.rays; }
     CycleAccount cycle_account(Cycle total_cycles) const override;
     nlohmann::json stats_json(Cycle total_cycles) const override;
 
@@ -97,11 +97,8 @@ private:
     LineCoalescer m_coalescer;
     Cycle m_fetch_at = 0;  ///< when the rays retire_and_refill() took may fetch their records
     Cycle m_sched_free = 0;
-    Cycle m_finish = 0;
     uint32_t m_frame = 0;
-    uint32_t m_active_lanes = 0;  ///< lanes with a ray (busy while > 0)
-    Cycle m_busy_since = 0, m_busy_cycles = 0;
-    uint64_t m_rays = 0, m_steps = 0, m_spill_writes = 0, m_spill_reads = 0, m_rejected = 0;
+    UnitTally m_tally;  ///< busy while a lane has a ray
     uint64_t m_warp_steps = 0, m_lane_steps = 0, m_fetch_steps = 0;
     std::vector<uint64_t> m_active_histogram;  ///< warp steps by active lanes (0 .. lanes)
     /// Per ray kind: lane-steps of lanes holding a ray of that kind, and those that stepped.

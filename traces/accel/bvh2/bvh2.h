@@ -7,6 +7,7 @@
 #include <string>
 
 #include "traces/accel/accel.h"
+#include "traces/accel/bvh2/bvh2_packet.h"
 #include "traces/accel/bvh2/bvh2_stepper.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/hw_layout.h"
@@ -47,6 +48,9 @@ public:
 
     std::unique_ptr<Stepper> make_stepper() const override;
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override;
+    std::unique_ptr<PacketStepper> make_packet_stepper() const override;
+    void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
+                      PacketCounts* counts, float split_below = 0.0f) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return kTraversalStackSize; }

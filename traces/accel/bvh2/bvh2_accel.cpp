@@ -184,6 +184,15 @@ Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const
     return trace_bvh2(m_view, ray, mode, work);
 }
 
+std::unique_ptr<PacketStepper> Bvh2Accel::make_packet_stepper() const {
+    return std::make_unique<Bvh2PacketStepper>(m_view);
+}
+
+void Bvh2Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
+                             PacketCounts* counts, float split_below) const {
+    trace_packet_bvh2(m_view, rays, modes, n, hits, work, counts, split_below);
+}
+
 LocalityPartition Bvh2Accel::partition(uint64_t budget_bytes) const {
     require(budget_bytes >= sizeof(HwNode), "treelet budget must be at least one node (64 bytes)");
     return partition_tree(bvh2_locality_tree(m_view.nodes, m_view.node_count), budget_bytes);

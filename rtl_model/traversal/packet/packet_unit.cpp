@@ -1,0 +1,243 @@
+#include "rtl_model/traversal/packet/packet_unit.h"
+
+#include <algorithm>
+#include <string>
+
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+namespace {
+
+/// The machine's step costs with a packet's stack entry.
+StepCosts packet_costs(StepCosts costs, uint32_t lanes) {
+    costs.stack_entry_bytes = packet_stack_entry_bytes(costs.stack_entry_bytes, lanes);
+    return costs;
+}
+
+}  // namespace
+
+PacketUnit::PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
+    : TraversalUnit(name),
+      m_config(setup.config),
+      m_ctx(setup.context),
+      m_map(setup.map),
+      m_accel(setup.steppers.accel()),
+      m_costs(packet_costs(setup.costs, setup.config.lanes)),
+      m_index(index),
+      m_packets(setup.config.warps()),
+      m_events(setup.config.warps()),
+      m_sync(setup.context.quantum_cycles),
+      m_coalescer(setup.context.line_bytes),
+      m_active_histogram(setup.config.lanes + 1, 0),
+      m_results(setup.config.lanes),
+      m_rays(setup.config.lanes),
+      m_modes(setup.config.lanes) {
+    for (Packet& p : m_packets) {
+        p.stepper = m_accel.make_packet_stepper();
+        require(p.stepper != nullptr, "config: 'traversal.model' packet needs a structure with a packet kernel "
+                                      "(bvh2); this trace's structure is '" + m_accel.kind() + "'");
+        p.stepper->set_split_below(float(setup.config.packet_split_below));
+        p.ids.resize(setup.config.lanes);
+    }
+    SC_THREAD(run);
+}
+
+void PacketUnit::run() {
+    Cycle now = 0;
+    fill_idle_packets(0);
+    for (;;) {
+        if (m_events.empty()) {
+            // No packet in flight. Done, unless dispatch holds the next frame's rays until this
+            // frame's last ray finishes (docs/model.md, "Frames"): wait for them.
+            const sc_core::sc_event* released = rays->released();
+            if (rays->exhausted() || !released) break;
+            if (rays->frame() == m_frame) wait(*released);
+            m_frame = rays->frame();
+            fill_idle_packets(now);
+            continue;
+        }
+        const Cycle ready = m_events.top_time();
+        const uint32_t p = m_events.begin_pop();
+        // The scheduler takes one phase of one packet per issue_cycles.
+        const Cycle t = std::max(ready, m_sched_free);
+        m_sched_free = t + m_config.issue_cycles;
+        now = t;
+        if (m_ctx.sync_private_steps || m_packets[p].phase != Phase::ops) m_sync(t);
+        advance(p, t);
+        m_events.finish_pop();
+        if (rays->frame() != m_frame) {  // a frame was released: fill every idle packet
+            if (!m_ctx.sync_private_steps) m_sync(t);
+            m_frame = rays->frame();
+            fill_idle_packets(t);
+        }
+    }
+}
+
+void PacketUnit::fill_idle_packets(Cycle t) {
+    for (uint32_t p = 0; p < m_packets.size(); ++p)
+        if (!m_packets[p].active && !start_packet(p, t)) break;
+}
+
+void PacketUnit::account(uint32_t p, CycleUse use, Cycle until) {
+    Packet& pk = m_packets[p];
+    if (until <= pk.accounted) return;
+    const Cycle dt = until - pk.accounted;
+    m_account.add(use, dt * pk.weight);
+    m_account.add(CycleUse::idle_lane, dt * (m_config.lanes - pk.weight));
+    pk.accounted = until;
+}
+
+void PacketUnit::account_read(uint32_t p, Cycle ready, const AccessInfo& info) {
+    Packet& pk = m_packets[p];
+    if (ready <= pk.accounted) return;
+    CycleAccount read;
+    account_memory(read, pk.accounted, ready, info);
+    for (CycleUse use : {CycleUse::l1_mshr_full, CycleUse::l2_mshr_full, CycleUse::l1_hit, CycleUse::l2, CycleUse::dram})
+        m_account.add(use, read[use] * pk.weight);
+    m_account.add(CycleUse::idle_lane, (ready - pk.accounted) * (m_config.lanes - pk.weight));
+    pk.accounted = ready;
+}
+
+bool PacketUnit::start_packet(uint32_t p, Cycle t) {
+    Packet& pk = m_packets[p];
+    uint32_t n = 0;
+    Cycle start = t;
+    RayJob job;
+    m_coalescer.clear();
+    while (n < m_config.lanes && rays->next_ray(m_index, &job)) {
+        start = std::max(start, job.not_before);  // a frame's rays start when the previous frame is done
+        m_rays[n] = job.ray;
+        m_modes[n] = job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
+        pk.ids[n] = job.id;
+        if (!ray_is_valid(job.ray)) ++m_tally.rejected;
+        m_coalescer.add(m_map.ray(job.id), sizeof(RayRecord), DataKind::ray);
+        ++n;
+    }
+    if (n == 0) return false;
+    pk.stepper->begin_packet(m_rays.data(), m_modes.data(), n);
+    pk.start = start;
+    pk.stack = StackSplit{};
+    pk.weight = m_config.lanes;
+    account(p, CycleUse::starved, start);  // idle until now, while rays were still to come
+    pk.active = true;
+    m_tally.busy.enter(start);
+    ++m_packets_traced;
+    // The rays' records are read (coalesced per line) before traversal starts.
+    pk.weight = n;
+    const Cycle fetch = start + m_ctx.dispatch_latency;
+    account(p, CycleUse::dispatch, fetch);
+    Cycle ready = fetch;
+    AccessInfo slowest, info;
+    bool first = true;
+    m_coalescer.issue([&](uint64_t addr, uint32_t bytes, DataKind kind) {
+        const Cycle done = mem->access({addr, bytes, false, kind, fetch, &info});
+        if (done > ready || first) slowest = info;
+        first = false;
+        ready = std::max(ready, done);
+    });
+    account_read(p, ready, slowest);
+    pk.phase = Phase::step;
+    m_events.schedule(p, ready);
+    return true;
+}
+
+void PacketUnit::advance(uint32_t p, Cycle t) {
+    ++m_tally.steps;
+    Packet& pk = m_packets[p];
+    account(p, CycleUse::issue, t);  // ready since its event, waiting for the scheduler
+    if (pk.phase == Phase::ops) return run_ops(p, t);
+    if (pk.stepper->plan().done) return finish_packet(p, t);
+    step(p, t);
+}
+
+void PacketUnit::step(uint32_t p, Cycle t) {
+    Packet& pk = m_packets[p];
+    // The packet's step is costed (and run, each ray with the one arithmetic) as its one fetch
+    // issues; its operations phase issues the active rays' tests once the data has arrived.
+    const uint32_t active = pk.stepper->active();
+    pk.weight = active;
+    ++m_packet_steps;
+    m_active_rays += active;
+    ++m_active_histogram[active];
+    StepDemand& d = pk.demand;
+    take_step(*pk.stepper, pk.stack, m_costs, d);
+    Cycle ready = t;
+    AccessInfo slowest, info;
+    for (int i = 0; i < d.read_count; ++i) {
+        const Fetch& f = d.reads[i];
+        m_node_fetches += f.kind == DataKind::node;
+        const Cycle done = mem->access({f.addr, f.bytes, false, f.kind, t, &info});
+        if (done > ready || i == 0) slowest = info;
+        ready = std::max(ready, done);
+    }
+    account_read(p, ready, slowest);
+    pk.phase = Phase::ops;
+    m_events.schedule(p, ready);
+}
+
+void PacketUnit::run_ops(uint32_t p, Cycle t) {
+    // The active rays' tests run on their pipelines in order (the plan's, then the alpha tests
+    // their hits called for), then spilled stack entries are read back.
+    Packet& pk = m_packets[p];
+    const StepDemand& d = pk.demand;
+    Cycle ready = t;
+    for (int i = 0; i < d.issue_count; ++i) {
+        ready = pipes[size_t(d.issues[i].kind)]->issue(ready, d.issues[i].issues, d.issues[i].tests);
+        account(p, pipe_use(d.issues[i].kind), ready);
+    }
+    // Spill slots belong to the packet context, reused packet after packet.
+    const uint64_t owner = uint64_t(m_index) * m_packets.size() + p;
+    ready = issue_stack_traffic(*mem[0], m_map, d, owner, m_costs.stack_entry_bytes, t, ready, &m_tally.spill_writes,
+                                &m_tally.spill_reads, [&] {
+                                    if (!m_ctx.sync_private_steps) m_sync(t);
+                                });
+    account(p, CycleUse::stack, ready);
+    pk.phase = Phase::step;
+    m_events.schedule(p, ready);
+}
+
+void PacketUnit::finish_packet(uint32_t p, Cycle t) {
+    Packet& pk = m_packets[p];
+    const PacketStepper& s = *pk.stepper;
+    const uint32_t n = s.size();
+    m_splits += s.counts().splits;
+    m_split_steps += s.counts().split_steps;
+    for (uint32_t i = 0; i < n; ++i) {
+        m_results[i] = RayResult{pk.ids[i], s.lane_hit(i), s.lane_work(i), pk.start, t, m_index, p * m_config.lanes + i};
+        m_tally.finish_ray(*mem[0], m_map, m_results[i]);
+        m_rays[i] = s.lane_ray(i);
+        m_modes[i] = s.lane_mode(i);
+    }
+    sink->packet_done(m_results.data(), m_rays.data(), m_modes.data(), n);
+    for (uint32_t i = 0; i < n; ++i) rays->ray_finished(t);
+    pk.active = false;
+    m_tally.busy.leave(t);
+    start_packet(p, t);
+}
+
+CycleAccount PacketUnit::cycle_account(Cycle total_cycles) const {
+    return with_tail(m_account, m_packets, total_cycles, m_config.lanes);
+}
+
+nlohmann::json PacketUnit::stats_json(Cycle total_cycles) const {
+    nlohmann::json j;
+    StatsWriter w(unit_stats(), j);
+    m_tally.write(w, m_sync, cycle_account(total_cycles), total_cycles);
+    const uint64_t slots = m_packet_steps * m_config.lanes;
+    w.set("packets", m_packets_traced)
+        .set("packet_steps", m_packet_steps)
+        .set("packet_node_fetches", m_node_fetches)
+        .set("node_fetches_per_packet", m_packets_traced ? double(m_node_fetches) / double(m_packets_traced) : 0.0)
+        .set("packet_occupancy", m_packet_steps ? double(m_active_rays) / double(m_packet_steps) : 0.0)
+        .set("packet_active_histogram", m_active_histogram)
+        .set("packet_splits", m_splits)
+        .set("packet_split_steps", m_split_steps)
+        .set("lane_slots", slots)
+        .set("active_lanes", m_active_rays)
+        .set("simd_efficiency", slots ? double(m_active_rays) / double(slots) : 0.0)
+        .done();
+    return j;
+}
+
+}  // namespace rtsim

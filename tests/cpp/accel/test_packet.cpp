@@ -1,0 +1,192 @@
+// Packets on the binary BVH (Wald et al. 2001): every ray's closest hit equals single-ray
+// traversal bit for bit and every any-hit ray agrees on occlusion, on the procedural scenes, an
+// alpha-masked soup and the hard cases (rays from inside closed meshes, aimed at shared vertices,
+// invalid rays); the packet stepper and the fused packet loop agree on hits, work and counts;
+// the stepper's plans ask for exactly the packet's work; a packet of one ray, or of copies of one
+// ray, does the single ray's work with every ray active in every step.
+#include <gtest/gtest.h>
+
+#include "structure_test_util.h"
+#include "traces/accel/bvh2/bvh2.h"
+#include "traces/common/error.h"
+
+namespace rtsim {
+namespace {
+
+std::unique_ptr<Accel> bvh2_of(const Scene& scene) { return load_accel(build_accel(scene, AccelOptions{}), "test"); }
+
+/// Packets of `lanes` consecutive rays: hits against single rays, stepper against fused loop,
+/// plans against work. Returns the packets' counts.
+PacketCounts check_packets(const Accel& accel, const std::vector<Ray>& rays, uint32_t lanes, TraversalMode mode,
+                           const std::string& what, float split_below = 0.0f) {
+    std::unique_ptr<PacketStepper> s = accel.make_packet_stepper();
+    s->set_split_below(split_below);
+    PacketCounts total;
+    int diffs = 0;
+    for (size_t first = 0; first < rays.size(); first += lanes) {
+        const uint32_t n = uint32_t(std::min<size_t>(lanes, rays.size() - first));
+        const std::vector<TraversalMode> modes(n, mode);
+        std::vector<Hit> hits(n);
+        std::vector<WorkCounts> work(n);
+        PacketCounts fused;
+        accel.trace_packet(&rays[first], modes.data(), n, hits.data(), work.data(), &fused, split_below);
+        // The stepper, driven step by step: its plans' tests are the active rays' tests.
+        s->begin_packet(&rays[first], modes.data(), n);
+        uint64_t box = 0, tri = 0, alpha = 0, fetches = 0;
+        while (!s->done()) {
+            const StepPlan& p = s->plan();
+            fetches += p.fetch_count;
+            for (int i = 0; i < p.op_count; ++i) (p.op[i].kind == OpKind::box ? box : tri) += p.op[i].count;
+            const StepOutcome out = s->execute();
+            for (int i = 0; i < out.op_count; ++i) alpha += out.op[i].count;
+        }
+        EXPECT_EQ(s->counts(), fused) << what;
+        EXPECT_EQ(fetches, fused.node_steps + fused.leaf_steps) << what << ": one fetch per packet step";
+        WorkCounts sum;
+        for (uint32_t i = 0; i < n; ++i) {
+            EXPECT_TRUE(test::same_hit(s->lane_hit(i), hits[i], TraversalMode::closest_hit)) << what;
+            EXPECT_EQ(s->lane_work(i), work[i]) << what;
+            sum.box_tests += work[i].box_tests, sum.tri_tests += work[i].tri_tests;
+            sum.anyhit_calls += work[i].anyhit_calls;
+            const Hit single = accel.trace(rays[first + i], mode);
+            if (!test::same_hit(hits[i], single, mode) && ++diffs <= 3)
+                ADD_FAILURE() << what << ": ray " << first + i << " packet prim " << hits[i].prim << " t " << hits[i].t
+                              << ", single prim " << single.prim << " t " << single.t;
+        }
+        EXPECT_EQ(box, sum.box_tests) << what;
+        EXPECT_EQ(tri, sum.tri_tests) << what;
+        EXPECT_EQ(alpha, sum.anyhit_calls) << what;
+        total += fused;
+    }
+    EXPECT_EQ(diffs, 0) << what;
+    return total;
+}
+
+/// Coherent rays: from one point outside the scene into a narrow cone, in pixel order.
+std::vector<Ray> camera_rays(const std::vector<HwTriangle>& tris, int n, uint64_t seed) {
+    Aabb bounds;
+    for (const HwTriangle& t : tris)
+        for (const float* v : {t.v0, t.v1, t.v2}) bounds.grow(Vec3(v[0], v[1], v[2]));
+    const Vec3 c = 0.5f * (bounds.lo + bounds.hi), e = bounds.hi - bounds.lo;
+    const Vec3 eye = c + Vec3(0.3f, 0.2f, 1.5f) * glm::length(e);
+    Rng rng(seed);
+    std::vector<Ray> rays;
+    const int side = int(std::sqrt(float(n)));
+    for (int y = 0; y < side; ++y)
+        for (int x = 0; x < side; ++x) {
+            const Vec3 target = bounds.lo + Vec3((x + rng.next()) / side, (y + rng.next()) / side, 0.5f) * e;
+            rays.push_back(test::make_ray(eye, target - eye));
+        }
+    return rays;
+}
+
+TEST(Packets, HitsEqualSingleRaysOnProceduralScenes) {
+    for (const std::string name : {"cornell", "hairball", "teapot_stadium", "rotated_walls"}) {
+        const Scene& scene = test::procedural(name);
+        const std::unique_ptr<Accel> accel = bvh2_of(scene);
+        const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+        const std::vector<Ray> random = test::random_rays(scene, tris, 7, 1024), camera = camera_rays(tris, 1024, 3);
+        for (uint32_t lanes : {1u, 4u, 16u, 64u})
+            for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+                const std::string what = name + " lanes " + std::to_string(lanes) + " mode " + std::to_string(int(mode));
+                check_packets(*accel, random, lanes, mode, what + " random");
+                const PacketCounts c = check_packets(*accel, camera, lanes, mode, what + " camera");
+                // Coherent packets share most of their steps: far fewer node fetches than rays.
+                if (lanes == 64 && mode == TraversalMode::closest_hit) {
+                    uint64_t single_steps = 0;
+                    for (const Ray& r : camera) {
+                        WorkCounts w;
+                        accel->trace(r, mode, &w);
+                        single_steps += w.steps;
+                    }
+                    EXPECT_LT(c.node_steps * 4, single_steps) << what;
+                }
+            }
+    }
+}
+
+TEST(Packets, TheHybridSplitsLowOccupancyPacketsIntoSingleRays) {
+    // Benthin et al. 2012: after a split each ray walks alone with the single-ray rules, so its
+    // hits stay the single ray's and the single-ray tail does a single ray's steps.
+    for (const std::string name : {"cornell", "hairball"}) {
+        const Scene& scene = test::procedural(name);
+        const std::unique_ptr<Accel> accel = bvh2_of(scene);
+        const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+        const std::vector<Ray> random = test::random_rays(scene, tris, 29, 1024), camera = camera_rays(tris, 1024, 5);
+        for (float split : {0.25f, 0.5f, 1.0f})
+            for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+                const std::string what = name + " split " + std::to_string(split);
+                const PacketCounts r = check_packets(*accel, random, 16, mode, what + " random", split);
+                EXPECT_GT(r.splits, 0u) << what;
+                EXPECT_GT(r.split_steps, 0u) << what;
+                check_packets(*accel, camera, 16, mode, what + " camera", split);
+            }
+        // Without a threshold nothing splits; with one, steps hold fewer rays on average (the
+        // single-ray tail runs one ray per step).
+        const PacketCounts none = check_packets(*accel, random, 16, TraversalMode::closest_hit, name, 0.0f);
+        const PacketCounts half = check_packets(*accel, random, 16, TraversalMode::closest_hit, name, 0.5f);
+        EXPECT_EQ(none.splits, 0u);
+        EXPECT_LT(half.active_rays * (none.node_steps + none.leaf_steps), none.active_rays * (half.node_steps + half.leaf_steps));
+    }
+}
+
+TEST(Packets, HardCasesAndAlphaMasks) {
+    // An alpha-masked soup with coincident triangles, a closed sphere from inside, invalid rays.
+    const Scene soup = test::random_soup(5, 400);
+    const std::unique_ptr<Accel> a = bvh2_of(soup);
+    std::vector<Ray> rays = test::random_rays(soup, test::hw_triangles(soup), 11, 512);
+    rays[3].tmin = std::numeric_limits<float>::quiet_NaN();
+    rays[17].direction = Vec3(0.0f);
+    for (uint32_t lanes : {4u, 16u, 64u})
+        for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit})
+            check_packets(*a, rays, lanes, mode, "soup " + std::to_string(lanes));
+    const std::vector<Vec3> sphere = test::icosphere(3);
+    const std::unique_ptr<Accel> s = bvh2_of(test::make_scene(sphere));
+    std::vector<Ray> inside;
+    for (size_t t = 0; t < sphere.size(); ++t) inside.push_back(test::make_ray(Vec3(0.0f), sphere[t]));
+    for (uint32_t lanes : {4u, 16u, 64u}) check_packets(*s, inside, lanes, TraversalMode::closest_hit, "sphere");
+    std::unique_ptr<PacketStepper> st = s->make_packet_stepper();
+    const Ray bad = test::make_ray(Vec3(0.0f), Vec3(0.0f));
+    const TraversalMode m = TraversalMode::closest_hit;
+    st->begin_packet(&bad, &m, 1);
+    EXPECT_TRUE(st->done());  // an invalid ray alone: no step at all
+    EXPECT_EQ(st->counts().node_steps, 0u);
+}
+
+TEST(Packets, CopiesOfOneRayDoItsSingleRayWorkFullyActive) {
+    const Scene& scene = test::procedural("hairball");
+    const std::unique_ptr<Accel> accel = bvh2_of(scene);
+    const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 19, 64);
+    for (const Ray& r : rays) {
+        if (!ray_is_valid(r)) continue;
+        WorkCounts single;
+        accel->trace(r, TraversalMode::closest_hit, &single);
+        const std::vector<Ray> same(16, r);
+        const std::vector<TraversalMode> modes(16, TraversalMode::closest_hit);
+        std::vector<WorkCounts> work(16);
+        PacketCounts c;
+        accel->trace_packet(same.data(), modes.data(), 16, nullptr, work.data(), &c);
+        for (const WorkCounts& w : work) EXPECT_EQ(w, single);
+        EXPECT_EQ(c.node_steps, single.steps);
+        EXPECT_EQ(c.active_rays, 16 * (c.node_steps + c.leaf_steps));  // occupancy exactly 1
+    }
+}
+
+TEST(Packets, OnlyTheBinaryBvhHasAPacketKernel) {
+    const Scene& scene = test::procedural("cornell");
+    AccelOptions o;
+    o.kind = "bvh8";
+    const std::unique_ptr<Accel> wide = load_accel(build_accel(scene, o), "bvh8");
+    EXPECT_EQ(wide->make_packet_stepper(), nullptr);
+    const Ray r = test::make_ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f));
+    const TraversalMode m = TraversalMode::closest_hit;
+    EXPECT_THROW(wide->trace_packet(&r, &m, 1, nullptr, nullptr, nullptr), Error);
+    const std::unique_ptr<Accel> bvh2 = bvh2_of(scene);
+    std::unique_ptr<PacketStepper> s = bvh2->make_packet_stepper();
+    std::vector<Ray> many(65, r);
+    std::vector<TraversalMode> modes(65, m);
+    EXPECT_THROW(s->begin_packet(many.data(), modes.data(), 65), Error);
+}
+
+}  // namespace
+}  // namespace rtsim

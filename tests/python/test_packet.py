@@ -1,0 +1,162 @@
+"""Packets (traversal.model=packet, Wald et al. 2001): every hit identical to single-ray
+traversal and every ray's work equal to the reference packet loop's, at every timed level and
+functional, with and without sorting and with the hybrid's split into single rays; occupancy
+exactly 1 when every ray of a packet is the same ray; one node fetch serves a packet; lanes'
+cycles accounted; structures without a packet kernel and bad settings refused, naming the field."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rtsim
+from conftest import sim_stats, simulate
+
+PACKET = ("traversal.model=packet", "traversal.ray_contexts=64")
+
+
+@pytest.fixture(scope="module")
+def cornell_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Cornell primary, shadow and diffuse rays, small."""
+    out = tmp_path_factory.mktemp("packet") / "cornell"
+    rtsim.trace_scene("cornell", out, workload="primary,shadow,diffuse", width=32, height=24)
+    return out
+
+
+@pytest.fixture(scope="module")
+def same_ray(tmp_path_factory: pytest.TempPathFactory, cornell_trace: Path) -> Path:
+    """128 copies of one primary ray that hits the scene."""
+    t = rtsim.open_trace(cornell_trace)
+    rays, hits = t.rays, t.hits
+    i = int(np.flatnonzero(hits["prim"] >= 0)[len(hits) // 4])
+    n = 128
+    out = tmp_path_factory.mktemp("same") / "t"
+    rtsim.write_trace(
+        "cornell",
+        np.repeat(rays["origin"][i : i + 1], n, axis=0),
+        np.repeat(rays["direction"][i : i + 1], n, axis=0),
+        float(rays["tmin"][i]),
+        float(rays["tmax"][i]),
+        out=out,
+    )
+    return out
+
+
+@pytest.mark.parametrize(
+    "sets",
+    [
+        ("traversal.lanes=4",),
+        ("traversal.lanes=16", "fidelity=detailed"),
+        ("traversal.lanes=64", "traversal.stack_entries=2"),
+        ("traversal.lanes=16", "dispatch.sort=origin_direction"),
+        ("traversal.lanes=16", "fidelity=functional"),
+        ("traversal.lanes=16", "traversal.packet_split_below=0.5"),
+        ("traversal.lanes=64", "traversal.packet_split_below=0.25", "fidelity=functional"),
+    ],
+)
+def test_packet_hits_and_work_match_the_reference(
+    sim_exe: Path, cornell_trace: Path, tmp_path: Path, sets: tuple[str, ...]
+) -> None:
+    stats = sim_stats(sim_exe, cornell_trace / "trace.rtt", tmp_path / "run", *PACKET, *sets)
+    s = stats["summary"]
+    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+    assert s["rays"] == rtsim.open_trace(cornell_trace).manifest["counts"]["rays"]
+    if "fidelity=functional" in sets:
+        return
+    lanes = int(next(x for x in sets if x.startswith("traversal.lanes=")).split("=")[1])
+    units = stats["model"]["units"].values()
+    assert sum(u["rays"] for u in units) == s["rays"]
+    assert 0.0 < s["simd_efficiency"] < 1.0  # diffuse rays leave the packet's path
+    for u in units:
+        assert u["lane_slots"] == u["packet_steps"] * lanes
+        assert sum(u["packet_active_histogram"]) == u["packet_steps"]
+        assert sum(k * n for k, n in enumerate(u["packet_active_histogram"])) == u["active_lanes"]
+        assert u["packet_active_histogram"][0] == 0  # a step always has a ray in it
+        assert u["packet_occupancy"] == pytest.approx(u["active_lanes"] / u["packet_steps"])
+        assert u["packets"] * lanes >= u["rays"] > (u["packets"] - 1) * 1
+        assert u["node_fetches_per_packet"] == pytest.approx(
+            u["packet_node_fetches"] / u["packets"]
+        )
+        if "traversal.stack_entries=2" in sets:
+            assert u["stack_spill_writes"] > 0
+        split = any(x.startswith("traversal.packet_split_below") for x in sets)
+        assert (u["packet_splits"] > 0) == split
+        assert (u["packet_split_steps"] > 0) == split
+    acc = stats["model"]["cycle_accounting"]
+    assert acc["context_cycles"] == 8 * 64 * s["cycles"]
+    assert sum(acc["by_use"].values()) == acc["context_cycles"]
+    assert acc["by_use"]["idle_lane"] > 0
+
+
+def test_packets_share_node_fetches(sim_exe: Path, cornell_trace: Path, tmp_path: Path) -> None:
+    """A packet's node step is one fetch: far fewer node reads than single rays make."""
+    mimd = sim_stats(
+        sim_exe, cornell_trace / "trace.rtt", tmp_path / "mimd", "traversal.ray_contexts=64"
+    )
+    pk = sim_stats(
+        sim_exe, cornell_trace / "trace.rtt", tmp_path / "pk", *PACKET, "traversal.lanes=16"
+    )
+    node_reads = sum(u["packet_node_fetches"] for u in pk["model"]["units"].values())
+    # A MIMD unit's scheduler steps: 2 per traversal step and 1 per ray.
+    single_steps = sum(u["steps"] for u in mimd["model"]["units"].values())
+    assert node_reads < single_steps / 2 / 4
+    # Each ray's box tests are its own: packets never test fewer boxes than single rays.
+    assert pk["summary"]["work_mismatches"] == 0
+
+
+def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray(
+    sim_exe: Path, same_ray: Path, tmp_path: Path
+) -> None:
+    for lanes in (4, 8, 16):
+        stats = sim_stats(
+            sim_exe,
+            same_ray / "trace.rtt",
+            tmp_path / f"l{lanes}",
+            "traversal.model=packet",
+            "traversal.units=1",
+            "traversal.ray_contexts=32",
+            f"traversal.lanes={lanes}",
+        )
+        s = stats["summary"]
+        assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+        assert s["simd_efficiency"] == 1.0
+        unit = stats["model"]["units"]["tu0"]
+        assert unit["packet_occupancy"] == float(lanes)
+        assert unit["packets"] == 128 // lanes
+        assert unit["packet_active_histogram"][:lanes] == [0] * lanes
+        assert "idle_lane" not in stats["model"]["cycle_accounting"]["by_use"]
+        # The packet walks the single ray's path: one node fetch per single-ray node step.
+        steps = int(rtsim.open_trace(same_ray).work["steps"][0])
+        assert unit["packet_node_fetches"] == steps * unit["packets"]
+
+
+def test_packet_needs_a_packet_kernel(sim_exe: Path, tmp_path: Path) -> None:
+    trace = tmp_path / "trace"
+    rtsim.trace_scene("cornell", trace, workload="primary", width=8, height=8, accel="bvh8")
+    result = simulate(sim_exe, trace / "trace.rtt", tmp_path / "run", "traversal.model=packet")
+    assert result.returncode == 2, result.stderr
+    assert "traversal.model" in result.stderr and "bvh8" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("sets", "named"),
+    [
+        (
+            ("traversal.model=packet", "traversal.packet_split_below=1.5"),
+            "traversal.packet_split_below",
+        ),
+        (("traversal.model=packet", "traversal.lanes=2"), "traversal.lanes"),
+        (
+            ("traversal.model=packet", "traversal.ray_contexts=20", "traversal.lanes=16"),
+            "traversal.ray_contexts",
+        ),
+    ],
+)
+def test_bad_packet_settings_are_named(
+    sim_exe: Path, cornell_trace: Path, tmp_path: Path, sets: tuple[str, ...], named: str
+) -> None:
+    result = simulate(sim_exe, cornell_trace / "trace.rtt", tmp_path / "run", *sets)
+    assert result.returncode == 2, result.stderr
+    assert named in result.stderr

@@ -1,0 +1,134 @@
+// The binary BVH's packet stepper and fused packet loop (bvh2_packet.h): the same node, leaf,
+// pop and split rules (bvh2_packet_kernel.h), one driven step by step, one in a loop.
+#include "traces/accel/bvh2/bvh2_packet.h"
+
+namespace rtsim {
+
+void Bvh2PacketStepper::begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) {
+    m_lanes.begin(rays, modes, n);
+    m_counts = PacketCounts{};
+    m_ray = rays[0];
+    m_mode = modes[0];
+    m_hit = Hit{};
+    m_work = WorkCounts{};
+    m_stack_size = 0;
+    m_split = false;
+    m_active = m_lanes.live;
+    if (m_active == 0 || m_view.node_count == 0) return finish();
+    m_ref = 0;  // the root: every valid ray starts there
+    m_count = 0;
+    plan_next();
+}
+
+void Bvh2PacketStepper::plan_next() {
+    if (!m_split && m_count == 0 && detail::should_split(m_lanes, m_active, m_split_below)) {
+        detail::begin_split(m_lanes, m_stack, m_stack_size, m_ref, m_count, m_active, m_walk);
+        m_split = true;
+        ++m_counts.splits;
+        if (!detail::split_next_ray(m_lanes, m_stack, m_walk, &m_ref, &m_count)) return finish();
+    }
+    if (m_split) {
+        // One ray's step: the frozen shared stack stays, the ray's own entries on top of it.
+        m_active = lane_bit(m_walk.ray);
+        m_stack_size = m_walk.frozen + m_walk.size;
+        ++m_counts.split_steps;
+    }
+    const uint32_t rays = lane_count(m_active);
+    m_counts.active_rays += rays;
+    if (m_count == 0) {
+        ++m_counts.node_steps;
+        m_plan.reset(m_ref);
+        m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+        m_plan.add_op(OpKind::box, 2 * rays);
+    } else {
+        ++m_counts.leaf_steps;
+        m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
+        m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
+                         uint32_t(sizeof(HwTriangle) * m_count), DataKind::triangle);
+        m_plan.add_op(OpKind::triangle, m_count * rays);
+    }
+}
+
+StepOutcome Bvh2PacketStepper::execute() {
+    StepOutcome out;
+    if (m_plan.done) return out;
+    if (m_split) {
+        bool more = false;
+        out.add_op(OpKind::anyhit, detail::split_step(m_lanes, m_view.nodes, m_view.triangles, m_stack, m_walk, &m_ref,
+                                                      &m_count, &more));
+        if (more) plan_next();
+        else finish();
+        return out;
+    }
+    if (m_count == 0) {
+        if (detail::packet_descend(m_lanes, m_active, m_view.nodes[m_ref], m_stack, m_stack_size, &m_ref, &m_count,
+                                   &m_active))
+            plan_next();
+        else
+            pop_next();
+        return out;
+    }
+    out.add_op(OpKind::anyhit, detail::packet_leaf(m_lanes, m_active, m_view.triangles + m_ref, m_count));
+    pop_next();
+    return out;
+}
+
+void Bvh2PacketStepper::pop_next() {
+    if (m_lanes.live && detail::packet_pop(m_lanes, m_stack, m_stack_size, &m_ref, &m_count, &m_active)) {
+        plan_next();
+        return;
+    }
+    finish();
+}
+
+void Bvh2PacketStepper::finish() {
+    m_lanes.finish();
+    m_active = 0;
+    m_stack_size = 0;
+    m_hit = m_lanes.hit[0];
+    m_work = m_lanes.work[0];
+    m_plan.finish();
+}
+
+void trace_packet_bvh2(const Bvh2View& bvh, const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits,
+                       WorkCounts* work, PacketCounts* counts, float split_below) {
+    static thread_local PacketLanes p;
+    static thread_local detail::PacketStackEntry stack[kTraversalStackSize];
+    static thread_local detail::SplitWalk walk;
+    p.begin(rays, modes, n);
+    PacketCounts c;
+    LaneMask active = p.live;
+    uint32_t ref = 0, count = 0;
+    int size = 0;
+    bool split = false;
+    bool more = active != 0 && bvh.node_count != 0;
+    while (more) {
+        if (!split && count == 0 && detail::should_split(p, active, split_below)) {
+            detail::begin_split(p, stack, size, ref, count, active, walk);
+            split = true;
+            ++c.splits;
+            if (!detail::split_next_ray(p, stack, walk, &ref, &count)) break;
+        }
+        c.active_rays += split ? 1 : lane_count(active);
+        ++(count == 0 ? c.node_steps : c.leaf_steps);
+        if (split) {
+            ++c.split_steps;
+            detail::split_step(p, bvh.nodes, bvh.triangles, stack, walk, &ref, &count, &more);
+            continue;
+        }
+        if (count == 0) {
+            if (detail::packet_descend(p, active, bvh.nodes[ref], stack, size, &ref, &count, &active)) continue;
+        } else {
+            detail::packet_leaf(p, active, bvh.triangles + ref, count);
+        }
+        more = p.live && detail::packet_pop(p, stack, size, &ref, &count, &active);
+    }
+    p.finish();
+    for (uint32_t i = 0; i < n; ++i) {
+        if (hits) hits[i] = p.hit[i];
+        if (work) work[i] = p.work[i];
+    }
+    if (counts) *counts = c;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,43 @@
+#pragma once
+// Packets on the binary BVH (Wald et al. 2001; rules in bvh2_packet_kernel.h): the packet stepper
+// the model's packet unit drives, and the fused packet loop the hit checker takes packet work
+// from. Both share the kernel, so they agree on every ray's hit and work and on the packet's
+// counts (tested, with the hits against single-ray traversal).
+//
+// A packet step fetches one 64-byte HwNode and runs 2 box tests per active ray (locality key:
+// the node), or fetches a leaf's HwTriangles once and runs one triangle test per triangle and
+// active ray, plus the alpha tests the hits call for.
+#include <cstdint>
+
+#include "traces/accel/bvh2/bvh2_packet_kernel.h"
+#include "traces/accel/bvh2/bvh2_stepper.h"
+
+namespace rtsim {
+
+class Bvh2PacketStepper final : public PacketStepper {
+public:
+    explicit Bvh2PacketStepper(const Bvh2View& view) : m_view(view) {}
+
+    void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) override;
+    StepOutcome execute() override;
+
+private:
+    void pop_next();
+    void plan_next();
+    void finish();
+
+    Bvh2View m_view;
+    uint32_t m_ref = 0;    ///< node index, or first triangle of a leaf
+    uint32_t m_count = 0;  ///< 0: m_ref is a node; else the leaf's triangle count
+    bool m_split = false;  ///< the hybrid: the packet split, its rays walk alone (m_walk)
+    detail::SplitWalk m_walk;
+    detail::PacketStackEntry m_stack[kTraversalStackSize];
+};
+
+/// The fused packet loop: rays[0, n) traced as one packet; each ray's hit and work, and the
+/// packet's counts (any of hits, work, counts may be null). `split_below`: the hybrid's threshold
+/// (PacketStepper::set_split_below; 0: never split).
+void trace_packet_bvh2(const Bvh2View& bvh, const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits,
+                       WorkCounts* work, PacketCounts* counts, float split_below = 0.0f);
+
+}  // namespace rtsim

@@ -1,0 +1,101 @@
+#pragma once
+// A PacketStepper walks a packet of rays through one acceleration structure together, one packet
+// step at a time (Wald, Slusallek, Benthin & Wagner 2001, "Interactive rendering with coherent
+// ray tracing"): the rays share one traversal stack, a node is entered when any active ray hits
+// its box, and an active mask says which rays take part in each step. It is a Stepper whose
+// plan() is the packet's step: one fetch of the node (or leaf triangles) serves every active ray,
+// and its operations are the active rays' tests together, so whoever times single-ray plans
+// times packet steps with the same step-demand function.
+//
+//   begin_packet(rays, modes, n);
+//   while (!plan().done) { ...fetch plan().fetch[], then... execute(); }
+//   lane_hit(i), lane_work(i), counts()
+//
+// A ray's work counts are the steps it was active in (node steps, its box and triangle tests),
+// so a packet of one ray, or of copies of one ray, does each ray's single-ray work exactly.
+#include <cstdint>
+
+#include "traces/accel/stepper.h"
+#include "traces/isect/ray_box.h"
+#include "traces/isect/ray_triangle.h"
+
+namespace rtsim {
+
+/// Widest packet a stepper takes (one bit per ray in a LaneMask).
+constexpr uint32_t kMaxPacketLanes = 64;
+using LaneMask = uint64_t;
+
+inline LaneMask lane_bit(uint32_t i) { return LaneMask(1) << i; }
+inline uint32_t lane_count(LaneMask m) { return uint32_t(__builtin_popcountll(m)); }
+/// Calls f(i) for every set bit i of m, lowest first.
+template <class F>
+inline void for_each_lane(LaneMask m, F&& f) {
+    while (m) {
+        f(uint32_t(__builtin_ctzll(m)));
+        m &= m - 1;
+    }
+}
+
+/// What a packet's walk did as a whole (the per-ray work is each ray's WorkCounts).
+struct PacketCounts {
+    uint64_t node_steps = 0;   ///< packet steps that fetched a node (one fetch for the packet)
+    uint64_t leaf_steps = 0;   ///< packet steps that fetched a leaf's triangles
+    uint64_t active_rays = 0;  ///< active rays summed over the packet steps
+    uint64_t split_steps = 0;  ///< of these steps, those of single rays after the packet split (hybrid)
+    uint64_t splits = 0;       ///< 1 if the packet split (hybrid)
+    bool operator==(const PacketCounts& o) const {
+        return node_steps == o.node_steps && leaf_steps == o.leaf_steps && active_rays == o.active_rays &&
+               split_steps == o.split_steps && splits == o.splits;
+    }
+    PacketCounts& operator+=(const PacketCounts& o) {
+        node_steps += o.node_steps, leaf_steps += o.leaf_steps, active_rays += o.active_rays;
+        split_steps += o.split_steps, splits += o.splits;
+        return *this;
+    }
+};
+
+/// The per-ray state of a packet: rays, their precomputed tests, best hits, cull distances, work.
+struct PacketLanes {
+    uint32_t n = 0;
+    LaneMask live = 0;  ///< rays still traversing: valid, and (any-hit) not yet done
+    Ray ray[kMaxPacketLanes];
+    TraversalMode mode[kMaxPacketLanes];
+    RayBoxPre box[kMaxPacketLanes];
+    RayTrianglePre tri[kMaxPacketLanes];
+    float cull[kMaxPacketLanes];  ///< boxes entered beyond this are culled: best t widened
+    Hit hit[kMaxPacketLanes];     ///< best hit so far (t: the shrinking tmax)
+    WorkCounts work[kMaxPacketLanes];
+
+    /// Starts the packet (n <= kMaxPacketLanes; throws rtsim::Error otherwise). Invalid rays are
+    /// never live: a miss, no work.
+    void begin(const Ray* rays, const TraversalMode* modes, uint32_t count);
+    /// Rays without a hit report Hit{} (t = +inf).
+    void finish();
+};
+
+class PacketStepper : public Stepper {
+public:
+    virtual void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) = 0;
+    /// The hybrid (Benthin et al. 2012): from the next packet on, a packet whose active rays at a
+    /// node are fewer than `fraction` of its rays splits, and they finish as single rays (0: never).
+    void set_split_below(float fraction) { m_split_below = fraction; }
+    /// A packet of one ray.
+    void begin(const Ray& ray, TraversalMode mode) override { begin_packet(&ray, &mode, 1); }
+
+    uint32_t size() const { return m_lanes.n; }
+    const Ray& lane_ray(uint32_t i) const { return m_lanes.ray[i]; }
+    TraversalMode lane_mode(uint32_t i) const { return m_lanes.mode[i]; }
+    const Hit& lane_hit(uint32_t i) const { return m_lanes.hit[i]; }
+    const WorkCounts& lane_work(uint32_t i) const { return m_lanes.work[i]; }
+    /// Rays taking part in the planned step (0 once done).
+    uint32_t active() const { return m_plan.done ? 0 : lane_count(m_active); }
+    const PacketCounts& counts() const { return m_counts; }
+
+protected:
+    PacketLanes m_lanes;
+    LaneMask m_active = 0;  ///< the rays of the planned step
+    PacketCounts m_counts;
+    float m_split_below = 0.0f;
+};
+
+}  // namespace rtsim
