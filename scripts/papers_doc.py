@@ -30,7 +30,6 @@ from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
 MODULES = Path(__file__).resolve().parent / "papers"
-sys.path.insert(0, str(REPO / "python"))
 
 from rtsim.doc_markers import write_between  # noqa: E402
 

@@ -291,6 +291,10 @@ void validate(const SimConfig& config) {
             "config: 'traversal.model' " + std::string(kUnitModelChoices.name(config.traversal.model)) +
                 " is not supported at fidelity 'analytic' (its closed form costs each ray context on its own, "
                 "with no lock-step warps); use approx or detailed, or traversal.model mimd");
+    require(config.traversal.stack_overflow == StackOverflow::spill || config.traversal.model != UnitModel::packet,
+            "config: 'traversal.stack_overflow' restart_trail is not supported with traversal.model packet (a "
+            "packet's rays share one stack, and the restart trail is a single ray's); use traversal.model mimd or "
+            "simt, or stack_overflow spill");
     require(config.sampling.fraction == 0 || config.sampling.count == 0,
             "config: set 'sampling.fraction' or 'sampling.count', not both");
     require(!config.sampling.enabled() || !config.treelets.enabled,

@@ -98,6 +98,9 @@ def test_short_stack_is_refused_by_name_where_it_cannot_run(
     assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr
     r = simulate(sim_exe, traces["bvh2"], tmp_path / "c", "traversal.stack_overflow=pop")
     assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr
+    # a packet's rays share one stack; the restart trail is a single ray's
+    r = simulate(sim_exe, traces["bvh2"], tmp_path / "p", SHORT, "traversal.model=packet")
+    assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr and "packet" in r.stderr
     # analytic with functional caches steps every ray and takes it
     stats = checked(
         sim_exe, traces["bvh2"], tmp_path / "af", SHORT, "fidelity=analytic",

@@ -43,8 +43,8 @@ void Bvh2PacketStepper::plan_next() {
     } else {
         ++m_counts.leaf_steps;
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
-        m_plan.add_fetch(m_view.triangle_base + uint64_t(m_ref) * sizeof(HwTriangle),
-                         uint32_t(sizeof(HwTriangle) * m_count), DataKind::triangle);
+        const TriangleAddressing::Span span = m_view.tri_at.span(m_ref, m_count);
+        m_plan.add_fetch(span.address, span.bytes, DataKind::triangle);
         m_plan.add_op(OpKind::triangle, m_count * rays);
     }
 }
