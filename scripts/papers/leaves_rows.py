@@ -186,7 +186,7 @@ def rows_from(r: dict[str, Any]) -> list[dict[str, str]]:
                 "compact reduced-precision traversal unit; 3.4 Grays/s path tracing (simulated GPU)"
             ),
             "setup": "-",
-            "ours": "not measured: the reduced-precision box pipeline is not built on this branch",
+            "ours": "not measured: rtsim has no reduced-precision box pipeline yet",
             "why": "not built yet",
         },
         {
