@@ -8,6 +8,7 @@
 
 #include <systemc>
 
+#include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/common/stats.h"
 #include "rtl_model/traversal/cycle_accounting.h"
@@ -122,6 +123,17 @@ Cycle issue_stack_traffic(MemIf& mem, const MemoryMap& map, const StepDemand& d,
         ready = std::max(ready, mem.access({map.stack(owner, slot, bytes), bytes, false, DataKind::stack, t}));
     });
     return ready;
+}
+
+/// A unit with no ray in flight: false when dispatch is done; otherwise waits until dispatch
+/// releases the next frame's rays, held until this frame's last ray finishes (docs/model.md,
+/// "Frames"), records that frame and returns true.
+inline bool await_next_frame(sc_core::sc_port<RaySourceIf>& rays, uint32_t& frame) {
+    const sc_core::sc_event* released = rays->released();
+    if (rays->exhausted() || !released) return false;
+    if (rays->frame() == frame) sc_core::wait(*released);
+    frame = rays->frame();
+    return true;
 }
 
 }  // namespace rtsim

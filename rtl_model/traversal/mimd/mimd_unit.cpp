@@ -27,12 +27,7 @@ void MimdUnit::run() {
     fill_idle_contexts(0);
     for (;;) {
         if (m_events.empty() && !m_treelet_mode) {
-            // No ray in flight here. Dispatch is empty: done, unless it holds the next frame's
-            // rays until this frame's last ray finishes (frames, docs/model.md): wait for them.
-            const sc_core::sc_event* released = rays->released();
-            if (rays->exhausted() || !released) break;
-            if (rays->frame() == m_frame) wait(*released);
-            m_frame = rays->frame();
+            if (!await_next_frame(rays, m_frame)) break;  // no ray in flight here
             fill_idle_contexts(now);
             continue;
         }

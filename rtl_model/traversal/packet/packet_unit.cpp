@@ -48,12 +48,7 @@ void PacketUnit::run() {
     fill_idle_packets(0);
     for (;;) {
         if (m_events.empty()) {
-            // No packet in flight. Done, unless dispatch holds the next frame's rays until this
-            // frame's last ray finishes (docs/model.md, "Frames"): wait for them.
-            const sc_core::sc_event* released = rays->released();
-            if (rays->exhausted() || !released) break;
-            if (rays->frame() == m_frame) wait(*released);
-            m_frame = rays->frame();
+            if (!await_next_frame(rays, m_frame)) break;  // no packet in flight
             fill_idle_packets(now);
             continue;
         }

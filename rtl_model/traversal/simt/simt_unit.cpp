@@ -28,12 +28,7 @@ void SimtUnit::run() {
     fill_idle_warps(0);
     for (;;) {
         if (m_events.empty()) {
-            // No warp has a ray. Done, unless dispatch holds the next frame's rays until this
-            // frame's last ray finishes (docs/model.md, "Frames"): wait for them.
-            const sc_core::sc_event* released = rays->released();
-            if (rays->exhausted() || !released) break;
-            if (rays->frame() == m_frame) wait(*released);
-            m_frame = rays->frame();
+            if (!await_next_frame(rays, m_frame)) break;  // no warp has a ray
             fill_idle_warps(now);
             continue;
         }
