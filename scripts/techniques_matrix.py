@@ -13,7 +13,7 @@ Runs are cached in OUT (a run folder with a stats.json is reused; --fresh redoes
 OUT/matrix.json and, with --write-docs, the table between the `techniques_matrix` markers of
 docs/papers.md. Exits 1 if any run has a mismatch. Usage:
 
-    python scripts/techniques_matrix.py [--out out/techniques] [--resolution 96x72]
+    python scripts/techniques_matrix.py [--out out/techniques] [--resolution 160x120]
         [--workload diffuse] [--scenes sponza,hairball,cornell] [--levels approx,detailed]
         [--jobs 2] [--write-docs]
 """
@@ -213,7 +213,7 @@ def table(result: dict[str, Any]) -> str:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=Path("out/techniques"))
-    p.add_argument("--resolution", default="96x72")
+    p.add_argument("--resolution", default="160x120")
     p.add_argument("--workload", default="diffuse")
     p.add_argument("--scenes", default="sponza,hairball,cornell")
     p.add_argument("--levels", default="approx,detailed")
