@@ -46,6 +46,9 @@ struct MemRequest {
 class MemIf : public virtual sc_core::sc_interface {
 public:
     virtual Cycle access(const MemRequest& req) = 0;
+    /// Simulation speed only, no effect on the model's state: brings the host memory a read of
+    /// `addr` will look at (a cache's tags of its set) into the host's cache ahead of the read.
+    virtual void prefetch_host(uint64_t addr) const { (void)addr; }
 };
 
 /// Contract: `tests` tests in `issues` issues (the step-demand function's count at this

@@ -46,6 +46,13 @@ public:
     uint32_t top() const { return uint32_t(m_key[1] & (kMaxSlots - 1)); }
     Cycle top_time() const { return m_key[1] >> kSlotBits; }
     bool empty() const { return top_time() == kNever; }
+    /// The slot that would be the earliest without the top one (kMaxSlots: none): the smallest
+    /// of the subtrees beside the top's path, log2(slots) loads. A driver prefetches its data.
+    uint32_t runner_up() const {
+        uint64_t best = key(kNever, 0);
+        for (uint32_t n = m_leaves + top(); n > 1; n >>= 1) best = min(best, m_key[n ^ 1]);
+        return (best >> kSlotBits) == kNever ? kMaxSlots : uint32_t(best & (kMaxSlots - 1));
+    }
 
 private:
     static uint64_t key(Cycle time, uint32_t s) { return (time << kSlotBits) | s; }

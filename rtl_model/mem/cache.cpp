@@ -62,6 +62,14 @@ Cycle Cache::access(const MemRequest& req) {
     return done;
 }
 
+void Cache::prefetch_host(uint64_t addr) const {
+    const size_t set = size_t((addr >> m_line_shift) & m_set_mask) * m_config.ways;
+    __builtin_prefetch(&m_tags[set]);
+    __builtin_prefetch(&m_last_use[set]);
+    __builtin_prefetch(&m_fills[set]);
+    if (m_next_cache) m_next_cache->prefetch_host(addr);  // the L2's set, for an L1 miss
+}
+
 Cycle Cache::forward(const MemRequest& down) {
     if (!m_next_resolved) {
         m_next_cache = dynamic_cast<Cache*>(next.get_interface());

@@ -40,6 +40,9 @@ public:
           bool exact = false, ServedBy level = ServedBy::l1);
 
     Cycle access(const MemRequest& req) final;
+    /// Prefetches the host memory of the set `addr` maps to (tags, LRU stamps, fills), here and
+    /// in the next level when it is a cache.
+    void prefetch_host(uint64_t addr) const final;
     /// Functional warming (sampling, SMARTS): makes the lines of [addr, addr + bytes) present and
     /// most recently used, as a read would, with no time, no stats and no traffic below.
     /// Returns true when every line was already present (a hit: the level below would not see it).

@@ -29,6 +29,12 @@ public:
     /// The context that goes next and its time.
     uint32_t top() const { return m_tree.top(); }
     Cycle top_time() const { return m_tree.top_time(); }
+    /// The context that goes after the top one unless the top's handler schedules it earlier
+    /// (kNone: no other), so its data can be prefetched into the host's cache one event ahead.
+    uint32_t runner_up() const {
+        const uint32_t c = m_tree.runner_up();
+        return c == MinTree::kMaxSlots ? kNone : c;
+    }
     /// Takes the top context's event (see the header comment); returns the context.
     uint32_t begin_pop() {
         m_popped = m_tree.top();
@@ -40,8 +46,9 @@ public:
         m_popped = kNone;
     }
 
-private:
     static constexpr uint32_t kNone = 0xFFFFFFFFu;
+
+private:
     MinTree m_tree;
     uint32_t m_popped = kNone;
     bool m_rescheduled = false;

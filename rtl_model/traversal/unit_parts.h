@@ -105,6 +105,56 @@ struct UnitTally {
     }
 };
 
+/// The reads of one step (or warp step) issued together at `t`: the step waits for the slowest,
+/// and where that one's time went is what its wait is accounted as (the first read's on ties).
+class StepReads {
+public:
+    explicit StepReads(MemIf& mem, Cycle t) : m_mem(mem), m_t(t), m_ready(t) {}
+    void read(uint64_t addr, uint32_t bytes, DataKind kind) {
+        const Cycle done = m_mem.access({addr, bytes, false, kind, m_t, &m_info});
+        if (done > m_ready || m_first) m_slowest = m_info;
+        m_first = false;
+        m_ready = std::max(m_ready, done);
+    }
+    void read(const Fetch& f) { read(f.addr, f.bytes, f.kind); }
+    Cycle ready() const { return m_ready; }
+    const AccessInfo& slowest() const { return m_slowest; }
+
+private:
+    MemIf& m_mem;
+    Cycle m_t, m_ready;
+    AccessInfo m_info, m_slowest;
+    bool m_first = true;
+};
+
+/// Simulation speed only, no effect on the model: what a context's next step will touch on the
+/// host (the stepper's plan, the structure's data its execute() reads, the L1's tags of its
+/// first fetch), noted when the step is planned (all hot then) and prefetched one event before
+/// the step runs, without chasing pointers. The stepper prefetched the data when it planned the
+/// step, but other rays' events ran since and evicted it (the node load was the step's stall).
+class HostAhead {
+public:
+    void note(const Stepper& stepper) {
+        const StepPlan& plan = stepper.plan();
+        m_plan = &plan;
+        m_data = plan.done ? nullptr : plan.host;
+        m_bytes = plan.host_bytes;
+        m_fetch = plan.done || plan.fetch_count == 0 ? kNoFetch : plan.fetch[0].addr;
+    }
+    void prefetch(const MemIf& l1) const {
+        __builtin_prefetch(m_plan);
+        if (m_data) prefetch_range(m_data, m_bytes);
+        if (m_fetch != kNoFetch) l1.prefetch_host(m_fetch);
+    }
+
+private:
+    static constexpr uint64_t kNoFetch = ~0ull;
+    const void* m_plan = nullptr;
+    const void* m_data = nullptr;
+    uint32_t m_bytes = 0;
+    uint64_t m_fetch = kNoFetch;
+};
+
 /// A step's stack traffic (docs/model.md, "Traversal stack") for the spill slots of `owner`:
 /// entries beyond the on-chip stack written to memory (posted), spilled entries read back (the
 /// ray waits for them). `before` runs before each access (a sync where the access is shared).

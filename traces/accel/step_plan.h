@@ -8,6 +8,7 @@
 
 #include "traces/common/data_kind.h"
 #include "traces/common/op_kind.h"
+#include "traces/common/prefetch.h"
 
 namespace rtsim {
 
@@ -40,16 +41,28 @@ struct StepPlan {
     uint8_t op_count = 0;
     Fetch fetch[kMaxFetches];
     Op op[kMaxOps];
+    /// The host's copy of the data execute() reads first (null: not given). Simulation speed
+    /// only: a driver interleaving other rays prefetches it again just before the step runs.
+    const void* host = nullptr;
+    uint32_t host_bytes = 0;
 
     void reset(uint32_t locality_key) {
         done = false;
         locality = locality_key;
         fetch_count = op_count = 0;
+        host = nullptr;
     }
     void finish() {
         done = true;
         locality = kNoLocality;
         fetch_count = op_count = 0;
+        host = nullptr;
+    }
+    /// Records the host data the step reads and prefetches it into the host's cache now.
+    void set_host(const void* data, uint32_t bytes) {
+        host = data;
+        host_bytes = bytes;
+        prefetch_range(data, bytes);
     }
     void add_fetch(uint64_t addr, uint32_t bytes, DataKind kind) { fetch[fetch_count++] = Fetch{addr, bytes, kind}; }
     void add_op(OpKind kind, uint32_t count) { op[op_count++] = Op{kind, count}; }

@@ -13,6 +13,7 @@ MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
       m_costs(setup.costs),
       m_index(index),
       m_contexts(setup.config.ray_contexts),
+      m_ahead(setup.config.ray_contexts),
       m_events(setup.config.ray_contexts),
       m_sync(setup.context.quantum_cycles) {
     SC_THREAD(run);
@@ -42,6 +43,10 @@ void MimdUnit::run() {
         }
         const Cycle ready = m_events.top_time();
         const uint32_t c = m_events.begin_pop();
+        // The context after this one (unless this one comes back first) runs next: its step's
+        // host data is brought in while this event runs.
+        const uint32_t after = m_events.runner_up();
+        if (after != ContextQueue::kNone) m_ahead[after].prefetch(*mem[0]);
         // The scheduler takes one step per issue_cycles.
         Cycle t = std::max(ready, m_sched_free);
         m_sched_free = t + m_config.issue_cycles;
@@ -51,6 +56,7 @@ void MimdUnit::run() {
         if (m_ctx.sync_private_steps || m_contexts[c].phase != Phase::ops) m_sync(t);
         advance(c, t);
         m_events.finish_pop();
+        if (!m_events.empty() && m_events.top() != after) m_ahead[m_events.top()].prefetch(*mem[0]);
         if (m_prefetcher.on()) m_prefetcher.drain(*mem[0], t);
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
         if (!m_treelet_mode && rays->frame() != m_frame) {  // a frame was released: fill every context
@@ -97,6 +103,7 @@ bool MimdUnit::start_ray(uint32_t c, Cycle t) {
     ctx.ray.ray_id = job.id;
     ctx.ray.start = t;
     ctx.ray.stack = StackSplit{};
+    m_ahead[c].note(*ctx.ray.stepper);
     activate(c, t);
     // The ray record is read from memory before traversal starts.
     const Cycle fetch = t + m_ctx.dispatch_latency;
@@ -120,6 +127,7 @@ bool MimdUnit::take_parked_ray(uint32_t c, Cycle t) {
     if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_tally.rejected;
     ++m_takes;
     if (m_prefetcher.on()) m_prefetcher.enter(ctx.treelet, t);
+    m_ahead[c].note(*ctx.ray.stepper);
     activate(c, t);
     account(c, CycleUse::ray_buffer, ready);
     ctx.phase = Phase::step;
@@ -153,21 +161,16 @@ void MimdUnit::step(uint32_t c, Cycle t) {
     // operations phase issues what the demand says once the data has arrived.
     // The plan's reads go to memory as the plan holds them, before the step runs; a treelet
     // prefetcher learns the treelet's lines from them.
-    Cycle ready = t;
-    AccessInfo slowest, info;
-    bool first = true;
-    MemIf& memory = *mem[0];
+    StepReads reads(*mem[0], t);
     const bool learning = m_prefetcher.on();
     take_step_reading(*ctx.ray.stepper, ctx.ray.stack, m_costs, ctx.demand, [&](const Fetch& f) {
         if (learning) m_prefetcher.learn(ctx.treelet, f);
-        const Cycle done = memory.access({f.addr, f.bytes, false, f.kind, t, &info});
-        if (done > ready || first) slowest = info;
-        ready = std::max(ready, done);
-        first = false;
+        reads.read(f);
     });
-    account_read(c, ready, slowest);
+    m_ahead[c].note(*ctx.ray.stepper);
+    account_read(c, reads.ready(), reads.slowest());
     ctx.phase = Phase::ops;
-    schedule(c, ready);
+    schedule(c, reads.ready());
 }
 
 void MimdUnit::run_ops(uint32_t c, Cycle t) {

@@ -76,6 +76,8 @@ private:
     const StepCosts m_costs;
     uint32_t m_index;
     std::vector<Context> m_contexts;
+    std::vector<HostAhead> m_ahead;  ///< per context: its next step's host data (speed only; kept
+                                     ///< apart from the contexts so the look-up stays in the host's cache)
     ContextQueue m_events;  ///< each context's next phase, earliest first
     QuantumSync m_sync;
     Cycle m_sched_free = 0;

@@ -122,18 +122,11 @@ bool PacketUnit::start_packet(uint32_t p, Cycle t) {
     pk.weight = n;
     const Cycle fetch = start + m_ctx.dispatch_latency;
     account(p, CycleUse::dispatch, fetch);
-    Cycle ready = fetch;
-    AccessInfo slowest, info;
-    bool first = true;
-    m_coalescer.issue([&](uint64_t addr, uint32_t bytes, DataKind kind) {
-        const Cycle done = mem->access({addr, bytes, false, kind, fetch, &info});
-        if (done > ready || first) slowest = info;
-        first = false;
-        ready = std::max(ready, done);
-    });
-    account_read(p, ready, slowest);
+    StepReads reads(*mem[0], fetch);
+    m_coalescer.issue([&](uint64_t addr, uint32_t bytes, DataKind kind) { reads.read(addr, bytes, kind); });
+    account_read(p, reads.ready(), reads.slowest());
     pk.phase = Phase::step;
-    m_events.schedule(p, ready);
+    m_events.schedule(p, reads.ready());
     return true;
 }
 
@@ -156,19 +149,14 @@ void PacketUnit::step(uint32_t p, Cycle t) {
     m_active_rays += active;
     ++m_active_histogram[active];
     StepDemand& d = pk.demand;
-    take_step(*pk.stepper, pk.stack, m_costs, d);
-    Cycle ready = t;
-    AccessInfo slowest, info;
-    for (int i = 0; i < d.read_count; ++i) {
-        const Fetch& f = d.reads[i];
+    StepReads reads(*mem[0], t);
+    take_step_reading(*pk.stepper, pk.stack, m_costs, d, [&](const Fetch& f) {
         m_node_fetches += f.kind == DataKind::node;
-        const Cycle done = mem->access({f.addr, f.bytes, false, f.kind, t, &info});
-        if (done > ready || i == 0) slowest = info;
-        ready = std::max(ready, done);
-    }
-    account_read(p, ready, slowest);
+        reads.read(f);
+    });
+    account_read(p, reads.ready(), reads.slowest());
     pk.phase = Phase::ops;
-    m_events.schedule(p, ready);
+    m_events.schedule(p, reads.ready());
 }
 
 void PacketUnit::run_ops(uint32_t p, Cycle t) {

@@ -157,9 +157,8 @@ void SimtUnit::step(uint32_t w, Cycle t) {
         lane.stepping = lane.has_ray && step_class(lane.ray.stepper->plan()) == cls;
         if (!lane.stepping) continue;
         account_until(m_account, lane.accounted, CycleUse::issue, t);
-        take_step(*lane.ray.stepper, lane.ray.stack, m_costs, lane.demand);
-        for (int i = 0; i < lane.demand.read_count; ++i)
-            m_coalescer.add(lane.demand.reads[i].addr, lane.demand.reads[i].bytes, lane.demand.reads[i].kind);
+        take_step_reading(*lane.ray.stepper, lane.ray.stack, m_costs, lane.demand,
+                          [&](const Fetch& f) { m_coalescer.add(f.addr, f.bytes, f.kind); });
     }
     AccessInfo slowest;
     const Cycle ready = issue_reads(t, &slowest);
@@ -212,16 +211,10 @@ void SimtUnit::run_ops(uint32_t w, Cycle t) {
 }
 
 Cycle SimtUnit::issue_reads(Cycle t, AccessInfo* slowest) {
-    Cycle ready = t;
-    bool first = true;
-    AccessInfo info;
-    m_coalescer.issue([&](uint64_t addr, uint32_t bytes, DataKind kind) {
-        const Cycle done = mem->access({addr, bytes, false, kind, t, &info});
-        if (done > ready || first) *slowest = info;
-        first = false;
-        ready = std::max(ready, done);
-    });
-    return ready;
+    StepReads reads(*mem[0], t);
+    m_coalescer.issue([&](uint64_t addr, uint32_t bytes, DataKind kind) { reads.read(addr, bytes, kind); });
+    *slowest = reads.slowest();
+    return reads.ready();
 }
 
 void SimtUnit::account_idle(uint32_t w, Cycle until) {

@@ -1,9 +1,11 @@
-// InOrderResource and BandwidthCalendar: the reservation primitives every shared block uses.
+// InOrderResource and BandwidthCalendar: the reservation primitives every shared block uses;
+// MinTree, the earliest of per-slot times (event queues, MSHRs).
 #include <gtest/gtest.h>
 
 #include <map>
 
 #include "rtl_model/common/calendar.h"
+#include "rtl_model/common/min_tree.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -104,6 +106,35 @@ TEST(OccupancyCalendar, CapsOutstandingRequestsAtItsSlots) {
         last = std::max(last, s + 64);
     }
     EXPECT_NEAR(double(last), 1000.0 * 64 / 8, 1000.0 * 64 / 8 * 0.05);
+}
+
+TEST(MinTree, RunnerUpIsTheEarliestSlotBesideTheTop) {
+    MinTree t(6);
+    EXPECT_EQ(t.runner_up(), MinTree::kMaxSlots);  // empty
+    t.set(4, 30);
+    EXPECT_EQ(t.top(), 4u);
+    EXPECT_EQ(t.runner_up(), MinTree::kMaxSlots);  // only one slot set
+    t.set(1, 50), t.set(5, 40), t.set(2, 30);
+    EXPECT_EQ(t.top(), 2u);        // ties to the lower slot
+    EXPECT_EQ(t.runner_up(), 4u);  // the tie's other slot, in another subtree
+    t.set(2, 60);
+    EXPECT_EQ(t.top(), 4u);
+    EXPECT_EQ(t.runner_up(), 5u);  // 40, before slot 1 (50) and slot 2 (60)
+    // Against a scan, over a changing set of times (ties to the lower slot).
+    MinTree r(6);
+    Cycle times[6];
+    for (Cycle& c : times) c = MinTree::kNever;
+    uint64_t seed = 7;
+    for (int i = 0; i < 200; ++i) {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        const uint32_t slot = uint32_t(seed >> 60) % 6;
+        times[slot] = (seed >> 20) % 16;
+        r.set(slot, times[slot]);
+        uint32_t second = MinTree::kMaxSlots;
+        for (uint32_t s = 0; s < 6; ++s)
+            if (s != r.top() && times[s] != MinTree::kNever && (second == MinTree::kMaxSlots || times[s] < times[second])) second = s;
+        EXPECT_EQ(r.runner_up(), second);
+    }
 }
 
 }  // namespace

@@ -5,8 +5,6 @@
 
 #include <string>
 
-#include "traces/common/prefetch.h"
-
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -48,13 +46,13 @@ void Bvh2Stepper::plan_next() {
     // The host's copy of the data this step reads is prefetched now (traces/common/prefetch.h;
     // the node load was the model's largest stall).
     if (m_count == 0) {
-        prefetch_range(&m_view.nodes[m_ref], sizeof(HwNode));
         m_plan.reset(m_ref);
+        m_plan.set_host(&m_view.nodes[m_ref], sizeof(HwNode));
         m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
         m_plan.add_op(OpKind::box, 2);
     } else {
-        prefetch_range(m_view.triangles + m_ref, sizeof(HwTriangle) * m_count);
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
+        m_plan.set_host(m_view.triangles + m_ref, uint32_t(sizeof(HwTriangle) * m_count));
         const TriangleAddressing::Span s = m_view.tri_at.span(m_ref, m_count);
         m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
         m_plan.add_op(OpKind::triangle, m_count);
