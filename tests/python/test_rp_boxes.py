@@ -14,7 +14,7 @@ import pytest
 
 import rtsim
 from conftest import run_rtsim, sim_stats, simulate
-from rtsim.sweep.spec import SpecError, parse_spec
+from rtsim.sweep.spec import parse_spec
 
 
 @pytest.fixture(scope="module")
@@ -114,9 +114,4 @@ def test_the_knob_is_a_config_field_and_a_sweep_axis() -> None:
         "s.yaml",
     )
     assert {r.config.traversal.box_precision_bits for r in spec.runs()} == {0, 8, 12}
-    with pytest.raises(SpecError, match=r"traversal\.box_precision_bits"):
-        parse_spec(
-            "scenes: [cornell]\nworkloads: [{rays: [primary]}]\ngrid:\n"
-            "  traversal.box_precision_bits: [0, 40]\n",
-            "s.yaml",
-        )
+    # out-of-range values are refused by rtsim-sim naming the field (test above)
