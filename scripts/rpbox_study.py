@@ -51,7 +51,9 @@ def points(bits: list[int], detailed_bits: int) -> list[tuple[str, list[str], bo
     return out
 
 
-def row(scene: str, accel: str, name: str, stats: dict[str, Any], fp32: dict[str, Any]) -> dict[str, Any]:
+def row(
+    scene: str, accel: str, name: str, stats: dict[str, Any], fp32: dict[str, Any]
+) -> dict[str, Any]:
     s, f = stats["summary"], fp32["summary"]
     bp = stats.get("box_precision") or {}
     per_ray = bp.get("per_ray") or {}
@@ -76,7 +78,8 @@ def row(scene: str, accel: str, name: str, stats: dict[str, Any], fp32: dict[str
         "box_mm2": area,
         "box_mm2_vs_fp32": area / fp32_area,
         "box_nj_per_ray": stats["energy"]["per_ray_nj"]["box"],
-        "box_energy_vs_fp32": stats["energy"]["per_ray_nj"]["box"] / fp32["energy"]["per_ray_nj"]["box"],
+        "box_energy_vs_fp32": stats["energy"]["per_ray_nj"]["box"]
+        / fp32["energy"]["per_ray_nj"]["box"],
         "energy_vs_fp32": (stats["summary"].get("energy_per_ray_nj") or 0)
         / (fp32["summary"].get("energy_per_ray_nj") or 1),
     }
@@ -134,8 +137,9 @@ def table(study: dict[str, Any]) -> str:
     for r in rows:
         bits = "fp32" if r["bits"] == 23 else str(r["bits"])
         lines.append(
-            f"| {r['scene']} | {r['accel']} | {r['fidelity']} | {bits} | {r['box_hits_per_ray']:.3f} "
-            f"| {pct(r['extra_steps'])} | {pct(r['extra_box_tests'])} | {pct(r['extra_tri_tests'])} "
+            f"| {r['scene']} | {r['accel']} | {r['fidelity']} | {bits} "
+            f"| {r['box_hits_per_ray']:.3f} | {pct(r['extra_steps'])} "
+            f"| {pct(r['extra_box_tests'])} | {pct(r['extra_tri_tests'])} "
             f"| {r['dram_vs_fp32']:.3f}x | {r['speed_vs_fp32']:.3f}x "
             f"| {r['box_test_pj_vs_fp32']:.2f}x | {r['box_mm2_vs_fp32']:.2f}x "
             f"| {r['box_energy_vs_fp32']:.2f}x |"

@@ -7,6 +7,7 @@ field with its range and a sweep axis, refused by name where it cannot run."""
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +48,11 @@ def test_narrow_boxes_keep_hits_and_reference_work(
     traces: dict[str, Path], sim_exe: Path, tmp_path: Path, accel: str, level: str
 ) -> None:
     narrow = checked(
-        sim_exe, traces[accel], tmp_path / "n", "traversal.box_precision_bits=4", f"fidelity={level}"
+        sim_exe,
+        traces[accel],
+        tmp_path / "n",
+        "traversal.box_precision_bits=4",
+        f"fidelity={level}",
     )
     fp32 = checked(sim_exe, traces[accel], tmp_path / "f", f"fidelity={level}")
     assert "box_precision" not in fp32
@@ -69,7 +74,9 @@ def test_narrow_boxes_keep_hits_and_reference_work(
         assert steps > fp32_steps
 
 
-def test_extra_work_grows_as_bits_shrink(traces: dict[str, Path], sim_exe: Path, tmp_path: Path) -> None:
+def test_extra_work_grows_as_bits_shrink(
+    traces: dict[str, Path], sim_exe: Path, tmp_path: Path
+) -> None:
     seen = []
     for bits in (20, 12, 8, 4):
         stats = checked(
@@ -78,7 +85,7 @@ def test_extra_work_grows_as_bits_shrink(traces: dict[str, Path], sim_exe: Path,
         )  # fmt: skip
         bp = stats["box_precision"]
         seen.append((bp["steps"], bp["tri_tests"], bp["box_hits"], -bp["box_test_pj"]))
-    for finer, coarser in zip(seen, seen[1:], strict=False):
+    for finer, coarser in itertools.pairwise(seen):
         assert all(c >= f for f, c in zip(finer, coarser, strict=True)), seen
     assert seen[-1][0] > seen[0][0]
 
