@@ -39,6 +39,7 @@ struct TraversalConfig {
     uint32_t stack_entries = 8;      ///< on-chip traversal stack entries per ray; deeper entries spill
     uint32_t stack_entry_bytes = 0;  ///< bytes per stack entry; 0: the structure's (8 for a BVH, 12 for a kd-tree, ...)
     StackOverflow stack_overflow = StackOverflow::spill;  ///< a push onto a full on-chip stack: spill or drop and restart
+    uint32_t box_precision_bits = 0;  ///< box tests' mantissa bits; 0: fp32 (docs/accel.md, "Reduced-precision box tests")
     uint32_t issue_cycles = 1;       ///< cycles the unit's scheduler needs per traversal step
     uint32_t lanes = 8;              ///< simt: rays per warp, stepping in lock-step; packet: rays per packet
     SimtPolicy simt_policy = SimtPolicy::while_while;  ///< simt: which operation kind a warp runs next
@@ -58,6 +59,7 @@ struct TraversalConfig {
         v.field("stack_entries", stack_entries, "entries", "On-chip stack entries per ray; overflow spills to memory", 1, 64);
         v.field("stack_entry_bytes", stack_entry_bytes, "bytes", "Bytes per stack entry (on-chip stack and spill traffic); 0: the structure's own (a BVH's 8: node and entry distance; a kd-tree's or BIH's 12; an octree's 32), resolved from the trace", 0, 64);
         v.choice("stack_overflow", stack_overflow, kStackOverflowChoices, "A push onto a full on-chip stack: spill (the oldest entry goes to memory and is read back) or restart_trail (a short stack: the oldest entry is dropped; an empty stack with dropped entries restarts at the root along a restart trail, Laine 2010; single-level BVH traces: bvh2, the wide and compressed BVHs)");
+        v.field("box_precision_bits", box_precision_bits, "bits", "Explicit mantissa bits of a reduced-precision, conservative box pipeline (Keely 2014; Vaidyanathan et al. 2016): boxes, differences and slab distances rounded outward, so it accepts every box fp32 does and some more, whose subtrees are walked as extra work (hits unchanged); 0: fp32 (23 bits). Single-level BVH traces: bvh2, the wide and compressed BVHs", 0, 22);
         v.field("issue_cycles", issue_cycles, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100);
         v.field("lanes", lanes, "rays", "simt: rays per warp in lock-step; packet: rays per packet; ray_contexts must be a multiple (warps or packets = ray_contexts / lanes)", 4, 64);
         v.choice("simt_policy", simt_policy, kSimtPolicyChoices, "simt: while_while (a warp keeps its operation kind while any lane needs it) or if_if (kinds in turn each warp step), Aila & Laine 2009");

@@ -295,6 +295,14 @@ void validate(const SimConfig& config) {
             "config: 'traversal.stack_overflow' restart_trail is not supported with traversal.model packet (a "
             "packet's rays share one stack, and the restart trail is a single ray's); use traversal.model mimd or "
             "simt, or stack_overflow spill");
+    require(config.traversal.box_precision_bits == 0 || config.fidelity != Fidelity::analytic ||
+                config.analytic.caches == AnalyticCaches::functional,
+            "config: 'traversal.box_precision_bits' is not supported at fidelity 'analytic' with "
+            "analytic.caches=statistical (its per-trace analysis prices steps from the trace's work records, which "
+            "hold no extra walk); use analytic.caches=functional, approx or detailed, or box_precision_bits 0");
+    require(config.traversal.box_precision_bits == 0 || config.traversal.model != UnitModel::packet,
+            "config: 'traversal.box_precision_bits' is not supported with traversal.model packet (a packet's "
+            "shared walk has no per-ray extra walk); use traversal.model mimd or simt, or box_precision_bits 0");
     require(config.sampling.fraction == 0 || config.sampling.count == 0,
             "config: set 'sampling.fraction' or 'sampling.count', not both");
     require(!config.sampling.enabled() || !config.treelets.enabled,

@@ -27,6 +27,7 @@
 #include "sim/report/summary_schema.h"
 #include "sim/report/mailbox_stats.h"
 #include "sim/report/short_stack_stats.h"
+#include "sim/report/box_precision_stats.h"
 #include "sim/harness/structure_defaults.h"
 #include "sim/harness/trace_stream.h"
 #include "sim/report/verdict.h"
@@ -101,6 +102,7 @@ SimOutcome write_outputs(const SimOptions& o, const std::string& rtt, const json
     out.stats["summary"]["frames"] = 1;  // animated traces are refused (check_frames_supported)
     add_mailbox_stats(out.stats, o.config, r.work, r.rays);
     add_short_stack_stats(out.stats, o.config, r.work, r.rays);
+    add_box_precision_stats(out.stats, o.config, r.work, r.rays);
     add_energy_area(out.stats, o.config, r.work, r.rays);
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], r.model);
     json verdict = o.verdict && out.stats["summary"].value("rays", 0) > 0 ? verdict_of(r.model) : json(nullptr);
@@ -126,6 +128,7 @@ SimOutcome run_functional_caches(const SimOptions& o, TraceReader& reader, const
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
     apply_mailbox(*accel, o.config);
     apply_short_stack(*accel, o.config);
+    apply_box_precision(*accel, o.config);
     RunStats r;
     r.workload = scan_workload(reader);
     reader.verify_all();

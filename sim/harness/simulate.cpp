@@ -17,6 +17,7 @@
 #include "sim/harness/run_files.h"
 #include "sim/report/mailbox_stats.h"
 #include "sim/report/short_stack_stats.h"
+#include "sim/report/box_precision_stats.h"
 #include "sim/report/two_level_stats.h"
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/model_errors.h"
@@ -84,7 +85,9 @@ json run_functional(Accel& accel, TraceReader& reader, HitChecker& checker, cons
     TraceRayStream stream(reader);
     std::vector<RayJob> jobs;
     // A short stack's restarts are counted by the steppers; the fused reference loops walk a full one.
-    const std::unique_ptr<Stepper> stepper = accel.short_stack_entries() ? accel.make_stepper() : nullptr;
+    // So is a reduced-precision box pipeline's extra walk.
+    const bool shadows = accel.short_stack_entries() || accel.box_precision_bits();
+    const std::unique_ptr<Stepper> stepper = shadows ? accel.make_stepper() : nullptr;
     uint32_t frame = 0;
     accel.bind_frame(0);
     while (stream.read_chunk(65536, &jobs)) {
@@ -130,6 +133,7 @@ SimOutcome run_simulation(const SimOptions& options) {
     const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), rtt);
     apply_mailbox(*accel, o.config);
     apply_short_stack(*accel, o.config);
+    apply_box_precision(*accel, o.config);
     // Animated traces (frames.h): replayed frame after frame, caches warm, one barrier between.
     const std::vector<FrameRecord> frames = read_frame_table(reader, accel->frame_count());
     check_frames_supported(o.config, frames.size(), rtt);
@@ -269,6 +273,7 @@ SimOutcome run_simulation(const SimOptions& options) {
     // never sees them.
     add_mailbox_stats(out.stats, o.config, checker.work_totals(), checker.checked());
     add_short_stack_stats(out.stats, o.config, checker.work_totals(), checker.checked());
+    add_box_precision_stats(out.stats, o.config, checker.work_totals(), checker.checked());
     if (accel->kind() == "two_level") add_two_level_stats(out.stats, checker.work_totals(), checker.checked());
     add_energy_area(out.stats, o.config, checker.work_totals(), checker.checked());
     out.stats["roofline"] = roofline_json(o.config, out.stats["summary"], model);

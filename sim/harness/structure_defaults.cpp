@@ -1,5 +1,7 @@
 #include "sim/harness/structure_defaults.h"
 
+#include <string>
+
 #include "sim/harness/run_files.h"
 #include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
@@ -28,6 +30,15 @@ void apply_short_stack(Accel& accel, const SimConfig& config) {
             "config: 'traversal.stack_overflow' restart_trail needs a single-level BVH trace (bvh2, or a wide or "
             "compressed BVH); this trace's structure is '" + accel.kind() + "'; use traversal.stack_overflow spill");
     accel.set_short_stack(t.stack_entries);
+}
+
+void apply_box_precision(Accel& accel, const SimConfig& config) {
+    const uint32_t bits = config.traversal.box_precision_bits;
+    require(bits == 0 || accel.supports_reduced_precision_boxes(),
+            "config: 'traversal.box_precision_bits' " + std::to_string(bits) +
+                " needs a single-level BVH trace (bvh2, or a wide or compressed BVH); this trace's structure is '" +
+                accel.kind() + "'; use traversal.box_precision_bits 0 (fp32)");
+    accel.set_box_precision(bits);
 }
 
 }  // namespace rtsim

@@ -21,4 +21,9 @@ inline void apply_mailbox(Accel& accel, const SimConfig& config) { accel.set_mai
 /// trace's structure has no short-stack walk.
 void apply_short_stack(Accel& accel, const SimConfig& config);
 
+/// Gives the structure's steppers the configured reduced-precision box test
+/// (traversal.box_precision_bits). Throws rtsim::Error naming the field when the trace's
+/// structure cannot count its extra walk.
+void apply_box_precision(Accel& accel, const SimConfig& config);
+
 }  // namespace rtsim

@@ -97,6 +97,17 @@ double flops_um2(const EnergyConfig& c, const Flops& f) {
            c.datapath_overhead;
 }
 
+/// A test's operations on a reduced-precision datapath, counted in fp32 equivalents: `bits`
+/// explicit mantissa bits (0: fp32, unchanged). An adder's or comparator's area and energy grow
+/// about linearly with its word width (sign, 8 exponent bits, the fraction: 32 for fp32), a
+/// multiplier's with its significand width squared (the partial-product array; 24 for fp32);
+/// Keely 2014 builds the box tests this way. Our first-order assumption (docs/energy_area.md).
+Flops at_precision(const Flops& f, uint32_t bits) {
+    if (bits == 0) return f;
+    const double word = (bits + 9.0) / 32.0, sig = (bits + 1.0) / 24.0;
+    return {f.add * word, f.mul * sig * sig, f.cmp * word, f.div * sig * sig};
+}
+
 /// A block's stat by its declared key (`block`), 0 when the level wrote null.
 double num(const StatBlock& block, const json& j, const char* key) {
     const json& v = StatsReader(block, j)[key];
@@ -148,7 +159,7 @@ json area_json(const SimConfig& s, const json& stats) {
     mm2["ray_buffer"] = s.treelets.enabled ? sram_mm2(c, double(s.treelets.buffer_kib) * 1024) : 0.0;
     mm2["stacks"] = sram_mm2(c, double(t.units) * t.ray_contexts * t.stack_entries * t.stack_entry_bytes);
     mm2["ray_contexts"] = sram_mm2(c, double(t.units) * t.ray_contexts * kContextStateBytes);
-    mm2["box"] = pipeline_mm2(c, s, s.box, kBoxFlops);
+    mm2["box"] = pipeline_mm2(c, s, s.box, at_precision(kBoxFlops, t.box_precision_bits));
     mm2["triangle"] = pipeline_mm2(c, s, s.triangle, kTriangleFlops);
     mm2["anyhit"] = instantiated(stats.value("instantiated", json::array()), "anyhit")
                         ? pipeline_mm2(c, s, s.anyhit, kAnyhitFlops)
@@ -167,6 +178,11 @@ json area_json(const SimConfig& s, const json& stats) {
 }
 
 }  // namespace
+
+BoxPipelineCost box_pipeline_cost(const SimConfig& config, uint32_t bits) {
+    const Flops f = at_precision(kBoxFlops, bits);
+    return {flops_pj(config.energy, f) * energy_scale(config.energy), pipeline_mm2(config.energy, config, config.box, f)};
+}
 
 double area_total_mm2(const SimConfig& config, const json& instantiated) {
     return area_json(config, json{{"instantiated", instantiated}})["total_mm2"].get<double>();
@@ -217,7 +233,8 @@ double sram_mm2(const EnergyConfig& c, double bytes) {
 
 void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint64_t rays) {
     const EnergyConfig& c = s.energy;
-    const OpEnergies op = op_energies(c);
+    OpEnergies op = op_energies(c);
+    op.test[size_t(OpKind::box)] = box_pipeline_cost(s, s.traversal.box_precision_bits).test_pj;
     const json& model = stats.value("model", json::object());
     json& summary = stats["summary"];
     const TraversalConfig& t = s.traversal;
@@ -227,9 +244,13 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     json pj = json::object();
     for (int k = 0; k < kOpKindCount; ++k)
         pj[op_kind_name(OpKind(k))] = double(w[work_field_of(OpKind(k))]) * op[OpKind(k)];
-    // A short stack's restarts re-test the boxes of the nodes they revisit.
-    if (w[WorkField::restart_box_tests])
-        pj["box"] = pj["box"].get<double>() + double(w[WorkField::restart_box_tests]) * op[OpKind::box];
+    // A short stack's restarts re-test the boxes of the nodes they revisit; a reduced-precision
+    // box pipeline's extra walk tests boxes and triangles (accel/rp_boxes.h).
+    if (w[WorkField::restart_box_tests] || w[WorkField::rp_box_tests])
+        pj["box"] = pj["box"].get<double>() +
+                    double(w[WorkField::restart_box_tests] + w[WorkField::rp_box_tests]) * op[OpKind::box];
+    if (w[WorkField::rp_tri_tests])
+        pj["triangle"] = pj["triangle"].get<double>() + double(w[WorkField::rp_tri_tests]) * op[OpKind::triangle];
     if (s.mailbox.entries) {
         // A lookup compares the reference with the ray's whole table (its entries read); a test
         // run records its primitive (one id written).
@@ -241,7 +262,7 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     // Traversal units: the ray's setup, and per step a read of the context's ray state and one
     // stack push or pop, each in the unit's SRAM of that kind.
     pj["traversal"] = double(rays) * op.ray_setup +
-                      double(w[WorkField::steps]) * (sram_access_pj(c, t.ray_contexts * kContextStateBytes, kContextReadBytes * 8) +
+                      double(w[WorkField::steps] + w[WorkField::rp_steps]) * (sram_access_pj(c, t.ray_contexts * kContextStateBytes, kContextReadBytes * 8) +
                                          sram_access_pj(c, double(t.ray_contexts) * t.stack_entries * t.stack_entry_bytes,
                                                         t.stack_entry_bytes * 8.0));
     const bool has_memory = model.contains("l1") || model.contains("ideal_memory");

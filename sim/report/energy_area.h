@@ -38,6 +38,15 @@ double sram_access_pj(const EnergyConfig& c, double bytes, double bits);
 /// Area of an SRAM of `bytes` of data at the configured node, mm^2 (without tags).
 double sram_mm2(const EnergyConfig& c, double bytes);
 
+/// The box pipelines at a mantissa width (traversal.box_precision_bits; 0: fp32): one test's
+/// energy, pJ, and all box pipelines' area, mm^2 (docs/energy_area.md, "Reduced-precision box
+/// pipeline": adders and comparators scale with the word width, multipliers with the significand
+/// width squared).
+struct BoxPipelineCost {
+    double test_pj = 0, mm2 = 0;
+};
+BoxPipelineCost box_pipeline_cost(const SimConfig& config, uint32_t bits);
+
 /// Adds `energy` and `area` to stats and `energy_per_ray_nj`, `mrays_per_joule`, `area_mm2` and
 /// `power_w` to stats["summary"] (null where the level cannot know them). Reads stats["model"],
 /// stats["summary"] (rays_per_second: the estimate of a sampled run) and stats["instantiated"].

@@ -14,6 +14,7 @@
 #include "sim/report/mailbox_stats.h"
 #include "sim/report/roofline.h"
 #include "sim/report/short_stack_stats.h"
+#include "sim/report/box_precision_stats.h"
 #include "sim/report/two_level_stats.h"
 #include "sim/report/summary_schema.h"
 #include "sim/report/verdict.h"
@@ -29,7 +30,7 @@ std::vector<const StatBlock*> stats_blocks() {
             &dispatch_stats(),   &ray_buffer_stats(),   &unit_stats(),       &pipeline_stats(),
             &cache_stats(),      &dram_stats(),         &cycle_accounting_stats(), &utilization_stats(),
             &analytic_stats(),   &ideal_memory_stats(), &provenance_stats(), &mailbox_stats(),
-            &short_stack_stats(), &two_level_stats()};
+            &short_stack_stats(), &two_level_stats(), &box_precision_stats()};
 }
 
 void check_run_stats(const nlohmann::json& stats, bool sampled) {
@@ -46,6 +47,7 @@ void check_run_stats(const nlohmann::json& stats, bool sampled) {
     if (stats.contains("mailbox")) mailbox_stats().check(stats.at("mailbox"));
     if (stats.contains("short_stack")) short_stack_stats().check(stats.at("short_stack"));
     if (stats.contains("two_level")) two_level_stats().check(stats.at("two_level"));
+    if (stats.contains("box_precision")) box_precision_stats().check(stats.at("box_precision"));
     validation_stats().check(stats.at("validation"));
     latency_stats().check(stats.at("latency"));
     workload_stats().check(stats.at("workload"));

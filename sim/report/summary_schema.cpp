@@ -133,6 +133,7 @@ const StatBlock& run_stats() {
             {"roofline", "", "the run against its throughput ceilings (below); `null` at functional"},
             {"mailbox", "", "only when `mailbox.entries > 0`: the mailboxes' lookups, hits and the triangle tests and fetches they saved (below)", false, true},
             {"short_stack", "", "only when `traversal.stack_overflow = restart_trail`: entries dropped, restarts and the re-traversal they cost (below)", false, true},
+            {"box_precision", "", "only when `traversal.box_precision_bits > 0`: the reduced-precision box pipeline's extra walk, its energy and area beside fp32's (below)", false, true},
             {"two_level", "", "only for two-level traces, at the levels that step every ray: the TLAS's and the BLASes' steps and box tests (below)", false, true},
             {"frames", "list", "one entry per frame of the trace (below): a single entry for a trace without frames; absent at the analytic level (it does not replay frames)", false, true},
         }};

@@ -73,6 +73,13 @@ public:
     /// work is counted in the model-only work fields. trace() always walks a full stack.
     void set_short_stack(uint32_t entries) { m_short_stack_entries = entries; }
     uint32_t short_stack_entries() const { return m_short_stack_entries; }
+    /// True when the steppers can count a reduced-precision box pipeline's extra walk (rp_boxes.h).
+    virtual bool supports_reduced_precision_boxes() const { return false; }
+    /// Mantissa bits of the steppers' reduced-precision box test from now on (0: fp32 alone, the
+    /// default; docs/accel.md, "Reduced-precision box tests"). Hits and the reference work never
+    /// change; the extra walk's work is counted in the model-only work fields.
+    void set_box_precision(uint32_t bits) { m_box_precision_bits = bits; }
+    uint32_t box_precision_bits() const { return m_box_precision_bits; }
     /// True when some triangle is alpha-MASKed (the any-hit stage is then needed).
     bool has_anyhit_triangles() const;
     /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
@@ -90,6 +97,7 @@ protected:
     TriangleStore m_triangles;
     uint32_t m_mailbox_entries = 0;
     uint32_t m_short_stack_entries = 0;
+    uint32_t m_box_precision_bits = 0;
 };
 
 /// How to build a structure: which kind, which builder for its tree, and the builder's config.

@@ -32,7 +32,9 @@
 // tri_tests + mailbox_hits equals the triangle tests without one.
 // A short stack's counts (docs/accel.md, "Short stacks"): the work its restarts add on top of
 // the full stack's, which the reference fields keep counting unchanged. The TLAS's share of a
-// two-level walk's steps and box tests (docs/accel.md, "Two-level structures").
+// two-level walk's steps and box tests (docs/accel.md, "Two-level structures"). The extra work of
+// a reduced-precision box pipeline: the subtrees its looser test enters that the fp32 test does
+// not (docs/accel.md, "Reduced-precision box tests"), on top of the reference work.
 #define RTSIM_MODEL_WORK_FIELDS(X)                                                                  \
     X(mailbox_lookups, kNoOpKind, false, "primitive references looked up in the ray's mailbox")    \
     X(mailbox_hits, kNoOpKind, false, "references found there: triangle neither fetched nor tested") \
@@ -41,7 +43,11 @@
     X(restart_steps, kNoOpKind, true, "short stack: node steps a restart's re-descent revisited")  \
     X(restart_box_tests, kNoOpKind, false, "short stack: box tests of those revisits")           \
     X(tlas_steps, kNoOpKind, false, "two-level: the steps that walked the TLAS (also in steps)")    \
-    X(tlas_box_tests, kNoOpKind, false, "two-level: their box tests (also in box_tests)")
+    X(tlas_box_tests, kNoOpKind, false, "two-level: their box tests (also in box_tests)")         \
+    X(rp_box_hits, kNoOpKind, false, "reduced-precision boxes: entered, though fp32 rejects or culls them") \
+    X(rp_steps, kNoOpKind, true, "reduced-precision boxes: node steps inside those boxes")           \
+    X(rp_box_tests, kNoOpKind, false, "reduced-precision boxes: box tests of those steps")          \
+    X(rp_tri_tests, kNoOpKind, false, "reduced-precision boxes: triangle tests in their leaves (no hit)")
 
 #define RTSIM_ALL_WORK_FIELDS(X) RTSIM_WORK_FIELDS(X) RTSIM_MODEL_WORK_FIELDS(X)
 
@@ -78,11 +84,13 @@ struct WorkCounts {
         return w;
     }
     /// What a trace records for the same traversal: without the mailbox, without a short
-    /// stack's restarts (their work is on top of the full stack's) and the TLAS's share.
+    /// stack's restarts and reduced-precision boxes' extra work (both on top of the reference
+    /// walk's) and the TLAS's share.
     WorkCounts traced() const {
         WorkCounts w = without_mailbox();
         w.stack_drops = w.restarts = w.restart_steps = w.restart_box_tests = 0;
         w.tlas_steps = w.tlas_box_tests = 0;
+        w.rp_box_hits = w.rp_steps = w.rp_box_tests = w.rp_tri_tests = 0;
         return w;
     }
 };

@@ -55,6 +55,7 @@ public:
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return kTraversalStackSize; }
     bool supports_short_stack() const override { return true; }
+    bool supports_reduced_precision_boxes() const override { return true; }
     const Bvh2View& view() const { return m_view; }
 
 private:

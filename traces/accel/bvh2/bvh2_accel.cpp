@@ -177,7 +177,7 @@ Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::m
 }
 
 std::unique_ptr<Stepper> Bvh2Accel::make_stepper() const {
-    return std::make_unique<Bvh2Stepper>(m_view, m_short_stack_entries);
+    return std::make_unique<Bvh2Stepper>(m_view, m_short_stack_entries, m_box_precision_bits);
 }
 
 Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {

@@ -6,10 +6,20 @@
 #include <string>
 
 #include "traces/common/error.h"
+#include "traces/isect/ray_box_rp.h"
 
 namespace rtsim {
 
 using detail::cull_distance;
+
+namespace {
+
+/// Child c's box of a binary node, per axis.
+void child_box(const HwNode& node, int c, float lo[3], float hi[3]) {
+    for (int a = 0; a < 3; ++a) lo[a] = node.lo(c, a), hi[a] = node.hi(c, a);
+}
+
+}  // namespace
 
 namespace detail {
 
@@ -28,6 +38,7 @@ void Bvh2Stepper::begin(const Ray& ray, TraversalMode mode) {
     m_stack_size = 0;
     m_depth = 0;
     m_short.begin();
+    m_rp.begin();
     if (!ray_is_valid(ray) || m_view.node_count == 0) {
         finish();
         return;
@@ -42,32 +53,41 @@ void Bvh2Stepper::begin(const Ray& ray, TraversalMode mode) {
     plan_next();
 }
 
-void Bvh2Stepper::plan_next() {
+void Bvh2Stepper::plan_at(uint32_t ref, uint32_t count) {
     // The host's copy of the data this step reads is prefetched now (traces/common/prefetch.h;
     // the node load was the model's largest stall).
-    if (m_count == 0) {
-        m_plan.reset(m_ref);
-        m_plan.set_host(&m_view.nodes[m_ref], sizeof(HwNode));
-        m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+    if (count == 0) {
+        m_plan.reset(ref);
+        m_plan.set_host(&m_view.nodes[ref], sizeof(HwNode));
+        m_plan.add_fetch(m_view.node_base + uint64_t(ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
         m_plan.add_op(OpKind::box, 2);
     } else {
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
-        m_plan.set_host(m_view.triangles + m_ref, uint32_t(sizeof(HwTriangle) * m_count));
-        const TriangleAddressing::Span s = m_view.tri_at.span(m_ref, m_count);
+        m_plan.set_host(m_view.triangles + ref, uint32_t(sizeof(HwTriangle) * count));
+        const TriangleAddressing::Span s = m_view.tri_at.span(ref, count);
         m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-        m_plan.add_op(OpKind::triangle, m_count);
+        m_plan.add_op(OpKind::triangle, count);
     }
 }
 
 StepOutcome Bvh2Stepper::execute() {
     StepOutcome out;
     if (m_plan.done) return out;
+    if (m_rp.walking()) {
+        rp_step();
+        return out;
+    }
     if (m_short.replaying()) {
         replay_step();
     } else if (m_count == 0) {
         visit_node(m_view.nodes[m_ref]);
     } else {
         out.add_op(OpKind::anyhit, visit_leaf(m_view.triangles + m_ref));
+    }
+    // Boxes only the reduced-precision test entered are walked before the step just planned.
+    if (m_rp.pending()) {
+        m_rp.start(m_plan);
+        plan_at(m_rp.next().ref, m_rp.next().count);
     }
     return out;
 }
@@ -76,8 +96,15 @@ void Bvh2Stepper::visit_node(const HwNode& node) {
     // Nearer child next (child 0 on equal entry distances); the farther one pushed.
     const int before = m_stack_size;
     if (m_short.enabled()) m_short.visit(m_ref, m_depth);
+    float rp_tnear[2];
+    if (m_rp.enabled()) rp_tests(node, rp_tnear);
     if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count))
         return pop_next();
+    if (m_rp.enabled() && m_stack_size > before) {
+        const detail::Bvh2StackEntry& pushed = m_stack[m_stack_size - 1];
+        const int slot = pushed.ref == node.child_ref[0] && pushed.count == node.child_count[0] ? 0 : 1;
+        m_rp_tnear[m_stack_size - 1] = rp_tnear[slot];
+    }
     if (m_short.enabled()) {
         if (m_stack_size > before) {
             m_entry_depth[m_stack_size - 1] = m_depth + 1;
@@ -109,7 +136,14 @@ void Bvh2Stepper::pop_next() {
     while (m_stack_size > 0) {
         const detail::Bvh2StackEntry& e = m_stack[--m_stack_size];
         if (m_short.enabled()) restart |= m_short.pop();
-        if (e.tnear > m_cull_t) continue;
+        if (e.tnear > m_cull_t) {
+            // The narrower test's entry distance may be near enough: the hardware visits it.
+            if (m_rp.enabled() && m_rp_tnear[m_stack_size] <= m_cull_t) {
+                m_work.rp_box_hits += 1;
+                m_rp.enter(e.ref, e.count);
+            }
+            continue;
+        }
         m_ref = e.ref;
         m_count = e.count;
         if (m_short.enabled()) m_depth = m_entry_depth[m_stack_size];
@@ -143,6 +177,43 @@ void Bvh2Stepper::replay_step() {
     if (m_short.replaying()) plan_replay();
     else if (m_resume) plan_next();
     else finish();
+}
+
+void Bvh2Stepper::rp_tests(const HwNode& node, float tnear[2]) {
+    for (int c = 0; c < 2; ++c) {
+        if (node.child_count[c] == kEmptyChild) continue;
+        float lo[3], hi[3];
+        child_box(node, c, lo, hi);
+        float t32 = 0.0f;  // the fp32 test is the node kernel's arithmetic (ray_box_kernel.h)
+        const bool fp32 = detail::box_kernel(m_box, lo, hi, m_ray.tmin, m_cull_t, &t32);
+        if (intersect_box_rp(m_box, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &tnear[c]) && !fp32) {
+            m_work.rp_box_hits += 1;
+            m_rp.enter(node.child_ref[c], node.child_count[c]);
+        }
+    }
+}
+
+void Bvh2Stepper::rp_step() {
+    // The extra walk tests with the narrower test alone; its leaves' fp32 triangle tests cannot
+    // hit (rp_boxes.h), so they are counted, not run.
+    const ReducedPrecisionBoxes::Entry e = m_rp.pop();
+    if (e.count == 0) {
+        const HwNode& node = m_view.nodes[e.ref];
+        m_work.rp_steps += 1;
+        m_work.rp_box_tests += 2;
+        for (int c = 0; c < 2; ++c) {
+            if (node.child_count[c] == kEmptyChild) continue;
+            float lo[3], hi[3];
+            child_box(node, c, lo, hi);
+            float t = 0.0f;
+            if (intersect_box_rp(m_box, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &t))
+                m_rp.enter(node.child_ref[c], node.child_count[c]);
+        }
+    } else {
+        m_work.rp_tri_tests += e.count;
+    }
+    if (!m_rp.empty()) plan_at(m_rp.next().ref, m_rp.next().count);
+    else m_plan = m_rp.resume();
 }
 
 void Bvh2Stepper::finish() {

@@ -10,11 +10,14 @@
 // alpha test for each MASK triangle hit (reported by execute()).
 //
 // With a short stack (set by the Accel; traces/accel/short_stack.h) a restart's re-descent adds
-// node steps of the same shape, counted in the model-only restart fields.
+// node steps of the same shape, counted in the model-only restart fields. With reduced-precision
+// box tests (traces/accel/rp_boxes.h) the subtrees only the narrower test enters add node and
+// leaf steps of the same shapes, counted in the model-only rp_* fields.
 #include <cstdint>
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
 #include "traces/accel/leaf_blocks.h"
+#include "traces/accel/rp_boxes.h"
 #include "traces/accel/short_stack.h"
 #include "traces/accel/stepper.h"
 #include "traces/bvh/hw_layout.h"
@@ -35,8 +38,10 @@ struct Bvh2View {
 
 class Bvh2Stepper final : public Stepper {
 public:
-    explicit Bvh2Stepper(const Bvh2View& view, uint32_t short_stack_entries = 0) : m_view(view) {
+    explicit Bvh2Stepper(const Bvh2View& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0)
+        : m_view(view) {
         m_short.configure(short_stack_entries);
+        m_rp.configure(box_precision_bits);
     }
 
     void begin(const Ray& ray, TraversalMode mode) override;
@@ -46,10 +51,15 @@ private:
     void visit_node(const HwNode& node);
     uint32_t visit_leaf(const HwTriangle* triangles);
     void pop_next();
-    void plan_next();
+    void plan_next() { plan_at(m_ref, m_count); }
+    void plan_at(uint32_t ref, uint32_t count);  ///< a node (count 0) or a leaf's triangles
     void begin_restart(uint32_t depth, bool resume);
     void plan_replay();  ///< the next node a short stack's restart revisits
     void replay_step();
+    /// Reduced-precision boxes: tests both children with the narrower test, hands the boxes only
+    /// it accepts to m_rp and writes its entry distances.
+    void rp_tests(const HwNode& node, float tnear[2]);
+    void rp_step();  ///< one step of the extra walk (rp_boxes.h)
     void finish();  ///< the plan is done; a ray without a hit reports Hit{} (t = +inf)
 
     Bvh2View m_view;
@@ -64,6 +74,9 @@ private:
     bool m_resume = false;  ///< after the re-descent: m_ref/m_count (true) or the end (false)
     uint32_t m_entry_depth[kTraversalStackSize];
     ShortStack m_short;
+    // Reduced-precision boxes only: each entry's entry distance by the narrower test, and the shadow.
+    float m_rp_tnear[kTraversalStackSize];
+    ReducedPrecisionBoxes m_rp;
 };
 
 }  // namespace rtsim

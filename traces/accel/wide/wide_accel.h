@@ -144,9 +144,10 @@ public:
     }
 
     std::unique_ptr<Stepper> make_stepper() const override {
-        return std::make_unique<WideStepper<Codec>>(m_view, m_short_stack_entries);
+        return std::make_unique<WideStepper<Codec>>(m_view, m_short_stack_entries, m_box_precision_bits);
     }
     bool supports_short_stack() const override { return true; }
+    bool supports_reduced_precision_boxes() const override { return true; }
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override {
         if constexpr (Codec::kFused) {
             if (m_view.order == ChildOrder::distance) return Codec::fused(m_view, ray, mode, work);

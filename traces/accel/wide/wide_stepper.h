@@ -10,18 +10,22 @@
 // for each MASK triangle hit. Popped entries entered beyond the best hit are dropped unfetched.
 // Hit rules, cull distance and any-hit termination are every structure's (leaf_kernel.h).
 // With a short stack (set by the Accel; traces/accel/short_stack.h) a restart's re-descent adds
-// node steps of the same shape, counted in the model-only restart fields.
+// node steps of the same shape, counted in the model-only restart fields. With reduced-precision
+// box tests (traces/accel/rp_boxes.h) the subtrees only the narrower test enters add node and
+// leaf steps of the same shapes, counted in the model-only rp_* fields.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "traces/accel/leaf_blocks.h"
+#include "traces/accel/rp_boxes.h"
 #include "traces/accel/short_stack.h"
 #include "traces/accel/stepper.h"
 #include "traces/accel/wide/wide_kernel.h"
 #include "traces/common/error.h"
 #include "traces/common/hw_triangle.h"
 #include "traces/isect/leaf_kernel.h"
+#include "traces/isect/ray_box_rp.h"
 #include "traces/isect/ray_triangle.h"
 
 namespace rtsim {
@@ -44,10 +48,12 @@ struct WideView {
 template <class Codec>
 class WideStepper final : public Stepper {
 public:
-    explicit WideStepper(const WideView& view, uint32_t short_stack_entries = 0)
+    explicit WideStepper(const WideView& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0)
         : m_view(view), m_stack(std::max<uint32_t>(1, view.max_stack)) {
         m_short.configure(short_stack_entries);
         if (m_short.enabled()) m_entry_depth.resize(m_stack.size());
+        m_rp.configure(box_precision_bits);
+        if (m_rp.enabled()) m_rp_tnear.resize(m_stack.size());
     }
 
     void begin(const Ray& ray, TraversalMode mode) override {
@@ -58,6 +64,7 @@ public:
         m_stack_size = 0;
         m_depth = 0;
         m_short.begin();
+        m_rp.begin();
         if (!ray_is_valid(ray) || m_view.node_count == 0) return finish();
         m_box = ray_box_precompute(ray);
         m_tri = ray_triangle_precompute(ray);
@@ -72,9 +79,12 @@ public:
     StepOutcome execute() override {
         StepOutcome out;
         if (m_plan.done) return out;
+        if (m_rp.walking()) return rp_step(), out;
         if (m_short.replaying()) replay_step();
         else if (m_count == 0) visit_node(node(m_ref));
         else out.add_op(OpKind::anyhit, visit_leaf());
+        // Boxes only the reduced-precision test entered are walked before the step just planned.
+        if (m_rp.pending()) m_rp.start(m_plan), plan_at(m_rp.next().ref, m_rp.next().count);
         return out;
     }
 
@@ -90,14 +100,15 @@ private:
         m_plan.add_op(OpKind::box, detail::popcount8(Codec::valid_mask(node(i))));
     }
 
-    void plan_next() {
-        if (m_count == 0) {
-            plan_node(m_ref);
+    void plan_next() { plan_at(m_ref, m_count); }
+    void plan_at(uint32_t ref, uint32_t count) {  // a node (count 0) or a leaf's triangles
+        if (count == 0) {
+            plan_node(ref);
         } else {
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
-            const TriangleAddressing::Span s = m_view.tri_at.span(m_ref, m_count);
+            const TriangleAddressing::Span s = m_view.tri_at.span(ref, count);
             m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-            m_plan.add_op(OpKind::triangle, m_count);
+            m_plan.add_op(OpKind::triangle, count);
         }
     }
 
@@ -108,6 +119,8 @@ private:
         m_work.box_tests += detail::popcount8(d.valid);
         float tnear[kMaxWideWidth];
         const uint32_t mask = detail::wide_box_tests(m_box, d, m_ray.tmin, m_cull_t, tnear);
+        float rp_tnear[kMaxWideWidth];
+        if (m_rp.enabled()) rp_tests(d, mask, rp_tnear);
         uint8_t order[kMaxWideWidth];
         const int hits = detail::order_children(mask, tnear, m_view.order, m_octant, order);
         if (m_short.enabled()) m_short.visit(m_ref, m_depth);
@@ -119,6 +132,7 @@ private:
                 m_entry_depth[size_t(m_stack_size)] = m_depth + 1;
                 if (m_short.push()) m_work.stack_drops += 1;
             }
+            if (m_rp.enabled()) m_rp_tnear[size_t(m_stack_size)] = rp_tnear[order[i]];
             m_stack[size_t(m_stack_size++)] = {d.ref[order[i]], d.count[order[i]], tnear[order[i]]};
         }
         m_depth += 1;
@@ -147,7 +161,12 @@ private:
         while (m_stack_size > 0) {
             const WideStackEntry& e = m_stack[size_t(--m_stack_size)];
             if (m_short.enabled()) restart |= m_short.pop();
-            if (e.tnear > m_cull_t) continue;
+            if (e.tnear > m_cull_t) {
+                // The narrower test's entry distance may be near enough: the hardware visits it.
+                if (m_rp.enabled() && m_rp_tnear[size_t(m_stack_size)] <= m_cull_t)
+                    m_work.rp_box_hits += 1, m_rp.enter(e.ref, e.count);
+                continue;
+            }
             m_ref = e.ref;
             m_count = e.count;
             if (m_short.enabled()) m_depth = m_entry_depth[size_t(m_stack_size)];
@@ -175,6 +194,40 @@ private:
         else finish();
     }
 
+    /// The narrower test on every slot of `d` (against the same interval); the slots only it
+    /// accepts (not in fp32_mask) are handed to m_rp when `enter`. Returns its hit mask.
+    uint32_t rp_tests(const DecodedNode& d, uint32_t fp32_mask, float tnear[kMaxWideWidth], bool enter = true) {
+        uint32_t mask = 0;
+        for (uint32_t v = d.valid; v; v &= v - 1) {
+            const int s = __builtin_ctz(v);
+            const float lo[3] = {d.lo[0][s], d.lo[1][s], d.lo[2][s]};
+            const float hi[3] = {d.hi[0][s], d.hi[1][s], d.hi[2][s]};
+            if (!intersect_box_rp(m_box, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &tnear[s])) continue;
+            mask |= 1u << s;
+            if (enter && !(fp32_mask >> s & 1u)) m_work.rp_box_hits += 1, m_rp.enter(d.ref[s], d.count[s]);
+        }
+        return mask;
+    }
+
+    void rp_step() {
+        // The extra walk tests with the narrower test alone; its leaves' fp32 triangle tests
+        // cannot hit (rp_boxes.h), so they are counted, not run.
+        const ReducedPrecisionBoxes::Entry e = m_rp.pop();
+        if (e.count == 0) {
+            DecodedNode d;
+            Codec::decode(node(e.ref), d);
+            m_work.rp_steps += 1;
+            m_work.rp_box_tests += detail::popcount8(d.valid);
+            float tnear[kMaxWideWidth];
+            const uint32_t mask = rp_tests(d, 0, tnear, false);
+            for (uint32_t m = mask; m; m &= m - 1) m_rp.enter(d.ref[__builtin_ctz(m)], d.count[__builtin_ctz(m)]);
+        } else {
+            m_work.rp_tri_tests += e.count;
+        }
+        if (!m_rp.empty()) plan_at(m_rp.next().ref, m_rp.next().count);
+        else m_plan = m_rp.resume();
+    }
+
     void finish() {
         if (m_hit.prim < 0) m_hit = Hit{};
         m_plan.finish();
@@ -193,6 +246,9 @@ private:
     bool m_resume = false;  ///< after the re-descent: m_ref/m_count (true) or the end (false)
     std::vector<uint32_t> m_entry_depth;
     ShortStack m_short;
+    // Reduced-precision boxes only: each entry's entry distance by the narrower test, and the shadow.
+    std::vector<float> m_rp_tnear;
+    ReducedPrecisionBoxes m_rp;
 };
 
 }  // namespace rtsim

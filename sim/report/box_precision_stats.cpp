@@ -1,0 +1,59 @@
+#include "sim/report/box_precision_stats.h"
+
+#include "sim/report/energy_area.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+const StatBlock& box_precision_stats() {
+    static const StatBlock block{
+        "box_precision",
+        {
+            {"bits", "bits", "`traversal.box_precision_bits`: explicit mantissa bits of the box tests (fp32: 23)"},
+            {"box_hits", "boxes", "boxes the reduced test entered that the fp32 walk rejected or culled at a pop: the roots of the extra walk"},
+            {"steps", "steps", "node steps of the extra walk (each a node fetch, counted in the caches and units)"},
+            {"box_tests", "tests", "box tests of those steps"},
+            {"tri_tests", "tests", "triangle tests in the extra walk's leaves (each leaf a triangle fetch; never a hit)"},
+            {"extra_steps_fraction", "", "`steps / summary work steps`: the extra walk over the fp32 walk's node steps; `null` without steps"},
+            {"extra_box_tests_fraction", "", "`box_tests / box_tests of the fp32 walk`; `null` without box tests"},
+            {"extra_tri_tests_fraction", "", "`tri_tests / tri_tests of the fp32 walk`; `null` without triangle tests"},
+            {"box_test_pj", "pJ", "energy of one box test at this width (docs/energy_area.md, \"Reduced-precision box pipeline\")"},
+            {"box_test_pj_fp32", "pJ", "the same test in fp32"},
+            {"box_mm2", "mm^2", "area of all box pipelines at this width (also `area.mm2.box`)"},
+            {"box_mm2_fp32", "mm^2", "the same pipelines in fp32"},
+            {"per_ray", "", "`{box_hits, steps, box_tests, tri_tests}` per ray; `null` without rays"},
+        }};
+    return block;
+}
+
+void add_box_precision_stats(json& stats, const SimConfig& c, const WorkTotals& w, uint64_t rays) {
+    const uint32_t bits = c.traversal.box_precision_bits;
+    if (bits == 0) return;
+    const uint64_t hits = w[WorkField::rp_box_hits], steps = w[WorkField::rp_steps];
+    const uint64_t boxes = w[WorkField::rp_box_tests], tris = w[WorkField::rp_tri_tests];
+    auto per_ray = [&](uint64_t x) { return rays ? json(double(x) / double(rays)) : json(nullptr); };
+    auto fraction = [](uint64_t x, uint64_t of) { return of ? json(double(x) / double(of)) : json(nullptr); };
+    const BoxPipelineCost reduced = box_pipeline_cost(c, bits), fp32 = box_pipeline_cost(c, 0);
+    StatsWriter(box_precision_stats(), stats["box_precision"])
+        .set("bits", bits)
+        .set("box_hits", hits)
+        .set("steps", steps)
+        .set("box_tests", boxes)
+        .set("tri_tests", tris)
+        .set("extra_steps_fraction", fraction(steps, w[WorkField::steps]))
+        .set("extra_box_tests_fraction", fraction(boxes, w[WorkField::box_tests]))
+        .set("extra_tri_tests_fraction", fraction(tris, w[WorkField::tri_tests]))
+        .set("box_test_pj", reduced.test_pj)
+        .set("box_test_pj_fp32", fp32.test_pj)
+        .set("box_mm2", reduced.mm2)
+        .set("box_mm2_fp32", fp32.mm2)
+        .set("per_ray", rays ? json{{"box_hits", per_ray(hits)},
+                                    {"steps", per_ray(steps)},
+                                    {"box_tests", per_ray(boxes)},
+                                    {"tri_tests", per_ray(tris)}}
+                             : json(nullptr))
+        .done();
+}
+
+}  // namespace rtsim
