@@ -23,40 +23,6 @@ double area_of(const Aabb& box) {
     return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-/// An order of the binary tree's reachable nodes with every child before its parent. Builders
-/// allocate children after their parent, so decreasing index order usually is one and reads the
-/// nodes sequentially; otherwise (or if some node is unreachable) a reversed pre-order.
-std::vector<uint32_t> children_first(const BuildTree& tree) {
-    const size_t n = tree.nodes.size();
-    std::vector<uint8_t> reached(n, 0);
-    reached[0] = 1;
-    bool by_index = true;
-    for (size_t i = 0; i < n && by_index; ++i) {
-        const BuildNode& b = tree.nodes[i];
-        if (!reached[i]) by_index = false;
-        else if (!b.is_leaf()) {
-            if (b.first <= i || size_t(b.first) + 1 >= n) by_index = false;
-            else reached[b.first] = reached[b.first + 1] = 1;
-        }
-    }
-    std::vector<uint32_t> order;
-    order.reserve(n);
-    if (by_index) {
-        for (size_t i = n; i-- > 0;) order.push_back(uint32_t(i));
-        return order;
-    }
-    std::vector<uint32_t> stack{0};
-    while (!stack.empty()) {
-        const uint32_t i = stack.back();
-        stack.pop_back();
-        order.push_back(i);
-        const BuildNode& b = tree.nodes[i];
-        if (!b.is_leaf()) stack.insert(stack.end(), {b.first, b.first + 1});
-    }
-    std::reverse(order.begin(), order.end());  // reversed pre-order: every child before its parent
-    return order;
-}
-
 /// Shared by both collapses: the output tree and the binary subtree helpers.
 class Collapser {
 public:
@@ -118,63 +84,104 @@ protected:
 ///   cost(n, i) = min(dist(n, i), cost(n, i - 1)) for i > 1
 ///   dist(n, j) = min over k in 1..j-1 of cost(left, k) + cost(right, j - k)
 /// Ties keep fewer slots and prefer leaves (fewer box tests, fewer steps).
+///
+/// The costs are solved in post-order with an explicit stack: a node's cost row is needed only
+/// until its parent is solved, so the rows live on a stack as deep as the tree instead of in a
+/// table over every node (8 doubles a node: tens of megabytes to allocate and miss in for a
+/// large scene). Only the choices, which fill() reads top-down afterwards, are kept per node.
 class DpCollapser : public Collapser {
 public:
     using Collapser::Collapser;
 
     void run() {
-        const size_t w = size_t(m_c.width);
-        // solve() writes every entry before it is read: no initial fill of these large arrays.
-        m_cost.reset(new double[m_in.nodes.size() * w]);
-        m_choice.reset(new uint8_t[m_in.nodes.size() * w]);
-        m_dist_k.assign(m_in.nodes.size(), 0);
-        m_tris.assign(m_in.nodes.size(), 0);
-        for (uint32_t n : children_first(m_in)) solve(n);
+        // solve() writes every reachable node's entries before fill() reads them: no initial fill.
+        m_choice.reset(new uint8_t[m_in.nodes.size() * size_t(m_c.width)]);
+        m_dist_k.reset(new uint8_t[m_in.nodes.size()]);
+        solve_all();
         const uint32_t root = new_node();
         if (m_in.nodes[0].is_leaf()) add_child(root, leaf_of(0));
         else fill(root, 0);
     }
 
 private:
-    double& cost(uint32_t n, uint32_t i) { return m_cost[size_t(n) * size_t(m_c.width) + (i - 1)]; }
+    /// cost(n, i) for i = 1..W (index i - 1) and the subtree's triangle count.
+    struct Row {
+        double cost[kMaxWideWidth];
+        uint32_t tris;
+    };
+
     uint8_t& choice(uint32_t n, uint32_t i) { return m_choice[size_t(n) * size_t(m_c.width) + (i - 1)]; }
 
-    void solve(uint32_t n) {
+    /// Every node reachable from the root, children before their parent.
+    void solve_all() {
+        struct Visit {
+            uint32_t node;
+            bool children_done;
+        };
+        std::vector<Visit> todo{{0, false}};
+        std::vector<Row> rows;  // solved subtrees whose parent is not solved yet
+        while (!todo.empty()) {
+            Visit& top = todo.back();
+            const BuildNode& b = m_in.nodes[top.node];
+            if (!b.is_leaf() && !top.children_done) {
+                top.children_done = true;
+                todo.push_back({b.first + 1, false});
+                todo.push_back({b.first, false});  // the left subtree is solved first
+                continue;
+            }
+            const uint32_t n = top.node;
+            todo.pop_back();
+            if (b.is_leaf()) {
+                rows.push_back(solve_leaf(n));
+            } else {
+                const Row r = rows.back();
+                rows.pop_back();
+                rows.back() = solve(n, rows.back(), r);
+            }
+        }
+    }
+
+    Row solve_leaf(uint32_t n) {
         const BuildNode& b = m_in.nodes[n];
+        if (b.count > m_c.leaf_max)
+            throw Error("collapse: binary leaf of " + std::to_string(b.count) +
+                        " triangles above the wide leaf limit (split it first)");
+        const double area = area_of(box_of(n));
+        Row row;
+        row.tris = b.count;
+        for (uint32_t i = 1; i <= uint32_t(m_c.width); ++i) {
+            row.cost[i - 1] = area * m_c.intersection_cost * b.count;
+            choice(n, i) = 0;  // a leaf, whatever the slots
+        }
+        return row;
+    }
+
+    /// Interior node n from its children's rows.
+    Row solve(uint32_t n, const Row& l, const Row& r) {
         const uint32_t width = uint32_t(m_c.width);
         const double area = area_of(box_of(n));
-        if (b.is_leaf()) {
-            if (b.count > m_c.leaf_max)
-                throw Error("collapse: binary leaf of " + std::to_string(b.count) +
-                            " triangles above the wide leaf limit (split it first)");
-            m_tris[n] = b.count;
-            for (uint32_t i = 1; i <= width; ++i) {
-                cost(n, i) = area * m_c.intersection_cost * b.count;
-                choice(n, i) = 0;  // a leaf, whatever the slots
-            }
-            return;
-        }
-        const uint32_t l = b.first, r = b.first + 1;
-        m_tris[n] = m_tris[l] + m_tris[r];
+        Row row;
+        row.tris = l.tris + r.tris;
         double dist[kMaxWideWidth + 1];
         uint8_t dist_k[kMaxWideWidth + 1] = {};
         for (uint32_t j = 2; j <= width; ++j) {
             dist[j] = kInfCost;
             for (uint32_t k = 1; k < j; ++k) {
-                const double c = cost(l, k) + cost(r, j - k);
+                const double c = l.cost[k - 1] + r.cost[j - k - 1];
                 if (c < dist[j]) dist[j] = c, dist_k[j] = uint8_t(k);
             }
         }
         m_dist_k[n] = dist_k[width];
         const double interior = area * m_c.traversal_cost + dist[width];
-        const double leaf = m_tris[n] <= m_c.leaf_max ? area * m_c.intersection_cost * m_tris[n] : kInfCost;
-        cost(n, 1) = std::min(leaf, interior);
+        const double leaf = row.tris <= m_c.leaf_max ? area * m_c.intersection_cost * row.tris : kInfCost;
+        row.cost[0] = std::min(leaf, interior);
         choice(n, 1) = leaf <= interior ? 0 : 1;  // 0: leaf, 1: interior node
         for (uint32_t i = 2; i <= width; ++i) {
-            const bool split = dist[i] < cost(n, i - 1);
-            cost(n, i) = split ? dist[i] : cost(n, i - 1);
+            const bool split = dist[i] < row.cost[i - 2];
+            row.cost[i - 1] = split ? dist[i] : row.cost[i - 2];
             choice(n, i) = split ? dist_k[i] : 0;  // 0: as with i - 1 slots; k: k slots to the left
         }
+        return row;
     }
 
     /// Wide node `node` gets binary node n's two subtrees as its (at most W) children.
@@ -206,10 +213,8 @@ private:
         add_child(node, c);
     }
 
-    std::unique_ptr<double[]> m_cost;
     std::unique_ptr<uint8_t[]> m_choice;
-    std::vector<uint8_t> m_dist_k;
-    std::vector<uint32_t> m_tris;
+    std::unique_ptr<uint8_t[]> m_dist_k;
 };
 
 /// Wald et al. 2008: start from the binary node's two children and repeatedly replace the
