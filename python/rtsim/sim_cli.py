@@ -69,7 +69,9 @@ def run_and_report(
     err_console = Console(stderr=True)
 
     def echo(line: str) -> None:
-        err_console.print(line, markup=False, highlight=False)
+        # Never wrapped: rtsim-sim's messages name files, and a path broken across lines (the
+        # console breaks long words at its width) cannot be copied.
+        err_console.print(line, markup=False, highlight=False, soft_wrap=True)
 
     job.progress = show_progress
     if show_progress:
