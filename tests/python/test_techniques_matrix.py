@@ -13,8 +13,9 @@ REPO = Path(__file__).resolve().parents[2]
 
 def test_matrix_runs_every_technique_with_zero_mismatches(tmp_path: Path) -> None:
     out = tmp_path / "matrix"
-    cmd = [sys.executable, str(REPO / "scripts" / "techniques_matrix.py"), "--out", str(out),
-           "--scenes", "cornell", "--levels", "approx,detailed", "--resolution", "24x18"]  # fmt: skip
+    script = str(REPO / "scripts" / "techniques_matrix.py")
+    cmd = [sys.executable, script, "--out", str(out), "--scenes", "cornell",
+           "--levels", "approx,detailed", "--resolution", "24x18"]  # fmt: skip
     done = subprocess.run(cmd, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-2000:]
     result = json.loads((out / "matrix.json").read_text())
