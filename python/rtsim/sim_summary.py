@@ -313,6 +313,32 @@ def short_stack_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def box_precision_table(stats: dict[str, Any]) -> Table:
+    """Reduced-precision box tests: the extra walk and the narrower pipeline's energy and area
+    (stats.json "box_precision", docs/accel.md)."""
+    m = stats.get("box_precision", {}) or {}
+    per_ray = m.get("per_ray", {}) or {}
+    table = Table(
+        title=f"reduced-precision box tests ({fmt_int(m.get('bits'))} mantissa bits)",
+        title_justify="left",
+    )
+    table.add_column("")
+    table.add_column("value", justify="right")
+    table.add_row("extra boxes entered / ray", fmt_float(per_ray.get("box_hits"), 3))
+    table.add_row("extra node steps", fmt_pct(m.get("extra_steps_fraction")))
+    table.add_row("extra box tests", fmt_pct(m.get("extra_box_tests_fraction")))
+    table.add_row("extra triangle tests", fmt_pct(m.get("extra_tri_tests_fraction")))
+    table.add_row(
+        "box test pJ (fp32)",
+        f"{fmt_float(m.get('box_test_pj'), 2)} ({fmt_float(m.get('box_test_pj_fp32'), 2)})",
+    )
+    table.add_row(
+        "box pipelines mm^2 (fp32)",
+        f"{fmt_float(m.get('box_mm2'), 3)} ({fmt_float(m.get('box_mm2_fp32'), 3)})",
+    )
+    return table
+
+
 def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> None:
     """Prints the run's headline numbers, utilisation, latency and what was built and why."""
     console = console or Console()
@@ -329,6 +355,8 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         console.print(mailbox_table(stats))
     if stats.get("short_stack"):
         console.print(short_stack_table(stats))
+    if stats.get("box_precision"):
+        console.print(box_precision_table(stats))
     if stats.get("energy"):
         console.print(energy_table(stats))
     if stats.get("effects"):

@@ -122,3 +122,16 @@ def test_the_knob_is_a_config_field_and_a_sweep_axis() -> None:
     )
     assert {r.config.traversal.box_precision_bits for r in spec.runs()} == {0, 8, 12}
     # out-of-range values are refused by rtsim-sim naming the field (test above)
+
+
+def test_the_summary_prints_the_extra_walk_and_the_narrow_pipeline(
+    traces: dict[str, Path], tmp_path: Path
+) -> None:
+    result = run_rtsim(
+        "simulate", str(traces["bvh2"]), "-o", str(tmp_path / "run"), "--no-progress",
+        "--set", "traversal.box_precision_bits=8", "--set", "fidelity=functional",
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    out = " ".join(result.stdout.split())
+    assert "reduced-precision box tests (8 mantissa bits)" in out
+    assert "extra node steps" in out and "box pipelines mm^2 (fp32)" in out
