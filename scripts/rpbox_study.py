@@ -26,7 +26,6 @@ docs/accel.md. Usage:
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import sys
 import time
@@ -34,11 +33,9 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-from rtsim.doc_markers import write_between
-
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "scripts"))
-from shortstack_study import make_trace, simulate  # noqa: E402  (the same trace and run cache)
+from shortstack_study import make_trace, save_and_print, simulate  # noqa: E402  (the same trace and run cache)
 
 
 def points(bits: list[int], detailed_bits: int) -> list[tuple[str, list[str], bool]]:
@@ -173,16 +170,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     study = run_study(args)
-    previous = args.out / "study.json"
-    if previous.is_file():  # runs reused from the cache: keep the wall time they took
-        old = json.loads(previous.read_text())
-        if old.get("rows") == study["rows"]:
-            study["wall_seconds"] = old["wall_seconds"]
-    (args.out / "study.json").write_text(json.dumps(study, indent=1))
-    text = table(study)
-    print(text)
-    if args.write_docs:
-        write_between(REPO / "docs" / "accel.md", "rp_boxes_table", text)
+    save_and_print(study, table(study), args, "rp_boxes_table")
 
 
 if __name__ == "__main__":

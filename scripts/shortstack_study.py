@@ -215,20 +215,26 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return args
 
 
-def main(argv: list[str] | None = None) -> None:
-    args = parse_args(argv)
-    args.out.mkdir(parents=True, exist_ok=True)
-    study = run_study(args)
+def save_and_print(study: dict[str, Any], text: str, args: argparse.Namespace, marker: str) -> None:
+    """Writes OUT/study.json (a study whose runs all came from the cache keeps the wall time they
+    took), prints the table and, with --write-docs, writes it between MARKER's markers of
+    docs/accel.md. Shared with the studies that reuse this one's trace and run cache."""
     previous = args.out / "study.json"
-    if previous.is_file():  # runs reused from the cache: keep the wall time they took
+    if previous.is_file():
         old = json.loads(previous.read_text())
         if old.get("rows") == study["rows"]:
             study["wall_seconds"] = old["wall_seconds"]
     (args.out / "study.json").write_text(json.dumps(study, indent=1))
-    text = table(study)
     print(text)
     if args.write_docs:
-        write_between(REPO / "docs" / "accel.md", "short_stack_table", text)
+        write_between(REPO / "docs" / "accel.md", marker, text)
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    study = run_study(args)
+    save_and_print(study, table(study), args, "short_stack_table")
 
 
 if __name__ == "__main__":
