@@ -64,6 +64,32 @@ def sim_stats(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict:
     return result.stats
 
 
+def checked(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict:
+    """sim_stats, asserting every ray was checked with zero hit and work mismatches."""
+    stats = sim_stats(sim_exe, trace, out, *sets)
+    s = stats["summary"]
+    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0, stats["validation"]
+    assert s["rays"] == stats["validation"]["rays_checked"] > 0
+    return stats
+
+
+@pytest.fixture(scope="session")
+def small_hairball_traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """A 2,000-triangle hairball at 32x24 (primary and diffuse), once per structure (bvh2,
+    cwbvh8, kdtree): the traces the short-stack and reduced-precision box tests replay."""
+    root = tmp_path_factory.mktemp("small_hairball_traces")
+    out = {}
+    for accel in ("bvh2", "cwbvh8", "kdtree"):
+        folder = root / accel
+        result = run_rtsim(
+            "trace", "hairball", "-o", str(folder), "--resolution", "32x24",
+            "--workload", "primary,diffuse", "--hairball-triangles", "2000", "--accel", accel,
+        )  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        out[accel] = folder
+    return out
+
+
 @pytest.fixture(scope="session")
 def cornell() -> rtsim.Scene:
     return rtsim.load_scene("cornell")

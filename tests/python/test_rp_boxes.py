@@ -9,52 +9,27 @@ from __future__ import annotations
 
 import itertools
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 import rtsim
-from conftest import run_rtsim, sim_stats, simulate
+from conftest import checked, run_rtsim, simulate
 from rtsim.sweep.spec import parse_spec
-
-
-@pytest.fixture(scope="module")
-def traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """A 2,000-triangle hairball at 32x24 (primary and diffuse), once per structure."""
-    root = tmp_path_factory.mktemp("rp_boxes_traces")
-    out = {}
-    for accel in ("bvh2", "cwbvh8", "kdtree"):
-        folder = root / accel
-        result = run_rtsim(
-            "trace", "hairball", "-o", str(folder), "--resolution", "32x24",
-            "--workload", "primary,diffuse", "--hairball-triangles", "2000", "--accel", accel,
-        )  # fmt: skip
-        assert result.returncode == 0, result.stderr
-        out[accel] = folder
-    return out
-
-
-def checked(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    stats = sim_stats(sim_exe, trace, out, *sets)
-    s = stats["summary"]
-    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0, stats["validation"]
-    assert s["rays"] == stats["validation"]["rays_checked"] > 0
-    return stats
 
 
 @pytest.mark.parametrize("level", ["functional", "approx", "detailed"])
 @pytest.mark.parametrize("accel", ["bvh2", "cwbvh8"])
 def test_narrow_boxes_keep_hits_and_reference_work(
-    traces: dict[str, Path], sim_exe: Path, tmp_path: Path, accel: str, level: str
+    small_hairball_traces: dict[str, Path], sim_exe: Path, tmp_path: Path, accel: str, level: str
 ) -> None:
     narrow = checked(
         sim_exe,
-        traces[accel],
+        small_hairball_traces[accel],
         tmp_path / "n",
         "traversal.box_precision_bits=4",
         f"fidelity={level}",
     )
-    fp32 = checked(sim_exe, traces[accel], tmp_path / "f", f"fidelity={level}")
+    fp32 = checked(sim_exe, small_hairball_traces[accel], tmp_path / "f", f"fidelity={level}")
     assert "box_precision" not in fp32
     bp = narrow["box_precision"]
     assert bp["bits"] == 4
@@ -75,13 +50,13 @@ def test_narrow_boxes_keep_hits_and_reference_work(
 
 
 def test_extra_work_grows_as_bits_shrink(
-    traces: dict[str, Path], sim_exe: Path, tmp_path: Path
+    small_hairball_traces: dict[str, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
     seen = []
     for bits in (20, 12, 8, 4):
         stats = checked(
-            sim_exe, traces["cwbvh8"], tmp_path / str(bits), f"traversal.box_precision_bits={bits}",
-            "fidelity=functional",
+            sim_exe, small_hairball_traces["cwbvh8"], tmp_path / str(bits),
+            f"traversal.box_precision_bits={bits}", "fidelity=functional",
         )  # fmt: skip
         bp = stats["box_precision"]
         seen.append((bp["steps"], bp["tri_tests"], bp["box_hits"], -bp["box_test_pj"]))
@@ -91,21 +66,29 @@ def test_extra_work_grows_as_bits_shrink(
 
 
 def test_box_precision_is_refused_by_name_where_it_cannot_run(
-    traces: dict[str, Path], sim_exe: Path, tmp_path: Path
+    small_hairball_traces: dict[str, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
     knob = "traversal.box_precision_bits"
-    r = simulate(sim_exe, traces["kdtree"], tmp_path / "k", f"{knob}=8")
+    r = simulate(sim_exe, small_hairball_traces["kdtree"], tmp_path / "k", f"{knob}=8")
     assert r.returncode == 2 and knob in r.stderr and "kdtree" in r.stderr
-    r = simulate(sim_exe, traces["bvh2"], tmp_path / "a", f"{knob}=8", "fidelity=analytic")
+    r = simulate(
+        sim_exe, small_hairball_traces["bvh2"], tmp_path / "a", f"{knob}=8", "fidelity=analytic"
+    )
     assert r.returncode == 2 and knob in r.stderr
     for bad in ("23", "-1", "eight"):
-        r = simulate(sim_exe, traces["bvh2"], tmp_path / f"b{bad}", f"{knob}={bad}")
+        r = simulate(sim_exe, small_hairball_traces["bvh2"], tmp_path / f"b{bad}", f"{knob}={bad}")
         assert r.returncode == 2 and "box_precision_bits" in r.stderr, (bad, r.stderr)
-    r = simulate(sim_exe, traces["bvh2"], tmp_path / "p", f"{knob}=8", "traversal.model=packet")
+    r = simulate(
+        sim_exe,
+        small_hairball_traces["bvh2"],
+        tmp_path / "p",
+        f"{knob}=8",
+        "traversal.model=packet",
+    )
     assert r.returncode == 2 and knob in r.stderr and "packet" in r.stderr
     # analytic with functional caches steps every ray and takes it
     stats = checked(
-        sim_exe, traces["bvh2"], tmp_path / "af", f"{knob}=6", "fidelity=analytic",
+        sim_exe, small_hairball_traces["bvh2"], tmp_path / "af", f"{knob}=6", "fidelity=analytic",
         "analytic.caches=functional",
     )  # fmt: skip
     assert stats["box_precision"]["steps"] > 0
@@ -125,11 +108,11 @@ def test_the_knob_is_a_config_field_and_a_sweep_axis() -> None:
 
 
 def test_the_summary_prints_the_extra_walk_and_the_narrow_pipeline(
-    traces: dict[str, Path], tmp_path: Path
+    small_hairball_traces: dict[str, Path], tmp_path: Path
 ) -> None:
     result = run_rtsim(
-        "simulate", str(traces["bvh2"]), "-o", str(tmp_path / "run"), "--no-progress",
-        "--set", "traversal.box_precision_bits=8", "--set", "fidelity=functional",
+        "simulate", str(small_hairball_traces["bvh2"]), "-o", str(tmp_path / "run"),
+        "--no-progress", "--set", "traversal.box_precision_bits=8", "--set", "fidelity=functional",
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     out = " ".join(result.stdout.split())

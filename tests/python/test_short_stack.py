@@ -14,34 +14,10 @@ from typing import Any
 import pytest
 
 import rtsim
-from conftest import run_rtsim, sim_stats, simulate
+from conftest import checked, simulate
 from rtsim.sweep.spec import SpecError, parse_spec
 
 SHORT = "traversal.stack_overflow=restart_trail"
-
-
-@pytest.fixture(scope="module")
-def traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """A 2,000-triangle hairball at 32x24 (primary and diffuse), once per structure."""
-    root = tmp_path_factory.mktemp("short_stack_traces")
-    out = {}
-    for accel in ("bvh2", "cwbvh8", "kdtree"):
-        folder = root / accel
-        result = run_rtsim(
-            "trace", "hairball", "-o", str(folder), "--resolution", "32x24",
-            "--workload", "primary,diffuse", "--hairball-triangles", "2000", "--accel", accel,
-        )  # fmt: skip
-        assert result.returncode == 0, result.stderr
-        out[accel] = folder
-    return out
-
-
-def checked(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    stats = sim_stats(sim_exe, trace, out, *sets)
-    s = stats["summary"]
-    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0, stats["validation"]
-    assert s["rays"] == stats["validation"]["rays_checked"] > 0
-    return stats
 
 
 def spilled(stats: dict[str, Any]) -> int:
@@ -53,11 +29,11 @@ def spilled(stats: dict[str, Any]) -> int:
 @pytest.mark.parametrize("level", ["functional", "approx", "detailed"])
 @pytest.mark.parametrize("accel", ["bvh2", "cwbvh8"])
 def test_short_stack_keeps_hits_and_reference_work(
-    traces: dict[str, Path], sim_exe: Path, tmp_path: Path, accel: str, level: str
+    small_hairball_traces: dict[str, Path], sim_exe: Path, tmp_path: Path, accel: str, level: str
 ) -> None:
     stats = checked(
         sim_exe,
-        traces[accel],
+        small_hairball_traces[accel],
         tmp_path / "s",
         SHORT,
         "traversal.stack_entries=1",
@@ -70,8 +46,8 @@ def test_short_stack_keeps_hits_and_reference_work(
     if level != "functional":
         assert spilled(stats) == 0
         # The units scheduled the revisits: two slots per step beyond the full stack's.
-        full = checked(sim_exe, traces[accel], tmp_path / "f", "traversal.stack_entries=64",
-                       f"fidelity={level}")  # fmt: skip
+        full = checked(sim_exe, small_hairball_traces[accel], tmp_path / "f",
+                       "traversal.stack_entries=64", f"fidelity={level}")  # fmt: skip
         steps = sum(u["steps"] for u in stats["model"]["units"].values())
         full_steps = sum(u["steps"] for u in full["model"]["units"].values())
         assert steps == full_steps + 2 * ss["restart_steps"]
@@ -79,10 +55,14 @@ def test_short_stack_keeps_hits_and_reference_work(
 
 
 def test_a_deep_enough_short_stack_never_restarts(
-    traces: dict[str, Path], sim_exe: Path, tmp_path: Path
+    small_hairball_traces: dict[str, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
-    short = checked(sim_exe, traces["bvh2"], tmp_path / "s", SHORT, "traversal.stack_entries=64")
-    spill = checked(sim_exe, traces["bvh2"], tmp_path / "p", "traversal.stack_entries=64")
+    short = checked(
+        sim_exe, small_hairball_traces["bvh2"], tmp_path / "s", SHORT, "traversal.stack_entries=64"
+    )
+    spill = checked(
+        sim_exe, small_hairball_traces["bvh2"], tmp_path / "p", "traversal.stack_entries=64"
+    )
     ss = short["short_stack"]
     assert ss["restarts"] == ss["restart_steps"] == ss["stack_drops"] == 0
     assert short["summary"]["cycles"] == spill["summary"]["cycles"]
@@ -90,20 +70,24 @@ def test_a_deep_enough_short_stack_never_restarts(
 
 
 def test_short_stack_is_refused_by_name_where_it_cannot_run(
-    traces: dict[str, Path], sim_exe: Path, tmp_path: Path
+    small_hairball_traces: dict[str, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
-    r = simulate(sim_exe, traces["kdtree"], tmp_path / "k", SHORT)
+    r = simulate(sim_exe, small_hairball_traces["kdtree"], tmp_path / "k", SHORT)
     assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr and "kdtree" in r.stderr
-    r = simulate(sim_exe, traces["bvh2"], tmp_path / "a", SHORT, "fidelity=analytic")
+    r = simulate(sim_exe, small_hairball_traces["bvh2"], tmp_path / "a", SHORT, "fidelity=analytic")
     assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr
-    r = simulate(sim_exe, traces["bvh2"], tmp_path / "c", "traversal.stack_overflow=pop")
+    r = simulate(
+        sim_exe, small_hairball_traces["bvh2"], tmp_path / "c", "traversal.stack_overflow=pop"
+    )
     assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr
     # a packet's rays share one stack; the restart trail is a single ray's
-    r = simulate(sim_exe, traces["bvh2"], tmp_path / "p", SHORT, "traversal.model=packet")
+    r = simulate(
+        sim_exe, small_hairball_traces["bvh2"], tmp_path / "p", SHORT, "traversal.model=packet"
+    )
     assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr and "packet" in r.stderr
     # analytic with functional caches steps every ray and takes it
     stats = checked(
-        sim_exe, traces["bvh2"], tmp_path / "af", SHORT, "fidelity=analytic",
+        sim_exe, small_hairball_traces["bvh2"], tmp_path / "af", SHORT, "fidelity=analytic",
         "analytic.caches=functional", "traversal.stack_entries=2",
     )  # fmt: skip
     assert stats["short_stack"]["restarts"] > 0
