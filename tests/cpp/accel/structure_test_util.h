@@ -17,6 +17,7 @@
 #include "traces/isect/brute_force.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim::test {
 
@@ -133,8 +134,7 @@ inline const Scene& procedural(const std::string& name) {
     static std::map<std::string, Scene> cache;
     auto it = cache.find(name);
     if (it != cache.end()) return it->second;
-    const std::string dir = (std::filesystem::path(::testing::TempDir()) / "rtsim_accel_tests").string();
-    std::filesystem::create_directories(dir);
+    const std::string dir = process_temp_dir("accel_scenes").string();
     ProceduralOptions options;
     options.hairball_triangles = 20000;
     return cache.emplace(name, load_gltf(write_procedural_scene(name, dir, options))).first->second;

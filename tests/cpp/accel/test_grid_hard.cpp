@@ -13,6 +13,7 @@
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/accel/grid/grid.h"
 #include "traces/common/error.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim {
 namespace {
@@ -153,7 +154,7 @@ TEST(GridRegistry, BuildsThroughTheRegistryAndRoundTripsThroughATrace) {
     o.builder = "binned";
     EXPECT_NE(error_of([&] { build_accel(scene, o); }).find("has no builder 'binned' (it takes: uniform)"),
               std::string::npos);
-    const std::string path = (std::filesystem::temp_directory_path() / "rtsim_test_grid.rtt").string();
+    const std::string path = (test::process_temp_dir("grid") / "grid.rtt").string();
     {
         TraceWriter w(path);
         write_accel_image(w, built);

@@ -11,6 +11,7 @@
 #include "traces/accel/accel_io.h"
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/common/error.h"
+#include "tests/cpp/process_temp_dir.h"
 
 using namespace rtsim;
 
@@ -24,7 +25,7 @@ AccelImage small_bvh2(size_t triangles = 500, uint64_t seed = 3) {
 }
 
 std::string temp_file(const std::string& name) {
-    return (std::filesystem::temp_directory_path() / ("rtsim_test_seam_" + name)).string();
+    return (test::process_temp_dir("seam") / name).string();
 }
 
 }  // namespace

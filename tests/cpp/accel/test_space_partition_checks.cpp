@@ -12,6 +12,7 @@
 #include "traces/accel/kdtree/kdtree.h"
 #include "traces/accel/octree/octree.h"
 #include "traces/common/error.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim {
 namespace {
@@ -171,7 +172,7 @@ TEST(SpacePartitionSeam, BuilderSettingsAreDataAndRefusedByName) {
 
 TEST(SpacePartitionSeam, ImagesRoundTripThroughATraceFile) {
     const Scene scene = test::random_soup(9, 500);
-    const std::string path = (std::filesystem::path(::testing::TempDir()) / "space_partition.rtt").string();
+    const std::string path = (test::process_temp_dir("space_partition") / "space_partition.rtt").string();
     for (const char* name : {"kdtree", "bih", "octree"}) {
         const auto built = build_named(scene, name);
         {

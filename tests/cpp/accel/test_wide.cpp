@@ -15,6 +15,7 @@
 #include "traces/isect/brute_force.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim {
 namespace {
@@ -236,8 +237,7 @@ TEST(WideTrace, BruteForceAgrees) {
 }
 
 TEST(WideTrace, ProceduralScenesEqualBvh2) {
-    const std::string dir = (std::filesystem::path(::testing::TempDir()) / "rtsim_test_wide").string();
-    std::filesystem::create_directories(dir);
+    const std::string dir = test::process_temp_dir("wide").string();
     ProceduralOptions options;
     options.hairball_triangles = 20000;
     for (const std::string& name : procedural_scene_names()) {

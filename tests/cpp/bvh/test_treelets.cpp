@@ -11,6 +11,7 @@
 #include "traces/common/error.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
+#include "tests/cpp/process_temp_dir.h"
 
 using namespace rtsim;
 
@@ -54,7 +55,7 @@ TEST(Treelets, PartitionInvariantsOverBudgetsAndScenes) {
 }
 
 TEST(Treelets, ProceduralScenesAndDeterminism) {
-    std::string dir = (std::filesystem::temp_directory_path() / "rtsim_test_treelets").string();
+    std::string dir = test::process_temp_dir("treelets").string();
     ProceduralOptions options;
     options.hairball_triangles = 30000;
     for (const std::string& name : procedural_scene_names()) {

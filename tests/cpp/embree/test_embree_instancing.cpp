@@ -20,6 +20,7 @@
 #include "traces/common/rng.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim {
 namespace {
@@ -146,8 +147,7 @@ TEST(EmbreeInstancing, SharedScenesAndGrove) {
         const std::string path = dir + "/" + name + "/" + name + ".gltf";
         if (std::filesystem::exists(path)) compare_with_embree(name, load_gltf(path, false));
     }
-    const std::string tmp = (std::filesystem::path(::testing::TempDir()) / "rtsim_embree_instancing").string();
-    std::filesystem::create_directories(tmp);
+    const std::string tmp = rtsim::test::process_temp_dir("embree_instancing").string();
     compare_with_embree("grove", load_gltf(write_procedural_scene("grove", tmp), false));
 }
 

@@ -15,6 +15,7 @@
 #include "oracle_compare.h"
 #include "oracle_rays.h"
 #include "traces/bvh/builder.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim::oracle {
 namespace {
@@ -55,7 +56,7 @@ void compare_scene(const std::string& name, const Scene& scene, uint32_t width =
 }
 
 std::string scratch_dir() {
-    return (std::filesystem::path(::testing::TempDir()) / "rtsim_embree_oracle").string();
+    return rtsim::test::process_temp_dir("embree_oracle").string();
 }
 
 TEST(EmbreeOracle, Sponza) {

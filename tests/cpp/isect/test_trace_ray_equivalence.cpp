@@ -11,6 +11,7 @@
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim {
 namespace {
@@ -101,9 +102,7 @@ TEST(TraceRayEquivalence, SingleLeafAndEmptyScenes) {
 }
 
 TEST(TraceRayEquivalence, ProceduralScenes) {
-    const std::string dir =
-        (std::filesystem::path(::testing::TempDir()) / "rtsim_trace_ray_equivalence").string();
-    std::filesystem::create_directories(dir);
+    const std::string dir = rtsim::test::process_temp_dir("trace_ray_equivalence").string();
     ProceduralOptions options;
     options.hairball_triangles = 20000;
     for (const std::string& name : procedural_scene_names()) {

@@ -11,6 +11,7 @@
 #include "traces/raygen/surface.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace rtsim;
@@ -18,7 +19,7 @@ using namespace rtsim;
 namespace {
 
 Scene procedural(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / "rtsim_test_raygen";
+    const fs::path dir = test::process_temp_dir("raygen");
     ProceduralOptions o;
     o.hairball_triangles = 20000;
     return load_gltf(write_procedural_scene(name, dir.string(), o));

@@ -16,6 +16,7 @@
 #include "traces/scene/gltf_loader.h"
 #include "traces/tracer/ray_trace.h"
 #include "traces/tracer/tracer.h"
+#include "tests/cpp/process_temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace rtsim;
@@ -23,7 +24,7 @@ using namespace rtsim;
 namespace {
 
 fs::path temp_dir(const std::string& name) {
-    fs::path p = fs::temp_directory_path() / ("rtsim_test_tracer_" + name);
+    fs::path p = test::process_temp_dir("tracer") / name;
     fs::remove_all(p);
     return p;
 }
