@@ -15,12 +15,10 @@
 #include <cstdint>
 
 #include "traces/accel/bih/bih_layout.h"
+#include "traces/accel/cell_stepper.h"
 #include "traces/accel/leaf_blocks.h"
-#include "traces/accel/stepper.h"
 #include "traces/common/aabb.h"
 #include "traces/common/hw_triangle.h"
-#include "traces/isect/ray_triangle.h"
-#include "traces/isect/slab_interval.h"
 
 namespace rtsim {
 
@@ -34,34 +32,26 @@ struct BihView {
     Aabb bounds;                                ///< the root cell
 };
 
-class BihStepper final : public Stepper {
+class BihStepper final : public BinaryCellStepper<BihStepper, kBihMaxDepth> {
 public:
+    static constexpr const char* kName = "BIH";
+
     explicit BihStepper(const BihView& view) : m_view(view) {}
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
 
 private:
+    friend class BinaryCellStepper<BihStepper, kBihMaxDepth>;
     enum class Phase : uint8_t { clip, node, leaf };
-    struct Entry {
-        uint32_t node;
-        detail::SlabInterval cell;
-    };
-    void clip();
     void visit(uint32_t node, const detail::SlabInterval& cell);
     void interior(const BihNode& node);
     uint32_t leaf();  ///< returns the alpha tests run
-    void pop_next();
-    void finish();
 
     BihView m_view;
-    RayBoxPre m_box;
-    RayTrianglePre m_tri;
-    float m_cull_t = 0.0f;
     Phase m_phase = Phase::clip;
     uint32_t m_node = 0;
     detail::SlabInterval m_cell;
-    Entry m_stack[kBihMaxDepth];
 };
 
 }  // namespace rtsim

@@ -2,30 +2,13 @@
 // the definition the SystemC model matches (docs/accel.md, "grid").
 #include "traces/accel/grid/grid_stepper.h"
 
-#include "traces/isect/leaf_kernel.h"
 #include "traces/isect/ray_box_kernel.h"
 
 namespace rtsim {
 
 void GridStepper::begin(const Ray& ray, TraversalMode mode) {
-    m_ray = ray;
-    m_mode = mode;
-    m_hit = Hit{};
-    m_work = WorkCounts{};
-    m_stack_size = 0;
     m_mailbox.clear();
-    if (!ray_is_valid(ray) || m_view.cell_count == 0) {
-        finish();
-        return;
-    }
-    m_box = ray_box_precompute(ray);
-    m_tri = ray_triangle_precompute(ray);
-    // While traversing, m_hit.t is the current best distance (the shrinking tmax).
-    m_hit.t = ray.tmax;
-    m_cull_t = detail::cull_distance(ray.tmax);
-    m_phase = Phase::clip;
-    m_plan.reset(kNoLocality);
-    m_plan.add_op(OpKind::box, 1);
+    if (start(ray, mode, m_view.cell_count == 0)) m_phase = Phase::clip;
 }
 
 StepOutcome GridStepper::execute() {
@@ -54,13 +37,7 @@ StepOutcome GridStepper::execute() {
             break;
         case Phase::triangles: {
             bool done = false;
-            const uint32_t alpha =
-                m_mode == TraversalMode::any_hit
-                    ? m_list.test_batch<true>(m_view.list, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox,
-                                              m_work, &done)
-                    : m_list.test_batch<false>(m_view.list, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox,
-                                               m_work, &done);
-            out.add_op(OpKind::anyhit, alpha);
+            out.add_op(OpKind::anyhit, test_refs(m_list, m_view.list, m_mailbox, &done));
             if (done) finish();
             else next_batch();
             break;
@@ -89,11 +66,6 @@ void GridStepper::next_cell() {
 
 void GridStepper::next_batch() {
     if (!m_list.plan_batch(m_view.list, m_mailbox, m_work, m_plan)) next_cell();
-}
-
-void GridStepper::finish() {
-    if (m_hit.prim < 0) m_hit = Hit{};
-    m_plan.finish();
 }
 
 }  // namespace rtsim

@@ -17,13 +17,9 @@
 // the first accepted hit. No stack.
 #include <cstdint>
 
+#include "traces/accel/cell_stepper.h"
 #include "traces/accel/grid/grid_dda.h"
-#include "traces/accel/mailbox.h"
-#include "traces/accel/ref_list.h"
-#include "traces/accel/stepper.h"
 #include "traces/common/hw_triangle.h"
-#include "traces/isect/ray_box.h"
-#include "traces/isect/ray_triangle.h"
 
 namespace rtsim {
 
@@ -36,7 +32,7 @@ struct GridView {
     uint64_t cell_base = 0;  ///< address of cell 0
 };
 
-class GridStepper final : public Stepper {
+class GridStepper final : public CellStepper {
 public:
     GridStepper(const GridView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
 
@@ -48,13 +44,9 @@ private:
     void clip();
     void next_cell();        ///< the DDA's next cell, or the end
     void next_batch();       ///< the list's next triangles, or the next cell
-    void finish();
 
     GridView m_view;
-    RayBoxPre m_box;
-    RayTrianglePre m_tri;
     GridDda m_dda;
-    float m_cull_t = 0.0f;  ///< cells entered beyond this are not visited: best t widened
     Phase m_phase = Phase::clip;
     uint32_t m_cell = 0;    ///< the current cell
     Mailbox m_mailbox;

@@ -18,13 +18,9 @@
 // (t, prim) is the binary BVH's bit for bit. Any hit stops at the first accepted hit.
 #include <cstdint>
 
+#include "traces/accel/cell_stepper.h"
 #include "traces/accel/kdtree/kd_layout.h"
-#include "traces/accel/mailbox.h"
-#include "traces/accel/ref_list.h"
-#include "traces/accel/stepper.h"
 #include "traces/common/aabb.h"
-#include "traces/isect/ray_triangle.h"
-#include "traces/isect/slab_interval.h"
 
 namespace rtsim {
 
@@ -37,36 +33,28 @@ struct KdView {
     Aabb bounds;             ///< the root cell
 };
 
-class KdStepper final : public Stepper {
+class KdStepper final : public BinaryCellStepper<KdStepper, kKdMaxDepth> {
 public:
+    static constexpr const char* kName = "kd-tree";
+
     KdStepper(const KdView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
 
 private:
+    friend class BinaryCellStepper<KdStepper, kKdMaxDepth>;
     enum class Phase : uint8_t { clip, node, refs, triangles };
-    struct Entry {
-        uint32_t node;
-        detail::SlabInterval cell;
-    };
-    void clip();
     void visit(uint32_t node, const detail::SlabInterval& cell);
     void interior(const KdNode& node);
     void next_batch();  ///< the leaf's next triangles, or the next cell
-    void pop_next();
-    void finish();
 
     KdView m_view;
-    RayBoxPre m_box;
-    RayTrianglePre m_tri;
     Mailbox m_mailbox;
     RefListWalk m_list;
-    float m_cull_t = 0.0f;
     Phase m_phase = Phase::clip;
     uint32_t m_node = 0;
     detail::SlabInterval m_cell;
-    Entry m_stack[kKdMaxDepth];
 };
 
 }  // namespace rtsim

@@ -5,30 +5,18 @@
 #include <utility>
 
 #include "traces/common/error.h"
-#include "traces/isect/leaf_kernel.h"
 
 namespace rtsim {
 
 void OctreeStepper::begin(const Ray& ray, TraversalMode mode) {
-    m_ray = ray;
-    m_mode = mode;
-    m_hit = Hit{};
-    m_work = WorkCounts{};
-    m_stack_size = 0;
     m_mailbox.clear();
-    if (!ray_is_valid(ray) || m_view.node_count == 0) return finish();
-    m_box = ray_box_precompute(ray);
-    m_tri = ray_triangle_precompute(ray);
+    if (!start(ray, mode, m_view.node_count == 0)) return;
     m_octant = 0;
     for (int a = 0; a < 3; ++a) {
         m_negative[a] = detail::slab_negative(m_box, a);
         m_octant |= uint32_t(m_negative[a]) << a;
     }
-    m_hit.t = ray.tmax;
-    m_cull_t = detail::cull_distance(ray.tmax);
     m_phase = Phase::clip;
-    m_plan.reset(kNoLocality);
-    m_plan.add_op(OpKind::box, 1);
 }
 
 StepOutcome OctreeStepper::execute() {
@@ -58,13 +46,7 @@ StepOutcome OctreeStepper::execute() {
             break;
         case Phase::triangles: {
             bool done = false;
-            const uint32_t alpha =
-                m_mode == TraversalMode::any_hit
-                    ? m_list.test_batch<true>(m_view.list, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox,
-                                              m_work, &done)
-                    : m_list.test_batch<false>(m_view.list, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox,
-                                               m_work, &done);
-            out.add_op(OpKind::anyhit, alpha);
+            out.add_op(OpKind::anyhit, test_refs(m_list, m_view.list, m_mailbox, &done));
             if (done) finish();
             else next_batch();
             break;
@@ -138,11 +120,6 @@ void OctreeStepper::pop_next() {
         return visit(c);
     }
     finish();
-}
-
-void OctreeStepper::finish() {
-    if (m_hit.prim < 0) m_hit = Hit{};
-    m_plan.finish();
 }
 
 }  // namespace rtsim

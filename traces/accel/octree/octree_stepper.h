@@ -21,13 +21,9 @@
 // Pending cells entered beyond the best hit's cull distance are dropped without a fetch.
 #include <cstdint>
 
-#include "traces/accel/mailbox.h"
+#include "traces/accel/cell_stepper.h"
 #include "traces/accel/octree/octree_layout.h"
-#include "traces/accel/ref_list.h"
-#include "traces/accel/stepper.h"
 #include "traces/common/aabb.h"
-#include "traces/isect/ray_triangle.h"
-#include "traces/isect/slab_interval.h"
 
 namespace rtsim {
 
@@ -40,7 +36,7 @@ struct OctView {
     Aabb bounds;  ///< the root cell
 };
 
-class OctreeStepper final : public Stepper {
+class OctreeStepper final : public CellStepper {
 public:
     OctreeStepper(const OctView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
 
@@ -60,16 +56,12 @@ private:
     void interior(const OctNode& node);
     void next_batch();
     void pop_next();
-    void finish();
 
     OctView m_view;
-    RayBoxPre m_box;
-    RayTrianglePre m_tri;
     bool m_negative[3] = {false, false, false};
     uint32_t m_octant = 0;  ///< bit a: the ray runs down axis a
     Mailbox m_mailbox;
     RefListWalk m_list;
-    float m_cull_t = 0.0f;
     Phase m_phase = Phase::clip;
     Cell m_cell{};
     Cell m_stack[kOctMaxStack];
