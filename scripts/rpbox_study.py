@@ -26,16 +26,20 @@ docs/accel.md. Usage:
 from __future__ import annotations
 
 import argparse
-import platform
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "scripts"))
-from shortstack_study import make_trace, save_and_print, simulate  # noqa: E402  (the same trace and run cache)
+from shortstack_study import (  # noqa: E402  (the same traces, run cache and study record)
+    make_trace,
+    pct,
+    run_points,
+    save_and_print,
+    study_record,
+)
 
 
 def points(bits: list[int], detailed_bits: int) -> list[tuple[str, list[str], bool]]:
@@ -92,26 +96,12 @@ def run_study(args: argparse.Namespace) -> dict[str, Any]:
         for name, sets, detailed in points(args.bits, args.detailed_bits)
         if not detailed or c == combos[0]
     ]
-    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        stats = list(pool.map(lambda j: simulate(traces[j[0]], j[1], j[2], args), jobs))
-    by = {(j[0], j[1]): st for j, st in zip(jobs, stats, strict=True)}
+    by = run_points(traces, jobs, args)
     rows = []
     for c, name, _ in jobs:
         base = "fp32-detailed" if name.endswith("-detailed") else "fp32"
         rows.append(row(*c, name, by[(c, name)], by[(c, base)]))
-    return {
-        "host": platform.node(),
-        "cpu": platform.processor() or platform.machine(),
-        "date": time.strftime("%Y-%m-%d"),
-        "resolution": args.resolution,
-        "workload": args.workload,
-        "wall_seconds": round(time.time() - t0, 1),
-        "rows": rows,
-    }
-
-
-def pct(x: float | None) -> str:
-    return "n/a" if x is None else f"{100 * x:+.1f}%"
+    return study_record(args, t0, rows)
 
 
 def table(study: dict[str, Any]) -> str:

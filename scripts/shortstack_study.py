@@ -139,10 +139,25 @@ def run_study(args: argparse.Namespace) -> dict[str, Any]:
     combos = [(sc, ac) for sc in args.scenes for ac in args.accels]
     traces = {c: make_trace(*c, args) for c in combos}
     jobs = [(c, name, sets) for c in combos for name, sets in points(args.entries)]
+    by = run_points(traces, jobs, args)
+    rows = [row(*c, name, by[(c, name)], by[(c, "full")]) for c, name, _ in jobs]
+    return study_record(args, t0, rows)
+
+
+Combo = tuple[str, str]  # (scene, structure)
+
+
+def run_points(
+    traces: dict[Combo, Path], jobs: list[tuple[Combo, str, list[str]]], args: argparse.Namespace
+) -> dict[tuple[Combo, str], dict[str, Any]]:
+    """Runs every (combo, point, settings) job on `args.jobs` threads: stats by (combo, point)."""
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         stats = list(pool.map(lambda j: simulate(traces[j[0]], j[1], j[2], args), jobs))
-    by = {(j[0], j[1]): st for j, st in zip(jobs, stats, strict=True)}
-    rows = [row(*c, name, by[(c, name)], by[(c, "full")]) for c, name, _ in jobs]
+    return {(j[0], j[1]): st for j, st in zip(jobs, stats, strict=True)}
+
+
+def study_record(args: argparse.Namespace, t0: float, rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """The study as saved: where and when it ran, what it traced, its wall time and its rows."""
     return {
         "host": platform.node(),
         "cpu": platform.processor() or platform.machine(),
