@@ -5,7 +5,9 @@
 # Idempotent: re-running skips installed packages and rebuilds incrementally in build/py.
 # Env: PYTHON (default: python), CMAKE_BUILD_PARALLEL_LEVEL (default: number of cores),
 #      RTSIM_LTO (default ON: link-time optimisation of the Release build; CI sets OFF, whose
-#      links take minutes on two cores, and tests the same code without it).
+#      links take minutes on two cores, and tests the same code without it),
+#      RTSIM_UNITY (default ON: unity batches, about half the compile time of a fresh build;
+#      OFF for a tree you rebuild file by file, docs/dependencies.md "Build time").
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -46,11 +48,11 @@ echo "setup: installing Python build and test tools"
 
 export CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)}"
 echo "setup: building and installing rtsim (C++ and Python; -j${CMAKE_BUILD_PARALLEL_LEVEL})"
-lto_args=()
+build_args=(-C "cmake.define.CMAKE_UNITY_BUILD=${RTSIM_UNITY:-ON}")
 if [ "${RTSIM_LTO:-ON}" = "OFF" ]; then
-  lto_args=(-C cmake.define.CMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF)
+  build_args+=(-C cmake.define.CMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF)
 fi
-"$PYTHON" -m pip install -q --no-build-isolation "${lto_args[@]}" ".[test]"
+"$PYTHON" -m pip install -q --no-build-isolation "${build_args[@]}" ".[test]"
 
 # pyenv only creates the `rtsim` shim on a rehash (`python -m pip` does not trigger one).
 if command -v pyenv >/dev/null 2>&1; then

@@ -21,6 +21,7 @@
 #include "traces/bvh/lbvh_builder.h"
 #include "traces/bvh/sbvh_builder.h"
 #include "traces/common/error.h"
+#include "traces/common/stopwatch.h"
 #include "traces/scene/scene.h"
 
 namespace rtsim {
@@ -286,7 +287,7 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
     auto finish = [&](AccelImage image) {
         if (s.leaves.compressed) compress_leaves(image, image.leaf_starts, s.leaves);
         image.leaf_starts.clear();
-        image.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        image.build_ms = ms_since(start);
         image.stats["footprint_bytes"] = image.footprint_bytes();
         // The TLAS's entries and the BLAS kind's share one stack: the larger size (two_level.h).
         image.stats["stack_entry_bytes"] = o.two_level ? std::max(kBvhStackEntryBytes, e.stack_entry_bytes)

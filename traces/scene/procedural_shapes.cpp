@@ -9,8 +9,6 @@ namespace rtsim {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// Grid of (nu x nv) quads over point(i, j); wrapped dimensions reuse their first row so seams are
 /// watertight. Triangles (a, b, c), (a, c, d) face along d/du x d/dv; degenerate ones are dropped.
 void add_grid(TriangleSoup& soup, int nu, int nv, bool wrap_u, bool wrap_v,

@@ -10,6 +10,9 @@
 
 namespace rtsim {
 
+/// Pi, for the shapes' angles.
+constexpr double kPi = 3.14159265358979323846;
+
 /// Closed surface of revolution about +Y: `profile` holds (radius, height) points from bottom to
 /// top; `segments` around. Faces wound outward when the profile runs bottom to top.
 void add_lathe(TriangleSoup& soup, const std::vector<glm::vec2>& profile, int segments,

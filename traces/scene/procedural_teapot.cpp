@@ -12,8 +12,6 @@ namespace rtsim {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// Catmull-Rom spline through `pts` (ends repeated), `per_span` samples per span, ends exact.
 std::vector<glm::vec2> smooth(const std::vector<glm::vec2>& pts, int per_span) {
     std::vector<glm::vec2> out;

@@ -5,6 +5,7 @@
 
 #include "traces/common/error.h"
 #include "traces/common/rng.h"
+#include "traces/common/stopwatch.h"
 
 namespace rtsim {
 
@@ -35,7 +36,7 @@ AnimatedImage build_animated(const Scene& scene, const AccelOptions& options, ui
     for (uint32_t f = 0; f < frames; ++f)
         for (uint32_t i = 0; i < scene.instances.size(); ++i) poses[f].push_back(animated_transform(out.motion, i, f));
     out.image = build_two_level_frames(scene, options, poses, &out.timing);
-    out.image.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    out.image.build_ms = ms_since(t0);
     return out;
 }
 

@@ -7,6 +7,7 @@
 #include "traces/common/build_info.h"
 #include "traces/common/error.h"
 #include "traces/common/files.h"
+#include "traces/common/stopwatch.h"
 
 namespace rtsim {
 
@@ -14,10 +15,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 std::string created(const std::string& out_dir) {
     require_utf8_path(out_dir, "output folder");

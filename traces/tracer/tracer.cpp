@@ -9,6 +9,7 @@
 #include "traces/accel/two_level/two_level.h"
 #include "traces/common/error.h"
 #include "traces/common/files.h"
+#include "traces/common/stopwatch.h"
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
 #include "traces/scene/gltf_loader.h"
@@ -24,10 +25,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// The camera the user gave, else the scene's first camera, else automatic framing.
 Camera choose_camera(const TraceOptions& o, const Scene& scene, const Accel& accel, std::string* source) {

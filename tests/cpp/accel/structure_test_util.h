@@ -6,18 +6,19 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "../isect/isect_test_util.h"
+#include "tests/cpp/process_temp_dir.h"
 #include "traces/accel/accel.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/isect/brute_force.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/procedural.h"
-#include "tests/cpp/process_temp_dir.h"
 
 namespace rtsim::test {
 
@@ -55,6 +56,9 @@ inline std::vector<HwTriangle> hw_triangles(const Scene& scene) {
     for (size_t i = 0; i < out.size(); ++i) out[i] = make_hw_triangle(scene, uint32_t(i));
     return out;
 }
+
+/// The default binary BVH of `scene`, loaded as the seam loads it.
+inline std::unique_ptr<Accel> bvh2_of(const Scene& scene) { return load_accel(build_accel(scene, AccelOptions{}), "test bvh2"); }
 
 inline Tracer brute_force(const std::vector<HwTriangle>& tris) {
     return [&tris](const Ray& r, TraversalMode m) { return trace_ray_brute_force(tris.data(), tris.size(), r, m); };

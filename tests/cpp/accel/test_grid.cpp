@@ -28,11 +28,6 @@ std::unique_ptr<Accel> grid_of(const Scene& scene, float density = 4.0f) {
     return load_accel(grid_image(scene, c), "test grid");
 }
 
-std::unique_ptr<Accel> bvh2_of(const Scene& scene) {
-    AccelOptions o;
-    return load_accel(build_accel(scene, o), "test bvh2");
-}
-
 const GridView& view_of(const Accel& a) { return static_cast<const GridAccel&>(a).view(); }
 
 using test::error_of;
@@ -45,7 +40,7 @@ void expect_same_hits(const Accel& grid, const Scene& scene, const std::vector<R
     EXPECT_EQ(brute.diffs, 0) << what;
     EXPECT_GE(brute.hits, min_hits) << what << ": the rays must exercise hits";
     if (!scene.triangles.empty()) {
-        const std::unique_ptr<Accel> bvh = bvh2_of(scene);
+        const std::unique_ptr<Accel> bvh = test::bvh2_of(scene);
         EXPECT_EQ(test::compare_rays(test::tracer(grid), test::tracer(*bvh), rays, what + " vs bvh2").diffs, 0) << what;
     }
 }
@@ -178,7 +173,7 @@ TEST(GridTrace, HitsEqualBvh2AndBruteForceOnRandomSoups) {
 TEST(GridTrace, HitsEqualBvh2OnProceduralScenes) {
     for (const std::string& name : procedural_scene_names()) {
         const Scene& scene = test::procedural(name);
-        const std::unique_ptr<Accel> g = grid_of(scene), bvh = bvh2_of(scene);
+        const std::unique_ptr<Accel> g = grid_of(scene), bvh = test::bvh2_of(scene);
         const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 7, 6000);
         const test::Agreement ag = test::compare_rays(test::tracer(*g), test::tracer(*bvh), rays, name);
         EXPECT_EQ(ag.diffs, 0) << name;
@@ -230,7 +225,7 @@ TEST(GridBenchmark, DISABLED_DensityOnSponza) {
     const std::string path = std::string(RTSIM_SCENES_DIR) + "/sponza/Sponza.gltf";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not found";
     const Scene scene = load_gltf(path);
-    const std::unique_ptr<Accel> bvh = bvh2_of(scene);
+    const std::unique_ptr<Accel> bvh = test::bvh2_of(scene);
     std::string why;
     const Camera cam = scene.cameras.empty() ? auto_frame(scene, *bvh, 4.0f / 3.0f, &why) : scene.cameras[0];
     const PinholeCamera pinhole = make_camera(cam, 160, 120);

@@ -13,8 +13,6 @@
 namespace rtsim {
 namespace {
 
-std::unique_ptr<Accel> bvh2_of(const Scene& scene) { return load_accel(build_accel(scene, AccelOptions{}), "test"); }
-
 /// Packets of `lanes` consecutive rays: hits against single rays, stepper against fused loop,
 /// plans against work. Returns the packets' counts.
 PacketCounts check_packets(const Accel& accel, const std::vector<Ray>& rays, uint32_t lanes, TraversalMode mode,
@@ -83,7 +81,7 @@ std::vector<Ray> camera_rays(const std::vector<HwTriangle>& tris, int n, uint64_
 TEST(Packets, HitsEqualSingleRaysOnProceduralScenes) {
     for (const std::string name : {"cornell", "hairball", "teapot_stadium", "rotated_walls"}) {
         const Scene& scene = test::procedural(name);
-        const std::unique_ptr<Accel> accel = bvh2_of(scene);
+        const std::unique_ptr<Accel> accel = test::bvh2_of(scene);
         const std::vector<HwTriangle> tris = test::hw_triangles(scene);
         const std::vector<Ray> random = test::random_rays(scene, tris, 7, 1024), camera = camera_rays(tris, 1024, 3);
         for (uint32_t lanes : {1u, 4u, 16u, 64u})
@@ -110,7 +108,7 @@ TEST(Packets, TheHybridSplitsLowOccupancyPacketsIntoSingleRays) {
     // hits stay the single ray's and the single-ray tail does a single ray's steps.
     for (const std::string name : {"cornell", "hairball"}) {
         const Scene& scene = test::procedural(name);
-        const std::unique_ptr<Accel> accel = bvh2_of(scene);
+        const std::unique_ptr<Accel> accel = test::bvh2_of(scene);
         const std::vector<HwTriangle> tris = test::hw_triangles(scene);
         const std::vector<Ray> random = test::random_rays(scene, tris, 29, 1024), camera = camera_rays(tris, 1024, 5);
         for (float split : {0.25f, 0.5f, 1.0f})
@@ -133,7 +131,7 @@ TEST(Packets, TheHybridSplitsLowOccupancyPacketsIntoSingleRays) {
 TEST(Packets, HardCasesAndAlphaMasks) {
     // An alpha-masked soup with coincident triangles, a closed sphere from inside, invalid rays.
     const Scene soup = test::random_soup(5, 400);
-    const std::unique_ptr<Accel> a = bvh2_of(soup);
+    const std::unique_ptr<Accel> a = test::bvh2_of(soup);
     std::vector<Ray> rays = test::random_rays(soup, test::hw_triangles(soup), 11, 512);
     rays[3].tmin = std::numeric_limits<float>::quiet_NaN();
     rays[17].direction = Vec3(0.0f);
@@ -141,7 +139,7 @@ TEST(Packets, HardCasesAndAlphaMasks) {
         for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit})
             check_packets(*a, rays, lanes, mode, "soup " + std::to_string(lanes));
     const std::vector<Vec3> sphere = test::icosphere(3);
-    const std::unique_ptr<Accel> s = bvh2_of(test::make_scene(sphere));
+    const std::unique_ptr<Accel> s = test::bvh2_of(test::make_scene(sphere));
     std::vector<Ray> inside;
     for (size_t t = 0; t < sphere.size(); ++t) inside.push_back(test::make_ray(Vec3(0.0f), sphere[t]));
     for (uint32_t lanes : {4u, 16u, 64u}) check_packets(*s, inside, lanes, TraversalMode::closest_hit, "sphere");
@@ -155,7 +153,7 @@ TEST(Packets, HardCasesAndAlphaMasks) {
 
 TEST(Packets, CopiesOfOneRayDoItsSingleRayWorkFullyActive) {
     const Scene& scene = test::procedural("hairball");
-    const std::unique_ptr<Accel> accel = bvh2_of(scene);
+    const std::unique_ptr<Accel> accel = test::bvh2_of(scene);
     const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 19, 64);
     for (const Ray& r : rays) {
         if (!ray_is_valid(r)) continue;
@@ -181,7 +179,7 @@ TEST(Packets, OnlyTheBinaryBvhHasAPacketKernel) {
     const Ray r = test::make_ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f));
     const TraversalMode m = TraversalMode::closest_hit;
     EXPECT_THROW(wide->trace_packet(&r, &m, 1, nullptr, nullptr, nullptr), Error);
-    const std::unique_ptr<Accel> bvh2 = bvh2_of(scene);
+    const std::unique_ptr<Accel> bvh2 = test::bvh2_of(scene);
     std::unique_ptr<PacketStepper> s = bvh2->make_packet_stepper();
     std::vector<Ray> many(65, r);
     std::vector<TraversalMode> modes(65, m);

@@ -16,6 +16,8 @@
 
 namespace rtsim::test {
 
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
 /// A scene with one mesh (triangle soup), one identity instance and the given materials;
 /// material_of[i] picks triangle i's material (all 0 when empty).
 inline Scene make_scene(const std::vector<Vec3>& soup, std::vector<Material> materials = {Material{}},

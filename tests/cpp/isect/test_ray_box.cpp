@@ -10,8 +10,8 @@
 namespace rtsim {
 namespace {
 
+using test::kInf;
 using test::make_ray;
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 bool hit_box(const Ray& r, const Vec3& lo, const Vec3& hi, float* tn) {
     return intersect_box(ray_box_precompute(r), &lo.x, &hi.x, r.tmin, r.tmax, tn);

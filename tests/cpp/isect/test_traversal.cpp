@@ -12,8 +12,8 @@
 namespace rtsim {
 namespace {
 
+using test::kInf;
 using test::make_ray;
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 HwTriangle make_tri(const Vec3& a, const Vec3& b, const Vec3& c, uint32_t prim, uint32_t flags = 0) {
     HwTriangle t{};

@@ -4,40 +4,20 @@
 // next level at i + 2 and fills at i + 2 + 20 + 2 = i + 24.
 #include <gtest/gtest.h>
 
-#include "rtl_model/mem/cache.h"
-#include "model_test_util.h"
+#include "tiny_cache.h"
 
 namespace rtsim {
 namespace {
 
-using test::FakeMemory;
-using test::TestKernel;
-
-constexpr uint64_t kLine = 256;
-// Lines: A = 0 (set 0), D = 1 (set 1), B = 2 (set 0), E = 3 (set 1), C = 4 (set 0).
-constexpr uint64_t A = 0 * kLine, D = 1 * kLine, B = 2 * kLine, E = 3 * kLine, C = 4 * kLine;
-
-CacheConfig tiny_config() {
-    CacheConfig c;
-    c.size_kib = 1;  // 1024 B = 2 sets x 2 ways x 256 B
-    c.ways = 2;
-    c.line_bytes = uint32_t(kLine);
-    c.latency = 4;
-    c.mshrs = 2;
-    c.banks = 1;
-    c.bank_cycles = 1;
-    return c;
-}
-
-struct Bench {
-    TestKernel kernel;
-    FakeMemory next{"next", 20};
-    Cache cache;
-    Bench(const CacheConfig& config, bool mshrs) : cache("cache", config, mshrs, 2) {
-        cache.next(next);
-        kernel.elaborate();
-    }
-};
+// The tiny cache (tiny_cache.h): its lines, config and bench.
+using test::A;
+using test::B;
+using test::Bench;
+using test::C;
+using test::D;
+using test::E;
+using test::kLine;
+using test::tiny_config;
 
 struct Step {
     Cycle time;

@@ -4,45 +4,28 @@
 // issued at tag done i fills at i + 24.
 #include <gtest/gtest.h>
 
-#include "rtl_model/mem/cache.h"
-#include "model_test_util.h"
+#include "tiny_cache.h"
 
 namespace rtsim {
 namespace {
 
-using test::FakeMemory;
-using test::TestKernel;
+// The tiny cache (tiny_cache.h): its lines, config and bench.
+using test::A;
+using test::B;
+using test::Bench;
+using test::C;
+using test::D;
+using test::E;
+using test::kLine;
+using test::tiny_config;
 
-constexpr uint64_t kLine = 256;
-constexpr uint64_t A = 0 * kLine, D = 1 * kLine, B = 2 * kLine, C = 4 * kLine, E = 3 * kLine;
-
-CacheConfig config() {
-    CacheConfig c;
-    c.size_kib = 1;
-    c.ways = 2;
-    c.line_bytes = uint32_t(kLine);
-    c.latency = 4;
-    c.mshrs = 4;
-    return c;
-}
-
-struct Bench {
-    TestKernel kernel;
-    FakeMemory next{"next", 20};
-    Cache cache{"cache", config(), true, 2};
-    Bench() {
-        cache.next(next);
-        kernel.elaborate();
-    }
-    Cycle prefetch(uint64_t addr, Cycle t) {
-        return cache.access({addr, uint32_t(kLine), false, DataKind::node, t, nullptr, true, ServedBy::l1});
-    }
-    Cycle read(uint64_t addr, Cycle t) { return cache.access({addr, 64, false, DataKind::node, t}); }
-    nlohmann::json pf() const { return cache.stats_json(1000)["prefetch"]; }
+/// test_cache.cpp's tiny cache with 4 MSHRs, so that prefetches (which may hold 2) leave room.
+struct PrefetchBench : Bench {
+    PrefetchBench() : Bench(tiny_config(4), true) {}
 };
 
 TEST(CachePrefetch, CountsEveryPrefetchedLineOnce) {
-    Bench b;
+    PrefetchBench b;
     EXPECT_EQ(b.prefetch(A, 0), 0u) << "taken: the prefetcher does not wait";
     EXPECT_EQ(b.read(A, 1), 28u) << "a read while A fills merges with the prefetch (late but useful)";
     EXPECT_EQ(b.prefetch(A, 2), 2u) << "A is there: redundant, nothing sent below";
@@ -52,7 +35,7 @@ TEST(CachePrefetch, CountsEveryPrefetchedLineOnce) {
     EXPECT_EQ(b.read(A, 350), 354u) << "A is used again: B is now the least recently used";
     EXPECT_EQ(b.read(C, 400), 428u) << "set 0 evicts B, never read: a useless prefetch";
     EXPECT_EQ(b.prefetch(E, 500), 500u) << "still unused at the end: resident";
-    const nlohmann::json pf = b.pf();
+    const nlohmann::json pf = b.prefetch_stats();
     EXPECT_EQ(pf["issued"], 4);
     EXPECT_EQ(pf["redundant"], 1);
     EXPECT_EQ(pf["useful"], 2);
@@ -67,20 +50,20 @@ TEST(CachePrefetch, CountsEveryPrefetchedLineOnce) {
 }
 
 TEST(CachePrefetch, HoldsAtMostHalfTheMshrs) {
-    Bench b;
+    PrefetchBench b;
     EXPECT_EQ(b.prefetch(A, 0), 0u);
     EXPECT_EQ(b.prefetch(D, 0), 0u);
     EXPECT_EQ(b.prefetch(B, 0), 28u) << "two prefetches in flight (2 of 4 MSHRs): retry when A fills";
     EXPECT_EQ(b.read(E, 1), 29u) << "a demand miss still finds a free MSHR: issue at 5, fill 29";
-    EXPECT_EQ(b.pf()["blocked"], 1);
-    EXPECT_EQ(b.pf()["issued"], 2);
+    EXPECT_EQ(b.prefetch_stats()["blocked"], 1);
+    EXPECT_EQ(b.prefetch_stats()["issued"], 2);
 }
 
 TEST(CachePrefetch, PassesDownToItsTarget) {
-    TestKernel kernel;
-    FakeMemory dram{"dram", 20};
-    Cache l2{"l2", config(), true, 0, false, ServedBy::l2};
-    Cache l1{"l1", config(), true, 2};
+    test::TestKernel kernel;
+    test::FakeMemory dram{"dram", 20};
+    Cache l2{"l2", tiny_config(4), true, 0, false, ServedBy::l2};
+    Cache l1{"l1", tiny_config(4), true, 2};
     l2.next(dram);
     l1.next(l2);
     kernel.elaborate();

@@ -54,9 +54,9 @@ std::unique_ptr<Accel> tiny_accel() {
 
 constexpr uint32_t kUnits = 2, kContexts = 16;
 
-struct Bench {
+struct BufferBench {
     /// lookahead: how far past the asking time admission may issue reads (default: unbounded).
-    Bench(const TreeletConfig& c, uint64_t rays, uint32_t treelets, const std::string& tag,
+    BufferBench(const TreeletConfig& c, uint64_t rays, uint32_t treelets, const std::string& tag,
           Cycle lookahead = Cycle(1) << 40)
         : lookahead(lookahead),
           config(c),
@@ -104,7 +104,7 @@ TreeletConfig config_with(uint32_t buffer_kib, const std::string& policy, uint32
 TEST(RayBuffer, AdmitsUpToCapacityAndOverflowsParkedRays) {
     test::TestKernel kernel;
     TreeletConfig c = config_with(1, "largest", 1);  // 1 KiB: 8 rays of 120 bytes
-    Bench b(c, 100, 4, "overflow");
+    BufferBench b(c, 100, 4, "overflow");
     ASSERT_EQ(b.buffer.capacity_rays(), 1024u / 120u);
     const uint64_t capacity = b.buffer.capacity_rays();
     RayState ray;
@@ -139,7 +139,7 @@ TEST(RayBuffer, AdmissionReadsAreStreamedNotBurst) {
     test::TestKernel kernel;
     TreeletConfig c = config_with(64, "largest", 1);  // 64 KiB: 546 rays
     c.admit_outstanding = 4;
-    Bench b(c, 300, 4, "admission");
+    BufferBench b(c, 300, 4, "admission");
     RayState ray;
     uint32_t treelet = 0;
     Cycle ready = 0;
@@ -165,7 +165,7 @@ TEST(RayBuffer, AdmissionIssuesNoReadBeyondTheLookahead) {
     test::TestKernel kernel;
     TreeletConfig c = config_with(64, "largest", 1);
     c.admit_outstanding = 4;
-    Bench b(c, 40, 4, "lookahead", 1);
+    BufferBench b(c, 40, 4, "lookahead", 1);
     RayState ray;
     uint32_t treelet = 0;
     Cycle ready = 0;
@@ -203,7 +203,7 @@ TEST(RayBuffer, EveryRayIsHandedOutExactlyOnceUnderEveryPolicy) {
         for (uint32_t kib : {1u, 64u}) {
             SCOPED_TRACE(std::string(policy) + " " + std::to_string(kib) + " KiB");
             test::TestKernel kernel;
-            Bench b(config_with(kib, policy, 4), 300, 6, std::string(policy) + std::to_string(kib));
+            BufferBench b(config_with(kib, policy, 4), 300, 6, std::string(policy) + std::to_string(kib));
             // Each ray visits treelets 0, then 1..5 by id, then finishes: 2 takes per ray.
             std::map<uint64_t, int> takes;
             std::set<uint64_t> finished;
@@ -230,7 +230,7 @@ TEST(RayBuffer, EveryRayIsHandedOutExactlyOnceUnderEveryPolicy) {
 
 TEST(RayBuffer, LargestPolicyRunsTheLongestQueue) {
     test::TestKernel kernel;
-    Bench b(config_with(64, "largest", 1), 10, 4, "largest");
+    BufferBench b(config_with(64, "largest", 1), 10, 4, "largest");
     RayState ray;
     uint32_t treelet = 0;
     Cycle ready = 0;

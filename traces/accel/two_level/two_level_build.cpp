@@ -11,6 +11,7 @@
 #include "traces/accel/two_level/two_level.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/common/error.h"
+#include "traces/common/stopwatch.h"
 #include "traces/scene/scene.h"
 
 namespace rtsim {
@@ -188,10 +189,6 @@ TlasFrame build_tlas(const Scene& scene, const BlasSet& blases, const std::vecto
         rec.instance = id;
     }
     return out;
-}
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 /// Appends the BLASes' regions to `image`, concatenated per name (each BLAS on a 64-byte
