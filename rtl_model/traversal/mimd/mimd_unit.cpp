@@ -73,14 +73,6 @@ void MimdUnit::fill_idle_contexts(Cycle t) {
     m_next_fill = t + m_ctx.idle_poll_cycles;
 }
 
-void MimdUnit::account(uint32_t c, CycleUse use, Cycle until) {
-    account_until(m_account, m_contexts[c].accounted, use, until);
-}
-
-void MimdUnit::account_read(uint32_t c, Cycle ready, const AccessInfo& info) {
-    account_read_until(m_account, m_contexts[c].accounted, ready, info);
-}
-
 void MimdUnit::activate(uint32_t c, Cycle t) {
     account(c, CycleUse::starved, t);  // idle until now, while rays were still to come
     m_contexts[c].active = true;
@@ -182,8 +174,10 @@ void MimdUnit::run_ops(uint32_t c, Cycle t) {
         ready = pipes[size_t(d.issues[i].kind)]->issue(ready, d.issues[i].issues, d.issues[i].tests);
         account(c, pipe_use(d.issues[i].kind), ready);
     }
-    ready = stack_traffic(c, t, ready);
-    account(c, CycleUse::stack, ready);  // spilled entries read back after the operations
+    if (d.spills || d.fills) {  // most steps move no stack entry to or from memory
+        ready = stack_traffic(c, t, ready);
+        account(c, CycleUse::stack, ready);  // spilled entries read back after the operations
+    }
     m_contexts[c].phase = Phase::step;
     schedule(c, ready);
 }
