@@ -73,21 +73,36 @@ def checked(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict:
     return stats
 
 
+def trace_per_structure(
+    root: Path,
+    scene: str,
+    resolution: str,
+    workload: str,
+    structures: dict[str, list[str]],
+    *extra: str,
+) -> dict[str, Path]:
+    """`rtsim trace SCENE` once per structure (name: its command-line arguments) under root."""
+    out = {}
+    for name, args in structures.items():
+        folder = root / name
+        result = run_rtsim(
+            "trace", scene, "-o", str(folder), "--resolution", resolution, "--workload", workload,
+            *extra, *args,
+        )  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        out[name] = folder
+    return out
+
+
 @pytest.fixture(scope="session")
 def small_hairball_traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """A 2,000-triangle hairball at 32x24 (primary and diffuse), once per structure (bvh2,
     cwbvh8, kdtree): the traces the short-stack and reduced-precision box tests replay."""
-    root = tmp_path_factory.mktemp("small_hairball_traces")
-    out = {}
-    for accel in ("bvh2", "cwbvh8", "kdtree"):
-        folder = root / accel
-        result = run_rtsim(
-            "trace", "hairball", "-o", str(folder), "--resolution", "32x24",
-            "--workload", "primary,diffuse", "--hairball-triangles", "2000", "--accel", accel,
-        )  # fmt: skip
-        assert result.returncode == 0, result.stderr
-        out[accel] = folder
-    return out
+    structures = {accel: ["--accel", accel] for accel in ("bvh2", "cwbvh8", "kdtree")}
+    return trace_per_structure(
+        tmp_path_factory.mktemp("small_hairball_traces"), "hairball", "32x24", "primary,diffuse",
+        structures, "--hairball-triangles", "2000",
+    )  # fmt: skip
 
 
 @pytest.fixture(scope="session")
@@ -121,4 +136,33 @@ def cornell_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "2",
     )
     assert result.returncode == 0, result.stderr
+    return out
+
+
+@pytest.fixture(scope="session")
+def small_cornell_rays(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Cornell primary, shadow and diffuse rays at 32x24 (the execution models' tests)."""
+    out = tmp_path_factory.mktemp("small_cornell_rays") / "cornell"
+    rtsim.trace_scene("cornell", out, workload="primary,shadow,diffuse", width=32, height=24)
+    return out
+
+
+@pytest.fixture(scope="session")
+def same_ray_trace(tmp_path_factory: pytest.TempPathFactory, small_cornell_rays: Path) -> Path:
+    """128 copies of one primary ray that hits the scene: every lane of a warp or packet alike."""
+    import numpy as np
+
+    t = rtsim.open_trace(small_cornell_rays)
+    rays, hits = t.rays, t.hits
+    i = int(np.flatnonzero(hits["prim"] >= 0)[len(hits) // 4])
+    n = 128
+    out = tmp_path_factory.mktemp("same_ray") / "t"
+    rtsim.write_trace(
+        "cornell",
+        np.repeat(rays["origin"][i : i + 1], n, axis=0),
+        np.repeat(rays["direction"][i : i + 1], n, axis=0),
+        float(rays["tmin"][i]),
+        float(rays["tmax"][i]),
+        out=out,
+    )
     return out

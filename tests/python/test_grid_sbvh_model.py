@@ -8,12 +8,11 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 import rtsim
-from conftest import run_rtsim, sim_stats
+from conftest import checked, run_rtsim, trace_per_structure
 
 STRUCTURES = {
     "grid": ["--accel", "grid"],
@@ -26,25 +25,7 @@ LEVELS = ("functional", "analytic", "approx", "detailed")
 def traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """cornell at 32x24 (primary, shadow, diffuse), once per structure."""
     root = tmp_path_factory.mktemp("accel_traces")
-    out = {}
-    for name, args in STRUCTURES.items():
-        folder = root / name
-        result = run_rtsim(
-            "trace", "cornell", "-o", str(folder), "--resolution", "32x24",
-            "--workload", "primary,shadow,diffuse", *args,
-        )  # fmt: skip
-        assert result.returncode == 0, result.stderr
-        out[name] = folder
-    return out
-
-
-def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    stats = sim_stats(sim_exe, trace, out, *sets)
-    summary = stats["summary"]
-    assert summary["hit_mismatches"] == 0, stats["validation"]["first_mismatches"]
-    assert summary["work_mismatches"] == 0, stats["validation"]["first_mismatches"]
-    assert summary["rays"] == stats["validation"]["rays_checked"] > 0
-    return stats
+    return trace_per_structure(root, "cornell", "32x24", "primary,shadow,diffuse", STRUCTURES)
 
 
 @pytest.mark.parametrize("level", LEVELS)
@@ -52,7 +33,7 @@ def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any
 def test_model_replays_every_structure(
     traces: dict[str, Path], sim_exe: Path, tmp_path: Path, structure: str, level: str
 ) -> None:
-    stats = simulate(sim_exe, traces[structure], tmp_path / "run", f"fidelity={level}")
+    stats = checked(sim_exe, traces[structure], tmp_path / "run", f"fidelity={level}")
     if level == "functional":
         assert stats["summary"]["cycles"] is None
         return
@@ -67,7 +48,7 @@ def test_grid_bricks_and_any_hit(
     traces: dict[str, Path], sim_exe: Path, tmp_path: Path, scenes_dir: Path
 ) -> None:
     # Treelet scheduling over the grid's bricks; 1 KiB bricks make rays move at most cells.
-    stats = simulate(
+    stats = checked(
         sim_exe, traces["grid"], tmp_path / "bricks",
         "treelets.enabled=true", "treelets.treelet_kib=1",
     )  # fmt: skip
@@ -81,7 +62,7 @@ def test_grid_bricks_and_any_hit(
         "--workload", "primary,shadow", "--accel", "grid",
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
-    stats = simulate(sim_exe, folder, tmp_path / "alpha_run")
+    stats = checked(sim_exe, folder, tmp_path / "alpha_run")
     assert {b["block"]: b["instantiated"] for b in stats["instantiated"]}["anyhit"] is True
 
 

@@ -8,40 +8,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import rtsim
 from conftest import sim_stats, simulate
 
 PACKET = ("traversal.model=packet", "traversal.ray_contexts=64")
-
-
-@pytest.fixture(scope="module")
-def cornell_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Cornell primary, shadow and diffuse rays, small."""
-    out = tmp_path_factory.mktemp("packet") / "cornell"
-    rtsim.trace_scene("cornell", out, workload="primary,shadow,diffuse", width=32, height=24)
-    return out
-
-
-@pytest.fixture(scope="module")
-def same_ray(tmp_path_factory: pytest.TempPathFactory, cornell_trace: Path) -> Path:
-    """128 copies of one primary ray that hits the scene."""
-    t = rtsim.open_trace(cornell_trace)
-    rays, hits = t.rays, t.hits
-    i = int(np.flatnonzero(hits["prim"] >= 0)[len(hits) // 4])
-    n = 128
-    out = tmp_path_factory.mktemp("same") / "t"
-    rtsim.write_trace(
-        "cornell",
-        np.repeat(rays["origin"][i : i + 1], n, axis=0),
-        np.repeat(rays["direction"][i : i + 1], n, axis=0),
-        float(rays["tmin"][i]),
-        float(rays["tmax"][i]),
-        out=out,
-    )
-    return out
 
 
 @pytest.mark.parametrize(
@@ -57,12 +29,12 @@ def same_ray(tmp_path_factory: pytest.TempPathFactory, cornell_trace: Path) -> P
     ],
 )
 def test_packet_hits_and_work_match_the_reference(
-    sim_exe: Path, cornell_trace: Path, tmp_path: Path, sets: tuple[str, ...]
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path, sets: tuple[str, ...]
 ) -> None:
-    stats = sim_stats(sim_exe, cornell_trace / "trace.rtt", tmp_path / "run", *PACKET, *sets)
+    stats = sim_stats(sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run", *PACKET, *sets)
     s = stats["summary"]
     assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
-    assert s["rays"] == rtsim.open_trace(cornell_trace).manifest["counts"]["rays"]
+    assert s["rays"] == rtsim.open_trace(small_cornell_rays).manifest["counts"]["rays"]
     if "fidelity=functional" in sets:
         return
     lanes = int(next(x for x in sets if x.startswith("traversal.lanes=")).split("=")[1])
@@ -90,13 +62,15 @@ def test_packet_hits_and_work_match_the_reference(
     assert acc["by_use"]["idle_lane"] > 0
 
 
-def test_packets_share_node_fetches(sim_exe: Path, cornell_trace: Path, tmp_path: Path) -> None:
+def test_packets_share_node_fetches(
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path
+) -> None:
     """A packet's node step is one fetch: far fewer node reads than single rays make."""
     mimd = sim_stats(
-        sim_exe, cornell_trace / "trace.rtt", tmp_path / "mimd", "traversal.ray_contexts=64"
+        sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "mimd", "traversal.ray_contexts=64"
     )
     pk = sim_stats(
-        sim_exe, cornell_trace / "trace.rtt", tmp_path / "pk", *PACKET, "traversal.lanes=16"
+        sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "pk", *PACKET, "traversal.lanes=16"
     )
     node_reads = sum(u["packet_node_fetches"] for u in pk["model"]["units"].values())
     # A MIMD unit's scheduler steps: 2 per traversal step and 1 per ray.
@@ -106,13 +80,13 @@ def test_packets_share_node_fetches(sim_exe: Path, cornell_trace: Path, tmp_path
     assert pk["summary"]["work_mismatches"] == 0
 
 
-def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray(
-    sim_exe: Path, same_ray: Path, tmp_path: Path
+def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray_trace(
+    sim_exe: Path, same_ray_trace: Path, tmp_path: Path
 ) -> None:
     for lanes in (4, 8, 16):
         stats = sim_stats(
             sim_exe,
-            same_ray / "trace.rtt",
+            same_ray_trace / "trace.rtt",
             tmp_path / f"l{lanes}",
             "traversal.model=packet",
             "traversal.units=1",
@@ -128,7 +102,7 @@ def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray(
         assert unit["packet_active_histogram"][:lanes] == [0] * lanes
         assert "idle_lane" not in stats["model"]["cycle_accounting"]["by_use"]
         # The packet walks the single ray's path: one node fetch per single-ray node step.
-        steps = int(rtsim.open_trace(same_ray).work["steps"][0])
+        steps = int(rtsim.open_trace(same_ray_trace).work["steps"][0])
         assert unit["packet_node_fetches"] == steps * unit["packets"]
 
 
@@ -155,8 +129,8 @@ def test_packet_needs_a_packet_kernel(sim_exe: Path, tmp_path: Path) -> None:
     ],
 )
 def test_bad_packet_settings_are_named(
-    sim_exe: Path, cornell_trace: Path, tmp_path: Path, sets: tuple[str, ...], named: str
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path, sets: tuple[str, ...], named: str
 ) -> None:
-    result = simulate(sim_exe, cornell_trace / "trace.rtt", tmp_path / "run", *sets)
+    result = simulate(sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run", *sets)
     assert result.returncode == 2, result.stderr
     assert named in result.stderr

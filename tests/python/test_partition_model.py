@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim, sim_stats
+from conftest import checked, run_rtsim, trace_per_structure
 
 STRUCTURES = {
     "kdtree": ["--accel", "kdtree"],
@@ -31,25 +31,7 @@ ENTRY_BYTES = {"kdtree": 12, "bih": 12, "octree": 32, "grid": 8, "bvh2": 8}
 def traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """rotated_walls at 24x18 (primary, shadow, diffuse), once per structure."""
     root = tmp_path_factory.mktemp("partition_traces")
-    out = {}
-    for name, args in STRUCTURES.items():
-        folder = root / name
-        result = run_rtsim(
-            "trace", "rotated_walls", "-o", str(folder), "--resolution", "24x18",
-            "--workload", "primary,shadow,diffuse", *args,
-        )  # fmt: skip
-        assert result.returncode == 0, result.stderr
-        out[name] = folder
-    return out
-
-
-def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any]:
-    stats = sim_stats(sim_exe, trace, out, *sets)
-    summary = stats["summary"]
-    assert summary["hit_mismatches"] == 0, stats["validation"]["first_mismatches"]
-    assert summary["work_mismatches"] == 0, stats["validation"]["first_mismatches"]
-    assert summary["rays"] == stats["validation"]["rays_checked"] > 0
-    return stats
+    return trace_per_structure(root, "rotated_walls", "24x18", "primary,shadow,diffuse", STRUCTURES)
 
 
 @pytest.mark.parametrize("level", LEVELS)
@@ -57,7 +39,7 @@ def simulate(sim_exe: Path, trace: Path, out: Path, *sets: str) -> dict[str, Any
 def test_model_replays_every_structure_at_every_level(
     traces: dict[str, Path], sim_exe: Path, tmp_path: Path, structure: str, level: str
 ) -> None:
-    stats = simulate(sim_exe, traces[structure], tmp_path / "run", f"fidelity={level}")
+    stats = checked(sim_exe, traces[structure], tmp_path / "run", f"fidelity={level}")
     resolved = json.loads((tmp_path / "run" / "config.resolved.json").read_text())
     assert resolved["traversal"]["stack_entry_bytes"] == ENTRY_BYTES[structure]
     if level == "functional":
@@ -87,8 +69,8 @@ def test_stack_entry_bytes_override_and_spill_traffic(
     traces: dict[str, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
     # One on-chip entry: the kd-tree spills; 12-byte entries move 1.5x the bytes of 8-byte ones.
-    own = simulate(sim_exe, traces["kdtree"], tmp_path / "own", "traversal.stack_entries=1")
-    forced = simulate(sim_exe, traces["kdtree"], tmp_path / "forced", "traversal.stack_entries=1",
+    own = checked(sim_exe, traces["kdtree"], tmp_path / "own", "traversal.stack_entries=1")
+    forced = checked(sim_exe, traces["kdtree"], tmp_path / "forced", "traversal.stack_entries=1",
                       "traversal.stack_entry_bytes=8")  # fmt: skip
 
     def spills(stats: dict[str, Any]) -> tuple[int, int]:
@@ -106,10 +88,10 @@ def test_stack_entry_bytes_override_and_spill_traffic(
 def test_mailbox_changes_no_hit_and_saves_tests(
     traces: dict[str, Path], sim_exe: Path, tmp_path: Path, structure: str
 ) -> None:
-    base = simulate(sim_exe, traces[structure], tmp_path / "base")
+    base = checked(sim_exe, traces[structure], tmp_path / "base")
     assert base["summary"]["mailbox_hits_per_ray"] is None and "mailbox" not in base
     for level in ("functional", "approx"):
-        stats = simulate(
+        stats = checked(
             sim_exe, traces[structure], tmp_path / level, "mailbox.entries=8", f"fidelity={level}"
         )
         m = stats["mailbox"]

@@ -6,40 +6,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import rtsim
 from conftest import REPO, sim_stats, simulate
 
 SIMT = ("traversal.model=simt", "traversal.ray_contexts=32")
-
-
-@pytest.fixture(scope="module")
-def coherent_and_not(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Cornell primary and diffuse rays, small."""
-    out = tmp_path_factory.mktemp("simt") / "cornell"
-    rtsim.trace_scene("cornell", out, workload="primary,diffuse", width=32, height=24)
-    return out
-
-
-@pytest.fixture(scope="module")
-def same_ray(tmp_path_factory: pytest.TempPathFactory, coherent_and_not: Path) -> Path:
-    """128 copies of one primary ray that hits the scene."""
-    rays = rtsim.open_trace(coherent_and_not).rays
-    hits = rtsim.open_trace(coherent_and_not).hits
-    i = int(np.flatnonzero(hits["prim"] >= 0)[len(hits) // 4])
-    n = 128
-    out = tmp_path_factory.mktemp("same") / "t"
-    rtsim.write_trace(
-        "cornell",
-        np.repeat(rays["origin"][i : i + 1], n, axis=0),
-        np.repeat(rays["direction"][i : i + 1], n, axis=0),
-        float(rays["tmin"][i]),
-        float(rays["tmax"][i]),
-        out=out,
-    )
-    return out
 
 
 @pytest.mark.parametrize(
@@ -52,12 +24,12 @@ def same_ray(tmp_path_factory: pytest.TempPathFactory, coherent_and_not: Path) -
     ],
 )
 def test_simt_hits_and_work_match_the_reference(
-    sim_exe: Path, coherent_and_not: Path, tmp_path: Path, sets: tuple[str, ...]
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path, sets: tuple[str, ...]
 ) -> None:
-    stats = sim_stats(sim_exe, coherent_and_not / "trace.rtt", tmp_path / "run", *SIMT, *sets)
+    stats = sim_stats(sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run", *SIMT, *sets)
     s = stats["summary"]
     assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
-    assert s["rays"] == rtsim.open_trace(coherent_and_not).manifest["counts"]["rays"]
+    assert s["rays"] == rtsim.open_trace(small_cornell_rays).manifest["counts"]["rays"]
     units = stats["model"]["units"].values()
     assert sum(u["rays"] for u in units) == s["rays"]
     assert 0.0 < s["simd_efficiency"] < 1.0  # diffuse rays diverge
@@ -77,14 +49,14 @@ def test_simt_hits_and_work_match_the_reference(
     assert acc["by_use"]["idle_lane"] > 0
 
 
-def test_simd_efficiency_is_one_when_every_lane_carries_the_same_ray(
-    sim_exe: Path, same_ray: Path, tmp_path: Path
+def test_simd_efficiency_is_one_when_every_lane_carries_the_same_ray_trace(
+    sim_exe: Path, same_ray_trace: Path, tmp_path: Path
 ) -> None:
     for refill in ("lane", "warp"):
         for policy in ("while_while", "if_if"):
             stats = sim_stats(
                 sim_exe,
-                same_ray / "trace.rtt",
+                same_ray_trace / "trace.rtt",
                 tmp_path / f"{refill}_{policy}",
                 "traversal.model=simt",
                 "traversal.units=1",
@@ -104,8 +76,8 @@ def test_simd_efficiency_is_one_when_every_lane_carries_the_same_ray(
             assert {p["value"] for p in unit["simd_efficiency_over_time"]} == {1.0}
 
 
-def test_mimd_writes_no_simt_keys(sim_exe: Path, coherent_and_not: Path, tmp_path: Path) -> None:
-    stats = sim_stats(sim_exe, coherent_and_not / "trace.rtt", tmp_path / "run")
+def test_mimd_writes_no_simt_keys(sim_exe: Path, small_cornell_rays: Path, tmp_path: Path) -> None:
+    stats = sim_stats(sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run")
     assert "simd_efficiency" not in stats["summary"]
     assert "warp_steps" not in stats["model"]["units"]["tu0"]
     assert "idle_lane" not in stats["model"]["cycle_accounting"]["by_use"]
@@ -114,10 +86,10 @@ def test_mimd_writes_no_simt_keys(sim_exe: Path, coherent_and_not: Path, tmp_pat
 
 @pytest.mark.parametrize("sort", ["octant", "morton", "origin_direction"])
 def test_sorted_dispatch_hands_out_every_ray_once(
-    sim_exe: Path, coherent_and_not: Path, tmp_path: Path, sort: str
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path, sort: str
 ) -> None:
     stats = sim_stats(
-        sim_exe, coherent_and_not / "trace.rtt", tmp_path / "run", f"dispatch.sort={sort}"
+        sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run", f"dispatch.sort={sort}"
     )
     s = stats["summary"]
     assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
@@ -145,9 +117,9 @@ def test_sorted_dispatch_hands_out_every_ray_once(
     ],
 )
 def test_bad_settings_are_named(
-    sim_exe: Path, coherent_and_not: Path, tmp_path: Path, sets: tuple[str, ...], named: str
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path, sets: tuple[str, ...], named: str
 ) -> None:
-    result = simulate(sim_exe, coherent_and_not / "trace.rtt", tmp_path / "run", *sets)
+    result = simulate(sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run", *sets)
     assert result.returncode == 2, result.stderr
     assert named in result.stderr
 
@@ -175,10 +147,10 @@ def test_simt_two_level_with_frames(sim_exe: Path, tmp_path: Path) -> None:
     assert len(stats["frames"]) == 3
 
 
-def test_simt_sampled(sim_exe: Path, coherent_and_not: Path, tmp_path: Path) -> None:
+def test_simt_sampled(sim_exe: Path, small_cornell_rays: Path, tmp_path: Path) -> None:
     small = ("traversal.model=simt", "traversal.units=2", "traversal.ray_contexts=16")
     stats = sim_stats(
-        sim_exe, coherent_and_not / "trace.rtt", tmp_path / "run", *small, "sampling.fraction=0.3"
+        sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run", *small, "sampling.fraction=0.3"
     )
     s = stats["summary"]
     assert s["sampled"] is True and s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
@@ -214,10 +186,10 @@ def test_execution_models_sweep_spec_parses() -> None:
     assert len(spec.points()) == 2 * 3 * 2
 
 
-def test_simt_is_deterministic(sim_exe: Path, coherent_and_not: Path, tmp_path: Path) -> None:
+def test_simt_is_deterministic(sim_exe: Path, small_cornell_rays: Path, tmp_path: Path) -> None:
     """Same trace and config: the same model figures, run after run (rule 9)."""
     sets = (*SIMT, "dispatch.sort=morton", "traversal.simt_policy=if_if")
-    trace = coherent_and_not / "trace.rtt"
+    trace = small_cornell_rays / "trace.rtt"
     runs = [sim_stats(sim_exe, trace, tmp_path / f"r{i}", *sets) for i in range(2)]
     assert runs[0]["model"] == runs[1]["model"]
     assert runs[0]["summary"]["cycles"] == runs[1]["summary"]["cycles"]

@@ -5,13 +5,6 @@
 
 namespace rtsim {
 
-Hit trace_with_stepper(Stepper& stepper, const Ray& ray, TraversalMode mode, WorkCounts* work) {
-    stepper.begin(ray, mode);
-    while (!stepper.done()) stepper.execute();
-    if (work) *work = stepper.work();
-    return stepper.hit();
-}
-
 Hit Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
     std::unique_ptr<Stepper> s = make_stepper();
     return trace_with_stepper(*s, ray, mode, work);

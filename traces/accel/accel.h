@@ -139,6 +139,13 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options);
 std::unique_ptr<Accel> load_accel(AccelImage image, const std::string& source = "accel image");
 
 /// Drives a stepper over a ray to the end: the definition every fused loop is tested against.
-Hit trace_with_stepper(Stepper& stepper, const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr);
+/// With a final stepper type (a structure's own, on the caller's stack) the calls are direct.
+template <class S>
+Hit trace_with_stepper(S& stepper, const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) {
+    stepper.begin(ray, mode);
+    while (!stepper.done()) stepper.execute();
+    if (work) *work = stepper.work();
+    return stepper.hit();
+}
 
 }  // namespace rtsim

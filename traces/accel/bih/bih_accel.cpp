@@ -102,10 +102,7 @@ std::unique_ptr<Stepper> BihAccel::make_stepper() const { return std::make_uniqu
 
 Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
     BihStepper stepper(m_view);  // on the stack: no allocation, no virtual calls
-    stepper.begin(ray, mode);
-    while (!stepper.done()) stepper.execute();
-    if (work) *work = stepper.work();
-    return stepper.hit();
+    return trace_with_stepper(stepper, ray, mode, work);
 }
 
 LocalityPartition BihAccel::partition(uint64_t budget_bytes) const {

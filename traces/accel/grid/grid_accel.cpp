@@ -64,10 +64,7 @@ std::unique_ptr<Stepper> GridAccel::make_stepper() const {
 
 Hit GridAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
     GridStepper stepper(m_view, m_mailbox_entries);
-    stepper.begin(ray, mode);
-    while (!stepper.done()) stepper.execute();
-    if (work) *work = stepper.work();
-    return stepper.hit();
+    return trace_with_stepper(stepper, ray, mode, work);
 }
 
 LocalityPartition GridAccel::partition(uint64_t budget_bytes) const { return grid_partition(m_view, budget_bytes); }

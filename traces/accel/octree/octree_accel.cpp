@@ -155,10 +155,7 @@ std::unique_ptr<Stepper> OctreeAccel::make_stepper() const {
 
 Hit OctreeAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
     OctreeStepper stepper(m_view, m_mailbox_entries);  // on the stack: no allocation, no virtual calls
-    stepper.begin(ray, mode);
-    while (!stepper.done()) stepper.execute();
-    if (work) *work = stepper.work();
-    return stepper.hit();
+    return trace_with_stepper(stepper, ray, mode, work);
 }
 
 LocalityPartition OctreeAccel::partition(uint64_t budget_bytes) const {
