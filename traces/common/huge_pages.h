@@ -16,7 +16,8 @@ namespace rtsim {
 constexpr size_t kHugePageBytes = size_t(2) << 20;
 constexpr size_t kHugePageThreshold = kHugePageBytes;
 
-/// `bytes` of storage aligned to at least 64 bytes (2 MiB when bytes >= kHugePageThreshold),
+/// `bytes` of storage aligned to at least 64 bytes (4 KiB when bytes >= kHugePageThreshold: on
+/// huge pages, starting at a varying offset into the first one, huge_pages.cpp),
 /// zero-filled (always so when mapped: fresh pages are zero; zero = false spares a small block
 /// the memset). Throws std::bad_alloc. Free with huge_free and the same `bytes`.
 void* huge_alloc(size_t bytes, bool zero = true);

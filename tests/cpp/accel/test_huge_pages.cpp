@@ -30,10 +30,10 @@ TEST(HugePages, SmallAllocationsAreZeroedAndLineAligned) {
     }
 }
 
-TEST(HugePages, LargeAllocationsAreZeroedAndHugePageAligned) {
+TEST(HugePages, LargeAllocationsAreZeroedAndPageAligned) {
     for (size_t bytes : {kHugePageThreshold, 3 * kHugePageBytes + 12345}) {
         auto* p = static_cast<uint8_t*>(huge_alloc(bytes));
-        EXPECT_EQ(reinterpret_cast<uintptr_t>(p) % kHugePageBytes, 0u) << bytes;
+        EXPECT_EQ(reinterpret_cast<uintptr_t>(p) % 4096, 0u) << bytes;
         EXPECT_TRUE(all_zero(p, bytes)) << bytes;
         p[0] = 1;
         p[bytes - 1] = 2;
@@ -42,11 +42,23 @@ TEST(HugePages, LargeAllocationsAreZeroedAndHugePageAligned) {
     }
 }
 
+TEST(HugePages, LargeArraysStartAtStaggeredOffsetsIntoTheirHugePage) {
+    // Arrays all starting 2 MiB-aligned would share their first records' cache sets.
+    std::vector<void*> arrays;
+    std::vector<uintptr_t> offsets;
+    for (int i = 0; i < 4; ++i) {
+        arrays.push_back(huge_alloc(kHugePageBytes));
+        offsets.push_back(reinterpret_cast<uintptr_t>(arrays.back()) % kHugePageBytes);
+    }
+    for (int i = 1; i < 4; ++i) EXPECT_NE(offsets[i], offsets[i - 1]) << i;
+    for (void* p : arrays) huge_free(p, kHugePageBytes);
+}
+
 TEST(HugePages, VectorKeepsItsContentsAcrossGrowth) {
     std::vector<uint32_t, HugePageAllocator<uint32_t>> v;
     const uint32_t n = uint32_t(3 * kHugePageBytes / sizeof(uint32_t));  // crosses the threshold
     for (uint32_t i = 0; i < n; ++i) v.push_back(i * 2654435761u);
-    EXPECT_EQ(reinterpret_cast<uintptr_t>(v.data()) % kHugePageBytes, 0u);
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(v.data()) % 4096, 0u);
     for (uint32_t i = 0; i < n; i += 997) ASSERT_EQ(v[i], i * 2654435761u) << i;
     std::vector<uint32_t, HugePageAllocator<uint32_t>> copy = v;
     EXPECT_EQ(copy, v);
@@ -54,7 +66,7 @@ TEST(HugePages, VectorKeepsItsContentsAcrossGrowth) {
 
 TEST(HugePages, AlignedBytesUsesThemForLargeRegions) {
     AlignedBytes big(5 * kHugePageBytes + 3);
-    EXPECT_EQ(reinterpret_cast<uintptr_t>(big.data()) % kHugePageBytes, 0u);
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(big.data()) % 4096, 0u);
     EXPECT_TRUE(all_zero(big.data(), big.size()));
     big.data()[big.size() - 1] = 9;
     AlignedBytes copy = big;
