@@ -29,7 +29,7 @@ constexpr uint32_t kMaxSupportedDepth = 64;
 
 // Per-primitive boxes, rejecting non-finite vertices (docs/architecture.md, rule 11); returns
 // the centroid bounds.
-Box make_refs(const std::vector<Triangle>& triangles, std::vector<PrimRef>& refs) {
+Box make_refs(const std::vector<Triangle>& triangles, PrimRefs& refs) {
     refs.resize(triangles.size());
     Box centroids;
     for (size_t i = 0; i < triangles.size(); ++i) {
@@ -49,7 +49,7 @@ Box make_refs(const std::vector<Triangle>& triangles, std::vector<PrimRef>& refs
     return centroids;
 }
 
-Box bounds_of(const std::vector<PrimRef>& refs) {
+Box bounds_of(const PrimRefs& refs) {
     Box box;
     for (const PrimRef& r : refs) box.grow(r.lo3(), r.hi);
     return box;
@@ -253,7 +253,7 @@ BuildTree build_binned_sah(const std::vector<Triangle>& triangles, const BuildCo
     require(!triangles.empty(), "scene has no triangles");
     validate(config, triangles.size());
     const uint32_t n = uint32_t(triangles.size());
-    std::vector<PrimRef> refs;
+    PrimRefs refs;
     const Box root_c = make_refs(triangles, refs);
     BuildTree tree;
     tree.nodes.reserve(2 * size_t(n) - 1);

@@ -60,7 +60,7 @@ std::vector<BuildNode> stitch(const std::vector<BuildNode>& top, const std::vect
 
 }  // namespace
 
-void build_parallel(std::vector<PrimRef>& refs, const BuildConfig& config, const WorkItem& root, unsigned threads,
+void build_parallel(PrimRefs& refs, const BuildConfig& config, const WorkItem& root, unsigned threads,
                     std::vector<BuildNode>& nodes) {
     const uint32_t grain = std::max(kMinTask, (root.end - root.begin) / (kTasksPerThread * threads));
     // The top of the tree, here; nodes of at most `grain` references become tasks.
