@@ -1,7 +1,7 @@
 #include "traces/common/huge_pages.h"
 
-#include <cstdlib>
 #include <atomic>
+#include <cstdlib>
 #include <cstring>
 
 #if defined(__linux__)
