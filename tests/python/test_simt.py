@@ -39,7 +39,7 @@ def test_simt_hits_and_work_match_the_reference(
         assert sum(u["active_lane_histogram"]) == u["warp_steps"]
         assert sum(k * n for k, n in enumerate(u["active_lane_histogram"])) == u["active_lanes"]
         assert u["coalesced_requests"] <= 1.1 * u["lane_requests"]  # a read may span 2 lines
-        assert set(u["simd_efficiency_by_kind"]) == {"primary", "diffuse"}
+        assert set(u["simd_efficiency_by_kind"]) == {"primary", "shadow", "diffuse"}
         assert all(0.0 < v <= 1.0 for v in u["simd_efficiency_by_kind"].values())
         assert all(0.0 <= p["value"] <= 1.0 for p in u["simd_efficiency_over_time"])
     # Every lane-cycle is in one use, idle lanes included.
