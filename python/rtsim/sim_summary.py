@@ -281,11 +281,7 @@ def mailbox_table(stats: dict[str, Any]) -> Table:
     """What the mailboxes saved (stats.json "mailbox", docs/accel.md, Mailboxes)."""
     m = stats.get("mailbox", {}) or {}
     per_ray = m.get("per_ray", {}) or {}
-    table = Table(
-        title=f"mailboxes ({fmt_int(m.get('entries'))} entries per ray)", title_justify="left"
-    )
-    table.add_column("")
-    table.add_column("value", justify="right")
+    table = _two_column(f"mailboxes ({fmt_int(m.get('entries'))} entries per ray)")
     table.add_row("lookups / ray", fmt_float(per_ray.get("lookups"), 2))
     table.add_row("hit rate", fmt_pct(m.get("hit_rate")))
     table.add_row("triangle tests / ray", fmt_float(per_ray.get("tri_tests"), 2))
@@ -298,12 +294,7 @@ def short_stack_table(stats: dict[str, Any]) -> Table:
     """A short stack's restarts and re-traversal (stats.json "short_stack", docs/accel.md)."""
     m = stats.get("short_stack", {}) or {}
     per_ray = m.get("per_ray", {}) or {}
-    table = Table(
-        title=f"short stack ({fmt_int(m.get('entries'))} entries per ray, restart trail)",
-        title_justify="left",
-    )
-    table.add_column("")
-    table.add_column("value", justify="right")
+    table = _two_column(f"short stack ({fmt_int(m.get('entries'))} entries per ray, restart trail)")
     table.add_row("entries dropped / ray", fmt_float(per_ray.get("stack_drops"), 2))
     table.add_row("restarts / ray", fmt_float(per_ray.get("restarts"), 3))
     table.add_row("nodes revisited / ray", fmt_float(per_ray.get("restart_steps"), 2))
@@ -318,12 +309,7 @@ def box_precision_table(stats: dict[str, Any]) -> Table:
     (stats.json "box_precision", docs/accel.md)."""
     m = stats.get("box_precision", {}) or {}
     per_ray = m.get("per_ray", {}) or {}
-    table = Table(
-        title=f"reduced-precision box tests ({fmt_int(m.get('bits'))} mantissa bits)",
-        title_justify="left",
-    )
-    table.add_column("")
-    table.add_column("value", justify="right")
+    table = _two_column(f"reduced-precision box tests ({fmt_int(m.get('bits'))} mantissa bits)")
     table.add_row("extra boxes entered / ray", fmt_float(per_ray.get("box_hits"), 3))
     table.add_row("extra node steps", fmt_pct(m.get("extra_steps_fraction")))
     table.add_row("extra box tests", fmt_pct(m.get("extra_box_tests_fraction")))

@@ -65,7 +65,9 @@ private:
     Cycle stack_traffic(uint32_t c, Cycle t, Cycle ready);
     void schedule(uint32_t c, Cycle t) { m_events.schedule(c, t); }
     /// Context c's cycles from its last accounted cycle to `until` went to `use`.
-    void account(uint32_t c, CycleUse use, Cycle until) { account_until(m_account, m_contexts[c].accounted, use, until); }
+    void account(uint32_t c, CycleUse use, Cycle until) {
+        account_until(m_account, m_contexts[c].accounted, use, until);
+    }
     /// Context c waited from its last accounted cycle to `ready` for a read (split by `info`).
     void account_read(uint32_t c, Cycle ready, const AccessInfo& info) {
         account_read_until(m_account, m_contexts[c].accounted, ready, info);
