@@ -29,10 +29,22 @@ void CellStepper::finish() {
     m_plan.finish();
 }
 
-uint32_t CellStepper::test_refs(RefListWalk& list, const RefListView& view, Mailbox& mailbox, bool* done) {
-    return m_mode == TraversalMode::any_hit
-               ? list.test_batch<true>(view, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, mailbox, m_work, done)
-               : list.test_batch<false>(view, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, mailbox, m_work, done);
+bool ListCellStepper::list_step(const RefListView& view, StepOutcome& out) {
+    if (m_list_arriving) {
+        m_list_arriving = false;
+        m_list.list_fetched(m_work);
+    } else {
+        bool done = false;
+        out.add_op(OpKind::anyhit,
+                   m_mode == TraversalMode::any_hit
+                       ? m_list.test_batch<true>(view, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox, m_work, &done)
+                       : m_list.test_batch<false>(view, m_tri, m_ray.tmin, m_ray.tmax, m_hit, m_cull_t, m_mailbox, m_work, &done));
+        if (done) {
+            finish();
+            return true;
+        }
+    }
+    return m_list.plan_batch(view, m_mailbox, m_work, m_plan);
 }
 
 }  // namespace rtsim

@@ -25,31 +25,59 @@ protected:
     bool start(const Ray& ray, TraversalMode mode, bool structure_empty);
     /// Ends the ray: a miss reports the empty hit, not its shrunken search distance.
     void finish();
-    /// Tests the reference list's planned batch (the ray's mode picks the hit rule). Returns the
-    /// alpha tests run; *done is set when an any-hit ray has its hit.
-    uint32_t test_refs(RefListWalk& list, const RefListView& view, Mailbox& mailbox, bool* done);
 
     RayBoxPre m_box;
     RayTrianglePre m_tri;
     float m_cull_t = 0.0f;  ///< cells entered beyond this are not visited: the best t, widened
 };
 
+/// The cells or leaves that list their triangles by reference (grid, kd-tree, octree): a list's
+/// fetch is one step, then each step tests one batch (ref_list.h), with the ray's mailbox.
+class ListCellStepper : public CellStepper {
+protected:
+    explicit ListCellStepper(uint32_t mailbox_entries) { m_mailbox.set_entries(mailbox_entries); }
+
+    /// CellStepper::start with an empty mailbox: a ray skips only what it tested itself.
+    bool start(const Ray& ray, TraversalMode mode, bool structure_empty) {
+        m_mailbox.clear();
+        return CellStepper::start(ray, mode, structure_empty);
+    }
+    /// Plans the fetch of list [first, first + count) (count > 0); list_step takes it from there.
+    void open_list(const RefListView& view, uint32_t first, uint32_t count) {
+        m_list_arriving = true;
+        m_list.plan_list(view, first, count, m_plan);
+    }
+    /// One step of the open list: its arrival (counted, the first batch planned) or the planned
+    /// batch's tests (the ray's mode picks the hit rule; alpha tests into `out`). False when the
+    /// list is used up and nothing is planned: the caller goes on to its next cell. An any-hit
+    /// ray that has its hit is finished here.
+    bool list_step(const RefListView& view, StepOutcome& out);
+
+private:
+    Mailbox m_mailbox;
+    RefListWalk m_list;
+    bool m_list_arriving = false;
+};
+
 /// The binary partitions' clip step and descent (kd-tree, BIH): Derived has visit(node, interval)
-/// (a friend of this base) and a kName for the stack-overflow error.
-template <class Derived, uint32_t kMaxDepth>
-class BinaryCellStepper : public CellStepper {
+/// (a friend of this base) and a kName for the stack-overflow error; Base is CellStepper or, for
+/// leaves with reference lists, ListCellStepper.
+template <class Derived, uint32_t kMaxDepth, class Base = CellStepper>
+class BinaryCellStepper : public Base {
 protected:
     struct Entry {
         uint32_t node;
         detail::SlabInterval cell;
     };
 
+    using Base::Base;
+
     /// The clip step: the ray against the root cell (one box test), then the root node.
     void clip(const Aabb& root) {
-        m_work.box_tests += 1;
+        this->m_work.box_tests += 1;
         const float lo[3] = {root.lo.x, root.lo.y, root.lo.z}, hi[3] = {root.hi.x, root.hi.y, root.hi.z};
-        const detail::SlabInterval cell = detail::slab_box(m_box, lo, hi, m_ray.tmin);
-        if (!detail::slab_hit(cell, m_cull_t)) return finish();
+        const detail::SlabInterval cell = detail::slab_box(this->m_box, lo, hi, this->m_ray.tmin);
+        if (!detail::slab_hit(cell, this->m_cull_t)) return this->finish();
         derived().visit(0, cell);
     }
 
@@ -60,11 +88,11 @@ protected:
         const detail::SlabInterval& near_cell = negative ? high : low;
         const detail::SlabInterval& far_cell = negative ? low : high;
         const uint32_t near_node = negative ? high_node : low_node, far_node = negative ? low_node : high_node;
-        const bool near_hit = detail::slab_hit(near_cell, m_cull_t), far_hit = detail::slab_hit(far_cell, m_cull_t);
+        const bool near_hit = detail::slab_hit(near_cell, this->m_cull_t), far_hit = detail::slab_hit(far_cell, this->m_cull_t);
         if (near_hit && far_hit) {
-            if (m_stack_size >= int(kMaxDepth))
+            if (this->m_stack_size >= int(kMaxDepth))
                 throw Error(std::string(Derived::kName) + " traversal stack overflow (deeper than its image said)");
-            m_stack[m_stack_size++] = Entry{far_node, far_cell};
+            m_stack[this->m_stack_size++] = Entry{far_node, far_cell};
         }
         if (near_hit) return derived().visit(near_node, near_cell);
         if (far_hit) return derived().visit(far_node, far_cell);
@@ -74,12 +102,12 @@ protected:
     /// Pending cells lie behind the current one: those entered beyond the best hit are dropped
     /// without a fetch.
     void pop_next() {
-        while (m_stack_size > 0) {
-            const Entry& e = m_stack[--m_stack_size];
-            if (e.cell.tn > m_cull_t) continue;
+        while (this->m_stack_size > 0) {
+            const Entry& e = m_stack[--this->m_stack_size];
+            if (e.cell.tn > this->m_cull_t) continue;
             return derived().visit(e.node, e.cell);
         }
-        finish();
+        this->finish();
     }
 
     Entry m_stack[kMaxDepth];

@@ -2,6 +2,7 @@
 #include <string>
 
 #include "traces/accel/grid/grid.h"
+#include "traces/accel/listed_regions.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -39,22 +40,15 @@ void validate_grid(const GridView& v, const std::string& source) {
 }
 
 GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
-    const Region& cells = m_image.region("cells");
-    const Region& refs = m_image.region("prim_refs");
-    const Region& tris = triangle_region(m_image);
-    require(cells.record_bytes == sizeof(GridCell) && refs.record_bytes == kRefBytes &&
-                triangle_records_ok(tris),
-            source + ": grid regions must hold 8-byte cells, 4-byte references and 48-byte triangles");
-    require(cells.kind == DataKind::cell && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
-            source + ": grid regions must be of data kinds cell, prim_ref and triangle");
+    const ListedRegions r = open_listed_regions(m_image, m_triangles, "grid", "cells", DataKind::cell,
+                                                uint32_t(sizeof(GridCell)), source);
     m_view.geometry = GridGeometry::from_json(m_image.params, source);
-    m_view.cells = cells.records<GridCell>();
-    m_triangles = TriangleStore::open(m_image, source);
-    m_view.list = RefListView{refs.records<uint32_t>(), m_triangles.triangles(), refs.base, m_triangles.addressing()};
-    m_view.cell_count = cells.count;
-    m_view.ref_count = refs.count;
-    m_view.triangle_count = m_triangles.count();
-    m_view.cell_base = cells.base;
+    m_view.cells = r.cells->records<GridCell>();
+    m_view.list = r.list;
+    m_view.cell_count = r.cells->count;
+    m_view.ref_count = r.ref_count;
+    m_view.triangle_count = r.triangle_count;
+    m_view.cell_base = r.cells->base;
     validate_grid(m_view, source);
 }
 

@@ -7,7 +7,6 @@
 namespace rtsim {
 
 void GridStepper::begin(const Ray& ray, TraversalMode mode) {
-    m_mailbox.clear();
     if (start(ray, mode, m_view.cell_count == 0)) m_phase = Phase::clip;
 }
 
@@ -26,22 +25,13 @@ StepOutcome GridStepper::execute() {
                 next_cell();
                 break;
             }
-            m_phase = Phase::refs;
-            m_list.plan_list(m_view.list, c.first_ref, c.ref_count, m_plan);  // belongs to its cell's brick
+            m_phase = Phase::list;
+            open_list(m_view.list, c.first_ref, c.ref_count);  // belongs to its cell's brick
             break;
         }
-        case Phase::refs:
-            m_list.list_fetched(m_work);
-            m_phase = Phase::triangles;
-            next_batch();
+        case Phase::list:
+            if (!list_step(m_view.list, out)) next_cell();
             break;
-        case Phase::triangles: {
-            bool done = false;
-            out.add_op(OpKind::anyhit, test_refs(m_list, m_view.list, m_mailbox, &done));
-            if (done) finish();
-            else next_batch();
-            break;
-        }
     }
     return out;
 }
@@ -62,10 +52,6 @@ void GridStepper::next_cell() {
     m_plan.reset(m_cell);
     m_plan.add_fetch(m_view.cell_base + uint64_t(m_cell) * sizeof(GridCell), sizeof(GridCell), DataKind::cell);
     m_plan.add_op(OpKind::cell, 1);
-}
-
-void GridStepper::next_batch() {
-    if (!m_list.plan_batch(m_view.list, m_mailbox, m_work, m_plan)) next_cell();
 }
 
 }  // namespace rtsim

@@ -32,25 +32,22 @@ struct GridView {
     uint64_t cell_base = 0;  ///< address of cell 0
 };
 
-class GridStepper final : public CellStepper {
+class GridStepper final : public ListCellStepper {
 public:
-    GridStepper(const GridView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
+    GridStepper(const GridView& view, uint32_t mailbox_entries) : ListCellStepper(mailbox_entries), m_view(view) {}
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
 
 private:
-    enum class Phase : uint8_t { clip, cell, refs, triangles };
+    enum class Phase : uint8_t { clip, cell, list };
     void clip();
     void next_cell();        ///< the DDA's next cell, or the end
-    void next_batch();       ///< the list's next triangles, or the next cell
 
     GridView m_view;
     GridDda m_dda;
     Phase m_phase = Phase::clip;
     uint32_t m_cell = 0;    ///< the current cell
-    Mailbox m_mailbox;
-    RefListWalk m_list;     ///< the current cell's list
 };
 
 }  // namespace rtsim

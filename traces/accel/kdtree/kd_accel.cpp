@@ -79,22 +79,7 @@ uint32_t validate_kdtree(const KdView& v, const std::string& source) {
 }
 
 KdAccel::KdAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
-    const Region& nodes = m_image.region("nodes");
-    const Region& refs = m_image.region("prim_refs");
-    const Region& tris = triangle_region(m_image);
-    require(nodes.record_bytes == sizeof(KdNode) && refs.record_bytes == kRefBytes &&
-                triangle_records_ok(tris),
-            source + ": kdtree regions must hold 8-byte nodes, 4-byte references and 48-byte triangles");
-    require(nodes.kind == DataKind::node && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
-            source + ": kdtree regions must be of data kinds node, prim_ref and triangle");
-    m_view.nodes = nodes.records<KdNode>();
-    m_view.node_count = nodes.count;
-    m_view.node_base = nodes.base;
-    m_triangles = TriangleStore::open(m_image, source);
-    m_view.list = RefListView{refs.records<uint32_t>(), m_triangles.triangles(), refs.base, m_triangles.addressing()};
-    m_view.ref_count = refs.count;
-    m_view.triangle_count = m_triangles.count();
-    m_view.bounds = root_cell_from_json(m_image.params, source + ": kdtree params");
+    m_view = open_listed_tree<KdNode>(m_image, m_triangles, "kdtree", source);
     m_depth = validate_kdtree(m_view, source);
 }
 

@@ -5,7 +5,6 @@
 namespace rtsim {
 
 void KdStepper::begin(const Ray& ray, TraversalMode mode) {
-    m_mailbox.clear();
     if (start(ray, mode, m_view.node_count == 0)) m_phase = Phase::clip;
 }
 
@@ -24,23 +23,14 @@ StepOutcome KdStepper::execute() {
             } else if (n.ref_count() == 0) {
                 pop_next();
             } else {
-                m_phase = Phase::refs;
-                m_list.plan_list(m_view.list, n.first_ref(), n.ref_count(), m_plan);
+                m_phase = Phase::list;
+                open_list(m_view.list, n.first_ref(), n.ref_count());
             }
             break;
         }
-        case Phase::refs:
-            m_list.list_fetched(m_work);
-            m_phase = Phase::triangles;
-            next_batch();
+        case Phase::list:
+            if (!list_step(m_view.list, out)) pop_next();
             break;
-        case Phase::triangles: {
-            bool done = false;
-            out.add_op(OpKind::anyhit, test_refs(m_list, m_view.list, m_mailbox, &done));
-            if (done) finish();
-            else next_batch();
-            break;
-        }
     }
     return out;
 }
@@ -63,10 +53,6 @@ void KdStepper::interior(const KdNode& n) {
     const detail::SlabInterval below = detail::slab_below(m_cell, t, negative);
     const detail::SlabInterval above = detail::slab_above(m_cell, t, negative);
     descend(m_node + 1, below, n.above(), above, negative);
-}
-
-void KdStepper::next_batch() {
-    if (!m_list.plan_batch(m_view.list, m_mailbox, m_work, m_plan)) pop_next();
 }
 
 }  // namespace rtsim

@@ -20,38 +20,30 @@
 
 #include "traces/accel/cell_stepper.h"
 #include "traces/accel/kdtree/kd_layout.h"
+#include "traces/accel/listed_regions.h"
 #include "traces/common/aabb.h"
 
 namespace rtsim {
 
 /// Where a kd-tree's data lives: arrays and their addresses in the memory image.
-struct KdView {
-    const KdNode* nodes = nullptr;
-    RefListView list;
-    uint64_t node_count = 0, ref_count = 0, triangle_count = 0;
-    uint64_t node_base = 0;  ///< address of node 0
-    Aabb bounds;             ///< the root cell
-};
+using KdView = ListedTreeView<KdNode>;
 
-class KdStepper final : public BinaryCellStepper<KdStepper, kKdMaxDepth> {
+class KdStepper final : public BinaryCellStepper<KdStepper, kKdMaxDepth, ListCellStepper> {
 public:
     static constexpr const char* kName = "kd-tree";
 
-    KdStepper(const KdView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
+    KdStepper(const KdView& view, uint32_t mailbox_entries) : BinaryCellStepper(mailbox_entries), m_view(view) {}
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
 
 private:
-    friend class BinaryCellStepper<KdStepper, kKdMaxDepth>;
-    enum class Phase : uint8_t { clip, node, refs, triangles };
+    friend class BinaryCellStepper<KdStepper, kKdMaxDepth, ListCellStepper>;
+    enum class Phase : uint8_t { clip, node, list };
     void visit(uint32_t node, const detail::SlabInterval& cell);
     void interior(const KdNode& node);
-    void next_batch();  ///< the leaf's next triangles, or the next cell
 
     KdView m_view;
-    Mailbox m_mailbox;
-    RefListWalk m_list;
     Phase m_phase = Phase::clip;
     uint32_t m_node = 0;
     detail::SlabInterval m_cell;

@@ -130,22 +130,7 @@ void check_octree_invariants(const OctView& v, const Scene& scene) {
 }
 
 OctreeAccel::OctreeAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
-    const Region& nodes = m_image.region("nodes");
-    const Region& refs = m_image.region("prim_refs");
-    const Region& tris = triangle_region(m_image);
-    require(nodes.record_bytes == sizeof(OctNode) && refs.record_bytes == kRefBytes &&
-                triangle_records_ok(tris),
-            source + ": octree regions must hold 16-byte nodes, 4-byte references and 48-byte triangles");
-    require(nodes.kind == DataKind::node && refs.kind == DataKind::prim_ref && tris.kind == DataKind::triangle,
-            source + ": octree regions must be of data kinds node, prim_ref and triangle");
-    m_view.nodes = nodes.records<OctNode>();
-    m_view.node_count = nodes.count;
-    m_view.node_base = nodes.base;
-    m_triangles = TriangleStore::open(m_image, source);
-    m_view.list = RefListView{refs.records<uint32_t>(), m_triangles.triangles(), refs.base, m_triangles.addressing()};
-    m_view.ref_count = refs.count;
-    m_view.triangle_count = m_triangles.count();
-    m_view.bounds = root_cell_from_json(m_image.params, source + ": octree params");
+    m_view = open_listed_tree<OctNode>(m_image, m_triangles, "octree", source);
     m_depth = validate_octree(m_view, source);
 }
 

@@ -9,7 +9,6 @@
 namespace rtsim {
 
 void OctreeStepper::begin(const Ray& ray, TraversalMode mode) {
-    m_mailbox.clear();
     if (!start(ray, mode, m_view.node_count == 0)) return;
     m_octant = 0;
     for (int a = 0; a < 3; ++a) {
@@ -34,23 +33,14 @@ StepOutcome OctreeStepper::execute() {
             } else if (n.ref_count() == 0) {
                 pop_next();
             } else {
-                m_phase = Phase::refs;
-                m_list.plan_list(m_view.list, n.first_ref(), n.ref_count(), m_plan);
+                m_phase = Phase::list;
+                open_list(m_view.list, n.first_ref(), n.ref_count());
             }
             break;
         }
-        case Phase::refs:
-            m_list.list_fetched(m_work);
-            m_phase = Phase::triangles;
-            next_batch();
+        case Phase::list:
+            if (!list_step(m_view.list, out)) pop_next();
             break;
-        case Phase::triangles: {
-            bool done = false;
-            out.add_op(OpKind::anyhit, test_refs(m_list, m_view.list, m_mailbox, &done));
-            if (done) finish();
-            else next_batch();
-            break;
-        }
     }
     return out;
 }
@@ -107,10 +97,6 @@ void OctreeStepper::interior(const OctNode& n) {
     if (m_stack_size + int(count) - 1 > int(kOctMaxStack)) throw Error("octree traversal stack overflow");
     for (uint32_t i = count; i-- > 1;) m_stack[m_stack_size++] = hit[i];
     visit(hit[0]);
-}
-
-void OctreeStepper::next_batch() {
-    if (!m_list.plan_batch(m_view.list, m_mailbox, m_work, m_plan)) pop_next();
 }
 
 void OctreeStepper::pop_next() {

@@ -22,29 +22,24 @@
 #include <cstdint>
 
 #include "traces/accel/cell_stepper.h"
+#include "traces/accel/listed_regions.h"
 #include "traces/accel/octree/octree_layout.h"
 #include "traces/common/aabb.h"
 
 namespace rtsim {
 
 /// Where an octree's data lives: arrays and their addresses in the memory image.
-struct OctView {
-    const OctNode* nodes = nullptr;
-    RefListView list;
-    uint64_t node_count = 0, ref_count = 0, triangle_count = 0;
-    uint64_t node_base = 0;
-    Aabb bounds;  ///< the root cell
-};
+using OctView = ListedTreeView<OctNode>;
 
-class OctreeStepper final : public CellStepper {
+class OctreeStepper final : public ListCellStepper {
 public:
-    OctreeStepper(const OctView& view, uint32_t mailbox_entries) : m_view(view) { m_mailbox.set_entries(mailbox_entries); }
+    OctreeStepper(const OctView& view, uint32_t mailbox_entries) : ListCellStepper(mailbox_entries), m_view(view) {}
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
 
 private:
-    enum class Phase : uint8_t { clip, node, refs, triangles };
+    enum class Phase : uint8_t { clip, node, list };
     /// A cell along the ray: its node, entry distance and six plane distances.
     struct Cell {
         uint32_t node;
@@ -54,14 +49,11 @@ private:
     void clip();
     void visit(const Cell& cell);
     void interior(const OctNode& node);
-    void next_batch();
     void pop_next();
 
     OctView m_view;
     bool m_negative[3] = {false, false, false};
     uint32_t m_octant = 0;  ///< bit a: the ray runs down axis a
-    Mailbox m_mailbox;
-    RefListWalk m_list;
     Phase m_phase = Phase::clip;
     Cell m_cell{};
     Cell m_stack[kOctMaxStack];
