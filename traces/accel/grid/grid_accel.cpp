@@ -8,8 +8,8 @@
 namespace rtsim {
 
 void validate_grid(const GridView& v, const std::string& source) {
-    // Messages are built only on failure: this pass runs over every cell of every trace opened.
-    auto fail = [&](const std::string& what) { throw Error(source + ": grid: " + what); };
+    const ListedChecks check(source, "grid");
+    auto fail = [&](const std::string& what) { check.fail(what); };
     const GridGeometry& g = v.geometry;
     if (v.cell_count != g.cell_count())
         fail("resolution " + std::to_string(g.res[0]) + " x " + std::to_string(g.res[1]) + " x " +
@@ -22,9 +22,7 @@ void validate_grid(const GridView& v, const std::string& source) {
     uint64_t next = 0;
     for (uint64_t c = 0; c < v.cell_count; ++c) {
         const GridCell& cell = v.cells[c];
-        if (uint64_t(cell.first_ref) + cell.ref_count > v.ref_count)
-            fail("cell " + std::to_string(c) + " lists prim_refs " + std::to_string(cell.first_ref) + ".." +
-                 std::to_string(uint64_t(cell.first_ref) + cell.ref_count - 1) + " of " + std::to_string(v.ref_count));
+        check.list_in_range("cell", c, cell.first_ref, cell.ref_count, v.ref_count);
         if (cell.first_ref != next)
             fail("cell " + std::to_string(c) + "'s list starts at prim_refs " + std::to_string(cell.first_ref) +
                  ", not " + std::to_string(next) + " where the previous cell's ends (lists must be back to back "
@@ -33,10 +31,7 @@ void validate_grid(const GridView& v, const std::string& source) {
     }
     if (next != v.ref_count)
         fail("the cells list " + std::to_string(next) + " of prim_refs' " + std::to_string(v.ref_count) + " references");
-    for (uint64_t r = 0; r < v.ref_count; ++r)
-        if (v.list.refs[r] >= v.triangle_count)
-            fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.list.refs[r]) + " of " +
-                 std::to_string(v.triangle_count));
+    check.refs_name_triangles(v.list, v.ref_count, v.triangle_count);
 }
 
 GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {

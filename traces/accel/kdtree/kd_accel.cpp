@@ -31,51 +31,22 @@ AccelImage kdtree_image(const Scene& scene, const KdConfig& config) {
 }
 
 uint32_t validate_kdtree(const KdView& v, const std::string& source) {
-    // Messages are built only on failure: this pass runs over every node of every trace opened.
-    auto fail = [&](const std::string& what) { throw Error(source + ": kd-tree: " + what); };
-    auto node_name = [](uint64_t i) { return "node " + std::to_string(i); };
-    if (v.node_count == 0) fail("no nodes");
-    if (v.node_count > KdNode::kMaxIndex || v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32))
-        fail("more than 2^30 nodes or 2^32 references or triangles");
-    // Depth first: children come after their parent, so one forward pass checks reachability and
-    // depth, and carries each node's cell to check that its split lies inside it.
-    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0);
-    std::vector<Aabb> cell(v.node_count);
-    seen[0] = 1;
-    cell[0] = v.bounds;
-    uint32_t deepest = 0;
-    for (uint64_t i = 0; i < v.node_count; ++i) {
-        const KdNode& n = v.nodes[i];
-        if (!seen[i]) fail(node_name(i) + " is not reachable from the root");
-        deepest = std::max<uint32_t>(deepest, depth[i]);
-        if (n.leaf()) {
-            if (uint64_t(n.first_ref()) + n.ref_count() > v.ref_count)
-                fail(node_name(i) + " lists prim_refs " + std::to_string(n.first_ref()) + ".." +
-                     std::to_string(uint64_t(n.first_ref()) + n.ref_count() - 1) + " of " + std::to_string(v.ref_count));
-            continue;
-        }
-        const int a = n.axis();
-        const float p = n.split();
-        if (!(std::isfinite(p) && p >= cell[i].lo[a] && p <= cell[i].hi[a]))
-            fail(node_name(i) + " splits axis " + std::to_string(a) + " at " + std::to_string(p) + " outside its cell");
-        const uint64_t kids[2] = {i + 1, n.above()};
-        for (int c = 0; c < 2; ++c) {
-            const uint64_t k = kids[c];
-            if (k <= i || k >= v.node_count)
-                fail(node_name(i) + " names child " + std::to_string(k) + (k < v.node_count ? " (not after it)" : " (out of range)"));
-            if (seen[k]) fail(node_name(k) + " has two parents");
-            if (depth[i] + 1u >= kKdMaxDepth) fail("deeper than the traversal stack (" + std::to_string(kKdMaxDepth) + ")");
-            seen[k] = 1;
-            depth[k] = uint8_t(depth[i] + 1);
-            cell[k] = cell[i];
-            (c == 0 ? cell[k].hi[a] : cell[k].lo[a]) = p;
-        }
-    }
-    for (uint64_t r = 0; r < v.ref_count; ++r)
-        if (v.list.refs[r] >= v.triangle_count)
-            fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.list.refs[r]) + " of " +
-                 std::to_string(v.triangle_count));
-    return deepest;
+    // Depth first: a node's below child is the next node; the split must lie inside the cell.
+    const ListedChecks check(source, "kd-tree");
+    return validate_listed_tree(
+        v, check, kKdMaxDepth - 1, "deeper than the traversal stack (" + std::to_string(kKdMaxDepth) + ")",
+        [&](uint64_t i, const KdNode& n, const Aabb& cell, auto&& add_child) {
+            const int a = n.axis();
+            const float p = n.split();
+            if (!(std::isfinite(p) && p >= cell.lo[a] && p <= cell.hi[a]))
+                check.fail("node " + std::to_string(i) + " splits axis " + std::to_string(a) + " at " +
+                           std::to_string(p) + " outside its cell");
+            Aabb below = cell, above = cell;
+            below.hi[a] = p;
+            above.lo[a] = p;
+            add_child(i + 1, below);
+            add_child(n.above(), above);
+        });
 }
 
 KdAccel::KdAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {

@@ -34,48 +34,19 @@ std::vector<Aabb> octree_cells(const OctView& v) {
 }  // namespace
 
 uint32_t validate_octree(const OctView& v, const std::string& source) {
-    // Messages are built only on failure: this pass runs over every node of every trace opened.
-    auto fail = [&](const std::string& what) { throw Error(source + ": octree: " + what); };
-    auto node_name = [](uint64_t i) { return "node " + std::to_string(i); };
-    if (v.node_count == 0) fail("no nodes");
-    if (v.node_count > OctNode::kMaxIndex || v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32))
-        fail("more than 2^24 nodes or 2^32 references or triangles");
-    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0);
-    std::vector<Aabb> cell(v.node_count);
-    seen[0] = 1;
-    cell[0] = v.bounds;
-    uint32_t deepest = 0;
-    for (uint64_t i = 0; i < v.node_count; ++i) {
-        const OctNode& n = v.nodes[i];
-        if (!seen[i]) fail(node_name(i) + " is not reachable from the root");
-        deepest = std::max<uint32_t>(deepest, depth[i]);
-        if (n.leaf()) {
-            if (uint64_t(n.first_ref()) + n.ref_count() > v.ref_count)
-                fail(node_name(i) + " lists prim_refs " + std::to_string(n.first_ref()) + ".." +
-                     std::to_string(uint64_t(n.first_ref()) + n.ref_count() - 1) + " of " + std::to_string(v.ref_count));
-            continue;
-        }
-        const float centre[3] = {n.centre(0), n.centre(1), n.centre(2)};
-        for (int a = 0; a < 3; ++a)
-            if (!(centre[a] >= cell[i].lo[a] && centre[a] <= cell[i].hi[a]))
-                fail(node_name(i) + "'s centre is outside its cell on axis " + std::to_string(a));
-        for (uint32_t c = 0; c < 8; ++c) {
-            if (!(n.mask() >> c & 1u)) continue;
-            const uint64_t k = n.child(c);
-            if (k <= i || k >= v.node_count)
-                fail(node_name(i) + " names child " + std::to_string(k) + (k < v.node_count ? " (not after it)" : " (out of range)"));
-            if (seen[k]) fail(node_name(k) + " has two parents");
-            if (depth[i] + 1u > kOctMaxDepth) fail("deeper than " + std::to_string(kOctMaxDepth) + " levels");
-            seen[k] = 1;
-            depth[k] = uint8_t(depth[i] + 1);
-            cell[k] = octree_child_cell(cell[i], centre, c);
-        }
-    }
-    for (uint64_t r = 0; r < v.ref_count; ++r)
-        if (v.list.refs[r] >= v.triangle_count)
-            fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(v.list.refs[r]) + " of " +
-                 std::to_string(v.triangle_count));
-    return deepest;
+    // The centre must lie inside the cell; each stored child's cell is an octant of it.
+    const ListedChecks check(source, "octree");
+    return validate_listed_tree(
+        v, check, kOctMaxDepth, "deeper than " + std::to_string(kOctMaxDepth) + " levels",
+        [&](uint64_t i, const OctNode& n, const Aabb& cell, auto&& add_child) {
+            const float centre[3] = {n.centre(0), n.centre(1), n.centre(2)};
+            for (int a = 0; a < 3; ++a)
+                if (!(centre[a] >= cell.lo[a] && centre[a] <= cell.hi[a]))
+                    check.fail("node " + std::to_string(i) + "'s centre is outside its cell on axis " +
+                               std::to_string(a));
+            for (uint32_t c = 0; c < 8; ++c)
+                if (n.mask() >> c & 1u) add_child(n.child(c), octree_child_cell(cell, centre, c));
+        });
 }
 
 void check_octree_invariants(const OctView& v, const Scene& scene) {
