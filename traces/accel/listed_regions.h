@@ -64,21 +64,24 @@ ListedTreeView<Node> open_listed_tree(const AccelImage& image, TriangleStore& tr
 /// Messages are built only on failure: these run over every cell and reference of every trace.
 class ListedChecks {
 public:
-    ListedChecks(const std::string& source, const std::string& structure) : m_prefix(source + ": " + structure + ": ") {}
+    ListedChecks(const std::string& source, const std::string& structure)
+        : m_prefix(source + ": " + structure + ": ") {}
 
     [[noreturn]] void fail(const std::string& what) const { throw Error(m_prefix + what); }
     /// `owner`'s ("node 3", "cell 3") list [first, first + count) lies inside prim_refs.
-    void list_in_range(const char* owner_kind, uint64_t owner, uint64_t first, uint64_t count, uint64_t ref_count) const {
+    void list_in_range(const char* owner_kind, uint64_t owner, uint64_t first, uint64_t count,
+                       uint64_t ref_count) const {
         if (first + count > ref_count)
-            fail(std::string(owner_kind) + " " + std::to_string(owner) + " lists prim_refs " + std::to_string(first) +
-                 ".." + std::to_string(first + count - 1) + " of " + std::to_string(ref_count));
+            fail(std::string(owner_kind) + " " + std::to_string(owner) + " lists prim_refs " +
+                 std::to_string(first) + ".." + std::to_string(first + count - 1) + " of " +
+                 std::to_string(ref_count));
     }
     /// Every reference names a triangle.
     void refs_name_triangles(const RefListView& list, uint64_t ref_count, uint64_t triangle_count) const {
         for (uint64_t r = 0; r < ref_count; ++r)
             if (list.refs[r] >= triangle_count)
-                fail("prim_refs entry " + std::to_string(r) + " names triangle " + std::to_string(list.refs[r]) +
-                     " of " + std::to_string(triangle_count));
+                fail("prim_refs entry " + std::to_string(r) + " names triangle " +
+                     std::to_string(list.refs[r]) + " of " + std::to_string(triangle_count));
     }
 
 private:
