@@ -88,7 +88,11 @@ def build_figures(scene: str, args: argparse.Namespace) -> dict[str, Any]:
     return dict(json.loads(path.read_text()))
 
 
-def trace(scene: str, accel: str, workload: str, args: argparse.Namespace) -> Path:
+def trace(
+    scene: str, accel: str, workload: str, args: argparse.Namespace, extra: tuple[str, ...] = ()
+) -> Path:
+    """One workload of a scene traced with one structure (`kind` or `kind:builder`; cached in
+    OUT/traces); `extra` are more `rtsim trace` arguments."""
     kind, _, builder = accel.partition(":")
     name = f"{scene}-{kind}-{builder or 'default'}-{workload}-{args.resolution}"
     folder = args.out / "traces" / name
@@ -97,40 +101,53 @@ def trace(scene: str, accel: str, workload: str, args: argparse.Namespace) -> Pa
     shutil.rmtree(folder, ignore_errors=True)
     cmd = [sys.executable, "-m", "rtsim", "trace", resolve_scene(scene), "-o", str(folder)]
     cmd += ["--workload", workload, "--resolution", args.resolution, "--accel", kind]
-    cmd += ["--hairball-triangles", str(args.hairball_triangles)]
+    cmd += ["--hairball-triangles", str(args.hairball_triangles), *extra]
     cmd += ["--builder", builder] if builder else []
     run(cmd)
     return folder
 
 
-def simulate(folder: Path, args: argparse.Namespace) -> dict[str, Any]:
-    out = args.out / "runs" / folder.name
+def simulate_stats(
+    folder: Path, args: argparse.Namespace, tag: str = "", sets: tuple[str, ...] = ()
+) -> dict[str, Any] | None:
+    """stats.json of the trace run on the model with `sets` (cached in OUT/runs/NAME[-TAG]);
+    None when it ran over --sim-timeout. Any hit or work mismatch stops the study."""
+    out = args.out / "runs" / (f"{folder.name}-{tag}" if tag else folder.name)
     stats_file = out / "stats.json"
     if args.fresh or not stats_file.is_file():
         shutil.rmtree(out, ignore_errors=True)
         try:
-            result = run_sim(SimJob(trace=folder, out_dir=out), timeout=args.sim_timeout)
+            job = SimJob(trace=folder, out_dir=out, sets=list(sets), verdict=False)
+            result = run_sim(job, timeout=args.sim_timeout)
         except OSError as err:
-            sys.exit(f"accel_study: cannot run rtsim-sim: {err}")
+            sys.exit(f"{Path(sys.argv[0]).stem}: cannot run rtsim-sim: {err}")
         if result.timed_out:
-            print(f"accel_study: {out.name}: no model figures (over {args.sim_timeout} s)")
-            return {"timed_out": args.sim_timeout}
+            print(f"{out.name}: no model figures (over {args.sim_timeout} s)", file=sys.stderr)
+            return None
     if not stats_file.is_file():
-        sys.exit(f"accel_study: rtsim-sim wrote no {stats_file}")
-    s = json.loads(stats_file.read_text())["summary"]
+        sys.exit(f"{Path(sys.argv[0]).stem}: rtsim-sim wrote no {stats_file}")
+    stats = dict(json.loads(stats_file.read_text()))
+    s = stats["summary"]
     if s["hit_mismatches"] or s["work_mismatches"]:
         sys.exit(f"{out}: {s['hit_mismatches']} hit and {s['work_mismatches']} work mismatches")
+    return stats
+
+
+def simulate(folder: Path, args: argparse.Namespace) -> dict[str, Any]:
+    stats = simulate_stats(folder, args)
+    if stats is None:
+        return {"timed_out": args.sim_timeout}
     keys = ("mrays_per_second", "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate", "rays")
-    return {k: s.get(k) for k in keys}
+    return {k: stats["summary"].get(k) for k in keys}
 
 
-def work_stats(folder: Path, ray_kind: str) -> dict[str, Any]:
+def work_stats(folder: Path, ray_kind: str, fields: tuple[str, ...] = WORK) -> dict[str, Any]:
     """Mean, p99 and sum of each work count over the trace's rays of one kind, and hit rate."""
     t = rtsim.open_trace(folder)
     mask = np.asarray(t.rays["kind"]) == rtsim.trace_file.RAY_KINDS.index(ray_kind)
     work, hits = np.asarray(t.work)[mask], np.asarray(t.hits)[mask]
     out: dict[str, Any] = {"rays": int(mask.sum()), "hit_rate": float((hits["prim"] >= 0).mean())}
-    for f in WORK:
+    for f in fields:
         v = work[f].astype(np.float64)
         out[f] = {
             "mean": float(v.mean()),

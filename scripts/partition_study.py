@@ -31,7 +31,6 @@ from __future__ import annotations
 import argparse
 import json
 import platform
-import shutil
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -41,11 +40,10 @@ from typing import Any
 import numpy as np
 
 import rtsim
-from rtsim.launcher import SimJob, run_sim
-from rtsim.scenes import resolve_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from accel_study import find_study, fmt, run  # one driver of rtsim-accel-study
+import accel_study  # one driver of rtsim-accel-study, the traces and the model runs
+from accel_study import build_figures, fmt, label, simulate_stats
 
 REPO = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- partition-study:begin -->", "<!-- partition-study:end -->"
@@ -56,52 +54,16 @@ MAILBOXED = ("kdtree", "octree", "grid")
 WORK = ("steps", "box_tests", "plane_tests", "tri_tests", "refs")
 
 
-def label(accel: str) -> str:
-    return accel.replace(":", " ")
-
-
-def build_figures(scene: str, args: argparse.Namespace) -> dict[str, Any]:
-    path = args.out / "build" / f"{scene}.json"
-    if args.fresh or not path.is_file():
-        path.parent.mkdir(parents=True, exist_ok=True)
-        cmd = [str(find_study()), resolve_scene(scene), "--accel", ",".join(args.accels)]
-        cmd += ["--repeat", str(args.repeats), "--json", str(path)]
-        cmd += ["--hairball-triangles", str(args.hairball_triangles)]
-        run(cmd)
-    return dict(json.loads(path.read_text()))
-
-
 def trace(scene: str, accel: str, workload: str, args: argparse.Namespace) -> Path:
-    kind, _, builder = accel.partition(":")
-    folder = (
-        args.out / "traces" / f"{scene}-{kind}-{builder or 'default'}-{workload}-{args.resolution}"
-    )
-    if (folder / "manifest.json").is_file() and not args.fresh:
-        return folder
-    shutil.rmtree(folder, ignore_errors=True)
-    cmd = [sys.executable, "-m", "rtsim", "trace", resolve_scene(scene), "-o", str(folder)]
-    cmd += ["--workload", workload, "--resolution", args.resolution, "--accel", kind]
-    cmd += ["--hairball-triangles", str(args.hairball_triangles), "--flatten"]
-    cmd += ["--builder", builder] if builder else []
-    run(cmd)
-    return folder
+    # Instanced scenes flattened: the space-partitioning structures have no two-level form.
+    return accel_study.trace(scene, accel, workload, args, extra=("--flatten",))
 
 
 def simulate(folder: Path, tag: str, sets: list[str], args: argparse.Namespace) -> dict[str, Any]:
-    out = args.out / "runs" / f"{folder.name}-{tag}"
-    stats_file = out / "stats.json"
-    if args.fresh or not stats_file.is_file():
-        shutil.rmtree(out, ignore_errors=True)
-        job = SimJob(folder, out, sets=list(sets), verdict=False)
-        if run_sim(job, timeout=args.sim_timeout).timed_out:
-            return {"timed_out": args.sim_timeout}
-    if not stats_file.is_file():
-        sys.exit(f"partition_study: rtsim-sim wrote no {stats_file}")
-    stats = json.loads(stats_file.read_text())
-    s = stats["summary"]
-    if s["hit_mismatches"] or s["work_mismatches"]:
-        sys.exit(f"{out}: {s['hit_mismatches']} hit and {s['work_mismatches']} work mismatches")
-    m = stats.get("mailbox") or {}
+    stats = simulate_stats(folder, args, tag, tuple(sets))
+    if stats is None:
+        return {"timed_out": args.sim_timeout}
+    s, m = stats["summary"], stats.get("mailbox") or {}
     return {
         "mrays_per_second": s["mrays_per_second"],
         "dram_bytes_per_ray": s["dram_bytes_per_ray"],
@@ -112,13 +74,7 @@ def simulate(folder: Path, tag: str, sets: list[str], args: argparse.Namespace) 
 
 
 def work_stats(folder: Path, workload: str) -> dict[str, Any]:
-    t = rtsim.open_trace(folder)
-    mask = np.asarray(t.rays["kind"]) == rtsim.trace_file.RAY_KINDS.index(workload)
-    work, hits = np.asarray(t.work)[mask], np.asarray(t.hits)[mask]
-    out: dict[str, Any] = {"rays": int(mask.sum()), "hit_rate": float((hits["prim"] >= 0).mean())}
-    for f in WORK:
-        v = work[f].astype(np.float64)
-        out[f] = {"mean": float(v.mean()), "p99": float(np.percentile(v, 99))}
+    out = accel_study.work_stats(folder, workload, WORK)
     manifest = json.loads((folder / "manifest.json").read_text())["accel"]
     out["accel"] = {
         k: manifest.get(k)
