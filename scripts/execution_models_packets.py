@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from execution_models_study import BLOCK, CONTEXTS, KINDS, SCENES, trace
+from execution_models_study import BLOCK, CONTEXTS, KINDS, SCENES, plot_against_mimd, trace
 
 from rtsim.doc_markers import write_between
 from rtsim.launcher import SimJob, run_sim
@@ -171,43 +171,13 @@ def trends(rows: list[dict[str, Any]]) -> str:
 
 
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    traces = list(dict.fromkeys(r["trace"] for r in rows))
-    configs = list(dict.fromkeys(r["config"] for r in rows))
-    base = {r["trace"]: r["mrays_per_second"] for r in rows if r["config"] == "MIMD"}
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9.5, 7.0), sharex=True)
-    width = 0.8 / len(configs)
-    colors = plt.get_cmap("tab10")
-    for i, cfg in enumerate(configs):
-        xs = [t + (i - (len(configs) - 1) / 2) * width for t in range(len(traces))]
-        by = {r["trace"]: r for r in rows if r["config"] == cfg}
-        top.bar(
-            xs,
-            [by[t]["mrays_per_second"] / base[t] for t in traces],
-            width,
-            label=cfg,
-            color=colors(i),
-        )
-        if by[traces[0]]["simd_efficiency"] is not None:
-            bottom.bar(xs, [by[t]["simd_efficiency"] for t in traces], width, color=colors(i))
-    top.axhline(1.0, color="black", linewidth=0.8)
-    top.set_ylabel("Mrays/s / MIMD's (bvh2)")
-    top.set_title("Packets against single rays (8 units x 64 ray contexts)")
-    ymax = max(r["mrays_per_second"] / base[r["trace"]] for r in rows)
-    top.set_ylim(0, max(1.5, ymax * 1.35))  # room for the legend above the bars
-    top.legend(ncol=4, fontsize=8, loc="upper center")
-    bottom.set_ylabel("SIMD efficiency")
-    bottom.set_ylim(0, 1)
-    bottom.set_xticks(range(len(traces)))
-    bottom.set_xticklabels(traces, fontsize=8)
-    bottom.set_title("packets: active rays per packet step / lanes", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    plot_against_mimd(
+        rows,
+        path,
+        lambda r: str(r["config"]),
+        "Packets against single rays (8 units x 64 ray contexts; MIMD: bvh2)",
+        "packets: active rays per packet step / lanes",
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

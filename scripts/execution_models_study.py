@@ -31,6 +31,7 @@ import platform
 import shutil
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -226,21 +227,29 @@ def trends(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def plot(rows: list[dict[str, Any]], path: Path) -> None:
+def plot_against_mimd(
+    rows: list[dict[str, Any]],
+    path: Path,
+    label_of: Callable[[dict[str, Any]], str],
+    title: str,
+    efficiency_title: str,
+) -> None:
+    """Bars per trace and configuration: Mrays/s over the MIMD row's of the same trace (top) and,
+    for configurations that report it, SIMD efficiency (bottom)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     traces = list(dict.fromkeys(r["trace"] for r in rows))
-    configs = list(dict.fromkeys(config_label(r) for r in rows))
-    base = {r["trace"]: r["mrays_per_second"] for r in rows if config_label(r) == "MIMD"}
+    configs = list(dict.fromkeys(label_of(r) for r in rows))
+    base = {r["trace"]: r["mrays_per_second"] for r in rows if label_of(r) == "MIMD"}
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9.5, 7.0), sharex=True)
     width = 0.8 / len(configs)
     colors = plt.get_cmap("tab10")
     for i, cfg in enumerate(configs):
         xs = [t + (i - (len(configs) - 1) / 2) * width for t in range(len(traces))]
-        by = {r["trace"]: r for r in rows if config_label(r) == cfg}
+        by = {r["trace"]: r for r in rows if label_of(r) == cfg}
         top.bar(
             xs,
             [by[t]["mrays_per_second"] / base[t] for t in traces],
@@ -248,21 +257,32 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
             label=cfg,
             color=colors(i),
         )
-        if cfg.startswith("SIMT"):
+        if by[traces[0]]["simd_efficiency"] is not None:
             bottom.bar(xs, [by[t]["simd_efficiency"] for t in traces], width, color=colors(i))
     top.axhline(1.0, color="black", linewidth=0.8)
     top.set_ylabel("Mrays/s / MIMD's")
-    top.set_title("Execution models: throughput against MIMD (8 units x 64 ray contexts)")
-    top.set_ylim(0, 1.45)  # room for the legend above the bars
-    top.legend(ncol=5, fontsize=8, loc="upper center")
+    top.set_title(title)
+    ymax = max(r["mrays_per_second"] / base[r["trace"]] for r in rows)
+    top.set_ylim(0, max(1.45, ymax * 1.35))  # room for the legend above the bars
+    top.legend(ncol=4, fontsize=8, loc="upper center")
     bottom.set_ylabel("SIMD efficiency")
     bottom.set_ylim(0, 1)
     bottom.set_xticks(range(len(traces)))
-    bottom.set_xticklabels(traces)
-    bottom.set_title("SIMT: active lanes / lane slots", fontsize=10)
+    bottom.set_xticklabels(traces, fontsize=8)
+    bottom.set_title(efficiency_title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def plot(rows: list[dict[str, Any]], path: Path) -> None:
+    plot_against_mimd(
+        rows,
+        path,
+        config_label,
+        "Execution models: throughput against MIMD (8 units x 64 ray contexts)",
+        "SIMT: active lanes / lane slots",
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
