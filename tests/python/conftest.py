@@ -39,6 +39,12 @@ def run_rtsim(*args: str, cwd: Path | None = None) -> subprocess.CompletedProces
     )
 
 
+def rtsim_trace(*args: str) -> None:
+    """`rtsim trace ARGS` through the command line, asserted to succeed (stderr shown if not)."""
+    result = run_rtsim("trace", *args)
+    assert result.returncode == 0, result.stderr
+
+
 def sim_or_fail() -> Path:
     """The rtsim-sim the package would run (rtsim.launcher.find_sim), or fail the test."""
     try:
@@ -85,11 +91,10 @@ def trace_per_structure(
     out = {}
     for name, args in structures.items():
         folder = root / name
-        result = run_rtsim(
-            "trace", scene, "-o", str(folder), "--resolution", resolution, "--workload", workload,
+        rtsim_trace(
+            scene, "-o", str(folder), "--resolution", resolution, "--workload", workload,
             *extra, *args,
         )  # fmt: skip
-        assert result.returncode == 0, result.stderr
         out[name] = folder
     return out
 
@@ -123,8 +128,7 @@ def scenes_dir() -> Path:
 def cornell_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """`rtsim trace cornell` run once through the command line; returns the trace folder."""
     out = tmp_path_factory.mktemp("cornell") / "trace"
-    result = run_rtsim(
-        "trace",
+    rtsim_trace(
         "cornell",
         "-o",
         str(out),
@@ -135,7 +139,6 @@ def cornell_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "--bounces",
         "2",
     )
-    assert result.returncode == 0, result.stderr
     return out
 
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim, sim_stats
+from conftest import rtsim_trace, sim_stats
 
 KINDS = ["bvh4", "bvh6", "bvh8", "cwbvh6", "cwbvh8", "bvh8_octant", "cwbvh8_octant"]
 NODE_BYTES = {"bvh4": 128, "bvh6": 192, "bvh8": 256, "cwbvh6": 64, "cwbvh8": 80}
@@ -38,11 +38,10 @@ def trace_of(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Path]:
     def trace(kind: str) -> Path:
         if kind not in made:
             out = root / kind
-            result = run_rtsim(
-                "trace", SCENE, "-o", str(out), "--accel", kind, "--workload", WORKLOAD,
+            rtsim_trace(
+                SCENE, "-o", str(out), "--accel", kind, "--workload", WORKLOAD,
                 "--resolution", RESOLUTION, "--bounces", "1",
             )  # fmt: skip
-            assert result.returncode == 0, result.stderr
             made[kind] = out
         return made[kind]
 

@@ -15,7 +15,7 @@ import pytest
 
 import rtsim
 from bad_corpus import SCENE_CASES, TRACE_CASES
-from conftest import run_rtsim
+from conftest import rtsim_trace
 from gltf_forge import png_bytes, triangle_doc, write_gltf
 from rtsim.cli import main
 from rtsim.launcher import find_sim
@@ -132,8 +132,7 @@ def test_images_are_not_decoded(tmp_path: Path) -> None:
 @pytest.fixture(scope="module")
 def good_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("bad_inputs") / "good"
-    result = run_rtsim("trace", "cornell", "-o", str(out), "--resolution", "16x12")
-    assert result.returncode == 0, result.stderr
+    rtsim_trace("cornell", "-o", str(out), "--resolution", "16x12")
     return out
 
 

@@ -9,14 +9,15 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from conftest import run_rtsim
+from conftest import rtsim_trace, run_rtsim
 
 
 def test_bench_model_reports_every_level_and_the_ratios(tmp_path: Path) -> None:
     trace = tmp_path / "trace"
-    made = run_rtsim("trace", "cornell", "-o", str(trace), "--workload", "diffuse",
-                     "--resolution", "32x24")  # fmt: skip
-    assert made.returncode == 0, made.stderr
+    rtsim_trace(
+        "cornell", "-o", str(trace), "--workload", "diffuse",
+        "--resolution", "32x24",
+    )  # fmt: skip
     out = tmp_path / "bench.json"
     result = run_rtsim("bench", "--model", str(trace), "--repeat", "1", "--json", str(out),
                        "--levels", "functional,analytic,approx,treelets",
@@ -52,8 +53,7 @@ def test_bench_model_against_another_binary_compares_cpu_and_cycles(tmp_path: Pa
     from rtsim.launcher import find_sim
 
     trace = tmp_path / "trace"
-    made = run_rtsim("trace", "cornell", "-o", str(trace), "--resolution", "16x12")
-    assert made.returncode == 0, made.stderr
+    rtsim_trace("cornell", "-o", str(trace), "--resolution", "16x12")
     out = tmp_path / "bench.json"
     # Against itself: the same simulation, so the cycles agree.
     result = run_rtsim("bench", "--model", str(trace), "--repeat", "1", "--json", str(out),
@@ -75,8 +75,7 @@ def test_bench_model_against_a_missing_binary_is_refused(tmp_path: Path) -> None
 
 def test_bench_model_says_whether_it_times_the_verdict(tmp_path: Path) -> None:
     trace = tmp_path / "trace"
-    made = run_rtsim("trace", "cornell", "-o", str(trace), "--resolution", "16x12")
-    assert made.returncode == 0, made.stderr
+    rtsim_trace("cornell", "-o", str(trace), "--resolution", "16x12")
     for flag, included in (((), False), (("--verdict",), True)):
         out = tmp_path / f"bench-{included}.json"
         result = run_rtsim("bench", "--model", str(trace), "--repeat", "1", "--json", str(out),

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim, sim_stats
+from conftest import rtsim_trace, run_rtsim, sim_stats
 from rtsim.sweep.spec import SpecError, parse_spec
 
 SCENE, RESOLUTION, WORKLOAD = "cornell", "32x24", "primary,shadow,diffuse"
@@ -33,11 +33,10 @@ def trace_of(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str, bool], 
         if (kind, compressed) not in made:
             out = root / f"{kind}-{int(compressed)}"
             extra = ["--build-set", "compressed_leaves=true"] if compressed else []
-            result = run_rtsim(
-                "trace", SCENE, "-o", str(out), "--accel", kind, "--workload", WORKLOAD,
+            rtsim_trace(
+                SCENE, "-o", str(out), "--accel", kind, "--workload", WORKLOAD,
                 "--resolution", RESOLUTION, "--bounces", "1", *extra,
             )  # fmt: skip
-            assert result.returncode == 0, result.stderr
             made[kind, compressed] = out
         return made[kind, compressed]
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import REPO, run_rtsim
+from conftest import REPO, rtsim_trace
 from rtsim.sweep.demo import demo_spec_text
 from rtsim.sweep.runner import trace_task
 from rtsim.sweep.spec import parse_spec
@@ -40,8 +40,7 @@ def test_trace_without_workload_traces_what_the_scene_calls_for(
     scenes_dir: Path, tmp_path: Path, scene: str, called_for: set[str]
 ) -> None:
     out = tmp_path / "trace"
-    result = run_rtsim("trace", scene, "-o", str(out), "--resolution", "24x16")
-    assert result.returncode == 0, result.stderr
+    rtsim_trace(scene, "-o", str(out), "--resolution", "24x16")
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["workload"]["requested"] == "scene"
     listed = effects(manifest)
@@ -59,11 +58,10 @@ def test_trace_without_workload_traces_what_the_scene_calls_for(
 
 def test_explicit_workload_narrows(scenes_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "trace"
-    result = run_rtsim(
-        "trace", "MetalRoughSpheresNoTextures", "-o", str(out), "--resolution", "24x16",
+    rtsim_trace(
+        "MetalRoughSpheresNoTextures", "-o", str(out), "--resolution", "24x16",
         "--workload", "primary,shadow",
     )  # fmt: skip
-    assert result.returncode == 0, result.stderr
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["workload"]["requested"] == ["primary", "shadow"]
     assert kinds_in(out) == {"primary"}

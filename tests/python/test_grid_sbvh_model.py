@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 import rtsim
-from conftest import checked, run_rtsim, trace_per_structure
+from conftest import checked, rtsim_trace, run_rtsim, trace_per_structure
 
 STRUCTURES = {
     "grid": ["--accel", "grid"],
@@ -57,11 +57,10 @@ def test_grid_bricks_and_any_hit(
     # Alpha-MASK triangles through the grid: the any-hit stage runs and matches.
     folder = tmp_path / "alpha"
     scene = scenes_dir / "AlphaBlendModeTest" / "AlphaBlendModeTest.gltf"
-    result = run_rtsim(
-        "trace", str(scene), "-o", str(folder), "--resolution", "32x24",
+    rtsim_trace(
+        str(scene), "-o", str(folder), "--resolution", "32x24",
         "--workload", "primary,shadow", "--accel", "grid",
     )  # fmt: skip
-    assert result.returncode == 0, result.stderr
     stats = checked(sim_exe, folder, tmp_path / "alpha_run")
     assert {b["block"]: b["instantiated"] for b in stats["instantiated"]}["anyhit"] is True
 

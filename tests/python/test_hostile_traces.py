@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim
+from conftest import rtsim_trace
 from rtsim.launcher import find_sim
 from trace_forge import read_sections, write_trace
 from trace_mutations import COUNT_EDITS, FRAME_EDITS, empty_first_frame, random_edits
@@ -29,27 +29,16 @@ def _sim(trace: Path, run: Path, *sets: str) -> subprocess.CompletedProcess[str]
 @pytest.fixture(scope="module")
 def small(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("hostile") / "small"
-    result = run_rtsim("trace", "cornell", "-o", str(out), "--resolution", "12x8")
-    assert result.returncode == 0, result.stderr
+    rtsim_trace("cornell", "-o", str(out), "--resolution", "12x8")
     return out
 
 
 @pytest.fixture(scope="module")
 def animated(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("hostile") / "grove"
-    result = run_rtsim(
-        "trace",
-        "grove",
-        "-o",
-        str(out),
-        "--resolution",
-        "8x6",
-        "--frames",
-        "3",
-        "--workload",
-        "primary",
+    rtsim_trace(
+        "grove", "-o", str(out), "--resolution", "8x6", "--frames", "3", "--workload", "primary"
     )
-    assert result.returncode == 0, result.stderr
     return out
 
 
@@ -161,10 +150,7 @@ def test_random_crc_repaired_edits(seed: int, small: Path, tmp_path: Path) -> No
 def test_grid_with_overlapping_cell_lists_refused(tmp_path: Path) -> None:
     """Every cell listing every reference: a ray would test cells x references triangles."""
     good = tmp_path / "grid"
-    result = run_rtsim(
-        "trace", "cornell", "-o", str(good), "--resolution", "8x6", "--accel", "grid"
-    )
-    assert result.returncode == 0, result.stderr
+    rtsim_trace("cornell", "-o", str(good), "--resolution", "8x6", "--accel", "grid")
 
     def overlap(s) -> str:
         cells = np.frombuffer(s["RG00"], dtype=[("first_ref", "<u4"), ("ref_count", "<u4")])

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import run_rtsim
+from conftest import rtsim_trace
 
 SIM_EXE = "rtsim-sim"
 RESOLUTION = "48x32"
@@ -88,11 +88,10 @@ def trace_of(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str, str], P
     def trace(name: str, scene: str) -> Path:
         if name not in made:
             out = root / name
-            result = run_rtsim(
-                "trace", scene, "-o", str(out), "--workload", WORKLOAD,
+            rtsim_trace(
+                scene, "-o", str(out), "--workload", WORKLOAD,
                 "--resolution", RESOLUTION, "--bounces", "1",
             )  # fmt: skip
-            assert result.returncode == 0, result.stderr
             made[name] = out
         return made[name]
 

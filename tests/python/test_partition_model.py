@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import rtsim
-from conftest import checked, run_rtsim, trace_per_structure
+from conftest import checked, rtsim_trace, run_rtsim, trace_per_structure
 
 STRUCTURES = {
     "kdtree": ["--accel", "kdtree"],
@@ -118,11 +118,10 @@ def test_mailbox_is_refused_where_the_analytic_level_cannot_price_it(
 
 def test_builder_settings_round_trip_through_the_manifest(tmp_path: Path) -> None:
     folder = tmp_path / "kd"
-    result = run_rtsim(
-        "trace", "cornell", "-o", str(folder), "--resolution", "16x12", "--workload", "primary",
+    rtsim_trace(
+        "cornell", "-o", str(folder), "--resolution", "16x12", "--workload", "primary",
         "--accel", "kdtree", "--build-set", "empty_bonus=0.5", "--build-set", "clip=false",
     )  # fmt: skip
-    assert result.returncode == 0, result.stderr
     accel = json.loads((folder / "manifest.json").read_text())["accel"]
     assert accel["build_set"] == {"empty_bonus": 0.5, "clip": False}
     settings = accel["build_settings"]

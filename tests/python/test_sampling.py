@@ -19,7 +19,7 @@ from typing import Any
 
 import pytest
 
-from conftest import REPO, run_rtsim, simulate
+from conftest import REPO, rtsim_trace, run_rtsim, simulate
 from rtsim.launcher import SimResult, find_sim
 
 # Two units of four contexts: few rays in flight, so a small trace has many clusters.
@@ -48,9 +48,10 @@ def traces(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Path]:
     def trace(scene: str) -> Path:
         if scene not in made:
             out = root / scene
-            result = run_rtsim("trace", scene, "-o", str(out), "--workload", "primary,diffuse",
-                               "--resolution", "64x48")  # fmt: skip
-            assert result.returncode == 0, result.stderr
+            rtsim_trace(
+                scene, "-o", str(out), "--workload", "primary,diffuse",
+                "--resolution", "64x48",
+            )  # fmt: skip
             made[scene] = out
         return made[scene]
 

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 
 import rtsim
-from conftest import REPO, rtsim_command, run_rtsim
+from conftest import REPO, rtsim_command, rtsim_trace, run_rtsim
 from rtsim.launcher import parse_progress
 
 
@@ -20,8 +20,7 @@ from rtsim.launcher import parse_progress
 def tiny_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A 48x32 cornell trace with every ray kind (shadow rays take the any-hit path)."""
     out = tmp_path_factory.mktemp("sim") / "trace"
-    result = run_rtsim(
-        "trace",
+    rtsim_trace(
         "cornell",
         "-o",
         str(out),
@@ -30,7 +29,6 @@ def tiny_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "--resolution",
         "48x32",
     )
-    assert result.returncode == 0, result.stderr
     return out
 
 

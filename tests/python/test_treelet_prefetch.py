@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from conftest import run_rtsim, sim_or_fail, sim_stats, simulate
+from conftest import rtsim_trace, sim_or_fail, sim_stats, simulate
 
 TREELETS = ("treelets.enabled=true", "treelets.buffer_kib=256", "l2.size_kib=128")
 
@@ -18,11 +18,10 @@ TREELETS = ("treelets.enabled=true", "treelets.buffer_kib=256", "l2.size_kib=128
 @pytest.fixture(scope="module")
 def hairball_diffuse(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("prefetch") / "hairball_diffuse"
-    result = run_rtsim(
-        "trace", "hairball", "-o", str(out), "--workload", "diffuse",
+    rtsim_trace(
+        "hairball", "-o", str(out), "--workload", "diffuse",
         "--resolution", "128x96", "--hairball-triangles", "20000",
     )  # fmt: skip
-    assert result.returncode == 0, result.stderr
     return out
 
 

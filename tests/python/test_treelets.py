@@ -10,17 +10,16 @@ from typing import Any
 
 import pytest
 
-from conftest import run_rtsim, sim_or_fail, sim_stats
+from conftest import rtsim_trace, sim_or_fail, sim_stats
 
 
 @pytest.fixture(scope="module")
 def hairball_diffuse(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("treelets") / "hairball_diffuse"
-    result = run_rtsim(
-        "trace", "hairball", "-o", str(out), "--workload", "diffuse",
+    rtsim_trace(
+        "hairball", "-o", str(out), "--workload", "diffuse",
         "--resolution", "256x192", "--hairball-triangles", "60000",
     )  # fmt: skip
-    assert result.returncode == 0, result.stderr
     return out
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import rtsim
-from conftest import run_rtsim, sim_stats
+from conftest import rtsim_trace, sim_stats
 
 
 @pytest.mark.parametrize("level", ["functional", "approx"])
@@ -17,9 +17,10 @@ def test_two_level_runs_split_tlas_and_blas_work(
     scenes_dir: Path, sim_exe: Path, tmp_path: Path, level: str
 ) -> None:
     trace = tmp_path / "trace"
-    result = run_rtsim("trace", str(scenes_dir / "SimpleInstancing" / "SimpleInstancing.gltf"),
-                       "-o", str(trace), "--resolution", "32x24")  # fmt: skip
-    assert result.returncode == 0, result.stderr
+    rtsim_trace(
+        str(scenes_dir / "SimpleInstancing" / "SimpleInstancing.gltf"),
+        "-o", str(trace), "--resolution", "32x24",
+    )  # fmt: skip
     stats = sim_stats(sim_exe, trace, tmp_path / "run", f"fidelity={level}")
     assert stats["summary"]["hit_mismatches"] == stats["summary"]["work_mismatches"] == 0
     split = stats["two_level"]
