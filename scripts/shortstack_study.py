@@ -43,9 +43,14 @@ REPO = Path(__file__).resolve().parents[1]
 FULL_ENTRIES = 64  # never overflows: every structure's depth is within the stepper's 64 entries
 
 
-def make_trace(scene: str, accel: str, args: argparse.Namespace) -> Path:
-    folder = args.out / "traces" / f"{scene}-{accel}-{args.workload}-{args.resolution}"
-    params = {"hairball_triangles": args.hairball_triangles}
+def make_trace(
+    scene: str, accel: str, args: argparse.Namespace, build: tuple[str, ...] = ()
+) -> Path:
+    """args.workload of `scene` traced with `accel` built with `build` (--build-set assignments),
+    at args.resolution; cached in OUT/traces and kept while the hairball's size is the same."""
+    tag = "-".join([scene, accel, *[b.replace("=", "_") for b in build]])
+    folder = args.out / "traces" / f"{tag}-{args.workload}-{args.resolution}"
+    params = {"hairball_triangles": getattr(args, "hairball_triangles", None)}
     stamp = folder / "study_params.json"
     cached = (folder / "trace.rtt").is_file() and stamp.is_file() and not args.fresh
     if cached and json.loads(stamp.read_text()) == params:
@@ -53,8 +58,10 @@ def make_trace(scene: str, accel: str, args: argparse.Namespace) -> Path:
     shutil.rmtree(folder, ignore_errors=True)
     cmd = [sys.executable, "-m", "rtsim", "trace", scene, "-o", str(folder), "--accel", accel]
     cmd += ["--workload", args.workload, "--resolution", args.resolution, "--threads", "0"]
-    if scene == "hairball":
-        cmd += ["--hairball-triangles", str(args.hairball_triangles)]
+    if scene == "hairball" and params["hairball_triangles"]:
+        cmd += ["--hairball-triangles", str(params["hairball_triangles"])]
+    for assignment in build:
+        cmd += ["--build-set", assignment]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr[-600:]}")

@@ -24,7 +24,6 @@ import argparse
 import json
 import platform
 import shutil
-import subprocess
 import sys
 import threading
 import time
@@ -35,6 +34,9 @@ from typing import Any
 
 from rtsim.doc_markers import write_between
 from rtsim.launcher import SimJob, run_sim
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from shortstack_study import make_trace
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -90,22 +92,6 @@ TECHNIQUES = (
 )
 
 
-def make_trace(scene: str, accel: str, build: tuple[str, ...], args: argparse.Namespace) -> Path:
-    tag = "-".join([scene, accel, *[b.replace("=", "_") for b in build]])
-    folder = args.out / "traces" / f"{tag}-{args.workload}-{args.resolution}"
-    if (folder / "trace.rtt").is_file() and not args.fresh:
-        return folder
-    shutil.rmtree(folder, ignore_errors=True)
-    cmd = [sys.executable, "-m", "rtsim", "trace", scene, "-o", str(folder), "--accel", accel]
-    cmd += ["--workload", args.workload, "--resolution", args.resolution, "--threads", "0"]
-    for b in build:
-        cmd += ["--build-set", b]
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr[-600:]}")
-    return folder
-
-
 _LOCKS: dict[Path, threading.Lock] = {}
 _LOCKS_GUARD = threading.Lock()
 
@@ -148,8 +134,8 @@ def run_slug(sets: tuple[str, ...]) -> str:
 
 
 def measure(t: Technique, scene: str, level: str, args: argparse.Namespace) -> dict[str, Any]:
-    off_trace = make_trace(scene, t.accel, (), args)
-    on_trace = make_trace(scene, t.accel, t.build, args) if t.build else off_trace
+    off_trace = make_trace(scene, t.accel, args)
+    on_trace = make_trace(scene, t.accel, args, t.build) if t.build else off_trace
     off = simulate(off_trace, run_slug(t.off_sets), level, t.off_sets, args.fresh)
     on = simulate(on_trace, run_slug(t.sets) if t.sets else "off", level, t.sets, args.fresh)
     s, f = on["summary"], off["summary"]
@@ -176,9 +162,9 @@ def run_matrix(args: argparse.Namespace) -> dict[str, Any]:
     # Traces first, one at a time (each uses every core), then the runs in parallel.
     for t in TECHNIQUES:
         for scene in args.scenes:
-            make_trace(scene, t.accel, (), args)
+            make_trace(scene, t.accel, args)
             if t.build:
-                make_trace(scene, t.accel, t.build, args)
+                make_trace(scene, t.accel, args, t.build)
     cells = [(t, sc, lv) for t in TECHNIQUES for sc in args.scenes for lv in args.levels]
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         rows = list(pool.map(lambda c: measure(*c, args), cells))
