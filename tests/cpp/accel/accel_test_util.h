@@ -47,31 +47,6 @@ inline std::unique_ptr<Accel> build_kind(const Scene& scene, const std::string& 
     return load_accel(build_accel(scene, o), kind);
 }
 
-/// Random rays around `bounds`: random and ±0 directions, clipped intervals, some aimed at a
-/// vertex or the interior of a triangle of `tris`, a few invalid (NaN tmin).
-inline Ray random_ray(Rng& rng, const Aabb& bounds, const HwTriangle* tris, uint64_t tri_count) {
-    const Vec3 extent = bounds.hi - bounds.lo;
-    const Vec3 o = random_point(rng, bounds.lo - 0.2f * extent, bounds.hi + 0.2f * extent);
-    Vec3 d = random_direction(rng);
-    if (rng.next() < 0.3f && tri_count) {
-        const HwTriangle& t = tris[uint64_t(rng.next() * float(tri_count)) % tri_count];
-        const Vec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]), v2(t.v2[0], t.v2[1], t.v2[2]);
-        const float a = rng.next(), b = rng.next() * (1.0f - a);
-        const Vec3 target = rng.next() < 0.3f ? v0 : v0 + a * (v1 - v0) + b * (v2 - v0);
-        if (target != o) d = target - o;
-    }
-    for (int a = 0; a < 3; ++a)
-        if (rng.next() < 0.05f) d[a] = rng.next() < 0.5f ? 0.0f : -0.0f;
-    if (d == Vec3(0.0f)) d.z = 1.0f;
-    const float len = glm::length(extent);
-    float tmin = 0.0f, tmax = std::numeric_limits<float>::infinity();
-    if (rng.next() < 0.3f) {
-        tmin = rng.next() * len * 0.5f;
-        tmax = tmin + rng.next() * len;
-    }
-    if (rng.next() < 0.01f) tmin = std::numeric_limits<float>::quiet_NaN();
-    return make_ray(o, d, tmin, tmax);
-}
 
 /// Bit-identical hits (prim, instance, t, u, v).
 inline bool same_hit(const Hit& a, const Hit& b) {

@@ -24,30 +24,9 @@ namespace rtsim::test {
 
 using Tracer = std::function<Hit(const Ray&, TraversalMode)>;
 
-/// Random rays around `bounds`: random and +-0 directions, clipped intervals, some aimed at a
-/// vertex or the interior of one of `tris`, a few invalid.
+/// test::random_ray over `tris`, aimed a little more often and invalid a little less.
 inline Ray accel_ray(Rng& rng, const std::vector<HwTriangle>& tris, const Aabb& bounds) {
-    const Vec3 extent = bounds.hi - bounds.lo;
-    const Vec3 o = random_point(rng, bounds.lo - 0.2f * extent, bounds.hi + 0.2f * extent);
-    Vec3 d = random_direction(rng);
-    if (rng.next() < 0.4f && !tris.empty()) {
-        const HwTriangle& t = tris[size_t(rng.next() * float(tris.size())) % tris.size()];
-        const Vec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]), v2(t.v2[0], t.v2[1], t.v2[2]);
-        const float a = rng.next(), b = rng.next() * (1.0f - a);
-        const Vec3 target = rng.next() < 0.3f ? v0 : v0 + a * (v1 - v0) + b * (v2 - v0);
-        if (target != o) d = target - o;
-    }
-    for (int a = 0; a < 3; ++a)
-        if (rng.next() < 0.05f) d[a] = rng.next() < 0.5f ? 0.0f : -0.0f;
-    if (d == Vec3(0.0f)) d.z = 1.0f;
-    const float len = glm::length(extent);
-    float tmin = 0.0f, tmax = std::numeric_limits<float>::infinity();
-    if (rng.next() < 0.3f) {
-        tmin = rng.next() * len * 0.5f;
-        tmax = tmin + rng.next() * len;
-    }
-    if (rng.next() < 0.005f) tmin = std::numeric_limits<float>::quiet_NaN();  // invalid ray
-    return make_ray(o, d, tmin, tmax);
+    return random_ray(rng, bounds, tris.data(), tris.size(), RandomRayMix{0.4f, 0.005f});
 }
 
 /// The scene's triangles as hardware records, in primitive order.

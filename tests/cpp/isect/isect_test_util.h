@@ -119,6 +119,39 @@ inline Ray make_ray(const Vec3& o, const Vec3& d, float tmin = 0.0f,
     return r;
 }
 
+/// How often random_ray aims at a triangle and makes an invalid (NaN tmin) ray.
+struct RandomRayMix {
+    float aimed = 0.3f;
+    float invalid = 0.01f;
+};
+
+/// Random rays around `bounds`: random and +-0 directions, clipped intervals, some aimed at a
+/// vertex or the interior of one of the `tri_count` triangles `tris`, a few invalid.
+inline Ray random_ray(Rng& rng, const Aabb& bounds, const HwTriangle* tris, uint64_t tri_count,
+                      RandomRayMix mix = {}) {
+    const Vec3 extent = bounds.hi - bounds.lo;
+    const Vec3 o = random_point(rng, bounds.lo - 0.2f * extent, bounds.hi + 0.2f * extent);
+    Vec3 d = random_direction(rng);
+    if (rng.next() < mix.aimed && tri_count) {
+        const HwTriangle& t = tris[uint64_t(rng.next() * float(tri_count)) % tri_count];
+        const Vec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]), v2(t.v2[0], t.v2[1], t.v2[2]);
+        const float a = rng.next(), b = rng.next() * (1.0f - a);
+        const Vec3 target = rng.next() < 0.3f ? v0 : v0 + a * (v1 - v0) + b * (v2 - v0);
+        if (target != o) d = target - o;
+    }
+    for (int a = 0; a < 3; ++a)
+        if (rng.next() < 0.05f) d[a] = rng.next() < 0.5f ? 0.0f : -0.0f;
+    if (d == Vec3(0.0f)) d.z = 1.0f;
+    const float len = glm::length(extent);
+    float tmin = 0.0f, tmax = std::numeric_limits<float>::infinity();
+    if (rng.next() < 0.3f) {
+        tmin = rng.next() * len * 0.5f;
+        tmax = tmin + rng.next() * len;
+    }
+    if (rng.next() < mix.invalid) tmin = std::numeric_limits<float>::quiet_NaN();
+    return make_ray(o, d, tmin, tmax);
+}
+
 inline uint32_t float_bits(float f) {
     uint32_t u;
     std::memcpy(&u, &f, 4);

@@ -17,33 +17,8 @@ namespace rtsim {
 namespace {
 
 
-/// Random rays around `bounds`: random and ±0 directions, clipped intervals, some aimed at a
-/// triangle's vertex or interior, a few invalid.
 Ray random_ray(Rng& rng, const HwBvh& bvh, const Aabb& bounds) {
-    const Vec3 extent = bounds.hi - bounds.lo;
-    const Vec3 o = test::random_point(rng, bounds.lo - 0.2f * extent, bounds.hi + 0.2f * extent);
-    Vec3 d = test::random_direction(rng);
-    const float kind = rng.next();
-    if (kind < 0.3f && !bvh.triangles.empty()) {  // aimed at a triangle: vertex or interior
-        const HwTriangle& t = bvh.triangles[size_t(rng.next() * float(bvh.triangles.size())) %
-                                            bvh.triangles.size()];
-        const Vec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]),
-            v2(t.v2[0], t.v2[1], t.v2[2]);
-        const float a = rng.next(), b = rng.next() * (1.0f - a);
-        const Vec3 target = rng.next() < 0.3f ? v0 : v0 + a * (v1 - v0) + b * (v2 - v0);
-        if (target != o) d = target - o;
-    }
-    for (int a = 0; a < 3; ++a)
-        if (rng.next() < 0.05f) d[a] = rng.next() < 0.5f ? 0.0f : -0.0f;
-    if (d == Vec3(0.0f)) d.z = 1.0f;
-    const float len = glm::length(extent);
-    float tmin = 0.0f, tmax = std::numeric_limits<float>::infinity();
-    if (rng.next() < 0.3f) {
-        tmin = rng.next() * len * 0.5f;
-        tmax = tmin + rng.next() * len;
-    }
-    if (rng.next() < 0.01f) tmin = std::numeric_limits<float>::quiet_NaN();  // invalid ray
-    return test::make_ray(o, d, tmin, tmax);
+    return test::random_ray(rng, bounds, bvh.triangles.data(), bvh.triangles.size());
 }
 
 ::testing::AssertionResult same(const Hit& a, const WorkCounts& wa, const Hit& b,
