@@ -34,6 +34,7 @@ import os
 import shutil
 import subprocess
 import sys
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -41,11 +42,11 @@ from typing import Any
 import numpy as np
 
 import rtsim
+from rtsim.doc_markers import write_between
 from rtsim.launcher import SimJob, run_sim
 from rtsim.scenes import resolve_scene
 
 REPO = Path(__file__).resolve().parents[1]
-BEGIN, END = "<!-- accel-study:begin -->", "<!-- accel-study:end -->"
 DEFAULT_SCENES = "sponza,bunny,hairball,teapot_stadium,rotated_walls,cornell"
 DEFAULT_ACCELS = "bvh2,bvh2:sbvh,bvh4,bvh6,bvh8,cwbvh6,cwbvh8,bvh8_octant,cwbvh8_octant,grid"
 WORK = ("steps", "box_tests", "tri_tests")
@@ -309,39 +310,60 @@ def tables(results: dict[str, Any], args: argparse.Namespace) -> str:
     return "\n".join(lines)
 
 
-def main() -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=REPO / "out" / "accel_study")
-    p.add_argument("--scenes", default=DEFAULT_SCENES, type=lambda s: s.split(","))
-    p.add_argument("--accels", default=DEFAULT_ACCELS, type=lambda s: s.split(","))
+def study_parser(
+    doc: str, out: str, scenes: str, accels: str, resolution: str
+) -> argparse.ArgumentParser:
+    """The options the structure studies share (this one and partition_study.py)."""
+    p = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    p.add_argument("--out", type=Path, default=REPO / "out" / out)
+    p.add_argument("--scenes", default=scenes, type=lambda s: s.split(","))
+    p.add_argument("--accels", default=accels, type=lambda s: s.split(","))
     p.add_argument("--workloads", default="primary,diffuse", type=lambda s: s.split(","))
-    p.add_argument("--resolution", default="128x96")
+    p.add_argument("--resolution", default=resolution)
     p.add_argument("--repeats", type=int, default=3, help="builds timed per structure (median)")
     p.add_argument("--hairball-triangles", type=int, default=200_000)
     p.add_argument("--jobs", type=int, default=2, help="traces and simulations at once")
-    p.add_argument("--no-sim", action="store_true", help="reference figures only")
-    p.add_argument(
-        "--sim-timeout", type=float, default=None, help="seconds per simulation (then no figures)"
-    )
     p.add_argument("--fresh", action="store_true", help="redo cached builds, traces and runs")
     p.add_argument("--render", action="store_true", help="only rewrite tables from OUT/study.json")
     p.add_argument("--write-docs", action="store_true", help="write the tables into docs/accel.md")
-    args = p.parse_args()
+    return p
+
+
+def run_and_write(
+    args: argparse.Namespace,
+    study: Callable[[argparse.Namespace], dict[str, Any]],
+    tables: Callable[[dict[str, Any], argparse.Namespace], str],
+    marker: str,
+) -> None:
+    """Runs the study (or reads OUT/study.json with --render) and writes OUT/study.json,
+    OUT/study.md and, with --write-docs, the tables between docs/accel.md's `marker` markers."""
     args.out.mkdir(parents=True, exist_ok=True)
     if args.render:
         results = json.loads((args.out / "study.json").read_text())
     else:
         results = study(args)
-        hit_differences(results, args)
-        (args.out / "study.json").write_text(json.dumps(results, indent=2) + "\n")
+        (args.out / "study.json").write_text(json.dumps(results, indent=2, default=str) + "\n")
     text = tables(results, args)
     (args.out / "study.md").write_text(text + "\n")
     print(text)
     if args.write_docs:
-        doc = REPO / "docs" / "accel.md"
-        content = doc.read_text()
-        start, end = content.index(BEGIN) + len(BEGIN), content.index(END)
-        doc.write_text(content[:start] + "\n" + text + "\n" + content[end:])
+        write_between(REPO / "docs" / "accel.md", marker, text)
+
+
+def main() -> int:
+    p = study_parser(__doc__, "accel_study", DEFAULT_SCENES, DEFAULT_ACCELS, "128x96")
+    p.add_argument("--no-sim", action="store_true", help="reference figures only")
+    p.add_argument(
+        "--sim-timeout", type=float, default=None, help="seconds per simulation (then no figures)"
+    )
+    args = p.parse_args()
+
+    def with_hit_differences(a: argparse.Namespace) -> dict[str, Any]:
+        results = study(a)
+        hit_differences(results, a)
+        return results
+
+    run_and_write(args, with_hit_differences, tables, "accel-study")
     return 0
 
 

@@ -43,10 +43,9 @@ import rtsim
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accel_study  # one driver of rtsim-accel-study, the traces and the model runs
-from accel_study import build_figures, fmt, label, simulate_stats
+from accel_study import build_figures, fmt, label, run_and_write, simulate_stats, study_parser
 
 REPO = Path(__file__).resolve().parents[1]
-BEGIN, END = "<!-- partition-study:begin -->", "<!-- partition-study:end -->"
 DEFAULT_SCENES = "teapot_stadium,rotated_walls,aligned_walls,sponza,stanford_bunny,hairball,cornell"
 DEFAULT_ACCELS = "bvh2,bvh2:sbvh,bvh2:lbvh,kdtree,bih,octree,grid"
 #: Structures whose leaves or cells list references (a mailbox applies).
@@ -249,42 +248,18 @@ def tables(results: dict[str, Any], args: argparse.Namespace) -> str:
 
 
 def main() -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=REPO / "out" / "partition_study")
-    p.add_argument("--scenes", default=DEFAULT_SCENES, type=lambda s: s.split(","))
-    p.add_argument("--accels", default=DEFAULT_ACCELS, type=lambda s: s.split(","))
-    p.add_argument("--workloads", default="primary,diffuse", type=lambda s: s.split(","))
-    p.add_argument("--resolution", default="64x48")
-    p.add_argument("--repeats", type=int, default=3, help="builds timed per structure (median)")
+    p = study_parser(__doc__, "partition_study", DEFAULT_SCENES, DEFAULT_ACCELS, "64x48")
     p.add_argument(
         "--mailbox", type=int, default=8, help="mailbox entries of the second run (0: none)"
     )
     p.add_argument(
         "--frame-rays", default="1e6,8e6", type=lambda s: [float(x) for x in s.split(",")]
     )
-    p.add_argument("--hairball-triangles", type=int, default=200_000)
-    p.add_argument("--jobs", type=int, default=2, help="traces and simulations at once")
     p.add_argument("--sim-timeout", type=float, default=1800.0, help="seconds per simulation")
-    p.add_argument("--fresh", action="store_true", help="redo cached builds, traces and runs")
-    p.add_argument("--render", action="store_true", help="only rewrite tables from OUT/study.json")
-    p.add_argument("--write-docs", action="store_true", help="write the tables into docs/accel.md")
     args = p.parse_args()
     if "bvh2" not in args.accels:
         args.accels.insert(0, "bvh2")  # the reference every structure is compared with
-    args.out.mkdir(parents=True, exist_ok=True)
-    if args.render:
-        results = json.loads((args.out / "study.json").read_text())
-    else:
-        results = study(args)
-        (args.out / "study.json").write_text(json.dumps(results, indent=2, default=str) + "\n")
-    text = tables(results, args)
-    (args.out / "study.md").write_text(text + "\n")
-    print(text)
-    if args.write_docs:
-        doc = REPO / "docs" / "accel.md"
-        content = doc.read_text()
-        start, end = content.index(BEGIN) + len(BEGIN), content.index(END)
-        doc.write_text(content[:start] + "\n" + text + "\n" + content[end:])
+    run_and_write(args, study, tables, "partition-study")
     return 0
 
 
