@@ -30,25 +30,6 @@ void expect_brute(const Scene& scene, const GridConfig& config, const std::vecto
     EXPECT_GE(ag.hits, min_hits) << what;
 }
 
-/// Rays on the lattice of a tessellated cube whose vertices are the grid's planes: along cell
-/// faces and edges (axis directions with +-0), through corners (diagonals: crossings on two or
-/// three axes at the same t), from inside, outside and on the bounds.
-std::vector<Ray> lattice_rays(float scale, const Vec3& offset) {
-    // (Directions scale with the scene so distances stay near 1 whatever the scale.)
-    std::vector<Ray> rays;
-    const float coords[] = {-1.5f, -1.0f, -0.75f, 0.0f, 0.25f, 1.0f, 1.25f};
-    const Vec3 dirs[] = {Vec3(1, 0, 0), Vec3(-0.0f, 1, 0), Vec3(0, -0.0f, -1), Vec3(1, 1, 0), Vec3(-1, 1, 1),
-                         Vec3(1, -1, -1), Vec3(0.5f, 0.25f, -1), Vec3(-0.0f, 0.0f, 1)};
-    for (float x : coords)
-        for (float y : coords)
-            for (float z : coords)
-                for (const Vec3& d : dirs) {
-                    rays.push_back(test::make_ray(offset + scale * Vec3(x, y, z), scale * d));
-                    rays.push_back(test::make_ray(offset + scale * Vec3(x, y, z), -scale * d));
-                }
-    return rays;
-}
-
 TEST(GridHardCases, RaysAlongCellFacesAndThroughCorners) {
     // 8 x 8 cells per face on a cube whose grid is 8^3 cells of 0.25: every vertex on a plane.
     const Scene cube = test::make_scene(test::tessellated_cube(8));
@@ -58,11 +39,11 @@ TEST(GridHardCases, RaysAlongCellFacesAndThroughCorners) {
     const GridGeometry g = GridGeometry::from_json(image.params, "t");
     ASSERT_EQ(g.res[0], 8u);
     ASSERT_EQ(g.cell[0], 0.25f);
-    expect_brute(cube, c, lattice_rays(1.0f, Vec3(0.0f)), "cube lattice", 500);
+    expect_brute(cube, c, test::lattice_rays(1.0f, Vec3(0.0f)), "cube lattice", 500);
     // Other resolutions put the planes between the vertices.
     for (float density : {0.1f, 3.0f, 30.0f}) {
         c.density = density;
-        expect_brute(cube, c, lattice_rays(1.0f, Vec3(0.0f)), "cube lattice, density " + std::to_string(density), 500);
+        expect_brute(cube, c, test::lattice_rays(1.0f, Vec3(0.0f)), "cube lattice, density " + std::to_string(density), 500);
     }
 }
 
@@ -76,7 +57,7 @@ TEST(GridHardCases, HugeAndTinyCoordinates) {
         for (const Vec3& v : unit) soup.push_back(Vec3(offset) + scale * v);
         const Scene scene = test::make_scene(soup);
         const std::string what = "cube x " + std::to_string(scale) + " + " + std::to_string(offset);
-        expect_brute(scene, GridConfig{}, lattice_rays(scale, Vec3(offset)), what, 100);
+        expect_brute(scene, GridConfig{}, test::lattice_rays(scale, Vec3(offset)), what, 100);
         // Random rays through the scaled soup.
         const Scene soup_scene = [&, scale = scale, offset = offset] {  // C++17: no captured bindings
             const Scene s = test::random_soup(11, 500);
@@ -106,7 +87,7 @@ TEST(GridHardCases, DegenerateTrianglesEmptyCellsAndEmptyScenes) {
     expect_brute(scene, GridConfig{}, test::random_rays(scene, test::hw_triangles(scene), 9, 4000), "clusters", 300);
     // An empty scene: one empty cell; every ray misses after the bounds test (and one cell).
     const std::unique_ptr<Accel> empty = load_accel(grid_image(Scene{}), "empty");
-    for (const Ray& r : lattice_rays(1.0f, Vec3(0.0f))) {
+    for (const Ray& r : test::lattice_rays(1.0f, Vec3(0.0f))) {
         WorkCounts w;
         EXPECT_FALSE(empty->trace(r, TraversalMode::closest_hit, &w).valid());
         EXPECT_LE(w.cell_steps, 1u);

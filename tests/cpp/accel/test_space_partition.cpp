@@ -124,24 +124,6 @@ TEST(SpacePartitionHardCases, RaysInTheStructuresOwnPlanes) {
     }
 }
 
-/// Rays on the lattice of a tessellated cube: along faces and edges (+-0 components), through
-/// vertices and corners (crossings on two or three axes at one t), from inside, outside and on
-/// the bounds.
-std::vector<Ray> lattice_rays(float scale, const Vec3& offset) {
-    std::vector<Ray> rays;
-    const float coords[] = {-1.5f, -1.0f, -0.75f, 0.0f, 0.25f, 1.0f, 1.25f};
-    const Vec3 dirs[] = {Vec3(1, 0, 0), Vec3(-0.0f, 1, 0), Vec3(0, -0.0f, -1), Vec3(1, 1, 0), Vec3(-1, 1, 1),
-                         Vec3(1, -1, -1), Vec3(0.5f, 0.25f, -1), Vec3(-0.0f, 0.0f, 1)};
-    for (float x : coords)
-        for (float y : coords)
-            for (float z : coords)
-                for (const Vec3& d : dirs) {
-                    rays.push_back(test::make_ray(offset + scale * Vec3(x, y, z), scale * d));
-                    rays.push_back(test::make_ray(offset + scale * Vec3(x, y, z), -scale * d));
-                }
-    return rays;
-}
-
 TEST(SpacePartitionHardCases, FacesEdgesVerticesAndScales) {
     const std::vector<Vec3> unit = test::tessellated_cube(8);
     for (const auto& [scale, offset] : std::vector<std::pair<float, float>>{{1.0f, 0.0f}, {1e12f, 0.0f}, {1e-12f, 0.0f},
@@ -151,7 +133,7 @@ TEST(SpacePartitionHardCases, FacesEdgesVerticesAndScales) {
         const Scene scene = test::make_scene(soup);
         const std::string what = "cube x " + std::to_string(scale) + " + " + std::to_string(offset);
         for (const std::string& name : test::partition_kinds())
-            EXPECT_GT(expect_structure_correct(*build_named(scene, name), scene, lattice_rays(scale, Vec3(offset)),
+            EXPECT_GT(expect_structure_correct(*build_named(scene, name), scene, test::lattice_rays(scale, Vec3(offset)),
                                                what + " " + name),
                       500)
                 << what << " " << name;
@@ -185,7 +167,7 @@ TEST(SpacePartitionHardCases, DegenerateTrianglesAndFlatScenes) {
         expect_structure_correct(*build_named(clusters, name), clusters,
                                  test::random_rays(clusters, test::hw_triangles(clusters), 9, 3000), "clusters " + name);
         std::vector<Ray> rays = test::random_rays(flat_scene, test::hw_triangles(flat_scene), 10, 2000);
-        for (const Ray& r : lattice_rays(2.0f, Vec3(0.0f, 0.0f, 0.5f))) rays.push_back(r);
+        for (const Ray& r : test::lattice_rays(2.0f, Vec3(0.0f, 0.0f, 0.5f))) rays.push_back(r);
         EXPECT_GT(expect_structure_correct(*build_named(flat_scene, name), flat_scene, rays, "flat " + name), 100) << name;
     }
 }

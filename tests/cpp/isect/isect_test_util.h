@@ -152,6 +152,25 @@ inline Ray random_ray(Rng& rng, const Aabb& bounds, const HwTriangle* tris, uint
     return make_ray(o, d, tmin, tmax);
 }
 
+/// Rays on the lattice of a tessellated cube (tessellated_cube, scaled and offset): along faces
+/// and edges (+-0 components), through vertices and corners (crossings on two or three axes at
+/// one t), from inside, outside and on the bounds. Directions scale with the scene so distances
+/// stay near 1 whatever the scale.
+inline std::vector<Ray> lattice_rays(float scale, const Vec3& offset) {
+    std::vector<Ray> rays;
+    const float coords[] = {-1.5f, -1.0f, -0.75f, 0.0f, 0.25f, 1.0f, 1.25f};
+    const Vec3 dirs[] = {Vec3(1, 0, 0),  Vec3(-0.0f, 1, 0), Vec3(0, -0.0f, -1),    Vec3(1, 1, 0),
+                         Vec3(-1, 1, 1), Vec3(1, -1, -1), Vec3(0.5f, 0.25f, -1), Vec3(-0.0f, 0.0f, 1)};
+    for (float x : coords)
+        for (float y : coords)
+            for (float z : coords)
+                for (const Vec3& d : dirs) {
+                    rays.push_back(make_ray(offset + scale * Vec3(x, y, z), scale * d));
+                    rays.push_back(make_ray(offset + scale * Vec3(x, y, z), -scale * d));
+                }
+    return rays;
+}
+
 inline uint32_t float_bits(float f) {
     uint32_t u;
     std::memcpy(&u, &f, 4);
