@@ -142,13 +142,20 @@ public:
         m_fetch = plan.done || plan.fetch_count == 0 ? kNoFetch : plan.fetch[0].addr;
     }
     void prefetch(const MemIf& l1) const {
-        __builtin_prefetch(m_plan);
-        if (m_data) prefetch_range(m_data, m_bytes);
+        prefetch_step();
         if (m_fetch != kNoFetch) l1.prefetch_host(m_fetch);
     }
+    /// The plan and the structure's data only (a caller with no L1 model).
+    void prefetch_step() const {
+        __builtin_prefetch(m_plan);
+        if (m_data) prefetch_range(m_data, m_bytes);
+    }
+    /// Address of the step's first fetch, or kNoFetch.
+    uint64_t first_fetch() const { return m_fetch; }
+
+    static constexpr uint64_t kNoFetch = ~0ull;
 
 private:
-    static constexpr uint64_t kNoFetch = ~0ull;
     const void* m_plan = nullptr;
     const void* m_data = nullptr;
     uint32_t m_bytes = 0;

@@ -114,21 +114,20 @@ double bin_miss_probability(const ReuseCurve& curve, int b, bool censored, doubl
     return miss / kPoints;
 }
 
-LastUse::LastUse(size_t capacity_pow2)
-    : m_keys(capacity_pow2, ~0ull), m_values(capacity_pow2, 0), m_mask(capacity_pow2 - 1) {}
+LastUse::LastUse(size_t capacity_pow2) : m_slots(capacity_pow2), m_mask(capacity_pow2 - 1) {}
 
 uint64_t LastUse::exchange(uint64_t key, uint64_t value) {
-    if (2 * (m_size + 1) > m_keys.size()) grow();
-    size_t i = size_t((key * 0x9E3779B97F4A7C15ull) >> 20) & m_mask;
+    if (2 * (m_size + 1) > m_slots.size()) grow();
+    size_t i = slot_of(key);
     while (true) {
-        if (m_keys[i] == key) {
-            const uint64_t old = m_values[i];
-            m_values[i] = value;
+        Slot& s = m_slots[i];
+        if (s.key == key) {
+            const uint64_t old = s.value;
+            s.value = value;
             return old;
         }
-        if (m_keys[i] == ~0ull) {
-            m_keys[i] = key;
-            m_values[i] = value;
+        if (s.key == ~0ull) {
+            s = Slot{key, value};
             ++m_size;
             return ~0ull;
         }
@@ -137,18 +136,17 @@ uint64_t LastUse::exchange(uint64_t key, uint64_t value) {
 }
 
 void LastUse::clear() {
-    std::fill(m_keys.begin(), m_keys.end(), ~0ull);
+    std::fill(m_slots.begin(), m_slots.end(), Slot{});
     m_size = 0;
 }
 
 void LastUse::grow() {
-    std::vector<uint64_t> keys(m_keys.size() * 2, ~0ull), values(m_keys.size() * 2, 0);
-    keys.swap(m_keys);
-    values.swap(m_values);
-    m_mask = m_keys.size() - 1;
+    std::vector<Slot, HugePageAllocator<Slot>> old(m_slots.size() * 2);
+    old.swap(m_slots);
+    m_mask = m_slots.size() - 1;
     m_size = 0;
-    for (size_t i = 0; i < keys.size(); ++i)
-        if (keys[i] != ~0ull) exchange(keys[i], values[i]);
+    for (const Slot& s : old)
+        if (s.key != ~0ull) exchange(s.key, s.value);
 }
 
 }  // namespace rtsim

@@ -12,10 +12,13 @@ SampleProfiler::SampleProfiler(const SimConfig& config, const Accel& accel, cons
       m_map(map),
       m_p(profile),
       m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts),
+      m_ahead(m_contexts.size()),
       m_units(config.traversal.units),
       m_slots(config.traversal.ray_contexts),
       m_shift(0),
-      m_unit_pos(config.traversal.units, 0) {
+      m_unit_pos(config.traversal.units, 0),
+      m_reads(kDataKindCount),
+      m_op_sizes(profile.op_sizes.size()) {
     for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper();
     while ((1u << m_shift) < config.l1.line_bytes) ++m_shift;
 }
@@ -31,15 +34,29 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
     for (uint32_t c = 0; c < m_slots; ++c)
         for (uint32_t u = 0; u < m_units; ++u) start_ray(dealer, u, c, sink);
     // Rounds: every active context takes one step, context-major then unit.
+    const size_t n = m_contexts.size();
+    auto index = [&](size_t p) { return (p % m_units) * m_slots + p / m_units; };
+    constexpr size_t kAhead = 4;  // steps of a few hundred ns against a host miss of about 100 (2 and 8 measure alike)
     for (bool any = true; any;) {
         any = false;
-        for (uint32_t c = 0; c < m_slots; ++c)
-            for (uint32_t u = 0; u < m_units; ++u)
-                if (m_contexts[size_t(u) * m_slots + c].active) {
-                    step(dealer, u, c, sink);
-                    any = true;
-                }
+        for (size_t p = 0; p < n; ++p) {
+            prefetch_ahead(index((p + kAhead) % n));
+            const size_t i = index(p);
+            if (!m_contexts[i].active) continue;
+            step(dealer, uint32_t(i / m_slots), uint32_t(i % m_slots), sink);
+            any = true;
+        }
     }
+}
+
+void SampleProfiler::prefetch_ahead(size_t index) const {
+    if (!m_contexts[index].active) return;
+    const HostAhead& a = m_ahead[index];
+    a.prefetch_step();
+    if (a.first_fetch() == HostAhead::kNoFetch) return;
+    const uint64_t line = a.first_fetch() >> m_shift;
+    m_global_last.prefetch(line);
+    m_unit_last.prefetch(line << 16 | index / m_slots);
 }
 
 bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink) {
@@ -53,8 +70,9 @@ bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, 
     ctx.plan_steps = 0;
     ctx.measured = job.id >= m_measure_first && job.id < m_measure_end;
     ctx.active = true;
+    m_ahead[size_t(unit) * m_slots + slot].note(*ctx.stepper);
     const Access a = read(unit, m_map.ray(job.id), sizeof(RayRecord), DataKind::ray, ctx.measured);
-    if (ctx.measured) m_p.ray_critical.add(a.key);
+    if (ctx.measured) m_ray_critical.add(a.key);
     (void)sink;
     return true;
 }
@@ -92,10 +110,11 @@ void SampleProfiler::step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySi
         const Access a = read(unit, d.reads[i].addr, d.reads[i].bytes, d.reads[i].kind, ctx.measured);
         if (i == 0 || a.rank > critical.rank) critical = a;
     }
-    if (ctx.measured && d.read_count) m_p.step_critical.add(critical.key);
+    if (ctx.measured && d.read_count) m_step_critical.add(critical.key);
     if (ctx.measured)  // tests per operation: the pipelines' widths are applied per configuration
-        for (int i = 0; i < d.issue_count; ++i) m_p.op_sizes[size_t(d.issues[i].kind)][d.issues[i].tests] += 1;
+        for (int i = 0; i < d.issue_count; ++i) m_op_sizes[size_t(d.issues[i].kind)].add(d.issues[i].tests);
     stack_traffic(unit, slot, d, ctx.measured);
+    m_ahead[size_t(unit) * m_slots + slot].note(stepper);
 }
 
 SampleProfiler::Access SampleProfiler::read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind,
@@ -123,7 +142,7 @@ SampleProfiler::Access SampleProfiler::read_line(uint32_t unit, uint64_t line, D
     (uc ? m_p.unit_censored : m_p.unit_events)[ub] += 1;
     (gc ? m_p.global_censored : m_p.global_events)[gb] += 1;
     const uint32_t key = JointHistogram::pack(ub, uc, gb, gc);
-    m_p.reads[size_t(kind)].add(key);
+    m_reads[size_t(kind)].add(key);
     return {key, (uint64_t(gc) << 63) | (uint64_t(uc) << 62) | (uint64_t(gb) << 8) | uint64_t(ub)};
 }
 
@@ -150,6 +169,12 @@ void SampleProfiler::stack_traffic(uint32_t unit, uint32_t slot, const StepDeman
 }
 
 void SampleProfiler::finish() {
+    for (size_t k = 0; k < m_reads.size(); ++k)
+        m_reads[k].drain([&](uint32_t key, uint64_t n) { m_p.reads[k].add(key, double(n)); });
+    for (size_t k = 0; k < m_op_sizes.size(); ++k)
+        m_op_sizes[k].drain([&](uint32_t key, uint64_t n) { m_p.op_sizes[k][key] += double(n); });
+    m_step_critical.drain([&](uint32_t key, uint64_t n) { m_p.step_critical.add(key, double(n)); });
+    m_ray_critical.drain([&](uint32_t key, uint64_t n) { m_p.ray_critical.add(key, double(n)); });
     // Least squares without intercept: plan steps = a (plan-step work) + b tri_tests.
     const double det = m_fit[0] * m_fit[2] - m_fit[1] * m_fit[1];
     if (det > 1e-9 * m_fit[0] * m_fit[2] && det > 0) {

@@ -16,7 +16,9 @@
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/dispatch/dispatch.h"
 #include "rtl_model/traversal/step_demand.h"
+#include "rtl_model/traversal/unit_parts.h"
 #include "sim/config/config.h"
+#include "sim/analytic/key_counts.h"
 #include "sim/analytic/profile.h"
 #include "sim/analytic/reuse.h"
 #include "traces/accel/accel.h"
@@ -52,17 +54,25 @@ private:
     void write(uint64_t addr, uint32_t bytes, DataKind kind, bool measured);
     void stack_traffic(uint32_t unit, uint32_t slot, const StepDemand& d, bool measured);
     void finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink);
+    /// Speed only: the host data of context `index`'s next step and its first line's reuse slots.
+    void prefetch_ahead(size_t index) const;
 
     const SimConfig& m_c;
     const StepCosts m_costs;
     const MemoryMap& m_map;
     AnalyticProfile& m_p;
     std::vector<Context> m_contexts;  ///< unit-major
+    /// Per context, what its next step touches on the host, noted when it is planned (hot then)
+    /// and prefetched a few steps before it runs: 128 other steps ran since, evicting it.
+    std::vector<HostAhead> m_ahead;
     uint32_t m_units, m_slots, m_shift;
     uint64_t m_measure_first = 0, m_measure_end = 0;
     LastUse m_unit_last, m_global_last;
     uint64_t m_global_pos = 0;
     std::vector<uint64_t> m_unit_pos;
+    // The profile's histograms as counted (finish() moves them into the profile).
+    std::vector<KeyCounts> m_reads, m_op_sizes;  ///< per DataKind, per OpKind
+    KeyCounts m_step_critical, m_ray_critical;
     double m_fit[5] = {};  ///< sums x1x1, x1x2, x2x2, x1y, x2y of the steps regression
 };
 

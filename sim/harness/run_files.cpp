@@ -65,9 +65,10 @@ json scan_workload(TraceReader& reader, WorkloadFeatures* features) {
         uint64_t count = std::min<uint64_t>(buf.size(), n - first);
         reader.read(SectionKind::rays, first, count, buf.data());
         for (uint64_t i = 0; i < count; ++i) {
-            require(buf[i].kind < kRayKindCount, reader.path() + ": ray " + std::to_string(first + i) +
-                                                     " has unknown ray kind " + std::to_string(buf[i].kind) +
-                                                     " (known kinds: 0.." + std::to_string(kRayKindCount - 1) + ")");
+            if (buf[i].kind >= kRayKindCount)  // the message is built only on failure: a loop over every ray
+                throw Error(reader.path() + ": ray " + std::to_string(first + i) + " has unknown ray kind " +
+                            std::to_string(buf[i].kind) + " (known kinds: 0.." + std::to_string(kRayKindCount - 1) +
+                            ")");
             ++kinds[buf[i].kind];
             features->occlusion_rays += (buf[i].flags & kRayFlagAnyHit) != 0;
         }
