@@ -96,6 +96,7 @@ def trace(
     OUT/traces); `extra` are more `rtsim trace` arguments."""
     kind, _, builder = accel.partition(":")
     name = f"{scene}-{kind}-{builder or 'default'}-{workload}-{args.resolution}"
+    name += "".join(e.replace("--", "-") for e in extra)  # another trace with other arguments
     folder = args.out / "traces" / name
     if (folder / "manifest.json").is_file() and not args.fresh:
         return folder

@@ -129,8 +129,9 @@ private:
 
 /// Simulation speed only, no effect on the model: what a context's next step will touch on the
 /// host (the stepper's plan, the structure's data its execute() reads, the L1's tags of its
-/// first fetch), noted when the step is planned (all hot then) and prefetched one event before
-/// the step runs, without chasing pointers. The stepper prefetched the data when it planned the
+/// first fetch), noted when the step is planned (all hot then) and prefetched shortly before
+/// the step runs (the MIMD unit: one event before; the analytic level's profiler: a few steps
+/// before), without chasing pointers. The stepper prefetched the data when it planned the
 /// step, but other rays' events ran since and evicted it (the node load was the step's stall).
 class HostAhead {
 public:

@@ -3,6 +3,7 @@
 // small open-addressing table that stays in the host's L1, instead of a walk down an ordered map.
 // The counts go into the profile's ordered maps once sampling ends; they are whole numbers, so the
 // maps hold exactly what one add per event would have left there.
+#include <cassert>
 #include <cstdint>
 #include <vector>
 
@@ -12,7 +13,9 @@ class KeyCounts {
 public:
     KeyCounts() : m_slots(kInitialSlots) {}
 
+    /// One more of `key` (any key but ~0u, the empty slot's mark).
     void add(uint32_t key) {
+        assert(key != kEmpty);
         size_t i = slot_of(key);
         while (m_slots[i].key != key) {
             if (m_slots[i].key == kEmpty) {
@@ -38,7 +41,7 @@ public:
     }
 
 private:
-    static constexpr uint32_t kEmpty = ~0u;  // no key: JointHistogram keys use 18 bits
+    static constexpr uint32_t kEmpty = ~0u;  // histogram keys use 18 bits, test counts a few
     static constexpr size_t kInitialSlots = 256;
     struct Slot {
         uint32_t key = kEmpty;

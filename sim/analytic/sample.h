@@ -17,10 +17,10 @@
 #include "rtl_model/dispatch/dispatch.h"
 #include "rtl_model/traversal/step_demand.h"
 #include "rtl_model/traversal/unit_parts.h"
-#include "sim/config/config.h"
 #include "sim/analytic/key_counts.h"
 #include "sim/analytic/profile.h"
 #include "sim/analytic/reuse.h"
+#include "sim/config/config.h"
 #include "traces/accel/accel.h"
 
 namespace rtsim {
@@ -63,7 +63,8 @@ private:
     AnalyticProfile& m_p;
     std::vector<Context> m_contexts;  ///< unit-major
     /// Per context, what its next step touches on the host, noted when it is planned (hot then)
-    /// and prefetched a few steps before it runs: 128 other steps ran since, evicting it.
+    /// and prefetched a few steps before it runs: the round's other units x ray_contexts - 1
+    /// steps ran since, evicting it.
     std::vector<HostAhead> m_ahead;
     uint32_t m_units, m_slots, m_shift;
     uint64_t m_measure_first = 0, m_measure_end = 0;

@@ -26,8 +26,12 @@ struct ListedRegions {
 };
 
 /// Checks that `image` holds region `cells_name` of `cell_bytes`-byte records of kind
-/// `cells_kind`, "prim_refs" of 4-byte references and the triangles, then opens the triangles
-/// into `triangles`. Throws rtsim::Error naming `source` and `structure` ("kdtree", ...).
+/// `cells_kind`, "prim_refs" of 4-byte references and the triangles. Throws rtsim::Error naming
+/// `source` and `structure` ("kdtree", ...).
+void check_listed_regions(const AccelImage& image, const std::string& structure, const std::string& cells_name,
+                          DataKind cells_kind, uint32_t cell_bytes, const std::string& source);
+
+/// check_listed_regions, then opens the triangles into `triangles`.
 ListedRegions open_listed_regions(const AccelImage& image, TriangleStore& triangles,
                                   const std::string& structure, const std::string& cells_name,
                                   DataKind cells_kind, uint32_t cell_bytes, const std::string& source);
@@ -90,17 +94,16 @@ private:
 
 /// Validates a tree of listing leaves whose children come after their parent, in one forward
 /// pass: its size, each node reachable once, each leaf's list, each child's index and depth (at
-/// most `max_depth` levels below the root, else `too_deep`), then the references. Each node's cell
+/// most `max_depth` levels below the root, else the message `too_deep()`), then the references. Each node's cell
 /// is carried down: `interior(i, node, cell, add_child)` checks interior node i against its cell
 /// and calls add_child(k, child_cell) for each child. Returns the deepest level.
-template <class Node, class Interior>
+template <class Node, class TooDeep, class Interior>
 uint32_t validate_listed_tree(const ListedTreeView<Node>& v, const ListedChecks& check, uint32_t max_depth,
-                              const std::string& too_deep, Interior interior) {
+                              TooDeep too_deep, Interior interior) {
     auto node_name = [](uint64_t i) { return "node " + std::to_string(i); };
     if (v.node_count == 0) check.fail("no nodes");
     if (v.node_count > Node::kMaxIndex || v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32))
-        check.fail("more than 2^" + std::to_string(63 - __builtin_clzll(uint64_t(Node::kMaxIndex) + 1)) +
-                   " nodes or 2^32 references or triangles");
+        check.fail("more than 2^" + std::to_string(Node::kIndexBits) + " nodes or 2^32 references or triangles");
     std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0);
     std::vector<Aabb> cell(v.node_count);
     seen[0] = 1;
@@ -119,7 +122,7 @@ uint32_t validate_listed_tree(const ListedTreeView<Node>& v, const ListedChecks&
                 check.fail(node_name(i) + " names child " + std::to_string(k) +
                            (k < v.node_count ? " (not after it)" : " (out of range)"));
             if (seen[k]) check.fail(node_name(k) + " has two parents");
-            if (depth[i] + 1u > max_depth) check.fail(too_deep);
+            if (depth[i] + 1u > max_depth) check.fail(too_deep());
             seen[k] = 1;
             depth[k] = uint8_t(depth[i] + 1);
             cell[k] = child_cell;

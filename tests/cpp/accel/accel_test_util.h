@@ -47,7 +47,6 @@ inline std::unique_ptr<Accel> build_kind(const Scene& scene, const std::string& 
     return load_accel(build_accel(scene, o), kind);
 }
 
-
 /// Bit-identical hits (prim, instance, t, u, v).
 inline bool same_hit(const Hit& a, const Hit& b) {
     return a.prim == b.prim && a.inst == b.inst && float_bits(a.t) == float_bits(b.t) &&

@@ -94,6 +94,10 @@ TEST(SpacePartitionValidation, BihAndOctreeRefuseCorruptImagesByName) {
         root = OctNode::interior(root.mask(), uint32_t(im.region("nodes").count), centre);
     });
     EXPECT_NE(msg.find("out of range"), std::string::npos) << msg;
+    msg = refused(oct, [](AccelImage& im) { im.region("nodes").record_bytes = 8; });
+    EXPECT_NE(msg.find("bad.rtt: octree regions must hold 16-byte nodes"), std::string::npos) << msg;
+    msg = refused(oct, [](AccelImage& im) { im.region("prim_refs").kind = DataKind::triangle; });
+    EXPECT_NE(msg.find("octree regions must be of data kinds node, prim_ref and triangle"), std::string::npos) << msg;
 }
 
 TEST(SpacePartitionSeam, StackEntriesOpKindsAndManifestKeys) {

@@ -9,13 +9,12 @@ namespace rtsim {
 
 void validate_grid(const GridView& v, const std::string& source) {
     const ListedChecks check(source, "grid");
-    auto fail = [&](const std::string& what) { check.fail(what); };
     const GridGeometry& g = v.geometry;
     if (v.cell_count != g.cell_count())
-        fail("resolution " + std::to_string(g.res[0]) + " x " + std::to_string(g.res[1]) + " x " +
+        check.fail("resolution " + std::to_string(g.res[0]) + " x " + std::to_string(g.res[1]) + " x " +
              std::to_string(g.res[2]) + " needs " + std::to_string(g.cell_count()) + " cells, region 'cells' holds " +
              std::to_string(v.cell_count));
-    if (v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) fail("more than 2^32 references or triangles");
+    if (v.ref_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) check.fail("more than 2^32 references or triangles");
     // Lists back to back in record order, each reference in one list: the listed references
     // total prim_refs' count, so a ray's work is bounded by the image (overlapping lists, every
     // cell listing every reference, would cost cells x references per ray).
@@ -24,20 +23,22 @@ void validate_grid(const GridView& v, const std::string& source) {
         const GridCell& cell = v.cells[c];
         check.list_in_range("cell", c, cell.first_ref, cell.ref_count, v.ref_count);
         if (cell.first_ref != next)
-            fail("cell " + std::to_string(c) + "'s list starts at prim_refs " + std::to_string(cell.first_ref) +
+            check.fail("cell " + std::to_string(c) + "'s list starts at prim_refs " + std::to_string(cell.first_ref) +
                  ", not " + std::to_string(next) + " where the previous cell's ends (lists must be back to back "
                  "in cell order, each reference in one list)");
         next += cell.ref_count;
     }
     if (next != v.ref_count)
-        fail("the cells list " + std::to_string(next) + " of prim_refs' " + std::to_string(v.ref_count) + " references");
+        check.fail("the cells list " + std::to_string(next) + " of prim_refs' " + std::to_string(v.ref_count) + " references");
     check.refs_name_triangles(v.list, v.ref_count, v.triangle_count);
 }
 
 GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
+    // Regions, then params, then the triangles (decoded when compressed): the order errors come in.
+    check_listed_regions(m_image, "grid", "cells", DataKind::cell, uint32_t(sizeof(GridCell)), source);
+    m_view.geometry = GridGeometry::from_json(m_image.params, source);
     const ListedRegions r = open_listed_regions(m_image, m_triangles, "grid", "cells", DataKind::cell,
                                                 uint32_t(sizeof(GridCell)), source);
-    m_view.geometry = GridGeometry::from_json(m_image.params, source);
     m_view.cells = r.cells->records<GridCell>();
     m_view.list = r.list;
     m_view.cell_count = r.cells->count;

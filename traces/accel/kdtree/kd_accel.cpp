@@ -34,7 +34,7 @@ uint32_t validate_kdtree(const KdView& v, const std::string& source) {
     // Depth first: a node's below child is the next node; the split must lie inside the cell.
     const ListedChecks check(source, "kd-tree");
     return validate_listed_tree(
-        v, check, kKdMaxDepth - 1, "deeper than the traversal stack (" + std::to_string(kKdMaxDepth) + ")",
+        v, check, kKdMaxDepth - 1, [] { return "deeper than the traversal stack (" + std::to_string(kKdMaxDepth) + ")"; },
         [&](uint64_t i, const KdNode& n, const Aabb& cell, auto&& add_child) {
             const int a = n.axis();
             const float p = n.split();

@@ -23,7 +23,8 @@ struct KdNode {        // 8 bytes
                        //    bits 2-31: interior: index of the above child; leaf: references listed
 
     static constexpr uint32_t kLeaf = 3;
-    static constexpr uint32_t kMaxIndex = (1u << 30) - 1;  ///< largest child index or list length
+    static constexpr uint32_t kIndexBits = 30;
+    static constexpr uint32_t kMaxIndex = (1u << kIndexBits) - 1;  ///< largest child index or list length
 
     bool leaf() const { return (word1 & 3u) == kLeaf; }
     int axis() const { return int(word1 & 3u); }

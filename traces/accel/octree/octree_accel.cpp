@@ -37,7 +37,7 @@ uint32_t validate_octree(const OctView& v, const std::string& source) {
     // The centre must lie inside the cell; each stored child's cell is an octant of it.
     const ListedChecks check(source, "octree");
     return validate_listed_tree(
-        v, check, kOctMaxDepth, "deeper than " + std::to_string(kOctMaxDepth) + " levels",
+        v, check, kOctMaxDepth, [] { return "deeper than " + std::to_string(kOctMaxDepth) + " levels"; },
         [&](uint64_t i, const OctNode& n, const Aabb& cell, auto&& add_child) {
             const float centre[3] = {n.centre(0), n.centre(1), n.centre(2)};
             for (int a = 0; a < 3; ++a)

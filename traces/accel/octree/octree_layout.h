@@ -27,7 +27,8 @@ struct OctNode {       // 16 bytes
     uint32_t word2;    // 8: interior: centre y (f32 bits); leaf: references listed
     uint32_t word3;    // 12: interior: centre z (f32 bits); leaf: 0
 
-    static constexpr uint32_t kMaxIndex = (1u << 24) - 1;
+    static constexpr uint32_t kIndexBits = 24;
+    static constexpr uint32_t kMaxIndex = (1u << kIndexBits) - 1;
 
     bool leaf() const { return (word0 & 0xFFu) == 0; }
     uint32_t mask() const { return word0 & 0xFFu; }
