@@ -61,7 +61,7 @@ NodeSplitter::NodeSplitter(PrimRef* refs, const BuildConfig& config)
       m_group_box(3 * size_t(m_stride)), m_group_count(3 * size_t(m_stride)), m_group_bin(3 * size_t(m_stride)),
       m_right_area(m_stride), m_right_count(m_stride) {}
 
-void NodeSplitter::build_subtree(const WorkItem& root, std::vector<BuildNode>& nodes) {
+void NodeSplitter::build_subtree(const WorkItem& root, BuildNodes& nodes) {
     // Depth-first over an explicit stack: the left child is split next, the right one waits.
     std::vector<WorkItem> stack;
     stack.reserve(2 * size_t(m_config.max_depth) + 2);
@@ -100,7 +100,7 @@ bool NodeSplitter::sah_split_fits_depth(const WorkItem& item, const Split& split
     return median_levels_needed(larger, m_config.max_leaf_size) + item.depth + 1 <= m_config.max_depth;
 }
 
-void NodeSplitter::split_node(const WorkItem& item, std::vector<BuildNode>& nodes, std::vector<WorkItem>& stack) {
+void NodeSplitter::split_node(const WorkItem& item, BuildNodes& nodes, std::vector<WorkItem>& stack) {
     const uint32_t count = item.end - item.begin;
     auto make_leaf = [&] {
         nodes[item.node].first = item.begin;
@@ -184,22 +184,40 @@ Split NodeSplitter::find_sah_split(uint32_t begin, uint32_t end, const BinMapper
 }
 
 // In-place two-way partition by bin; each reference is classified once and its doubled
-// centroid grows the bounds of its side.
+// centroid grows the bounds of its side. The branch follows the mesh's order, so it predicts
+// well; what the loop waits on is the classification, so it is done on the split axis alone in
+// scalar arithmetic (lane `axis` of BinMapper's, the same operations, so the same bin), and the
+// bounds grow in registers (a reference parameter would keep them in memory, since the swaps
+// might alias it). (A branch-free variant, sides classified in a first pass and moved in a
+// second, was slower: 29% of the Sponza build against 21%.)
 uint32_t NodeSplitter::partition_bins(const WorkItem& item, const Split& split, const BinMapper& map, Box& left_c,
                                       Box& right_c) {
+    const int a = split.axis;
+    const float origin = map.origin[a], scale = map.scale[a], last = map.last[a];
+    const int32_t bin = int32_t(split.bin);
+    auto is_left = [=](const PrimRef& r) {
+        const float* v = reinterpret_cast<const float*>(&r);  // lo in floats 0..3, hi in 4..7
+        float f = ((v[a] + v[4 + a]) - origin) * scale;
+        f = f > 0.0f ? f : 0.0f;
+        f = f < last ? f : last;
+        return int32_t(f) < bin;
+    };
+    Box lc, rc;
     uint32_t i = item.begin, j = item.end;
     while (i < j) {
         const PrimRef& r = m_refs[i];
-        Float4 c = r.centroid2();
-        if (uint32_t(map(r)[split.axis]) < split.bin) {
-            left_c.grow_point(c);
+        const Float4 c = r.centroid2();
+        if (is_left(r)) {
+            lc.grow_point(c);
             ++i;
         } else {
             --j;
             std::swap(m_refs[i], m_refs[j]);
-            right_c.grow_point(c);
+            rc.grow_point(c);
         }
     }
+    left_c = lc;
+    right_c = rc;
     return i;
 }
 
