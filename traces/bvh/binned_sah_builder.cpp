@@ -27,32 +27,40 @@ constexpr uint32_t kMaxSupportedDepth = 64;
 
 }  // namespace
 
-// Per-primitive boxes, rejecting non-finite vertices (docs/architecture.md, rule 11); returns
-// the centroid bounds.
-Box make_refs(const std::vector<Triangle>& triangles, PrimRefs& refs) {
-    refs.resize(triangles.size());
-    Box centroids;
-    for (size_t i = 0; i < triangles.size(); ++i) {
-        const Triangle& t = triangles[i];
-        PrimRef& r = refs[i];
-        for (int a = 0; a < 3; ++a) {
-            r.lo[a] = std::min(t.v0[a], std::min(t.v1[a], t.v2[a]));
-            r.hi[a] = std::max(t.v0[a], std::max(t.v1[a], t.v2[a]));
-            if (!std::isfinite(t.v0[a]) || !std::isfinite(t.v1[a]) || !std::isfinite(t.v2[a]))
-                throw Error("build_bvh: triangle " + std::to_string(i) + " has a non-finite vertex");
-        }
-        uint32_t id = uint32_t(i);
-        std::memcpy(reinterpret_cast<char*>(&r.lo) + 12, &id, 4);
-        r.hi[3] = 0.0f;
-        centroids.grow_point(r.centroid2());
-    }
-    return centroids;
+namespace {
+
+/// Three floats into lanes 0..2, lane 3 zero.
+inline Float4 load3(const Vec3& v) { return Float4{v[0], v[1], v[2], 0.0f}; }
+
+/// True if every lane is finite (inf - inf and NaN - NaN are NaN, which compares unequal).
+inline bool all_finite(Float4 v) {
+    const Int4 ok = (v - v) == Float4{0.0f, 0.0f, 0.0f, 0.0f};
+    return (ok[0] & ok[1] & ok[2]) != 0;
 }
 
-Box bounds_of(const PrimRefs& refs) {
-    Box box;
-    for (const PrimRef& r : refs) box.grow(r.lo3(), r.hi);
-    return box;
+}  // namespace
+
+// Per-primitive boxes, rejecting non-finite vertices (docs/architecture.md, rule 11), in one
+// pass that also grows the root's box and its centroid bounds (in reference order, as a pass
+// over the references would). Lane for lane the box is std::min(v0, std::min(v1, v2)) and
+// std::max(v0, std::max(v1, v2)): vmin(a, b) = a < b ? a : b is std::min(b, a).
+RootBoxes make_refs(const std::vector<Triangle>& triangles, PrimRefs& refs) {
+    refs.resize(triangles.size());
+    RootBoxes root;
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        const Triangle& t = triangles[i];
+        const Float4 v0 = load3(t.v0), v1 = load3(t.v1), v2 = load3(t.v2);
+        if (!all_finite(v0) || !all_finite(v1) || !all_finite(v2))
+            throw Error("build_bvh: triangle " + std::to_string(i) + " has a non-finite vertex");
+        PrimRef& r = refs[i];
+        r.lo = vmin(vmin(v2, v1), v0);
+        r.hi = vmax(vmax(v2, v1), v0);
+        uint32_t id = uint32_t(i);
+        std::memcpy(reinterpret_cast<char*>(&r.lo) + 12, &id, 4);
+        root.bounds.grow(r.lo3(), r.hi);
+        root.centroids.grow_point(r.centroid2());
+    }
+    return root;
 }
 
 NodeSplitter::NodeSplitter(PrimRef* refs, const BuildConfig& config)
@@ -272,12 +280,12 @@ BuildTree build_binned_sah(const std::vector<Triangle>& triangles, const BuildCo
     validate(config, triangles.size());
     const uint32_t n = uint32_t(triangles.size());
     PrimRefs refs;
-    const Box root_c = make_refs(triangles, refs);
+    const RootBoxes root_boxes = make_refs(triangles, refs);
     BuildTree tree;
     tree.nodes.reserve(2 * size_t(n) - 1);
     tree.nodes.emplace_back();
-    tree.nodes[0].box = bounds_of(refs).to_aabb();
-    const WorkItem root{0, 0, n, 0, root_c};
+    tree.nodes[0].box = root_boxes.bounds.to_aabb();
+    const WorkItem root{0, 0, n, 0, root_boxes.centroids};
     if (threads > 1) build_parallel(refs, config, root, threads, tree.nodes);
     else NodeSplitter(refs.data(), config).build_subtree(root, tree.nodes);
     tree.prim_ids.resize(n);

@@ -134,10 +134,12 @@ private:
 
 /// Throws rtsim::Error if the config is unusable or cannot hold `triangle_count` triangles.
 void validate(const BuildConfig& c, size_t triangle_count);
-/// Per-primitive references (rejecting non-finite vertices); returns their centroid bounds.
-Box make_refs(const std::vector<Triangle>& triangles, PrimRefs& refs);
-/// The root's box over all references.
-Box bounds_of(const PrimRefs& refs);
+/// The root's box over all references and the bounds of their (doubled) centroids.
+struct RootBoxes {
+    Box bounds, centroids;
+};
+/// Per-primitive references (rejecting non-finite vertices), and the root's boxes.
+RootBoxes make_refs(const std::vector<Triangle>& triangles, PrimRefs& refs);
 
 /// The multi-threaded build (binned_sah_parallel.cpp): the same splits on `threads` threads,
 /// and the same tree, node for node, as NodeSplitter::build_subtree from the root.
