@@ -100,9 +100,9 @@ public:
 
     /// Splits `item` (a node of `nodes`) or makes it a leaf; children go to the end of `nodes`
     /// and their items onto `stack`, the left one on top.
-    void split_node(const WorkItem& item, std::vector<BuildNode>& nodes, std::vector<WorkItem>& stack);
+    void split_node(const WorkItem& item, BuildNodes& nodes, std::vector<WorkItem>& stack);
     /// Splits `root` and everything below it, depth first.
-    void build_subtree(const WorkItem& root, std::vector<BuildNode>& nodes);
+    void build_subtree(const WorkItem& root, BuildNodes& nodes);
 
 private:
     BinMapper make_mapper(const Box& centroids, bool* usable) const;
@@ -134,15 +134,17 @@ private:
 
 /// Throws rtsim::Error if the config is unusable or cannot hold `triangle_count` triangles.
 void validate(const BuildConfig& c, size_t triangle_count);
-/// Per-primitive references (rejecting non-finite vertices); returns their centroid bounds.
-Box make_refs(const std::vector<Triangle>& triangles, PrimRefs& refs);
-/// The root's box over all references.
-Box bounds_of(const PrimRefs& refs);
+/// The root's box over all references and the bounds of their (doubled) centroids.
+struct RootBoxes {
+    Box bounds, centroids;
+};
+/// Per-primitive references (rejecting non-finite vertices), and the root's boxes.
+RootBoxes make_refs(const std::vector<Triangle>& triangles, PrimRefs& refs);
 
 /// The multi-threaded build (binned_sah_parallel.cpp): the same splits on `threads` threads,
 /// and the same tree, node for node, as NodeSplitter::build_subtree from the root.
 void build_parallel(PrimRefs& refs, const BuildConfig& config, const WorkItem& root,
-                    unsigned threads, std::vector<BuildNode>& nodes);
+                    unsigned threads, BuildNodes& nodes);
 
 }  // namespace binned_detail
 }  // namespace rtsim

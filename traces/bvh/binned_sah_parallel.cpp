@@ -31,12 +31,12 @@ struct Handle {
 };
 
 /// The nodes of `top` and of the tasks' arrays in the single-threaded build's numbering.
-std::vector<BuildNode> stitch(const std::vector<BuildNode>& top, const std::vector<std::vector<BuildNode>>& local,
+BuildNodes stitch(const BuildNodes& top, const std::vector<BuildNodes>& local,
                               const std::vector<uint32_t>& task_of, size_t total, uint32_t max_depth) {
     auto at = [&](Handle h) -> const BuildNode& { return h.array == 0 ? top[h.index] : local[h.array - 1][h.index]; };
     // A top node that was handed to a task is that task's root.
     auto resolve = [&](Handle h) { return h.array == 0 && task_of[h.index] ? Handle{task_of[h.index], 0} : h; };
-    std::vector<BuildNode> out(total);
+    BuildNodes out(total);
     std::vector<std::pair<Handle, uint32_t>> stack;  // a node and its index in `out`
     stack.reserve(2 * size_t(max_depth) + 2);
     stack.push_back({resolve({0, 0}), 0});
@@ -61,7 +61,7 @@ std::vector<BuildNode> stitch(const std::vector<BuildNode>& top, const std::vect
 }  // namespace
 
 void build_parallel(PrimRefs& refs, const BuildConfig& config, const WorkItem& root, unsigned threads,
-                    std::vector<BuildNode>& nodes) {
+                    BuildNodes& nodes) {
     const uint32_t grain = std::max(kMinTask, (root.end - root.begin) / (kTasksPerThread * threads));
     // The top of the tree, here; nodes of at most `grain` references become tasks.
     std::vector<WorkItem> stack{root}, tasks;
@@ -79,7 +79,7 @@ void build_parallel(PrimRefs& refs, const BuildConfig& config, const WorkItem& r
     std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
         return tasks[a].end - tasks[a].begin > tasks[b].end - tasks[b].begin;
     });
-    std::vector<std::vector<BuildNode>> local(tasks.size());
+    std::vector<BuildNodes> local(tasks.size());
     std::atomic<size_t> next{0};
     std::exception_ptr error;
     std::atomic<bool> failed{false};
@@ -88,7 +88,7 @@ void build_parallel(PrimRefs& refs, const BuildConfig& config, const WorkItem& r
             NodeSplitter splitter(refs.data(), config);
             for (size_t k; !failed && (k = next.fetch_add(1)) < order.size();) {
                 const WorkItem& task = tasks[order[k]];
-                std::vector<BuildNode>& out = local[order[k]];
+                BuildNodes& out = local[order[k]];
                 out.reserve(2 * size_t(task.end - task.begin));
                 out.push_back(nodes[task.node]);
                 WorkItem subtree = task;

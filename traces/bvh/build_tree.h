@@ -7,6 +7,7 @@
 
 #include "traces/bvh/config.h"
 #include "traces/bvh/hw_layout.h"
+#include "traces/common/huge_pages.h"
 #include "traces/scene/scene.h"
 
 namespace rtsim {
@@ -18,13 +19,17 @@ struct BuildNode {
     bool is_leaf() const { return count != 0; }
 };
 
+/// A build's nodes (16 MB on Sponza, written node after node and read back by parent index): on
+/// huge pages, like the references they are built from.
+using BuildNodes = std::vector<BuildNode, HugePageAllocator<BuildNode>>;
+
 /// Node 0 is the root; children are allocated in adjacent pairs. Leaves own disjoint ranges of
 /// prim_ids, laid out left subtree before right subtree. The binned builder's prim_ids are a
 /// permutation of 0..N-1; the SBVH builder's (sbvh_builder.h) hold every primitive at least once
 /// and may repeat one in several leaves (spatial splits): a converter must give each entry its
 /// own triangle record (flatten_bvh does) and never assume prim_ids.size() == N.
 struct BuildTree {
-    std::vector<BuildNode> nodes;
+    BuildNodes nodes;
     std::vector<uint32_t> prim_ids;
 };
 

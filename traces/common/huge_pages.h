@@ -11,23 +11,24 @@
 
 namespace rtsim {
 
-/// Allocations of at least this many bytes are mapped 2 MiB-aligned and advised as huge pages;
-/// smaller ones come from the heap (a huge page for a few KB would waste memory).
+/// The huge page size. It is also the threshold (huge_mapped): an allocation of at least one
+/// huge page is mapped 2 MiB-aligned and advised as huge pages; smaller ones come from the heap
+/// (a huge page for a few KB would waste memory).
 constexpr size_t kHugePageBytes = size_t(2) << 20;
-constexpr size_t kHugePageThreshold = kHugePageBytes;
 
-/// `bytes` of storage aligned to at least 64 bytes (4 KiB when bytes >= kHugePageThreshold: on
+/// `bytes` of storage aligned to at least 64 bytes (4 KiB when huge_mapped(bytes): on
 /// huge pages, starting at a varying offset into the first one, huge_pages.cpp),
 /// zero-filled (always so when mapped: fresh pages are zero; zero = false spares a small block
 /// the memset). Throws std::bad_alloc. Free with huge_free and the same `bytes`.
 void* huge_alloc(size_t bytes, bool zero = true);
 void huge_free(void* p, size_t bytes) noexcept;
 
-/// True when huge_alloc(bytes) maps whole 2 MiB pages (the caller may skip zeroing them).
-inline bool huge_mapped(size_t bytes) { return bytes >= kHugePageThreshold; }
+/// True when huge_alloc(bytes) maps whole 2 MiB pages (the caller may skip zeroing them): the
+/// one place that decides which allocations go on huge pages.
+inline bool huge_mapped(size_t bytes) { return bytes >= kHugePageBytes; }
 
 /// std::allocator for large vectors (the build's temporaries): same as huge_alloc, so a
-/// vector's storage moves to huge pages once it grows past kHugePageThreshold.
+/// vector's storage moves to huge pages once huge_mapped says so.
 template <class T>
 struct HugePageAllocator {
     using value_type = T;

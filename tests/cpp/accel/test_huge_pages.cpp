@@ -21,7 +21,8 @@ bool all_zero(const uint8_t* p, size_t n) {
 }
 
 TEST(HugePages, SmallAllocationsAreZeroedAndLineAligned) {
-    for (size_t bytes : {size_t(1), size_t(100), size_t(4096), kHugePageThreshold - 1}) {
+    for (size_t bytes : {size_t(1), size_t(100), size_t(4096), kHugePageBytes - 1}) {
+        EXPECT_FALSE(huge_mapped(bytes)) << bytes;
         auto* p = static_cast<uint8_t*>(huge_alloc(bytes));
         EXPECT_EQ(reinterpret_cast<uintptr_t>(p) % 64, 0u) << bytes;
         EXPECT_TRUE(all_zero(p, bytes)) << bytes;
@@ -31,7 +32,8 @@ TEST(HugePages, SmallAllocationsAreZeroedAndLineAligned) {
 }
 
 TEST(HugePages, LargeAllocationsAreZeroedAndPageAligned) {
-    for (size_t bytes : {kHugePageThreshold, 3 * kHugePageBytes + 12345}) {
+    for (size_t bytes : {kHugePageBytes, 3 * kHugePageBytes + 12345}) {
+        EXPECT_TRUE(huge_mapped(bytes)) << bytes;
         auto* p = static_cast<uint8_t*>(huge_alloc(bytes));
         EXPECT_EQ(reinterpret_cast<uintptr_t>(p) % 4096, 0u) << bytes;
         EXPECT_TRUE(all_zero(p, bytes)) << bytes;

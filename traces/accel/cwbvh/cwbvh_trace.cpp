@@ -43,15 +43,23 @@ inline uint32_t cw8_valid(const CwNode8& n) {
 
 /// Child `slot` as Cw8Codec::decode gives it: an interior child (imask, which validation holds
 /// equal to the meta bytes' interiors) is node base_node + the interior children in lower slots;
-/// a leaf, meta_leaf_count(meta) triangles from base_tri + its offset. Selects, not branches;
-/// `popcount` is the instruction set's (this is on the chain from one node to the next).
-template <class Popcount>
-inline void cw8_child(const CwNode8& n, uint32_t slot, uint32_t& ref, uint32_t& count, Popcount popcount) {
-    const uint8_t m = n.meta[slot];
+/// a leaf, meta_leaf_count(meta) triangles from base_tri + its offset. Selects, not branches.
+/// The two bit counts come from the caller, which counts cw8_child_bits with its instruction
+/// set's popcount: this is on the chain from one node to the next, and a popcount passed in as a
+/// function would stay a call (this function is compiled for the baseline, an AVX2 one cannot be
+/// inlined into it; that call cost cwbvh8 about 10% on primary rays).
+struct Cw8ChildBits {
+    uint32_t lower_interiors;  // imask bits below the slot
+    uint32_t unary_count;      // the meta byte's top 3 bits: a leaf's count in unary
+};
+inline Cw8ChildBits cw8_child_bits(const CwNode8& n, uint32_t slot) {
+    return {n.imask & ((1u << slot) - 1u), uint32_t(n.meta[slot]) >> 5};
+}
+inline void cw8_child(const CwNode8& n, uint32_t slot, uint32_t lower_interiors_count, uint32_t leaf_count,
+                      uint32_t& ref, uint32_t& count) {
     const bool interior = (n.imask >> slot) & 1u;
-    const uint32_t node_ref = n.base_node + popcount(n.imask & ((1u << slot) - 1u));
-    ref = interior ? node_ref : n.base_tri + meta_leaf_offset(m);
-    count = interior ? 0u : popcount(uint32_t(m) >> 5);  // meta_leaf_count
+    ref = interior ? n.base_node + lower_interiors_count : n.base_tri + meta_leaf_offset(n.meta[slot]);
+    count = interior ? 0u : leaf_count;
 }
 
 #if defined(__SSE2__)
@@ -92,7 +100,8 @@ struct Cw8 {
         return mask;
     }
     static void child(const Node& n, uint32_t slot, uint32_t& ref, uint32_t& count) {
-        cw8_child(n, slot, ref, count, detail::popcount8);
+        const Cw8ChildBits b = cw8_child_bits(n, slot);
+        cw8_child(n, slot, detail::popcount8(b.lower_interiors), detail::popcount8(b.unary_count), ref, count);
     }
 };
 
@@ -150,7 +159,9 @@ struct Cw8 {
         return box_lanes(l, near, far, tnear);
     }
     static void child(const Node& n, uint32_t slot, uint32_t& ref, uint32_t& count) {
-        cw8_child(n, slot, ref, count, [](uint32_t x) { return uint32_t(__builtin_popcount(x)); });
+        const Cw8ChildBits b = cw8_child_bits(n, slot);
+        cw8_child(n, slot, uint32_t(__builtin_popcount(b.lower_interiors)), uint32_t(__builtin_popcount(b.unary_count)),
+                  ref, count);
     }
 };
 

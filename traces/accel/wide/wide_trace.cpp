@@ -77,14 +77,15 @@ struct Fp32 {
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define RTSIM_WIDE_AVX 1
-// Only the functions below are compiled for AVX; they are internal to this file, so no AVX code
-// can be chosen by the linker for a caller elsewhere (inline functions of the headers above are
-// compiled for the baseline and inlined here).
+// Only the functions below are compiled for AVX (and POPCNT, which every AVX CPU has: the loop
+// counts each node's box tests with it, lane_count); they are internal to this file, so no AVX
+// code can be chosen by the linker for a caller elsewhere (inline functions of the headers above
+// are compiled for the baseline and inlined here).
 #if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx"))), apply_to = function)
+#pragma clang attribute push(__attribute__((target("avx,popcnt"))), apply_to = function)
 #else
 #pragma GCC push_options
-#pragma GCC target("avx")
+#pragma GCC target("avx,popcnt")
 #endif
 namespace avx {
 
@@ -140,7 +141,7 @@ bool wide_simd_has(const char* feature) {
 }
 
 bool wide_simd_has_avx() {
-    static const bool has = wide_simd_has("avx");
+    static const bool has = wide_simd_has("avx") && wide_simd_has("popcnt");
     return has;
 }
 
