@@ -31,6 +31,7 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
         if (exact) m_exact_banks.emplace_back(1, config.bank_cycles);
         else m_banks.emplace_back(16, 16 * config.bank_cycles);
     }
+    m_bank_always_free = !exact && config.banks == 1 && config.bank_cycles == 1;
 }
 
 Cycle Cache::access(const MemRequest& req) {
@@ -75,9 +76,8 @@ Cycle Cache::forward(const MemRequest& down) {
     return next->access(down);
 }
 
-Cycle Cache::bank_start(uint64_t line, Cycle time) {
+Cycle Cache::reserve_bank(uint64_t line, Cycle time) {
     if (!m_exact_banks.empty()) return m_exact_banks[m_bank_of.mod(line)].reserve(time, 1);
-    if (m_banks.size() == 1 && m_config.bank_cycles == 1) return time;  // fast path: one access per cycle
     return m_banks[m_bank_of.mod(line)].reserve(time, 1);
 }
 

@@ -84,7 +84,10 @@ private:
     Cycle forward(const MemRequest& down);
     Cycle access_line(uint64_t line_addr, const MemRequest& req, AccessInfo* info);
     Cycle miss(uint64_t line_addr, const MemRequest& req, Cycle tag_done, AccessInfo* info);
-    Cycle bank_start(uint64_t line_addr, Cycle time);
+    /// Cycle the line's bank takes an access arriving at `time` (at once with one bank serving
+    /// an access per cycle, the L1s' default: no calendar then).
+    Cycle bank_start(uint64_t line_addr, Cycle time) { return m_bank_always_free ? time : reserve_bank(line_addr, time); }
+    Cycle reserve_bank(uint64_t line_addr, Cycle time);
 
     CacheConfig m_config;
     ServedBy m_level;
@@ -104,6 +107,7 @@ private:
     Divider m_bank_of;  ///< line -> bank (line-interleaved)
     std::vector<BandwidthCalendar> m_banks;
     std::vector<SlotCalendar> m_exact_banks;  ///< detailed level only
+    bool m_bank_always_free = false;          ///< one bank, one access per cycle, not exact
     MemStats m_stats;
     uint64_t m_evictions = 0;
     uint64_t m_mshr_stall_cycles = 0;  ///< request-cycles waited for an MSHR (summed over misses)

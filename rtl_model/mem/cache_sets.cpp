@@ -30,16 +30,12 @@ CacheSets::CacheSets(uint64_t sets, uint32_t ways, uint32_t line_shift)
 
 void CacheSets::FreeAligned::operator()(uint8_t* p) const { std::free(p); }
 
-uint32_t CacheSets::tag_of(uint64_t line) const {
-    const uint64_t tag = line >> m_tag_shift;
-    if (tag >= kInvalidTag) {
-        std::ostringstream msg;
-        msg << "model: address 0x" << std::hex << (line << m_line_shift) << std::dec
-            << " is beyond what the cache model's tags cover (" << (32 + m_tag_shift + m_line_shift)
-            << " address bits)";
-        throw Error(msg.str());
-    }
-    return uint32_t(tag);
+void CacheSets::beyond_tags(uint64_t line) const {
+    std::ostringstream msg;
+    msg << "model: address 0x" << std::hex << (line << m_line_shift) << std::dec
+        << " is beyond what the cache model's tags cover (" << (32 + m_tag_shift + m_line_shift)
+        << " address bits)";
+    throw Error(msg.str());
 }
 
 uint16_t CacheSets::renumber(uint8_t* b) {

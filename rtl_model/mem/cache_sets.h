@@ -91,7 +91,12 @@ private:
     static constexpr uint32_t kClockOffset = 8;
     static constexpr uint32_t kTagsOffset = 16;
 
-    uint32_t tag_of(uint64_t line) const;
+    uint32_t tag_of(uint64_t line) const {
+        const uint64_t tag = line >> m_tag_shift;
+        if (__builtin_expect(tag >= kInvalidTag, 0)) beyond_tags(line);
+        return uint32_t(tag);
+    }
+    [[noreturn]] void beyond_tags(uint64_t line) const;
     uint8_t* block(uint64_t set) { return m_blocks.get() + set * m_stride; }
     const uint8_t* block(uint64_t set) const { return m_blocks.get() + set * m_stride; }
     static uint32_t* tags_of(uint8_t* b) { return reinterpret_cast<uint32_t*>(b + kTagsOffset); }
