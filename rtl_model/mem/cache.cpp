@@ -20,13 +20,10 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
       m_mshrs_enabled(mshrs_enabled),
       m_next_latency(next_latency),
       m_line_shift(log2_exact(config.line_bytes)),
+      m_sets(config.lines() / config.ways, config.ways, m_line_shift),
       m_mshr_free(config.mshrs, 0),
       m_bank_of(config.banks) {
-    uint64_t sets = config.lines() / config.ways;
-    m_set_mask = sets - 1;
-    m_tags.assign(sets * config.ways, kInvalid);
-    m_last_use.assign(sets * config.ways, 0);
-    m_fills.resize(sets * config.ways);
+    m_fills.resize(config.lines());
     // Each bank serves one access per bank_cycles; the calendar counts them per 16-access window
     // (a finer window only makes the forward search longer when a bank is busy).
     // The detailed level reserves single accesses exactly (one per bank_cycles, no fast path).
@@ -34,6 +31,7 @@ Cache::Cache(sc_core::sc_module_name name, const CacheConfig& config, bool mshrs
         if (exact) m_exact_banks.emplace_back(1, config.bank_cycles);
         else m_banks.emplace_back(16, 16 * config.bank_cycles);
     }
+    m_bank_always_free = !exact && config.banks == 1 && config.bank_cycles == 1;
 }
 
 Cycle Cache::access(const MemRequest& req) {
@@ -63,10 +61,7 @@ Cycle Cache::access(const MemRequest& req) {
 }
 
 void Cache::prefetch_host(uint64_t addr) const {
-    const size_t set = size_t((addr >> m_line_shift) & m_set_mask) * m_config.ways;
-    __builtin_prefetch(&m_tags[set]);
-    __builtin_prefetch(&m_last_use[set]);
-    __builtin_prefetch(&m_fills[set]);
+    m_sets.prefetch(m_sets.set_of(addr >> m_line_shift));
     if (m_next_cache) m_next_cache->prefetch_host(addr);  // the L2's set, for an L1 miss
 }
 
@@ -81,9 +76,8 @@ Cycle Cache::forward(const MemRequest& down) {
     return next->access(down);
 }
 
-Cycle Cache::bank_start(uint64_t line, Cycle time) {
+Cycle Cache::reserve_bank(uint64_t line, Cycle time) {
     if (!m_exact_banks.empty()) return m_exact_banks[m_bank_of.mod(line)].reserve(time, 1);
-    if (m_banks.size() == 1 && m_config.bank_cycles == 1) return time;  // fast path: one access per cycle
     return m_banks[m_bank_of.mod(line)].reserve(time, 1);
 }
 
@@ -110,23 +104,23 @@ Cycle Cache::access_line(uint64_t line, const MemRequest& req, AccessInfo* info)
     }
     ++c.reads;
     c.read_bytes += bytes;
-    const size_t set = size_t(line & m_set_mask) * m_config.ways;
-    const uint64_t* tags = &m_tags[set];
-    for (uint32_t w = 0; w < m_config.ways; ++w) {
-        if (tags[w] != line) continue;
-        m_last_use[set + w] = ++m_use_clock;
-        const LineFill& fill = m_fills[set + w];
-        if (!m_prefetched.empty() && m_prefetched[set + w]) prefetch_used(set + w, fill.ready > tag_done);
-        if (fill.ready > tag_done) {
-            ++c.merged;
-            if (info) info->level = fill.filled_from;  // waits for a fill in flight
-            return fill.ready;
-        }
-        ++c.read_hits;
-        if (info) info->level = m_level;
-        return tag_done;
+    const uint32_t way = m_sets.find(line);
+    if (way == CacheSets::kNoWay) return miss(line, req, tag_done, info);
+    const uint64_t set = m_sets.set_of(line);
+    m_sets.touch(set, way);
+    const size_t index = size_t(set) * m_config.ways + way;
+    // The line's fill record is read only when some fill of its set may still be in flight.
+    const bool set_filling = m_sets.latest_fill(set) > tag_done;
+    const LineFill* in_flight = set_filling && m_fills[index].ready > tag_done ? &m_fills[index] : nullptr;
+    if (!m_prefetched.empty() && m_prefetched[index]) prefetch_used(index, in_flight != nullptr);
+    if (in_flight) {
+        ++c.merged;
+        if (info) info->level = in_flight->filled_from;  // waits for a fill in flight
+        return in_flight->ready;
     }
-    return miss(line, req, tag_done, info);
+    ++c.read_hits;
+    if (info) info->level = m_level;
+    return tag_done;
 }
 
 Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessInfo* info) {
@@ -162,9 +156,11 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
         m_expected_miss += (double(fill - issue) - m_expected_miss) / 64.0;  // running mean
     }
 
-    // LRU victim (invalid lines have last_use 0 and go first).
-    const size_t victim = lru_way(size_t(line & m_set_mask) * m_config.ways);
-    if (m_tags[victim] != kInvalid) ++m_evictions;
+    // LRU victim (never-used ways go first).
+    const uint64_t set = m_sets.set_of(line);
+    const uint32_t way = m_sets.victim(set);
+    const size_t victim = size_t(set) * m_config.ways + way;
+    if (m_sets.valid(set, way)) ++m_evictions;
     if (req.prefetch) {
         m_prefetch_seen = true;
         m_prefetch.below_bytes += m_config.line_bytes;  // traffic below this level caused by prefetching
@@ -173,34 +169,26 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
         if (m_prefetched[victim]) ++m_prefetch.useless;  // evicted before any read used it
         m_prefetched[victim] = req.prefetch && req.prefetch_into == m_level;
     }
-    m_tags[victim] = line;
+    m_sets.place(way, line);
+    m_sets.note_fill(set, fill);
     m_fills[victim] = {fill, below.level};
-    m_last_use[victim] = ++m_use_clock;
     return fill;
-}
-
-size_t Cache::lru_way(size_t set) const {
-    size_t victim = set;
-    for (size_t w = set + 1; w < set + m_config.ways; ++w)
-        if (m_last_use[w] < m_last_use[victim]) victim = w;
-    return victim;
 }
 
 bool Cache::warm(uint64_t addr, uint32_t bytes) {
     bool hit = true;
     const uint64_t last = (addr + std::max<uint32_t>(bytes, 1) - 1) >> m_line_shift;
     for (uint64_t line = addr >> m_line_shift; line <= last; ++line) {
-        const size_t set = size_t(line & m_set_mask) * m_config.ways;
-        size_t way = set + m_config.ways;
-        for (size_t w = set; w < set + m_config.ways; ++w)
-            if (m_tags[w] == line) way = w;
-        if (way == set + m_config.ways) {
-            hit = false;
-            way = lru_way(set);
-            m_tags[way] = line;
-            m_fills[way] = {0, m_level};
+        const uint64_t set = m_sets.set_of(line);
+        const uint32_t way = m_sets.find(line);
+        if (way != CacheSets::kNoWay) {
+            m_sets.touch(set, way);
+            continue;
         }
-        m_last_use[way] = ++m_use_clock;
+        hit = false;
+        const uint32_t victim = m_sets.victim(set);
+        m_sets.place(victim, line);
+        m_fills[size_t(set) * m_config.ways + victim] = {0, m_level};
     }
     return hit;
 }

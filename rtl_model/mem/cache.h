@@ -26,6 +26,7 @@
 #include "rtl_model/common/usage_series.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/mem/cache_config.h"
+#include "rtl_model/mem/cache_sets.h"
 #include "rtl_model/mem/dram.h"
 
 namespace rtsim {
@@ -40,7 +41,7 @@ public:
           bool exact = false, ServedBy level = ServedBy::l1);
 
     Cycle access(const MemRequest& req) final;
-    /// Prefetches the host memory of the set `addr` maps to (tags, LRU stamps, fills), here and
+    /// Prefetches the host memory of the set `addr` maps to (its tags and LRU stamps), here and
     /// in the next level when it is a cache.
     void prefetch_host(uint64_t addr) const final;
     /// Functional warming (sampling, SMARTS): makes the lines of [addr, addr + bytes) present and
@@ -78,14 +79,15 @@ private:
         Cycle ready = 0;                      ///< cycle the fill completes
         ServedBy filled_from = ServedBy::l1;  ///< where its fill came from (for merged reads)
     };
-    static constexpr uint64_t kInvalid = ~0ull;  ///< tag of an empty line
     /// A request to the next level: a direct call when it is a Cache or the Dram (the usual
     /// L1 -> L2 -> DRAM chain, resolved on first use), else through the port.
     Cycle forward(const MemRequest& down);
     Cycle access_line(uint64_t line_addr, const MemRequest& req, AccessInfo* info);
     Cycle miss(uint64_t line_addr, const MemRequest& req, Cycle tag_done, AccessInfo* info);
-    Cycle bank_start(uint64_t line_addr, Cycle time);
-    size_t lru_way(size_t set) const;  ///< least recently used way of the set starting at `set`
+    /// Cycle the line's bank takes an access arriving at `time` (at once with one bank serving
+    /// an access per cycle, the L1s' default: no calendar then).
+    Cycle bank_start(uint64_t line_addr, Cycle time) { return m_bank_always_free ? time : reserve_bank(line_addr, time); }
+    Cycle reserve_bank(uint64_t line_addr, Cycle time);
 
     CacheConfig m_config;
     ServedBy m_level;
@@ -95,11 +97,9 @@ private:
     bool m_mshrs_enabled;
     Cycle m_next_latency;
     uint32_t m_line_shift;
-    uint64_t m_set_mask;
-    // Lines as three arrays of sets x ways (a set's tags are contiguous: a lookup touches one or
-    // two host cache lines instead of ways x 32 bytes; the simulator's time is mostly such misses).
-    std::vector<uint64_t> m_tags;      ///< line address, or kInvalid
-    std::vector<uint64_t> m_last_use;  ///< LRU stamp (0: never used, goes first)
+    // Tags and LRU state packed set by set (cache_sets.h: a lookup touches its set's one or two
+    // host lines); the fill records, sets x ways, are read only on a miss or a fill in flight.
+    CacheSets m_sets;
     std::vector<LineFill> m_fills;
     MinTree m_mshr_free;  ///< cycle each MSHR is free again; the earliest is the next one used
     std::unique_ptr<OccupancyCalendar> m_mshr_occupancy;  ///< out-of-order MSHR bound (approx L2)
@@ -107,7 +107,7 @@ private:
     Divider m_bank_of;  ///< line -> bank (line-interleaved)
     std::vector<BandwidthCalendar> m_banks;
     std::vector<SlotCalendar> m_exact_banks;  ///< detailed level only
-    uint64_t m_use_clock = 0;
+    bool m_bank_always_free = false;          ///< one bank, one access per cycle, not exact
     MemStats m_stats;
     uint64_t m_evictions = 0;
     uint64_t m_mshr_stall_cycles = 0;  ///< request-cycles waited for an MSHR (summed over misses)

@@ -26,12 +26,10 @@ Cycle Cache::prefetch(const MemRequest& req) {
     }
     m_prefetch_seen = true;
     const uint64_t line = req.addr >> m_line_shift;
-    const size_t set = size_t(line & m_set_mask) * m_config.ways;
-    for (uint32_t w = 0; w < m_config.ways; ++w)
-        if (m_tags[set + w] == line) {
-            ++m_prefetch.redundant;  // present or being filled: nothing to fetch
-            return req.time;
-        }
+    if (m_sets.find(line) != CacheSets::kNoWay) {
+        ++m_prefetch.redundant;  // present or being filled: nothing to fetch
+        return req.time;
+    }
     if (!m_prefetch_mshrs)
         m_prefetch_mshrs = std::make_unique<MinTree>(std::max<uint32_t>(1, m_config.mshrs / kPrefetchMshrShare), 0);
     Cycle free = m_prefetch_mshrs->top_time();
@@ -47,7 +45,7 @@ Cycle Cache::prefetch(const MemRequest& req) {
             return start;
         }
     }
-    if (m_prefetched.empty()) m_prefetched.assign(m_tags.size(), 0);
+    if (m_prefetched.empty()) m_prefetched.assign(m_fills.size(), 0);
     const Cycle bank = bank_start(line, req.time);
     m_bank_use.add(bank, 1);
     ++m_prefetch.issued;

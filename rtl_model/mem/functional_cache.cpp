@@ -2,32 +2,34 @@
 
 namespace rtsim {
 
-FunctionalCache::FunctionalCache(const CacheConfig& config) : m_config(config) {
-    while ((1u << m_line_shift) < config.line_bytes) ++m_line_shift;
-    const uint64_t sets = config.lines() / config.ways;
-    m_set_mask = sets - 1;
-    m_lines.resize(sets * config.ways);
+uint32_t FunctionalCache::line_shift_of(uint32_t line_bytes) {
+    uint32_t shift = 0;
+    while ((1u << shift) < line_bytes) ++shift;
+    return shift;
 }
+
+FunctionalCache::FunctionalCache(const CacheConfig& config)
+    : m_config(config),
+      m_line_shift(line_shift_of(config.line_bytes)),
+      m_sets(config.lines() / config.ways, config.ways, m_line_shift),
+      m_ready(config.lines(), 0) {}
 
 bool FunctionalCache::read(uint64_t line, uint32_t bytes, DataKind kind, Cycle now, Cycle* ready, Cycle** fill) {
     MemCounters& c = m_stats[kind];
     ++c.reads;
     c.read_bytes += bytes;
-    Line* set = &m_lines[(line & m_set_mask) * m_config.ways];
-    Line* victim = set;
-    for (uint32_t w = 0; w < m_config.ways; ++w) {
-        if (set[w].tag == line) {
-            set[w].last_use = ++m_use_clock;
-            *ready = set[w].ready;
-            ++(set[w].ready > now ? c.merged : c.read_hits);
-            return true;
-        }
-        if (set[w].last_use < victim->last_use) victim = &set[w];
+    const uint64_t set = m_sets.set_of(line);
+    const uint32_t way = m_sets.find(line);
+    if (way != CacheSets::kNoWay) {
+        m_sets.touch(set, way);
+        *ready = m_ready[set * m_config.ways + way];
+        ++(*ready > now ? c.merged : c.read_hits);
+        return true;
     }
-    if (victim->tag != ~0ull) ++m_evictions;
-    victim->tag = line;
-    victim->last_use = ++m_use_clock;
-    *fill = &victim->ready;
+    const uint32_t victim = m_sets.victim(set);
+    if (m_sets.valid(set, victim)) ++m_evictions;
+    m_sets.place(victim, line);
+    *fill = &m_ready[set * m_config.ways + victim];
     return false;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // A cache with tags, LRU and fill times only: the functional cache simulation of the analytic
-// fidelity level. Same geometry, replacement (LRU, invalid lines first) and write policy
+// fidelity level. Same geometry, replacement (CacheSets: LRU, invalid lines first) and write policy
 // (write-through, no-write-allocate) as Cache, so hit rates agree when accesses come in the
 // same order. The caller supplies the time of each access and the fill time of each miss (the
 // analytic level's unloaded clocks), so a read of a line still being filled is a merged miss
@@ -12,6 +12,7 @@
 
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/mem/cache_config.h"
+#include "rtl_model/mem/cache_sets.h"
 
 namespace rtsim {
 
@@ -33,16 +34,12 @@ public:
     nlohmann::json stats_json() const;
 
 private:
-    struct Line {
-        uint64_t tag = ~0ull;
-        uint64_t last_use = 0;
-        Cycle ready = 0;
-    };
+    static uint32_t line_shift_of(uint32_t line_bytes);
+
     CacheConfig m_config;
     uint32_t m_line_shift = 0;
-    uint64_t m_set_mask = 0;
-    std::vector<Line> m_lines;
-    uint64_t m_use_clock = 0;
+    CacheSets m_sets;            ///< tags and LRU, as Cache keeps them
+    std::vector<Cycle> m_ready;  ///< fill cycle per line (sets x ways)
     uint64_t m_evictions = 0;
     MemStats m_stats;
 };
