@@ -5,17 +5,9 @@
 namespace rtsim {
 
 MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
-    : TraversalUnit(name),
-      m_config(setup.config),
-      m_ctx(setup.context),
-      m_map(setup.map),
-      m_steppers(setup.steppers),
-      m_costs(setup.costs),
-      m_index(index),
+    : ScheduledUnit(name, setup, index, setup.config.ray_contexts, setup.costs),
       m_contexts(setup.config.ray_contexts),
-      m_ahead(setup.config.ray_contexts),
-      m_events(setup.config.ray_contexts),
-      m_sync(setup.context.quantum_cycles) {
+      m_ahead(setup.config.ray_contexts) {
     SC_THREAD(run);
 }
 

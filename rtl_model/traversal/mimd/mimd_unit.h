@@ -23,20 +23,17 @@
 #include <cstdint>
 #include <vector>
 
-#include "rtl_model/traversal/context_queue.h"
-#include "rtl_model/traversal/traversal_unit.h"
+#include "rtl_model/traversal/scheduled_unit.h"
 #include "rtl_model/traversal/treelet_prefetcher.h"
 #include "rtl_model/traversal/unit_parts.h"
 
 namespace rtsim {
 
-class MimdUnit : public TraversalUnit {
+class MimdUnit : public ScheduledUnit {
 public:
     SC_HAS_PROCESS(MimdUnit);
     MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index);
 
-    Cycle finish_cycle() const override { return m_tally.finish; }
-    uint64_t rays_done() const override { return m_tally.rays; }
     CycleAccount cycle_account(Cycle total_cycles) const override;
     nlohmann::json stats_json(Cycle total_cycles) const override;
 
@@ -73,24 +70,12 @@ private:
         account_read_until(m_account, m_contexts[c].accounted, ready, info);
     }
 
-    const TraversalConfig& m_config;
-    UnitContext m_ctx;
-    const MemoryMap& m_map;
-    StepperPool& m_steppers;
-    const StepCosts m_costs;
-    uint32_t m_index;
     std::vector<Context> m_contexts;
     std::vector<HostAhead> m_ahead;  ///< per context: its next step's host data (speed only; kept
                                      ///< apart from the contexts so the look-up stays in the host's cache)
-    ContextQueue m_events;  ///< each context's next phase, earliest first
-    QuantumSync m_sync;
-    Cycle m_sched_free = 0;
-    UnitTally m_tally;
     bool m_treelet_mode = false;
-    uint32_t m_frame = 0;  ///< the dispatch frame this unit last filled its contexts from
     Cycle m_next_fill = 0;
     uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
-    CycleAccount m_account;
     TreeletPrefetcher m_prefetcher;
 };
 

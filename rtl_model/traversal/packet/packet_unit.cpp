@@ -18,25 +18,17 @@ StepCosts packet_costs(StepCosts costs, uint32_t lanes) {
 }  // namespace
 
 PacketUnit::PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
-    : TraversalUnit(name),
-      m_config(setup.config),
-      m_ctx(setup.context),
-      m_map(setup.map),
-      m_accel(setup.steppers.accel()),
-      m_costs(packet_costs(setup.costs, setup.config.lanes)),
-      m_index(index),
+    : ScheduledUnit(name, setup, index, setup.config.warps(), packet_costs(setup.costs, setup.config.lanes)),
       m_packets(setup.config.warps()),
-      m_events(setup.config.warps()),
-      m_sync(setup.context.quantum_cycles),
       m_coalescer(setup.context.line_bytes),
       m_active_histogram(setup.config.lanes + 1, 0),
       m_results(setup.config.lanes),
       m_rays(setup.config.lanes),
       m_modes(setup.config.lanes) {
     for (Packet& p : m_packets) {
-        p.stepper = m_accel.make_packet_stepper();
+        p.stepper = m_steppers.accel().make_packet_stepper();
         require(p.stepper != nullptr, "config: 'traversal.model' packet needs a structure with a packet kernel "
-                                      "(bvh2); this trace's structure is '" + m_accel.kind() + "'");
+                                      "(bvh2); this trace's structure is '" + m_steppers.accel().kind() + "'");
         p.stepper->set_split_below(float(setup.config.packet_split_below));
         p.ids.resize(setup.config.lanes);
     }

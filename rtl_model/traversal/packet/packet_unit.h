@@ -26,9 +26,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "rtl_model/traversal/context_queue.h"
+#include "rtl_model/traversal/scheduled_unit.h"
 #include "rtl_model/traversal/simt/coalescer.h"
-#include "rtl_model/traversal/traversal_unit.h"
 #include "rtl_model/traversal/unit_parts.h"
 #include "traces/accel/packet_stepper.h"
 
@@ -40,13 +39,11 @@ inline uint32_t packet_stack_entry_bytes(uint32_t entry_bytes, uint32_t lanes) {
     return entry_bytes + 4 * (lanes - 1) + (lanes + 7) / 8;
 }
 
-class PacketUnit : public TraversalUnit {
+class PacketUnit : public ScheduledUnit {
 public:
     SC_HAS_PROCESS(PacketUnit);
     PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index);
 
-    Cycle finish_cycle() const override { return m_tally.finish; }
-    uint64_t rays_done() const override { return m_tally.rays; }
     CycleAccount cycle_account(Cycle total_cycles) const override;
     nlohmann::json stats_json(Cycle total_cycles) const override;
 
@@ -77,26 +74,14 @@ private:
     /// Packet p waited to `ready` for a read (split by where it went, `info`).
     void account_read(uint32_t p, Cycle ready, const AccessInfo& info);
 
-    const TraversalConfig& m_config;
-    UnitContext m_ctx;
-    const MemoryMap& m_map;
-    const Accel& m_accel;
-    StepCosts m_costs;  ///< the machine's, with the packet's stack entry size
-    uint32_t m_index;
     std::vector<Packet> m_packets;
-    ContextQueue m_events;  ///< each packet's next phase, earliest first
-    QuantumSync m_sync;
     LineCoalescer m_coalescer;  ///< a new packet's ray records, per line
-    Cycle m_sched_free = 0;
-    uint32_t m_frame = 0;
-    UnitTally m_tally;
     uint64_t m_packets_traced = 0, m_packet_steps = 0, m_node_fetches = 0, m_active_rays = 0;
     uint64_t m_splits = 0, m_split_steps = 0;  ///< the hybrid: packets that split, steps of their single rays
     std::vector<uint64_t> m_active_histogram;  ///< packet steps by active rays (0 .. lanes)
     std::vector<RayResult> m_results;          ///< scratch: a finished packet's results
     std::vector<Ray> m_rays;
     std::vector<TraversalMode> m_modes;
-    CycleAccount m_account;
 };
 
 }  // namespace rtsim

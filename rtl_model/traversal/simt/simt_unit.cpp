@@ -6,17 +6,9 @@
 namespace rtsim {
 
 SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
-    : TraversalUnit(name),
-      m_config(setup.config),
-      m_ctx(setup.context),
-      m_map(setup.map),
-      m_steppers(setup.steppers),
-      m_costs(setup.costs),
-      m_index(index),
+    : ScheduledUnit(name, setup, index, setup.config.warps(), setup.costs),
       m_lanes(setup.config.warps() * setup.config.lanes),
       m_warps(setup.config.warps()),
-      m_events(setup.config.warps()),
-      m_sync(setup.context.quantum_cycles),
       m_coalescer(setup.context.line_bytes),
       m_active_histogram(setup.config.lanes + 1, 0) {
     SC_THREAD(run);

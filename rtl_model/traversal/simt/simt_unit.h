@@ -24,20 +24,17 @@
 #include <vector>
 
 #include "rtl_model/common/usage_series.h"
-#include "rtl_model/traversal/context_queue.h"
+#include "rtl_model/traversal/scheduled_unit.h"
 #include "rtl_model/traversal/simt/coalescer.h"
-#include "rtl_model/traversal/traversal_unit.h"
 #include "rtl_model/traversal/unit_parts.h"
 
 namespace rtsim {
 
-class SimtUnit : public TraversalUnit {
+class SimtUnit : public ScheduledUnit {
 public:
     SC_HAS_PROCESS(SimtUnit);
     SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index);
 
-    Cycle finish_cycle() const override { return m_tally.finish; }
-    uint64_t rays_done() const override { return m_tally.rays; }
     CycleAccount cycle_account(Cycle total_cycles) const override;
     nlohmann::json stats_json(Cycle total_cycles) const override;
 
@@ -84,27 +81,15 @@ private:
     bool warp_has_ray(uint32_t w) const;
     uint32_t first_lane(uint32_t w) const { return w * m_config.lanes; }
 
-    const TraversalConfig& m_config;
-    UnitContext m_ctx;
-    const MemoryMap& m_map;
-    StepperPool& m_steppers;
-    const StepCosts m_costs;
-    uint32_t m_index;
     std::vector<Lane> m_lanes;
     std::vector<Warp> m_warps;
-    ContextQueue m_events;  ///< each warp's next phase, earliest first
-    QuantumSync m_sync;
     LineCoalescer m_coalescer;
     Cycle m_fetch_at = 0;  ///< when the rays retire_and_refill() took may fetch their records
-    Cycle m_sched_free = 0;
-    uint32_t m_frame = 0;
-    UnitTally m_tally;  ///< busy while a lane has a ray
     uint64_t m_warp_steps = 0, m_lane_steps = 0, m_fetch_steps = 0;
     std::vector<uint64_t> m_active_histogram;  ///< warp steps by active lanes (0 .. lanes)
     /// Per ray kind: lane-steps of lanes holding a ray of that kind, and those that stepped.
     std::array<uint64_t, kRayKindCount> m_kind_present{}, m_kind_active{};
     UsageSeries m_slot_use, m_active_use;  ///< lane slots and active lanes over time
-    CycleAccount m_account;
 };
 
 }  // namespace rtsim
