@@ -1,34 +1,22 @@
 #include "rtl_model/mem/cache_sets.h"
 
 #include <array>
-#include <cstdlib>
-#include <new>
 #include <sstream>
 
 #include "traces/common/error.h"
 
 namespace rtsim {
 
-namespace {
-constexpr uint32_t kHostLine = 64;
-}  // namespace
-
 CacheSets::CacheSets(uint64_t sets, uint32_t ways, uint32_t line_shift)
     : m_ways(ways),
-      m_stride((kTagsOffset + 6 * ways + kHostLine - 1) / kHostLine * kHostLine),
+      m_stride(uint32_t((kTagsOffset + 6 * ways + AlignedBytes::kAlign - 1) / AlignedBytes::kAlign * AlignedBytes::kAlign)),
       m_tag_shift(0),
       m_set_mask(sets - 1),
       m_line_shift(line_shift) {
     while ((uint64_t(1) << m_tag_shift) < sets) ++m_tag_shift;
-    const size_t bytes = size_t(sets) * m_stride;
-    auto* p = static_cast<uint8_t*>(std::aligned_alloc(kHostLine, bytes));
-    if (!p) throw std::bad_alloc();
-    m_blocks.reset(p);
-    std::memset(p, 0, bytes);  // latest fill 0, clock 0, stamps 0 (never used)
+    m_blocks.resize(size_t(sets) * m_stride);  // zero: latest fill 0, clock 0, stamps 0 (never used)
     for (uint64_t s = 0; s < sets; ++s) std::fill_n(tags_of(block(s)), ways, kInvalidTag);
 }
-
-void CacheSets::FreeAligned::operator()(uint8_t* p) const { std::free(p); }
 
 void CacheSets::beyond_tags(uint64_t line) const {
     std::ostringstream msg;

@@ -20,7 +20,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <memory>
+
+#include "traces/accel/aligned_bytes.h"
 
 namespace rtsim {
 
@@ -68,8 +69,7 @@ public:
         tags_of(block(set))[way] = tag_of(line);
         touch(set, way);
     }
-    /// No line of `set` is filled after this cycle (plain C++: cycles as uint64_t) (a bound: the latest fill
-    /// ever placed).
+    /// No line of `set` is filled after this cycle (a bound: the latest fill ever placed).
     uint64_t latest_fill(uint64_t set) const {
         uint64_t c;
         std::memcpy(&c, block(set), sizeof c);
@@ -97,8 +97,8 @@ private:
         return uint32_t(tag);
     }
     [[noreturn]] void beyond_tags(uint64_t line) const;
-    uint8_t* block(uint64_t set) { return m_blocks.get() + set * m_stride; }
-    const uint8_t* block(uint64_t set) const { return m_blocks.get() + set * m_stride; }
+    uint8_t* block(uint64_t set) { return m_blocks.data() + set * m_stride; }
+    const uint8_t* block(uint64_t set) const { return m_blocks.data() + set * m_stride; }
     static uint32_t* tags_of(uint8_t* b) { return reinterpret_cast<uint32_t*>(b + kTagsOffset); }
     static const uint32_t* tags_of(const uint8_t* b) {
         return reinterpret_cast<const uint32_t*>(b + kTagsOffset);
@@ -112,15 +112,12 @@ private:
     /// Renumbers the used ways' stamps 1..n in the same order; returns n (the set's new clock).
     uint16_t renumber(uint8_t* b);
 
-    struct FreeAligned {
-        void operator()(uint8_t* p) const;
-    };
     uint32_t m_ways;
     uint32_t m_stride;     ///< bytes per set: a multiple of the host's 64-byte line
     uint32_t m_tag_shift;  ///< line-number bits the set index takes
     uint64_t m_set_mask;
     uint32_t m_line_shift;
-    std::unique_ptr<uint8_t[], FreeAligned> m_blocks;
+    AlignedBytes m_blocks;  ///< the sets, 64-byte aligned
 };
 
 }  // namespace rtsim

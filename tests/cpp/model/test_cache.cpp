@@ -9,16 +9,6 @@
 namespace rtsim {
 namespace {
 
-// The tiny cache (tiny_cache.h): its lines, config and bench.
-using test::A;
-using test::B;
-using test::Bench;
-using test::C;
-using test::D;
-using test::E;
-using test::kLine;
-using test::tiny_config;
-
 struct Step {
     Cycle time;
     uint64_t addr;

@@ -9,16 +9,6 @@
 namespace rtsim {
 namespace {
 
-// The tiny cache (tiny_cache.h): its lines, config and bench.
-using test::A;
-using test::B;
-using test::Bench;
-using test::C;
-using test::D;
-using test::E;
-using test::kLine;
-using test::tiny_config;
-
 /// test_cache.cpp's tiny cache with 4 MSHRs, so that prefetches (which may hold 2) leave room.
 struct PrefetchBench : Bench {
     PrefetchBench() : Bench(tiny_config(4), true) {}

@@ -45,3 +45,18 @@ struct Bench {
 };
 
 }  // namespace rtsim::test
+
+namespace rtsim {
+namespace {
+// Its names as the two cache tests that include it use them (test_cache.cpp,
+// test_cache_prefetch.cpp).
+using test::A;
+using test::B;
+using test::Bench;
+using test::C;
+using test::D;
+using test::E;
+using test::kLine;
+using test::tiny_config;
+}  // namespace
+}  // namespace rtsim
