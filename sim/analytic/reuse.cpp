@@ -114,39 +114,4 @@ double bin_miss_probability(const ReuseCurve& curve, int b, bool censored, doubl
     return miss / kPoints;
 }
 
-LastUse::LastUse(size_t capacity_pow2) : m_slots(capacity_pow2), m_mask(capacity_pow2 - 1) {}
-
-uint64_t LastUse::exchange(uint64_t key, uint64_t value) {
-    if (2 * (m_size + 1) > m_slots.size()) grow();
-    size_t i = slot_of(key);
-    while (true) {
-        Slot& s = m_slots[i];
-        if (s.key == key) {
-            const uint64_t old = s.value;
-            s.value = value;
-            return old;
-        }
-        if (s.key == ~0ull) {
-            s = Slot{key, value};
-            ++m_size;
-            return ~0ull;
-        }
-        i = (i + 1) & m_mask;
-    }
-}
-
-void LastUse::clear() {
-    std::fill(m_slots.begin(), m_slots.end(), Slot{});
-    m_size = 0;
-}
-
-void LastUse::grow() {
-    std::vector<Slot, HugePageAllocator<Slot>> old(m_slots.size() * 2);
-    old.swap(m_slots);
-    m_mask = m_slots.size() - 1;
-    m_size = 0;
-    for (const Slot& s : old)
-        if (s.key != ~0ull) exchange(s.key, s.value);
-}
-
 }  // namespace rtsim

@@ -19,10 +19,10 @@
 // in the cluster. The survival function is the Kaplan-Meier (1958) estimate over observed and
 // censored distances; a censored access hits with the conditional probability given that bound.
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "sim/analytic/probe_table.h"
 #include "traces/common/huge_pages.h"
 
 namespace rtsim {
@@ -66,30 +66,30 @@ double lru_hit_probability(double sd, double lines, uint32_t ways);
 double bin_miss_probability(const ReuseCurve& curve, int b, bool censored, double lines, uint32_t ways,
                             bool censored_is_cold = false);
 
-/// Open-addressing hash map uint64 -> uint64 (last access position of a line), cleared per
-/// cluster; the analysis's hot loop does one lookup per access and stream. The table grows to
-/// tens of MB on a large scene and is probed at random, so a key sits with its value (one host
-/// cache line per probe) and the table lies on huge pages (no TLB miss per probe).
+/// The last access position of each line (a key), cleared per cluster; the analysis's hot loop
+/// does one exchange per access and stream. The table grows to tens of MB on a large scene and is
+/// probed at random, so it lies on huge pages (no TLB miss per probe).
 class LastUse {
 public:
-    explicit LastUse(size_t capacity_pow2 = 1u << 16);
+    explicit LastUse(size_t capacity_pow2 = 1u << 16) : m_table(capacity_pow2) {}
     /// Returns the previous value for `key` (or ~0 when absent) and stores `value`.
-    uint64_t exchange(uint64_t key, uint64_t value);
+    uint64_t exchange(uint64_t key, uint64_t value) {
+        bool found;
+        uint64_t& slot = m_table.find_or_add(key, found);
+        const uint64_t old = found ? slot : ~0ull;
+        slot = value;
+        return old;
+    }
     /// Brings `key`'s first probe into the host's cache (speed only).
-    void prefetch(uint64_t key) const { __builtin_prefetch(&m_slots[slot_of(key)]); }
-    void clear();
-    size_t size() const { return m_size; }
+    void prefetch(uint64_t key) const { m_table.prefetch(key); }
+    void clear() { m_table.clear(); }
+    size_t size() const { return m_table.size(); }
 
 private:
-    struct Slot {
-        uint64_t key = ~0ull;  ///< ~0: empty
-        uint64_t value = 0;
+    struct Hash {
+        size_t operator()(uint64_t key) const { return size_t((key * 0x9E3779B97F4A7C15ull) >> 20); }
     };
-    size_t slot_of(uint64_t key) const { return size_t((key * 0x9E3779B97F4A7C15ull) >> 20) & m_mask; }
-    void grow();
-    std::vector<Slot, HugePageAllocator<Slot>> m_slots;
-    size_t m_size = 0;
-    uint64_t m_mask;
+    ProbeTable<uint64_t, uint64_t, Hash, HugePageAllocator> m_table;
 };
 
 }  // namespace rtsim
