@@ -1,11 +1,12 @@
 // The BIH's validation, Accel, locality tree and invariants (bih.h).
 #include <cmath>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "traces/accel/bih/bih.h"
+#include "traces/accel/leaf_coverage.h"
 #include "traces/accel/spatial_params.h"
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
@@ -19,7 +20,8 @@ uint32_t validate_bih(const BihView& v, const std::string& source) {
     if (v.node_count == 0) fail("no nodes");
     if (v.node_count > BihNode::kMaxIndex || v.triangle_count > BihNode::kMaxIndex)
         fail("more than 2^30 nodes or triangles");
-    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0), covered(v.triangle_count, 0);
+    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0);
+    LeafCoverage covered(v.triangle_count);
     seen[0] = 1;
     uint32_t deepest = 0;
     for (uint64_t i = 0; i < v.node_count; ++i) {
@@ -27,13 +29,7 @@ uint32_t validate_bih(const BihView& v, const std::string& source) {
         if (!seen[i]) fail(node_name(i) + " is not reachable from the root");
         deepest = std::max<uint32_t>(deepest, depth[i]);
         if (n.leaf()) {
-            if (uint64_t(n.first()) + n.count() > v.triangle_count)
-                fail(node_name(i) + " holds triangles " + std::to_string(n.first()) + ".." +
-                     std::to_string(uint64_t(n.first()) + n.count() - 1) + " of " + std::to_string(v.triangle_count));
-            for (uint64_t k = n.first(); k < uint64_t(n.first()) + n.count(); ++k) {
-                if (covered[k]) fail("triangle " + std::to_string(k) + " is in two leaves");
-                covered[k] = 1;
-            }
+            covered.add(n.first(), n.count(), fail, [&] { return node_name(i); });
             continue;
         }
         if (std::isnan(n.clip(0)) || std::isnan(n.clip(1))) fail(node_name(i) + " has a NaN clip plane");
@@ -46,8 +42,7 @@ uint32_t validate_bih(const BihView& v, const std::string& source) {
             depth[k] = uint8_t(depth[i] + 1);
         }
     }
-    for (uint64_t k = 0; k < v.triangle_count; ++k)
-        if (!covered[k]) fail("triangle " + std::to_string(k) + " is in no leaf (unreachable)");
+    covered.finish(fail);
     return deepest;
 }
 

@@ -6,6 +6,7 @@
 
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/accel/bvh_image_stats.h"
+#include "traces/accel/leaf_coverage.h"
 #include "traces/bvh/builder.h"
 #include "traces/common/error.h"
 #include "traces/isect/brute_force.h"
@@ -134,7 +135,8 @@ void validate_bvh2(const Bvh2View& v, const std::string& source) {
     if (v.node_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) fail("more than 2^32 nodes or triangles");
     // Depth-first layout: a child always comes after its parent, so following children can
     // never cycle, and depth can be checked in one forward pass.
-    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0), covered(v.triangle_count, 0);
+    std::vector<uint8_t> depth(v.node_count, 0), seen(v.node_count, 0);
+    LeafCoverage covered(v.triangle_count);
     seen[0] = 1;
     for (uint64_t i = 0; i < v.node_count; ++i) {
         const HwNode& n = v.nodes[i];
@@ -164,17 +166,10 @@ void validate_bvh2(const Bvh2View& v, const std::string& source) {
             if (count > kMaxLeafTriangles)
                 fail(child(i, c) + " is a leaf of " + std::to_string(count) + " triangles (at most " +
                      std::to_string(kMaxLeafTriangles) + ")");
-            if (uint64_t(ref) + count > v.triangle_count)
-                fail(child(i, c) + " references triangles " + std::to_string(ref) + ".." +
-                     std::to_string(uint64_t(ref) + count - 1) + " of " + std::to_string(v.triangle_count));
-            for (uint64_t k = ref; k < uint64_t(ref) + count; ++k) {
-                if (covered[k]) fail("triangle " + std::to_string(k) + " is in two leaves");
-                covered[k] = 1;
-            }
+            covered.add(ref, count, fail, [&] { return child(i, c); });
         }
     }
-    for (uint64_t k = 0; k < v.triangle_count; ++k)
-        if (!covered[k]) fail("triangle " + std::to_string(k) + " is in no leaf (unreachable)");
+    covered.finish(fail);
 }
 
 Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::move(image)) {

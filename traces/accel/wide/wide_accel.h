@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "traces/accel/accel.h"
+#include "traces/accel/leaf_coverage.h"
 #include "traces/accel/wide/wide_stepper.h"
 #include "traces/common/error.h"
 
@@ -48,7 +49,8 @@ uint32_t validate_wide(const WideView& v, const std::string& source, const std::
     auto at = [](uint64_t i, int s) { return "node " + std::to_string(i) + " slot " + std::to_string(s); };
     if (v.node_count >= (1ull << 32) || v.triangle_count >= (1ull << 32)) fail("more than 2^32 nodes or triangles");
     std::vector<uint32_t> need(v.node_count, 0);  // stack entries outstanding on entering a node
-    std::vector<uint8_t> seen(v.node_count, 0), covered(v.triangle_count, 0);
+    std::vector<uint8_t> seen(v.node_count, 0);
+    LeafCoverage covered(v.triangle_count);
     uint32_t max_stack = 1;
     DecodedNode d;
     for (uint64_t i = 0; i < v.node_count; ++i) {
@@ -74,17 +76,10 @@ uint32_t validate_wide(const WideView& v, const std::string& source, const std::
                 continue;
             }
             if (count > kWideMaxLeafTriangles) fail(at(i, s) + " is a leaf of " + std::to_string(count) + " triangles");
-            if (uint64_t(ref) + count > v.triangle_count)
-                fail(at(i, s) + " references triangles " + std::to_string(ref) + ".." +
-                     std::to_string(uint64_t(ref) + count - 1) + " of " + std::to_string(v.triangle_count));
-            for (uint64_t t = ref; t < uint64_t(ref) + count; ++t) {
-                if (covered[t]) fail("triangle " + std::to_string(t) + " is in two leaves");
-                covered[t] = 1;
-            }
+            covered.add(ref, count, fail, [&] { return at(i, s); });
         }
     }
-    for (uint64_t t = 0; t < v.triangle_count; ++t)
-        if (!covered[t]) fail("triangle " + std::to_string(t) + " is in no leaf (unreachable)");
+    covered.finish(fail);
     return max_stack;
 }
 
