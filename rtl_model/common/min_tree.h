@@ -33,13 +33,18 @@ public:
 
     /// Slot s's time is now `time` (< kNever, or kNever to empty it).
     void set(uint32_t s, Cycle time) {
+        uint64_t* keys = m_key.data();
         uint32_t n = m_leaves + s;
         uint64_t k = key(time, s);
-        m_key[n] = k;
-        for (n >>= 1; n >= 1; n >>= 1) {
-            const uint64_t sibling_min = min(m_key[2 * n], m_key[2 * n + 1]);
-            if (m_key[n] == sibling_min) break;  // nothing above changes
-            m_key[n] = sibling_min;
+        keys[n] = k;
+        // The key coming up stays in a register: each level loads only the sibling and the old
+        // parent, neither of which waits for the store below it (reloading both children made
+        // every level wait for the previous level's store, the unit's longest dependency chain).
+        for (; n > 1; n >>= 1) {
+            k = min(k, keys[n ^ 1]);
+            uint64_t& parent = keys[n >> 1];
+            if (parent == k) break;  // nothing above changes
+            parent = k;
         }
     }
     /// The earliest slot (lowest index among equal times) and its time.

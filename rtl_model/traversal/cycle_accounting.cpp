@@ -32,18 +32,4 @@ nlohmann::json CycleAccount::to_json() const {
     return j;
 }
 
-void account_memory(CycleAccount& account, Cycle start, Cycle ready, const AccessInfo& info) {
-    Cycle left = ready > start ? ready - start : 0;
-    const Cycle l1 = std::min(info.mshr_wait[0], left);
-    account.add(CycleUse::l1_mshr_full, l1);
-    left -= l1;
-    const Cycle l2 = std::min(info.mshr_wait[1], left);
-    account.add(CycleUse::l2_mshr_full, l2);
-    left -= l2;
-    const CycleUse level = info.level == ServedBy::dram ? CycleUse::dram
-                           : info.level == ServedBy::l2 ? CycleUse::l2
-                                                        : CycleUse::l1_hit;
-    account.add(level, left);
-}
-
 }  // namespace rtsim

@@ -3,6 +3,7 @@
 // context of a run is in exactly one use, so the uses of a unit sum to ray_contexts x the run's
 // cycles (tested). It says where time goes: issuing, each pipeline kind, each memory level,
 // MSHRs full, stack spills, the ray buffer, or no ray to run.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -51,7 +52,19 @@ private:
 };
 
 /// The time of a read from `start` to `ready`, split by where it went (MSHR waits first, then the
-/// level that served it), into `account`.
-void account_memory(CycleAccount& account, Cycle start, Cycle ready, const AccessInfo& info);
+/// level that served it), into `account`. Inline: every step of every unit calls it.
+inline void account_memory(CycleAccount& account, Cycle start, Cycle ready, const AccessInfo& info) {
+    Cycle left = ready > start ? ready - start : 0;
+    const Cycle l1 = std::min(info.mshr_wait[0], left);
+    account.add(CycleUse::l1_mshr_full, l1);
+    left -= l1;
+    const Cycle l2 = std::min(info.mshr_wait[1], left);
+    account.add(CycleUse::l2_mshr_full, l2);
+    left -= l2;
+    const CycleUse level = info.level == ServedBy::dram ? CycleUse::dram
+                           : info.level == ServedBy::l2 ? CycleUse::l2
+                                                        : CycleUse::l1_hit;
+    account.add(level, left);
+}
 
 }  // namespace rtsim

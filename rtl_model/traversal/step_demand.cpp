@@ -9,14 +9,6 @@ namespace rtsim {
 
 namespace {
 
-void add_issue(const Op& op, const StepCosts& costs, StepDemand& d) {
-    const uint32_t width = costs.width[size_t(op.kind)];
-    if (width == 0)
-        throw Error(std::string("model: a step issued '") + op_kind_name(op.kind) +
-                    "' operations but the machine has no pipeline for them");
-    d.issues[d.issue_count++] = OpIssue{op.kind, op.count, issues_for(op.count, width)};
-}
-
 void plan_demand(const StepPlan& plan, const StepCosts& costs, StepDemand& d) {
     d.read_count = plan.fetch_count;
     std::copy(plan.fetch, plan.fetch + plan.fetch_count, d.reads);
@@ -24,7 +16,7 @@ void plan_demand(const StepPlan& plan, const StepCosts& costs, StepDemand& d) {
 }
 
 void outcome_demand(const StepOutcome& outcome, const StepCosts& costs, StepDemand& d) {
-    for (int i = 0; i < outcome.op_count; ++i) add_issue(outcome.op[i], costs, d);
+    for (int i = 0; i < outcome.op_count; ++i) step_parts::add_issue(outcome.op[i], costs, d);
 }
 
 /// Pushes beyond the on-chip entries spill the oldest entry to the next spill slot; pops with
@@ -61,10 +53,9 @@ void take_step(Stepper& stepper, StackSplit& stack, const StepCosts& costs, Step
 
 namespace step_parts {
 
-void plan_issues(const StepPlan& plan, const StepCosts& costs, StepDemand& d) {
-    d.issue_count = 0;
-    for (int i = 0; i < plan.op_count; ++i) add_issue(plan.op[i], costs, d);
-    d.scheduler_slots = kSchedulerSlotsPerStep;
+void no_pipeline(OpKind kind) {
+    throw Error(std::string("model: a step issued '") + op_kind_name(kind) +
+                "' operations but the machine has no pipeline for them");
 }
 
 void run_and_cost(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& d) {

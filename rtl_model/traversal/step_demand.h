@@ -34,7 +34,8 @@ constexpr uint32_t kSchedulerSlotsPerStep = 2;
 
 /// Pipeline issues `tests` tests take at `width` tests per issue.
 inline uint32_t issues_for(uint32_t tests, uint32_t width) {
-    return tests <= width ? (tests ? 1 : 0) : (tests + width - 1) / width;
+    if (tests <= width) return tests ? 1 : 0;
+    return width == 1 ? tests : (tests + width - 1) / width;  // width 1 (the default) needs no division
 }
 
 /// What costing depends on, resolved once per run: the stack's size and each operation kind's
@@ -97,8 +98,20 @@ StepDemand step_demand(const StepPlan& plan, const StepOutcome& outcome, int sta
 void take_step(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& demand);
 
 namespace step_parts {
+/// Throws rtsim::Error: a step issued operations of `kind` and the machine has no pipeline for them.
+[[noreturn]] void no_pipeline(OpKind kind);
+/// Appends the issues of `op` at its pipeline's width (inline: every step of every unit calls it).
+inline void add_issue(const Op& op, const StepCosts& costs, StepDemand& d) {
+    const uint32_t width = costs.width[size_t(op.kind)];
+    if (width == 0) no_pipeline(op.kind);
+    d.issues[d.issue_count++] = OpIssue{op.kind, op.count, issues_for(op.count, width)};
+}
 /// The issues of the plan's operations (take_step's first part, after the reads).
-void plan_issues(const StepPlan& plan, const StepCosts& costs, StepDemand& demand);
+inline void plan_issues(const StepPlan& plan, const StepCosts& costs, StepDemand& d) {
+    d.issue_count = 0;
+    for (int i = 0; i < plan.op_count; ++i) add_issue(plan.op[i], costs, d);
+    d.scheduler_slots = kSchedulerSlotsPerStep;
+}
 /// Runs the planned step, then costs the operations its results called for and its stack.
 void run_and_cost(Stepper& stepper, StackSplit& stack, const StepCosts& costs, StepDemand& demand);
 }  // namespace step_parts
