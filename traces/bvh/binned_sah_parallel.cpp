@@ -2,23 +2,16 @@
 // of the single-threaded build node for node: the same splits, the same reference order, the
 // same node numbering.
 //
-// Every node is a task, split by whichever thread takes it; its children are tasks again. A
-// node of more than a grain of references is split alone (its two children into a small array
-// of its own, each handed on as a new task); a smaller node's whole subtree is built by one
-// thread into its own node array. So the threads share the top of the tree as well as the
-// subtrees: after the root, the two halves of the tree are split at the same time. Nodes own
-// disjoint ranges of the references, so the threads share nothing else; a node's split depends
-// only on its range, so the order in which the threads take the tasks changes no split. Tasks
-// are taken largest first. Finally the arrays are stitched together in the order the
-// single-threaded build allocates nodes: a depth-first walk, left child first, that gives each
-// split node's children the next pair of indices.
+// The top of the tree is split on the calling thread until nodes hold fewer than a grain of
+// references; each smaller node is a task whose whole subtree one thread builds into its own
+// node array (subtrees own disjoint ranges of the references, so the threads share nothing
+// else). Tasks are handed out largest first. Finally the node arrays are stitched together in
+// the order the single-threaded build allocates nodes: a depth-first walk, left child first,
+// that gives each split node's children the next pair of indices.
 #include <algorithm>
-#include <array>
-#include <condition_variable>
-#include <deque>
+#include <atomic>
 #include <exception>
-#include <mutex>
-#include <queue>
+#include <numeric>
 #include <thread>
 
 #include "traces/bvh/binned_sah_impl.h"
@@ -27,50 +20,37 @@ namespace rtsim {
 namespace binned_detail {
 namespace {
 
-/// Subtree tasks per thread: enough that taking the largest first balances the threads.
+/// Tasks per thread: enough that handing out the largest first balances the threads.
 constexpr uint32_t kTasksPerThread = 8;
-/// No subtree task is made smaller than this: below it a hand-off costs more than it saves.
+/// No task is made smaller than this: below it a thread's hand-off costs more than it saves.
 constexpr uint32_t kMinTask = 4096;
 
-/// A node of the tree under construction: index `index` of array `array`.
+/// A node of the stitched tree: array 0 is the top's nodes, array t + 1 task t's.
 struct Handle {
     uint32_t array, index;
 };
 
-/// The node arrays: one per task. A split task's array holds its node and its two children,
-/// which were handed on (`handed[a]`: the arrays of those children's tasks); a subtree task's
-/// array holds its whole subtree. Node 0 of every array is its task's root.
-struct Arrays {
-    std::deque<BuildNodes> nodes;                ///< a deque: arrays stay in place while others are added
-    std::deque<std::array<uint32_t, 2>> handed;  ///< {0, 0}: nothing handed on
-
-    const BuildNode& at(Handle h) const { return nodes[h.array][h.index]; }
-    /// A handed-on child is its task's root.
-    Handle resolve(Handle h) const {
-        if (h.index == 0 || h.index > 2) return h;  // only nodes 1 and 2 are ever handed on
-        const uint32_t to = handed[h.array][h.index - 1];
-        return to ? Handle{to, 0} : h;
-    }
-};
-
-/// The nodes in the single-threaded build's numbering, array 0 the root's.
-BuildNodes stitch(const Arrays& arrays, size_t total, uint32_t max_depth) {
+/// The nodes of `top` and of the tasks' arrays in the single-threaded build's numbering.
+BuildNodes stitch(const BuildNodes& top, const std::vector<BuildNodes>& local,
+                              const std::vector<uint32_t>& task_of, size_t total, uint32_t max_depth) {
+    auto at = [&](Handle h) -> const BuildNode& { return h.array == 0 ? top[h.index] : local[h.array - 1][h.index]; };
+    // A top node that was handed to a task is that task's root.
+    auto resolve = [&](Handle h) { return h.array == 0 && task_of[h.index] ? Handle{task_of[h.index], 0} : h; };
     BuildNodes out(total);
     std::vector<std::pair<Handle, uint32_t>> stack;  // a node and its index in `out`
     stack.reserve(2 * size_t(max_depth) + 2);
-    stack.push_back({Handle{0, 0}, 0});
-    out[0] = arrays.at(stack.back().first);
+    stack.push_back({resolve({0, 0}), 0});
+    out[0] = at(stack.back().first);
     uint32_t next = 1;
     while (!stack.empty()) {
         const auto [h, to] = stack.back();
         stack.pop_back();
-        const BuildNode& b = arrays.at(h);
+        const BuildNode& b = at(h);
         if (b.is_leaf()) continue;
-        const Handle left = arrays.resolve({h.array, b.first}),
-                     right = arrays.resolve({h.array, b.first + 1});
+        const Handle left = resolve({h.array, b.first}), right = resolve({h.array, b.first + 1});
         out[to].first = next;
-        out[next] = arrays.at(left);
-        out[next + 1] = arrays.at(right);
+        out[next] = at(left);
+        out[next + 1] = at(right);
         stack.push_back({right, next + 1});
         stack.push_back({left, next});
         next += 2;
@@ -78,116 +58,60 @@ BuildNodes stitch(const Arrays& arrays, size_t total, uint32_t max_depth) {
     return out;
 }
 
-/// A node to split: its range, and the array its task fills (its root, node 0, already there).
-struct Task {
-    WorkItem item;
-    uint32_t array;
-    uint32_t size() const { return item.end - item.begin; }
-    bool operator<(const Task& o) const { return size() < o.size(); }  // the largest on top
-};
-
-/// The tasks and their arrays, shared by the threads.
-class TaskPool {
-public:
-    TaskPool(PrimRef* refs, const BuildConfig& config, uint32_t grain)
-        : m_refs(refs), m_config(config), m_grain(grain) {}
-
-    /// The root's task, before the threads start.
-    void add_root(const WorkItem& root, const BuildNode& node) {
-        std::lock_guard<std::mutex> lock(m_mutex);
-        m_todo.push(new_task(root, node));
-    }
-    /// Takes tasks until every node is split; any thread's error ends every thread's work.
-    void work() {
-        try {
-            NodeSplitter splitter(m_refs, m_config);
-            Task t;
-            for (BuildNodes* out; (out = take(t));) run(splitter, t, *out);
-        } catch (...) {
-            std::lock_guard<std::mutex> lock(m_mutex);
-            if (!m_error) m_error = std::current_exception();
-            m_stop = true;
-            m_wake.notify_all();
-        }
-    }
-    /// After every thread's work: the tree, or the first error.
-    BuildNodes result() {
-        if (m_error) std::rethrow_exception(m_error);
-        size_t total = 1;  // the root, then each array's nodes but the root it shares with its parent
-        for (const BuildNodes& a : m_arrays.nodes) total += a.size() - 1;
-        return stitch(m_arrays, total, m_config.max_depth);
-    }
-
-private:
-    /// A task's array holds its root; call with the lock held.
-    Task new_task(const WorkItem& item, const BuildNode& node) {
-        const uint32_t array = uint32_t(m_arrays.nodes.size());
-        BuildNodes& nodes = m_arrays.nodes.emplace_back();
-        m_arrays.handed.push_back({0, 0});
-        const uint32_t size = item.end - item.begin;
-        nodes.reserve(size > m_grain ? 3 : 2 * size_t(size));
-        nodes.push_back(node);
-        WorkItem local = item;
-        local.node = 0;
-        ++m_pending;
-        return Task{local, array};
-    }
-    /// The next task and its array (found under the lock: another thread may be adding arrays),
-    /// or null when every node is split or a thread failed.
-    BuildNodes* take(Task& t) {
-        std::unique_lock<std::mutex> lock(m_mutex);
-        m_wake.wait(lock, [&] { return m_stop || !m_todo.empty() || m_pending == 0; });
-        if (m_stop || m_todo.empty()) return nullptr;
-        t = m_todo.top();
-        m_todo.pop();
-        return &m_arrays.nodes[t.array];
-    }
-    void run(NodeSplitter& splitter, const Task& t, BuildNodes& out) {
-        if (t.size() <= m_grain) {
-            splitter.build_subtree(t.item, out);
-            finish({});
-            return;
-        }
-        std::vector<WorkItem> children;
-        splitter.split_node(t.item, out, children);
-        finish(children, t.array, &out);
-    }
-    /// Hands on a split task's children (none for a leaf or a subtree) and retires the task.
-    void finish(const std::vector<WorkItem>& children, uint32_t array = 0, const BuildNodes* out = nullptr) {
-        std::lock_guard<std::mutex> lock(m_mutex);
-        for (const WorkItem& c : children) {
-            const Task child = new_task(c, (*out)[c.node]);
-            m_arrays.handed[array][c.node - 1] = child.array;
-            m_todo.push(child);
-        }
-        --m_pending;
-        m_wake.notify_all();
-    }
-
-    PrimRef* const m_refs;
-    const BuildConfig& m_config;
-    const uint32_t m_grain;
-    std::mutex m_mutex;
-    std::condition_variable m_wake;
-    std::priority_queue<Task> m_todo;
-    Arrays m_arrays;
-    size_t m_pending = 0;  ///< tasks queued or running
-    bool m_stop = false;
-    std::exception_ptr m_error;
-};
-
 }  // namespace
 
 void build_parallel(PrimRefs& refs, const BuildConfig& config, const WorkItem& root, unsigned threads,
                     BuildNodes& nodes) {
     const uint32_t grain = std::max(kMinTask, (root.end - root.begin) / (kTasksPerThread * threads));
-    TaskPool pool(refs.data(), config, grain);
-    pool.add_root(root, nodes[root.node]);
-    std::vector<std::thread> helpers;
-    for (unsigned t = 1; t < threads; ++t) helpers.emplace_back([&pool] { pool.work(); });
-    pool.work();
-    for (std::thread& t : helpers) t.join();
-    nodes = pool.result();
+    // The top of the tree, here; nodes of at most `grain` references become tasks.
+    std::vector<WorkItem> stack{root}, tasks;
+    NodeSplitter top(refs.data(), config);
+    while (!stack.empty()) {
+        const WorkItem item = stack.back();
+        stack.pop_back();
+        if (item.end - item.begin <= grain) tasks.push_back(item);
+        else top.split_node(item, nodes, stack);
+    }
+
+    // Each task's subtree into its own array (its root first), largest tasks first.
+    std::vector<uint32_t> order(tasks.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return tasks[a].end - tasks[a].begin > tasks[b].end - tasks[b].begin;
+    });
+    std::vector<BuildNodes> local(tasks.size());
+    std::atomic<size_t> next{0};
+    std::exception_ptr error;
+    std::atomic<bool> failed{false};
+    auto worker = [&] {
+        try {
+            NodeSplitter splitter(refs.data(), config);
+            for (size_t k; !failed && (k = next.fetch_add(1)) < order.size();) {
+                const WorkItem& task = tasks[order[k]];
+                BuildNodes& out = local[order[k]];
+                out.reserve(2 * size_t(task.end - task.begin));
+                out.push_back(nodes[task.node]);
+                WorkItem subtree = task;
+                subtree.node = 0;
+                splitter.build_subtree(subtree, out);
+            }
+        } catch (...) {
+            if (!failed.exchange(true)) error = std::current_exception();
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < std::min<size_t>(threads, tasks.size()); ++t) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+
+    std::vector<uint32_t> task_of(nodes.size(), 0);
+    size_t total = nodes.size();
+    for (size_t t = 0; t < tasks.size(); ++t) {
+        task_of[tasks[t].node] = uint32_t(t + 1);
+        total += local[t].size() - 1;
+    }
+    nodes = stitch(nodes, local, task_of, total, config.max_depth);
 }
 
 }  // namespace binned_detail
