@@ -23,7 +23,7 @@ public:
     Value& find_or_add(Key key, bool& found) {
         assert(key != kEmpty);
         if (2 * (m_size + 1) > m_slots.size()) grow();
-        for (size_t i = Hash{}(key)&m_mask;; i = (i + 1) & m_mask) {
+        for (size_t i = slot_of(key);; i = (i + 1) & m_mask) {
             Slot& s = m_slots[i];
             found = s.key == key;
             if (found) return s.value;
@@ -35,7 +35,7 @@ public:
         }
     }
     /// Brings `key`'s first probe into the host's cache (speed only).
-    void prefetch(Key key) const { __builtin_prefetch(&m_slots[Hash{}(key)&m_mask]); }
+    void prefetch(Key key) const { __builtin_prefetch(&m_slots[slot_of(key)]); }
     /// Calls f(key, value) for every key held, in slot order.
     template <class F>
     void for_each(F&& f) const {
@@ -61,13 +61,14 @@ private:
         Key key = kEmpty;
         Value value{};
     };
+    size_t slot_of(Key key) const { return size_t(Hash{}(key)) & m_mask; }
     void grow() {
         std::vector<Slot, Alloc<Slot>> old(m_slots.size() * 2);
         old.swap(m_slots);
         m_mask = m_slots.size() - 1;
         for (const Slot& s : old) {
             if (s.key == kEmpty) continue;
-            size_t i = Hash{}(s.key) & m_mask;
+            size_t i = slot_of(s.key);
             while (m_slots[i].key != kEmpty) i = (i + 1) & m_mask;
             m_slots[i] = s;
         }
