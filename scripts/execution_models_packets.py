@@ -55,7 +55,7 @@ def run(folder: Path, config: tuple, args: argparse.Namespace) -> dict[str, Any]
     sets = [f"traversal.model={model}", f"traversal.ray_contexts={CONTEXTS}",
             f"dispatch.sort={sort}", f"dispatch.block_rays={BLOCK}"]  # fmt: skip
     if lanes:
-        sets += [f"traversal.lanes={lanes}", f"traversal.packet_split_below={split}"]
+        sets += [f"traversal.packet.lanes={lanes}", f"traversal.packet.split_below={split}"]
     result = run_sim(SimJob(trace=folder, out_dir=args.out / "packet_runs" / name, sets=sets))
     if result.returncode != 0 or result.stats is None:
         raise SystemExit(f"{name}: rtsim-sim exit {result.returncode}: {result.stderr[-600:]}")

@@ -83,8 +83,8 @@ def run(
     sets = [f"traversal.model={model}", f"traversal.ray_contexts={CONTEXTS}",
             f"dispatch.sort={sort}", f"dispatch.block_rays={BLOCK}"]  # fmt: skip
     if lanes:
-        sets += [f"traversal.lanes={lanes}", f"traversal.simt_policy={policy}",
-                 f"traversal.simt_refill={refill}"]  # fmt: skip
+        sets += [f"traversal.simt.lanes={lanes}", f"traversal.simt.policy={policy}",
+                 f"traversal.simt.refill={refill}"]  # fmt: skip
     sets += list(extra)
     result = run_sim(SimJob(trace=folder, out_dir=args.out / "runs" / name, sets=sets))
     if result.returncode != 0 or result.stats is None:

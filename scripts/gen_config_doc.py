@@ -40,8 +40,8 @@ SECTION_ORDER = (
 
 SECTION_NOTES = {
     "dispatch": "Hands rays from the trace to free ray contexts (`rtl_model/dispatch`).",
-    "traversal": "The traversal units (chosen by `model`), their ray contexts and stacks "
-    "(`rtl_model/traversal`).",
+    "traversal": "The traversal units (`model` names a kind; each kind registers itself), their "
+    "ray contexts and stacks (`rtl_model/traversal`); each kind's own fields follow.",
     "box": "The ray-box pipelines: one test per child box, a whole node is 2 tests.",
     "triangle": "The ray-triangle pipelines: one test per leaf triangle.",
     "anyhit": "The alpha-test stage; built only when the BVH has alpha-MASK triangles.",
@@ -62,6 +62,11 @@ SECTION_NOTES = {
     "It does not change timing.",
 }
 
+SUBSECTION_NOTE = (
+    "The `{name}` unit kind's own fields (its folder, `rtl_model/{section}/{name}/`); they act "
+    "only with `{section}.model = {name}`."
+)
+
 HEADER = """\
 # Simulator configuration
 
@@ -76,12 +81,20 @@ field, e.g. `rtsim simulate TRACE -o RUN --set l1.size_kib=32 --set box.sharing=
 `rtsim config --defaults` prints the default config and `rtsim config --schema` this table as JSON.
 Every run writes the config it used to `RUN/config.resolved.json`.
 
-Cross-field rules checked by `validate()` besides the ranges below:
+Each block's own field rules, checked by `validate()` besides the ranges below:
 
 - `l1.size_kib` and `l2.size_kib` must hold a power-of-two number of sets of `ways` lines of
   `line_bytes` bytes (e.g. `l1.size_kib=3` is rejected);
 - `l1.line_bytes` must equal `l2.line_bytes` and be a power of two;
 - `dram.interleave_bytes` must be a power of two and at least the line size.
+
+What may combine with what (a unit kind, a technique, a structure, a level) is decided once per
+run by the resolution step, against the trace's structure: every rule, why, and what to change
+are in [capabilities.md](capabilities.md) (`rtsim capabilities`). A unit kind's own fields are
+its section (`traversal.simt`, `traversal.packet`), declared in its folder; they act only when
+`traversal.model` names it. Fields left at 0 that the run derives (`traversal.ray_contexts`,
+`traversal.stack_entry_bytes`) are written resolved to `config.resolved.json` and listed in the
+summary (`summary.resolved`).
 
 How the defaults were chosen: they are a small TRaX/STRaTA-like MIMD design that simulates in
 seconds, checked by a sensitivity study (each knob doubled alone on Sponza's diffuse rays) so that
@@ -145,6 +158,8 @@ def field_table(fields: dict[str, Any], prefix: str) -> list[str]:
     ]
     for name in sorted(fields):
         f = fields[name]
+        if f.get("type") == "section":
+            continue  # its own table follows (a unit kind's section: subsections())
         lines.append(
             f"| `{prefix}{name}` | {_default(f)} | {_cell(f.get('unit', '') or '')} | "
             f"{_cell(_range(f))} | {_cell(f.get('doc', ''))} |"
@@ -163,7 +178,16 @@ def render(schema: dict[str, Any]) -> str:
         out += [f"## `{name}`", ""]
         if name in SECTION_NOTES:
             out += [SECTION_NOTES[name], ""]
-        out += [*field_table(sections[name].get("fields", {}), f"{name}."), ""]
+        fields = sections[name].get("fields", {})
+        out += [*field_table(fields, f"{name}."), ""]
+        for inner in sorted(k for k, v in fields.items() if v.get("type") == "section"):
+            out += [
+                f"### `{name}.{inner}`",
+                "",
+                SUBSECTION_NOTE.format(section=name, name=inner),
+                "",
+            ]
+            out += [*field_table(fields[inner].get("fields", {}), f"{name}.{inner}."), ""]
     return "\n".join(out).rstrip("\n") + "\n"
 
 

@@ -12,6 +12,7 @@
 
 #include "sim/harness/simulate.h"
 #include "sim/report/stats_schema.h"
+#include "sim/resolve/resolve.h"
 #include "traces/common/error.h"
 #include "traces/common/files.h"
 
@@ -53,7 +54,8 @@ int sc_main(int argc, char** argv) {
     std::string trace, config_path, out_dir;
     std::vector<std::string> sets;
     bool timeline = false, progress = false, dump_defaults = false, dump_schema = false, dump_stats_schema = false,
-         no_verdict = false, check_verdict = false;
+         no_verdict = false, check_verdict = false, capabilities = false, capabilities_md = false;
+    std::string check_runs;
     app.add_option("trace", trace, "Trace folder (from rtsim trace) or .rtt file");
     app.add_option("--config", config_path, "Config JSON (defaults for missing keys)");
     app.add_option("--set", sets, "Override a config key: key.path=value (repeatable)");
@@ -67,10 +69,31 @@ int sc_main(int argc, char** argv) {
     app.add_flag("--dump-defaults", dump_defaults, "Print the default config as JSON and exit");
     app.add_flag("--dump-schema", dump_schema, "Print every config field with default, unit, range, doc");
     app.add_flag("--dump-stats-schema", dump_stats_schema, "Print every stats.json block's declared keys with unit and meaning");
+    bool dump_names = false;
+    app.add_flag("--dump-names", dump_names,
+                 "Print the names the C++ side declares and Python reads (ray kinds, data kinds, operation kinds, "
+                 "unit kinds, structures) as JSON");
+    app.add_flag("--capabilities", capabilities, "Print what composes with what (rules, structures, unit kinds, levels) as JSON");
+    app.add_flag("--capabilities-markdown", capabilities_md, "Print the same as Markdown (docs/capabilities.md)");
+    app.add_option("--check-runs", check_runs,
+                   "Resolve each run of a JSON list [{config, accel, blas_kind, compressed_leaves}] before any trace "
+                   "exists (sweeps check their specs this way) and print [{ok, error, resolved}]");
     CLI11_PARSE(app, argc, argv);
     try {
         if (dump_stats_schema) {
             std::cout << rtsim::stats_schema_json().dump(2) << "\n";
+            return 0;
+        }
+        if (dump_names) {
+            std::cout << rtsim::declared_names().dump(2) << "\n";
+            return 0;
+        }
+        if (capabilities || capabilities_md) {
+            std::cout << (capabilities ? rtsim::capability_table().dump(2) : rtsim::capability_markdown()) << "\n";
+            return 0;
+        }
+        if (!check_runs.empty()) {
+            std::cout << rtsim::check_runs(check_runs).dump() << "\n";
             return 0;
         }
         if (dump_defaults || dump_schema) {

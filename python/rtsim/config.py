@@ -91,40 +91,39 @@ class _Root:
         one validate() in rtsim-sim."""
         return apply_patch(self, unflatten(values))  # type: ignore[arg-type]
 
-    def sram_bytes(self) -> int:
-        """On-chip SRAM of the accelerator: the L1s, the L2, the traversal stacks, the mailboxes
-        and, with treelet scheduling, the ray buffer."""
-        c: Any = self
-        t = c.traversal
-        # stack_entry_bytes 0 is the structure's own, known only with a trace: a BVH's 8 here
-        # (stats.json "area" has the run's exact figure).
-        entry = t.stack_entry_bytes or 8
-        stacks = t.units * t.ray_contexts * t.stack_entries * entry
-        mailboxes = t.units * t.ray_contexts * c.mailbox.entries * 4
-        ray_buffer = c.treelets.buffer_kib * 1024 if c.treelets.enabled else 0
-        return (c.l1.size_kib * t.units + c.l2.size_kib) * 1024 + stacks + mailboxes + ray_buffer
+
+def _section_class(path: str, fields: dict[str, Any], sections: dict[str, type]) -> type:
+    """The dataclass of the section at dotted `path` (its own sections nested, e.g. a unit kind's
+    traversal.simt), registered in `sections` under its path."""
+    members: list[tuple[str, Any, Any]] = []
+    for name, entry in _in_order(fields):
+        if entry["type"] == "section":
+            inner = _section_class(f"{path}.{name}", entry["fields"], sections)
+            members.append((name, inner.__name__, field(default_factory=inner)))
+        else:
+            members.append((name, _TYPES[entry["type"]], _field(entry)))
+    cls = dataclasses.make_dataclass(_class_name(path.replace(".", "_")), members)
+    cls.__doc__ = f"Section `{path}` of the config tree (as rtsim-sim declares it)."
+    cls.__module__ = __name__
+    sections[path] = cls
+    return cls
 
 
 def _build_tree(schema: dict[str, Any]) -> tuple[type, dict[str, type]]:
-    """SimConfig and the section classes from the C++ schema, in declaration order."""
+    """SimConfig and the section classes (by dotted path) from the C++ schema, in declaration
+    order."""
     sections: dict[str, type] = {}
     root_fields: list[tuple[str, str, Any]] = []
     for name, entry in _in_order(schema):
         if entry["type"] == "section":
-            cls = dataclasses.make_dataclass(
-                _class_name(name),
-                [(n, _TYPES[e["type"]], _field(e)) for n, e in _in_order(entry["fields"])],
-            )
-            cls.__doc__ = f"Section `{name}` of the config tree (as rtsim-sim declares it)."
-            cls.__module__ = __name__
-            sections[name] = cls
+            cls = _section_class(name, entry["fields"], sections)
             root_fields.append((name, cls.__name__, field(default_factory=cls)))
         else:
             root_fields.append((name, _TYPES[entry["type"]], _field(entry)))
     root = dataclasses.make_dataclass("SimConfig", root_fields, bases=(_Root,))
     root.__doc__ = "The whole simulator config: the root of the tree rtsim-sim reads with --config."
     root.__module__ = __name__
-    root.sections = tuple(sections)
+    root.sections = tuple(n for n, e in _in_order(schema) if e["type"] == "section")
     return root, sections
 
 
@@ -239,21 +238,36 @@ def flatten(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
 
 def field_info(key: str) -> dataclasses.Field[Any]:
     """The dataclass field (with unit, doc, range metadata) at a dotted key path."""
-    cls: type = SimConfig
+    node: Any = SimConfig()
     *parents, leaf = key.split(".")
     for part in parents:
-        fields = _names(cls)
-        if part not in fields or part not in SimConfig.sections:
+        if not dataclasses.is_dataclass(node) or part not in _names(type(node)):
             raise ConfigError(f"config: unknown key '{key}'")
-        cls = type(getattr(SimConfig(), part))
-    fields = _names(cls)
-    if leaf not in fields or (cls is SimConfig and leaf in SimConfig.sections):
+        node = getattr(node, part)
+    if not dataclasses.is_dataclass(node) or leaf not in _names(type(node)):
         raise ConfigError(f"config: unknown key '{key}'")
-    return fields[leaf]
+    if dataclasses.is_dataclass(getattr(node, leaf)):
+        raise ConfigError(f"config: unknown key '{key}'")
+    return _names(type(node))[leaf]
 
 
-#: Sections whose every other field has no effect while the switch is off: (prefix, switch).
-INACTIVE_UNLESS: tuple[tuple[str, str], ...] = (("treelets.", "treelets.enabled"),)
+def _unit_kind_sections() -> tuple[tuple[str, str, Any], ...]:
+    """Each unit kind's own section (traversal.<kind>.*) acts only when traversal.model is it."""
+    traversal = config_schema()["traversal"]["fields"]
+    kinds = traversal["model"]["choices"]
+    return tuple(
+        (f"traversal.{name}.", "traversal.model", name)
+        for name, entry in traversal.items()
+        if entry["type"] == "section" and name in kinds
+    )
+
+
+#: Sections whose every other field has no effect unless a switch has a value:
+#: (prefix, switch, the value that switches it on).
+INACTIVE_UNLESS: tuple[tuple[str, str, Any], ...] = (
+    ("treelets.", "treelets.enabled", True),
+    *_unit_kind_sections(),
+)
 
 
 def effective_dict(config: SimConfig) -> dict[str, Any]:
@@ -262,8 +276,8 @@ def effective_dict(config: SimConfig) -> dict[str, Any]:
     (a sweep simulates them once)."""
     data = config.to_dict()
     flat, default = flatten(data), flatten(SimConfig().to_dict())
-    for prefix, switch in INACTIVE_UNLESS:
-        if flat.get(switch) is False:
+    for prefix, switch, on in INACTIVE_UNLESS:
+        if switch in flat and flat[switch] != on:
             for key in flat:
                 if key.startswith(prefix) and key != switch:
                     flat[key] = default[key]

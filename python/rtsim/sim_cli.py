@@ -4,6 +4,7 @@ drive a progress bar from its JSON progress lines and print the run's summary.
 rtsim simulate TRACE [--config CFG.json] [--set key=value ...] -o RUN [--timeline] [--timeout S]
                [--check-verdict]
 rtsim config --defaults | --schema
+rtsim capabilities [--json]
 
 Kept light at import time (no numpy, no C++ extension): a short simulation should not wait for
 Python start-up. rich is imported when a run starts.
@@ -157,8 +158,18 @@ def cmd_config(args: argparse.Namespace, console: Any) -> int:
     return 0
 
 
+def cmd_capabilities(args: argparse.Namespace, console: Any) -> int:
+    flag = "--capabilities" if args.json else "--capabilities-markdown"
+    result = subprocess.run([str(find_sim()), flag], capture_output=True, text=True, check=False)
+    if result.returncode != 0:
+        sys.stderr.write(result.stderr)
+        return result.returncode if result.returncode > 0 else 1
+    sys.stdout.write(result.stdout)
+    return 0
+
+
 def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    """Registers `simulate` and `config` on the `rtsim` subcommand parser."""
+    """Registers `simulate`, `config` and `capabilities` on the `rtsim` subcommand parser."""
     p = sub.add_parser(
         "simulate",
         formatter_class=HelpFormatter,
@@ -218,3 +229,16 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         "--schema", action="store_true", help="every field: default, unit, range, doc (JSON)"
     )
     p.set_defaults(func=cmd_config)
+
+    p = sub.add_parser(
+        "capabilities",
+        formatter_class=HelpFormatter,
+        help="print what composes with what: structures, unit kinds, levels and every rule",
+        description="Prints the table the run's one resolution step applies "
+        "(docs/capabilities.md): what each acceleration structure offers, what each traversal "
+        "unit kind needs, what each fidelity level costs, every rule that refuses a combination "
+        "(why, and what to change), and the matrix of techniques x unit kinds x structures and "
+        "x levels.",
+    )
+    p.add_argument("--json", action="store_true", help="as JSON (default: Markdown)")
+    p.set_defaults(func=cmd_capabilities)

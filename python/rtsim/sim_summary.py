@@ -277,6 +277,18 @@ def frames_table(stats: dict[str, Any]) -> Table:
     return table
 
 
+def resolved_table(stats: dict[str, Any]) -> Table:
+    """What the run's resolution step settled (stats.json summary.resolved, docs/capabilities.md):
+    the fields the config left to the run, and settings that have no effect on it."""
+    r = _get(stats, "summary.resolved") or {}
+    table = _two_column("resolved for this run")
+    for d in r.get("derived") or []:
+        table.add_row(f"{d.get('key')} = {d.get('value')}", f"derived: {d.get('why')}")
+    for u in r.get("unused") or []:
+        table.add_row(str(u.get("key")), f"no effect: {u.get('why')}")
+    return table
+
+
 def mailbox_table(stats: dict[str, Any]) -> Table:
     """What the mailboxes saved (stats.json "mailbox", docs/accel.md, Mailboxes)."""
     m = stats.get("mailbox", {}) or {}
@@ -329,6 +341,10 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
     """Prints the run's headline numbers, utilisation, latency and what was built and why."""
     console = console or Console()
     console.print(performance_table(stats))
+    if (_get(stats, "summary.resolved") or {}).get("derived") or (
+        _get(stats, "summary.resolved") or {}
+    ).get("unused"):
+        console.print(resolved_table(stats))
     if len(stats.get("frames", []) or []) > 1:
         console.print(frames_table(stats))
     if _get(stats, "summary.cycles") is not None:

@@ -20,12 +20,12 @@ struct RayState {
     StackSplit stack;          ///< its stack entries on chip and spilled to memory
 };
 
-/// Steppers for rays in flight, reused: a free list over the structure's make_stepper().
+/// Steppers for rays in flight, reused: a free list over the structure's make_stepper(options).
 class StepperPool {
 public:
-    explicit StepperPool(const Accel& accel) : m_accel(accel) {}
+    StepperPool(const Accel& accel, const StepOptions& options) : m_accel(accel), m_options(options) {}
     std::unique_ptr<Stepper> acquire() {
-        if (m_free.empty()) return m_accel.make_stepper();
+        if (m_free.empty()) return m_accel.make_stepper(m_options);
         std::unique_ptr<Stepper> s = std::move(m_free.back());
         m_free.pop_back();
         return s;
@@ -38,6 +38,7 @@ public:
 
 private:
     const Accel& m_accel;
+    const StepOptions m_options;
     std::vector<std::unique_ptr<Stepper>> m_free;
 };
 

@@ -1,5 +1,8 @@
 #include "rtl_model/common/stats.h"
 
+#include <algorithm>
+#include <string>
+
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -44,6 +47,51 @@ StatsWriter& StatsWriter::untimed() {
     for (const StatDecl& d : m_block.stats)
         if (d.timed) m_out[d.key] = nullptr;
     return *this;
+}
+
+namespace {
+
+std::vector<const StatBlock& (*)()>& stat_block_fns() {
+    static std::vector<const StatBlock& (*)()> fns;
+    return fns;
+}
+
+}  // namespace
+
+bool register_stat_block(const StatBlock& (*block)()) {
+    stat_block_fns().push_back(block);
+    return true;
+}
+
+std::vector<const StatBlock*> registered_stat_blocks() {
+    std::vector<const StatBlock*> out;
+    for (auto fn : stat_block_fns()) out.push_back(&fn());
+    std::sort(out.begin(), out.end(), [](const StatBlock* a, const StatBlock* b) {
+        return std::string(a->path) < std::string(b->path);
+    });
+    return out;
+}
+
+const StatBlock& registered_stat_block(const std::string& path) {
+    for (auto fn : stat_block_fns())
+        if (path == fn().path) return fn();
+    throw Error("stats: no block '" + path + "' is registered");
+}
+
+void require_optional_stat(const char* path, const StatDecl& d) {
+    require(d.optional, std::string("stats: '") + path + "." + d.key + "' is declared but its source gave no value");
+}
+
+StatBlock merged_block(const char* path, const std::vector<const StatBlock*>& parts) {
+    StatBlock out{path, {}};
+    for (const StatBlock* b : parts) {
+        if (!b) continue;
+        for (const StatDecl& d : b->stats) {
+            require(out.find(d.key) == nullptr, std::string("stats: '") + path + "." + d.key + "' is declared twice");
+            out.stats.push_back(d);
+        }
+    }
+    return out;
 }
 
 const nlohmann::json& StatsReader::operator[](const char* key) const {

@@ -154,4 +154,6 @@ void Dispatch::ray_finished(Cycle cycle) {
     m_released.notify(sc_core::SC_ZERO_TIME);
 }
 
+RTSIM_REGISTER_STAT_BLOCK(dispatch_stats)
+
 }  // namespace rtsim

@@ -56,4 +56,6 @@ nlohmann::json Pipeline::stats_json(Cycle total_cycles) const {
     return j;
 }
 
+RTSIM_REGISTER_STAT_BLOCK(pipeline_stats)
+
 }  // namespace rtsim

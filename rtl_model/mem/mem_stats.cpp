@@ -118,4 +118,8 @@ nlohmann::json MemStats::to_json() const {
     return j;
 }
 
+RTSIM_REGISTER_STAT_BLOCK(cache_stats)
+RTSIM_REGISTER_STAT_BLOCK(dram_stats)
+RTSIM_REGISTER_STAT_BLOCK(ideal_memory_stats)
+
 }  // namespace rtsim

@@ -288,4 +288,6 @@ nlohmann::json RayBuffer::stats_json() const {
     return j;
 }
 
+RTSIM_REGISTER_STAT_BLOCK(ray_buffer_stats)
+
 }  // namespace rtsim

@@ -20,24 +20,6 @@ void validate_cache(const CacheConfig& c, const char* name) {
     require(power_of_two(lines / c.ways), p + ".size_kib' / (ways x line_bytes) must be a power of two (sets)");
 }
 
-/// The execution model's cross-field rules.
-void validate_traversal_model(const ModelConfig& config) {
-    const TraversalConfig& t = config.traversal;
-    require(config.dispatch.sort == RaySort::none || !config.treelets.enabled,
-            "config: 'dispatch.sort' needs treelets.enabled false: the ray buffer takes rays from dispatch in its own "
-            "order and reorders them by treelet itself");
-    if (t.model == UnitModel::mimd) return;
-    const std::string model = kUnitModelChoices.name(t.model);
-    const char* group = t.model == UnitModel::simt ? "warps' lanes" : "packets' rays";
-    require(t.ray_contexts % t.lanes == 0,
-            "config: 'traversal.ray_contexts' (" + std::to_string(t.ray_contexts) + ") must be a multiple of "
-            "'traversal.lanes' (" + std::to_string(t.lanes) + ") with traversal.model " + model +
-                ": a unit's ray contexts are its " + group);
-    require(!config.treelets.enabled,
-            "config: 'treelets.enabled' is not supported with traversal.model " + model + " (a group's rays would "
-            "leave for different treelets' queues); use traversal.model mimd");
-}
-
 }  // namespace
 
 const PipelineConfig& ModelConfig::pipeline(OpKind kind) const {
@@ -68,7 +50,6 @@ void validate_model(const ModelConfig& config) {
             "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas with dram.model banks (it is the "
             "latency of an access to a closed bank); raise dram.latency, lower dram.t_rcd/dram.t_cas, or set "
             "dram.model=bandwidth");
-    validate_traversal_model(config);
 }
 
 }  // namespace rtsim

@@ -21,6 +21,15 @@
 
 namespace rtsim {
 
+/// A pipeline with PipelineConfig's defaults (initiation interval 1, private to each unit, a pool
+/// of 4 when shared) but its latency and width.
+inline PipelineConfig pipeline_of(uint32_t latency, uint32_t width) {
+    PipelineConfig p;
+    p.latency = latency;
+    p.width = width;
+    return p;
+}
+
 /// How a run is simulated (docs/fidelity.md). The SystemC model runs approx and detailed; the
 /// harness runs functional (reference traversal, no time) and analytic (a closed form).
 enum class Fidelity : uint8_t { functional = 0, analytic = 1, approx = 2, detailed = 3 };
@@ -34,21 +43,38 @@ struct ModelConfig {
     bool ideal_memory = false;       ///< every access hits in L1 (upper bound on performance)
     DispatchConfig dispatch;
     TraversalConfig traversal;
-    PipelineConfig box{8, 1, 2, Sharing::per_unit, 4};
-    PipelineConfig triangle{20, 1, 1, Sharing::per_unit, 4};
-    PipelineConfig anyhit{10, 1, 1, Sharing::per_unit, 4};
-    PipelineConfig cell{4, 1, 1, Sharing::per_unit, 4};
+    // Each block's defaults are its config struct's; a member below names only what differs.
+    /// Ray/box tests: both child boxes of a binary node in one issue.
+    PipelineConfig box = pipeline_of(/*latency=*/8, /*width=*/2);
+    /// Watertight ray/triangle tests (Woop et al. 2013): a longer pipeline, one test per issue.
+    PipelineConfig triangle = pipeline_of(/*latency=*/20, /*width=*/1);
+    /// Alpha tests of alpha-MASK triangles' texels.
+    PipelineConfig anyhit = pipeline_of(/*latency=*/10, /*width=*/1);
+    /// Grid cell steps (3D-DDA: a compare and an add per step).
+    PipelineConfig cell = pipeline_of(/*latency=*/4, /*width=*/1);
     /// Instance transforms of two-level structures: a 3x4 matrix times the ray's origin and
     /// direction (18 multiply-adds), pipelined like a box test (Vulkan-Sim's instance transform).
-    PipelineConfig transform{8, 1, 1, Sharing::per_unit, 4};
+    PipelineConfig transform = pipeline_of(/*latency=*/8, /*width=*/1);
     /// Ray/split-plane tests of kd-trees, BIHs and octrees: (plane - origin) x 1/d and two
     /// compares, one slab of a box test; two per issue (a BIH node's pair).
-    PipelineConfig plane{4, 1, 2, Sharing::per_unit, 4};
+    PipelineConfig plane = pipeline_of(/*latency=*/4, /*width=*/2);
     MailboxConfig mailbox;
     // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
     // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
-    CacheConfig l1{16, 4, 64, 4, 16, 1, 1};
-    CacheConfig l2{1024, 16, 64, 20, 64, 8, 1};
+    CacheConfig l1 = [] {
+        CacheConfig c;  // 16 KiB, 4 ways, 64-byte lines, 4 cycles, 1 bank
+        c.mshrs = 16;
+        return c;
+    }();
+    CacheConfig l2 = [] {
+        CacheConfig c;  // 64-byte lines, 1 cycle per bank access
+        c.size_kib = 1024;
+        c.ways = 16;
+        c.latency = 20;
+        c.mshrs = 64;
+        c.banks = 8;
+        return c;
+    }();
     DramConfig dram;
     TreeletConfig treelets;
 

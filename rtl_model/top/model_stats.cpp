@@ -87,13 +87,13 @@ void check_group(const nlohmann::json& group, const StatBlock& block) {
 }  // namespace
 
 std::string traversal_units_text(const TraversalConfig& t) {
-    return std::to_string(t.units) + " units x " + std::to_string(t.ray_contexts) + " ray contexts";
+    return std::to_string(t.units) + " units x " + std::to_string(t.contexts()) + " ray contexts";
 }
 
-void check_model_stats(const nlohmann::json& m) {
+void check_model_stats(const nlohmann::json& m, const std::string& unit_kind) {
     model_stats().check(m);
     dispatch_stats().check(m.at("dispatch"));
-    check_group(m.at("units"), unit_stats());
+    check_group(m.at("units"), unit_stats_of(unit_kind));
     for (const char* kind : kOpKindNames)
         if (m.contains(kind)) check_group(m.at(kind), pipeline_stats());
     if (m.contains("l1")) check_group(m.at("l1"), cache_stats());
@@ -104,5 +104,9 @@ void check_model_stats(const nlohmann::json& m) {
     if (m.contains("cycle_accounting")) cycle_accounting_stats().check(m.at("cycle_accounting"));
     if (m.contains("utilization")) utilization_stats().check(m.at("utilization"));
 }
+
+RTSIM_REGISTER_STAT_BLOCK(model_stats)
+RTSIM_REGISTER_STAT_BLOCK(cycle_accounting_stats)
+RTSIM_REGISTER_STAT_BLOCK(utilization_stats)
 
 }  // namespace rtsim

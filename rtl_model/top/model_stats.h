@@ -27,6 +27,8 @@ std::string traversal_units_text(const TraversalConfig& traversal);
 
 /// Checks a "model" object and every block in it against its declaration; throws rtsim::Error
 /// naming the first undeclared or missing key.
-void check_model_stats(const nlohmann::json& model);
+/// `unit_kind`: traversal.model, whose stats block each unit's is checked against beside
+/// unit_stats() (rtl_model/traversal/unit_stats.h).
+void check_model_stats(const nlohmann::json& model, const std::string& unit_kind);
 
 }  // namespace rtsim

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "rtl_model/top/model_stats.h"
+#include "traces/common/error.h"
 
 namespace rtsim {
 
@@ -29,12 +30,15 @@ private:
     MemStats m_stats;
 };
 
-Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const MemoryMap& map,
-         RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features)
+Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const StepOptions& step,
+         const MemoryMap& map, RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features)
     : sc_core::sc_module(name),
       m_config(config),
       m_unit_context{config.quantum_cycles, config.dispatch.latency, config.treelets.idle_poll_cycles},
-      m_steppers(accel) {
+      m_steppers(accel, step) {
+    require(config.traversal.ray_contexts > 0 && config.traversal.stack_entry_bytes > 0,
+            "model: the config is not resolved (traversal.ray_contexts and stack_entry_bytes 0); the run's "
+            "resolution step derives them");
     m_unit_context.line_bytes = config.l1.line_bytes;
     m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, config.traversal.units, rays);
     build_memory();
@@ -48,8 +52,9 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
     m_unit_context.sync_private_steps =
         !(m_config.fidelity == Fidelity::detailed && private_ops && !m_config.treelets.enabled);
     const UnitSetup setup{config.traversal, m_unit_context, map, m_steppers, step_costs(config, accel.op_kinds())};
+    const UnitKind& kind = config.traversal.kind();
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
-        auto unit = make_traversal_unit(("tu" + std::to_string(u)).c_str(), setup, u);
+        auto unit = kind.make_unit(("tu" + std::to_string(u)).c_str(), setup, u);
         unit->rays(*m_dispatch);
         unit->sink(sink);
         if (m_ideal) unit->mem(*m_ideal);
@@ -144,7 +149,7 @@ void Top::build_ray_buffer(const Accel& accel, const MemoryMap& map) {
     }
     m_partition = accel.partition(uint64_t(t.treelet_kib) * 1024);
     const TraversalConfig& tc = m_config.traversal;
-    m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", t, m_partition, map, m_steppers, tc.units, tc.ray_contexts,
+    m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", t, m_partition, map, m_steppers, tc.units, tc.contexts(),
                                                ray_state_bytes(tc.stack_entries, tc.stack_entry_bytes,
                                                                m_config.mailbox.entries * MailboxConfig::kEntryBytes),
                                                m_config.quantum_cycles);
@@ -205,7 +210,7 @@ nlohmann::json Top::stats_json() const {
     if (m_dram) j["dram"] = m_dram->stats_json(total, m_config.clock_ghz);
     j["cycle_accounting"] = cycle_accounting_json(total);
     j["utilization"] = utilization_json(total);
-    check_model_stats(j);
+    check_model_stats(j, m_config.traversal.model);
     return j;
 }
 

@@ -17,7 +17,8 @@
 #include "rtl_model/mem/cache.h"
 #include "rtl_model/mem/dram.h"
 #include "rtl_model/ray_buffer/ray_buffer.h"
-#include "rtl_model/traversal/unit_registry.h"
+#include "rtl_model/traversal/traversal_unit.h"
+#include "rtl_model/traversal/unit_kind.h"
 #include "rtl_model/top/model_config.h"
 
 namespace rtsim {
@@ -38,8 +39,10 @@ struct MemoryTotals {
 
 class Top : public sc_core::sc_module {
 public:
-    Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const MemoryMap& map,
-        RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features);
+    /// `config` is resolved (sim/resolve/resolve.h: ray contexts derived, the stack entry known);
+    /// the steppers walk with `step` (the run's StepOptions).
+    Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const StepOptions& step,
+        const MemoryMap& map, RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features);
     ~Top() override;
 
     /// Cycle the last ray finished.

@@ -1,8 +1,8 @@
 #pragma once
 // What every kind of traversal unit is to the rest of the machine (docs/model.md, "Traversal
 // units"): ports to dispatch, its memory (the L1), one pipeline port per operation kind, the hit
-// sink and, with treelet scheduling, the ray buffer; and the stats it reports. Kinds are chosen
-// by name (traversal.model) from unit_registry.h; each costs its steps with the step-demand
+// sink and, with treelet scheduling, the ray buffer; and the stats it reports. Kinds register
+// themselves by name (traversal.model; unit_kind.h); each costs its steps with the step-demand
 // function (step_demand.h), so none re-types a timing rule.
 #include <cstdint>
 
@@ -16,12 +16,9 @@
 #include "rtl_model/traversal/cycle_accounting.h"
 #include "rtl_model/traversal/step_demand.h"
 #include "rtl_model/traversal/traversal_config.h"
+#include "rtl_model/traversal/unit_stats.h"
 
 namespace rtsim {
-
-/// The stats every traversal unit writes (model.units.<unit>; the analytic level's too), whatever
-/// its kind; keys only some kinds or modes write are optional.
-const StatBlock& unit_stats();
 
 /// What a unit needs from beyond its own config, set by the top level from the config tree.
 struct UnitContext {

@@ -62,10 +62,10 @@ std::string trace_identity(const TraceReader& reader) {
 }
 
 json analysis_key(const SimConfig& c, const AnalyticConfig& s, const std::string& identity) {
-    return {{"version", kAnalysisVersion},
+    json key = {{"version", kAnalysisVersion},
             {"trace", identity},
             {"units", c.traversal.units},
-            {"ray_contexts", c.traversal.ray_contexts},
+            {"ray_contexts", c.traversal.contexts()},
             {"stack_entries", c.traversal.stack_entries},
             {"stack_entry_bytes", c.traversal.stack_entry_bytes},
             {"dispatch", {{"policy", kDispatchPolicyChoices.name(c.dispatch.policy)},
@@ -76,6 +76,12 @@ json analysis_key(const SimConfig& c, const AnalyticConfig& s, const std::string
                         {"clusters", s.clusters},
                         {"warmup_rays", s.resolved_warmup_rays(c.l2.lines())},
                         {"measured_rays", s.measured_rays}}}};
+    // What the steppers walk with changes the stepped work (mailbox lookups, restarts, the
+    // reduced-precision walk); named only when set, so a plain run's key is as it always was.
+    if (c.mailbox.entries) key["mailbox_entries"] = c.mailbox.entries;
+    if (c.traversal.stack_overflow != StackOverflow::spill) key["short_stack_entries"] = c.traversal.stack_entries;
+    if (c.traversal.box_precision_bits) key["box_precision_bits"] = c.traversal.box_precision_bits;
+    return key;
 }
 
 std::string analysis_path(const std::string& rtt, const json& key) {

@@ -82,7 +82,7 @@ std::map<std::string, Memo>& memo() {
     return m;
 }
 
-std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& accel) {
+std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& accel, const StepOptions& step) {
     uint64_t h = 1469598103934665603ull;
     auto add = [&](const void* data, size_t n) {
         const auto* p = static_cast<const unsigned char*>(data);
@@ -90,6 +90,9 @@ std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& acc
     };
     const void* a = &accel;
     add(&a, sizeof a);
+    add(&step.mailbox_entries, sizeof step.mailbox_entries);
+    add(&step.short_stack_entries, sizeof step.short_stack_entries);
+    add(&step.box_precision_bits, sizeof step.box_precision_bits);
     for (const RayJob& j : jobs) {
         add(&j.id, sizeof j.id);
         add(&j.ray, sizeof j.ray);
@@ -110,11 +113,11 @@ AnalyticOutcome outcome_of(const SimConfig& config, const AnalyticProfile& profi
 }  // namespace
 
 const AnalyticProfile& analyze_stream(const SimConfig& config, const Accel& accel, const MemoryMap& map,
-                                      RayStream& rays, RaySinkIf& sink) {
+                                      const StepOptions& step, RayStream& rays, RaySinkIf& sink) {
     std::vector<RayJob> jobs;
     while (rays.read_chunk(65536, &jobs)) {
     }
-    const std::string key = analysis_key(config, config.analytic, stream_fingerprint(jobs, accel)).dump();
+    const std::string key = analysis_key(config, config.analytic, stream_fingerprint(jobs, accel, step)).dump();
     auto& cache = memo();
     auto it = cache.find(key);
     if (it != cache.end()) {
@@ -126,7 +129,7 @@ const AnalyticProfile& analyze_stream(const SimConfig& config, const Accel& acce
     p.accel_kind = accel.kind();
     p.op_kinds = accel.op_kinds();
     RecordingSink recording(sink);
-    SampleProfiler profiler(config, accel, map, p);
+    SampleProfiler profiler(config, accel, map, step, p);
     VectorStream stream(jobs);
     profiler.run_cluster(stream, 0, ~0ull, recording);
     profiler.finish();
@@ -143,15 +146,15 @@ const AnalyticProfile& analyze_stream(const SimConfig& config, const Accel& acce
     return cache.emplace(key, std::move(m)).first->second.profile;
 }
 
-AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
-                             RaySinkIf& sink) {
-    return outcome_of(config, analyze_stream(config, accel, map, rays, sink));
+AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                             const StepOptions& step, RayStream& rays, RaySinkIf& sink) {
+    return outcome_of(config, analyze_stream(config, accel, map, step, rays, sink));
 }
 
 SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig& config) {
     SamplePlan plan;
     plan.trace_rays = rays;
-    const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.ray_contexts;
+    const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.contexts();
     const uint32_t warmup = s.resolved_warmup_rays(config.l2.lines());
     const uint64_t length = uint64_t(warmup) + s.measured_rays + tail;
     const uint64_t clusters = std::min<uint64_t>(s.clusters, length ? rays / length : 0);
@@ -170,8 +173,9 @@ SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig
     return plan;
 }
 
-AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map, TraceReader& reader,
-                              RaySinkIf& sink, const AnalyticConfig& sample) {
+AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                              const StepOptions& step, TraceReader& reader, RaySinkIf& sink,
+                              const AnalyticConfig& sample) {
     const auto t0 = std::chrono::steady_clock::now();
     AnalyticProfile p;
     p.accel_kind = accel.kind();
@@ -179,7 +183,7 @@ AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const
     work_totals(reader, &p);
     const SamplePlan plan = analysis_plan(p.rays, sample, config);
     const bool whole = plan.clusters.size() == 1 && plan.clusters[0].warmup == 0;
-    SampleProfiler profiler(config, accel, map, p);
+    SampleProfiler profiler(config, accel, map, step, p);
     std::vector<RayRecord> buffer;
     for (const SamplePlan::Cluster& c : plan.clusters) {
         std::vector<RayJob> jobs;

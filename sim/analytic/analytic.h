@@ -24,7 +24,6 @@
 #include "rtl_model/dispatch/dispatch.h"
 #include "sim/config/config.h"
 #include "sim/analytic/profile.h"
-#include "sim/harness/simulate.h"
 #include "traces/accel/accel.h"
 #include "traces/format/trace_reader.h"
 
@@ -40,32 +39,30 @@ struct AnalyticOutcome {
 /// its own sample, e.g. the verdict's 8192 rays), each finished ray reported to `sink` (start
 /// and end 0). The analysis of a stream is kept in memory for the process, so evaluating several
 /// configurations with the same key on the same rays steps them once.
-AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map, RayStream& rays,
-                             RaySinkIf& sink);
+AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                             const StepOptions& step, RayStream& rays, RaySinkIf& sink);
 
 /// The analysis run_analytic evaluates: the stream stepped once per process and key (later calls
 /// with the same rays and key return the kept analysis, replaying the results to `sink`). The
 /// reference stays valid until the next call (a handful of analyses are kept).
 const AnalyticProfile& analyze_stream(const SimConfig& config, const Accel& accel, const MemoryMap& map,
-                                      RayStream& rays, RaySinkIf& sink);
+                                      const StepOptions& step, RayStream& rays, RaySinkIf& sink);
 
 /// The exact variant: every ray stepped, every access through functional
 /// caches on unloaded clocks (exact.cpp); for tests and comparisons.
 AnalyticOutcome run_analytic_exact(const SimConfig& config, const Accel& accel, const MemoryMap& map,
-                                   RayStream& rays, RaySinkIf& sink);
+                                   const StepOptions& step, RayStream& rays, RaySinkIf& sink);
 
 /// The per-trace analysis of a whole trace: work counts of every ray, the sampled clusters
 /// (every stepped ray checked through `sink`).
-AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map, TraceReader& reader,
-                              RaySinkIf& sink, const AnalyticConfig& sample);
+AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+                              const StepOptions& step, TraceReader& reader, RaySinkIf& sink,
+                              const AnalyticConfig& sample);
 
 /// Which rays the analysis of a trace of `rays` rays steps: clusters of (warm-up, measured) in
 /// trace order (sim/sampling/sampling.h's plan type; measured = the cluster's rest).
 struct SamplePlan;
 SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& sample, const SimConfig& config);
 
-/// rtsim-sim at fidelity = analytic: the analysis from the cache beside the trace (or computed
-/// and cached), the estimate, stats.json, config.resolved.json, provenance.json.
-SimOutcome run_analytic_simulation(const SimOptions& options);
 
 }  // namespace rtsim

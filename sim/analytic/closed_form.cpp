@@ -53,7 +53,7 @@ json bounds_of(const SimConfig& c, const std::vector<OpKind>& ops, const Analyti
         b["l2_mshrs"] = std::max(d.l2_hold / double(c.l2.mshrs), l2_loop_bound(c, d));
     }
     b["scheduler"] = d.scheduler_steps * t.issue_cycles / t.units;
-    b["latency"] = std::max(d.latency_sum / (double(t.units) * t.ray_contexts), d.latency_max);
+    b["latency"] = std::max(d.latency_sum / (double(t.units) * t.contexts()), d.latency_max);
     return b;
 }
 
@@ -95,7 +95,7 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
     think = std::max(think, 0.0);
     std::vector<double> queue(stations.size(), 0.0), r(stations.size());
     double x = 0;
-    for (uint32_t n = 1; n <= c.traversal.ray_contexts; ++n) {
+    for (uint32_t n = 1; n <= c.traversal.contexts(); ++n) {
         double residence = think;
         for (size_t k = 0; k < stations.size(); ++k) {
             r[k] = stations[k].demand * (1.0 + (stations[k].shared ? units : 1.0) * queue[k]);
@@ -141,8 +141,8 @@ const StatBlock& analytic_stats() {
     return block;
 }
 
-void check_analytic_model(const json& model) {
-    check_model_stats(model);
+void check_analytic_model(const json& model, const std::string& unit_kind) {
+    check_model_stats(model, unit_kind);
     if (model.contains("analytic")) analytic_stats().check(model.at("analytic"));
 }
 
@@ -203,5 +203,7 @@ json analytic_instantiated(const SimConfig& c, const std::string& accel_kind, co
     }
     return out;
 }
+
+RTSIM_REGISTER_STAT_BLOCK(analytic_stats)
 
 }  // namespace rtsim

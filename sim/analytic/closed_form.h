@@ -52,7 +52,7 @@ ClosedForm closed_form(const SimConfig& config, const std::vector<OpKind>& ops, 
 const StatBlock& analytic_stats();
 /// Checks a model tree the analytic level wrote against the declarations (the model's blocks
 /// and model.analytic), as the timed levels' is checked (check_model_stats).
-void check_analytic_model(const nlohmann::json& model);
+void check_analytic_model(const nlohmann::json& model, const std::string& unit_kind);
 
 /// The closed form's keys of model.analytic (docs/stats.md).
 nlohmann::json closed_form_json(const ClosedForm& f, const AnalyticDemands& d);

@@ -32,10 +32,11 @@ struct UnitCounts {
 
 class AnalyticModel {
 public:
-    AnalyticModel(const SimConfig& config, const Accel& accel, const MemoryMap& map, RaySinkIf& sink)
+    AnalyticModel(const SimConfig& config, const Accel& accel, const MemoryMap& map, const StepOptions& step,
+                  RaySinkIf& sink)
         : m_c(config), m_costs(step_costs(config, accel.op_kinds())), m_map(map), m_sink(sink), m_ops(accel.op_kinds()), m_units(config.traversal.units),
-          m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts) {
-        for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper();
+          m_contexts(size_t(config.traversal.units) * config.traversal.contexts()) {
+        for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper(step);
         if (!config.ideal_memory) {
             for (uint32_t u = 0; u < config.traversal.units; ++u) m_l1.emplace_back(config.l1);
             m_l2 = std::make_unique<FunctionalCache>(config.l2);
@@ -84,7 +85,7 @@ private:
 
 void AnalyticModel::run(RayStream& rays) {
     m_dispatch = std::make_unique<RayDealer>(m_c.dispatch, m_c.traversal.units, rays);
-    const uint32_t units = m_c.traversal.units, contexts = m_c.traversal.ray_contexts;
+    const uint32_t units = m_c.traversal.units, contexts = m_c.traversal.contexts();
     // The context whose unloaded clock is earliest takes the next step (ties: context-major,
     // then unit, so the first rays spread over the units); a context that finishes a ray takes
     // the next one at once. The clocks order the accesses and detect fills in flight only.
@@ -107,7 +108,7 @@ bool AnalyticModel::start_ray(uint32_t unit, uint32_t slot) {
     RayJob job;
     if (!m_dispatch->next_ray(unit, &job)) return false;
     ++m_dispatched;
-    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
+    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.contexts() + slot];
     ctx.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_units[unit].rejected;
     ctx.id = job.id;
@@ -121,7 +122,7 @@ bool AnalyticModel::start_ray(uint32_t unit, uint32_t slot) {
 }
 
 void AnalyticModel::step(uint32_t unit, uint32_t slot) {
-    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.ray_contexts + slot];
+    Context& ctx = m_contexts[size_t(unit) * m_c.traversal.contexts() + slot];
     UnitCounts& uc = m_units[unit];
     Stepper& stepper = *ctx.stepper;
     const StepPlan& plan = stepper.plan();
@@ -219,7 +220,7 @@ void AnalyticModel::write(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind
 /// demand; returns the refill latency.
 Cycle AnalyticModel::stack_traffic(uint32_t unit, uint32_t slot, const StepDemand& d, Cycle now) {
     const uint32_t bytes = m_costs.stack_entry_bytes;
-    const uint64_t owner = uint64_t(unit) * m_c.traversal.ray_contexts + slot;
+    const uint64_t owner = uint64_t(unit) * m_c.traversal.contexts() + slot;
     Cycle refill = 0;
     d.for_each_spill([&](uint32_t s) {
         write(unit, m_map.stack(owner, s, bytes), bytes, DataKind::stack);
@@ -300,8 +301,8 @@ AnalyticOutcome AnalyticModel::outcome(const Accel& accel) const {
 }  // namespace
 
 AnalyticOutcome run_analytic_exact(const SimConfig& config, const Accel& accel, const MemoryMap& map,
-                                   RayStream& rays, RaySinkIf& sink) {
-    AnalyticModel model(config, accel, map, sink);
+                                   const StepOptions& step, RayStream& rays, RaySinkIf& sink) {
+    AnalyticModel model(config, accel, map, step, sink);
     model.run(rays);
     return model.outcome(accel);
 }

@@ -5,21 +5,21 @@
 
 namespace rtsim {
 
-SampleProfiler::SampleProfiler(const SimConfig& config, const Accel& accel, const MemoryMap& map,
+SampleProfiler::SampleProfiler(const SimConfig& config, const Accel& accel, const MemoryMap& map, const StepOptions& step,
                                AnalyticProfile& profile)
     : m_c(config),
       m_costs(step_costs(config, accel.op_kinds())),
       m_map(map),
       m_p(profile),
-      m_contexts(size_t(config.traversal.units) * config.traversal.ray_contexts),
+      m_contexts(size_t(config.traversal.units) * config.traversal.contexts()),
       m_ahead(m_contexts.size()),
       m_units(config.traversal.units),
-      m_slots(config.traversal.ray_contexts),
+      m_slots(config.traversal.contexts()),
       m_shift(0),
       m_unit_pos(config.traversal.units, 0),
       m_reads(kDataKindCount),
       m_op_sizes(profile.op_sizes.size()) {
-    for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper();
+    for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper(step);
     while ((1u << m_shift) < config.l1.line_bytes) ++m_shift;
 }
 

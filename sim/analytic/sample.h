@@ -27,7 +27,8 @@ namespace rtsim {
 
 class SampleProfiler {
 public:
-    SampleProfiler(const SimConfig& config, const Accel& accel, const MemoryMap& map, AnalyticProfile& profile);
+    SampleProfiler(const SimConfig& config, const Accel& accel, const MemoryMap& map, const StepOptions& step,
+                   AnalyticProfile& profile);
     /// Steps every ray of `stream` (one cluster, fresh history); rays with trace index in
     /// [measure_first, measure_end) are measured. Every stepped ray goes to `sink` (the checker).
     void run_cluster(RayStream& stream, uint64_t measure_first, uint64_t measure_end, RaySinkIf& sink);

@@ -27,8 +27,45 @@ std::string format_number(double x) {
     return out.str();
 }
 
+/// What every visitor of the tree does with choices: an enum's Choices, a string among names
+/// (traversal.model, whose names are the registered unit kinds) and an erased section's index
+/// (rtl_model/common/config_section.h) all reach the visitor's one choice_names().
+template <class Derived>
+class ChoiceVisits {
+public:
+    template <class E, size_t N>
+    void choice(const char* name, E& value, const Choices<E, N>& choices, const char* doc) {
+        size_t index = static_cast<size_t>(value);
+        self().choice_names(name, index, std::vector<const char*>(choices.names.begin(), choices.names.end()), doc);
+        value = static_cast<E>(index);
+    }
+    void choice_of(const char* name, std::string& value, const std::vector<const char*>& names, const char* doc) {
+        size_t index = 0;
+        while (index < names.size() && value != names[index]) ++index;
+        self().choice_names(name, index, names, doc);
+        if (index < names.size()) value = names[index];
+    }
+
+private:
+    Derived& self() { return static_cast<Derived&>(*this); }
+};
+
+/// Keys that moved into a unit kind's own section (traversal.<kind>): an old spec's key is
+/// refused with where it went.
+std::string moved_to(const std::string& key) {
+    static const std::pair<const char*, const char*> kMoved[] = {
+        {"traversal.lanes", "traversal.simt.lanes (warps) or traversal.packet.lanes (packets)"},
+        {"traversal.simt_policy", "traversal.simt.policy"},
+        {"traversal.simt_refill", "traversal.simt.refill"},
+        {"traversal.packet_split_below", "traversal.packet.split_below"},
+    };
+    for (const auto& [from, to] : kMoved)
+        if (key == from) return std::string(": it moved to ") + to;
+    return "";
+}
+
 /// Reads fields from a JSON object; every key of the object must be visited (else: unknown).
-class JsonReader {
+class JsonReader : public ChoiceVisits<JsonReader> {
 public:
     JsonReader(const json& j, std::string prefix) : m_json(j), m_prefix(std::move(prefix)) {
         require(j.is_object(), "config: '" + (m_prefix.empty() ? std::string("(root)") : m_prefix) + "' must be an object");
@@ -48,15 +85,18 @@ public:
             value = j->get<T>();
         }
     }
-    template <class E, size_t N>
-    void choice(const char* name, E& value, const Choices<E, N>& choices, const char*) {
+    void choice_names(const char* name, size_t& index, const std::vector<const char*>& names, const char*) {
         const json* j = take(name);
         if (!j) return;
         require(j->is_string(), "config: '" + join_path(m_prefix, name) + "' must be a string");
         const std::string text = j->get<std::string>();
-        if (choices.parse(text.c_str(), &value)) return;
+        for (size_t i = 0; i < names.size(); ++i)
+            if (text == names[i]) {
+                index = i;
+                return;
+            }
         std::string list;
-        for (const char* o : choices.names) list += (list.empty() ? "" : ", ") + std::string(o);
+        for (const char* o : names) list += (list.empty() ? "" : ", ") + std::string(o);
         throw Error("config: '" + join_path(m_prefix, name) + "' = '" + text + "' is not one of: " + list);
     }
     void flag(const char* name, bool& value, const char*) {
@@ -77,7 +117,8 @@ public:
     void finish() const {
         for (auto it = m_json.begin(); it != m_json.end(); ++it)
             if (std::find(m_seen.begin(), m_seen.end(), it.key()) == m_seen.end())
-                throw Error("config: unknown key '" + join_path(m_prefix, it.key().c_str()) + "'" + known_keys());
+                throw Error("config: unknown key '" + join_path(m_prefix, it.key().c_str()) + "'" +
+                            moved_to(join_path(m_prefix, it.key().c_str())) + known_keys());
     }
 
 private:
@@ -96,13 +137,14 @@ private:
     std::vector<std::string> m_seen;
 };
 
-class JsonWriter {
+class JsonWriter : public ChoiceVisits<JsonWriter> {
 public:
     explicit JsonWriter(json& out) : m_out(out) { m_out = json::object(); }
     template <class T>
     void field(const char* name, T& value, const char*, const char*, double, double) { m_out[name] = value; }
-    template <class E, size_t N>
-    void choice(const char* name, E& value, const Choices<E, N>& choices, const char*) { m_out[name] = choices.name(value); }
+    void choice_names(const char* name, size_t& index, const std::vector<const char*>& names, const char*) {
+        m_out[name] = index < names.size() ? names[index] : "unknown";
+    }
     void flag(const char* name, bool& value, const char*) { m_out[name] = value; }
     template <class S>
     void section(const char* name, S& s) {
@@ -114,7 +156,7 @@ private:
     json& m_out;
 };
 
-class SchemaWriter {
+class SchemaWriter : public ChoiceVisits<SchemaWriter> {
 public:
     explicit SchemaWriter(json& out) : m_out(out) { m_out = json::object(); }
     template <class T>
@@ -122,10 +164,9 @@ public:
         add(name, {{"type", std::is_integral_v<T> ? "int" : "float"}, {"default", value}, {"unit", unit},
                    {"min", lo}, {"max", hi}, {"doc", doc}});
     }
-    template <class E, size_t N>
-    void choice(const char* name, E& value, const Choices<E, N>& choices, const char* doc) {
-        add(name, {{"type", "choice"}, {"default", choices.name(value)},
-                   {"choices", std::vector<std::string>(choices.names.begin(), choices.names.end())}, {"doc", doc}});
+    void choice_names(const char* name, size_t& index, const std::vector<const char*>& names, const char* doc) {
+        add(name, {{"type", "choice"}, {"default", index < names.size() ? names[index] : "unknown"},
+                   {"choices", std::vector<std::string>(names.begin(), names.end())}, {"doc", doc}});
     }
     void flag(const char* name, bool& value, const char* doc) {
         add(name, {{"type", "bool"}, {"default", value}, {"doc", doc}});
@@ -148,7 +189,7 @@ private:
     int m_next = 0;
 };
 
-class RangeValidator {
+class RangeValidator : public ChoiceVisits<RangeValidator> {
 public:
     explicit RangeValidator(std::string prefix = "") : m_prefix(std::move(prefix)) {}
     template <class T>
@@ -158,10 +199,12 @@ public:
                 "config: '" + join_path(m_prefix, name) + "' = " + format_number(d) + " is out of range [" +
                     format_number(lo) + ", " + format_number(hi) + "] " + unit);
     }
-    /// Choices are validated when read (JsonReader::choice); an enum in range is always valid.
-    template <class E, size_t N>
-    void choice(const char* name, E& value, const Choices<E, N>&, const char*) {
-        require(static_cast<size_t>(value) < N, "config: '" + join_path(m_prefix, name) + "' holds an invalid value");
+    /// Choices are validated when read (JsonReader::choice_names); one set in code may be invalid.
+    void choice_names(const char* name, size_t& index, const std::vector<const char*>& names, const char*) {
+        std::string list;
+        for (const char* o : names) list += (list.empty() ? "" : ", ") + std::string(o);
+        require(index < names.size(), "config: '" + join_path(m_prefix, name) + "' holds an invalid value (one of: " +
+                                          list + ")");
     }
     void flag(const char*, bool&, const char*) {}
     template <class S>
@@ -219,7 +262,7 @@ json config_to_json(const SimConfig& config) {
 namespace {
 
 /// Finds one field by its dotted path.
-class FieldFinder {
+class FieldFinder : public ChoiceVisits<FieldFinder> {
 public:
     FieldFinder(const std::string& key, std::string prefix, ConfigField* out, bool* found)
         : m_key(key), m_prefix(std::move(prefix)), m_out(out), m_found(found) {}
@@ -227,9 +270,9 @@ public:
     void field(const char* name, T& value, const char*, const char*, double lo, double hi) {
         if (join_path(m_prefix, name) == m_key) *m_out = {json(value), lo, hi}, *m_found = true;
     }
-    template <class E, size_t N>
-    void choice(const char* name, E& value, const Choices<E, N>& choices, const char*) {
-        if (join_path(m_prefix, name) == m_key) *m_out = {json(choices.name(value)), 0, 0}, *m_found = true;
+    void choice_names(const char* name, size_t& index, const std::vector<const char*>& names, const char*) {
+        if (join_path(m_prefix, name) == m_key)
+            *m_out = {json(index < names.size() ? names[index] : "unknown"), 0, 0}, *m_found = true;
     }
     void flag(const char* name, bool& value, const char*) {
         if (join_path(m_prefix, name) == m_key) *m_out = {json(value), 0, 0}, *m_found = true;
@@ -274,45 +317,8 @@ void validate(const SimConfig& config) {
     RangeValidator ranges;
     copy.visit(ranges);
     validate_model(config);
-    require(!config.treelets.enabled || config.fidelity != Fidelity::analytic,
-            "config: 'treelets.enabled' is not supported at fidelity 'analytic' (its closed form models plain "
-            "dispatch); use approx or detailed");
-    require(config.mailbox.entries == 0 || config.fidelity != Fidelity::analytic ||
-                config.analytic.caches == AnalyticCaches::functional,
-            "config: 'mailbox.entries' is not supported at fidelity 'analytic' with analytic.caches=statistical (its "
-            "per-trace analysis prices triangle tests from the trace's work records, which hold no mailbox); use "
-            "analytic.caches=functional, approx or detailed");
-    require(config.traversal.stack_overflow == StackOverflow::spill || config.fidelity != Fidelity::analytic ||
-                config.analytic.caches == AnalyticCaches::functional,
-            "config: 'traversal.stack_overflow' restart_trail is not supported at fidelity 'analytic' with "
-            "analytic.caches=statistical (its per-trace analysis prices steps from the trace's work records, which "
-            "hold no restarts); use analytic.caches=functional, approx or detailed");
-    require(config.traversal.model == UnitModel::mimd || config.fidelity != Fidelity::analytic,
-            "config: 'traversal.model' " + std::string(kUnitModelChoices.name(config.traversal.model)) +
-                " is not supported at fidelity 'analytic' (its closed form costs each ray context on its own, "
-                "with no lock-step warps); use approx or detailed, or traversal.model mimd");
-    require(config.traversal.stack_overflow == StackOverflow::spill || config.traversal.model != UnitModel::packet,
-            "config: 'traversal.stack_overflow' restart_trail is not supported with traversal.model packet (a "
-            "packet's rays share one stack, and the restart trail is a single ray's); use traversal.model mimd or "
-            "simt, or stack_overflow spill");
-    require(config.traversal.box_precision_bits == 0 || config.fidelity != Fidelity::analytic ||
-                config.analytic.caches == AnalyticCaches::functional,
-            "config: 'traversal.box_precision_bits' is not supported at fidelity 'analytic' with "
-            "analytic.caches=statistical (its per-trace analysis prices steps from the trace's work records, which "
-            "hold no extra walk); use analytic.caches=functional, approx or detailed, or box_precision_bits 0");
-    require(config.traversal.box_precision_bits == 0 || config.traversal.model != UnitModel::packet,
-            "config: 'traversal.box_precision_bits' is not supported with traversal.model packet (a packet's "
-            "shared walk has no per-ray extra walk); use traversal.model mimd or simt, or box_precision_bits 0");
-    require(config.sampling.fraction == 0 || config.sampling.count == 0,
-            "config: set 'sampling.fraction' or 'sampling.count', not both");
-    require(!config.sampling.enabled() || !config.treelets.enabled,
-            "config: sampling ('sampling.fraction' or 'sampling.count') is not supported with 'treelets.enabled': "
-            "the ray buffer admits a cluster's rays long before the machine can trace them, so the span of their "
-            "starts does not measure throughput (a 1% sample of Sponza on 4 units estimated -81%); simulate the "
-            "whole trace");
-    require(!config.sampling.enabled() || config.timed(),
-            "config: sampling ('sampling.fraction' or 'sampling.count') needs a timed SystemC level: fidelity approx "
-            "or detailed, not '" + std::string(kFidelityChoices.name(config.fidelity)) + "'");
+    // What may combine with what (techniques, unit kinds, structures, levels) is the resolution
+    // step's (sim/resolve/rules.h), matched once per run against the structure it runs.
 }
 
 }  // namespace rtsim

@@ -46,7 +46,9 @@ struct ConfigField {
 ConfigField config_field(const SimConfig& config, const std::string& key);
 /// Every field with default, unit, range, choices and doc: the schema the Python side mirrors.
 nlohmann::json config_schema();
-/// Range checks plus cross-field rules; throws rtsim::Error naming the field.
+/// Range checks plus each block's own field rules (cache geometry, DRAM address fields); throws
+/// rtsim::Error naming the field. What combines with what is the resolution step's
+/// (sim/resolve/resolve.h).
 void validate(const SimConfig& config);
 
 }  // namespace rtsim

@@ -9,16 +9,6 @@ namespace rtsim {
 
 using nlohmann::json;
 
-void check_frames_supported(const SimConfig& config, size_t frames, const std::string& trace) {
-    if (frames <= 1) return;
-    const std::string what = trace + ": an animated trace (" + std::to_string(frames) + " frames) ";
-    require(config.fidelity != Fidelity::analytic,
-            what + "replays at fidelity functional, approx or detailed; fidelity=analytic does not replay frames yet");
-    require(!config.sampling.enabled(), what + "is replayed whole; sampling does not cut frames yet (sampling.fraction)");
-    require(!config.treelets.enabled,
-            what + "is replayed without treelet scheduling; treelets.enabled=true does not hold frame barriers yet");
-}
-
 FrameRayStream::FrameRayStream(TraceReader& reader, std::vector<FrameRecord> frames)
     : m_reader(reader), m_frames(std::move(frames)), m_total(reader.section(SectionKind::rays).record_count) {
     begin_frame(0);
@@ -109,5 +99,7 @@ const StatBlock& frame_stats() {
         }};
     return block;
 }
+
+RTSIM_REGISTER_STAT_BLOCK(frame_stats)
 
 }  // namespace rtsim

@@ -17,10 +17,6 @@
 
 namespace rtsim {
 
-/// Refuses (rtsim::Error naming the field) what does not replay frames yet: the analytic level,
-/// sampling and treelet scheduling.
-void check_frames_supported(const SimConfig& config, size_t frames, const std::string& trace);
-
 /// Rays of the trace in order, each read ending at the current frame's last ray.
 class FrameRayStream : public RayStream {
 public:

@@ -89,4 +89,6 @@ const StatBlock& validation_stats() {
     return block;
 }
 
+RTSIM_REGISTER_STAT_BLOCK(validation_stats)
+
 }  // namespace rtsim

@@ -71,4 +71,6 @@ const StatBlock& latency_stats() {
     return block;
 }
 
+RTSIM_REGISTER_STAT_BLOCK(latency_stats)
+
 }  // namespace rtsim

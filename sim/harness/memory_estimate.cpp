@@ -38,7 +38,7 @@ uint64_t memory_limit_bytes() {
 MemoryEstimate estimate_sim_memory(const SimConfig& c, uint64_t image_bytes) {
     const double image = 2.0 * double(image_bytes);
     const double units = c.traversal.units;
-    const double contexts = units * c.traversal.ray_contexts;
+    const double contexts = units * c.traversal.contexts();
     double model = 0.0, context_bytes = 0.0, l1 = 0.0, l2 = 0.0;
     if (c.fidelity != Fidelity::functional) {
         l1 = units * cache_lines(c.l1) * kPerCacheLine;

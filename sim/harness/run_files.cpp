@@ -96,4 +96,6 @@ const StatBlock& workload_stats() {
     return block;
 }
 
+RTSIM_REGISTER_STAT_BLOCK(workload_stats)
+
 }  // namespace rtsim

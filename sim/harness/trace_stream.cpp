@@ -25,6 +25,23 @@ void read_ray_jobs(TraceReader& reader, uint64_t first, size_t n, std::vector<Ra
     }
 }
 
+SampleStream::SampleStream(TraceReader& reader, uint64_t first, uint64_t total, uint64_t sample) : m_reader(reader) {
+    const uint64_t blocks = total <= sample ? 1 : 16, block = total <= sample ? total : sample / blocks;
+    for (uint64_t b = 0; b < blocks; ++b) m_blocks.push_back({first + b * (total / blocks), block});
+    m_total = blocks * block;
+}
+
+size_t SampleStream::read_chunk(size_t max, std::vector<RayJob>* out) {
+    if (m_next == m_blocks.size()) return 0;
+    auto& [first, left] = m_blocks[m_next];
+    const size_t n = size_t(std::min<uint64_t>(max, left));
+    read_ray_jobs(m_reader, first, n, &m_buffer, out);
+    first += n;
+    left -= n;
+    if (left == 0) ++m_next;
+    return n;
+}
+
 size_t TraceRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
     size_t n = size_t(std::min<uint64_t>(max, m_total - m_next));
     if (n == 0) return 0;

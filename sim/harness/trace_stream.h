@@ -30,6 +30,22 @@ private:
     std::vector<RayRecord> m_buffer;
 };
 
+/// Evenly spread blocks of rays [first, first + total): the sample the verdict's analysis steps
+/// (16 blocks, `sample` rays in all; the whole range when it is no larger).
+class SampleStream : public RayStream {
+public:
+    SampleStream(TraceReader& reader, uint64_t first, uint64_t total, uint64_t sample);
+    size_t read_chunk(size_t max, std::vector<RayJob>* out) override;
+    uint64_t total_rays() const override { return m_total; }
+
+private:
+    TraceReader& m_reader;
+    std::vector<std::pair<uint64_t, uint64_t>> m_blocks;  ///< first ray, rays left
+    size_t m_next = 0;
+    uint64_t m_total = 0;
+    std::vector<RayRecord> m_buffer;
+};
+
 /// Where the hit checker looks up a ray's reference hit and work by its trace index.
 class ReferenceSource {
 public:

@@ -1,4 +1,5 @@
 #include "sim/report/box_precision_stats.h"
+#include "sim/report/report_block.h"
 
 #include "sim/report/energy_area.h"
 
@@ -55,5 +56,22 @@ void add_box_precision_stats(json& stats, const SimConfig& c, const WorkTotals& 
                              : json(nullptr))
         .done();
 }
+
+RTSIM_REGISTER_STAT_BLOCK(box_precision_stats)
+
+namespace {
+
+ReportBlock box_precision_report() {
+    ReportBlock b;
+    b.name = "reduced-precision boxes";
+    b.order = 30;
+    b.add = [](json& stats, const ReportInputs& in) { add_box_precision_stats(stats, in.config, in.work, in.rays); };
+    b.keys = {{"box_precision", box_precision_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(box_precision_report())
 
 }  // namespace rtsim

@@ -1,4 +1,5 @@
 #include "sim/report/energy_area.h"
+#include "sim/report/report_block.h"
 
 #include <algorithm>
 #include <array>
@@ -136,7 +137,7 @@ double pipeline_mm2(const EnergyConfig& c, const SimConfig& s, const PipelineCon
 
 /// The mailboxes' SRAM, bytes: one table of mailbox.entries primitive ids per ray context.
 double mailbox_bytes(const SimConfig& s) {
-    return double(s.traversal.units) * s.traversal.ray_contexts * s.mailbox.entries * MailboxConfig::kEntryBytes;
+    return double(s.traversal.units) * s.traversal.contexts() * s.mailbox.entries * MailboxConfig::kEntryBytes;
 }
 
 bool instantiated(const json& list, const char* block) {
@@ -149,16 +150,22 @@ json area_json(const SimConfig& s, const json& stats) {
     const EnergyConfig& c = s.energy;
     const TraversalConfig& t = s.traversal;
     const double tags = 1 + c.sram_tag_overhead;
+    // The on-chip SRAM by block, bytes (data only; the caches' tags cost area below).
+    json bytes = json::object();
+    bytes["l1"] = s.ideal_memory ? 0.0 : double(t.units) * s.l1.size_kib * 1024;
+    bytes["l2"] = s.ideal_memory ? 0.0 : double(s.l2.size_kib) * 1024;
+    bytes["ray_buffer"] = s.treelets.enabled ? double(s.treelets.buffer_kib) * 1024 : 0.0;
+    bytes["stacks"] = double(t.units) * t.contexts() * t.stack_entries * t.stack_entry_bytes;
+    bytes["ray_contexts"] = double(t.units) * t.contexts() * kContextStateBytes;
+    if (s.mailbox.entries) bytes["mailbox"] = mailbox_bytes(s);
     json mm2 = json::object();
-    if (!s.ideal_memory) {
-        mm2["l1"] = sram_mm2(c, double(t.units) * s.l1.size_kib * 1024) * tags;
-        mm2["l2"] = sram_mm2(c, double(s.l2.size_kib) * 1024) * tags;
-    } else {
-        mm2["l1"] = mm2["l2"] = 0.0;
+    double sram = 0, sram_bytes = 0;
+    for (auto it = bytes.begin(); it != bytes.end(); ++it) {
+        const bool cache = it.key() == "l1" || it.key() == "l2";
+        mm2[it.key()] = sram_mm2(c, it->get<double>()) * (cache ? tags : 1.0);
+        sram += mm2[it.key()].get<double>();
+        sram_bytes += it->get<double>();
     }
-    mm2["ray_buffer"] = s.treelets.enabled ? sram_mm2(c, double(s.treelets.buffer_kib) * 1024) : 0.0;
-    mm2["stacks"] = sram_mm2(c, double(t.units) * t.ray_contexts * t.stack_entries * t.stack_entry_bytes);
-    mm2["ray_contexts"] = sram_mm2(c, double(t.units) * t.ray_contexts * kContextStateBytes);
     mm2["box"] = pipeline_mm2(c, s, s.box, at_precision(kBoxFlops, t.box_precision_bits));
     mm2["triangle"] = pipeline_mm2(c, s, s.triangle, kTriangleFlops);
     mm2["anyhit"] = instantiated(stats.value("instantiated", json::array()), "anyhit")
@@ -167,14 +174,10 @@ json area_json(const SimConfig& s, const json& stats) {
     // Blocks only some structures or configs have are listed only when built.
     if (instantiated(stats.value("instantiated", json::array()), "plane"))
         mm2["plane"] = pipeline_mm2(c, s, s.plane, kPlaneFlops);
-    if (s.mailbox.entries) mm2["mailbox"] = sram_mm2(c, mailbox_bytes(s));
-    double total = 0, sram = 0;
-    for (auto it = mm2.begin(); it != mm2.end(); ++it) {
-        total += it->get<double>();
-        if (it.key() != "box" && it.key() != "triangle" && it.key() != "anyhit" && it.key() != "plane")
-            sram += it->get<double>();
-    }
-    return {{"mm2", mm2}, {"total_mm2", total}, {"sram_mm2", sram}, {"logic_mm2", total - sram}};
+    double total = 0;
+    for (auto it = mm2.begin(); it != mm2.end(); ++it) total += it->get<double>();
+    return {{"mm2", mm2},        {"total_mm2", total},          {"sram_mm2", sram},
+            {"logic_mm2", total - sram}, {"sram_bytes", bytes}, {"sram_total_bytes", sram_bytes}};
 }
 
 }  // namespace
@@ -254,7 +257,7 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     if (s.mailbox.entries) {
         // A lookup compares the reference with the ray's whole table (its entries read); a test
         // run records its primitive (one id written).
-        const double table = double(t.ray_contexts) * s.mailbox.entries * MailboxConfig::kEntryBytes;
+        const double table = double(t.contexts()) * s.mailbox.entries * MailboxConfig::kEntryBytes;
         const double lookups = double(w[WorkField::mailbox_lookups]), hits = double(w[WorkField::mailbox_hits]);
         pj["mailbox"] = lookups * sram_access_pj(c, table, s.mailbox.entries * 32.0) +
                         (lookups - hits) * sram_access_pj(c, table, 32.0);
@@ -262,8 +265,8 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     // Traversal units: the ray's setup, and per step a read of the context's ray state and one
     // stack push or pop, each in the unit's SRAM of that kind.
     pj["traversal"] = double(rays) * op.ray_setup +
-                      double(w[WorkField::steps] + w[WorkField::rp_steps]) * (sram_access_pj(c, t.ray_contexts * kContextStateBytes, kContextReadBytes * 8) +
-                                         sram_access_pj(c, double(t.ray_contexts) * t.stack_entries * t.stack_entry_bytes,
+                      double(w[WorkField::steps] + w[WorkField::rp_steps]) * (sram_access_pj(c, t.contexts() * kContextStateBytes, kContextReadBytes * 8) +
+                                         sram_access_pj(c, double(t.contexts()) * t.stack_entries * t.stack_entry_bytes,
                                                         t.stack_entry_bytes * 8.0));
     const bool has_memory = model.contains("l1") || model.contains("ideal_memory");
     if (model.contains("ideal_memory")) {
@@ -370,8 +373,28 @@ const StatBlock& area_stats() {
             {"total_mm2", "mm^2", "all blocks"},
             {"sram_mm2", "mm^2", "the SRAM blocks"},
             {"logic_mm2", "mm^2", "the pipelines"},
+            {"sram_bytes", "B", "`{block: bytes}`: the on-chip SRAM's data, by block (`l1` all units, `l2`, `ray_buffer`, `stacks`, `ray_contexts`, `mailbox`); what a sweep's SRAM column and Pareto fronts read"},
+            {"sram_total_bytes", "B", "the sum of `sram_bytes`"},
         }};
     return block;
 }
+
+RTSIM_REGISTER_STAT_BLOCK(energy_stats)
+RTSIM_REGISTER_STAT_BLOCK(area_stats)
+
+namespace {
+
+ReportBlock energy_area_report() {
+    ReportBlock b;
+    b.name = "energy and area";
+    b.order = 50;
+    b.add = [](json& stats, const ReportInputs& in) { add_energy_area(stats, in.config, in.work, in.rays); };
+    b.keys = {{"energy", energy_stats}, {"area", area_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(energy_area_report())
 
 }  // namespace rtsim

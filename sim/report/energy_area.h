@@ -13,7 +13,7 @@
 
 #include "rtl_model/common/stats.h"
 #include "sim/config/config.h"
-#include "sim/harness/hit_checker.h"
+#include "traces/common/work_counts.h"
 
 namespace rtsim {
 

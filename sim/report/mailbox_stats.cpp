@@ -1,4 +1,5 @@
 #include "sim/report/mailbox_stats.h"
+#include "sim/report/report_block.h"
 
 #include "traces/common/hw_triangle.h"
 
@@ -36,7 +37,7 @@ void add_mailbox_stats(json& stats, const SimConfig& c, const WorkTotals& w, uin
     auto per_ray = [&](double x) { return rays ? json(x / n) : json(nullptr); };
     StatsWriter(mailbox_stats(), stats["mailbox"])
         .set("entries", c.mailbox.entries)
-        .set("sram_bytes", uint64_t(c.traversal.units) * c.traversal.ray_contexts * c.mailbox.entries *
+        .set("sram_bytes", uint64_t(c.traversal.units) * c.traversal.contexts() * c.mailbox.entries *
                                MailboxConfig::kEntryBytes)
         .set("lookups", lookups)
         .set("hits", hits)
@@ -52,5 +53,22 @@ void add_mailbox_stats(json& stats, const SimConfig& c, const WorkTotals& w, uin
                              {"tri_tests_without_mailbox", per_ray(without)}})
         .done();
 }
+
+RTSIM_REGISTER_STAT_BLOCK(mailbox_stats)
+
+namespace {
+
+ReportBlock mailbox_report() {
+    ReportBlock b;
+    b.name = "mailbox";
+    b.order = 10;
+    b.add = [](json& stats, const ReportInputs& in) { add_mailbox_stats(stats, in.config, in.work, in.rays); };
+    b.keys = {{"mailbox", mailbox_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(mailbox_report())
 
 }  // namespace rtsim

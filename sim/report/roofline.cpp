@@ -1,7 +1,7 @@
 #include "sim/report/roofline.h"
+#include "sim/report/report_block.h"
 
 #include "rtl_model/isect/pipeline.h"
-#include "rtl_model/traversal/traversal_unit.h"
 
 namespace rtsim {
 
@@ -82,7 +82,7 @@ json roofline_json(const SimConfig& c, const json& summary, const json& model) {
         if (issues > 0) ceilings[name] = pipelines * hz / c.pipeline(OpKind(k)).initiation_interval / (issues / rays);
     }
     double steps = 0;
-    for (const json& u : model.value("units", json::object())) steps += StatsReader(unit_stats(), u)["steps"].get<double>();
+    for (const json& u : model.value("units", json::object())) steps += StatsReader(registered_stat_block("model.units.<unit>"), u)["steps"].get<double>();
     if (steps > 0) ceilings["scheduler"] = double(c.traversal.units) * hz / c.traversal.issue_cycles / (steps / rays);
     json little = json::object();
     memory_ceilings(c, model, rays, hz, &ceilings, &little);
@@ -116,5 +116,24 @@ const StatBlock& roofline_stats() {
         }};
     return block;
 }
+
+RTSIM_REGISTER_STAT_BLOCK(roofline_stats)
+
+namespace {
+
+ReportBlock roofline_report() {
+    ReportBlock b;
+    b.name = "roofline";
+    b.order = 60;
+    b.add = [](json& stats, const ReportInputs& in) {
+        stats["roofline"] = roofline_json(in.config, stats["summary"], stats.value("model", json::object()));
+    };
+    b.keys = {{"roofline", roofline_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(roofline_report())
 
 }  // namespace rtsim

@@ -1,4 +1,5 @@
 #include "sim/report/short_stack_stats.h"
+#include "sim/report/report_block.h"
 
 namespace rtsim {
 
@@ -45,5 +46,22 @@ void add_short_stack_stats(json& stats, const SimConfig& c, const WorkTotals& w,
                              : json(nullptr))
         .done();
 }
+
+RTSIM_REGISTER_STAT_BLOCK(short_stack_stats)
+
+namespace {
+
+ReportBlock short_stack_report() {
+    ReportBlock b;
+    b.name = "short stack";
+    b.order = 20;
+    b.add = [](json& stats, const ReportInputs& in) { add_short_stack_stats(stats, in.config, in.work, in.rays); };
+    b.keys = {{"short_stack", short_stack_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(short_stack_report())
 
 }  // namespace rtsim

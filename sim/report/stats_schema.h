@@ -1,6 +1,7 @@
 #pragma once
-// Every stats block a run can write, declared by its producer (rtl_model/common/stats.h), in one
-// list: what `rtsim-sim --dump-stats-schema` prints and docs/stats.md's tables are generated from.
+// Every stats block a run can write, declared by its producer and registered from its .cpp
+// (rtl_model/common/stats.h): what `rtsim-sim --dump-stats-schema` prints and docs/stats.md's
+// tables are generated from; and the check of a run's whole stats.json against them.
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -9,8 +10,6 @@
 
 namespace rtsim {
 
-/// The blocks in the order docs/stats.md describes them.
-std::vector<const StatBlock*> stats_blocks();
 /// [{path, stats: [{key, unit, meaning, timed, optional}]}, ...]
 nlohmann::json stats_schema_json();
 /// Checks a run's whole stats.json against the declarations before it is written (the model

@@ -10,7 +10,6 @@
 
 #include "rtl_model/isect/pipeline.h"
 #include "rtl_model/mem/mem_stats.h"
-#include "rtl_model/traversal/traversal_unit.h"
 #include "sim/report/summary_schema.h"
 #include "traces/common/build_info.h"
 
@@ -37,6 +36,10 @@ json hit_rate(const json& caches) {
 }
 
 /// Mean of a stat over the blocks of a group ({"box_0": {...}, ...}) that all declare it in `block`.
+/// The stats every traversal unit writes, by its registered path (a report reads declared stats,
+/// never a unit kind).
+const StatBlock& unit_block() { return registered_stat_block("model.units.<unit>"); }
+
 json mean_of(const json& group, const StatBlock& block, const char* key) {
     if (!group.is_object() || group.empty()) return nullptr;
     double sum = 0, n = 0;
@@ -54,7 +57,7 @@ json simd_efficiency(const json& units) {
     double active = 0, slots = 0;
     bool simt = false;
     for (const json& u : units) {
-        const StatsReader r(unit_stats(), u);
+        const StatsReader r(unit_block(), u);
         if (!u.contains("lane_slots")) continue;
         simt = true;
         active += r["active_lanes"].get<double>();
@@ -77,12 +80,12 @@ double peak_memory_mib() {
 
 }  // namespace
 
-json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& model, const HitChecker& checker,
+json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& model, const CheckTotals& checker,
                double wall) {
     json s = {{"rays", rays},
               {"fidelity", kFidelityChoices.name(c.fidelity)},
-              {"hit_mismatches", checker.hit_mismatches()},
-              {"work_mismatches", checker.work_mismatches()},
+              {"hit_mismatches", checker.hit_mismatches},
+              {"work_mismatches", checker.work_mismatches},
               {"wall_seconds", wall},
               {"peak_memory_mib", peak_memory_mib()},
               {"simulated_rays_per_wall_second", wall > 0 ? double(rays) / wall : 0.0}};
@@ -98,8 +101,8 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
     s["seconds"] = seconds;
     s["rays_per_second"] = seconds > 0 ? double(rays) / seconds : 0.0;
     s["mrays_per_second"] = seconds > 0 ? double(rays) / seconds / 1e6 : 0.0;
-    s["avg_ray_latency_cycles"] = checker.latency().mean();
-    s["unit_busy_fraction"] = mean_of(model.value("units", json::object()), unit_stats(), "busy_fraction");
+    s["avg_ray_latency_cycles"] = checker.mean_latency_cycles;
+    s["unit_busy_fraction"] = mean_of(model.value("units", json::object()), unit_block(), "busy_fraction");
     if (const json simd = simd_efficiency(model.value("units", json::object())); !simd.is_null())
         s["simd_efficiency"] = simd;
     s["box_utilization"] = mean_of(model.value("box", json::object()), pipeline_stats(), "utilization");

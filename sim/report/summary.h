@@ -8,12 +8,18 @@
 #include <nlohmann/json.hpp>
 
 #include "sim/config/config.h"
-#include "sim/harness/hit_checker.h"
 
 namespace rtsim {
 
+/// What the run's hit check found, as the summary reports it.
+struct CheckTotals {
+    uint64_t hit_mismatches = 0;
+    uint64_t work_mismatches = 0;
+    double mean_latency_cycles = 0;  ///< the checked rays' mean latency (timed levels)
+};
+
 nlohmann::json summarize(const SimConfig& config, uint64_t cycles, uint64_t rays, const nlohmann::json& model,
-                         const HitChecker& checker, double wall_seconds);
+                         const CheckTotals& check, double wall_seconds);
 
 /// started: the run's start as seconds since the epoch.
 nlohmann::json provenance(const std::string& command_line, const std::string& trace, const nlohmann::json& manifest,

@@ -49,7 +49,7 @@ const StatBlock& summary_stats() {
          "mean over units of `model.units.<unit>.busy_fraction`",
          true, false},
         {"simd_efficiency", "fraction",
-         "`traversal.model` simt and packet: active lanes / lane slots over every unit's warp (or packet) steps (`model.units.<unit>.simd_efficiency`, Aila & Laine 2009)",
+         "unit kinds that step groups in lock-step (simt, packet): active lanes / lane slots over every unit's warp (or packet) steps (`model.units.<unit>.simd_efficiency`, Aila & Laine 2009)",
          false, true},
         {"box_utilization", "fraction",
          "mean over box pipeline blocks of `utilization`",
@@ -80,6 +80,9 @@ const StatBlock& summary_stats() {
          false, false},
         {"sampled", "bool",
          "true when only a sample of the rays was simulated ([fidelity.md](fidelity.md#sampling))",
+         false, false},
+        {"resolved", "",
+         "what the run's resolution step settled ([capabilities.md](capabilities.md)): `derived`, the fields the config left to the run (`[{key, value, why}]`: `traversal.ray_contexts` 0 follows the unit kind's warps or packets, `traversal.stack_entry_bytes` 0 the structure's), and `unused`, settings that have no effect on this run (`[{key, why}]`)",
          false, false},
         {"cycles_ci95", "cycles",
          "sampled runs only: `[lo, hi]`, the 95% confidence interval of `cycles`",
@@ -166,5 +169,9 @@ void check_summary(const nlohmann::json& summary, bool sampled) {
         require(!sampled_only(d) || !sampled || summary.contains(d.key),
                 std::string("stats: 'summary.") + d.key + "' is declared for sampled runs but was not written");
 }
+
+RTSIM_REGISTER_STAT_BLOCK(summary_stats)
+RTSIM_REGISTER_STAT_BLOCK(run_stats)
+RTSIM_REGISTER_STAT_BLOCK(provenance_stats)
 
 }  // namespace rtsim

@@ -1,4 +1,5 @@
 #include "sim/report/two_level_stats.h"
+#include "sim/report/report_block.h"
 
 namespace rtsim {
 
@@ -39,5 +40,24 @@ void add_two_level_stats(json& stats, const WorkTotals& w, uint64_t rays) {
                              : json(nullptr))
         .done();
 }
+
+RTSIM_REGISTER_STAT_BLOCK(two_level_stats)
+
+namespace {
+
+ReportBlock two_level_report() {
+    ReportBlock b;
+    b.name = "two levels";
+    b.order = 40;
+    b.add = [](json& stats, const ReportInputs& in) {
+        if (in.structure_kind == "two_level") add_two_level_stats(stats, in.work, in.rays);
+    };
+    b.keys = {{"two_level", two_level_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(two_level_report())
 
 }  // namespace rtsim

@@ -1,5 +1,8 @@
 #include "sim/report/verdict.h"
 
+#include <cctype>
+#include "sim/report/report_block.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -254,13 +257,16 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
 }
 
 /// Why the estimates do not describe this machine ("" when they do).
-std::string coverage_gap(const SimConfig& c) {
+std::string coverage_gap(const SimConfig& c, const UnitTraits& unit) {
     if (c.treelets.enabled)
         return "not estimated: the analytic level does not model treelet admission and queues, so the knobs "
                "are ranked by the cycle accounting; measure them with --check-verdict";
-    if (c.traversal.model != UnitModel::mimd)
-        return "estimated for the MIMD machine with the same ray contexts (the analytic level has no "
+    if (!unit.estimate_as.empty()) {
+        std::string stand_in = unit.estimate_as;
+        for (char& ch : stand_in) ch = char(std::toupper(static_cast<unsigned char>(ch)));
+        return "estimated for the " + stand_in + " machine with the same ray contexts (the analytic level has no "
                "lock-step warps: divergence is not in the estimates); measure them with --check-verdict";
+    }
     return "";
 }
 
@@ -282,9 +288,9 @@ json judge(const VerdictContext& c) {
     const auto [base_cycles, analytic_binding] = estimator(c.config);
     const bool timed = c.config.fidelity != Fidelity::analytic;
     const Evidence evidence = timed ? timed_evidence(c.config, c.model) : analytic_evidence(c.model, analytic_binding);
-    const std::string not_covered = coverage_gap(c.config);
+    const std::string not_covered = coverage_gap(c.config, c.unit);
     WeighInputs in{c.config, c.instantiated, [&](const SimConfig& x) { return estimator(x).first; }, base_cycles,
-                   not_covered, evidence.share};
+                   not_covered, evidence.share, c.unit.knobs};
     const json weighed = weigh_knobs(in);
     // The binding resource: the best knob's when it buys 2% (or, unestimated, when the
     // evidence points at it); else the largest cycle use's.
@@ -346,5 +352,27 @@ const StatBlock& verdict_stats() {
         }};
     return block;
 }
+
+RTSIM_REGISTER_STAT_BLOCK(verdict_stats)
+
+namespace {
+
+ReportBlock verdict_report() {
+    ReportBlock b;
+    b.name = "verdict";
+    b.order = 70;
+    b.add = [](json& stats, const ReportInputs& in) {
+        const json verdict = in.verdict ? in.verdict() : json(nullptr);
+        stats["verdict"] = verdict;
+        stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
+        stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];
+    };
+    b.keys = {{"verdict", verdict_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(verdict_report())
 
 }  // namespace rtsim

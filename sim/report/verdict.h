@@ -23,11 +23,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/stats.h"
 #include "rtl_model/common/memory_map.h"
+#include "rtl_model/dispatch/dispatch.h"
 #include "sim/config/config.h"
 #include "traces/accel/accel.h"
-#include "traces/format/trace_reader.h"
 #include "sim/report/verdict_knobs.h"
 
 namespace rtsim {
@@ -36,12 +37,21 @@ namespace rtsim {
 /// "scheduler", "latency", ...), doubled; an empty key when no knob does.
 Relaxation relaxation_for(const std::string& resource, const SimConfig& config);
 
+/// Evenly spread blocks of `sample` rays of rays [first, first + rays) of the run's trace: the
+/// rays the verdict's own analysis steps (the run loop reads them: sim/harness/trace_stream.h).
+using SampleStreamFactory = std::function<std::unique_ptr<RayStream>(uint64_t first, uint64_t rays, uint64_t sample)>;
+
 struct VerdictContext {
     const SimConfig& config;
     const nlohmann::json& model;  ///< the run's model stats (cycle accounting, utilisation, ...)
-    const Accel* accel;           ///< the structure, its memory map and the trace: the sample
-    const MemoryMap* map;         ///< the analytic estimates run on (unless `estimate` is set)
-    TraceReader* reader;
+    const Accel* accel;           ///< the structure, its memory map and the trace's rays: the
+    const MemoryMap* map;         ///< sample the analytic estimates run on (unless `estimate` is set)
+    SampleStreamFactory sample_stream;
+    StepOptions step = {};        ///< what the sample's steppers walk with (the run's)
+    std::string identity = {};    ///< the trace's identity (analysis_cache.h), "" when none
+    uint64_t trace_rays = 0;      ///< rays in the trace
+    /// The run's unit kind as the verdict needs it (the resolution step's, sim/resolve/resolve.h).
+    UnitTraits unit = {};
     uint64_t sample_rays = 8192;  ///< rays the analytic estimates run on (evenly spread blocks)
     /// When set, the analytic estimates (cycles, binding bound) come from it instead: the
     /// analytic level passes its own per-trace analysis, so it needs no second pass over rays.

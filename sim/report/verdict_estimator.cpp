@@ -6,40 +6,11 @@
 #include "sim/analytic/analysis_cache.h"
 #include "sim/analytic/analytic.h"
 #include "sim/analytic/estimate.h"
-#include "sim/harness/trace_stream.h"
 #include "sim/report/verdict.h"
 
 namespace rtsim {
 
 namespace {
-
-/// Evenly spread blocks of rays [first, first + count): a cheap sample for the estimates.
-class SampleStream : public RayStream {
-public:
-    SampleStream(TraceReader& reader, uint64_t first, uint64_t total, uint64_t sample) : m_reader(reader) {
-        const uint64_t blocks = total <= sample ? 1 : 16, block = total <= sample ? total : sample / blocks;
-        for (uint64_t b = 0; b < blocks; ++b) m_blocks.push_back({first + b * (total / blocks), block});
-        m_total = blocks * block;
-    }
-    size_t read_chunk(size_t max, std::vector<RayJob>* out) override {
-        if (m_next == m_blocks.size()) return 0;
-        auto& [first, left] = m_blocks[m_next];
-        const size_t n = size_t(std::min<uint64_t>(max, left));
-        read_ray_jobs(m_reader, first, n, &m_buffer, out);
-        first += n;
-        left -= n;
-        if (left == 0) ++m_next;
-        return n;
-    }
-    uint64_t total_rays() const override { return m_total; }
-
-private:
-    TraceReader& m_reader;
-    std::vector<std::pair<uint64_t, uint64_t>> m_blocks;  ///< first ray, rays left
-    size_t m_next = 0;
-    uint64_t m_total = 0;
-    std::vector<RayRecord> m_buffer;
-};
 
 class DiscardSink : public RaySinkIf {
 public:
@@ -48,13 +19,13 @@ public:
 
 }  // namespace
 
-SimConfig analytic_config(SimConfig config) {
+SimConfig analytic_config(SimConfig config, const std::string& estimate_as) {
     config.fidelity = Fidelity::analytic;
     config.treelets.enabled = false;
     config.sampling = SamplingConfig{};
-    // The closed form times each ray context on its own: a SIMT machine's relaxations are
-    // estimated for the MIMD machine with the same contexts (divergence is not in it).
-    config.traversal.model = UnitModel::mimd;
+    // The closed form times each ray context on its own: a lock-step kind's relaxations are
+    // estimated for the kind that stands in for it with the same contexts (divergence is not in it).
+    if (!estimate_as.empty()) config.traversal.model = estimate_as;
     return config;
 }
 
@@ -78,8 +49,8 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
         m_method = c.estimate_method;
         return;
     }
-    const SimConfig base = analytic_config(c.config);
-    const std::string identity = c.trace_path.empty() ? std::string() : trace_identity(*c.reader);
+    const SimConfig base = analytic_config(c.config, c.unit.estimate_as);
+    const std::string identity = c.trace_path.empty() ? std::string() : c.identity;
     // The analysis stored beside the trace for this key, if a run at the analytic level made it.
     if (c.frames == 1 && !c.trace_path.empty()) {
         const nlohmann::json key = analysis_key(base, base.analytic, identity);
@@ -93,9 +64,9 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
             return;
         }
     }
-    const uint64_t total = c.reader->section(SectionKind::rays).record_count;
-    const uint64_t rays = c.frame_rays ? c.frame_rays : total;
-    SampleStream stream(*c.reader, c.first_ray, rays, c.sample_rays);
+    const uint64_t rays = c.frame_rays ? c.frame_rays : c.trace_rays;
+    const std::unique_ptr<RayStream> sample = c.sample_stream(c.first_ray, rays, c.sample_rays);
+    RayStream& stream = *sample;
     m_method = "analytic level on " + std::to_string(stream.total_rays()) + " sampled rays" +
                (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " (treelets off)" : "");
     // Else the verdict's own sample analysis: stored beside the trace by the first run that
@@ -109,7 +80,7 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
         stored = load_analysis(path, key);
         if (!stored) {
             DiscardSink sink;
-            m_profile = &analyze_stream(base, *c.accel, *c.map, stream, sink);
+            m_profile = &analyze_stream(base, *c.accel, *c.map, c.step, stream, sink);
             if (!path.empty()) {
                 AnalyticProfile keyed = *m_profile;
                 keyed.key = key;
@@ -126,7 +97,7 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
 }
 
 std::pair<double, std::string> VerdictEstimator::operator()(const SimConfig& config) const {
-    const SimConfig a = analytic_config(config);
+    const SimConfig a = analytic_config(config, m_context.unit.estimate_as);
     if (m_context.estimate) return m_context.estimate(a);
     const ClosedForm form = (*m_form)(a);
     return {form.cycles, form.binding};

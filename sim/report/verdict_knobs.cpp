@@ -122,7 +122,7 @@ Relaxation halved(const SimConfig& c, const std::string& key) {
     return {key, f.value, json(value / 2)};
 }
 
-std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops) {
+std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops, const std::vector<KindKnob>& kind_knobs) {
     std::vector<Knob> out;
     add(&out, doubled(c, "traversal.units"), "units");
     add(&out, doubled(c, "traversal.ray_contexts"), "latency");
@@ -138,8 +138,8 @@ std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops)
         add(&out, doubled(c, "dram.channels"), "dram");
     }
     add(&out, doubled(c, "traversal.stack_entries"), "stack");
-    // Narrower warps (or packets) diverge less; the analytic level has neither, so only a re-run measures it.
-    if (c.traversal.model != UnitModel::mimd) add(&out, halved(c, "traversal.lanes"), "divergence", false);
+    for (const KindKnob& k : kind_knobs)
+        add(&out, k.halve ? halved(c, k.key) : doubled(c, k.key), k.resource, k.estimated);
     if (c.treelets.enabled) treelet_knobs(c, &out);
     return out;
 }
@@ -160,7 +160,7 @@ json weigh_knobs(const WeighInputs& in) {
                 ops.push_back(OpKind(k));
     const double base_mm2 = area_total_mm2(in.config, in.instantiated);
     json knobs = json::array();
-    for (const Knob& k : every_knob(in.config, ops)) {
+    for (const Knob& k : every_knob(in.config, ops, in.kind_knobs)) {
         json j = {{"key", k.relax.key}, {"resource", k.resource}, {"from", k.relax.from}, {"to", k.relax.to},
                   {"speedup", nullptr}, {"added_mm2", nullptr}, {"gain_per_mm2", nullptr}};
         const auto e = in.evidence.find(k.resource);

@@ -38,10 +38,28 @@ struct Knob {
     bool estimable = true;  ///< the analytic level models what the knob changes
 };
 
+/// A knob of the unit kind's own (its registration's UnitKnob, handed over by the run loop).
+struct KindKnob {
+    std::string key;
+    bool halve = false;     ///< relaxed by halving (else doubling)
+    std::string resource;
+    bool estimated = true;  ///< the analytic level can estimate it
+};
+
+/// What the verdict knows of the run's unit kind, from the run's resolution step: its own knobs,
+/// and the kind whose analytic estimate stands in where the level has no lock-step groups.
+struct UnitTraits {
+    std::string name = "mimd";
+    std::vector<KindKnob> knobs;
+    std::string estimate_as;  ///< "" when the analytic level costs the kind itself
+};
+
 /// Every knob of this config that relaxes a resource: units, ray contexts, the pipelines of the
 /// operation kinds in `ops`, the scheduler, L1 and L2 capacity, banks and MSHRs, DRAM channels,
-/// the on-chip stack and, with treelets on, the ray buffer, admission and scheduling.
-std::vector<Knob> every_knob(const SimConfig& config, const std::vector<OpKind>& ops);
+/// the on-chip stack, the unit kind's own knobs and, with treelets on, the ray buffer, admission
+/// and scheduling.
+std::vector<Knob> every_knob(const SimConfig& config, const std::vector<OpKind>& ops,
+                             const std::vector<KindKnob>& kind_knobs = {});
 
 /// The cycles the estimator gives for a config; throws rtsim::Error for a config it refuses.
 using CycleEstimate = std::function<double(const SimConfig&)>;
@@ -53,6 +71,7 @@ struct WeighInputs {
     double base_cycles = 0;               ///< the estimator's cycles for `config`
     std::string not_covered;              ///< why the estimates do not describe this machine ("" if they do)
     std::map<std::string, double> evidence;  ///< resource -> share of context cycles pointing at it
+    std::vector<KindKnob> kind_knobs = {};   ///< the unit kind's own knobs
 };
 
 /// {knobs (best first), top (three), top_per_mm2 (three), co_limits}; each knob {key, resource,

@@ -14,7 +14,7 @@ using nlohmann::json;
 namespace {
 
 /// Rays the machine holds at once: what a cluster's warm-up must at least replace.
-uint64_t rays_in_flight(const SimConfig& c) { return uint64_t(c.traversal.units) * c.traversal.ray_contexts; }
+uint64_t rays_in_flight(const SimConfig& c) { return uint64_t(c.traversal.units) * c.traversal.contexts(); }
 
 /// The warm-up a cluster wants: the rays in flight twice over (pipelines and L1s), and an eighth
 /// of the L2's lines in rays, about what refills the L2's share of the region the cluster is in
@@ -322,5 +322,7 @@ const StatBlock& sampling_stats() {
         }};
     return block;
 }
+
+RTSIM_REGISTER_STAT_BLOCK(sampling_stats)
 
 }  // namespace rtsim

@@ -5,11 +5,11 @@
 
 namespace rtsim {
 
-FunctionalWarmer::FunctionalWarmer(const Accel& accel, const StepCosts& costs, const MemoryMap& map,
-                                   TraceReader& reader, uint32_t units, WarmRead warm)
+FunctionalWarmer::FunctionalWarmer(const Accel& accel, const StepOptions& step, const StepCosts& costs,
+                                   const MemoryMap& map, TraceReader& reader, uint32_t units, WarmRead warm)
     : m_costs(costs),
       m_map(map), m_reader(reader), m_units(std::max<uint32_t>(units, 1)), m_warm(std::move(warm)),
-      m_stepper(accel.make_stepper()) {}
+      m_stepper(accel.make_stepper(step)) {}
 
 void FunctionalWarmer::warm(uint64_t first, uint64_t end, uint32_t next_unit) {
     const auto t0 = std::chrono::steady_clock::now();

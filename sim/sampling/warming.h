@@ -25,7 +25,8 @@ using WarmRead = std::function<void(uint32_t unit, uint64_t addr, uint32_t bytes
 
 class FunctionalWarmer {
 public:
-    FunctionalWarmer(const Accel& accel, const StepCosts& costs, const MemoryMap& map, TraceReader& reader,
+    FunctionalWarmer(const Accel& accel, const StepOptions& step, const StepCosts& costs, const MemoryMap& map,
+                     TraceReader& reader,
                      uint32_t units, WarmRead warm);
     /// Replays rays [first, end) of the trace, in order, through the caches. `next_unit` is the
     /// unit the dispatch deals ray `end` to (interleaved, block_rays = 1: consecutive rays go to

@@ -74,8 +74,10 @@ def test_round_trip_through_rtsim_sim(cornell_trace: Path, tmp_path: Path) -> No
     assert proc.returncode == 0, proc.stderr
     resolved = json.loads((run / "config.resolved.json").read_text())
     assert config.traversal.stack_entry_bytes == 0
-    assert resolved == config.with_values({"traversal.stack_entry_bytes": 8}).to_dict()
-    assert SimConfig.from_dict(resolved) == config.with_values({"traversal.stack_entry_bytes": 8})
+    # ...and the contexts the unit kind's groups derive (traversal.ray_contexts 0: 16 for MIMD).
+    expected = {"traversal.stack_entry_bytes": 8, "traversal.ray_contexts": 16}
+    assert resolved == config.with_values(expected).to_dict()
+    assert SimConfig.from_dict(resolved) == config.with_values(expected)
 
 
 @pytest.mark.parametrize(
@@ -105,17 +107,6 @@ def test_presets_and_modifiers_compose() -> None:
     assert compose("tu16+tu4").traversal.units == 4
     with pytest.raises(ConfigError, match="unknown preset or modifier 'tu17'"):
         compose("base+tu17")
-
-
-def test_sram_bytes() -> None:
-    c = SimConfig()
-    t = c.traversal
-    stacks = t.units * t.ray_contexts * t.stack_entries * 8  # entry bytes 0: a BVH's 8
-    assert c.sram_bytes() == (16 * 8 + 1024) * 1024 + stacks
-    assert compose("l1-64k").sram_bytes() - c.sram_bytes() == 48 * 1024 * 8
-    kd = c.with_values({"traversal.stack_entry_bytes": 12, "mailbox.entries": 8})
-    per_context = t.stack_entries * (12 - 8) + 8 * 4  # wider stack entries, 8 mailbox entries
-    assert kd.sram_bytes() - c.sram_bytes() == t.units * t.ray_contexts * per_context
 
 
 def test_dataclasses_are_typed() -> None:

@@ -107,7 +107,7 @@ def test_one_frame_trace_has_one_frame_entry(
 @pytest.mark.parametrize(
     ("sets", "field"),
     [
-        (["fidelity=analytic"], "fidelity=analytic"),
+        (["fidelity=analytic"], "fidelity 'analytic"),
         (["treelets.enabled=true"], "treelets.enabled"),
         (["sampling.fraction=0.5"], "sampling"),
     ],

@@ -19,13 +19,13 @@ PACKET = ("traversal.model=packet", "traversal.ray_contexts=64")
 @pytest.mark.parametrize(
     "sets",
     [
-        ("traversal.lanes=4",),
-        ("traversal.lanes=16", "fidelity=detailed"),
-        ("traversal.lanes=64", "traversal.stack_entries=2"),
-        ("traversal.lanes=16", "dispatch.sort=origin_direction"),
-        ("traversal.lanes=16", "fidelity=functional"),
-        ("traversal.lanes=16", "traversal.packet_split_below=0.5"),
-        ("traversal.lanes=64", "traversal.packet_split_below=0.25", "fidelity=functional"),
+        ("traversal.packet.lanes=4",),
+        ("traversal.packet.lanes=16", "fidelity=detailed"),
+        ("traversal.packet.lanes=64", "traversal.stack_entries=2"),
+        ("traversal.packet.lanes=16", "dispatch.sort=origin_direction"),
+        ("traversal.packet.lanes=16", "fidelity=functional"),
+        ("traversal.packet.lanes=16", "traversal.packet.split_below=0.5"),
+        ("traversal.packet.lanes=64", "traversal.packet.split_below=0.25", "fidelity=functional"),
     ],
 )
 def test_packet_hits_and_work_match_the_reference(
@@ -37,7 +37,7 @@ def test_packet_hits_and_work_match_the_reference(
     assert s["rays"] == rtsim.open_trace(small_cornell_rays).manifest["counts"]["rays"]
     if "fidelity=functional" in sets:
         return
-    lanes = int(next(x for x in sets if x.startswith("traversal.lanes=")).split("=")[1])
+    lanes = int(next(x for x in sets if x.startswith("traversal.packet.lanes=")).split("=")[1])
     units = stats["model"]["units"].values()
     assert sum(u["rays"] for u in units) == s["rays"]
     assert 0.0 < s["simd_efficiency"] < 1.0  # diffuse rays leave the packet's path
@@ -53,7 +53,7 @@ def test_packet_hits_and_work_match_the_reference(
         )
         if "traversal.stack_entries=2" in sets:
             assert u["stack_spill_writes"] > 0
-        split = any(x.startswith("traversal.packet_split_below") for x in sets)
+        split = any(x.startswith("traversal.packet.split_below") for x in sets)
         assert (u["packet_splits"] > 0) == split
         assert (u["packet_split_steps"] > 0) == split
     acc = stats["model"]["cycle_accounting"]
@@ -70,7 +70,11 @@ def test_packets_share_node_fetches(
         sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "mimd", "traversal.ray_contexts=64"
     )
     pk = sim_stats(
-        sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "pk", *PACKET, "traversal.lanes=16"
+        sim_exe,
+        small_cornell_rays / "trace.rtt",
+        tmp_path / "pk",
+        *PACKET,
+        "traversal.packet.lanes=16",
     )
     node_reads = sum(u["packet_node_fetches"] for u in pk["model"]["units"].values())
     # A MIMD unit's scheduler steps: 2 per traversal step and 1 per ray.
@@ -91,7 +95,7 @@ def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray_trace(
             "traversal.model=packet",
             "traversal.units=1",
             "traversal.ray_contexts=32",
-            f"traversal.lanes={lanes}",
+            f"traversal.packet.lanes={lanes}",
         )
         s = stats["summary"]
         assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
@@ -118,12 +122,12 @@ def test_packet_needs_a_packet_kernel(sim_exe: Path, tmp_path: Path) -> None:
     ("sets", "named"),
     [
         (
-            ("traversal.model=packet", "traversal.packet_split_below=1.5"),
-            "traversal.packet_split_below",
+            ("traversal.model=packet", "traversal.packet.split_below=1.5"),
+            "traversal.packet.split_below",
         ),
-        (("traversal.model=packet", "traversal.lanes=2"), "traversal.lanes"),
+        (("traversal.model=packet", "traversal.packet.lanes=2"), "traversal.packet.lanes"),
         (
-            ("traversal.model=packet", "traversal.ray_contexts=20", "traversal.lanes=16"),
+            ("traversal.model=packet", "traversal.ray_contexts=20", "traversal.packet.lanes=16"),
             "traversal.ray_contexts",
         ),
     ],

@@ -17,10 +17,10 @@ SIMT = ("traversal.model=simt", "traversal.ray_contexts=32")
 @pytest.mark.parametrize(
     "sets",
     [
-        ("traversal.lanes=8",),
-        ("traversal.lanes=16", "traversal.simt_policy=if_if"),
-        ("traversal.lanes=32", "traversal.simt_refill=warp"),
-        ("traversal.lanes=8", "dispatch.sort=origin_direction", "fidelity=detailed"),
+        ("traversal.simt.lanes=8",),
+        ("traversal.simt.lanes=16", "traversal.simt.policy=if_if"),
+        ("traversal.simt.lanes=32", "traversal.simt.refill=warp"),
+        ("traversal.simt.lanes=8", "dispatch.sort=origin_direction", "fidelity=detailed"),
     ],
 )
 def test_simt_hits_and_work_match_the_reference(
@@ -33,7 +33,7 @@ def test_simt_hits_and_work_match_the_reference(
     units = stats["model"]["units"].values()
     assert sum(u["rays"] for u in units) == s["rays"]
     assert 0.0 < s["simd_efficiency"] < 1.0  # diffuse rays diverge
-    lanes = int(next(x for x in sets if x.startswith("traversal.lanes=")).split("=")[1])
+    lanes = int(next(x for x in sets if x.startswith("traversal.simt.lanes=")).split("=")[1])
     for u in units:
         assert u["lane_slots"] == u["warp_steps"] * lanes
         assert sum(u["active_lane_histogram"]) == u["warp_steps"]
@@ -61,9 +61,9 @@ def test_simd_efficiency_is_one_when_every_lane_carries_the_same_ray_trace(
                 "traversal.model=simt",
                 "traversal.units=1",
                 "traversal.ray_contexts=16",
-                "traversal.lanes=8",
-                f"traversal.simt_refill={refill}",
-                f"traversal.simt_policy={policy}",
+                "traversal.simt.lanes=8",
+                f"traversal.simt.refill={refill}",
+                f"traversal.simt.policy={policy}",
             )
             assert stats["summary"]["hit_mismatches"] == 0
             assert stats["summary"]["simd_efficiency"] == 1.0
@@ -102,16 +102,22 @@ def test_sorted_dispatch_hands_out_every_ray_once(
 @pytest.mark.parametrize(
     ("sets", "named"),
     [
-        (("traversal.lanes=3",), "traversal.lanes"),
-        (("traversal.lanes=65",), "traversal.lanes"),
-        (("traversal.model=simt", "traversal.lanes=12"), "traversal.ray_contexts"),
+        (("traversal.simt.lanes=3",), "traversal.simt.lanes"),
+        (("traversal.simt.lanes=65",), "traversal.simt.lanes"),
+        (
+            ("traversal.model=simt", "traversal.simt.lanes=12", "traversal.ray_contexts=16"),
+            "traversal.ray_contexts",
+        ),
         (("traversal.model=simd",), "traversal.model"),
-        (("traversal.model=packet", "traversal.lanes=12"), "traversal.ray_contexts"),
+        (
+            ("traversal.model=packet", "traversal.packet.lanes=12", "traversal.ray_contexts=16"),
+            "traversal.ray_contexts",
+        ),
         (("traversal.model=packet", "treelets.enabled=true"), "treelets.enabled"),
         (("traversal.model=packet", "fidelity=analytic"), "traversal.model"),
         (("traversal.model=simt", "fidelity=analytic"), "traversal.model"),
         (("traversal.model=simt", "treelets.enabled=true"), "treelets.enabled"),
-        (("traversal.simt_policy=while",), "traversal.simt_policy"),
+        (("traversal.simt.policy=while",), "traversal.simt.policy"),
         (("dispatch.sort=hilbert",), "dispatch.sort"),
         (("dispatch.sort_window=1",), "dispatch.sort_window"),
     ],
@@ -130,7 +136,9 @@ def test_simt_on_every_structure_kind(sim_exe: Path, tmp_path: Path, accel: str)
     trace = tmp_path / "trace"
     kinds = "primary,diffuse"
     rtsim.trace_scene("cornell", trace, workload=kinds, width=24, height=16, accel=accel)
-    stats = sim_stats(sim_exe, trace / "trace.rtt", tmp_path / "run", *SIMT, "traversal.lanes=16")
+    stats = sim_stats(
+        sim_exe, trace / "trace.rtt", tmp_path / "run", *SIMT, "traversal.simt.lanes=16"
+    )
     s = stats["summary"]
     assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0 and s["rays"] > 0
     assert 0.0 < s["simd_efficiency"] <= 1.0
@@ -188,7 +196,7 @@ def test_execution_models_sweep_spec_parses() -> None:
 
 def test_simt_is_deterministic(sim_exe: Path, small_cornell_rays: Path, tmp_path: Path) -> None:
     """Same trace and config: the same model figures, run after run (rule 9)."""
-    sets = (*SIMT, "dispatch.sort=morton", "traversal.simt_policy=if_if")
+    sets = (*SIMT, "dispatch.sort=morton", "traversal.simt.policy=if_if")
     trace = small_cornell_rays / "trace.rtt"
     runs = [sim_stats(sim_exe, trace, tmp_path / f"r{i}", *sets) for i in range(2)]
     assert runs[0]["model"] == runs[1]["model"]

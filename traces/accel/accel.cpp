@@ -5,8 +5,8 @@
 
 namespace rtsim {
 
-Hit Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
-    std::unique_ptr<Stepper> s = make_stepper();
+Hit Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
+    std::unique_ptr<Stepper> s = make_stepper(options);
     return trace_with_stepper(*s, ray, mode, work);
 }
 
@@ -35,6 +35,8 @@ bool Accel::has_anyhit_triangles() const {
     }
     return false;
 }
+
+AccelCapabilities Accel::capabilities() const { return accel_capabilities(kind()); }
 
 void Accel::bind_frame(uint32_t f) {
     require(f < frame_count(), "accel image '" + kind() + "': frame " + std::to_string(f) + " of " +

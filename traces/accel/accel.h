@@ -12,9 +12,11 @@
 #include <vector>
 
 #include "traces/accel/accel_image.h"
+#include "traces/accel/capabilities.h"
 #include "traces/accel/leaf_blocks.h"
 #include "traces/accel/locality.h"
 #include "traces/accel/packet_stepper.h"
+#include "traces/accel/step_options.h"
 #include "traces/accel/stepper.h"
 #include "traces/bvh/config.h"
 
@@ -37,12 +39,15 @@ public:
     const AccelImage& image() const { return m_image; }
     const std::string& kind() const { return m_image.kind; }
 
-    virtual std::unique_ptr<Stepper> make_stepper() const = 0;
-    /// The reference loop: the stepper's steps, fused for speed where a kind provides one
-    /// (the default drives a stepper).
-    virtual Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const;
+    /// A stepper walking with `options` (step_options.h); an option the structure's capabilities
+    /// do not offer is ignored (the run's resolution step never sets one).
+    virtual std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const = 0;
+    /// The reference loop: the stepper's steps, fused for speed where a kind provides one and
+    /// `options` let it (StepOptions::fused_loop_walks_alike); the default drives a stepper.
+    virtual Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
+                      const StepOptions& options = {}) const;
     /// A packet stepper (rays sharing one traversal stack, packet_stepper.h), or null where the
-    /// kind has no packet kernel (the model's packet unit then refuses the structure).
+    /// kind has no packet kernel (capabilities().packet_kernel false).
     virtual std::unique_ptr<PacketStepper> make_packet_stepper() const { return nullptr; }
     /// The reference packet loop: rays[0, n) traced as one packet, each ray's hit and work and the
     /// packet's counts (any output may be null); `split_below` as PacketStepper::set_split_below.
@@ -55,31 +60,13 @@ public:
     virtual std::vector<OpKind> op_kinds() const = 0;
     /// Deepest traversal stack a ray can need (sizes the model's stack spill area).
     virtual uint32_t max_stack_entries() const = 0;
+    /// What the structure offers the techniques a run may ask for, as its registry entry declares
+    /// it (capabilities.h; a two-level structure's follow from its BLAS kind's).
+    virtual AccelCapabilities capabilities() const;
     /// Bytes of one traversal stack entry in this structure's hardware: what a spill moves and
     /// what the on-chip stack holds per entry (a BVH's 8: node and entry distance; a kd-tree's
     /// 12: node, tnear, tfar; an octree's 32: node, tnear and the cell's six plane distances).
-    virtual uint32_t stack_entry_bytes() const { return kBvhStackEntryBytes; }
-    /// True when the structure lists primitive references that can repeat along a ray (grid,
-    /// kd-tree, octree): its steppers then honour a mailbox (mailbox.h).
-    virtual bool uses_mailbox() const { return false; }
-    /// Mailbox entries per ray for the steppers and trace() from now on (0: none, the default;
-    /// docs/accel.md, "Mailboxes"). Hits never change; see WorkCounts for the counts.
-    void set_mailbox(uint32_t entries) { m_mailbox_entries = entries; }
-    uint32_t mailbox_entries() const { return m_mailbox_entries; }
-    /// True when the steppers can shadow a short stack with a restart trail (short_stack.h).
-    virtual bool supports_short_stack() const { return false; }
-    /// Short-stack entries per ray for the steppers from now on (0: a full stack, the default;
-    /// docs/accel.md, "Short stacks"). Hits and the reference work never change; the restarts'
-    /// work is counted in the model-only work fields. trace() always walks a full stack.
-    void set_short_stack(uint32_t entries) { m_short_stack_entries = entries; }
-    uint32_t short_stack_entries() const { return m_short_stack_entries; }
-    /// True when the steppers can count a reduced-precision box pipeline's extra walk (rp_boxes.h).
-    virtual bool supports_reduced_precision_boxes() const { return false; }
-    /// Mantissa bits of the steppers' reduced-precision box test from now on (0: fp32 alone, the
-    /// default; docs/accel.md, "Reduced-precision box tests"). Hits and the reference work never
-    /// change; the extra walk's work is counted in the model-only work fields.
-    void set_box_precision(uint32_t bits) { m_box_precision_bits = bits; }
-    uint32_t box_precision_bits() const { return m_box_precision_bits; }
+    uint32_t stack_entry_bytes() const { return capabilities().stack_entry_bytes; }
     /// True when some triangle is alpha-MASKed (the any-hit stage is then needed).
     bool has_anyhit_triangles() const;
     /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
@@ -95,9 +82,6 @@ protected:
     /// The triangles the steppers read, plain or decoded from compressed leaves (leaf_blocks.h);
     /// opened by structures that have a triangle region.
     TriangleStore m_triangles;
-    uint32_t m_mailbox_entries = 0;
-    uint32_t m_short_stack_entries = 0;
-    uint32_t m_box_precision_bits = 0;
 };
 
 /// How to build a structure: which kind, which builder for its tree, and the builder's config.
@@ -121,6 +105,7 @@ struct AccelKindInfo {
     std::string name;
     std::string description;
     std::vector<std::string> builders;  ///< builders this kind accepts (first: default)
+    AccelCapabilities capabilities;     ///< what it offers a run's techniques (capabilities.h)
 };
 
 /// The settings a kind's builder takes, as a schema {name: {type, default, unit, min, max, doc}}.
@@ -129,6 +114,9 @@ nlohmann::json accel_settings_schema(const std::string& kind, const std::string&
 
 /// Every registered structure, in a stable order.
 const std::vector<AccelKindInfo>& accel_kinds();
+/// The capabilities a kind's registry entry declares (capabilities.h); "two_level" with the
+/// BLAS kind `blas_kind`. Throws rtsim::Error listing the known kinds if `kind` is none.
+AccelCapabilities accel_capabilities(const std::string& kind, const std::string& blas_kind = "bvh2");
 /// Throws rtsim::Error listing the known kinds and builders if the options name none.
 void validate_accel_options(const AccelOptions& options);
 /// Builds the image of a structure over a flattened scene (two-level: over its meshes and

@@ -45,8 +45,7 @@ using BuildFn = std::function<AccelImage(const Scene&, const AccelOptions&, cons
 using LoadFn = std::function<std::unique_ptr<Accel>(AccelImage, const std::string&)>;
 
 struct Entry {
-    AccelKindInfo info;
-    uint32_t stack_entry_bytes;  ///< the kind's Accel::stack_entry_bytes(), recorded in the manifest
+    AccelKindInfo info;  ///< its name, description, builders and capabilities (as data: capabilities.h)
     SettingsFn settings;
     BuildFn build;
     LoadFn load;
@@ -153,7 +152,10 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
     LoadFn load = [=](AccelImage image, const std::string& source) {
         return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
     };
-    return {{name, description, tree_builder_names()}, kBvhStackEntryBytes, tree_settings, build, load};
+    const AccelCapabilities c = single_level(kBvhStackEntryBytes)
+                                    .with(&AccelCapabilities::restart_trail)
+                                    .with(&AccelCapabilities::reduced_precision_boxes);
+    return {{name, description, tree_builder_names(), c}, tree_settings, build, load};
 }
 
 template <class A>
@@ -163,8 +165,12 @@ LoadFn loader() {
 
 const std::vector<Entry>& registry() {
     static const std::vector<Entry> entries = {
-        {{"bvh2", "binary BVH, 64-byte nodes holding both child boxes (docs/bvh_layout.md)", tree_builder_names()},
-         kBvhStackEntryBytes, tree_settings, build_bvh2, loader<Bvh2Accel>()},
+        {{"bvh2", "binary BVH, 64-byte nodes holding both child boxes (docs/bvh_layout.md)", tree_builder_names(),
+          single_level(kBvhStackEntryBytes)
+              .with(&AccelCapabilities::packet_kernel)
+              .with(&AccelCapabilities::restart_trail)
+              .with(&AccelCapabilities::reduced_precision_boxes)},
+         tree_settings, build_bvh2, loader<Bvh2Accel>()},
         wide_entry("bvh4", "4-wide BVH, 128-byte fp32 nodes, SAH-optimal collapse of the binary tree (docs/accel.md)", 4,
                    false, ChildOrder::distance),
         wide_entry("bvh6", "6-wide BVH, 192-byte fp32 nodes, SAH-optimal collapse", 6, false, ChildOrder::distance),
@@ -178,20 +184,17 @@ const std::vector<Entry>& registry() {
         wide_entry("cwbvh8_octant", "cwbvh8 with children in octant slots, visited in a fixed per-octant order", 8,
                    true, ChildOrder::octant),
         {{"grid", "uniform grid, cells of lambda x N by density, 3D-DDA traversal, no stack (docs/accel.md)",
-          {"uniform"}},
-         kBvhStackEntryBytes,  // no stack: the machine's entry size is moot
+          {"uniform"}, single_level(kBvhStackEntryBytes).with(&AccelCapabilities::mailbox)},  // no stack: the machine's entry size is moot
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.grid.visit(v); },
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return grid_image(scene, s.grid); },
          loader<GridAccel>()},
         {{"kdtree", "kd-tree, SAH in O(N log N) with perfect splits (Wald & Havran 2006), 8-byte nodes, plane tests",
-          {"sah"}},
-         kKdStackEntryBytes,
+          {"sah"}, single_level(kKdStackEntryBytes).with(&AccelCapabilities::mailbox)},
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.kd.visit(v); },
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
          loader<KdAccel>()},
         {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
-          {"binned", "wachter_keller", "lbvh"}},
-         kBihStackEntryBytes,
+          {"binned", "wachter_keller", "lbvh"}, single_level(kBihStackEntryBytes)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              if (builder == "wachter_keller") s.bih.visit(v);
              else tree_settings(builder, s, v);
@@ -202,8 +205,8 @@ const std::vector<Entry>& registry() {
              return bih_image(bih_from_build_tree(build_tree(scene, o, s, &unused)), scene, o.builder);
          },
          loader<BihAccel>()},
-        {{"octree", "adaptive octree, 16-byte nodes, parametric traversal (Revelles et al. 2000)", {"adaptive"}},
-         kOctStackEntryBytes,
+        {{"octree", "adaptive octree, 16-byte nodes, parametric traversal (Revelles et al. 2000)", {"adaptive"},
+          single_level(kOctStackEntryBytes).with(&AccelCapabilities::mailbox)},
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.octree.visit(v); },
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return octree_image(scene, s.octree); },
          loader<OctreeAccel>()},
@@ -258,6 +261,22 @@ const std::vector<AccelKindInfo>& accel_kinds() {
     return kinds;
 }
 
+AccelCapabilities accel_capabilities(const std::string& kind, const std::string& blas_kind) {
+    if (kind != "two_level") {
+        const Entry* e = find(kind);
+        require(e != nullptr, "accel: unknown structure '" + kind + "' (known: " + known_kinds() + ", two_level)");
+        return e->info.capabilities;
+    }
+    // A TLAS over BLASes of one kind: one stack holds the TLAS's entries and the BLAS kind's, and
+    // what needs one walk of one tree is not offered (two_level.h).
+    const AccelCapabilities blas = accel_capabilities(blas_kind);
+    AccelCapabilities c;
+    c.mailbox = blas.mailbox;
+    c.treelet_partition = blas.treelet_partition;
+    c.stack_entry_bytes = std::max(kBvhStackEntryBytes, blas.stack_entry_bytes);
+    return c;
+}
+
 nlohmann::json accel_settings_schema(const std::string& kind, const std::string& builder) {
     AccelOptions o;
     o.kind = kind;
@@ -290,8 +309,8 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
         image.build_ms = ms_since(start);
         image.stats["footprint_bytes"] = image.footprint_bytes();
         // The TLAS's entries and the BLAS kind's share one stack: the larger size (two_level.h).
-        image.stats["stack_entry_bytes"] = o.two_level ? std::max(kBvhStackEntryBytes, e.stack_entry_bytes)
-                                                       : e.stack_entry_bytes;
+        image.stats["stack_entry_bytes"] =
+            accel_capabilities(o.two_level ? "two_level" : o.kind, o.kind).stack_entry_bytes;
         image.stats["build_settings"] = values;
         image.stats["build_set"] = o.settings;
         return image;

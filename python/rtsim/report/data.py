@@ -35,10 +35,10 @@ FLAG_KEYS: dict[str, str] = {"treelets.enabled": "treelets", "ideal_memory": "id
 
 def key_active(key: str, config: dict[str, Any]) -> bool:
     """False for a key whose switch is off in this run's config (treelets.buffer_kib without
-    treelets.enabled)."""
+    treelets.enabled, traversal.simt.lanes under traversal.model mimd)."""
     flat = flatten(config) if config else {}
-    for prefix, switch in INACTIVE_UNLESS:
-        if key.startswith(prefix) and key != switch and flat.get(switch) is False:
+    for prefix, switch, on in INACTIVE_UNLESS:
+        if key.startswith(prefix) and key != switch and switch in flat and flat[switch] != on:
             return False
     return True
 
@@ -171,8 +171,10 @@ def mrays(rec: RunRecord) -> float:
     return float(rec.summary.get("rays_per_second") or 0.0) / 1e6
 
 
-def sram_kib(rec: RunRecord) -> float:
-    return sram_bytes(rec.config) / 1024
+def sram_kib(rec: RunRecord) -> float | None:
+    """On-chip SRAM in KiB (the C++ area model's count, stats.json `area.sram_total_bytes`)."""
+    b = sram_bytes(rec)
+    return None if b is None else b / 1024
 
 
 def area_mm2(rec: RunRecord) -> float | None:
@@ -199,7 +201,10 @@ class Cost:
 
 COSTS: dict[str, Cost] = {
     "sram": Cost(
-        "on-chip SRAM", "on-chip SRAM: L1s + L2 + stacks + ray buffer (KiB)", "KiB", sram_kib
+        "on-chip SRAM",
+        "on-chip SRAM: L1s + L2 + stacks + contexts + ray buffer (KiB)",
+        "KiB",
+        sram_kib,
     ),
     "area": Cost("area", "chip area: SRAM + pipelines (mm², docs/energy_area.md)", "mm²", area_mm2),
     "energy": Cost("energy", "energy per ray (nJ, docs/energy_area.md)", "nJ/ray", energy_nj),

@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
+from rtsim.kinds import DATA_KINDS
 from rtsim.report.data import (
     COSTS,
     Group,
@@ -25,7 +26,7 @@ from rtsim.report.data import (
     pareto_front,
     short_label,
 )
-from rtsim.sweep.results import DATA_KINDS, bytes_per_ray_by_kind
+from rtsim.sweep.results import bytes_per_ray_by_kind
 from rtsim.sweep.store import RunRecord
 
 KIND_COLORS = {

@@ -140,7 +140,7 @@ def _front_table(data: SweepData, fronts: dict[str, list[RunRecord]], cost: str)
                     escape(title),
                     str(i + 1),
                     name,
-                    f"{sram_kib(r):,.0f}",
+                    _num(sram_kib(r), ",.0f"),
                     _num(area_mm2(r), ".2f"),
                     _num(energy_nj(r), ".2f"),
                     f"{mrays(r):.1f}",
@@ -162,9 +162,9 @@ def _baseline_text(data: SweepData) -> str:
 def _pareto_section(data: SweepData) -> list[str]:
     """A Pareto front of rays/s against each cost (SRAM, area, energy) with its table."""
     captions = {
-        "sram": "On-chip SRAM = L1 size x traversal units + L2 + traversal stacks (units x ray "
-        "contexts x stack entries x entry bytes), plus the ray buffer when treelet scheduling is "
-        "on.",
+        "sram": "On-chip SRAM as the area model counts it (stats.json area.sram_bytes): L1 size x "
+        "traversal units + L2 + traversal stacks (units x ray contexts x stack entries x entry "
+        "bytes) + ray-context state, plus the mailboxes and the ray buffer when they are on.",
         "area": "Chip area from the first-order model of docs/energy_area.md: SRAM (L1s, L2, ray "
         "buffer, stacks, ray contexts) plus the box, triangle and any-hit pipelines, at the "
         "configured technology node (energy.node_nm).",

@@ -9,7 +9,7 @@ import io
 from collections.abc import Iterable
 from typing import Any
 
-from rtsim.config import SimConfig, config_keys, flatten
+from rtsim.config import config_keys, flatten
 from rtsim.sweep.store import RunRecord
 
 ID_COLUMNS = (
@@ -25,11 +25,15 @@ ID_COLUMNS = (
     "finished_utc",
     "wall_seconds",
 )
-DATA_KINDS = ("node", "triangle", "ray", "hit", "stack", "ray_buffer")
 
 
-def sram_bytes(config: dict[str, Any]) -> int:
-    return SimConfig.from_dict(config).sram_bytes()
+def sram_bytes(rec: RunRecord) -> float | None:
+    """The run's on-chip SRAM in bytes, as the C++ area model counts it (stats.json
+    `area.sram_total_bytes`: L1s, L2, stacks, ray contexts, mailboxes, ray buffer); None for a run
+    without stats (a failed run, an older store)."""
+    area = (rec.stats or {}).get("area") or {}
+    v = area.get("sram_total_bytes")
+    return float(v) if isinstance(v, (int, float)) else None
 
 
 def bytes_per_ray_by_kind(rec: RunRecord) -> dict[str, float]:
@@ -59,7 +63,7 @@ def tidy_row(rec: RunRecord) -> dict[str, Any]:
     row: dict[str, Any] = {c: getattr(rec, c) for c in ID_COLUMNS}
     config = flatten(rec.config)
     row.update({k: config.get(k) for k in config_keys()})
-    row["sram_bytes"] = sram_bytes(rec.config)
+    row["sram_bytes"] = sram_bytes(rec)
     for key, value in rec.summary.items():
         row[key] = value
     for kind, value in bytes_per_ray_by_kind(rec).items():

@@ -5,9 +5,9 @@
 namespace rtsim {
 
 MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
-    : ScheduledUnit(name, setup, index, setup.config.ray_contexts, setup.costs),
-      m_contexts(setup.config.ray_contexts),
-      m_ahead(setup.config.ray_contexts) {
+    : ScheduledUnit(name, setup, index, setup.config.contexts(), setup.costs),
+      m_contexts(setup.config.contexts()),
+      m_ahead(setup.config.contexts()) {
     SC_THREAD(run);
 }
 
@@ -205,12 +205,28 @@ CycleAccount MimdUnit::cycle_account(Cycle total_cycles) const {
 
 nlohmann::json MimdUnit::stats_json(Cycle total_cycles) const {
     nlohmann::json j;
-    StatsWriter w(unit_stats(), j);
+    StatsWriter w(unit_stats_of("mimd"), j);
     m_tally.write(w, m_sync, cycle_account(total_cycles), total_cycles);
     if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
     if (m_prefetcher.on()) w.set("prefetch", m_prefetcher.stats_json());
     w.done();
     return j;
 }
+
+namespace {
+
+UnitKind mimd_kind() {
+    UnitKind k;
+    k.name = "mimd";
+    k.summary = "each ray context steps on its own, no lock-step (TRaX/STRaTA-style MIMD units, Kopta et al. 2013)";
+    k.make_unit = [](const char* name, const UnitSetup& setup, uint32_t index) -> std::unique_ptr<TraversalUnit> {
+        return std::make_unique<MimdUnit>(name, setup, index);
+    };
+    return k;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_UNIT_KIND(mimd_kind())
 
 }  // namespace rtsim

@@ -18,19 +18,21 @@ StepCosts packet_costs(StepCosts costs, uint32_t lanes) {
 }  // namespace
 
 PacketUnit::PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
-    : ScheduledUnit(name, setup, index, setup.config.warps(), packet_costs(setup.costs, setup.config.lanes)),
-      m_packets(setup.config.warps()),
+    : ScheduledUnit(name, setup, index, setup.config.groups(),
+                    packet_costs(setup.costs, setup.config.kind_config<PacketConfig>().lanes)),
+      m_packet(setup.config.kind_config<PacketConfig>()),
+      m_packets(setup.config.groups()),
       m_coalescer(setup.context.line_bytes),
-      m_active_histogram(setup.config.lanes + 1, 0),
-      m_results(setup.config.lanes),
-      m_rays(setup.config.lanes),
-      m_modes(setup.config.lanes) {
+      m_active_histogram(m_packet.lanes + 1, 0),
+      m_results(m_packet.lanes),
+      m_rays(m_packet.lanes),
+      m_modes(m_packet.lanes) {
+    // The run's resolution step refused structures without a packet kernel (capabilities.h).
     for (Packet& p : m_packets) {
         p.stepper = m_steppers.accel().make_packet_stepper();
-        require(p.stepper != nullptr, "config: 'traversal.model' packet needs a structure with a packet kernel "
-                                      "(bvh2); this trace's structure is '" + m_steppers.accel().kind() + "'");
-        p.stepper->set_split_below(float(setup.config.packet_split_below));
-        p.ids.resize(setup.config.lanes);
+        require(p.stepper != nullptr, "model: structure '" + m_steppers.accel().kind() + "' has no packet kernel");
+        p.stepper->set_split_below(float(m_packet.split_below));
+        p.ids.resize(m_packet.lanes);
     }
     SC_THREAD(run);
 }
@@ -71,7 +73,7 @@ void PacketUnit::account(uint32_t p, CycleUse use, Cycle until) {
     if (until <= pk.accounted) return;
     const Cycle dt = until - pk.accounted;
     m_account.add(use, dt * pk.weight);
-    m_account.add(CycleUse::idle_lane, dt * (m_config.lanes - pk.weight));
+    m_account.add(CycleUse::idle_lane, dt * (m_packet.lanes - pk.weight));
     pk.accounted = until;
 }
 
@@ -82,7 +84,7 @@ void PacketUnit::account_read(uint32_t p, Cycle ready, const AccessInfo& info) {
     account_memory(read, pk.accounted, ready, info);
     for (CycleUse use : {CycleUse::l1_mshr_full, CycleUse::l2_mshr_full, CycleUse::l1_hit, CycleUse::l2, CycleUse::dram})
         m_account.add(use, read[use] * pk.weight);
-    m_account.add(CycleUse::idle_lane, (ready - pk.accounted) * (m_config.lanes - pk.weight));
+    m_account.add(CycleUse::idle_lane, (ready - pk.accounted) * (m_packet.lanes - pk.weight));
     pk.accounted = ready;
 }
 
@@ -92,7 +94,7 @@ bool PacketUnit::start_packet(uint32_t p, Cycle t) {
     Cycle start = t;
     RayJob job;
     m_coalescer.clear();
-    while (n < m_config.lanes && rays->next_ray(m_index, &job)) {
+    while (n < m_packet.lanes && rays->next_ray(m_index, &job)) {
         start = std::max(start, job.not_before);  // a frame's rays start when the previous frame is done
         m_rays[n] = job.ray;
         m_modes[n] = job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
@@ -105,7 +107,7 @@ bool PacketUnit::start_packet(uint32_t p, Cycle t) {
     pk.stepper->begin_packet(m_rays.data(), m_modes.data(), n);
     pk.start = start;
     pk.stack = StackSplit{};
-    pk.weight = m_config.lanes;
+    pk.weight = m_packet.lanes;
     account(p, CycleUse::starved, start);  // idle until now, while rays were still to come
     pk.active = true;
     m_tally.busy.enter(start);
@@ -179,7 +181,7 @@ void PacketUnit::finish_packet(uint32_t p, Cycle t) {
     m_splits += s.counts().splits;
     m_split_steps += s.counts().split_steps;
     for (uint32_t i = 0; i < n; ++i) {
-        m_results[i] = RayResult{pk.ids[i], s.lane_hit(i), s.lane_work(i), pk.start, t, m_index, p * m_config.lanes + i};
+        m_results[i] = RayResult{pk.ids[i], s.lane_hit(i), s.lane_work(i), pk.start, t, m_index, p * m_packet.lanes + i};
         m_tally.finish_ray(*mem[0], m_map, m_results[i]);
         m_rays[i] = s.lane_ray(i);
         m_modes[i] = s.lane_mode(i);
@@ -192,27 +194,83 @@ void PacketUnit::finish_packet(uint32_t p, Cycle t) {
 }
 
 CycleAccount PacketUnit::cycle_account(Cycle total_cycles) const {
-    return with_tail(m_account, m_packets, total_cycles, m_config.lanes);
+    return with_tail(m_account, m_packets, total_cycles, m_packet.lanes);
+}
+
+const StatTable<PacketUnit>& PacketUnit::kind_stats() {
+    using json = nlohmann::json;
+    static const StatTable<PacketUnit> table{
+        "model.units.<unit> (packet)",
+        {
+            {{"packets", "packets", "packets traced (each up to `traversal.packet.lanes` rays taken from dispatch together)"},
+             [](const PacketUnit& u) { return u.m_packets_traced; }},
+            {{"packet_steps", "steps", "packet steps (one node or leaf fetch serving the packet's active rays)"},
+             [](const PacketUnit& u) { return u.m_packet_steps; }},
+            {{"packet_node_fetches", "fetches", "node fetches, one per packet node step"},
+             [](const PacketUnit& u) { return u.m_node_fetches; }},
+            {{"node_fetches_per_packet", "fetches", "`packet_node_fetches / packets`"},
+             [](const PacketUnit& u) {
+                 return json(u.m_packets_traced ? double(u.m_node_fetches) / double(u.m_packets_traced) : 0.0);
+             }},
+            {{"packet_occupancy", "rays", "active rays per packet step (`active_lanes / packet_steps`; Wald et al. 2001's packets keep it near `traversal.packet.lanes` on coherent rays)"},
+             [](const PacketUnit& u) {
+                 return json(u.m_packet_steps ? double(u.m_active_rays) / double(u.m_packet_steps) : 0.0);
+             }},
+            {{"packet_active_histogram", "steps", "packet steps by active rays, index 0 .. `traversal.packet.lanes`"},
+             [](const PacketUnit& u) { return u.m_active_histogram; }},
+            {{"packet_splits", "packets", "packets that split into single rays (`traversal.packet.split_below`, Benthin et al. 2012's hybrid)"},
+             [](const PacketUnit& u) { return u.m_splits; }},
+            {{"packet_split_steps", "steps", "of `packet_steps`, the single-ray steps after a split (one ray active each)"},
+             [](const PacketUnit& u) { return u.m_split_steps; }},
+        }};
+    return table;
 }
 
 nlohmann::json PacketUnit::stats_json(Cycle total_cycles) const {
     nlohmann::json j;
-    StatsWriter w(unit_stats(), j);
+    StatsWriter w(unit_stats_of("packet"), j);
     m_tally.write(w, m_sync, cycle_account(total_cycles), total_cycles);
-    const uint64_t slots = m_packet_steps * m_config.lanes;
-    w.set("packets", m_packets_traced)
-        .set("packet_steps", m_packet_steps)
-        .set("packet_node_fetches", m_node_fetches)
-        .set("node_fetches_per_packet", m_packets_traced ? double(m_node_fetches) / double(m_packets_traced) : 0.0)
-        .set("packet_occupancy", m_packet_steps ? double(m_active_rays) / double(m_packet_steps) : 0.0)
-        .set("packet_active_histogram", m_active_histogram)
-        .set("packet_splits", m_splits)
-        .set("packet_split_steps", m_split_steps)
-        .set("lane_slots", slots)
+    const uint64_t slots = m_packet_steps * m_packet.lanes;
+    w.set("lane_slots", slots)
         .set("active_lanes", m_active_rays)
-        .set("simd_efficiency", slots ? double(m_active_rays) / double(slots) : 0.0)
-        .done();
+        .set("simd_efficiency", slots ? double(m_active_rays) / double(slots) : 0.0);
+    kind_stats().write(*this, j);
+    w.done();
     return j;
 }
+
+namespace {
+
+UnitKind packet_kind() {
+    UnitKind k;
+    k.name = "packet";
+    k.summary = "packets of traversal.packet.lanes rays sharing one traversal stack and one node fetch per step "
+                "(Wald et al. 2001), splitting into single rays below traversal.packet.split_below (Benthin et al. 2012)";
+    k.make_unit = [](const char* name, const UnitSetup& setup, uint32_t index) -> std::unique_ptr<TraversalUnit> {
+        return std::make_unique<PacketUnit>(name, setup, index);
+    };
+    k.section<PacketConfig>();
+    k.stats = &PacketUnit::kind_stats().block();
+    k.group_size = [](const TraversalConfig& t) { return t.kinds.of<PacketConfig>("packet").lanes; };
+    k.group_name = "packet";
+    k.needs.packet_kernel = true;
+    k.needs.lock_step = true;
+    k.needs.per_ray_stack = false;
+    k.needs.treelet_queues = false;
+    k.knobs = {{"traversal.packet.lanes", /*halve=*/true, "divergence", /*estimated=*/false}};
+    k.estimate_as = "mimd";
+    k.packet_reference = [](const TraversalConfig& t) {
+        const PacketConfig& p = t.kinds.of<PacketConfig>("packet");
+        return PacketReference{p.lanes, float(p.split_below)};
+    };
+    return k;
+}
+
+const StatBlock& packet_stats_block() { return PacketUnit::kind_stats().block(); }
+
+}  // namespace
+
+RTSIM_REGISTER_UNIT_KIND(packet_kind())
+RTSIM_REGISTER_STAT_BLOCK(packet_stats_block)
 
 }  // namespace rtsim

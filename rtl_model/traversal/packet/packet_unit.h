@@ -1,6 +1,6 @@
 #pragma once
 // The packet traversal unit, traversal.model = "packet": the unit's ray contexts are grouped
-// `lanes` at a time into packets, and a packet's rays share one traversal (Wald, Slusallek,
+// traversal.packet.lanes at a time into packets, and a packet's rays share one traversal (Wald, Slusallek,
 // Benthin & Wagner 2001): one stack, an active mask, one node fetch serving every active ray.
 // Each packet drives the structure's packet stepper (traces/accel/packet_stepper.h), whose plan is
 // the packet's step: its one fetch, and its operations the active rays' tests together; the
@@ -18,7 +18,7 @@
 //
 // The shared stack holds, per entry, the node, the packet's mask and each ray's entry distance
 // (packet_stack_entry_bytes); `stack_entries` of them are on chip per packet, deeper ones spill.
-// With traversal.packet_split_below (Benthin et al. 2012's hybrid), a packet whose active rays at
+// With traversal.packet.split_below (Benthin et al. 2012's hybrid), a packet whose active rays at
 // a node fall below that fraction splits: the stepper then plans one ray's step at a time (one
 // ray active), each ray finishing alone, so the same costing prices the single-ray tail.
 // Cycle accounting: a packet's `lanes` ray contexts spend each cycle on what the packet waits
@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "rtl_model/traversal/packet/packet_config.h"
 #include "rtl_model/traversal/scheduled_unit.h"
 #include "rtl_model/traversal/simt/coalescer.h"
 #include "rtl_model/traversal/unit_parts.h"
@@ -46,6 +47,8 @@ public:
 
     CycleAccount cycle_account(Cycle total_cycles) const override;
     nlohmann::json stats_json(Cycle total_cycles) const override;
+    /// The kind's own stats (model.units.<unit> beside unit_stats()), bound to their counters.
+    static const StatTable<PacketUnit>& kind_stats();
 
 private:
     enum class Phase : uint8_t { step, ops };
@@ -74,6 +77,7 @@ private:
     /// Packet p waited to `ready` for a read (split by where it went, `info`).
     void account_read(uint32_t p, Cycle ready, const AccessInfo& info);
 
+    const PacketConfig& m_packet;
     std::vector<Packet> m_packets;
     LineCoalescer m_coalescer;  ///< a new packet's ray records, per line
     uint64_t m_packets_traced = 0, m_packet_steps = 0, m_node_fetches = 0, m_active_rays = 0;

@@ -6,11 +6,12 @@
 namespace rtsim {
 
 SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
-    : ScheduledUnit(name, setup, index, setup.config.warps(), setup.costs),
-      m_lanes(setup.config.warps() * setup.config.lanes),
-      m_warps(setup.config.warps()),
+    : ScheduledUnit(name, setup, index, setup.config.groups(), setup.costs),
+      m_simt(setup.config.kind_config<SimtConfig>()),
+      m_lanes(setup.config.groups() * m_simt.lanes),
+      m_warps(setup.config.groups()),
       m_coalescer(setup.context.line_bytes),
-      m_active_histogram(setup.config.lanes + 1, 0) {
+      m_active_histogram(m_simt.lanes + 1, 0) {
     SC_THREAD(run);
 }
 
@@ -41,7 +42,7 @@ void SimtUnit::run() {
 }
 
 bool SimtUnit::warp_has_ray(uint32_t w) const {
-    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l)
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l)
         if (m_lanes[l].has_ray) return true;
     return false;
 }
@@ -62,14 +63,14 @@ void SimtUnit::advance(uint32_t w, Cycle t) {
 
 bool SimtUnit::retire_and_refill(uint32_t w, Cycle t) {
     m_coalescer.clear();
-    const uint32_t end = first_lane(w) + m_config.lanes;
+    const uint32_t end = first_lane(w) + m_simt.lanes;
     bool any_ray = false;
     for (uint32_t l = first_lane(w); l < end; ++l) {
         m_lanes[l].stepping = false;
         if (m_lanes[l].has_ray && m_lanes[l].ray.stepper->plan().done) finish_lane(l, t);
         any_ray = any_ray || m_lanes[l].has_ray;
     }
-    if (m_config.simt_refill == SimtRefill::warp && any_ray) return false;  // the warp has not retired
+    if (m_simt.refill == SimtRefill::warp && any_ray) return false;  // the warp has not retired
     Cycle fetch = 0;
     bool taken = false;
     for (uint32_t l = first_lane(w); l < end; ++l)
@@ -105,7 +106,7 @@ void SimtUnit::fetch_rays(uint32_t w, Cycle t) {
     // already had rays wait for it.
     AccessInfo slowest;
     const Cycle ready = issue_reads(m_fetch_at, &slowest);
-    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         Lane& lane = m_lanes[l];
         if (!lane.stepping) continue;
         account_until(m_account, lane.accounted, CycleUse::dispatch, m_fetch_at);
@@ -121,7 +122,7 @@ void SimtUnit::fetch_rays(uint32_t w, Cycle t) {
 uint32_t SimtUnit::choose_class(uint32_t w) const {
     std::array<uint32_t, kClasses> want{};
     bool any = false;
-    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l)
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l)
         if (m_lanes[l].has_ray) {
             ++want[step_class(m_lanes[l].ray.stepper->plan())];
             any = true;
@@ -130,7 +131,7 @@ uint32_t SimtUnit::choose_class(uint32_t w) const {
     const uint32_t last = m_warps[w].last_class;
     // while-while stays in its inner loop while any lane needs it; both policies then take the
     // next kind in program order that some lane needs.
-    if (m_config.simt_policy == SimtPolicy::while_while && want[last]) return last;
+    if (m_simt.policy == SimtPolicy::while_while && want[last]) return last;
     for (uint32_t i = 1; i <= kClasses; ++i)
         if (want[(last + i) % kClasses]) return (last + i) % kClasses;
     return last;
@@ -144,7 +145,7 @@ void SimtUnit::step(uint32_t w, Cycle t) {
     warp.last_class = cls;
     // The lanes whose next step runs the warp's kind step (costed and run with the one
     // arithmetic as their fetches issue); their fetches are coalesced per line.
-    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         Lane& lane = m_lanes[l];
         lane.stepping = lane.has_ray && step_class(lane.ray.stepper->plan()) == cls;
         if (!lane.stepping) continue;
@@ -154,7 +155,7 @@ void SimtUnit::step(uint32_t w, Cycle t) {
     }
     AccessInfo slowest;
     const Cycle ready = issue_reads(t, &slowest);
-    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l)
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l)
         if (m_lanes[l].stepping) account_read_until(m_account, m_lanes[l].accounted, ready, slowest);
     account_idle(w, ready);
     count_warp_step(w, t);
@@ -169,7 +170,7 @@ void SimtUnit::run_ops(uint32_t w, Cycle t) {
     std::array<bool, kOpKindCount> seen{};
     std::array<OpKind, kOpKindCount> order{};
     uint32_t kinds = 0;
-    const uint32_t begin = first_lane(w), end = begin + m_config.lanes;
+    const uint32_t begin = first_lane(w), end = begin + m_simt.lanes;
     for (uint32_t l = begin; l < end; ++l) {
         if (!m_lanes[l].stepping) continue;
         account_until(m_account, m_lanes[l].accounted, CycleUse::issue, t);
@@ -210,8 +211,8 @@ Cycle SimtUnit::issue_reads(Cycle t, AccessInfo* slowest) {
 }
 
 void SimtUnit::account_idle(uint32_t w, Cycle until) {
-    const bool waiting = m_config.simt_refill == SimtRefill::warp && warp_has_ray(w);
-    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+    const bool waiting = m_simt.refill == SimtRefill::warp && warp_has_ray(w);
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         Lane& lane = m_lanes[l];
         if (!lane.stepping && (lane.has_ray || waiting)) account_until(m_account, lane.accounted, CycleUse::idle_lane, until);
     }
@@ -219,7 +220,7 @@ void SimtUnit::account_idle(uint32_t w, Cycle until) {
 
 void SimtUnit::count_warp_step(uint32_t w, Cycle t) {
     uint32_t active = 0;
-    for (uint32_t l = first_lane(w); l < first_lane(w) + m_config.lanes; ++l) {
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         const Lane& lane = m_lanes[l];
         if (!lane.has_ray) continue;
         ++m_kind_present[size_t(lane.kind)];
@@ -228,7 +229,7 @@ void SimtUnit::count_warp_step(uint32_t w, Cycle t) {
     ++m_warp_steps;
     m_lane_steps += active;
     ++m_active_histogram[active];
-    m_slot_use.add(t, m_config.lanes);
+    m_slot_use.add(t, m_simt.lanes);
     m_active_use.add(t, active);
 }
 
@@ -267,23 +268,68 @@ CycleAccount SimtUnit::cycle_account(Cycle total_cycles) const {
     return with_tail(m_account, m_lanes, total_cycles);
 }
 
+const StatTable<SimtUnit>& SimtUnit::kind_stats() {
+    static const StatTable<SimtUnit> table{
+        "model.units.<unit> (simt)",
+        {
+            {{"warp_steps", "steps", "warp steps (one operation kind for the warp, or the new rays' record fetch)"},
+             [](const SimtUnit& u) { return u.m_warp_steps; }},
+            {{"ray_fetch_steps", "steps", "warp steps that fetched new rays' records"},
+             [](const SimtUnit& u) { return u.m_fetch_steps; }},
+            {{"active_lane_histogram", "steps", "warp steps by active lanes, index 0 .. `traversal.simt.lanes`"},
+             [](const SimtUnit& u) { return u.m_active_histogram; }},
+            {{"simd_efficiency_by_kind", "fraction", "`{ray kind: lanes of that kind that stepped / lanes holding a ray of that kind}` over warp steps (empty lanes are in no kind)"},
+             [](const SimtUnit& u) { return u.efficiency_by_kind(); }},
+            {{"simd_efficiency_over_time", "fraction", "`[{cycle, value}]`, active lanes / lane slots of the warp steps issued in each interval (at most 256 points)"},
+             [](const SimtUnit& u) { return u.efficiency_over_time(); }},
+            {{"lane_requests", "requests", "reads the stepping lanes asked for (a MIMD unit's requests for the same steps)"},
+             [](const SimtUnit& u) { return u.m_coalescer.lane_requests(); }},
+            {{"coalesced_requests", "requests", "read requests after coalescing a warp step's reads per L1 line"},
+             [](const SimtUnit& u) { return u.m_coalescer.requests(); }},
+        }};
+    return table;
+}
+
 nlohmann::json SimtUnit::stats_json(Cycle total_cycles) const {
     nlohmann::json j;
-    const uint64_t slots = m_warp_steps * m_config.lanes;
-    StatsWriter w(unit_stats(), j);
+    const uint64_t slots = m_warp_steps * m_simt.lanes;
+    StatsWriter w(unit_stats_of("simt"), j);
     m_tally.write(w, m_sync, cycle_account(total_cycles), total_cycles);
-    w.set("warp_steps", m_warp_steps)
-        .set("ray_fetch_steps", m_fetch_steps)
-        .set("lane_slots", slots)
+    w.set("lane_slots", slots)
         .set("active_lanes", m_lane_steps)
-        .set("simd_efficiency", slots ? double(m_lane_steps) / double(slots) : 0.0)
-        .set("active_lane_histogram", m_active_histogram)
-        .set("simd_efficiency_by_kind", efficiency_by_kind())
-        .set("simd_efficiency_over_time", efficiency_over_time())
-        .set("lane_requests", m_coalescer.lane_requests())
-        .set("coalesced_requests", m_coalescer.requests())
-        .done();
+        .set("simd_efficiency", slots ? double(m_lane_steps) / double(slots) : 0.0);
+    kind_stats().write(*this, j);
+    w.done();
     return j;
 }
+
+namespace {
+
+UnitKind simt_kind() {
+    UnitKind k;
+    k.name = "simt";
+    k.summary = "warps of traversal.simt.lanes ray contexts stepping in lock-step, one operation kind per warp step "
+                "(Aila & Laine 2009; Vulkan-Sim's RT unit)";
+    k.make_unit = [](const char* name, const UnitSetup& setup, uint32_t index) -> std::unique_ptr<TraversalUnit> {
+        return std::make_unique<SimtUnit>(name, setup, index);
+    };
+    k.section<SimtConfig>();
+    k.stats = &SimtUnit::kind_stats().block();
+    k.group_size = [](const TraversalConfig& t) { return t.kinds.of<SimtConfig>("simt").lanes; };
+    k.group_name = "warp";
+    k.needs.lock_step = true;
+    k.needs.treelet_queues = false;
+    // Narrower warps diverge less; the analytic level has no warps, so only a re-run measures it.
+    k.knobs = {{"traversal.simt.lanes", /*halve=*/true, "divergence", /*estimated=*/false}};
+    k.estimate_as = "mimd";
+    return k;
+}
+
+const StatBlock& simt_stats_block() { return SimtUnit::kind_stats().block(); }
+
+}  // namespace
+
+RTSIM_REGISTER_UNIT_KIND(simt_kind())
+RTSIM_REGISTER_STAT_BLOCK(simt_stats_block)
 
 }  // namespace rtsim

@@ -1,11 +1,11 @@
 #pragma once
 // The SIMT traversal unit, traversal.model = "simt": the unit's ray contexts are the lanes of
-// `ray_contexts / lanes` warps, and a warp's lanes step in lock-step, as GPU ray tracing runs one
+// `ray_contexts / traversal.simt.lanes` warps, and a warp's lanes step in lock-step, as GPU ray tracing runs one
 // ray per SIMD lane (Aila & Laine 2009; Vulkan-Sim's RT unit). Each lane drives its own stepper
 // (its own stack) and costs its step with the step-demand function (../step_demand.h); the warp
 // merges its lanes' demands:
 //
-//   warp step:  one operation kind for the warp (traversal.simt_policy: while-while or if-if, as
+//   warp step:  one operation kind for the warp (traversal.simt.policy: while-while or if-if, as
 //               Aila & Laine define them); the lanes whose next step runs that kind step, the others
 //               idle (counted: lane slots, idle_lane cycles)
 //   fetches:    the stepping lanes' fetches coalesced per L1 line: one request per distinct line
@@ -16,7 +16,7 @@
 // Like the MIMD unit, a warp step is two scheduler phases (fetches, then operations) so requests
 // to the private L1 and pipelines come in time order, and the unit runs ahead of SystemC time by
 // at most quantum_cycles. A lane whose ray finished writes its hit at the warp's next step and
-// takes a new ray then (traversal.simt_refill = lane, persistent threads) or once its whole warp
+// takes a new ray then (traversal.simt.refill = lane, persistent threads) or once its whole warp
 // has finished (warp); new rays' records are fetched in a warp step of their own (the lanes that
 // fetch are its active lanes: refilling few lanes costs a mostly idle step, as on a GPU).
 #include <array>
@@ -26,6 +26,7 @@
 #include "rtl_model/common/usage_series.h"
 #include "rtl_model/traversal/scheduled_unit.h"
 #include "rtl_model/traversal/simt/coalescer.h"
+#include "rtl_model/traversal/simt/simt_config.h"
 #include "rtl_model/traversal/unit_parts.h"
 
 namespace rtsim {
@@ -37,6 +38,9 @@ public:
 
     CycleAccount cycle_account(Cycle total_cycles) const override;
     nlohmann::json stats_json(Cycle total_cycles) const override;
+
+    /// The kind's own stats (model.units.<unit> beside unit_stats()), bound to their counters.
+    static const StatTable<SimtUnit>& kind_stats();
 
     /// The step class of a plan: its first operation's kind, or kOpKindCount for a step with none.
     static uint32_t step_class(const StepPlan& plan) { return plan.op_count ? uint32_t(plan.op[0].kind) : kOpKindCount; }
@@ -79,8 +83,9 @@ private:
     void account_idle(uint32_t w, Cycle until);
     Cycle issue_reads(Cycle t, AccessInfo* slowest);
     bool warp_has_ray(uint32_t w) const;
-    uint32_t first_lane(uint32_t w) const { return w * m_config.lanes; }
+    uint32_t first_lane(uint32_t w) const { return w * m_simt.lanes; }
 
+    const SimtConfig& m_simt;
     std::vector<Lane> m_lanes;
     std::vector<Warp> m_warps;
     LineCoalescer m_coalescer;

@@ -20,35 +20,32 @@ inline const std::vector<std::string>& partition_kinds() {
 }
 
 inline std::unique_ptr<Accel> build_named(const Scene& scene, const std::string& name,
-                                          const nlohmann::json& settings = nlohmann::json::object(),
-                                          uint32_t mailbox = 0) {
+                                          const nlohmann::json& settings = nlohmann::json::object()) {
     AccelOptions o;
     const size_t colon = name.find(':');
     o.kind = name.substr(0, colon);
     if (colon != std::string::npos) o.builder = name.substr(colon + 1);
     o.settings = settings;
-    std::unique_ptr<Accel> a = load_accel(build_accel(scene, o), name);
-    a->set_mailbox(mailbox);
-    return a;
+    return load_accel(build_accel(scene, o), name);
 }
 
 /// Hits identical to brute force and to the binary BVH (closest: bits; any: hit or miss), and on
 /// every ray the fused loop's work equal to the stepper's and to what the stepper's plans asked
 /// for. Returns the closest hits found (so callers can require the rays to exercise hits).
 inline int expect_structure_correct(const Accel& accel, const Scene& scene, const std::vector<Ray>& rays,
-                                    const std::string& what) {
+                                    const std::string& what, const StepOptions& step = {}) {
     const std::vector<HwTriangle> tris = hw_triangles(scene);
-    const Agreement brute = compare_rays(tracer(accel), brute_force(tris), rays, what + " vs brute force");
+    const Agreement brute = compare_rays(tracer(accel, step), brute_force(tris), rays, what + " vs brute force");
     EXPECT_EQ(brute.diffs, 0) << what;
     AccelOptions o;
     const std::unique_ptr<Accel> bvh = load_accel(build_accel(scene, o), "bvh2");
-    EXPECT_EQ(compare_rays(tracer(accel), tracer(*bvh), rays, what + " vs bvh2").diffs, 0) << what;
-    std::unique_ptr<Stepper> s = accel.make_stepper();
+    EXPECT_EQ(compare_rays(tracer(accel, step), tracer(*bvh), rays, what + " vs bvh2").diffs, 0) << what;
+    std::unique_ptr<Stepper> s = accel.make_stepper(step);
     int work_diffs = 0;
     for (const Ray& r : rays)
         for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
             WorkCounts fused;
-            const Hit h = accel.trace(r, mode, &fused);
+            const Hit h = accel.trace(r, mode, &fused, step);
             const WorkCounts planned = tally_plans(*s, r, mode);
             WorkCounts stepped = s->work();
             stepped.mailbox_lookups = stepped.mailbox_hits = 0;  // the plans do not show the mailbox

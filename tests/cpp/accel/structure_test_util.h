@@ -43,8 +43,8 @@ inline Tracer brute_force(const std::vector<HwTriangle>& tris) {
     return [&tris](const Ray& r, TraversalMode m) { return trace_ray_brute_force(tris.data(), tris.size(), r, m); };
 }
 
-inline Tracer tracer(const Accel& accel) {
-    return [&accel](const Ray& r, TraversalMode m) { return accel.trace(r, m); };
+inline Tracer tracer(const Accel& accel, const StepOptions& step = {}) {
+    return [&accel, step](const Ray& r, TraversalMode m) { return accel.trace(r, m, nullptr, step); };
 }
 
 struct Agreement {

@@ -61,7 +61,7 @@ TEST(CompressedLeaves, EveryKindAndSceneDecodesExactlyAndTracesTheSame) {
             // Leaves that are runs of triangles share their vertices; a structure that fetches
             // single triangles keeps one-line blocks, mostly of one triangle (52 bytes with its
             // flags, 56 with an instance id too).
-            if (plain->uses_mailbox())
+            if (plain->capabilities().mailbox)
                 EXPECT_LE(packed->image().region(kLeafBlocksRegion).size_bytes(), 56 * store.count()) << what;
             else
                 EXPECT_LT(packed->image().footprint_bytes(), plain->image().footprint_bytes()) << what;
@@ -83,7 +83,7 @@ TEST(CompressedLeaves, EveryKindAndSceneDecodesExactlyAndTracesTheSame) {
                     // A single-triangle fetch brings its whole block (at most a 64-byte line);
                     // a leaf's blocks are at most its records plus a block header and shared
                     // words (a lone triangle with its flags: 52 bytes).
-                    const uint64_t bound = plain->uses_mailbox() ? wp.tri_tests * kSingleFetchBlockBytes
+                    const uint64_t bound = plain->capabilities().mailbox ? wp.tri_tests * kSingleFetchBlockBytes
                                                                  : plain_bytes + 8 * leaf_fetches;
                     EXPECT_LE(packed_bytes, bound) << what;
                 }

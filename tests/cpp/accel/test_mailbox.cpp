@@ -14,13 +14,15 @@ namespace {
 using test::build_named;
 
 /// The tests saved over the rays (both modes), after checking each ray against no mailbox.
-uint64_t check_mailbox(const Accel& with, const Accel& without, const std::vector<Ray>& rays, const std::string& what) {
+uint64_t check_mailbox(const Accel& accel, uint32_t entries, const std::vector<Ray>& rays, const std::string& what) {
+    StepOptions with;
+    with.mailbox_entries = entries;
     uint64_t saved = 0, lookups = 0;
     int diffs = 0;
     for (const Ray& r : rays)
         for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
             WorkCounts a, b;
-            const Hit ha = with.trace(r, mode, &a), hb = without.trace(r, mode, &b);
+            const Hit ha = accel.trace(r, mode, &a, with), hb = accel.trace(r, mode, &b);
             const bool same = test::same_hit(ha, hb, TraversalMode::closest_hit);  // bits, in both modes
             const bool ledger = a.without_mailbox() == b && a.mailbox_hits <= a.mailbox_lookups;
             if ((!same || !ledger) && ++diffs <= 3)
@@ -48,17 +50,17 @@ TEST_P(MailboxPerStructure, ChangesNoHitAndKeepsTheLedgerExact) {
     for (const char* scene_name : {"soup", "rotated_walls", "cornell"}) {
         const Scene& scene = std::string(scene_name) == "soup" ? soup : test::procedural(scene_name);
         const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 12, 1500);
-        // Two builds of the structure (the octree's clipping build dominates the test's time); the
-        // mailbox is a traversal setting, sized on the second.
-        const auto without = build_named(scene, name, settings);
-        const auto with = build_named(scene, name, settings);
+        // One build of the structure (the octree's clipping build dominates the test's time); the
+        // mailbox is a traversal option, handed to its steppers by value.
+        const auto accel = build_named(scene, name, settings);
         uint64_t last = 0;
         for (uint32_t entries : {1u, 4u, 16u, 64u}) {
-            with->set_mailbox(entries);
             const std::string what = std::string(scene_name) + " " + name + " mailbox " + std::to_string(entries);
-            const uint64_t saved = check_mailbox(*with, *without, rays, what);
+            const uint64_t saved = check_mailbox(*accel, entries, rays, what);
             // The fused loop, the stepper and its plans still agree, and hits match brute force.
-            test::expect_structure_correct(*with, scene, std::vector<Ray>(rays.begin(), rays.begin() + 300), what);
+            StepOptions step;
+            step.mailbox_entries = entries;
+            test::expect_structure_correct(*accel, scene, std::vector<Ray>(rays.begin(), rays.begin() + 300), what, step);
             last = saved;  // (a FIFO table is not monotone in its size: Belady's anomaly)
         }
         EXPECT_GT(last, 0u) << scene_name << " " << name << ": the mailbox saved no test";
@@ -72,9 +74,7 @@ TEST(Mailbox, IgnoredByStructuresWithoutReferenceLists) {
     const Scene scene = test::random_soup(13, 600);
     const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 14, 500);
     for (const std::string name : {"bvh2", "bvh2:sbvh", "bih", "bvh8", "cwbvh8"}) {
-        const auto with = build_named(scene, name, nlohmann::json::object(), 8);
-        const auto without = build_named(scene, name);
-        EXPECT_EQ(check_mailbox(*with, *without, rays, name), 0u) << name;
+        EXPECT_EQ(check_mailbox(*build_named(scene, name), 8, rays, name), 0u) << name;
     }
 }
 

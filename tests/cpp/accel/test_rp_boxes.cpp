@@ -18,11 +18,10 @@ using test::make_ray;
 /// with each ray's rp_steps + rp_tri_tests; when `finer` is given, checks none is below it.
 uint64_t check_bits(Accel& accel, uint32_t bits, const std::vector<Ray>& rays, const std::string& what,
                     std::vector<uint64_t>* per_ray, const std::vector<uint64_t>* finer) {
-    accel.set_box_precision(0);
+    StepOptions reduced;
+    reduced.box_precision_bits = bits;
     std::unique_ptr<Stepper> fp32 = accel.make_stepper();
-    accel.set_box_precision(bits);
-    std::unique_ptr<Stepper> narrow = accel.make_stepper();
-    accel.set_box_precision(0);
+    std::unique_ptr<Stepper> narrow = accel.make_stepper(reduced);
     per_ray->clear();
     uint64_t extra = 0;
     int diffs = 0;
@@ -60,7 +59,7 @@ TEST(ReducedPrecisionBoxes, ChangeNoHitNorReferenceWorkAndGrowAsBitsShrink) {
         const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 9, 300);
         for (const std::string& kind : test::with_compressed_leaves(kinds)) {
             const auto accel = test::build_kind(scene, kind);
-            ASSERT_TRUE(accel->supports_reduced_precision_boxes()) << kind;
+            ASSERT_TRUE(accel->capabilities().reduced_precision_boxes) << kind;
             const std::string what = std::string(scene_name) + " " + kind;
             std::vector<uint64_t> a, b;
             uint64_t previous = 0;
@@ -115,7 +114,7 @@ TEST(ReducedPrecisionBoxes, HardCasesKeepTheirHits) {
 TEST(ReducedPrecisionBoxes, OtherStructuresDoNotOfferIt) {
     const Scene scene = test::random_soup(3, 500);
     for (const std::string kind : {"grid", "kdtree", "octree", "bih"})
-        EXPECT_FALSE(test::build_kind(scene, kind)->supports_reduced_precision_boxes()) << kind;
+        EXPECT_FALSE(test::build_kind(scene, kind)->capabilities().reduced_precision_boxes) << kind;
 }
 
 }  // namespace

@@ -17,11 +17,10 @@ struct Totals {
 
 /// Checks every ray of `rays` (both modes) against the full stack; returns the restarts' totals.
 Totals check_short_stack(Accel& accel, uint32_t entries, const std::vector<Ray>& rays, const std::string& what) {
-    accel.set_short_stack(0);
+    StepOptions shorter;
+    shorter.short_stack_entries = entries;
     std::unique_ptr<Stepper> full = accel.make_stepper();
-    accel.set_short_stack(entries);
-    std::unique_ptr<Stepper> shortened = accel.make_stepper();
-    accel.set_short_stack(0);
+    std::unique_ptr<Stepper> shortened = accel.make_stepper(shorter);
     Totals t;
     int diffs = 0;
     for (const Ray& r : rays)
@@ -56,7 +55,7 @@ TEST(ShortStack, ChangesNoHitNorReferenceWorkAndRestartsOnlyWhenShort) {
         const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 7, 1500);
         for (const std::string kind : {"bvh2", "bvh4", "bvh8", "cwbvh8"}) {
             const auto accel = test::build_kind(scene, kind);
-            ASSERT_TRUE(accel->supports_short_stack()) << kind;
+            ASSERT_TRUE(accel->capabilities().restart_trail) << kind;
             const std::string what = std::string(scene_name) + " " + kind;
             const Totals one = check_short_stack(*accel, 1, rays, what + " 1 entry");
             const Totals four = check_short_stack(*accel, 4, rays, what + " 4 entries");
@@ -74,7 +73,7 @@ TEST(ShortStack, ChangesNoHitNorReferenceWorkAndRestartsOnlyWhenShort) {
 TEST(ShortStack, OtherStructuresDoNotOfferIt) {
     const Scene scene = test::random_soup(3, 500);
     for (const std::string kind : {"grid", "kdtree", "octree", "bih"})
-        EXPECT_FALSE(test::build_kind(scene, kind)->supports_short_stack()) << kind;
+        EXPECT_FALSE(test::build_kind(scene, kind)->capabilities().restart_trail) << kind;
 }
 
 }  // namespace

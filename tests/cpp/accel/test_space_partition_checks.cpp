@@ -115,7 +115,7 @@ TEST(SpacePartitionSeam, StackEntriesOpKindsAndManifestKeys) {
         const auto a = build_named(scene, w.name);
         EXPECT_EQ(a->stack_entry_bytes(), w.entry_bytes) << w.name;
         EXPECT_EQ(a->image().stats["stack_entry_bytes"], w.entry_bytes) << w.name;
-        EXPECT_EQ(a->uses_mailbox(), w.mailbox) << w.name;
+        EXPECT_EQ(a->capabilities().mailbox, w.mailbox) << w.name;
         EXPECT_EQ(a->image().stats["node_bytes"], w.node_bytes) << w.name;
         if (w.width) {
             EXPECT_EQ(a->image().stats["width"], w.width) << w.name;

@@ -140,7 +140,7 @@ struct Workload {
         }
     }
     MemoryMap map(const SimConfig& c) const {
-        return MemoryMap(accel->image().end_address(), jobs.size(), uint64_t(c.traversal.units) * c.traversal.ray_contexts,
+        return MemoryMap(accel->image().end_address(), jobs.size(), uint64_t(c.traversal.units) * c.traversal.contexts(),
                          accel->max_stack_entries(), c.traversal.stack_entry_bytes);
     }
 };
@@ -172,7 +172,7 @@ TEST(AnalyticLevel, StatisticalHitRatesTrackTheFunctionalCaches) {
     const MemoryMap map = w.map(c);
     AnalyticProfile profile;
     profile.op_kinds = w.accel->op_kinds();
-    SampleProfiler profiler(c, *w.accel, map, profile);
+    SampleProfiler profiler(c, *w.accel, map, StepOptions{}, profile);
     RayList sample(w.jobs);
     Discard sink;
     profiler.run_cluster(sample, 0, ~0ull, sink);
@@ -186,7 +186,7 @@ TEST(AnalyticLevel, StatisticalHitRatesTrackTheFunctionalCaches) {
                 c.l1.size_kib = l1, c.l1.ways = ways, c.l2.size_kib = l2;
                 RayList rays(w.jobs);
                 Discard exact_sink;
-                const AnalyticOutcome exact = run_analytic_exact(c, *w.accel, map, rays, exact_sink);
+                const AnalyticOutcome exact = run_analytic_exact(c, *w.accel, map, StepOptions{}, rays, exact_sink);
                 const PredictedRates p = predicted_rates(c, profile);
                 const double l1_exact = hit_rate(exact.model["l1"]);
                 const double l2_exact = hit_rate(nlohmann::json::array({exact.model["l2"]}));
@@ -205,7 +205,7 @@ TEST(AnalyticLevel, FormEstimatorEqualsTheFullEstimate) {
     SimConfig c = small_machine();
     RayList rays(w.jobs);
     Discard sink;
-    const AnalyticProfile& p = analyze_stream(c, *w.accel, w.map(c), rays, sink);
+    const AnalyticProfile& p = analyze_stream(c, *w.accel, w.map(c), StepOptions{}, rays, sink);
     const FormEstimator form(p);
     const std::vector<std::vector<std::string>> configs = {
         {}, {"l1.size_kib=64"}, {"l2.size_kib=512"}, {"l1.size_kib=64", "l2.ways=4"}, {"dram.channels=1"},
@@ -233,7 +233,7 @@ TEST(AnalyticLevel, NeverPredictsFasterThanItsRoofline) {
         for (const std::string& s : sets) config_set(c, s);
         RayList rays(w.jobs);
         Discard sink;
-        const AnalyticOutcome out = run_analytic(c, *w.accel, w.map(c), rays, sink);
+        const AnalyticOutcome out = run_analytic(c, *w.accel, w.map(c), StepOptions{}, rays, sink);
         const nlohmann::json& a = out.model["analytic"];
         ASSERT_GT(out.cycles, 0u);
         for (const auto& [name, bound] : a["bounds"].items())
@@ -247,9 +247,9 @@ TEST(AnalyticLevel, SecondConfigurationOnTheSameRaysReusesTheAnalysis) {
     SimConfig c = small_machine();
     RayList a(w.jobs), b(w.jobs);
     Discard first, second;
-    const AnalyticOutcome base = run_analytic(c, *w.accel, w.map(c), a, first);
+    const AnalyticOutcome base = run_analytic(c, *w.accel, w.map(c), StepOptions{}, a, first);
     c.dram.bytes_per_cycle = 1;  // not in the key: the same analysis, a slower answer
-    const AnalyticOutcome slow = run_analytic(c, *w.accel, w.map(c), b, second);
+    const AnalyticOutcome slow = run_analytic(c, *w.accel, w.map(c), StepOptions{}, b, second);
     EXPECT_EQ(first.rays, w.jobs.size());
     EXPECT_EQ(second.rays, w.jobs.size());  // replayed to the sink
     EXPECT_EQ(first.steps, second.steps);

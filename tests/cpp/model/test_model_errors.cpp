@@ -29,8 +29,8 @@ TEST(ModelErrors, UnwrapReport) {
 class FailingAccel final : public Accel {
 public:
     explicit FailingAccel(bool fail) : Accel(AccelImage{}), m_fail(fail) {}
-    std::unique_ptr<Stepper> make_stepper() const override { return nullptr; }
-    Hit trace(const Ray& ray, TraversalMode, WorkCounts*) const override {
+    std::unique_ptr<Stepper> make_stepper(const StepOptions&) const override { return nullptr; }
+    Hit trace(const Ray& ray, TraversalMode, WorkCounts*, const StepOptions&) const override {
         if (m_fail && ray.origin.x == 0.0f) throw Error("traversal stack overflow (64 entries)");
         return Hit{};
     }

@@ -63,7 +63,7 @@ struct BufferBench {
           partition(partition_of(treelets)),
           accel(tiny_accel()),
           map(accel->image().end_address(), rays, rays, 64, 8),
-          steppers(*accel),
+          steppers(*accel, StepOptions{}),
           dispatch(("dispatch_" + tag).c_str(), rays),
           memory(("memory_" + tag).c_str(), 100),
           buffer(("ray_buffer_" + tag).c_str(), config, partition, map, steppers, kUnits, kContexts,

@@ -14,6 +14,7 @@ namespace {
 
 TEST(Verdict, EachResourceHasItsKnobDoubled) {
     SimConfig c;
+    c.traversal.ray_contexts = 16;  // as the run's resolution step derives it (the verdict sees resolved configs)
     struct Case {
         const char* resource;
         const char* key;
@@ -48,6 +49,7 @@ TEST(Verdict, EachResourceHasItsKnobDoubled) {
 
 TEST(Verdict, EveryKnobIsACandidate) {
     SimConfig c;
+    c.traversal.ray_contexts = 16;  // resolved
     std::set<std::string> keys;
     for (const Knob& k : every_knob(c, {OpKind::box, OpKind::triangle})) keys.insert(k.relax.key);
     for (const char* key : {"traversal.units", "traversal.ray_contexts", "box.width", "triangle.width", "l1.size_kib",

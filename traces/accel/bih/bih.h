@@ -50,12 +50,12 @@ class BihAccel final : public Accel {
 public:
     BihAccel(AccelImage image, const std::string& source);
 
-    std::unique_ptr<Stepper> make_stepper() const override;
-    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override;
+    std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
+              const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return m_depth; }
-    uint32_t stack_entry_bytes() const override { return kBihStackEntryBytes; }
     const BihView& view() const { return m_view; }
 
 private:

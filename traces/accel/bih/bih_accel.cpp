@@ -93,9 +93,9 @@ BihAccel::BihAccel(AccelImage image, const std::string& source) : Accel(std::mov
     m_depth = validate_bih(m_view, source);
 }
 
-std::unique_ptr<Stepper> BihAccel::make_stepper() const { return std::make_unique<BihStepper>(m_view); }
+std::unique_ptr<Stepper> BihAccel::make_stepper(const StepOptions&) const { return std::make_unique<BihStepper>(m_view); }
 
-Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
+Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions&) const {
     BihStepper stepper(m_view);  // on the stack: no allocation, no virtual calls
     return trace_with_stepper(stepper, ray, mode, work);
 }

@@ -46,16 +46,15 @@ class Bvh2Accel final : public Accel {
 public:
     Bvh2Accel(AccelImage image, const std::string& source);
 
-    std::unique_ptr<Stepper> make_stepper() const override;
-    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override;
+    std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
+              const StepOptions& options = {}) const override;
     std::unique_ptr<PacketStepper> make_packet_stepper() const override;
     void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
                       PacketCounts* counts, float split_below = 0.0f) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return kTraversalStackSize; }
-    bool supports_short_stack() const override { return true; }
-    bool supports_reduced_precision_boxes() const override { return true; }
     const Bvh2View& view() const { return m_view; }
 
 private:

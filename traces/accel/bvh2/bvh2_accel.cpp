@@ -187,11 +187,12 @@ Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::m
     validate_bvh2(m_view, source);
 }
 
-std::unique_ptr<Stepper> Bvh2Accel::make_stepper() const {
-    return std::make_unique<Bvh2Stepper>(m_view, m_short_stack_entries, m_box_precision_bits);
+std::unique_ptr<Stepper> Bvh2Accel::make_stepper(const StepOptions& options) const {
+    return std::make_unique<Bvh2Stepper>(m_view, options.short_stack_entries, options.box_precision_bits);
 }
 
-Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
+Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
+    if (!options.fused_loop_walks_alike()) return Accel::trace(ray, mode, work, options);
     return trace_bvh2(m_view, ray, mode, work);
 }
 

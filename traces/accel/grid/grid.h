@@ -37,13 +37,13 @@ class GridAccel final : public Accel {
 public:
     GridAccel(AccelImage image, const std::string& source);
 
-    std::unique_ptr<Stepper> make_stepper() const override;
+    std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
     /// The stepper's own loop on a stack instance (no allocation, no virtual calls).
-    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override;
+    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
+              const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return 0; }  // no stack
-    bool uses_mailbox() const override { return true; }
     const GridView& view() const { return m_view; }
 
 private:

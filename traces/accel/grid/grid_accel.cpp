@@ -48,12 +48,12 @@ GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::m
     validate_grid(m_view, source);
 }
 
-std::unique_ptr<Stepper> GridAccel::make_stepper() const {
-    return std::make_unique<GridStepper>(m_view, m_mailbox_entries);
+std::unique_ptr<Stepper> GridAccel::make_stepper(const StepOptions& options) const {
+    return std::make_unique<GridStepper>(m_view, options.mailbox_entries);
 }
 
-Hit GridAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
-    GridStepper stepper(m_view, m_mailbox_entries);
+Hit GridAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
+    GridStepper stepper(m_view, options.mailbox_entries);
     return trace_with_stepper(stepper, ray, mode, work);
 }
 

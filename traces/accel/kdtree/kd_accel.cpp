@@ -54,12 +54,12 @@ KdAccel::KdAccel(AccelImage image, const std::string& source) : Accel(std::move(
     m_depth = validate_kdtree(m_view, source);
 }
 
-std::unique_ptr<Stepper> KdAccel::make_stepper() const {
-    return std::make_unique<KdStepper>(m_view, m_mailbox_entries);
+std::unique_ptr<Stepper> KdAccel::make_stepper(const StepOptions& options) const {
+    return std::make_unique<KdStepper>(m_view, options.mailbox_entries);
 }
 
-Hit KdAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
-    KdStepper stepper(m_view, m_mailbox_entries);  // on the stack: no allocation, no virtual calls
+Hit KdAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
+    KdStepper stepper(m_view, options.mailbox_entries);  // on the stack: no allocation, no virtual calls
     return trace_with_stepper(stepper, ray, mode, work);
 }
 

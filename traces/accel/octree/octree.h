@@ -35,13 +35,12 @@ class OctreeAccel final : public Accel {
 public:
     OctreeAccel(AccelImage image, const std::string& source);
 
-    std::unique_ptr<Stepper> make_stepper() const override;
-    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override;
+    std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
+              const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return 7 * m_depth; }
-    uint32_t stack_entry_bytes() const override { return kOctStackEntryBytes; }
-    bool uses_mailbox() const override { return true; }
     const OctView& view() const { return m_view; }
 
 private:

@@ -105,12 +105,12 @@ OctreeAccel::OctreeAccel(AccelImage image, const std::string& source) : Accel(st
     m_depth = validate_octree(m_view, source);
 }
 
-std::unique_ptr<Stepper> OctreeAccel::make_stepper() const {
-    return std::make_unique<OctreeStepper>(m_view, m_mailbox_entries);
+std::unique_ptr<Stepper> OctreeAccel::make_stepper(const StepOptions& options) const {
+    return std::make_unique<OctreeStepper>(m_view, options.mailbox_entries);
 }
 
-Hit OctreeAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work) const {
-    OctreeStepper stepper(m_view, m_mailbox_entries);  // on the stack: no allocation, no virtual calls
+Hit OctreeAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
+    OctreeStepper stepper(m_view, options.mailbox_entries);  // on the stack: no allocation, no virtual calls
     return trace_with_stepper(stepper, ray, mode, work);
 }
 

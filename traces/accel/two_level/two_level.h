@@ -55,12 +55,14 @@ public:
     /// the TLAS and the instance records; throws rtsim::Error naming `source` and the record.
     TwoLevelAccel(AccelImage image, const std::string& source);
 
-    std::unique_ptr<Stepper> make_stepper() const override;
+    std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override;
-    /// The larger of the TLAS's 8-byte entries and the BLAS kind's (the stack holds both).
-    uint32_t stack_entry_bytes() const override;
+    /// The BLAS kind's, the stack entry the larger of the TLAS's 8 bytes and the BLAS kind's (the
+    /// stack holds both); nothing that needs one walk of one tree (a packet kernel, a restart
+    /// trail, reduced-precision boxes, compressed leaves).
+    AccelCapabilities capabilities() const override;
 
     uint32_t frame_count() const override { return uint32_t(m_frames.size()); }
     void bind_frame(uint32_t f) override;

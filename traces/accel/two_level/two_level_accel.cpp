@@ -150,7 +150,9 @@ void TwoLevelAccel::bind_frame(uint32_t f) {
     m_frame = f;
 }
 
-std::unique_ptr<Stepper> TwoLevelAccel::make_stepper() const { return std::make_unique<TwoLevelStepper>(*this); }
+std::unique_ptr<Stepper> TwoLevelAccel::make_stepper(const StepOptions& options) const {
+    return std::make_unique<TwoLevelStepper>(*this, options);
+}
 
 LocalityPartition TwoLevelAccel::partition(uint64_t budget_bytes) const {
     require(budget_bytes >= sizeof(HwNode), "treelet budget must be at least one node (64 bytes)");
@@ -201,10 +203,8 @@ uint32_t TwoLevelAccel::max_stack_entries() const {
     return kTraversalStackSize + deepest;
 }
 
-uint32_t TwoLevelAccel::stack_entry_bytes() const {
-    uint32_t bytes = Accel::stack_entry_bytes();
-    for (const auto& b : m_blases) bytes = std::max(bytes, b->stack_entry_bytes());
-    return bytes;
+AccelCapabilities TwoLevelAccel::capabilities() const {
+    return accel_capabilities(kind(), m_image.params.value("blas_kind", "bvh2"));
 }
 
 }  // namespace rtsim

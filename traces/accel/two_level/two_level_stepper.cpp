@@ -8,8 +8,8 @@ namespace rtsim {
 
 using detail::cull_distance;
 
-TwoLevelStepper::TwoLevelStepper(const TwoLevelAccel& accel) : m_accel(accel) {
-    for (const auto& blas : accel.blases()) m_blas_steppers.push_back(blas->make_stepper());
+TwoLevelStepper::TwoLevelStepper(const TwoLevelAccel& accel, const StepOptions& options) : m_accel(accel) {
+    for (const auto& blas : accel.blases()) m_blas_steppers.push_back(blas->make_stepper(options));
 }
 
 void TwoLevelStepper::begin(const Ray& ray, TraversalMode mode) {

@@ -24,7 +24,8 @@ class TwoLevelAccel;
 
 class TwoLevelStepper final : public Stepper {
 public:
-    explicit TwoLevelStepper(const TwoLevelAccel& accel);
+    /// The BLASes' steppers walk with `options` (a mailbox, where their kind has one).
+    TwoLevelStepper(const TwoLevelAccel& accel, const StepOptions& options);
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;

@@ -138,16 +138,16 @@ public:
         m_view.valid = m_valid.data();
     }
 
-    std::unique_ptr<Stepper> make_stepper() const override {
-        return std::make_unique<WideStepper<Codec>>(m_view, m_short_stack_entries, m_box_precision_bits);
+    std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override {
+        return std::make_unique<WideStepper<Codec>>(m_view, options.short_stack_entries, options.box_precision_bits);
     }
-    bool supports_short_stack() const override { return true; }
-    bool supports_reduced_precision_boxes() const override { return true; }
-    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr) const override {
+    Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
+              const StepOptions& options = {}) const override {
         if constexpr (Codec::kFused) {
-            if (m_view.order == ChildOrder::distance) return Codec::fused(m_view, ray, mode, work);
+            if (m_view.order == ChildOrder::distance && options.fused_loop_walks_alike())
+                return Codec::fused(m_view, ray, mode, work);
         }
-        return Accel::trace(ray, mode, work);
+        return Accel::trace(ray, mode, work, options);
     }
     LocalityPartition partition(uint64_t budget_bytes) const override {
         require(budget_bytes >= Codec::kBytes, "treelet budget must be at least one node (" +

@@ -1,0 +1,142 @@
+#pragma once
+// Traversal unit kinds register themselves (docs/architecture.md, "Adding a traversal unit kind"),
+// the way Ramulator 2 registers implementations: each kind's folder declares, once, in its own
+// .cpp, its name, its factory, its own config section (traversal.<kind>.*), its own stats block
+// and what it needs of a structure and a level, and one line registers it:
+//
+//   RTSIM_REGISTER_UNIT_KIND(simt_kind());
+//
+// Nothing central lists the kinds: traversal.model's choices, the config tree's sections, the
+// stats schema, the resolution step's rules (sim/resolve/resolve.h) and `rtsim capabilities` all
+// read this registry. The kinds' folders are globbed by rtl_model/traversal/CMakeLists.txt and
+// linked whole, so a registration is never dropped by the linker.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rtl_model/common/config_section.h"
+#include "rtl_model/common/stats.h"
+
+namespace rtsim {
+
+struct TraversalConfig;
+struct UnitSetup;
+class TraversalUnit;
+
+/// What a unit kind needs of the rest of a run; the resolution step matches these against the
+/// structure's capabilities (traces/accel/capabilities.h), the level's and the techniques'.
+struct UnitNeeds {
+    /// Its rays step as one packet over one shared walk: the structure needs a packet kernel, and
+    /// each ray's reference work is the packet loop's (HitChecker::set_packet_reference).
+    bool packet_kernel = false;
+    /// Its groups of rays step in lock-step: a level must cost lock-step groups.
+    bool lock_step = false;
+    /// Each ray walks with its own stack: per-ray techniques (restart trails, reduced-precision
+    /// walks) can run on it.
+    bool per_ray_stack = true;
+    /// It takes rays one at a time from treelet queues and parks each alone: treelet scheduling.
+    bool treelet_queues = true;
+};
+
+/// A knob of the kind's own the verdict may turn (sim/report/verdict_knobs.cpp).
+struct UnitKnob {
+    std::string key;       ///< its config key, e.g. "traversal.simt.lanes"
+    bool halve = false;    ///< relaxed by halving (else by doubling)
+    std::string resource;  ///< the resource it relaxes ("divergence", ...)
+    bool estimated = true; ///< the analytic level can estimate it (else only a re-run measures it)
+};
+
+/// Every reference-walk parameter a packet kind asks the hit checker for.
+struct PacketReference {
+    uint32_t lanes = 0;       ///< rays per packet, in trace order
+    float split_below = 0.0f; ///< PacketStepper::set_split_below
+};
+
+using UnitFactory = std::function<std::unique_ptr<TraversalUnit>(const char* name, const UnitSetup&, uint32_t index)>;
+
+struct UnitKind {
+    std::string name;     ///< traversal.model's value
+    std::string summary;  ///< one line: what it models and after whom
+    UnitFactory make_unit;
+    /// Its own config section's defaults (traversal.<name>), or null when it has none.
+    std::function<std::unique_ptr<ConfigSection>()> make_section;
+    /// Its stats beyond unit_stats() (merged into model.units.<unit>), or null.
+    const StatBlock* stats = nullptr;
+    /// Rays that step together (1: each context alone); ray contexts are a whole number of groups.
+    std::function<uint32_t(const TraversalConfig&)> group_size = [](const TraversalConfig&) { return 1u; };
+    /// What a group is called in messages ("warp", "packet").
+    std::string group_name = "context";
+    UnitNeeds needs;
+    std::vector<UnitKnob> knobs;
+    /// Where a level cannot cost lock-step groups (the verdict's analytic estimates), the kind
+    /// whose estimate stands in for this one with the same ray contexts.
+    std::string estimate_as;
+    /// The packet reference walk the hit checker checks its rays' work against (packet kernels).
+    std::function<PacketReference(const TraversalConfig&)> packet_reference;
+
+    /// Sets make_section to C's defaults (C: a struct with a template visit()).
+    template <class C>
+    void section() {
+        make_section = [] { return std::make_unique<ConfigSectionOf<C>>(); };
+    }
+};
+
+/// Adds a kind to the registry (at static initialisation); throws on a repeated name.
+bool register_unit_kind(UnitKind kind);
+/// Every registered kind, ordered by name.
+std::vector<const UnitKind*> unit_kinds();
+/// The kind named `name`; throws rtsim::Error naming traversal.model and the known kinds.
+const UnitKind& unit_kind(const std::string& name);
+/// Registered names, ordered, joined by ", ".
+std::string unit_kind_names();
+
+#define RTSIM_UNIT_KIND_CONCAT2(a, b) a##b
+#define RTSIM_UNIT_KIND_CONCAT(a, b) RTSIM_UNIT_KIND_CONCAT2(a, b)
+/// Registers the UnitKind `expr` once, from the unit kind's own .cpp (a unique name per use, so
+/// kinds compiled in one unity batch do not collide).
+#define RTSIM_REGISTER_UNIT_KIND(expr)                                                        \
+    namespace {                                                                               \
+    [[maybe_unused]] const bool RTSIM_UNIT_KIND_CONCAT(rtsim_unit_kind_registered_, __COUNTER__) = \
+        ::rtsim::register_unit_kind(expr);                                                    \
+    }
+
+/// Each registered kind's own config section, by kind name: what TraversalConfig holds for
+/// traversal.<kind>. Copies deeply; a kind's section is made at its defaults when first needed
+/// (so configs made before every kind registered still see them all).
+class UnitSections {
+public:
+    UnitSections() = default;
+    UnitSections(const UnitSections& other);
+    UnitSections& operator=(const UnitSections& other);
+    UnitSections(UnitSections&&) = default;
+    UnitSections& operator=(UnitSections&&) = default;
+
+    /// Kind `kind`'s section, made at its defaults if absent; throws if the kind has none.
+    ConfigSection& get(const std::string& kind) const;
+    /// Kind `kind`'s section values as C (its registered type).
+    template <class C>
+    const C& of(const std::string& kind) const {
+        return dynamic_cast<ConfigSectionOf<C>&>(get(kind)).value;
+    }
+    template <class C>
+    C& of(const std::string& kind) {
+        return dynamic_cast<ConfigSectionOf<C>&>(get(kind)).value;
+    }
+
+    /// v.section(kind, ...) for every registered kind with a section, in name order.
+    template <class V>
+    void visit(V& v) {
+        for (const UnitKind* k : unit_kinds()) {
+            if (!k->make_section) continue;
+            ConfigSectionRef ref{get(k->name)};
+            v.section(k->name.c_str(), ref);
+        }
+    }
+
+private:
+    mutable std::vector<std::pair<std::string, std::unique_ptr<ConfigSection>>> m_sections;
+};
+
+}  // namespace rtsim

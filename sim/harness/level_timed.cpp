@@ -1,0 +1,144 @@
+// The timed levels (approx, detailed): the SystemC model over the whole trace or, with sampling,
+// over a stratified sample of it (sim/sampling/sampling.h) with functional warming; animated
+// traces replayed frame after frame with caches warm.
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+
+#include "rtl_model/top/top.h"
+#include "sim/harness/frames.h"
+#include "sim/harness/hit_checker.h"
+#include "sim/harness/level.h"
+#include "sim/harness/model_errors.h"
+#include "sim/harness/trace_stream.h"
+#include "sim/report/summary.h"
+#include "sim/report/timeline.h"
+#include "sim/sampling/sampling.h"
+#include "sim/sampling/warming.h"
+#include "traces/common/error.h"
+
+namespace rtsim {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+/// The config the SystemC model times with. Detailed: units synchronise every cycle (quantum 1),
+/// so shared blocks see requests in time order (docs/model.md, "The detailed level"); approx with
+/// treelets: a shorter quantum (treelets.quantum_cycles; docs/fidelity.md). The resolved config
+/// keeps the user's value.
+SimConfig timed_config(const SimConfig& c) {
+    SimConfig t = c;
+    if (c.fidelity == Fidelity::detailed) t.quantum_cycles = 1;
+    else if (c.treelets.enabled) t.quantum_cycles = std::min(t.quantum_cycles, c.treelets.quantum_cycles);
+    return t;
+}
+
+}  // namespace
+
+LevelResult run_timed_level(RunInputs& in) {
+    const RunSetup& s = in.setup;
+    const SimConfig& c = s.config;
+    // Spill areas belong to contexts, or to rays in treelet mode (they move between units).
+    BuiltRun built = build_run(in, c.treelets.enabled);
+    Accel& accel = *built.accel;
+    const MemoryMap& map = *built.map;
+    // Sampling (sim/sampling/sampling.h): only the sample's rays are simulated and checked.
+    std::unique_ptr<SampledRun> sampled;
+    if (c.sampling.enabled() && !sample_covers_trace(c, built.rays))
+        sampled = std::make_unique<SampledRun>(in.reader, c, built.rays);
+    const uint64_t simulated = sampled ? sampled->plan.simulated_rays : built.rays;
+    ReferenceWindow reference(in.reader, c.dispatch.chunk_rays);
+    HitChecker checker("checker", sampled ? static_cast<ReferenceSource&>(sampled->reference) : reference, simulated,
+                       progress_of(in.options));
+    if (s.packet_reference) {
+        // Packets change each ray's work: it is checked against the reference packet loop.
+        const float split = s.packet_reference->split_below;
+        checker.set_packet_reference([&accel, split](const Ray* r, const TraversalMode* m, uint32_t n, Hit* h,
+                                                     WorkCounts* w) { accel.trace_packet(r, m, n, h, w, nullptr, split); });
+    }
+    FrameRecorder frame_figures(c, built.frames, in.manifest.value("frames", json(nullptr)));
+    Timeline timeline(c.clock_ghz);
+    const SimConfig model_config = timed_config(c);
+    FrameRayStream stream(in.reader, built.frames);
+    Top top("top", model_config, accel, s.step, map, sampled ? static_cast<RayStream&>(sampled->stream) : stream,
+            checker, built.features);
+    // Frame barriers: record each frame's figures, then bind the structure's next frame.
+    std::vector<uint64_t> frame_rays;
+    for (const FrameRecord& f : built.frames) frame_rays.push_back(f.rays);
+    if (!sampled)
+        top.dispatch().set_frames(
+            frame_rays, [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); },
+            [&](uint32_t f) { accel.bind_frame(f); });
+    std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
+    if (in.options.timeline) {
+        kind_reader = std::make_unique<TraceReader>(in.rtt);
+        checker.on_ray = [&](const RayResult& r) {
+            if (r.id < Timeline::kMaxRays) {
+                RayRecord rec;
+                kind_reader->read(SectionKind::rays, r.id, 1, &rec);
+                timeline.ray(r, rec.kind);
+            }
+        };
+    }
+    if (sampled)
+        checker.on_ray = [&, hook = checker.on_ray](const RayResult& r) {
+            sampled->estimator.ray_done(r);
+            if (hook) hook(r);
+        };
+    std::unique_ptr<FunctionalWarmer> warmer;  // sampled runs with functional warming
+    if (sampled && c.sampling.warming_rays > 0) {
+        warmer = std::make_unique<FunctionalWarmer>(
+            accel, s.step, step_costs(c, accel.op_kinds()), map, in.reader, c.traversal.units,
+            [&top](uint32_t unit, uint64_t addr, uint32_t bytes) { top.warm(unit, addr, bytes); });
+        sampled->stream.set_warming(c.sampling.warming_rays, [&](uint64_t first, uint64_t end, uint64_t position) {
+            warmer->warm(first, end, uint32_t(position % c.traversal.units));
+        });
+    }
+    try {
+        sc_core::sc_start();
+    } catch (const sc_core::sc_report& e) {
+        // An rtsim::Error raised in a SystemC process (a traversal stack overflow, say): name
+        // the trace and the ray instead of SystemC's wrapper (exit 2, not a raw report).
+        const std::string ray = first_failing_ray(accel, in.reader);
+        throw Error(in.rtt + ": " + (ray.empty() ? "simulation failed: " + unwrap_report(e.what()) : ray));
+    }
+    require(checker.checked() == simulated, "simulation ended with " + std::to_string(checker.checked()) + " of " +
+                                                std::to_string(simulated) + " rays finished");
+    LevelResult r;
+    r.cycles = top.total_cycles();
+    r.model = top.stats_json();
+    r.instantiated = top.instantiated();
+    if (in.options.timeline && top.dram())
+        timeline.write((fs::path(in.options.out_dir) / "timeline.json").string(), top.units(),
+                       top.dram()->bytes_over_time(), Dram::bucket_cycles());
+    const double wall = in.wall_seconds();
+    r.summary = summarize(c, r.cycles, built.rays, r.model,
+                          {checker.hit_mismatches(), checker.work_mismatches(), checker.latency().mean()}, wall);
+    if (sampled) {
+        apply_sampling_to_summary(r.summary, c, sampled->plan, sampled->estimator);
+        r.sampling = sampled->estimator.to_json(c, r.cycles, wall);
+        r.sampling["functional_warming"] = {{"rays_per_cluster", c.sampling.warming_rays},
+                                            {"warmed_rays", warmer ? warmer->warmed_rays() : 0},
+                                            {"warmed_reads", warmer ? warmer->warmed_reads() : 0},
+                                            {"seconds", warmer ? warmer->seconds() : 0.0}};
+    }
+    r.validation = checker.to_json();
+    r.latency = checker.latency().to_json();
+    r.workload = built.workload;
+    r.frames = frame_figures.to_json();
+    r.frame_count = built.frames.size();
+    r.work = checker.work_totals();
+    r.rays = checker.checked();
+    r.bad = checker.hit_mismatches() || checker.work_mismatches();
+    // The verdict's estimates trace a sample of rays against the structure (kept alive by the
+    // closure, as the report stage runs after this level returns).
+    auto kept = std::make_shared<BuiltRun>(std::move(built));
+    r.judge = [&in, kept, instantiated = r.instantiated](const json& model) {
+        return judge(verdict_context(in, *kept, model, instantiated));
+    };
+    return r;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,30 @@
+#include "sim/resolve/levels.h"
+
+namespace rtsim {
+
+LevelCapabilities level_capabilities(const SimConfig& c) {
+    LevelCapabilities l;
+    l.name = kFidelityChoices.name(c.fidelity);
+    switch (c.fidelity) {
+        case Fidelity::functional:
+            // The reference walks, no time: every kind's rays walk as they would (packets as
+            // packets), and the timing-only techniques have nothing to change.
+            l.lock_step = l.treelets = l.frames = l.steps_rays = true;
+            break;
+        case Fidelity::analytic: {
+            // A closed form over a per-trace analysis: each ray context costed on its own, plain
+            // dispatch, one frame (sim/analytic/analytic.h).
+            const bool functional = c.analytic.caches == AnalyticCaches::functional;
+            l.name += std::string(" (analytic.caches=") + (functional ? "functional" : "statistical") + ")";
+            l.steps_rays = functional;
+            break;
+        }
+        case Fidelity::approx:
+        case Fidelity::detailed:
+            l.timed = l.lock_step = l.treelets = l.frames = l.steps_rays = true;
+            break;
+    }
+    return l;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,26 @@
+#pragma once
+// What each fidelity level can cost (docs/fidelity.md), as data: the resolution step matches a
+// unit kind's and the techniques' needs against it. The analytic level is two levels here: its
+// statistical caches price steps from the trace's work records, its functional caches step
+// every ray (analytic.caches).
+#include <string>
+
+#include "sim/config/config.h"
+
+namespace rtsim {
+
+struct LevelCapabilities {
+    std::string name;        ///< "approx", "analytic (analytic.caches=statistical)", ...
+    bool timed = false;      ///< the SystemC model times it (approx, detailed)
+    bool lock_step = false;  ///< it costs groups of rays stepping in lock-step (warps, packets)
+    bool treelets = false;   ///< it models treelet admission and queues
+    bool frames = false;     ///< it replays an animated trace's frames
+    /// It steps rays itself, so it counts work the trace's records hold none of (mailbox lookups,
+    /// restart-trail restarts, a reduced-precision walk's extra steps).
+    bool steps_rays = false;
+};
+
+/// The capabilities of the level `config` runs at.
+LevelCapabilities level_capabilities(const SimConfig& config);
+
+}  // namespace rtsim

@@ -1,0 +1,158 @@
+#include "sim/resolve/rules.h"
+
+namespace rtsim {
+
+namespace {
+
+bool restart_trail(const RunFacts& f) { return f.config.traversal.stack_overflow == StackOverflow::restart_trail; }
+bool reduced_boxes(const RunFacts& f) { return f.config.traversal.box_precision_bits != 0; }
+bool treelets(const RunFacts& f) { return f.config.treelets.enabled; }
+bool sampling(const RunFacts& f) { return f.config.sampling.enabled(); }
+bool animated(const RunFacts& f) { return f.structure.frames > 1; }
+
+/// How a message names the side a rule matches against.
+std::string side_name(const Rule& r, const RunFacts& f) {
+    switch (r.side) {
+        case RuleSide::structure: return f.structure.name();
+        case RuleSide::unit: return "traversal.model '" + f.unit.name + "'";
+        case RuleSide::level: return "fidelity '" + f.level.name + "'";
+        case RuleSide::technique: break;
+    }
+    return "this run";
+}
+
+std::vector<Rule> make_rules() {
+    std::vector<Rule> rules;
+    auto add = [&](Rule r) { rules.push_back(std::move(r)); };
+
+    // Unit kinds: what their groups need.
+    add({"unit/packet_kernel", "traversal.model (a kind whose rays step as one packet)",
+         [](const RunFacts& f) { return f.unit.needs.packet_kernel; }, RuleSide::structure, "a packet kernel",
+         [](const RunFacts& f) { return f.structure.caps.packet_kernel; },
+         "a packet's rays walk one shared traversal, which the structure provides as a packet stepper and a "
+         "reference packet loop (the hit checker checks each packet's work against it)",
+         "traversal.model=mimd or simt, or trace a structure with a packet kernel (rtsim capabilities)", "kdtree",
+         {"traversal.model=packet"}});
+    add({"unit/groups", "traversal.ray_contexts",
+         [](const RunFacts& f) { return f.config.traversal.ray_contexts != 0 && f.unit.group_size(f.config.traversal) > 1; },
+         RuleSide::unit, "a whole number of its groups (warps or packets)",
+         [](const RunFacts& f) {
+             return f.config.traversal.ray_contexts % f.unit.group_size(f.config.traversal) == 0;
+         },
+         "a unit's ray contexts are its warps' lanes or its packets' rays",
+         "traversal.ray_contexts a multiple of the kind's lanes, or 0 (derived: 16 rounded up to whole groups)",
+         "bvh2", {"traversal.model=simt", "traversal.ray_contexts=20"}});
+    add({"unit/lock_step", "traversal.model (a kind whose rays step in lock-step groups)",
+         [](const RunFacts& f) { return f.unit.needs.lock_step; }, RuleSide::level, "a level that costs lock-step groups",
+         [](const RunFacts& f) { return f.level.lock_step; },
+         "the analytic closed form costs each ray context on its own, with no lock-step warps or packets",
+         "fidelity=approx or detailed, or traversal.model=mimd", "bvh2",
+         {"traversal.model=simt", "fidelity=analytic"}});
+
+    // Treelet scheduling.
+    add({"treelets/unit", "treelets.enabled=true", treelets, RuleSide::unit,
+         "a unit kind that takes rays one at a time from treelet queues",
+         [](const RunFacts& f) { return f.unit.needs.treelet_queues; },
+         "a group's rays would leave for different treelets' queues", "traversal.model=mimd, or treelets.enabled=false",
+         "bvh2", {"traversal.model=simt", "treelets.enabled=true"}});
+    add({"treelets/level", "treelets.enabled=true", treelets, RuleSide::level, "a level that models treelet queues",
+         [](const RunFacts& f) { return f.level.treelets; }, "the analytic closed form models plain dispatch",
+         "fidelity=approx or detailed", "bvh2", {"treelets.enabled=true", "fidelity=analytic"}});
+    add({"treelets/sampling", "treelets.enabled=true", treelets, RuleSide::technique,
+         "no sampling (sampling.fraction and sampling.count 0)", [](const RunFacts& f) { return !sampling(f); },
+         "the ray buffer admits a cluster's rays long before the machine can trace them, so the span of their starts "
+         "does not measure throughput (a 1% sample of Sponza on 4 units estimated -81%)",
+         "simulate the whole trace (sampling.fraction=0), or treelets.enabled=false", "bvh2",
+         {"treelets.enabled=true", "sampling.fraction=0.2"}});
+    add({"sort/treelets", "dispatch.sort (ray sorting)", [](const RunFacts& f) { return f.config.dispatch.sort != RaySort::none; },
+         RuleSide::technique, "treelets.enabled=false", [](const RunFacts& f) { return !treelets(f); },
+         "the ray buffer takes rays from dispatch in its own order and reorders them by treelet itself",
+         "dispatch.sort=none, or treelets.enabled=false", "bvh2", {"dispatch.sort=morton", "treelets.enabled=true"}});
+
+    // Per-ray traversal techniques.
+    add({"restart_trail/structure", "traversal.stack_overflow=restart_trail", restart_trail, RuleSide::structure,
+         "a restart trail", [](const RunFacts& f) { return f.structure.caps.restart_trail; },
+         "the restart trail records a BVH walk's position per level of one tree (Laine 2010)",
+         "traversal.stack_overflow=spill, or trace a structure with a restart trail (rtsim capabilities)", "kdtree",
+         {"traversal.stack_overflow=restart_trail"}});
+    add({"restart_trail/unit", "traversal.stack_overflow=restart_trail", restart_trail, RuleSide::unit,
+         "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
+         "a packet's rays share one stack, and the restart trail is a single ray's",
+         "traversal.model=mimd or simt, or traversal.stack_overflow=spill", "bvh2",
+         {"traversal.model=packet", "traversal.stack_overflow=restart_trail"}});
+    add({"restart_trail/level", "traversal.stack_overflow=restart_trail", restart_trail, RuleSide::level,
+         "a level that steps the rays", [](const RunFacts& f) { return f.level.steps_rays; },
+         "its per-trace analysis prices steps from the trace's work records, which hold no restarts",
+         "analytic.caches=functional, or fidelity=approx or detailed", "bvh2",
+         {"traversal.stack_overflow=restart_trail", "fidelity=analytic"}});
+    add({"box_precision/structure", "traversal.box_precision_bits (reduced-precision boxes)", reduced_boxes,
+         RuleSide::structure, "a reduced-precision box walk",
+         [](const RunFacts& f) { return f.structure.caps.reduced_precision_boxes; },
+         "the conservative walk re-tests a BVH's child boxes rounded outward (Vaidyanathan et al. 2016); the "
+         "structure must count the extra subtrees it enters",
+         "traversal.box_precision_bits=0 (fp32), or trace a structure with a reduced-precision walk (rtsim "
+         "capabilities)",
+         "grid", {"traversal.box_precision_bits=7"}});
+    add({"box_precision/unit", "traversal.box_precision_bits (reduced-precision boxes)", reduced_boxes, RuleSide::unit,
+         "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
+         "a packet's shared walk has no per-ray extra walk", "traversal.model=mimd or simt, or box_precision_bits=0",
+         "bvh2", {"traversal.model=packet", "traversal.box_precision_bits=7"}});
+    add({"box_precision/level", "traversal.box_precision_bits (reduced-precision boxes)", reduced_boxes,
+         RuleSide::level, "a level that steps the rays", [](const RunFacts& f) { return f.level.steps_rays; },
+         "its per-trace analysis prices steps from the trace's work records, which hold no extra walk",
+         "analytic.caches=functional, fidelity=approx or detailed, or box_precision_bits=0", "bvh2",
+         {"traversal.box_precision_bits=7", "fidelity=analytic"}});
+    add({"mailbox/level", "mailbox.entries", [](const RunFacts& f) { return f.config.mailbox.entries != 0; },
+         RuleSide::level, "a level that steps the rays", [](const RunFacts& f) { return f.level.steps_rays; },
+         "its per-trace analysis prices triangle tests from the trace's work records, which hold no mailbox",
+         "analytic.caches=functional, or fidelity=approx or detailed", "kdtree",
+         {"mailbox.entries=8", "fidelity=analytic"}});
+
+    // Sampling.
+    add({"sampling/level", "sampling.fraction or sampling.count", sampling, RuleSide::level, "a timed level",
+         [](const RunFacts& f) { return f.level.timed; },
+         "a sample's clusters are timed on the SystemC model and scaled to the whole trace",
+         "fidelity=approx or detailed", "bvh2", {"sampling.fraction=0.2", "fidelity=functional"}});
+    add({"sampling/size", "sampling.fraction", [](const RunFacts& f) { return f.config.sampling.fraction > 0; },
+         RuleSide::technique, "sampling.count 0", [](const RunFacts& f) { return f.config.sampling.count == 0; },
+         "a sample is sized one way", "set sampling.fraction or sampling.count, not both", "bvh2",
+         {"sampling.fraction=0.2", "sampling.count=100"}});
+
+    // Animated traces (docs/accel.md, "Frames").
+    add({"frames/level", "an animated trace (--frames)", animated, RuleSide::level, "a level that replays frames",
+         [](const RunFacts& f) { return f.level.frames; }, "the analytic level does not replay frames yet",
+         "fidelity=functional, approx or detailed", "frames", {"fidelity=analytic"}});
+    add({"frames/sampling", "an animated trace (--frames)", animated, RuleSide::technique,
+         "no sampling (sampling.fraction and sampling.count 0)", [](const RunFacts& f) { return !sampling(f); },
+         "sampling does not cut frames yet: an animated trace is replayed whole", "sampling.fraction=0", "frames",
+         {"sampling.fraction=0.2"}});
+    add({"frames/treelets", "an animated trace (--frames)", animated, RuleSide::technique, "treelets.enabled=false",
+         [](const RunFacts& f) { return !treelets(f); }, "treelet scheduling does not hold frame barriers yet",
+         "treelets.enabled=false", "frames", {"treelets.enabled=true"}});
+    return rules;
+}
+
+}  // namespace
+
+const std::vector<Rule>& run_rules() {
+    static const std::vector<Rule> rules = make_rules();
+    return rules;
+}
+
+std::string refusal(const Rule& r, const RunFacts& f) {
+    const std::string asks = r.asks.rfind("an ", 0) == 0 ? r.asks : "'" + r.asks + "'";
+    std::string side = side_name(r, f);
+    if (r.side == RuleSide::technique) return "config: " + asks + " needs " + r.needs + ": " + r.reason + "; change " + r.change;
+    return "config: " + asks + " needs " + r.needs + ", which " + side + " lacks: " + r.reason + "; change " + r.change;
+}
+
+std::vector<Unused> unused_settings(const RunFacts& f) {
+    std::vector<Unused> out;
+    if (f.config.mailbox.entries && !f.structure.caps.mailbox)
+        out.push_back({"mailbox.entries", f.structure.name() + " lists no primitive twice along a ray"});
+    if (f.config.treelets.prefetch && !f.config.treelets.enabled)
+        out.push_back({"treelets.prefetch", "it prefetches the treelets the ray buffer schedules (treelets.enabled)"});
+    return out;
+}
+
+}  // namespace rtsim
