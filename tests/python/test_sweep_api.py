@@ -50,10 +50,14 @@ def comparable(row: dict) -> dict:
     for key in ("provenance", "latency", "sampling"):
         stats.pop(key, None)
     return {
-        "run_id": row["run_id"], "status": row["status"], "params": json.loads(row["params_json"]),
-        "config": json.loads(row["config_json"]), "summary": stats["summary"],
-        "model": stats.get("model"), "area": stats.get("area"),
-    }  # fmt: skip
+        "run_id": row["run_id"],
+        "status": row["status"],
+        "params": json.loads(row["params_json"]),
+        "config": json.loads(row["config_json"]),
+        "summary": stats["summary"],
+        "model": stats.get("model"),
+        "area": stats.get("area"),
+    }
 
 
 @pytest.fixture(scope="module")
@@ -81,8 +85,12 @@ def test_resume_from_python_after_kill(tmp_path: Path) -> None:
     spec["grid"]["traversal.units"] = [1, 2, 4, 8]
     out = tmp_path / "out"
     code = f"import rtsim; rtsim.sweep({spec!r}, {str(out)!r}, workers=1, progress=False)"
-    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 120
     try:
         while time.monotonic() < deadline and proc.poll() is None:
@@ -109,12 +117,27 @@ def test_resume_from_python_after_kill(tmp_path: Path) -> None:
     assert len(results.to_pandas()) == 8
 
 
-def test_dataframe_columns_are_rtsim_results_columns(py_sweep: rtsim.Results, tmp_path: Path) -> None:
+def test_dataframe_columns_are_rtsim_results_columns(
+    py_sweep: rtsim.Results, tmp_path: Path
+) -> None:
     df = py_sweep.to_pandas()
     names = list(df.columns)
-    for key in ("scene", "workload", "accel", "fidelity", "traversal.units", "l1.size_kib",
-                "point", "mrays_per_second", "dram_bytes_per_ray.node", "l1_hit_rate",
-                "box_utilization", "energy_per_ray_nj", "area_mm2", "sram_bytes"):  # fmt: skip
+    for key in (
+        "scene",
+        "workload",
+        "accel",
+        "fidelity",
+        "traversal.units",
+        "l1.size_kib",
+        "point",
+        "mrays_per_second",
+        "dram_bytes_per_ray.node",
+        "l1_hit_rate",
+        "box_utilization",
+        "energy_per_ray_nj",
+        "area_mm2",
+        "sram_bytes",
+    ):
         assert key in names, key
     assert df.attrs["units"]["mrays_per_second"] == "Mrays/s"
     assert df.attrs["units"]["l1.size_kib"] == "KiB"
@@ -187,8 +210,18 @@ def test_study_reruns_reuse_runs_and_write_its_markers(tmp_path: Path) -> None:
     docs = tmp_path / "docs"
     docs.mkdir()
     (docs / "doc.md").write_text("before\n<!-- tiny:begin -->\nold\n<!-- tiny:end -->\nafter\n")
-    args = ["study", str(study), "-o", str(tmp_path / "out"), "--workers", "1", "--no-progress",
-            "--write-docs", "--docs", str(docs)]  # fmt: skip
+    args = [
+        "study",
+        str(study),
+        "-o",
+        str(tmp_path / "out"),
+        "--workers",
+        "1",
+        "--no-progress",
+        "--write-docs",
+        "--docs",
+        str(docs),
+    ]
     first = run_rtsim(*args)
     assert first.returncode == 0, first.stdout + first.stderr
     text = (docs / "doc.md").read_text()
@@ -197,7 +230,9 @@ def test_study_reruns_reuse_runs_and_write_its_markers(tmp_path: Path) -> None:
     body = text.split("<!-- tiny:begin -->\n")[1].split("<!-- tiny:end -->")[0]
     assert [line.split()[:2] for line in body.splitlines()] == [["a", "2"], ["b", "2"]]
     again = run_rtsim(*args)
-    assert again.returncode == 0 and "1 already in results.sqlite" in again.stderr.replace("\n", " ")
+    assert again.returncode == 0 and "1 already in results.sqlite" in again.stderr.replace(
+        "\n", " "
+    )
     assert (docs / "doc.md").read_text() == text
     bad = run_rtsim("study", str(study), "--option", "bogus=1", "-o", str(tmp_path / "x"))
     assert bad.returncode == 2 and "unknown option 'bogus'" in bad.stderr

@@ -24,21 +24,26 @@ def points(bits: list[int], detailed_bits: int, detailed: bool) -> list[dict[str
     out += [{"label": f"b{b}", "set": {"traversal.box_precision_bits": b}} for b in bits]
     if detailed and detailed_bits:
         for name, b in (("fp32-detailed", 0), (f"b{detailed_bits}-detailed", detailed_bits)):
-            out.append({"label": name, "set": {"fidelity": "detailed",
-                                               "traversal.box_precision_bits": b}})  # fmt: skip
+            out.append(
+                {"label": name, "set": {"fidelity": "detailed", "traversal.box_precision_bits": b}}
+            )
     return out
 
 
 def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
     combos = [(s, a) for s in o["scenes"] for a in o["accels"]]
-    return [{
-        "name": f"rpbox-{s}-{a}",
-        "scenes": [scene(s, o["hairball_triangles"])],
-        "workloads": [{"name": o["workload"], "rays": [o["workload"]],
-                       "resolution": o["resolution"]}],
-        "accel": [a],
-        "points": points(o["bits"], o["detailed_bits"], (s, a) == combos[0]),
-    } for s, a in combos]  # fmt: skip
+    return [
+        {
+            "name": f"rpbox-{s}-{a}",
+            "scenes": [scene(s, o["hairball_triangles"])],
+            "workloads": [
+                {"name": o["workload"], "rays": [o["workload"]], "resolution": o["resolution"]}
+            ],
+            "accel": [a],
+            "points": points(o["bits"], o["detailed_bits"], (s, a) == combos[0]),
+        }
+        for s, a in combos
+    ]
 
 
 def rows(run: StudyRun) -> list[dict[str, Any]]:
@@ -47,20 +52,23 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
     for r in plain:
         base = "fp32-detailed" if r["point"].endswith("-detailed") else "fp32"
         f = next(b for b in plain if (b["part"], b["point"]) == (r["part"], base))
-        out.append({
-            "scene": r["scene"], "accel": r["accel"],
-            "fidelity": "detailed" if r["point"].endswith("-detailed") else "approx",
-            "bits": r["bp_bits"] or 23,
-            "box_hits_per_ray": r["bp_box_hits"] or 0.0,
-            "extra_steps": r["bp_extra_steps"] or 0.0,
-            "extra_box_tests": r["bp_extra_box_tests"] or 0.0,
-            "extra_tri_tests": r["bp_extra_tri_tests"] or 0.0,
-            "dram_vs_fp32": r["dram_bytes_per_ray"] / f["dram_bytes_per_ray"],
-            "speed_vs_fp32": r["mrays_per_second"] / f["mrays_per_second"],
-            "box_test_pj_vs_fp32": r["box_test_pj"] / f["box_test_pj"],
-            "box_mm2_vs_fp32": r["box_mm2"] / f["box_mm2"],
-            "box_energy_vs_fp32": r["box_nj_per_ray"] / f["box_nj_per_ray"],
-        })  # fmt: skip
+        out.append(
+            {
+                "scene": r["scene"],
+                "accel": r["accel"],
+                "fidelity": "detailed" if r["point"].endswith("-detailed") else "approx",
+                "bits": r["bp_bits"] or 23,
+                "box_hits_per_ray": r["bp_box_hits"] or 0.0,
+                "extra_steps": r["bp_extra_steps"] or 0.0,
+                "extra_box_tests": r["bp_extra_box_tests"] or 0.0,
+                "extra_tri_tests": r["bp_extra_tri_tests"] or 0.0,
+                "dram_vs_fp32": r["dram_bytes_per_ray"] / f["dram_bytes_per_ray"],
+                "speed_vs_fp32": r["mrays_per_second"] / f["mrays_per_second"],
+                "box_test_pj_vs_fp32": r["box_test_pj"] / f["box_test_pj"],
+                "box_mm2_vs_fp32": r["box_mm2"] / f["box_mm2"],
+                "box_energy_vs_fp32": r["box_nj_per_ray"] / f["box_nj_per_ray"],
+            }
+        )
     return out
 
 
@@ -100,9 +108,15 @@ STUDY = Study(
     about="reduced-precision box tests against fp32: extra walk, speed, energy and area",
     specs=specs,
     tables=[Table("accel.md", "rp_boxes_table", table)],
-    options={"resolution": "96x72", "workload": "diffuse",
-             "scenes": ["sponza", "hairball", "cornell"], "accels": ["bvh2", "cwbvh8"],
-             "bits": [16, 12, 8, 6, 4], "detailed_bits": 8, "hairball_triangles": 50000},
+    options={
+        "resolution": "96x72",
+        "workload": "diffuse",
+        "scenes": ["sponza", "hairball", "cornell"],
+        "accels": ["bvh2", "cwbvh8"],
+        "bits": [16, 12, 8, 6, 4],
+        "detailed_bits": 8,
+        "hairball_triangles": 50000,
+    },
     quick={"resolution": "32x24", "scenes": ["cornell"], "bits": [8, 4]},
     extra={
         "bp_bits": "box_precision.bits",
@@ -114,4 +128,4 @@ STUDY = Study(
         "box_mm2": "area.mm2.box",
         "box_nj_per_ray": "energy.per_ray_nj.box",
     },
-)  # fmt: skip
+)

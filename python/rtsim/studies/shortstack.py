@@ -24,22 +24,31 @@ def points(entries: list[int]) -> list[dict[str, Any]]:
     """The full stack, then each size short (restart trail) and spilling."""
     out = [{"label": "full", "set": {"traversal.stack_entries": FULL_ENTRIES}}]
     for n in entries:
-        out.append({"label": f"short{n}", "set": {"traversal.stack_entries": n,
-                                                  "traversal.stack_overflow": "restart_trail"}})
+        out.append(
+            {
+                "label": f"short{n}",
+                "set": {"traversal.stack_entries": n, "traversal.stack_overflow": "restart_trail"},
+            }
+        )
         out.append({"label": f"spill{n}", "set": {"traversal.stack_entries": n}})
-    return out  # fmt: skip
+    return out
 
 
 def spec_of(o: dict[str, Any], name: str) -> list[dict[str, Any]]:
     """One spec per scene and structure (the table's order)."""
-    return [{
-        "name": f"{name}-{s}-{a}",
-        "scenes": [scene(s, o["hairball_triangles"])],
-        "workloads": [{"name": o["workload"], "rays": [o["workload"]],
-                       "resolution": o["resolution"]}],
-        "accel": [a],
-        "points": points(o["entries"]),
-    } for s in o["scenes"] for a in o["accels"]]  # fmt: skip
+    return [
+        {
+            "name": f"{name}-{s}-{a}",
+            "scenes": [scene(s, o["hairball_triangles"])],
+            "workloads": [
+                {"name": o["workload"], "rays": [o["workload"]], "resolution": o["resolution"]}
+            ],
+            "accel": [a],
+            "points": points(o["entries"]),
+        }
+        for s in o["scenes"]
+        for a in o["accels"]
+    ]
 
 
 def spilled_entries(rec: Any) -> int:
@@ -53,22 +62,29 @@ def rows(run: StudyRun, part: str = "shortstack") -> list[dict[str, Any]]:
     full = {(r["scene"], r["accel"]): r for r in plain if r["point"] == "full"}
     for r in plain:
         f, name = full[(r["scene"], r["accel"])], r["point"]
-        policy = "full" if name == "full" else ("restart_trail" if name.startswith("short")
-                                                else "spill")  # fmt: skip
-        out.append({
-            "scene": r["scene"], "accel": r["accel"], "run": name, "policy": policy,
-            "entries": FULL_ENTRIES if name == "full"
-            else int(name.removeprefix("short").removeprefix("spill")),
-            "rays": r["rays"],
-            "extra_steps": r["ss_extra_steps"] or 0.0,
-            "extra_box_tests": r["ss_extra_box_tests"] or 0.0,
-            "restarts_per_ray": r["ss_restarts"] or 0.0,
-            "spill_entries_per_ray": r["spilled_entries"] / r["rays"],
-            "dram_bytes_per_ray": r["dram_bytes_per_ray"],
-            "dram_vs_full": r["dram_bytes_per_ray"] / f["dram_bytes_per_ray"],
-            "mrays_per_second": r["mrays_per_second"],
-            "speed_vs_full": r["mrays_per_second"] / f["mrays_per_second"],
-        })  # fmt: skip
+        policy = (
+            "full" if name == "full" else ("restart_trail" if name.startswith("short") else "spill")
+        )
+        out.append(
+            {
+                "scene": r["scene"],
+                "accel": r["accel"],
+                "run": name,
+                "policy": policy,
+                "entries": FULL_ENTRIES
+                if name == "full"
+                else int(name.removeprefix("short").removeprefix("spill")),
+                "rays": r["rays"],
+                "extra_steps": r["ss_extra_steps"] or 0.0,
+                "extra_box_tests": r["ss_extra_box_tests"] or 0.0,
+                "restarts_per_ray": r["ss_restarts"] or 0.0,
+                "spill_entries_per_ray": r["spilled_entries"] / r["rays"],
+                "dram_bytes_per_ray": r["dram_bytes_per_ray"],
+                "dram_vs_full": r["dram_bytes_per_ray"] / f["dram_bytes_per_ray"],
+                "mrays_per_second": r["mrays_per_second"],
+                "speed_vs_full": r["mrays_per_second"] / f["mrays_per_second"],
+            }
+        )
     return out
 
 
@@ -113,9 +129,14 @@ STUDY = Study(
     about="short stacks with a restart trail against a full and a spilling stack",
     specs=lambda o: spec_of(o, "shortstack"),
     tables=[Table("accel.md", "short_stack_table", table)],
-    options={"resolution": "96x72", "workload": "diffuse", "scenes": ["sponza", "hairball"],
-             "accels": ["bvh2", "bvh8", "cwbvh8"], "entries": [1, 2, 3, 4, 5, 6, 8, 12],
-             "hairball_triangles": 50000},  # fmt: skip
+    options={
+        "resolution": "96x72",
+        "workload": "diffuse",
+        "scenes": ["sponza", "hairball"],
+        "accels": ["bvh2", "bvh8", "cwbvh8"],
+        "entries": [1, 2, 3, 4, 5, 6, 8, 12],
+        "hairball_triangles": 50000,
+    },
     quick={"resolution": "32x24", "scenes": ["sponza"], "accels": ["cwbvh8"], "entries": [2, 5, 8]},
     extra=EXTRA,
 )

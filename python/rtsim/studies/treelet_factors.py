@@ -20,13 +20,21 @@ TREELETS = {"treelets.enabled": True}
 
 def tl(name: str, factor: str, baseline: str = "base", **sets: Any) -> dict[str, Any]:
     """A treelet point: its name (the row), the factor it varies, the point it is compared with."""
-    return {"name": name, "factor": factor, "baseline": baseline,
-            "set": {**TREELETS, **{k.replace("__", "."): v for k, v in sets.items()}}}  # fmt: skip
+    return {
+        "name": name,
+        "factor": factor,
+        "baseline": baseline,
+        "set": {**TREELETS, **{k.replace("__", "."): v for k, v in sets.items()}},
+    }
 
 
 def off(name: str, factor: str, **sets: Any) -> dict[str, Any]:
-    return {"name": name, "factor": factor, "baseline": "base",
-            "set": {k.replace("__", "."): v for k, v in sets.items()}}  # fmt: skip
+    return {
+        "name": name,
+        "factor": factor,
+        "baseline": "base",
+        "set": {k.replace("__", "."): v for k, v in sets.items()},
+    }
 
 
 POINTS = [
@@ -44,20 +52,51 @@ POINTS = [
     tl("policy oldest", "scheduling", treelets__policy="oldest"),
     tl("policy round_robin", "scheduling", treelets__policy="round_robin"),
     tl("prefetch into L1", "prefetching", "treelets (defaults)", treelets__prefetch=True),
-    tl("prefetch into L2", "prefetching", "treelets (defaults)", treelets__prefetch=True,
-       treelets__prefetch_into="l2"),
-    tl("prefetch 32 lines into L1", "prefetching", "treelets (defaults)",
-       treelets__prefetch=True, treelets__prefetch_lines=32),
-    tl("prefetch 32 lines into L2", "prefetching", "treelets (defaults)",
-       treelets__prefetch=True, treelets__prefetch_lines=32, treelets__prefetch_into="l2"),
-    tl("32 KiB treelets, 8 MiB buffer", "combined", treelets__treelet_kib=32,
-       treelets__buffer_kib=8192),
-    tl("32 KiB treelets, 8 MiB buffer, L2 256 KiB", "combined", "baseline, L2 256 KiB",
-       treelets__treelet_kib=32, treelets__buffer_kib=8192, l2__size_kib=256),
-    tl("32 KiB treelets, 8 MiB buffer, prefetch into L1", "combined",
-       "32 KiB treelets, 8 MiB buffer", treelets__treelet_kib=32,
-       treelets__buffer_kib=8192, treelets__prefetch=True),
-]  # fmt: skip
+    tl(
+        "prefetch into L2",
+        "prefetching",
+        "treelets (defaults)",
+        treelets__prefetch=True,
+        treelets__prefetch_into="l2",
+    ),
+    tl(
+        "prefetch 32 lines into L1",
+        "prefetching",
+        "treelets (defaults)",
+        treelets__prefetch=True,
+        treelets__prefetch_lines=32,
+    ),
+    tl(
+        "prefetch 32 lines into L2",
+        "prefetching",
+        "treelets (defaults)",
+        treelets__prefetch=True,
+        treelets__prefetch_lines=32,
+        treelets__prefetch_into="l2",
+    ),
+    tl(
+        "32 KiB treelets, 8 MiB buffer",
+        "combined",
+        treelets__treelet_kib=32,
+        treelets__buffer_kib=8192,
+    ),
+    tl(
+        "32 KiB treelets, 8 MiB buffer, L2 256 KiB",
+        "combined",
+        "baseline, L2 256 KiB",
+        treelets__treelet_kib=32,
+        treelets__buffer_kib=8192,
+        l2__size_kib=256,
+    ),
+    tl(
+        "32 KiB treelets, 8 MiB buffer, prefetch into L1",
+        "combined",
+        "32 KiB treelets, 8 MiB buffer",
+        treelets__treelet_kib=32,
+        treelets__buffer_kib=8192,
+        treelets__prefetch=True,
+    ),
+]
 QUICK = ["baseline", "treelets (defaults)", "buffer 2 MiB", "prefetch into L1", "prefetch into L2"]
 BY_NAME = {p["name"]: p for p in POINTS}
 
@@ -65,12 +104,15 @@ BY_NAME = {p["name"]: p for p in POINTS}
 def spec(resolution: str, hairball_triangles: int, quick: bool, name: str) -> list[dict[str, Any]]:
     """One spec per scene (the table's order): every factor point on its diffuse rays."""
     points = [p for p in POINTS if not quick or p["name"] in QUICK]
-    return [{
-        "name": f"{name}-{s}",
-        "scenes": [scene(s, hairball_triangles)],
-        "workloads": [{"name": "diffuse", "rays": ["diffuse"], "resolution": resolution}],
-        "points": [{"label": p["name"], "set": p["set"]} for p in points],
-    } for s in SCENES]  # fmt: skip
+    return [
+        {
+            "name": f"{name}-{s}",
+            "scenes": [scene(s, hairball_triangles)],
+            "workloads": [{"name": "diffuse", "rays": ["diffuse"], "resolution": resolution}],
+            "points": [{"label": p["name"], "set": p["set"]} for p in points],
+        }
+        for s in SCENES
+    ]
 
 
 def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
@@ -85,18 +127,26 @@ def rows(run: StudyRun, part: str = "treelet-factors") -> list[dict[str, Any]]:
             continue
         p, rays = BY_NAME[r["point"]], r["rays"]
         on = bool(r["treelets.enabled"])
-        out.append({
-            "scene": r["scene"], "name": p["name"], "factor": p["factor"],
-            "baseline": p["baseline"], "treelets": on, "rays": rays,
-            "dram_bytes_per_ray": r["dram_bytes_per_ray"], "bvh_bytes_per_ray": r["bvh_bytes_per_ray"],
-            "l2_read_bytes_per_ray": r["l2_read_bytes"] / rays,
-            "mrays_per_second": r["mrays_per_second"],
-            "dram_bandwidth_utilization": r["dram_bandwidth_utilization"],
-            "treelet_count": r["treelet_count"], "queue_at_pick": r["queue_at_pick"],
-            "drain_pick_fraction": r["drain_pick_fraction"],
-            "parks_per_ray": r["parked"] / rays if on else None,
-            "prefetch": r["prefetch"],
-        })  # fmt: skip
+        out.append(
+            {
+                "scene": r["scene"],
+                "name": p["name"],
+                "factor": p["factor"],
+                "baseline": p["baseline"],
+                "treelets": on,
+                "rays": rays,
+                "dram_bytes_per_ray": r["dram_bytes_per_ray"],
+                "bvh_bytes_per_ray": r["bvh_bytes_per_ray"],
+                "l2_read_bytes_per_ray": r["l2_read_bytes"] / rays,
+                "mrays_per_second": r["mrays_per_second"],
+                "dram_bandwidth_utilization": r["dram_bandwidth_utilization"],
+                "treelet_count": r["treelet_count"],
+                "queue_at_pick": r["queue_at_pick"],
+                "drain_pick_fraction": r["drain_pick_fraction"],
+                "parks_per_ray": r["parked"] / rays if on else None,
+                "prefetch": r["prefetch"],
+            }
+        )
     return out
 
 
@@ -167,11 +217,14 @@ EXTRA = {
     "l2_read_bytes": "model.l2.read_bytes",
     "treelet_count": lambda r: ray_buffer(r).get("treelets", {}).get("count"),
     "queue_at_pick": lambda r: ray_buffer(r).get("avg_queue_rays_at_pick"),
-    "drain_pick_fraction": lambda r: (ray_buffer(r)["drain_picks"] / ray_buffer(r)["picks"]
-                                      if ray_buffer(r).get("picks") else None),
+    "drain_pick_fraction": lambda r: (
+        ray_buffer(r)["drain_picks"] / ray_buffer(r)["picks"]
+        if ray_buffer(r).get("picks")
+        else None
+    ),
     "parked": lambda r: ray_buffer(r).get("parked"),
     "prefetch": prefetch_totals,
-}  # fmt: skip
+}
 
 STUDY = Study(
     name="treelet_factors",

@@ -41,12 +41,14 @@ def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
                     points += [_point(b, tl) for b in o["buffers"]]
             if w == "diffuse" and o["overflow_rays"]:
                 points.append(_point(512, o["budgets"][0], o["overflow_rays"]))
-            out.append({
-                "name": f"treelets-{s}-{w}",
-                "scenes": [scene(s, o["hairball_triangles"])],
-                "workloads": [{"name": w, "rays": [w], "resolution": o["resolution"]}],
-                "points": points,
-            })  # fmt: skip
+            out.append(
+                {
+                    "name": f"treelets-{s}-{w}",
+                    "scenes": [scene(s, o["hairball_triangles"])],
+                    "workloads": [{"name": w, "rays": [w], "resolution": o["resolution"]}],
+                    "points": points,
+                }
+            )
     return out
 
 
@@ -56,19 +58,25 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
     for r in run.rows():
         on = bool(r["treelets.enabled"])
         rays = r["rays"]
-        out.append({
-            "scene": r["scene"], "workload": r["workload"],
-            "buffer_kib": r["treelets.buffer_kib"] if on else None,
-            "treelet_kib": r["treelets.treelet_kib"], "in_flight": r["treelets.max_rays_in_flight"],
-            "rays": rays, "dram_bytes_per_ray": r["dram_bytes_per_ray"],
-            "bvh_bytes_per_ray": r["bvh_bytes_per_ray"],
-            "l2_reads_per_ray": r["l2_reads"] / rays, "l2_read_bytes_per_ray": r["l2_read_bytes"] / rays,
-            "mrays_per_second": r["mrays_per_second"],
-            "hit_mismatches": r["hit_mismatches"],
-            "avg_queue_rays_at_pick": r["queue_at_pick"],
-            "parks_per_ray": r["parked"] / rays if on else None,
-            "overflow_writes": r["overflow_writes"],
-        })  # fmt: skip
+        out.append(
+            {
+                "scene": r["scene"],
+                "workload": r["workload"],
+                "buffer_kib": r["treelets.buffer_kib"] if on else None,
+                "treelet_kib": r["treelets.treelet_kib"],
+                "in_flight": r["treelets.max_rays_in_flight"],
+                "rays": rays,
+                "dram_bytes_per_ray": r["dram_bytes_per_ray"],
+                "bvh_bytes_per_ray": r["bvh_bytes_per_ray"],
+                "l2_reads_per_ray": r["l2_reads"] / rays,
+                "l2_read_bytes_per_ray": r["l2_read_bytes"] / rays,
+                "mrays_per_second": r["mrays_per_second"],
+                "hit_mismatches": r["hit_mismatches"],
+                "avg_queue_rays_at_pick": r["queue_at_pick"],
+                "parks_per_ray": r["parked"] / rays if on else None,
+                "overflow_writes": r["overflow_writes"],
+            }
+        )
     return out
 
 
@@ -105,7 +113,7 @@ def table(run: StudyRun) -> str:
     note = (
         f"Measured with `{run.command}` (resolution {o['resolution']}, hairball "
         f"{o['hairball_triangles']:,} triangles, default config otherwise; rtsim-sim git "
-        f"{run.measured()['git']}). BVH = node + triangle reads from DRAM; \"queue at pick\" = "
+        f'{run.measured()["git"]}). BVH = node + triangle reads from DRAM; "queue at pick" = '
         "mean rays in the queue a unit picked; every run has 0 hit and 0 work mismatches.\n\n"
     )
     return note + "\n".join(out) + "\n"
@@ -129,12 +137,24 @@ def plot(run: StudyRun, path: Path) -> None:
             for ax, key in ((ax_dram, "dram_bytes_per_ray"), (ax_speed, "mrays_per_second")):
                 ax.axhline(base[key], color=color, ls="--", lw=1.2, label=f"{workload}, baseline")
                 for tl, (ls, marker) in styles.items():
-                    line = sorted((r for r in group if r["buffer_kib"] and r["treelet_kib"] == tl
-                                   and not r["in_flight"]), key=lambda r: r["buffer_kib"])  # fmt: skip
+                    line = sorted(
+                        (
+                            r
+                            for r in group
+                            if r["buffer_kib"] and r["treelet_kib"] == tl and not r["in_flight"]
+                        ),
+                        key=lambda r: r["buffer_kib"],
+                    )
                     if line:
-                        ax.plot([r["buffer_kib"] for r in line], [r[key] for r in line],
-                                color=color, ls=ls, marker=marker, ms=5,
-                                label=f"{workload}, treelets {tl} KiB")  # fmt: skip
+                        ax.plot(
+                            [r["buffer_kib"] for r in line],
+                            [r[key] for r in line],
+                            color=color,
+                            ls=ls,
+                            marker=marker,
+                            ms=5,
+                            label=f"{workload}, treelets {tl} KiB",
+                        )
         rays = {r["workload"]: r["rays"] for r in rs if r["scene"] == sc}
         sub = ", ".join(f"{w} {n:,}" for w, n in rays.items())
         ax_dram.set_title(f"{sc}: DRAM traffic ({sub} rays)", fontsize=10)
@@ -151,8 +171,10 @@ def plot(run: StudyRun, path: Path) -> None:
             ax.grid(True, which="major", alpha=0.3)
     handles, labels = axes[0][0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9, frameon=False)
-    fig.suptitle("Treelet scheduling vs baseline (dashed), default accelerator (8 units, 1 MiB L2)",
-                 fontsize=12)  # fmt: skip
+    fig.suptitle(
+        "Treelet scheduling vs baseline (dashed), default accelerator (8 units, 1 MiB L2)",
+        fontsize=12,
+    )
     fig.tight_layout(rect=(0, 0.07, 1, 0.97))
     fig.savefig(path, dpi=80)
     plt.close(fig)
@@ -164,11 +186,19 @@ STUDY = Study(
     specs=specs,
     tables=[Table("treelets.md", "treelet-study", table)],
     figures=[Figure("treelets.png", plot)],
-    options={"resolution": "320x240", "hairball_triangles": 200_000,
-             "buffers": [128, 512, 2048, 8192, 32768], "budgets": [16, 32],
-             "overflow_rays": 65536},  # fmt: skip
-    quick={"resolution": "32x24", "hairball_triangles": 20_000, "buffers": [128, 2048],
-           "overflow_rays": 4096},  # fmt: skip
+    options={
+        "resolution": "320x240",
+        "hairball_triangles": 200_000,
+        "buffers": [128, 512, 2048, 8192, 32768],
+        "budgets": [16, 32],
+        "overflow_rays": 65536,
+    },
+    quick={
+        "resolution": "32x24",
+        "hairball_triangles": 20_000,
+        "buffers": [128, 2048],
+        "overflow_rays": 4096,
+    },
     extra={
         "bvh_bytes_per_ray": bvh_bytes_per_ray,
         "l2_reads": "model.l2.reads",

@@ -34,8 +34,16 @@ def cmd_study(args: argparse.Namespace, console: Console) -> int:
         given[key.strip()] = value.strip()
     out = Path(args.output or f"out/studies/{study.name}{'-quick' if args.quick else ''}")
     err = Console(stderr=True)
-    run = run_study(study, out, quick=args.quick, options=given, workers=args.workers,
-                    scheduler=args.scheduler, progress=not args.no_progress, console=err)  # fmt: skip
+    run = run_study(
+        study,
+        out,
+        quick=args.quick,
+        options=given,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=not args.no_progress,
+        console=err,
+    )
     docs = Path(args.docs) if args.write_docs else None
     if docs is not None and not docs.is_dir():
         raise StudyError(f"--docs {docs}: not a folder")
@@ -52,21 +60,42 @@ def add_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-ar
         "folder), prints its tables, and with --write-docs writes them between the markers they "
         "own in the docs and draws its figures there.",
     )
-    p.add_argument("name", nargs="?", metavar="NAME|FILE.py", help="a study (--list) or a file "
-                   "defining STUDY")  # fmt: skip
+    p.add_argument(
+        "name", nargs="?", metavar="NAME|FILE.py", help="a study (--list) or a file defining STUDY"
+    )
     p.add_argument("--list", action="store_true", help="list the studies")
     p.add_argument("--quick", action="store_true", help="the study's quick mode: small runs")
-    p.add_argument("--option", action="append", metavar="KEY=VALUE",
-                   help="a study option (repeatable; `rtsim study --list` and docs/studies.md "
-                   "name them)")  # fmt: skip
-    p.add_argument("-o", "--output", metavar="OUT", default=None,
-                   help="the study's sweep folder (default: out/studies/NAME[-quick])")  # fmt: skip
-    p.add_argument("--write-docs", action="store_true",
-                   help="write the tables between their markers and the figures into --docs")  # fmt: skip
+    p.add_argument(
+        "--option",
+        action="append",
+        metavar="KEY=VALUE",
+        help="a study option (repeatable; `rtsim study --list` and docs/studies.md name them)",
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="OUT",
+        default=None,
+        help="the study's sweep folder (default: out/studies/NAME[-quick])",
+    )
+    p.add_argument(
+        "--write-docs",
+        action="store_true",
+        help="write the tables between their markers and the figures into --docs",
+    )
     p.add_argument("--docs", metavar="DIR", default="docs", help="the docs folder (default: docs)")
-    p.add_argument("--workers", type=int, default=0, metavar="N",
-                   help="local Dask workers (default: one per core)")  # fmt: skip
-    p.add_argument("--scheduler", metavar="tcp://HOST:PORT", default=None,
-                   help="an existing Dask scheduler (default: a local cluster)")  # fmt: skip
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=0,
+        metavar="N",
+        help="local Dask workers (default: one per core)",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        default=None,
+        help="an existing Dask scheduler (default: a local cluster)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_study)

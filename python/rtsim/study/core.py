@@ -122,8 +122,8 @@ class StudyRun:
     plain: list[dict[str, Any]] = field(default_factory=list)  # the frame's rows, plain values
 
     def rows(self, **where: Any) -> list[dict[str, Any]]:
-        """The frame's rows as dicts (plain Python values, None where missing), optionally only those whose columns
-        equal `where` (`run.rows(scene="sponza", point="baseline")`)."""
+        """The frame's rows as dicts (plain Python values, None where missing), optionally only
+        those whose columns equal `where` (`run.rows(scene="sponza", point="baseline")`)."""
         return [r for r in self.plain if all(r.get(k) == v for k, v in where.items())]
 
     def row(self, **where: Any) -> dict[str, Any]:
@@ -141,13 +141,10 @@ class StudyRun:
     def command(self) -> str:
         """The command that makes this study's output, with the options it was given."""
         base = self.study.resolve(self.quick)
-        given = [
-            f"--option {k}={_text(v)}"
-            for k, v in self.options.items()
-            if v != base.get(k)
-        ]
-        return " ".join(["rtsim study", self.study.name, *(["--quick"] if self.quick else []),
-                         *given])  # fmt: skip
+        given = [f"--option {k}={_text(v)}" for k, v in self.options.items() if v != base.get(k)]
+        return " ".join(
+            ["rtsim study", self.study.name, *(["--quick"] if self.quick else []), *given]
+        )
 
     @property
     def runs(self) -> int:
@@ -162,8 +159,12 @@ class StudyRun:
 
     def measured(self) -> dict[str, str]:
         """Where and when: host, machine, today's date, the rtsim-sim git hashes of the runs."""
-        gits = sorted({str((self.records[r].provenance or {}).get("git"))
-                       for r in self.frame["run_id"].unique()})  # fmt: skip
+        gits = sorted(
+            {
+                str((self.records[r].provenance or {}).get("git"))
+                for r in self.frame["run_id"].unique()
+            }
+        )
         return {
             "host": platform.node() or "host",
             "machine": platform.machine(),
@@ -205,9 +206,13 @@ def build_frame(
         for plan in spec.plans():
             rec = records.get(plan.run_id)
             row: dict[str, Any] = {c.name: c.get(rec) for c in cols} if rec else {}
-            row.update(run_id=plan.run_id, scene=plan.trace.scene.label,
-                       workload=plan.trace.workload.label, accel=plan.trace.accel.label,
-                       status=rec.status if rec else "missing")  # fmt: skip
+            row.update(
+                run_id=plan.run_id,
+                scene=plan.trace.scene.label,
+                workload=plan.trace.workload.label,
+                accel=plan.trace.accel.label,
+                status=rec.status if rec else "missing",
+            )
             row.update(plan.params)
             row["part"] = spec.name
             row["trace_dir"] = str(results.path / "traces" / plan.trace.folder_name)
@@ -249,8 +254,9 @@ def run_study(
     t0 = time.monotonic()
     run_sweep(specs, sweep_opts, console)
     results = Results(out)
-    run = StudyRun(study, opts, quick, out, results, specs,
-                   *build_frame(specs, results, study.extra))  # fmt: skip
+    run = StudyRun(
+        study, opts, quick, out, results, specs, *build_frame(specs, results, study.extra)
+    )
     if study.follow_up is not None:
         specs = specs + parse(study.follow_up(run))
         run_sweep(specs, sweep_opts, console)
@@ -264,13 +270,13 @@ def run_study(
 
 def _check(run: StudyRun) -> None:
     bad = run.frame[run.frame["status"] != "ok"].drop_duplicates("run_id")
-    if not run.study.allow_failed:
-        failed = bad
-    else:
-        failed = bad[bad["status"] == "mismatch"]
+    failed = bad[bad["status"] == "mismatch"] if run.study.allow_failed else bad
     if len(failed):
-        lines = [f"  {r.scene} {r.workload} {r.accel} {r.run_id[:12]}: {r.status} "
-                 f"{str(r.error or '').splitlines()[:1]}" for r in failed.itertuples()]  # fmt: skip
+        lines = [
+            f"  {r.scene} {r.workload} {r.accel} {r.run_id[:12]}: {r.status} "
+            f"{str(r.error or '').splitlines()[:1]}"
+            for r in failed.itertuples()
+        ]
         raise StudyError(f"study {run.study.name}: {len(failed)} runs not ok:\n" + "\n".join(lines))
 
 

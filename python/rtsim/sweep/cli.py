@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rtsim.cli_help import HelpFormatter
 
@@ -198,8 +198,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         help="write the table as Parquet to FILE (needs pyarrow: pip install 'rtsim[parquet]')",
     )
     p.add_argument(
-        "--config", action="store_true", help="add a column per config key (every key, not only "
-        "the swept ones)"
+        "--config",
+        action="store_true",
+        help="add a column per config key (every key, not only the swept ones)",
     )
     p.set_defaults(func=cmd_results)
 

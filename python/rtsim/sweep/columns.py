@@ -153,28 +153,61 @@ def _summary_columns(kinds: Iterable[str]) -> list[Column]:
         present = True  # a summary key no run has a value for is a feature the sweep never used
         if key.endswith("_ci95"):
             for i, side in enumerate(("lo", "hi")):
-                cols.append(Column(f"{key}_{side}", unit, f"{side} end: {doc}", _ci(key, i),
-                                   True, f"summary.{key}[{i}]"))  # fmt: skip
+                cols.append(
+                    Column(
+                        f"{key}_{side}",
+                        unit,
+                        f"{side} end: {doc}",
+                        _ci(key, i),
+                        True,
+                        f"summary.{key}[{i}]",
+                    )
+                )
             continue
         cols.append(Column(key, unit, doc, _summary(key), present, f"summary.{key}"))
         if key == "dram_bytes_per_ray":
             for kind in kinds:
-                cols.append(Column(f"dram_bytes_per_ray.{kind}", "bytes/ray",
-                                   f"DRAM bytes read and written per ray for {kind} data",
-                                   _kind(kind), True,
-                                   f"model.dram.by_kind.{kind} (read + write) / rays"))  # fmt: skip
+                cols.append(
+                    Column(
+                        f"dram_bytes_per_ray.{kind}",
+                        "bytes/ray",
+                        f"DRAM bytes read and written per ray for {kind} data",
+                        _kind(kind),
+                        True,
+                        f"model.dram.by_kind.{kind} (read + write) / rays",
+                    )
+                )
     return cols
 
 
 def _chip_columns() -> list[Column]:
     return [
-        Column("sram_mm2", "mm^2", "area of the SRAM blocks (L1s, L2, stacks, ray buffer)",
-               _stat("area", "sram_mm2"), True, "area.sram_mm2"),
-        Column("logic_mm2", "mm^2", "area of the pipelines", _stat("area", "logic_mm2"),
-               True, "area.logic_mm2"),
-        Column("sram_bytes", "bytes", "on-chip SRAM: L1s x units, L2, traversal stacks, "
-               "mailboxes and the ray buffer (with treelets)", _sram, True, "config"),
-    ]  # fmt: skip
+        Column(
+            "sram_mm2",
+            "mm^2",
+            "area of the SRAM blocks (L1s, L2, stacks, ray buffer)",
+            _stat("area", "sram_mm2"),
+            True,
+            "area.sram_mm2",
+        ),
+        Column(
+            "logic_mm2",
+            "mm^2",
+            "area of the pipelines",
+            _stat("area", "logic_mm2"),
+            True,
+            "area.logic_mm2",
+        ),
+        Column(
+            "sram_bytes",
+            "bytes",
+            "on-chip SRAM: L1s x units, L2, traversal stacks, "
+            "mailboxes and the ray buffer (with treelets)",
+            _sram,
+            True,
+            "config",
+        ),
+    ]
 
 
 def columns(records: list[RunRecord], keys: list[str]) -> list[Column]:
@@ -183,10 +216,21 @@ def columns(records: list[RunRecord], keys: list[str]) -> list[Column]:
     moved = {k for r in records for k in bytes_per_ray_by_kind(r)}
     kinds = [k for k in DATA_KINDS if k in moved] + sorted(moved - set(DATA_KINDS))
     swept = [k for k in keys if k not in ("accel", "preset")]
-    level = Column("fidelity", "", "the level that ran (functional, analytic, approx, detailed)",
-                   _summary("fidelity"), True, "summary.fidelity")  # fmt: skip
-    cols = [*_identity(), *(_swept(k) for k in swept if k != "fidelity"), level,
-            *_summary_columns(kinds), *_chip_columns()]  # fmt: skip
+    level = Column(
+        "fidelity",
+        "",
+        "the level that ran (functional, analytic, approx, detailed)",
+        _summary("fidelity"),
+        True,
+        "summary.fidelity",
+    )
+    cols = [
+        *_identity(),
+        *(_swept(k) for k in swept if k != "fidelity"),
+        level,
+        *_summary_columns(kinds),
+        *_chip_columns(),
+    ]
     return [c for c in cols if not c.where_present or any(c.get(r) is not None for r in records)]
 
 

@@ -132,7 +132,9 @@ class Results:
             cols = _with_config(cols)
         return cols, [{c.name: c.get(r) for c in cols} for r in records]
 
-    def to_pandas(self, config: bool = False, extra: dict[str, Extra] | None = None) -> pd.DataFrame:
+    def to_pandas(
+        self, config: bool = False, extra: dict[str, Extra] | None = None
+    ) -> pd.DataFrame:
         """The tidy table as a DataFrame: one row per run. Units and meanings are in
         `df.attrs["units"]` and `df.attrs["docs"]`; `config=True` adds a column per config key;
         `extra` adds columns from each run's stats.json (`{"l2_reads": "model.l2.reads"}`, or a
@@ -146,7 +148,9 @@ class Results:
         for name, how in (extra or {}).items():
             get = _stats_path(how) if isinstance(how, str) else how
             cols.append(Column(name, "", how if isinstance(how, str) else "extra", get))
-        df = pd.DataFrame([[c.get(r) for c in cols] for r in records], columns=[c.name for c in cols])
+        df = pd.DataFrame(
+            [[c.get(r) for c in cols] for r in records], columns=[c.name for c in cols]
+        )
         df.attrs["units"] = {c.name: c.unit for c in cols}
         df.attrs["docs"] = {c.name: c.doc for c in cols}
         df.attrs["sweep"] = str(self.path)

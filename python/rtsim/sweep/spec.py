@@ -340,7 +340,9 @@ class _Reader:
         seed = self.number(d, "seed", f"scenes[{i}].seed", True) if "seed" in d else 1
         flat = d.get("flatten", False)
         if not isinstance(flat, bool):
-            raise self.fail(d, "flatten", f"scenes[{i}].flatten", f"expected true or false, got {flat!r}")
+            raise self.fail(
+                d, "flatten", f"scenes[{i}].flatten", f"expected true or false, got {flat!r}"
+            )
         return SceneSpec(label, source, tris, seed, flat)
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
