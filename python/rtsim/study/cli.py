@@ -69,7 +69,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-ar
         "--option",
         action="append",
         metavar="KEY=VALUE",
-        help="a study option (repeatable; `rtsim study --list` and docs/studies.md name them)",
+        help="a study option (repeatable; docs/studies.md names them; default: none)",
     )
     p.add_argument(
         "-o",

@@ -189,13 +189,14 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         const="-",
         default=None,
         metavar="FILE",
-        help="write the table as CSV to FILE, or stdout if no FILE",
+        help="write the table as CSV to FILE, or stdout if no FILE (default: print it as text)",
     )
     p.add_argument(
         "--parquet",
         default=None,
         metavar="FILE",
-        help="write the table as Parquet to FILE (needs pyarrow: pip install 'rtsim[parquet]')",
+        help="write the table as Parquet to FILE (needs pyarrow: pip install 'rtsim[parquet]'; "
+        "default: none)",
     )
     p.add_argument(
         "--config",
