@@ -24,6 +24,7 @@ import argparse
 import json
 import platform
 import shutil
+import subprocess
 import sys
 import threading
 import time
@@ -34,9 +35,6 @@ from typing import Any
 
 from rtsim.doc_markers import write_between
 from rtsim.launcher import SimJob, run_sim
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from shortstack_study import make_trace
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -90,6 +88,32 @@ TECHNIQUES = (
         sets=TREELETS,
     ),
 )
+
+
+def make_trace(
+    scene: str, accel: str, args: argparse.Namespace, build: tuple[str, ...] = ()
+) -> Path:
+    """args.workload of `scene` traced with `accel` built with `build` (--build-set assignments),
+    at args.resolution; cached in OUT/traces and kept while the hairball's size is the same."""
+    tag = "-".join([scene, accel, *[b.replace("=", "_") for b in build]])
+    folder = args.out / "traces" / f"{tag}-{args.workload}-{args.resolution}"
+    params = {"hairball_triangles": getattr(args, "hairball_triangles", None)}
+    stamp = folder / "study_params.json"
+    cached = (folder / "trace.rtt").is_file() and stamp.is_file() and not args.fresh
+    if cached and json.loads(stamp.read_text()) == params:
+        return folder
+    shutil.rmtree(folder, ignore_errors=True)
+    cmd = [sys.executable, "-m", "rtsim", "trace", scene, "-o", str(folder), "--accel", accel]
+    cmd += ["--workload", args.workload, "--resolution", args.resolution, "--threads", "0"]
+    if scene == "hairball" and params["hairball_triangles"]:
+        cmd += ["--hairball-triangles", str(params["hairball_triangles"])]
+    for assignment in build:
+        cmd += ["--build-set", assignment]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr[-600:]}")
+    stamp.write_text(json.dumps(params))
+    return folder
 
 
 _LOCKS: dict[Path, threading.Lock] = {}

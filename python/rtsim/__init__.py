@@ -6,6 +6,8 @@
 >>> rtsim.trace_scene("cornell", "out/cornell")     # the workload the scene calls for
 >>> stats = rtsim.simulate("out/cornell", l1__size_kib=32)
 >>> stats.mrays_per_second, stats.dram_bytes_per_ray
+>>> results = rtsim.sweep({"scenes": ["cornell"], ...}, "out/s1")   # a sweep, resumable
+>>> results.to_pandas()                             # one row per run, tidy columns
 
 Names are imported on first use (PEP 562), so ``import rtsim`` and the command line stay fast:
 the C++ extension ``rtsim._core`` (and numpy with it) loads only when a tracer function is used.
@@ -41,6 +43,9 @@ _LAZY = {
     "simulate": "rtsim.simulation",
     "Stats": "rtsim.stats",
     "SimConfig": "rtsim.config",
+    "Results": "rtsim.sweep.results",
+    "open_results": "rtsim.sweep.results",
+    "Study": "rtsim.study",
 }
 
 #: Public names defined under another name in their module.
@@ -51,6 +56,8 @@ if TYPE_CHECKING:
     from rtsim.config import SimConfig
     from rtsim.simulation import simulate
     from rtsim.stats import Stats
+    from rtsim.study import Study
+    from rtsim.sweep.results import Results, open_results
     from rtsim.trace_file import Trace, open_trace
     from rtsim.trace_file import trace_section_table as trace_sections
     from rtsim.trace_file import verify_trace_file as verify_trace
@@ -64,6 +71,8 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
+    if name == "sweep":  # the subpackage, callable: rtsim.sweep(spec, out) runs a sweep
+        return importlib.import_module("rtsim.sweep")
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'rtsim' has no attribute '{name}'")
@@ -73,21 +82,25 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted([*globals(), *_LAZY])
+    return sorted([*globals(), *_LAZY, "sweep"])
 
 
 __all__ = [
     "HitMismatchError",
+    "Results",
     "RtsimError",
     "Scene",
     "SimConfig",
     "Stats",
+    "Study",
     "Trace",
     "__version__",
     "load_scene",
+    "open_results",
     "open_trace",
     "procedural_scene_names",
     "simulate",
+    "sweep",
     "trace_rays",
     "trace_scene",
     "trace_sections",

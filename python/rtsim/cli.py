@@ -33,6 +33,7 @@ from rtsim.cli_help import HelpFormatter, LazyHelpStore
 from rtsim.errors import RtsimError
 from rtsim.kinds import RAY_KINDS
 from rtsim.sim_cli import add_parsers as add_simulate_parsers
+from rtsim.study.cli import add_parser as add_study_parser
 from rtsim.sweep.cli import add_parsers as add_sweep_parsers
 from rtsim.tracing import parse_setting_value
 
@@ -594,6 +595,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_simulate_parsers(sub)
     add_accuracy_parser(sub, parse_resolution)
     add_sweep_parsers(sub)
+    add_study_parser(sub)
     add_bench_parser(sub)
     return parser
 

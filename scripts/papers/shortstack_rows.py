@@ -1,20 +1,19 @@
 """Short stacks' rows of the papers page (docs/papers.md): Vaidyanathan, Woop & Benthin 2019 and
 Laine 2010 set beside our short stack with a restart trail (docs/accel.md, "Short stacks").
 
-`rows(out_dir, quick)` runs scripts/shortstack_study.py's points (traces and runs cached under
-out_dir) and returns one dict per published figure with the keys technique, paper, published,
-setup, ours and why. quick: Sponza diffuse at 64x48 on cwbvh8 and bvh2 (under a minute on two
-cores); otherwise Sponza and a 50k-triangle hairball at 160x120.
+`rows(out_dir, quick)` runs the shortstack study's points (`rtsim study shortstack`, through the
+sweep engine into out_dir) and returns one dict per published figure with the keys technique,
+paper, published, setup, ours and why. quick: Sponza diffuse at 64x48 on cwbvh8 and bvh2 (under
+a minute on two cores); otherwise Sponza and a 50k-triangle hairball at 160x120.
 """
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import Any
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import shortstack_study as study  # a script beside this folder
+from rtsim.studies import shortstack
+from rtsim.study import run_study
 
 
 def _pick(rows: list[dict[str, Any]], scene: str, accel: str, run: str) -> dict[str, Any]:
@@ -43,17 +42,17 @@ def _extra(rows: list[dict[str, Any]], scene: str, entries: int) -> str:
 
 
 def rows(out_dir: Path, quick: bool) -> list[dict[str, str]]:
-    argv = ["--out", str(Path(out_dir) / "shortstack"), "--accels", "cwbvh8,bvh2"]
-    argv += ["--resolution", "64x48", "--scenes", "sponza", "--entries", "1,2,5"] if quick else []
-    argv += ["--entries", "1,2,3,5,8"] if not quick else []
-    args = study.parse_args(argv)
-    args.out.mkdir(parents=True, exist_ok=True)
-    result = study.run_study(args)
-    found = result["rows"]
-    scenes = args.scenes
+    options = {"accels": "cwbvh8,bvh2", "resolution": "64x48", "scenes": "sponza",
+               "entries": "1,2,5"} if quick else {"accels": "cwbvh8,bvh2",
+                                                  "entries": "1,2,3,5,8",
+                                                  "resolution": "160x120"}  # fmt: skip
+    run = run_study(shortstack.STUDY, Path(out_dir) / "shortstack", options=options,
+                    progress=False)  # fmt: skip
+    found = shortstack.rows(run)
+    scenes = run.options["scenes"]
     setup = (
-        f"{result['workload']} rays at {result['resolution']}, default machine (approx level), "
-        "restart trail against a 64-entry stack that never spills"
+        f"{run.options['workload']} rays at {run.options['resolution']}, default machine (approx "
+        "level), restart trail against a 64-entry stack that never spills"
     )
     return [
         {

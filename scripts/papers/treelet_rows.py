@@ -1,16 +1,16 @@
 """Papers-page rows for treelets (Aila & Karras 2010) and treelet prefetching (Chou, Nowicki &
-Aamodt 2023), measured by scripts/treelet_factors.py's points on diffuse rays of Sponza and a
-200k-triangle hairball (quick: 128x96 rays, a 30k-triangle hairball and five points)."""
+Aamodt 2023), measured by the treelet_factors study's points (`rtsim study treelet_factors`, run
+through the sweep engine into out_dir) on diffuse rays of Sponza and a 200k-triangle hairball
+(quick: 128x96 rays, a 30k-triangle hairball and five points)."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import Any
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from treelet_factors import against, measure
+from rtsim.studies import treelet_factors
+from rtsim.studies.treelet_factors import against
+from rtsim.study import run_study
 
 Row = dict[str, Any]
 
@@ -99,5 +99,7 @@ def chou(rows: list[Row], scenes: list[str]) -> dict[str, str]:
 def rows(out_dir: Path, quick: bool) -> list[dict[str, str]]:
     scenes = ["sponza", "hairball"]
     resolution, triangles = ("128x96", 30_000) if quick else ("320x240", 200_000)
-    measured = measure(scenes, out_dir, resolution, triangles, quick)
+    options = {"resolution": resolution, "hairball_triangles": str(triangles), "short": str(quick)}
+    run = run_study(treelet_factors.STUDY, out_dir, options=options, progress=False)
+    measured = treelet_factors.rows(run)
     return [aila_karras(measured, scenes), chou(measured, scenes)]

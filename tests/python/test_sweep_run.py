@@ -89,8 +89,8 @@ def test_results_csv(tiny_sweep: Path) -> None:
     assert result.returncode == 0, result.stderr
     table = list(csv.DictReader(io.StringIO(result.stdout)))
     assert len(table) == 4
-    assert {"scene", "workload", "status", "traversal.units", "l2.size_kib", "rays_per_second",
-            "sram_bytes", "dram_bytes_per_ray.node"} <= set(table[0])  # fmt: skip
+    assert {"scene", "workload", "status", "traversal.units", "l1.size_kib", "rays_per_second",
+            "sram_bytes", "dram_bytes_per_ray.node", "area_mm2"} <= set(table[0])  # fmt: skip
     ok = [r for r in table if r["status"] == "ok"]
     assert len(ok) == 2 and all(float(r["rays_per_second"]) > 0 for r in ok)
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rtsim.cli_help import HelpFormatter
 
@@ -89,77 +89,36 @@ def print_front_check(out: Path, args: argparse.Namespace, console: Console) -> 
 
 
 def cmd_results(args: argparse.Namespace, console: Console) -> int:
-    from rich.table import Table
+    from rtsim.sweep.results import Results, text_table
 
-    from rtsim.sweep.results import tidy_rows, to_csv
-    from rtsim.sweep.store import open_store
-
-    with open_store(Path(args.sweep), readonly=True) as store:
-        records = list(store.runs())
+    results = Results(Path(args.sweep))
+    config = bool(getattr(args, "config", False))
+    wrote = False
+    if getattr(args, "parquet", None):
+        results.to_parquet(args.parquet, config=config)
+        console.print(f"wrote {len(results)} runs to {args.parquet}", highlight=False)
+        wrote = True
     if args.csv is not None:
-        text = to_csv(tidy_rows(records))
+        text = results.to_csv(config=config)
         if args.csv == "-":
             sys.stdout.write(text)
         else:
             Path(args.csv).write_text(text)
-            console.print(f"wrote {len(records)} runs to {args.csv}")
-        return 0
-    keys = list(dict.fromkeys(k for r in records for k in r.params))
-    table = Table(title=f"{args.sweep}: {len(records)} runs")
-    for col in ("scene", "workload", *keys, "status", "Mrays/s", "DRAM B/ray", "wall s"):
-        # Headers are never cut: a column is at least as wide as its name (the table wraps the
-        # cells, not the key names a reader needs to tell the columns apart).
-        table.add_column(
-            col,
-            justify="left" if col in ("scene", "workload", "status") else "right",
-            min_width=len(col),
-            no_wrap=True,
-        )
-    for r in results_order(records, keys):
-        s = r.summary
-        table.add_row(
-            r.scene,
-            r.workload,
-            *(_key_cell(r, k) for k in keys),
-            r.status if r.status == "ok" else f"[red]{r.status}[/]",
-            f"{s['mrays_per_second']:.1f}" if s.get("mrays_per_second") is not None else "-",
-            f"{s['dram_bytes_per_ray']:.0f}" if s.get("dram_bytes_per_ray") is not None else "-",
-            f"{r.wall_seconds:.2f}" if r.wall_seconds is not None else "-",
-        )
-    # Wider than the terminal: print the table whole (the terminal wraps long lines) rather
-    # than cutting its headers or its last columns.
-    columns = ("scene", "workload", *keys, "status", "Mrays/s", "DRAM B/ray", "wall s")
-    wide = sum(len(c) + 3 for c in columns) + 1
-    console.print(table, width=max(console.width, wide), crop=False)
+            console.print(f"wrote {len(results)} runs to {args.csv}", highlight=False)
+        wrote = True
+    if not wrote:
+        # Plain text: every column under its full name, the same columns as to_pandas() and the
+        # CSV, never cut and never coloured, whether on a terminal or through a pipe.
+        cols, rows = results.rows(config)
+        sys.stdout.write(text_table([c.name for c in cols], rows))
     return 0
 
 
 def results_order(records: list[RunRecord], keys: list[str]) -> list[RunRecord]:
-    """Runs in a stable, readable order: by scene, workload, then each swept key's value
-    (numbers by value, 2 before 16; text by name), never the order they happened to finish."""
-    from rtsim.sweep.results import key_value
+    """Runs in the table's order (rtsim/sweep/results.py)."""
+    from rtsim.sweep.results import results_order as order
 
-    def rank(value: Any) -> tuple[int, float, str]:
-        if isinstance(value, bool) or value is None:
-            return (2, 0.0, str(value))
-        if isinstance(value, int | float):
-            return (0, float(value), "")
-        return (1, 0.0, str(value))
-
-    return sorted(
-        records,
-        key=lambda r: (r.scene, r.workload, *(rank(key_value(r, k)[0]) for k in keys)),
-    )
-
-
-def _key_cell(rec: RunRecord, key: str) -> str:
-    """The run's value of a swept key; dimmed when the run's spec did not sweep it (a store
-    mixing two specs), so no column is ever blank."""
-    from rtsim.sweep.results import key_value
-
-    value, swept = key_value(rec, key)
-    text = "-" if value is None else str(value)
-    return text if swept else f"[dim]{text}[/]"
+    return order(records, keys)
 
 
 def cmd_report(args: argparse.Namespace, console: Console) -> int:
@@ -217,9 +176,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
     p = sub.add_parser(
         "results",
         formatter_class=HelpFormatter,
-        help="a sweep's results: a summary table, or --csv",
-        description="Prints a summary table of a sweep's runs, or writes the tidy table (one "
-        "row per run: config keys and summary stats) as CSV.",
+        help="a sweep's results: the tidy table as text, --csv or --parquet",
+        description="Prints the tidy table of a sweep's runs (one row per run: the swept keys, "
+        "the summary stats, DRAM bytes per ray by data kind, area, energy and SRAM; the columns "
+        "of rtsim.open_results(SWEEP).to_pandas(), docs/sweeps.md) as plain aligned text, or "
+        "writes it as CSV or Parquet.",
     )
     p.add_argument("sweep", metavar="SWEEP", help="sweep folder (holds results.sqlite)")
     p.add_argument(
@@ -228,8 +189,19 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
         const="-",
         default=None,
         metavar="FILE",
-        help="write the tidy table (one row per run) as CSV to FILE, or stdout if no FILE "
-        "(default: print the summary table instead)",
+        help="write the table as CSV to FILE, or stdout if no FILE (default: print it as text)",
+    )
+    p.add_argument(
+        "--parquet",
+        default=None,
+        metavar="FILE",
+        help="write the table as Parquet to FILE (needs pyarrow: pip install 'rtsim[parquet]'; "
+        "default: none)",
+    )
+    p.add_argument(
+        "--config",
+        action="store_true",
+        help="add a column per config key (every key, not only the swept ones)",
     )
     p.set_defaults(func=cmd_results)
 

@@ -14,18 +14,11 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
 
 from rtsim import __version__
 from rtsim.sweep.accel_axis import folder_label
 from rtsim.sweep.lock import clean_stale_traces, sweep_lock
+from rtsim.sweep.progress_bar import SweepBar
 from rtsim.sweep.spec import RunPlan, SweepSpec, TracePlan
 from rtsim.sweep.store import ResultsStore, RunRecord, open_store
 from rtsim.sweep.tasks import SimTask, TraceTask, make_trace, run_sim, utc_now
@@ -85,6 +78,8 @@ def trace_task(plan: TracePlan, out: Path) -> TraceTask:
         accel=plan.accel.kind,
         builder=plan.accel.builder,
         build_settings=dict(plan.accel.settings),
+        frames=w.frames,
+        flatten=plan.scene.flatten,
     )
 
 
@@ -109,39 +104,6 @@ def _record(run: RunPlan, result: dict[str, Any]) -> RunRecord:
     )
 
 
-class _Bar:
-    """done / failed / remaining with an ETA."""
-
-    def __init__(self, total: int, enabled: bool, console: Console) -> None:
-        self.progress = Progress(
-            TextColumn("[bold]sweep"),
-            BarColumn(),
-            MofNCompleteColumn(),
-            TextColumn(
-                "[green]ok {task.fields[ok]}[/] [red]failed {task.fields[failed]}[/] "
-                "remaining {task.fields[remaining]}"
-            ),
-            TimeElapsedColumn(),
-            TextColumn("eta"),
-            TimeRemainingColumn(),
-            console=console,
-            disable=not enabled,
-        )
-        self.total, self.ok, self.failed = total, 0, 0
-        self.task = self.progress.add_task("sweep", total=total, ok=0, failed=0, remaining=total)
-
-    def add(self, status: str) -> None:
-        self.ok += status != "failed"
-        self.failed += status == "failed"
-        self.progress.update(
-            self.task,
-            advance=1,
-            ok=self.ok,
-            failed=self.failed,
-            remaining=self.total - self.ok - self.failed,
-        )
-
-
 def _client(opts: SweepOptions) -> Any:
     from distributed import Client, LocalCluster
 
@@ -158,40 +120,63 @@ def _client(opts: SweepOptions) -> Any:
     return Client(cluster)
 
 
-def run_sweep(spec: SweepSpec, opts: SweepOptions, console: Console) -> SweepOutcome:
-    """Runs every run of the spec not yet in the store (and failed ones with retry_failed)."""
+def run_sweep(
+    spec: SweepSpec | list[SweepSpec], opts: SweepOptions, console: Console
+) -> SweepOutcome:
+    """Runs every run of the spec not yet in the store (and failed ones with retry_failed).
+    Several specs (a study's parts) run as one sweep into one store: one cluster, their runs
+    merged (a run two parts ask for runs once)."""
+    specs = spec if isinstance(spec, list) else [spec]
     out = opts.out_dir.resolve()
     out.mkdir(parents=True, exist_ok=True)
     with sweep_lock(out):
         stale = clean_stale_traces(out)
         if stale:
             console.print(f"removed {len(stale)} unfinished trace folder(s) of an earlier sweep")
-        return _run_locked(spec, opts, out, console)
+        return _run_locked(specs, opts, out, console)
 
 
-def _run_locked(spec: SweepSpec, opts: SweepOptions, out: Path, console: Console) -> SweepOutcome:
-    runs = spec.runs()
+def _merged_runs(specs: list[SweepSpec]) -> list[RunPlan]:
+    runs, seen = [], set()
+    for spec in specs:
+        for run in spec.runs():
+            if run.run_id not in seen:
+                seen.add(run.run_id)
+                runs.append(run)
+    return runs
+
+
+def _run_locked(
+    specs: list[SweepSpec], opts: SweepOptions, out: Path, console: Console
+) -> SweepOutcome:
+    spec = specs[0]
+    runs = _merged_runs(specs)
     timeout = opts.timeout if opts.timeout is not None else (spec.timeout or DEFAULT_TIMEOUT)
+    swept = list(dict.fromkeys(k for s in specs for k in s.swept_keys))
     with open_store(out) as store:
         store.set_meta(
             {
                 "name": spec.name,
-                "spec": spec.text,
+                "spec": "\n---\n".join(s.text for s in specs),
                 "rtsim_version": __version__,
-                "swept_keys": ",".join(spec.swept_keys),
+                "swept_keys": ",".join(swept),
             }
         )
         if "created_utc" not in store.meta():
             store.set_meta({"created_utc": utc_now()})
-        store.ensure_columns([k for k in spec.swept_keys if k != "preset"])
+        store.ensure_columns([k for k in swept if k != "preset"])
         status = store.statuses()
         skip = {"ok", "mismatch"} | (set() if opts.retry_failed else {"failed"})
         todo = [r for r in runs if status.get(r.run_id) not in skip]
         outcome = SweepOutcome(total=len(runs), skipped=len(runs) - len(todo))
+        shape = (
+            f"{len(spec.scenes)} scenes x {len(spec.workloads)} workloads x "
+            f"{len(spec.accels or [None])} structures x {len(spec.points())} configs"
+            if len(specs) == 1
+            else f"{len(specs)} specs"
+        )
         console.print(
-            f"[bold]rtsim sweep[/] {spec.name}: {len(runs)} runs "
-            f"({len(spec.scenes)} scenes x {len(spec.workloads)} workloads x "
-            f"{len(spec.accels or [None])} structures x {len(spec.points())} configs), "
+            f"[bold]rtsim sweep[/] {spec.name}: {len(runs)} runs ({shape}), "
             f"{outcome.skipped} already in {store.path.name}, {len(todo)} to run"
         )
         t0 = time.monotonic()
@@ -238,8 +223,7 @@ def _execute(
         }
         sims: dict[Any, RunPlan] = {}
         pending = as_completed(list(traces))
-        bar = _Bar(len(todo), opts.progress, console)
-        with bar.progress:
+        with SweepBar(len(todo), opts.progress, console) as bar:
             for fut in pending:
                 if fut in traces:
                     trace = _result(fut)

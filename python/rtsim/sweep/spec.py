@@ -41,6 +41,7 @@ from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
 SAMPLING_METHODS = ("random", "latin_hypercube")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
+POINT_KEY = "point"  # the swept key under which a `points` entry's label is recorded
 TOP_KEYS = (
     "name",
     "scenes",
@@ -48,6 +49,7 @@ TOP_KEYS = (
     "accel",
     "config",
     "grid",
+    "points",
     "sampling",
     "timeout",
     "baseline",
@@ -77,13 +79,17 @@ class SceneSpec:
     source: str  # built-in name, shared scene name or glTF path (resolved at trace time)
     hairball_triangles: int = 200_000
     seed: int = 1
+    flatten: bool = False  # instanced scenes: one world-space structure (rtsim trace --flatten)
 
     def key(self) -> dict[str, Any]:
-        return {
+        key: dict[str, Any] = {
             "source": self.source,
             "hairball_triangles": self.hairball_triangles,
             "seed": self.seed,
         }
+        if self.flatten:  # (absent when off: the keys of earlier sweeps stay valid)
+            key["flatten"] = True
+        return key
 
 
 @dataclass(frozen=True)
@@ -94,15 +100,19 @@ class WorkloadSpec:
     height: int
     bounces: int = 1
     seed: int = 1
+    frames: int = 1  # an animated trace of N frames (rtsim trace --frames N)
 
     def key(self) -> dict[str, Any]:
-        return {
+        key: dict[str, Any] = {
             "rays": list(self.rays) or "scene",
             "width": self.width,
             "height": self.height,
             "bounces": self.bounces,
             "seed": self.seed,
         }
+        if self.frames != 1:  # (absent for one frame: the keys of earlier sweeps stay valid)
+            key["frames"] = self.frames
+        return key
 
 
 @dataclass(frozen=True)
@@ -167,6 +177,9 @@ class SweepSpec:
     preset: str = "base"
     sets: dict[str, Any] = field(default_factory=dict)
     grid: dict[str, list[Any]] = field(default_factory=dict)
+    # Named config points (`points`: label, preset, set), crossed with the grid; each is a dict
+    # of swept values ({"point": label, "preset": name, "l1.size_kib": 64}).
+    named_points: list[dict[str, Any]] = field(default_factory=list)
     sampling: SamplingSpec | None = None
     timeout: float | None = None
     text: str = ""
@@ -177,17 +190,20 @@ class SweepSpec:
     @property
     def swept_keys(self) -> list[str]:
         keys = ([ACCEL_KEY] if self.accels is not None else []) + list(self.grid)
+        for point in self.named_points:
+            keys += [k for k in point if k not in keys]
         if self.sampling:
             keys += [k for k in self.sampling.ranges if k not in keys]
         return keys
 
     def points(self) -> list[dict[str, Any]]:
-        """Grid points x sampled points (either may be absent: one empty point)."""
+        """Grid points x named points x sampled points (each may be absent: one empty point)."""
         grid = [
             dict(zip(self.grid, v, strict=True)) for v in itertools.product(*self.grid.values())
         ]
+        named = self.named_points or [{}]
         samples = sample_points(self.sampling) if self.sampling else [{}]
-        return [{**g, **s} for g in grid for s in samples]
+        return [{**g, **n, **s} for g in grid for n in named for s in samples]
 
     def traces(self) -> list[TracePlan]:
         accels = self.accels if self.accels is not None else [default_accel()]
@@ -198,22 +214,30 @@ class SweepSpec:
             for a in accels
         ]
 
-    def runs(self) -> list[RunPlan]:
-        """Every run, traces outermost, without duplicates (same trace and resolved config)."""
+    def plans(self) -> list[RunPlan]:
+        """Every (trace, point) of the spec, traces outermost, duplicates included: two points
+        that resolve to one config on one trace are two plans of one run (a study's table has
+        a row for each)."""
         base_sets = unflatten(self.sets)
-        runs, seen = [], set()
+        plans = []
         for trace in self.traces():
             for point in self.points():
                 preset = str(point.get(PRESET_KEY, self.preset))
-                values = {k: v for k, v in point.items() if k != PRESET_KEY}
+                values = {k: v for k, v in point.items() if k not in (PRESET_KEY, POINT_KEY)}
                 config = apply_patch(apply_patch(compose(preset), base_sets), unflatten(values))
                 params = dict(point)
                 if self.accels is not None:
                     params = {ACCEL_KEY: trace.accel.label, **params}
-                run = RunPlan(trace, preset, params, config)
-                if run.run_id not in seen:
-                    seen.add(run.run_id)
-                    runs.append(run)
+                plans.append(RunPlan(trace, preset, params, config))
+        return plans
+
+    def runs(self) -> list[RunPlan]:
+        """Every run, traces outermost, without duplicates (same trace and resolved config)."""
+        runs, seen = [], set()
+        for run in self.plans():
+            if run.run_id not in seen:
+                seen.add(run.run_id)
+                runs.append(run)
         return runs
 
 
@@ -292,7 +316,7 @@ class _Reader:
             d = LineDict({"name": items[i]})
             d.line = items.item_line(i)
         else:
-            allowed = ("name", "label", "hairball_triangles", "seed")
+            allowed = ("name", "label", "hairball_triangles", "seed", "flatten")
             d = self.mapping(items, i, f"scenes[{i}]", allowed)
         if not isinstance(d.get("name"), str) or not d["name"]:
             raise self.fail(items, i, f"scenes[{i}].name", "a scene needs a name or path")
@@ -314,10 +338,15 @@ class _Reader:
             else 200_000
         )
         seed = self.number(d, "seed", f"scenes[{i}].seed", True) if "seed" in d else 1
-        return SceneSpec(label, source, tris, seed)
+        flat = d.get("flatten", False)
+        if not isinstance(flat, bool):
+            raise self.fail(
+                d, "flatten", f"scenes[{i}].flatten", f"expected true or false, got {flat!r}"
+            )
+        return SceneSpec(label, source, tris, seed, flat)
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
-        allowed = ("name", "rays", "resolution", "bounces", "seed")
+        allowed = ("name", "rays", "resolution", "bounces", "seed", "frames")
         d = self.mapping(items, i, f"workloads[{i}]", allowed)
         path = f"workloads[{i}]"
         rays = d.get("rays", [])  # absent: what the scene calls for
@@ -346,8 +375,9 @@ class _Reader:
             else 1
         )
         seed = self.number(d, "seed", f"{path}.seed", True) if "seed" in d else 1
+        frames = self.number(d, "frames", f"{path}.frames", True, 1) if "frames" in d else 1
         label = str(d.get("name") or "-".join(rays) or "scene")
-        return WorkloadSpec(label, tuple(rays), int(w), int(h), bounces, seed)
+        return WorkloadSpec(label, tuple(rays), int(w), int(h), bounces, seed, frames)
 
     def accels(self, doc: LineDict) -> list[AccelSpec]:
         """The `accel` axis: a list (or one entry) of KIND, KIND:BUILDER or {kind, builder,
@@ -401,6 +431,32 @@ class _Reader:
                 else:
                     self.config_value(values, j, path, str(key), v)
             out[str(key)] = list(values)
+        return out
+
+    def named_points(self, doc: LineDict, grid: dict[str, list[Any]]) -> list[dict[str, Any]]:
+        """`points`: a list of named configs ({label, preset, set}), each a swept point."""
+        items = doc["points"]
+        if not isinstance(items, list) or not items:
+            raise self.fail(doc, "points", "points", "expected a non-empty list of points")
+        out = []
+        for i, _ in enumerate(items):
+            path = f"points[{i}]"
+            p = self.mapping(items, i, path, ("label", "preset", "set"))
+            point: dict[str, Any] = {}
+            if "label" in p:
+                point[POINT_KEY] = str(p["label"])
+            if "preset" in p:
+                try:
+                    compose(str(p["preset"]))
+                except ConfigError as err:
+                    raise self.fail(p, "preset", f"{path}.preset", str(err)) from None
+                point[PRESET_KEY] = str(p["preset"])
+            for key, value in (self.mapping(p, "set", f"{path}.set") if "set" in p else {}).items():
+                if key in grid:
+                    raise self.fail(p["set"], key, f"{path}.set.{key}", "already swept by the grid")
+                self.config_value(p["set"], key, f"{path}.set.{key}", str(key), value)
+                point[str(key)] = value
+            out.append(point)
         return out
 
     def baseline(self, doc: LineDict, grid: dict[str, list[Any]]) -> dict[str, Any]:
@@ -506,16 +562,20 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
                 spec.sets[str(key)] = value
     if "grid" in doc:
         spec.grid = rd.grid(doc)
+    if "points" in doc:
+        spec.named_points = rd.named_points(doc, spec.grid)
     if "sampling" in doc:
         spec.sampling = rd.sampling(doc)
-        both = set(spec.grid) & set(spec.sampling.ranges)
+        both = (set(spec.grid) | {k for p in spec.named_points for k in p}) & set(
+            spec.sampling.ranges
+        )
         if both:
             key = sorted(both)[0]
             raise rd.fail(
                 doc["sampling"]["ranges"],
                 key,
                 f"sampling.ranges.{key}",
-                "already swept by the grid",
+                "already swept by the grid or the points",
             )
     _check_size(rd, doc, spec)
     if "timeout" in doc:
@@ -529,6 +589,7 @@ def _check_size(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
     """Refuses a sweep of more than MAX_RUNS runs before anything is enumerated."""
     points = math.prod(len(v) for v in spec.grid.values())
     points *= spec.sampling.n if spec.sampling else 1
+    points *= len(spec.named_points) or 1
     accels = len(spec.accels) if spec.accels else 1
     runs = points * len(spec.scenes) * len(spec.workloads) * accels
     if runs <= MAX_RUNS:
@@ -543,6 +604,32 @@ def _check_size(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
         "runs per sweep (docs/sweeps.md); split the sweep, or sample points (sampling.n) "
         "instead of a grid",
     )
+
+
+def spec_from_dict(data: dict[str, Any], source: str = "<dict>") -> SweepSpec:
+    """A SweepSpec from a dict of the YAML's shape (what `rtsim.sweep` takes in a notebook):
+    written out as YAML and parsed like a file, so it is checked the same way and the store
+    records the same text; errors name the key (and the line of that YAML). Relative scene
+    paths are relative to the working folder."""
+    if not isinstance(data, dict):
+        raise SpecError(f"{source}: a spec is a mapping (scenes, workloads, grid, ...), got "
+                        f"{type(data).__name__}")  # fmt: skip
+    try:
+        text = yaml.safe_dump(_plain(data), sort_keys=False, allow_unicode=True)
+    except yaml.YAMLError as err:
+        raise SpecError(f"{source}: cannot be written as YAML: {err}") from None
+    return parse_spec(text, source=source, base=Path.cwd())
+
+
+def _plain(value: Any) -> Any:
+    """Numpy scalars and tuples as the plain values YAML writes."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item") and type(value).__module__ == "numpy":
+        return value.item()
+    return value
 
 
 def load_spec(path: Path) -> SweepSpec:

@@ -46,6 +46,8 @@ class TraceTask:
     accel: str = "bvh2"  # the structure (rtsim trace --accel)
     builder: str = ""  # its builder; empty: the structure's default
     build_settings: dict[str, Any] = field(default_factory=dict)  # rtsim trace --build-set
+    frames: int = 1  # rtsim trace --frames N (an animated trace)
+    flatten: bool = False  # rtsim trace --flatten (instanced scenes: one world-space structure)
 
     def command(self, out: str) -> list[str]:
         workload = ["--workload", ",".join(self.rays)] if self.rays else []
@@ -74,6 +76,8 @@ class TraceTask:
                 for k, v in self.build_settings.items()
                 for a in ("--build-set", f"{k}={_text(v)}")
             ],
+            *(["--frames", str(self.frames)] if self.frames != 1 else []),
+            *(["--flatten"] if self.flatten else []),
         ]
 
 

@@ -1,0 +1,93 @@
+"""What the studies' tables and figures share: number formats, the stats.json figures several
+studies read (BVH bytes per ray, ray-buffer counters, prefetch totals), the `rtsim trace` scene
+entries of the project's scenes, and matplotlib set up for files."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rtsim.sweep.store import RunRecord
+
+
+def fmt(value: Any, spec: str, none: str = "-") -> str:
+    """`value` formatted by `spec`, or `none` when missing."""
+    return none if value is None else format(value, spec)
+
+
+def pct(x: float | None) -> str:
+    """A fraction as a signed percentage with one decimal (`+1.5%`); n/a when missing."""
+    return "n/a" if x is None else f"{100 * x:+.1f}%"
+
+
+def change(a: float, b: float) -> str:
+    """a against b as a signed whole percentage (`-35%`)."""
+    return f"{100 * (a / b - 1):+.0f}%"
+
+
+def kib(v: int) -> str:
+    return f"{v // 1024} MiB" if v >= 1024 else f"{v} KiB"
+
+
+def scene(name: str, hairball_triangles: int | None = None, **more: Any) -> dict[str, Any]:
+    """A spec's scene entry (the hairball with its size)."""
+    entry: dict[str, Any] = {"name": name, **more}
+    if name == "hairball" and hairball_triangles:
+        entry["hairball_triangles"] = hairball_triangles
+    return entry
+
+
+def markdown(header: list[str], align: str, rows: list[list[str]]) -> str:
+    """A markdown table: `align` is one character per column, `l` or `r`."""
+    rule = "|" + "|".join("---:" if a == "r" else "---" for a in align) + "|"
+    lines = ["| " + " | ".join(header) + " |", rule]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+# Figures of stats.json several studies read, as extra columns of their DataFrame.
+
+
+def _model(rec: RunRecord) -> dict[str, Any]:
+    return (rec.stats or {}).get("model") or {}
+
+
+def _rays(rec: RunRecord) -> int:
+    return int(rec.summary.get("rays") or 1)
+
+
+def bvh_bytes_per_ray(rec: RunRecord) -> float:
+    """BVH bytes: node and triangle reads from DRAM, per ray."""
+    dram = _model(rec).get("dram", {}).get("by_kind", {})
+    return sum(dram.get(k, {}).get("read_bytes", 0) for k in ("node", "triangle")) / _rays(rec)
+
+
+def ray_buffer(rec: RunRecord) -> dict[str, Any]:
+    return _model(rec).get("ray_buffer") or {}
+
+
+def prefetch_totals(rec: RunRecord) -> dict[str, int]:
+    """Prefetch counters summed over the caches (only its target issues; the other counts 0),
+    and `dram_bytes`: the DRAM traffic prefetching caused (the L2's reads below for it)."""
+    model = _model(rec)
+    total: dict[str, int] = {}
+    for cache in [*model.get("l1", {}).values(), model.get("l2", {})]:
+        for k, v in cache.get("prefetch", {}).items():
+            total[k] = total.get(k, 0) + v
+    if total:
+        total["dram_bytes"] = model["l2"].get("prefetch", {}).get("below_bytes", 0)
+    return total
+
+
+def units(rec: RunRecord) -> list[dict[str, Any]]:
+    """Every traversal unit's counters."""
+    return list((_model(rec).get("units") or {}).values())
+
+
+def pyplot() -> Any:
+    """matplotlib's pyplot drawing into files (no display)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
