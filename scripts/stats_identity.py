@@ -134,7 +134,12 @@ OLD_KEYS = {
 
 #: Fields the new binary adds that the old one never wrote (what the run's resolution step
 #: settled; the area model's SRAM by block): reported apart, not as differences.
-ADDED_FIELDS = {("summary", "resolved"), ("area", "sram_bytes"), ("area", "sram_total_bytes")}
+ADDED_FIELDS = {
+    ("summary", "resolved"),
+    ("area", "sram_bytes"),
+    ("area", "sram_total_bytes"),
+    ("sampling", "measured_by"),
+}
 
 
 def old_sets(sets: list[str]) -> list[str]:

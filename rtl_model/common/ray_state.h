@@ -8,7 +8,6 @@
 
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/common/stack_split.h"
-#include "rtl_model/common/treelet_footprint.h"
 #include "traces/accel/accel.h"
 
 namespace rtsim {
@@ -16,6 +15,7 @@ namespace rtsim {
 struct RayState {
     std::unique_ptr<Stepper> stepper;
     uint64_t ray_id = 0;
+    RayKind kind = RayKind::primary;  ///< what the ray is (per-kind figures: SIMD efficiency by kind)
     Cycle start = 0;           ///< cycle the ray entered the machine (latency is measured from it)
     StackSplit stack;          ///< its stack entries on chip and spilled to memory
 };
@@ -49,23 +49,22 @@ inline uint32_t ray_state_bytes(uint32_t stack_entries, uint32_t stack_entry_byt
 }
 
 /// The ray buffer as the traversal units see it (treelet scheduling).
-/// Contract: take() hands each waiting ray to exactly one unit; park() accepts every ray (it
+/// Contract: take() hands each waiting ray to exactly one consumer; park() accepts every ray (it
 /// overflows to memory when the SRAM is full), so units never block on it.
 class RayBufferIf : public virtual sc_core::sc_interface {
 public:
-    /// Next ray of `unit`'s current treelet, choosing a new treelet for the unit when that queue
-    /// is empty. False when no ray can be run now. *ready: cycle the ray's state is in the unit.
-    virtual bool take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) = 0;
+    /// Next ray of `consumer`'s current treelet, choosing a new treelet for it when that queue is
+    /// empty and `may_switch` (else false). A consumer is what runs one treelet at a time: a MIMD
+    /// unit, or one warp of a SIMT unit (UnitKind::treelet_consumers). False when no ray can be
+    /// run now. *ready: cycle the ray's state is in the unit.
+    virtual bool take(uint32_t consumer, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready,
+                      bool may_switch = true) = 0;
     /// A ray leaves its treelet for `treelet`; returns the cycle its state is written.
     virtual Cycle park(uint32_t treelet, RayState&& ray, Cycle time) = 0;
     /// A ray finished (its hit was written).
     virtual void finished(Cycle time) = 0;
     /// No ray is left anywhere: not in dispatch, not in queues, not in flight.
     virtual bool done() const = 0;
-    /// Treelet of a step's locality key (StepPlan::locality; never kNoLocality).
-    virtual uint32_t treelet_of(uint32_t locality) const = 0;
-    /// The treelets' lines for prefetching (treelets.prefetch), or null when prefetching is off.
-    virtual TreeletFootprints* footprints() { return nullptr; }
 };
 
 }  // namespace rtsim

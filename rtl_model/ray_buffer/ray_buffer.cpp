@@ -7,27 +7,27 @@
 
 namespace rtsim {
 
-RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const LocalityPartition& partition,
+RayBuffer::RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const TreeletMap& treelets,
                      const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts,
-                     uint32_t state_bytes, Cycle lookahead)
+                     uint32_t consumers, uint32_t state_bytes, Cycle lookahead)
     : sc_core::sc_module(name),
       m_config(config),
-      m_partition(partition),
+      m_treelets(treelets),
       m_map(map),
       m_steppers(steppers),
       m_state_bytes(state_bytes),
       m_capacity(std::max<uint64_t>(1, uint64_t(config.buffer_kib) * 1024 / m_state_bytes)),
       m_max_in_flight(config.max_rays_in_flight ? config.max_rays_in_flight
                                                 : m_capacity + uint64_t(units) * ray_contexts),
-      m_queues(partition.treelets.size()),
-      m_unit_treelet(units, -1),
+      m_queues(treelets.treelets()),
+      m_consumer_treelet(consumers, -1),
       m_admit_slots(config.admit_outstanding, 0),  // (the config allows at most MinTree::kMaxSlots)
       m_lookahead(lookahead),
       m_sram(16ull * config.bytes_per_cycle, 16),
-      m_by_size(config.policy == TreeletPolicy::largest ? uint32_t(partition.treelets.size()) : 1) {
+      m_by_size(config.policy == TreeletPolicy::largest ? treelets.treelets() : 1) {
     SC_THREAD(admission);
-    require(config.policy != TreeletPolicy::largest || partition.treelets.size() <= SizeTree::kMaxSlots,
-            "ray buffer: " + std::to_string(partition.treelets.size()) + " treelets, at most " +
+    require(config.policy != TreeletPolicy::largest || treelets.treelets() <= SizeTree::kMaxSlots,
+            "ray buffer: " + std::to_string(treelets.treelets()) + " treelets, at most " +
                 std::to_string(SizeTree::kMaxSlots) + " (raise treelets.treelet_kib)");
 }
 
@@ -60,10 +60,6 @@ void RayBuffer::push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time) 
     index(treelet);
 }
 
-void RayBuffer::enable_prefetch(uint32_t line_bytes, ServedBy into) {
-    m_footprints = std::make_unique<TreeletFootprints>(uint32_t(m_queues.size()), line_bytes, m_config.prefetch_lines, into);
-}
-
 bool RayBuffer::has_room() const {
     // By default (no explicit limit) admission also waits for SRAM room, so it never overflows.
     // It leaves one entry free: a unit parks a ray and takes the next in one step, so the SRAM
@@ -86,8 +82,8 @@ void RayBuffer::admit_until(Cycle time, Cycle horizon) {
         s.stepper = m_steppers.acquire();
         s.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
         s.ray_id = job.id;
-        const uint32_t first = s.stepper->plan().locality;
-        const uint32_t treelet = first == kNoLocality ? m_partition.root_group : m_partition.group_of[first];
+        s.kind = job.kind;
+        const uint32_t treelet = m_treelets.first_treelet(s.stepper->plan().locality);
         const Cycle issue = next_admit_issue(time);
         s.start = issue;
         const Cycle fetched = fetch_ray_record(job.id, issue);
@@ -147,7 +143,7 @@ void RayBuffer::index(uint32_t t) {
     else m_nonempty.insert(t);
 }
 
-int64_t RayBuffer::pick(uint32_t) {
+int64_t RayBuffer::pick() {
     // The policy's first queue with at least `threshold` rays among the first few candidates; if
     // none is that long, its first queue anyway (draining). Waiting for a queue to fill instead was
     // tried and idles the machine: only running rays refill the queues (docs/treelets.md). With
@@ -185,10 +181,12 @@ int64_t RayBuffer::pick(uint32_t) {
     return chosen;
 }
 
-bool RayBuffer::take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) {
-    int64_t& current = m_unit_treelet[unit];
+bool RayBuffer::take(uint32_t consumer, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready,
+                     bool may_switch) {
+    int64_t& current = m_consumer_treelet[consumer];
     if (current < 0 || m_queues[current].empty()) {
-        current = pick(unit);
+        if (!may_switch) return false;
+        current = pick();
         if (current < 0) return false;
     }
     Waiting& w = m_queues[current].front();
@@ -251,14 +249,6 @@ const StatBlock& ray_buffer_stats() {
 }
 
 nlohmann::json RayBuffer::stats_json() const {
-    const auto& t = m_partition.treelets;
-    uint64_t max_bytes = 0, sum_bytes = 0;
-    uint32_t max_depth = 0;
-    for (const TreeletInfo& i : t) {
-        max_bytes = std::max(max_bytes, i.bytes);
-        sum_bytes += i.bytes;
-        max_depth = std::max(max_depth, i.depth);
-    }
     nlohmann::json j;
     StatsWriter(ray_buffer_stats(), j)
         .set("ray_state_bytes", m_state_bytes)
@@ -274,16 +264,8 @@ nlohmann::json RayBuffer::stats_json() const {
         .set("picks", m_picks)
         .set("drain_picks", m_drain_picks)
         .set("avg_queue_rays_at_pick", m_picks ? double(m_picked_queue_rays) / double(m_picks) : 0.0)
-        .set("treelets", nlohmann::json{{"count", t.size()},
-                                        {"budget_bytes", m_partition.budget_bytes},
-                                        {"mean_bytes", t.empty() ? 0.0 : double(sum_bytes) / double(t.size())},
-                                        {"max_bytes", max_bytes},
-                                        {"max_depth", max_depth}});
-    if (m_footprints) {
-        const uint64_t learnt = m_footprints->treelets_learnt(), lines = m_footprints->lines_learnt();
-        j["prefetch"] = {{"treelets_learnt", learnt}, {"lines_learnt", lines},
-                         {"mean_lines", learnt ? double(lines) / double(learnt) : 0.0}};
-    }
+        .set("treelets", m_treelets.partition_json());
+    if (m_treelets.footprints()) j["prefetch"] = m_treelets.prefetch_json();
     ray_buffer_stats().check(j);
     return j;
 }

@@ -32,6 +32,7 @@
 #include "rtl_model/common/min_tree.h"
 #include "rtl_model/common/ray_state.h"
 #include "rtl_model/common/stats.h"
+#include "rtl_model/common/treelet_map.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
 #include "traces/accel/locality.h"
 
@@ -45,14 +46,16 @@ public:
     sc_core::sc_port<RaySourceIf> rays;  ///< dispatch
     sc_core::sc_port<MemIf> mem;          ///< ray records in, overflow out (the L2)
 
-    /// units x ray_contexts: the rays the traversal units hold; state_bytes: ray_state_bytes().
-    /// lookahead: how far past SystemC time the admission engine may issue reads (the units'
-    /// quantum: 1 cycle at the detailed level, where the L2 and DRAM see requests in time order).
-    RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const LocalityPartition& partition,
-              const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts, uint32_t state_bytes,
-              Cycle lookahead);
+    /// units x ray_contexts: the rays the traversal units hold; consumers: what takes rays of one
+    /// treelet at a time (take()); state_bytes: ray_state_bytes(). lookahead: how far past SystemC
+    /// time the admission engine may issue reads (the units' quantum: 1 cycle at the detailed
+    /// level, where the L2 and DRAM see requests in time order).
+    RayBuffer(sc_core::sc_module_name name, const TreeletConfig& config, const TreeletMap& treelets,
+              const MemoryMap& map, StepperPool& steppers, uint32_t units, uint32_t ray_contexts, uint32_t consumers,
+              uint32_t state_bytes, Cycle lookahead);
 
-    bool take(uint32_t unit, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready) override;
+    bool take(uint32_t consumer, Cycle time, RayState* ray, uint32_t* treelet, Cycle* ready,
+              bool may_switch = true) override;
     /// The admission engine up to `horizon`, asked at `time`: issues, in order, every ray-record
     /// read that can leave at or before `horizon` (one per cycle from `time` on, at most
     /// admit_outstanding in flight) while the machine has room, and queues those rays. The
@@ -61,10 +64,6 @@ public:
     Cycle park(uint32_t treelet, RayState&& ray, Cycle time) override;
     void finished(Cycle time) override;
     bool done() const override { return m_dispatch_empty && m_in_machine == 0; }
-    uint32_t treelet_of(uint32_t locality) const override { return m_partition.group_of[locality]; }
-    /// Treelet prefetching on (treelets.prefetch): the units learn and prefetch through the table.
-    void enable_prefetch(uint32_t line_bytes, ServedBy into);
-    TreeletFootprints* footprints() override { return m_footprints.get(); }
 
     uint64_t capacity_rays() const { return m_capacity; }
     uint64_t max_occupancy() const { return m_max_occupancy; }
@@ -91,18 +90,18 @@ private:
     void unindex(uint32_t treelet);
     void index(uint32_t treelet);
     void push(uint32_t treelet, RayState&& ray, Cycle ready, Cycle time);
-    int64_t pick(uint32_t unit);
+    int64_t pick();
     Cycle sram(Cycle time);
 
     const TreeletConfig& m_config;
-    const LocalityPartition& m_partition;
+    const TreeletMap& m_treelets;
     const MemoryMap& m_map;
     StepperPool& m_steppers;
     uint32_t m_state_bytes;
     uint64_t m_capacity;
     uint64_t m_max_in_flight;
     std::vector<std::deque<Waiting>> m_queues;
-    std::vector<int64_t> m_unit_treelet;
+    std::vector<int64_t> m_consumer_treelet;  ///< each consumer's current treelet (-1: none yet)
     MinTree m_admit_slots;             ///< completion cycle of each admission read slot
     Cycle m_admit_next = 0;            ///< earliest cycle the next admission read can issue
     Cycle m_lookahead;                 ///< the engine issues reads at most this far past SystemC time
@@ -122,7 +121,6 @@ private:
     uint64_t m_occupancy = 0, m_max_occupancy = 0, m_in_machine = 0;
     uint64_t m_admitted = 0, m_parked = 0, m_taken = 0, m_overflows = 0, m_overflow_reads = 0;
     uint64_t m_picks = 0, m_drain_picks = 0, m_picked_queue_rays = 0;
-    std::unique_ptr<TreeletFootprints> m_footprints;  ///< treelet prefetching only
 };
 
 }  // namespace rtsim

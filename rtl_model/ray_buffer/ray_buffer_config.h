@@ -42,7 +42,7 @@ struct TreeletConfig {
         v.field("max_rays_in_flight", max_rays_in_flight, "rays", "Rays admitted into the machine at once; beyond what the SRAM holds, queues overflow to DRAM (0: SRAM capacity plus the ray contexts, never overflows)", 0, 1u << 30);
         v.field("admit_outstanding", admit_outstanding, "reads", "Ray-record reads the ray buffer keeps in flight while admitting new rays (a streaming engine, one read issued per cycle)", 1, 4096);
         v.field("quantum_cycles", quantum_cycles, "cycles", "At the approx level with treelets, the units (and the admission engine) run ahead of each other by at most this many cycles (the smaller of this and quantum_cycles): treelet queues' dynamics depend on the order of parks and takes, and longer quanta made approx up to 37% off detailed (docs/fidelity.md)", 1, 1u << 20);
-        v.flag("prefetch", prefetch, "Treelet prefetching (Chou, Nowicki & Aamodt 2023): when a unit starts a treelet's queue, the treelet's lines are requested ahead of its rays (needs treelets.enabled; docs/treelets.md)");
+        v.flag("prefetch", prefetch, "Treelet prefetching (Chou, Nowicki & Aamodt 2023): when a unit starts a treelet's queue, or without treelet queues (treelets.enabled false) when a ray steps into a treelet, the treelet's lines are requested ahead of its rays (docs/treelets.md)");
         v.field("prefetch_lines", prefetch_lines, "lines", "Lines prefetched per treelet entry, in the order rays first read them (the treelet's root first); 0: the whole treelet", 0, 1u << 16);
         v.choice("prefetch_into", prefetch_into, kPrefetchIntoChoices, "Cache the prefetched lines are filled into: the unit's l1 or the shared l2");
     }

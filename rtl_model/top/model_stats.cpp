@@ -23,6 +23,7 @@ const StatBlock& model_stats() {
                         {"dram", "", "DRAM (`model.dram`); absent with `ideal_memory`", false, true},
                         {"ideal_memory", "", "only with `ideal_memory`: the one memory that serves every access", false, true},
                         {"ray_buffer", "", "only with `treelets.enabled` (`model.ray_buffer`)", false, true},
+                        {"treelet_prefetch", "", "only with `treelets.prefetch` and `treelets.enabled` false: `{treelets, prefetch}`, the partition and the footprint table the prefetchers use, as `model.ray_buffer` reports them with treelet queues", false, true},
                         {"cycle_accounting", "", "where ray-context time went (`model.cycle_accounting`); timed levels only", false, true},
                         {"utilization", "", "shared resources' busy fractions (`model.utilization`); timed levels only", false, true},
                         {"analytic", "", "the analytic level's closed form (`model.analytic`); analytic level only", false, true},

@@ -43,7 +43,7 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
     m_dispatch = std::make_unique<Dispatch>("dispatch", config.dispatch, config.traversal.units, rays);
     build_memory();
     build_pipelines(accel);
-    build_ray_buffer(accel, map);
+    build_treelets(accel, map);
     // Detailed (quantum 1) with private pipelines: a unit's operations phases touch only its own
     // blocks, so they need not wait for SystemC time (docs/model.md, "Detailed level").
     bool private_ops = true;
@@ -51,7 +51,8 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
         for (const auto& p : pipes) private_ops = private_ops && !p->shared();
     m_unit_context.sync_private_steps =
         !(m_config.fidelity == Fidelity::detailed && private_ops && !m_config.treelets.enabled);
-    const UnitSetup setup{config.traversal, m_unit_context, map, m_steppers, step_costs(config, accel.op_kinds())};
+    const UnitSetup setup{config.traversal, m_unit_context, map, m_steppers, step_costs(config, accel.op_kinds()),
+                          m_treelets.get()};
     const UnitKind& kind = config.traversal.kind();
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
         auto unit = kind.make_unit(("tu" + std::to_string(u)).c_str(), setup, u);
@@ -140,33 +141,48 @@ void Top::build_pipelines(const Accel& accel) {
     }
 }
 
-void Top::build_ray_buffer(const Accel& accel, const MemoryMap& map) {
+void Top::build_treelets(const Accel& accel, const MemoryMap& map) {
     const TreeletConfig& t = m_config.treelets;
+    // Prefetching needs the partition and the footprint table, not the queues (Chou et al.
+    // prefetch on a warp-based RT unit without treelet queues); scheduling needs both.
+    const bool prefetch = t.prefetch && !m_ideal;
+    if (t.enabled || prefetch) {
+        LocalityPartition partition = accel.partition(uint64_t(t.treelet_kib) * 1024);
+        std::unique_ptr<TreeletFootprints> footprints;
+        if (prefetch)
+            footprints = std::make_unique<TreeletFootprints>(
+                uint32_t(partition.treelets.size()), m_config.l1.line_bytes, t.prefetch_lines,
+                t.prefetch_into == PrefetchInto::l1 ? ServedBy::l1 : ServedBy::l2);
+        m_treelets = std::make_unique<TreeletMap>(std::move(partition), std::move(footprints));
+    }
+    const std::string prefetch_why =
+        prefetch ? std::string(", treelet prefetch into ") + kPrefetchIntoChoices.name(t.prefetch_into) : std::string();
     if (!t.enabled) {
         m_instantiated.push_back({{"block", "ray_buffer"}, {"instantiated", false},
                                   {"why", "treelets.enabled is false: rays go from dispatch straight to the units"}});
+        if (prefetch)
+            m_instantiated.push_back(
+                {{"block", "treelet_prefetch"}, {"instantiated", true},
+                 {"why", std::to_string(m_treelets->treelets()) + " treelets of at most " +
+                             std::to_string(t.treelet_kib) + " KiB prefetched when a ray enters one, without treelet "
+                             "queues" + prefetch_why}});
         return;
     }
-    m_partition = accel.partition(uint64_t(t.treelet_kib) * 1024);
     const TraversalConfig& tc = m_config.traversal;
-    m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", t, m_partition, map, m_steppers, tc.units, tc.contexts(),
+    const uint32_t consumers = tc.units * tc.kind().treelet_consumers(tc);
+    m_ray_buffer = std::make_unique<RayBuffer>("ray_buffer", t, *m_treelets, map, m_steppers, tc.units, tc.contexts(),
+                                               consumers,
                                                ray_state_bytes(tc.stack_entries, tc.stack_entry_bytes,
                                                                m_config.mailbox.entries * MailboxConfig::kEntryBytes),
                                                m_config.quantum_cycles);
     m_ray_buffer->rays(*m_dispatch);
-    if (t.prefetch && !m_ideal)
-        m_ray_buffer->enable_prefetch(m_config.l1.line_bytes,
-                                      t.prefetch_into == PrefetchInto::l1 ? ServedBy::l1 : ServedBy::l2);
     if (m_ideal) m_ray_buffer->mem(*m_ideal);
     else m_ray_buffer->mem(*m_l2);
     m_instantiated.push_back({{"block", "ray_buffer"}, {"instantiated", true},
-                              {"why", std::to_string(m_partition.treelets.size()) + " treelets of at most " +
+                              {"why", std::to_string(m_treelets->treelets()) + " treelets of at most " +
                                           std::to_string(t.treelet_kib) + " KiB, " + std::to_string(t.buffer_kib) +
                                           " KiB ray buffer (" + std::to_string(m_ray_buffer->capacity_rays()) +
-                                          " rays), policy " + kTreeletPolicyChoices.name(t.policy) +
-                                          (t.prefetch && !m_ideal ? std::string(", treelet prefetch into ") +
-                                                                        kPrefetchIntoChoices.name(t.prefetch_into)
-                                                                  : std::string())}});
+                                          " rays), policy " + kTreeletPolicyChoices.name(t.policy) + prefetch_why}});
 }
 
 void Top::warm(uint32_t unit, uint64_t addr, uint32_t bytes) {
@@ -205,6 +221,8 @@ nlohmann::json Top::stats_json() const {
         for (const auto& p : m_pipes[size_t(k)]) j[op_kind_name(OpKind(k))][p->basename()] = p->stats_json(total);
     if (m_ideal) j["ideal_memory"] = m_ideal->stats_json();
     if (m_ray_buffer) j["ray_buffer"] = m_ray_buffer->stats_json();
+    else if (m_treelets && m_treelets->footprints())
+        j["treelet_prefetch"] = {{"treelets", m_treelets->partition_json()}, {"prefetch", m_treelets->prefetch_json()}};
     for (const auto& l1 : m_l1) j["l1"][l1->basename()] = l1->stats_json(total);
     if (m_l2) j["l2"] = m_l2->stats_json(total, true);
     if (m_dram) j["dram"] = m_dram->stats_json(total, m_config.clock_ghz);

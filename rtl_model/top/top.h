@@ -66,7 +66,7 @@ private:
     nlohmann::json utilization_json(Cycle total) const;
     void build_memory();
     void build_pipelines(const Accel& accel);
-    void build_ray_buffer(const Accel& accel, const MemoryMap& map);
+    void build_treelets(const Accel& accel, const MemoryMap& map);
 
     const ModelConfig& m_config;
     UnitContext m_unit_context;
@@ -78,7 +78,7 @@ private:
     std::vector<std::unique_ptr<Cache>> m_l1;
     std::array<PipelineSet, kOpKindCount> m_pipes;  ///< per operation kind: one per unit, or one pool
     std::vector<std::unique_ptr<TraversalUnit>> m_units;
-    LocalityPartition m_partition;
+    std::unique_ptr<TreeletMap> m_treelets;  ///< treelet scheduling or prefetching only
     std::unique_ptr<RayBuffer> m_ray_buffer;
     nlohmann::json m_instantiated = nlohmann::json::array();
 };

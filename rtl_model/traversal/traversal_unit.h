@@ -13,6 +13,7 @@
 #include "rtl_model/common/memory_map.h"
 #include "rtl_model/common/ray_state.h"
 #include "rtl_model/common/stats.h"
+#include "rtl_model/common/treelet_map.h"
 #include "rtl_model/traversal/cycle_accounting.h"
 #include "rtl_model/traversal/step_demand.h"
 #include "rtl_model/traversal/traversal_config.h"
@@ -39,6 +40,9 @@ struct UnitSetup {
     const MemoryMap& map;
     StepperPool& steppers;
     StepCosts costs;
+    /// The treelet partition (and the prefetchers' footprint table), with treelet scheduling or
+    /// prefetching; null otherwise.
+    const TreeletMap* treelets = nullptr;
 };
 
 class TraversalUnit : public sc_core::sc_module {

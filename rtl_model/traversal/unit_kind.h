@@ -66,6 +66,9 @@ struct UnitKind {
     const StatBlock* stats = nullptr;
     /// Rays that step together (1: each context alone); ray contexts are a whole number of groups.
     std::function<uint32_t(const TraversalConfig&)> group_size = [](const TraversalConfig&) { return 1u; };
+    /// What takes rays of one treelet at a time under treelet scheduling, per unit: a MIMD unit
+    /// runs one treelet (1), a SIMT unit one per warp (its groups).
+    std::function<uint32_t(const TraversalConfig&)> treelet_consumers = [](const TraversalConfig&) { return 1u; };
     /// What a group is called in messages ("warp", "packet").
     std::string group_name = "context";
     UnitNeeds needs;

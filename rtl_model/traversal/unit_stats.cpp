@@ -23,7 +23,7 @@ const StatBlock& unit_stats() {
             {"rays_taken", "rays", "treelet scheduling only: rays it took from the ray buffer", false, true},
             {"rays_parked", "rays", "treelet scheduling only: rays it parked in another treelet's queue", false, true},
             {"idle_polls", "count", "treelet scheduling only: times it found no ray and looked again after `treelets.idle_poll_cycles`", false, true},
-            {"prefetch", "", "treelet prefetching only (`treelets.prefetch`): `entries` treelets the unit started and prefetched, `queued` lines queued for them, `sent` lines sent to the cache, `cancelled` lines dropped unsent when the unit moved to another treelet, `waits` times the target had no free MSHR and the engine waited", false, true},
+            {"prefetch", "", "treelet prefetching only (`treelets.prefetch`, with or without treelet queues): `entries` treelets the unit's rays entered and it prefetched, `queued` lines queued for them, `sent` lines sent to the cache, `cancelled` lines dropped unsent (the unit moved to another treelet, or past the engine's queue), `waits` times the target had no free MSHR and the engine waited", false, true},
             {"lane_slots", "lane-steps", "kinds that step groups of rays in lock-step (simt warps, packets): group steps x rays per group", false, true},
             {"active_lanes", "lane-steps", "kinds that step groups in lock-step: rays that took part, summed over group steps", false, true},
             {"simd_efficiency", "fraction", "kinds that step groups in lock-step: `active_lanes / lane_slots` (Aila & Laine 2009's SIMD efficiency; for packets, `packet_occupancy / traversal.packet.lanes`)", false, true},

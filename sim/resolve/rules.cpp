@@ -51,19 +51,14 @@ std::vector<Rule> make_rules() {
 
     // Treelet scheduling.
     add({"treelets/unit", "treelets.enabled=true", treelets, RuleSide::unit,
-         "a unit kind that takes rays one at a time from treelet queues",
+         "a unit kind whose rays can leave for other treelets' queues one by one",
          [](const RunFacts& f) { return f.unit.needs.treelet_queues; },
-         "a group's rays would leave for different treelets' queues", "traversal.model=mimd, or treelets.enabled=false",
-         "bvh2", {"traversal.model=simt", "treelets.enabled=true"}});
+         "a packet's rays share one walk, while a treelet queue holds single rays", "traversal.model=mimd or simt, or "
+         "treelets.enabled=false",
+         "bvh2", {"traversal.model=packet", "treelets.enabled=true"}});
     add({"treelets/level", "treelets.enabled=true", treelets, RuleSide::level, "a level that models treelet queues",
          [](const RunFacts& f) { return f.level.treelets; }, "the analytic closed form models plain dispatch",
          "fidelity=approx or detailed", "bvh2", {"treelets.enabled=true", "fidelity=analytic"}});
-    add({"treelets/sampling", "treelets.enabled=true", treelets, RuleSide::technique,
-         "no sampling (sampling.fraction and sampling.count 0)", [](const RunFacts& f) { return !sampling(f); },
-         "the ray buffer admits a cluster's rays long before the machine can trace them, so the span of their starts "
-         "does not measure throughput (a 1% sample of Sponza on 4 units estimated -81%)",
-         "simulate the whole trace (sampling.fraction=0), or treelets.enabled=false", "bvh2",
-         {"treelets.enabled=true", "sampling.fraction=0.2"}});
     add({"sort/treelets", "dispatch.sort (ray sorting)", [](const RunFacts& f) { return f.config.dispatch.sort != RaySort::none; },
          RuleSide::technique, "treelets.enabled=false", [](const RunFacts& f) { return !treelets(f); },
          "the ray buffer takes rays from dispatch in its own order and reorders them by treelet itself",
@@ -150,8 +145,8 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
     std::vector<Unused> out;
     if (f.config.mailbox.entries && !f.structure.caps.mailbox)
         out.push_back({"mailbox.entries", f.structure.name() + " lists no primitive twice along a ray"});
-    if (f.config.treelets.prefetch && !f.config.treelets.enabled)
-        out.push_back({"treelets.prefetch", "it prefetches the treelets the ray buffer schedules (treelets.enabled)"});
+    if (f.config.treelets.prefetch && f.config.ideal_memory)
+        out.push_back({"treelets.prefetch", "with ideal_memory every access hits: there is nothing to prefetch"});
     return out;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rtl_model/common/ray_state.h"
 #include "traces/common/error.h"
 #include "traces/common/rng.h"
 #include "traces/format/trace_checks.h"
@@ -13,8 +14,23 @@ using nlohmann::json;
 
 namespace {
 
-/// Rays the machine holds at once: what a cluster's warm-up must at least replace.
+/// Rays the machine's contexts hold at once: what a cluster's warm-up must at least replace.
 uint64_t rays_in_flight(const SimConfig& c) { return uint64_t(c.traversal.units) * c.traversal.contexts(); }
+
+/// With treelet scheduling, the rays the ray buffer admits beyond the contexts' (its SRAM's, or
+/// treelets.max_rays_in_flight's excess); 0 without. Until the buffer has filled its queues are
+/// short and a treelet load serves few rays: a cluster must fill it before it measures, and
+/// measure at least as long (docs/fidelity.md, "Sampling with treelets").
+uint64_t buffer_rays(const SimConfig& c) {
+    if (!c.treelets.enabled) return 0;
+    if (c.treelets.max_rays_in_flight) {
+        const uint64_t contexts = rays_in_flight(c);
+        return c.treelets.max_rays_in_flight > contexts ? c.treelets.max_rays_in_flight - contexts : 0;
+    }
+    const uint32_t state = ray_state_bytes(c.traversal.stack_entries, c.traversal.stack_entry_bytes,
+                                           c.mailbox.entries * MailboxConfig::kEntryBytes);
+    return std::max<uint64_t>(1, uint64_t(c.treelets.buffer_kib) * 1024 / std::max<uint32_t>(state, 1));
+}
 
 /// The warm-up a cluster wants: the rays in flight twice over (pipelines and L1s), and an eighth
 /// of the L2's lines in rays, about what refills the L2's share of the region the cluster is in
@@ -23,9 +39,9 @@ uint64_t rays_in_flight(const SimConfig& c) { return uint64_t(c.traversal.units)
 uint64_t warmup_target(const SimConfig& c) {
     // Functional warming fills the caches: the simulated warm-up only refills the contexts and
     // pipelines (SMARTS's detailed warming).
-    if (c.sampling.warming_rays > 0) return 2 * rays_in_flight(c);
+    if (c.sampling.warming_rays > 0) return 2 * rays_in_flight(c) + buffer_rays(c);
     const uint64_t l2_lines = c.l2.lines();
-    return std::max<uint64_t>(2 * rays_in_flight(c), c.ideal_memory ? 0 : l2_lines / 8);
+    return std::max<uint64_t>(2 * rays_in_flight(c) + buffer_rays(c), c.ideal_memory ? 0 : l2_lines / 8);
 }
 
 constexpr uint64_t kMinClusters = 5;  ///< below this the t interval is too wide to be useful
@@ -41,9 +57,10 @@ json sample_caveats(const SimConfig& c, const SamplePlan& plan) {
     if (plan.warmup_rays < plan.warmup_target)
         out.push_back("warm-up cut to " + std::to_string(plan.warmup_rays) + " of the " +
                       std::to_string(plan.warmup_target) + " rays wanted per cluster: the estimate is biased high");
-    if (k && plan.clusters[0].measured < 4 * rays_in_flight(c))
+    if (k && plan.clusters[0].measured < 4 * rays_in_flight(c) + buffer_rays(c))
         out.push_back("clusters of " + std::to_string(plan.clusters[0].measured) +
-                      " measured rays, under 4 x the rays in flight: the estimate may be biased high");
+                      " measured rays, under 4 x the rays in flight" + (c.treelets.enabled ? " plus the ray buffer's" : "") +
+                      ": the estimate may be biased high");
     if (c.sampling.warming_rays == 0 && !c.ideal_memory)
         out.push_back("no functional warming: the caches see only the sampled rays (biased high)");
     return out;
@@ -66,7 +83,8 @@ SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
     // clusters. Before the cluster hand-off (SampledRayStream::next_segment) shorter ones (M = 2 x
     // in flight) measured Sponza diffuse about 3% slow; with it, 16 units at K = 7, M = 601 still
     // +3% against +1.4% at K = 5, M = 1046 (docs/fidelity.md, "Cluster hand-off").
-    const uint64_t min_measured = s.warming_rays > 0 && s.warmup_rays == 0 ? 4 * rays_in_flight(c) : 0;
+    const uint64_t min_measured =
+        s.warming_rays > 0 && s.warmup_rays == 0 ? 4 * rays_in_flight(c) + buffer_rays(c) : 0;
     uint64_t clusters = std::min<uint64_t>(s.clusters, budget / (w + std::max(w, min_measured)));
     if (!s.warmup_rays && clusters < kMinClusters) {
         // Too small a sample for full warm-up: keep kMinClusters and shrink the warm-up to half of
@@ -204,19 +222,20 @@ void SampledReference::checked(uint64_t id) {
         m_loaded.erase(std::find_if(m_loaded.begin(), m_loaded.end(), [&](const Loaded& x) { return &x == &l; }));
 }
 
-SampleEstimator::SampleEstimator(const SamplePlan& plan)
-    : m_plan(plan), m_start(plan.simulated_rays, 0), m_seen(plan.simulated_rays, 0) {}
+SampleEstimator::SampleEstimator(const SamplePlan& plan, SampleMeasure measure)
+    : m_plan(plan), m_measure(measure), m_start(plan.simulated_rays, 0), m_seen(plan.simulated_rays, 0) {}
 
 void SampleEstimator::ray_done(const RayResult& r) {
     const size_t i = sample_index(m_plan, r.id);
-    m_start[i] = r.start;
+    m_start[i] = m_measure == SampleMeasure::starts ? r.start : r.end;
     m_seen[i] = 1;
     m_done = false;
 }
 
 void SampleEstimator::finish() const {
     if (m_done) return;
-    // Every ray's start, sorted: the rays the machine took on within a window of cycles.
+    // Every ray's start (or end), sorted: the rays the machine took on (or finished) within a
+    // window of cycles.
     std::vector<Cycle> starts(m_start);
     std::sort(starts.begin(), starts.end());
     const size_t per_cluster = size_t(m_plan.warmup_rays + m_plan.clusters[0].measured);
@@ -226,8 +245,8 @@ void SampleEstimator::finish() const {
         const SamplePlan::Cluster& c = m_plan.clusters[k];
         const auto first = m_start.begin() + std::ptrdiff_t(k * per_cluster + c.warmup);
         const auto [lo, hi] = std::minmax_element(first, first + std::ptrdiff_t(c.measured));
-        // Rays that started within [first measured start, last measured start], minus one: the
-        // number of start-to-start intervals the window spans (ties at one cycle count as 0-length).
+        // Rays that started (finished) within [first measured start, last measured start], minus
+        // one: the number of intervals the window spans (ties at one cycle count as 0-length).
         const size_t started = size_t(std::upper_bound(starts.begin(), starts.end(), *hi) -
                                       std::lower_bound(starts.begin(), starts.end(), *lo));
         const double cpr = started > 1 ? double(*hi - *lo) / double(started - 1) : 0.0;
@@ -260,6 +279,7 @@ json SampleEstimator::to_json(const SimConfig& config, Cycle simulated_cycles, d
                           {"cycles_per_ray", m_cycles_per_ray[k]}});
     }
     return {{"clusters", m_plan.clusters.size()},
+            {"measured_by", m_measure == SampleMeasure::starts ? "starts" : "completions"},
             {"warmup_rays", m_plan.warmup_rays},
             {"warmup_target_rays", m_plan.warmup_target},
             {"measured_rays", m_plan.clusters[0].measured},
@@ -302,6 +322,7 @@ const StatBlock& sampling_stats() {
         "sampling",
         {
             {"clusters", "clusters", "strata of the trace, one simulated cluster each (K)"},
+            {"measured_by", "", "how each cluster's throughput is measured: `starts` (the span of its measured rays' start cycles over the rays started in it) or, with treelet scheduling (whose ray buffer admits rays long before it traces them), `completions` (the span of their end cycles over every sampled ray finished in it)"},
             {"warmup_rays", "rays", "warm-up rays at the start of each cluster: simulated, not measured (W)"},
             {"warmup_target_rays", "rays", "the warm-up wanted (`sampling.warmup_rays` or automatic); more than `warmup_rays` when the sample was too small for it, and then the estimate is biased high"},
             {"measured_rays", "rays", "measured rays per cluster, after its warm-up (M)"},

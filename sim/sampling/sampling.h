@@ -117,10 +117,18 @@ private:
 
 };
 
-/// Records each simulated ray's start cycle and turns them into the estimate.
+/// How a cluster's throughput is measured. starts: the span of its measured rays' start cycles
+/// over the rays the machine started in it (rays enter contexts as contexts free up). With
+/// treelet scheduling the ray buffer admits rays long before the machine traces them, so starts
+/// measure admission, not work: completions then measures the span of the measured rays' end
+/// cycles over every sampled ray the machine finished in it (any cluster's: the machine's
+/// completion rate while it worked on the stratum, clusters overlapping in the buffer).
+enum class SampleMeasure : uint8_t { starts, completions };
+
+/// Records each simulated ray's start and end cycles and turns them into the estimate.
 class SampleEstimator {
 public:
-    explicit SampleEstimator(const SamplePlan& plan);
+    SampleEstimator(const SamplePlan& plan, SampleMeasure measure);
     void ray_done(const RayResult& r);
     /// stats.json "sampling": the estimate, its interval and the per-stratum measurements.
     nlohmann::json to_json(const SimConfig& config, Cycle simulated_cycles, double wall_seconds) const;
@@ -133,7 +141,8 @@ private:
     void finish() const;
 
     const SamplePlan& m_plan;
-    std::vector<Cycle> m_start;  ///< per simulated ray, in sample order
+    SampleMeasure m_measure;
+    std::vector<Cycle> m_start;  ///< per simulated ray, in sample order (starts or ends: m_measure)
     std::vector<uint8_t> m_seen;
     mutable bool m_done = false;
     mutable std::vector<double> m_cycles_per_ray;  ///< per cluster
@@ -147,7 +156,10 @@ size_t sample_index(const SamplePlan& plan, uint64_t id, size_t* cluster = nullp
 /// reference the hit checker reads and the estimator that records start cycles.
 struct SampledRun {
     SampledRun(TraceReader& reader, const SimConfig& config, uint64_t trace_rays)
-        : plan(plan_sample(config, trace_rays)), stream(reader, plan), reference(reader, plan), estimator(plan) {}
+        : plan(plan_sample(config, trace_rays)),
+          stream(reader, plan),
+          reference(reader, plan),
+          estimator(plan, config.treelets.enabled ? SampleMeasure::completions : SampleMeasure::starts) {}
     SamplePlan plan;
     SampledRayStream stream;
     SampledReference reference;

@@ -180,7 +180,6 @@ def test_a_small_sample_says_it_is_too_small(traces: Callable[[str], Path], tmp_
         (["sampling.fraction=1.5"], "sampling.fraction"),
         (["sampling.count=100"], "sampling.count"),  # too small for 2 clusters with warm-up
         (["sampling.count=100000000"], "sampling.count"),  # more than the trace
-        (["sampling.fraction=0.5", "treelets.enabled=true"], "treelets.enabled"),  # start span
     ],
 )
 def test_bad_sampling_config_exits_2(
@@ -235,3 +234,28 @@ def test_accuracy_writes_table_and_plot(tmp_path: Path) -> None:
     assert sampled and all(r["sampling_error"] and r["ci_contains_full"] for r in sampled)
     assert all(r["hit_mismatches"] in ("", "0") for r in rows)
     assert (out / "accuracy.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_sampling_with_treelets_measures_completions(
+    traces: Callable[[str], Path], tmp_path: Path
+) -> None:
+    """With treelet scheduling a cluster fills the ray buffer before it measures, and its
+    throughput is measured from completions, not starts (the buffer admits rays long before the
+    machine traces them): the run samples, and every sampled ray is checked."""
+    small = (
+        "treelets.enabled=true",
+        "treelets.buffer_kib=8",
+        "traversal.units=2",
+        "traversal.ray_contexts=8",
+    )
+    result = sim(traces("cornell"), tmp_path / "run", *small, "sampling.fraction=0.6")
+    assert result.returncode == 0, result.stderr
+    stats = json.loads((tmp_path / "run" / "stats.json").read_text())
+    sampling = stats["sampling"]
+    assert stats["summary"]["sampled"] and sampling["measured_by"] == "completions"
+    assert (
+        stats["validation"]["hit_mismatches"] == 0 and stats["validation"]["work_mismatches"] == 0
+    )
+    # The warm-up fills the buffer (its rays) and the contexts twice over.
+    buffer_rays = stats["model"]["ray_buffer"]["capacity_rays"]
+    assert sampling["warmup_target_rays"] == 2 * 2 * 8 + buffer_rays

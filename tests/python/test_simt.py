@@ -116,7 +116,6 @@ def test_sorted_dispatch_hands_out_every_ray_once(
         (("traversal.model=packet", "treelets.enabled=true"), "treelets.enabled"),
         (("traversal.model=packet", "fidelity=analytic"), "traversal.model"),
         (("traversal.model=simt", "fidelity=analytic"), "traversal.model"),
-        (("traversal.model=simt", "treelets.enabled=true"), "treelets.enabled"),
         (("traversal.simt.policy=while",), "traversal.simt.policy"),
         (("dispatch.sort=hilbert",), "dispatch.sort"),
         (("dispatch.sort_window=1",), "dispatch.sort_window"),
@@ -202,3 +201,35 @@ def test_simt_is_deterministic(sim_exe: Path, small_cornell_rays: Path, tmp_path
     assert runs[0]["model"] == runs[1]["model"]
     assert runs[0]["summary"]["cycles"] == runs[1]["summary"]["cycles"]
     assert runs[0]["summary"]["simd_efficiency"] == runs[1]["summary"]["simd_efficiency"]
+
+
+@pytest.mark.parametrize(
+    "sets",
+    [
+        ("traversal.simt.refill=lane",),
+        ("traversal.simt.refill=warp",),
+        ("traversal.simt.refill=lane", "fidelity=detailed"),
+        ("traversal.simt.lanes=16", "treelets.prefetch=true", "treelets.policy=oldest"),
+    ],
+)
+def test_simt_with_treelets_hands_every_ray_out_once(
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path, sets: tuple[str, ...]
+) -> None:
+    """Warps formed from one treelet queue's rays: every ray is admitted once, each take hands
+    one waiting ray to one lane, every ray retires once, and hits and work match the reference."""
+    stats = sim_stats(
+        sim_exe, small_cornell_rays / "trace.rtt", tmp_path / "run", *SIMT, "treelets.enabled=true",
+        "treelets.treelet_kib=2", *sets,
+    )  # fmt: skip
+    s = stats["summary"]
+    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+    units = stats["model"]["units"].values()
+    buffer = stats["model"]["ray_buffer"]
+    assert sum(u["rays"] for u in units) == s["rays"] == buffer["admitted"]
+    assert (
+        sum(u["rays_taken"] for u in units)
+        == buffer["taken"]
+        == buffer["admitted"] + buffer["parked"]
+    )
+    assert sum(u["rays_parked"] for u in units) == buffer["parked"] > 0
+    assert 0.0 < s["simd_efficiency"] <= 1.0

@@ -100,3 +100,27 @@ def test_prefetch_fields_are_sweep_axes() -> None:
     assert spec.grid["treelets.prefetch"] == [False, True]
     assert spec.grid["treelets.prefetch_into"] == ["l1", "l2"]
     assert len(list(spec.points())) == 8
+
+
+@pytest.mark.parametrize("model", ["mimd", "simt"])
+def test_prefetching_without_queues_changes_no_hit_or_work(
+    hairball_diffuse: Path, tmp_path: Path, model: str
+) -> None:
+    """Chou et al.'s prefetcher on its own: the partition drives only the prefetcher, as rays
+    step into treelets (no ray buffer, no queue); hits and the traversal are as without it."""
+    base = (f"traversal.model={model}", "l2.size_kib=128")
+    off = sim_stats(sim_or_fail(), hairball_diffuse, tmp_path / "off", *base)
+    on = sim_stats(
+        sim_or_fail(), hairball_diffuse, tmp_path / "on", *base, "treelets.prefetch=true"
+    )
+    assert on["validation"]["hit_mismatches"] == 0 and on["validation"]["work_mismatches"] == 0
+    units, units_off = on["model"]["units"], off["model"]["units"]
+    if model == "mimd":  # (a warp's steps depend on when its lanes refill: timing, not traversal)
+        assert sum(u["steps"] for u in units.values()) == sum(u["steps"] for u in units_off.values())
+    assert on["summary"]["rays"] == off["summary"]["rays"]
+    assert "ray_buffer" not in on["model"]
+    table = on["model"]["treelet_prefetch"]
+    assert 0 < table["prefetch"]["treelets_learnt"] <= table["treelets"]["count"]
+    assert sum(u["prefetch"]["entries"] for u in units.values()) > 0
+    assert sum(u["prefetch"]["sent"] for u in units.values()) > 0
+    assert any(b["block"] == "treelet_prefetch" and b["instantiated"] for b in on["instantiated"])

@@ -6,6 +6,7 @@ namespace rtsim {
 
 MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
     : ScheduledUnit(name, setup, index, setup.config.contexts(), setup.costs),
+      m_treelets(setup.treelets),
       m_contexts(setup.config.contexts()),
       m_ahead(setup.config.contexts()) {
     SC_THREAD(run);
@@ -13,7 +14,9 @@ MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
 
 void MimdUnit::run() {
     m_treelet_mode = ray_buffer.size() > 0;
-    if (m_treelet_mode) m_prefetcher.attach(ray_buffer->footprints());
+    // Prefetching follows the unit's treelet queue (replace), or without queues each ray's entry
+    // into a treelet (append: the unit's rays are in many treelets at once).
+    if (m_treelets && m_treelets->footprints()) m_prefetcher.attach(m_treelets->footprints(), m_treelet_mode);
     if (!m_treelet_mode)
         for (Context& ctx : m_contexts) ctx.ray.stepper = m_steppers.acquire();
     Cycle now = 0;
@@ -87,6 +90,7 @@ bool MimdUnit::start_ray(uint32_t c, Cycle t) {
     ctx.ray.ray_id = job.id;
     ctx.ray.start = t;
     ctx.ray.stack = StackSplit{};
+    ctx.treelet = kNoTreelet;  // its first step enters one (prefetching without queues)
     m_ahead[c].note(*ctx.ray.stepper);
     activate(c, t);
     // The ray record is read from memory before traversal starts.
@@ -137,16 +141,20 @@ void MimdUnit::step(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
     const StepPlan& plan = ctx.ray.stepper->plan();
     if (plan.done) return finish_ray(c, t);
-    if (m_treelet_mode && plan.locality != kNoLocality) {
-        const uint32_t target = ray_buffer->treelet_of(plan.locality);
-        if (target != ctx.treelet) return park_ray(c, target, t);  // leaves its treelet
+    if (m_treelets && plan.locality != kNoLocality) {
+        const uint32_t target = m_treelets->treelet_of(plan.locality);
+        if (target != ctx.treelet) {
+            if (m_treelet_mode) return park_ray(c, target, t);  // leaves its treelet
+            ctx.treelet = target;  // without queues: the ray walks on into it, prefetched
+            if (m_prefetcher.on()) m_prefetcher.enter(target, t);
+        }
     }
     // The step is costed (and run, with the one arithmetic) as its fetches issue; its
     // operations phase issues what the demand says once the data has arrived.
     // The plan's reads go to memory as the plan holds them, before the step runs; a treelet
     // prefetcher learns the treelet's lines from them.
     StepReads reads(*mem[0], t);
-    const bool learning = m_prefetcher.on();
+    const bool learning = m_prefetcher.on() && ctx.treelet != kNoTreelet;
     take_step_reading(*ctx.ray.stepper, ctx.ray.stack, m_costs, ctx.demand, [&](const Fetch& f) {
         if (learning) m_prefetcher.learn(ctx.treelet, f);
         reads.read(f);

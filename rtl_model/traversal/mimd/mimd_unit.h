@@ -43,7 +43,7 @@ private:
         RayState ray;              ///< stepper, ray id, start cycle, stack split
         StepDemand demand;         ///< the step in flight: costed when its fetches issue
         Phase phase = Phase::step;
-        uint32_t treelet = 0;      ///< treelet the ray is traversing (treelet mode)
+        uint32_t treelet = kNoTreelet;  ///< treelet the ray is traversing (treelet scheduling or prefetching)
         bool active = false;
         Cycle accounted = 0;       ///< its cycles up to here are in m_account
     };
@@ -70,6 +70,7 @@ private:
         account_read_until(m_account, m_contexts[c].accounted, ready, info);
     }
 
+    const TreeletMap* m_treelets;  ///< treelet scheduling or prefetching; else null
     std::vector<Context> m_contexts;
     std::vector<HostAhead> m_ahead;  ///< per context: its next step's host data (speed only; kept
                                      ///< apart from the contexts so the look-up stays in the host's cache)

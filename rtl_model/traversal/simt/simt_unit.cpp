@@ -8,6 +8,7 @@ namespace rtsim {
 SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
     : ScheduledUnit(name, setup, index, setup.config.groups(), setup.costs),
       m_simt(setup.config.kind_config<SimtConfig>()),
+      m_treelets(setup.treelets),
       m_lanes(setup.config.groups() * m_simt.lanes),
       m_warps(setup.config.groups()),
       m_coalescer(setup.context.line_bytes),
@@ -16,12 +17,26 @@ SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
 }
 
 void SimtUnit::run() {
-    for (Lane& lane : m_lanes) lane.ray.stepper = m_steppers.acquire();
+    m_treelet_mode = ray_buffer.size() > 0;
+    // Each warp runs a treelet queue of its own, so the unit's rays are in several treelets at
+    // once: prefetches append (treelet_prefetcher.h), with queues or without.
+    if (m_treelets && m_treelets->footprints()) m_prefetcher.attach(m_treelets->footprints(), false);
+    if (!m_treelet_mode)
+        for (Lane& lane : m_lanes) lane.ray.stepper = m_steppers.acquire();
     Cycle now = 0;
     fill_idle_warps(0);
     for (;;) {
-        if (m_events.empty()) {
+        if (m_events.empty() && !m_treelet_mode) {
             if (!await_next_frame(rays, m_frame)) break;  // no warp has a ray
+            fill_idle_warps(now);
+            continue;
+        }
+        if (m_events.empty()) {
+            // With treelets, rays may still be parked by other units: look again a little later.
+            if (ray_buffer->done()) break;
+            now += m_ctx.idle_poll_cycles;
+            ++m_idle_polls;
+            m_sync(now);
             fill_idle_warps(now);
             continue;
         }
@@ -34,11 +49,19 @@ void SimtUnit::run() {
         m_sync(t);
         advance(w, t);
         m_events.finish_pop();
-        if (rays->frame() != m_frame) {  // a frame was released: fill the idle warps
+        if (m_prefetcher.on()) m_prefetcher.drain(*mem[0], t);
+        if (m_treelet_mode) {
+            if (t >= m_next_fill) fill_when_idle(t);
+        } else if (rays->frame() != m_frame) {  // a frame was released: fill the idle warps
             m_frame = rays->frame();
             fill_idle_warps(t);
         }
     }
+}
+
+void SimtUnit::fill_when_idle(Cycle t) {
+    fill_idle_warps(t);
+    m_next_fill = t + m_ctx.idle_poll_cycles;
 }
 
 bool SimtUnit::warp_has_ray(uint32_t w) const {
@@ -75,11 +98,62 @@ bool SimtUnit::retire_and_refill(uint32_t w, Cycle t) {
     bool taken = false;
     for (uint32_t l = first_lane(w); l < end; ++l)
         if (!m_lanes[l].has_ray) {
-            if (!start_lane(l, t, &fetch)) break;
+            // Treelet scheduling: a warp is formed from one treelet queue's rays; it moves to
+            // another queue only once it holds no ray.
+            const bool ok = m_treelet_mode ? take_lane(w, l, t, !any_ray && !taken, &fetch) : start_lane(l, t, &fetch);
+            if (!ok) break;
             taken = true;
         }
     m_fetch_at = fetch;
     return taken;
+}
+
+bool SimtUnit::take_lane(uint32_t w, uint32_t l, Cycle t, bool may_switch, Cycle* fetch) {
+    Lane& lane = m_lanes[l];
+    RayState taken;
+    uint32_t treelet = 0;
+    Cycle ready = t;
+    const uint32_t consumer = m_index * uint32_t(m_warps.size()) + w;
+    if (!ray_buffer->take(consumer, t, &taken, &treelet, &ready, may_switch)) return false;
+    m_steppers.release(std::move(lane.ray.stepper));  // the finished ray's stepper is free again
+    lane.ray = std::move(taken);
+    const Stepper& s = *lane.ray.stepper;
+    if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_tally.rejected;
+    ++m_takes;
+    if (m_warps[w].treelet != treelet && m_prefetcher.on()) m_prefetcher.enter(treelet, t);
+    m_warps[w].treelet = treelet;
+    account_until(m_account, lane.accounted, CycleUse::starved, t);  // no ray until now
+    lane.has_ray = lane.stepping = true;
+    lane.ready = ready;
+    m_tally.busy.enter(t);
+    *fetch = std::max(*fetch, ready);
+    return true;
+}
+
+void SimtUnit::park_leavers(uint32_t w, Cycle t) {
+    for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
+        Lane& lane = m_lanes[l];
+        if (!lane.has_ray) continue;
+        const StepPlan& plan = lane.ray.stepper->plan();
+        if (plan.done || plan.locality == kNoLocality) continue;
+        const uint32_t target = m_treelets->treelet_of(plan.locality);
+        if (target == m_warps[w].treelet) continue;
+        account_until(m_account, lane.accounted, CycleUse::issue, t);
+        ray_buffer->park(target, std::move(lane.ray), t);
+        ++m_parks;
+        lane.has_ray = false;
+        m_tally.busy.leave(t);
+    }
+}
+
+void SimtUnit::note_treelet(uint32_t l, Cycle t) {
+    Lane& lane = m_lanes[l];
+    const StepPlan& plan = lane.ray.stepper->plan();
+    if (plan.locality == kNoLocality) return;
+    const uint32_t treelet = m_treelets->treelet_of(plan.locality);
+    if (treelet == lane.treelet) return;
+    lane.treelet = treelet;
+    m_prefetcher.enter(treelet, t);
 }
 
 bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
@@ -90,9 +164,10 @@ bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
     lane.ray.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
     if (!ray_is_valid(job.ray)) ++m_tally.rejected;
     lane.ray.ray_id = job.id;
-    lane.kind = job.kind;
+    lane.ray.kind = job.kind;
     lane.ray.start = start;
     lane.ray.stack = StackSplit{};
+    lane.treelet = kNoTreelet;
     account_until(m_account, lane.accounted, CycleUse::starved, start);  // no ray until now
     lane.has_ray = lane.stepping = true;
     m_tally.busy.enter(start);
@@ -102,13 +177,19 @@ bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
 }
 
 void SimtUnit::fetch_rays(uint32_t w, Cycle t) {
-    // The new rays' records are read (coalesced) in a warp step of their own; the lanes that
-    // already had rays wait for it.
+    // The new rays' records are read (coalesced) in a warp step of their own, or with treelet
+    // scheduling their states come from the ray buffer's SRAM; the lanes that already had rays
+    // wait for it.
     AccessInfo slowest;
-    const Cycle ready = issue_reads(m_fetch_at, &slowest);
+    const Cycle ready = m_treelet_mode ? m_fetch_at : issue_reads(m_fetch_at, &slowest);
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         Lane& lane = m_lanes[l];
         if (!lane.stepping) continue;
+        if (m_treelet_mode) {
+            account_until(m_account, lane.accounted, CycleUse::ray_buffer, lane.ready);
+            account_until(m_account, lane.accounted, CycleUse::issue, ready);  // the warp's slowest state
+            continue;
+        }
         account_until(m_account, lane.accounted, CycleUse::dispatch, m_fetch_at);
         account_read_until(m_account, lane.accounted, ready, slowest);
     }
@@ -139,8 +220,13 @@ uint32_t SimtUnit::choose_class(uint32_t w) const {
 
 void SimtUnit::step(uint32_t w, Cycle t) {
     if (retire_and_refill(w, t)) return fetch_rays(w, t);
+    if (m_treelet_mode) {
+        park_leavers(w, t);
+        // Every ray left the warp's treelet (or finished): the warp forms again from a queue.
+        if (!warp_has_ray(w) && retire_and_refill(w, t)) return fetch_rays(w, t);
+    }
     const uint32_t cls = choose_class(w);
-    if (cls == kClasses) return;  // every lane finished and dispatch is empty: the warp idles
+    if (cls == kClasses) return;  // every lane finished and no ray is to be had now: the warp idles
     Warp& warp = m_warps[w];
     warp.last_class = cls;
     // The lanes whose next step runs the warp's kind step (costed and run with the one
@@ -150,8 +236,12 @@ void SimtUnit::step(uint32_t w, Cycle t) {
         lane.stepping = lane.has_ray && step_class(lane.ray.stepper->plan()) == cls;
         if (!lane.stepping) continue;
         account_until(m_account, lane.accounted, CycleUse::issue, t);
-        take_step_reading(*lane.ray.stepper, lane.ray.stack, m_costs, lane.demand,
-                          [&](const Fetch& f) { m_coalescer.add(f.addr, f.bytes, f.kind); });
+        if (m_prefetcher.on() && !m_treelet_mode) note_treelet(l, t);
+        const uint32_t treelet = m_treelet_mode ? warp.treelet : lane.treelet;
+        take_step_reading(*lane.ray.stepper, lane.ray.stack, m_costs, lane.demand, [&](const Fetch& f) {
+            if (m_prefetcher.on() && treelet != kNoTreelet) m_prefetcher.learn(treelet, f);
+            m_coalescer.add(f.addr, f.bytes, f.kind);
+        });
     }
     AccessInfo slowest;
     const Cycle ready = issue_reads(t, &slowest);
@@ -192,7 +282,8 @@ void SimtUnit::run_ops(uint32_t w, Cycle t) {
     const Cycle ops_done = ready;
     for (uint32_t l = begin; l < end; ++l) {
         if (!m_lanes[l].stepping) continue;
-        const uint64_t owner = uint64_t(m_index) * m_lanes.size() + l;  // spill slots belong to the lane
+        // Spill slots belong to the lane, or with treelets to the ray (it moves between units).
+        const uint64_t owner = m_treelet_mode ? m_lanes[l].ray.ray_id : uint64_t(m_index) * m_lanes.size() + l;
         ready = std::max(ready, issue_stack_traffic(*mem[0], m_map, m_lanes[l].demand, owner, m_costs.stack_entry_bytes, t,
                                                     ops_done, &m_tally.spill_writes, &m_tally.spill_reads, [] {}));
     }
@@ -223,8 +314,8 @@ void SimtUnit::count_warp_step(uint32_t w, Cycle t) {
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         const Lane& lane = m_lanes[l];
         if (!lane.has_ray) continue;
-        ++m_kind_present[size_t(lane.kind)];
-        if (lane.stepping) ++active, ++m_kind_active[size_t(lane.kind)];
+        ++m_kind_present[size_t(lane.ray.kind)];
+        if (lane.stepping) ++active, ++m_kind_active[size_t(lane.ray.kind)];
     }
     ++m_warp_steps;
     m_lane_steps += active;
@@ -259,7 +350,8 @@ void SimtUnit::finish_lane(uint32_t l, Cycle t) {
     const RayResult r{lane.ray.ray_id, s.hit(), s.work(), lane.ray.start, t, m_index, l};
     m_tally.finish_ray(*mem[0], m_map, r);
     sink->ray_done(r);
-    rays->ray_finished(t);
+    if (m_treelet_mode) ray_buffer->finished(t);
+    else rays->ray_finished(t);
     lane.has_ray = false;
     m_tally.busy.leave(t);
 }
@@ -298,6 +390,8 @@ nlohmann::json SimtUnit::stats_json(Cycle total_cycles) const {
     w.set("lane_slots", slots)
         .set("active_lanes", m_lane_steps)
         .set("simd_efficiency", slots ? double(m_lane_steps) / double(slots) : 0.0);
+    if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
+    if (m_prefetcher.on()) w.set("prefetch", m_prefetcher.stats_json());
     kind_stats().write(*this, j);
     w.done();
     return j;
@@ -318,7 +412,9 @@ UnitKind simt_kind() {
     k.group_size = [](const TraversalConfig& t) { return t.kinds.of<SimtConfig>("simt").lanes; };
     k.group_name = "warp";
     k.needs.lock_step = true;
-    k.needs.treelet_queues = false;
+    // Under treelet scheduling each warp takes one treelet queue's rays (Aila & Karras 2010's
+    // queues run by warps, as Chou et al. 2023 evaluate on Vulkan-Sim's RT unit).
+    k.treelet_consumers = [](const TraversalConfig& t) { return t.groups(); };
     // Narrower warps diverge less; the analytic level has no warps, so only a re-run measures it.
     k.knobs = {{"traversal.simt.lanes", /*halve=*/true, "divergence", /*estimated=*/false}};
     k.estimate_as = "mimd";

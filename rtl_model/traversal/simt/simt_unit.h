@@ -27,6 +27,7 @@
 #include "rtl_model/traversal/scheduled_unit.h"
 #include "rtl_model/traversal/simt/coalescer.h"
 #include "rtl_model/traversal/simt/simt_config.h"
+#include "rtl_model/traversal/treelet_prefetcher.h"
 #include "rtl_model/traversal/unit_parts.h"
 
 namespace rtsim {
@@ -51,13 +52,15 @@ private:
     struct Lane {
         RayState ray;
         StepDemand demand;      ///< its step in the warp step in flight
-        RayKind kind = RayKind::primary;
+        uint32_t treelet = kNoTreelet;  ///< prefetching without queues: the treelet its ray is in
+        Cycle ready = 0;        ///< treelet scheduling: cycle its ray's state came from the ray buffer
         bool has_ray = false;
         bool stepping = false;  ///< active in the warp step in flight
         Cycle accounted = 0;
     };
     struct Warp {
         Phase phase = Phase::step;
+        uint32_t treelet = kNoTreelet;  ///< treelet scheduling: the queue its rays come from
         uint32_t last_class = 0;  ///< the step class it ran last
     };
 
@@ -71,6 +74,14 @@ private:
     bool retire_and_refill(uint32_t w, Cycle t);
     void fetch_rays(uint32_t w, Cycle t);
     bool start_lane(uint32_t l, Cycle t, Cycle* fetch);
+    /// Treelet scheduling: lane l of warp w takes a ray of the warp's treelet queue (a new
+    /// treelet only when `may_switch`, its warp then empty); false when there is none.
+    bool take_lane(uint32_t w, uint32_t l, Cycle t, bool may_switch, Cycle* fetch);
+    /// Treelet scheduling: lanes whose next step lies in another treelet park their rays there.
+    void park_leavers(uint32_t w, Cycle t);
+    /// Prefetching without queues: lane l's next step entered another treelet.
+    void note_treelet(uint32_t l, Cycle t);
+    void fill_when_idle(Cycle t);
     void finish_lane(uint32_t l, Cycle t);
     /// The step class the warp runs next (simt_policy), or kClasses when no lane has a ray.
     uint32_t choose_class(uint32_t w) const;
@@ -86,6 +97,11 @@ private:
     uint32_t first_lane(uint32_t w) const { return w * m_simt.lanes; }
 
     const SimtConfig& m_simt;
+    const TreeletMap* m_treelets;  ///< treelet scheduling or prefetching; else null
+    bool m_treelet_mode = false;   ///< rays come from and park in the ray buffer's treelet queues
+    Cycle m_next_fill = 0;
+    uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
+    TreeletPrefetcher m_prefetcher;
     std::vector<Lane> m_lanes;
     std::vector<Warp> m_warps;
     LineCoalescer m_coalescer;

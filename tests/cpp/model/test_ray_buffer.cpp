@@ -60,13 +60,13 @@ struct BufferBench {
           Cycle lookahead = Cycle(1) << 40)
         : lookahead(lookahead),
           config(c),
-          partition(partition_of(treelets)),
+          treelets(partition_of(treelets), nullptr),
           accel(tiny_accel()),
           map(accel->image().end_address(), rays, rays, 64, 8),
           steppers(*accel, StepOptions{}),
           dispatch(("dispatch_" + tag).c_str(), rays),
           memory(("memory_" + tag).c_str(), 100),
-          buffer(("ray_buffer_" + tag).c_str(), config, partition, map, steppers, kUnits, kContexts,
+          buffer(("ray_buffer_" + tag).c_str(), config, this->treelets, map, steppers, kUnits, kContexts, kUnits,
                  ray_state_bytes(8, 8), lookahead) {
         buffer.rays(dispatch);
         buffer.mem(memory);
@@ -81,7 +81,7 @@ struct BufferBench {
     }
     Cycle lookahead;
     TreeletConfig config;  ///< the buffer keeps a reference, as to Top's config
-    LocalityPartition partition;
+    TreeletMap treelets;
     std::unique_ptr<Accel> accel;
     MemoryMap map;
     StepperPool steppers;
