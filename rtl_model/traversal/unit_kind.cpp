@@ -44,6 +44,39 @@ const UnitKind& unit_kind(const std::string& name) {
     return it->second;
 }
 
+GroupProfile& GroupProfile::operator+=(const GroupProfile& o) {
+    rays += o.rays, scheduler_steps += o.scheduler_steps, group_steps += o.group_steps;
+    lane_slots += o.lane_slots, active_lanes += o.active_lanes;
+    lane_requests += o.lane_requests, requests += o.requests;
+    for (size_t i = 0; i < work.size(); ++i) work[i] += o.work[i], single_work[i] += o.single_work[i];
+    for (size_t i = 0; i < kind_steps.size(); ++i) kind_steps[i] += o.kind_steps[i];
+    return *this;
+}
+
+nlohmann::json GroupProfile::to_json() const {
+    return {{"rays", rays},
+            {"scheduler_steps", scheduler_steps},
+            {"group_steps", group_steps},
+            {"lane_slots", lane_slots},
+            {"active_lanes", active_lanes},
+            {"lane_requests", lane_requests},
+            {"requests", requests},
+            {"work", work},
+            {"single_work", single_work},
+            {"kind_steps", kind_steps}};
+}
+
+GroupProfile GroupProfile::from_json(const nlohmann::json& j) {
+    GroupProfile g;
+    g.rays = j.at("rays"), g.scheduler_steps = j.at("scheduler_steps"), g.group_steps = j.at("group_steps");
+    g.lane_slots = j.at("lane_slots"), g.active_lanes = j.at("active_lanes");
+    g.lane_requests = j.at("lane_requests"), g.requests = j.at("requests");
+    g.work = j.at("work").get<std::array<double, kWorkFieldCount>>();
+    g.single_work = j.at("single_work").get<std::array<double, kWorkFieldCount>>();
+    g.kind_steps = j.at("kind_steps").get<std::array<double, kOpKindCount>>();
+    return g;
+}
+
 UnitSections::UnitSections(const UnitSections& other) { *this = other; }
 
 UnitSections& UnitSections::operator=(const UnitSections& other) {

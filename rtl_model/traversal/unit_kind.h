@@ -18,12 +18,44 @@
 
 #include "rtl_model/common/config_section.h"
 #include "rtl_model/common/stats.h"
+#include "traces/common/work_counts.h"
 
 namespace rtsim {
 
 struct TraversalConfig;
 struct UnitSetup;
+struct RayJob;
+struct StepOptions;
+class Accel;
 class TraversalUnit;
+
+/// What a lock-step kind's groups do on a sample of rays, stepped functionally (no time, no
+/// memory model): what the analytic level needs to cost them (sim/analytic/estimate.cpp).
+struct GroupProfile {
+    double rays = 0;             ///< rays of the sample
+    double scheduler_steps = 0;  ///< scheduler phases the unit would take (its tally's steps)
+    double group_steps = 0;      ///< warp or packet steps
+    double lane_slots = 0;       ///< group steps x rays per group
+    double active_lanes = 0;     ///< rays that took part, summed over group steps
+    double lane_requests = 0;    ///< structure reads the stepping rays asked for
+    double requests = 0;         ///< structure reads after coalescing (a packet's: one per step)
+    /// Group steps by the operation kind they run (a warp step's kind, a packet's node or leaf
+    /// step): what a group step's operations cost depends on it.
+    std::array<double, kOpKindCount> kind_steps{};
+    /// The rays' work as the groups walk it (packets change it) and walked alone.
+    std::array<double, kWorkFieldCount> work{}, single_work{};
+
+    GroupProfile& operator+=(const GroupProfile& o);
+    nlohmann::json to_json() const;
+    static GroupProfile from_json(const nlohmann::json& j);
+};
+
+/// A kind's functional group stepping on the machine `traversal` describes: `rays_by_unit[u]`
+/// the rays dispatch deals unit u, in order; the structure walked with `step`; reads coalesced
+/// per `line_bytes`-byte line.
+using GroupProfileFn =
+    std::function<GroupProfile(const Accel&, const StepOptions& step, const TraversalConfig& traversal,
+                               const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t line_bytes)>;
 
 /// What a unit kind needs of the rest of a run; the resolution step matches these against the
 /// structure's capabilities (traces/accel/capabilities.h), the level's and the techniques'.
@@ -78,6 +110,9 @@ struct UnitKind {
     std::string estimate_as;
     /// The packet reference walk the hit checker checks its rays' work against (packet kernels).
     std::function<PacketReference(const TraversalConfig&)> packet_reference;
+    /// Lock-step kinds: its groups stepped functionally, what the analytic level costs them from
+    /// (null: the analytic level cannot cost the kind, and the resolution step says so).
+    GroupProfileFn group_profile;
 
     /// Sets make_section to C's defaults (C: a struct with a template visit()).
     template <class C>

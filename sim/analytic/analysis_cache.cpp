@@ -81,6 +81,10 @@ json analysis_key(const SimConfig& c, const AnalyticConfig& s, const std::string
     if (c.mailbox.entries) key["mailbox_entries"] = c.mailbox.entries;
     if (c.traversal.stack_overflow != StackOverflow::spill) key["short_stack_entries"] = c.traversal.stack_entries;
     if (c.traversal.box_precision_bits) key["box_precision_bits"] = c.traversal.box_precision_bits;
+    // A lock-step kind's groups are profiled with its own settings (UnitKind::group_profile).
+    if (c.traversal.kind().group_profile)
+        key["unit"] = {{"model", c.traversal.model},
+                       {"section", config_to_json(c)["traversal"][c.traversal.model]}};
     return key;
 }
 

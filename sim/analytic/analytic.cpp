@@ -101,6 +101,28 @@ std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& acc
     return std::to_string(h) + ":" + std::to_string(jobs.size());
 }
 
+/// The sample's rays stepped in the unit kind's lock-step groups, functionally (warps, packets:
+/// UnitKind::group_profile), added to the profile; nothing for kinds whose contexts run alone.
+void profile_groups(const SimConfig& c, const Accel& accel, const StepOptions& step, const std::vector<RayJob>& jobs,
+                    AnalyticProfile& p) {
+    const UnitKind& kind = c.traversal.kind();
+    if (!kind.group_profile) return;
+    // Each unit's rays as the dispatch deals them (interleaved blocks, the sorting stage): the
+    // groups a unit forms are of its own rays.
+    VectorStream stream(jobs);
+    RayDealer dealer(c.dispatch, c.traversal.units, stream);
+    std::vector<std::vector<RayJob>> by_unit(c.traversal.units);
+    for (bool dealt = true; dealt;) {
+        dealt = false;
+        for (uint32_t u = 0; u < c.traversal.units; ++u) {
+            RayJob job;
+            if (dealer.next_ray(u, &job)) by_unit[u].push_back(job), dealt = true;
+        }
+    }
+    p.group += kind.group_profile(accel, step, c.traversal, by_unit, c.l1.line_bytes);
+    p.has_group = true;
+}
+
 AnalyticOutcome outcome_of(const SimConfig& config, const AnalyticProfile& profile) {
     AnalyticEstimate e = estimate_analytic(config, profile);
     AnalyticOutcome out;
@@ -133,6 +155,7 @@ const AnalyticProfile& analyze_stream(const SimConfig& config, const Accel& acce
     VectorStream stream(jobs);
     profiler.run_cluster(stream, 0, ~0ull, recording);
     profiler.finish();
+    profile_groups(config, accel, step, jobs, p);
     // The stream is its own sample: its work totals are the stepped rays'; nothing ran before it.
     p.whole_trace = true;
     p.rays = uint64_t(p.sample_rays);
@@ -192,6 +215,7 @@ AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const
         const uint64_t measure_first = c.first + c.warmup;
         const uint64_t measure_end = whole ? c.end() : measure_first + sample.measured_rays;
         profiler.run_cluster(stream, measure_first, measure_end, sink);
+        profile_groups(config, accel, step, jobs, p);
     }
     profiler.finish();
     p.whole_trace = whole;

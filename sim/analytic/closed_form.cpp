@@ -66,8 +66,9 @@ json bounds_of(const SimConfig& c, const std::vector<OpKind>& ops, const Analyti
 /// above any bound, and it adds the queueing the roofline leaves out when several resources are
 /// loaded at once. Returns the cycles for all rays.
 double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const AnalyticDemands& d, const json& bounds) {
-    const double rays = d.rays, units = c.traversal.units;
+    const double rays = d.visits > 0 ? d.visits : d.rays, units = c.traversal.units;
     if (rays <= 0) return 0;
+    const uint32_t customers = d.customers > 0 ? uint32_t(std::lround(d.customers)) : c.traversal.contexts();
     struct Station {
         double demand;  ///< cycles per ray of one class (unit)
         bool shared;
@@ -77,7 +78,9 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
     for (const char* name : {"scheduler", "l1_banks", "l1_mshrs"}) kinds.push_back({name, false});
     for (const char* name : {"dram", "l2_banks", "l2_mshrs"}) kinds.push_back({name, true});
     std::vector<Station> stations;
-    double think = d.latency_sum / rays;  // unloaded latency per ray
+    // Unloaded latency per visit: the rays' residence over the visits, shared by each customer's
+    // rays (a group's rays wait together).
+    double think = d.latency_sum / rays * double(customers) / double(c.traversal.contexts());
     for (const auto& [name, shared] : kinds) {
         if (!bounds.contains(name)) continue;
         const double bound = bounds[name].get<double>();
@@ -95,7 +98,7 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
     think = std::max(think, 0.0);
     std::vector<double> queue(stations.size(), 0.0), r(stations.size());
     double x = 0;
-    for (uint32_t n = 1; n <= c.traversal.contexts(); ++n) {
+    for (uint32_t n = 1; n <= customers; ++n) {
         double residence = think;
         for (size_t k = 0; k < stations.size(); ++k) {
             r[k] = stations[k].demand * (1.0 + (stations[k].shared ? units : 1.0) * queue[k]);

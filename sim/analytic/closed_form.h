@@ -34,6 +34,10 @@ struct AnalyticDemands {
     double l1_hold = 0, l2_hold = 0;   ///< cycles misses hold an L1 / L2 MSHR, summed
     double latency_sum = 0;            ///< sum of the rays' unloaded latencies
     double latency_max = 0;            ///< the longest ray's
+    /// What circulates through the machine in the mean value analysis: each unit's ray contexts,
+    /// each visiting once per ray (0, 0: the config's contexts and d.rays); a lock-step kind's
+    /// groups, each visiting once per group step (its rays step, wait and issue together).
+    double customers = 0, visits = 0;
 };
 
 struct ClosedForm {

@@ -94,6 +94,7 @@ json counters_json(double reads, double writes, double hits, double read_bytes, 
 class Estimator {
 public:
     Estimator(const SimConfig& c, const AnalyticProfile& p, MissModel& misses) : m_c(c), m_p(p), m_miss(c, misses) {
+        group_factors();
         const double line = c.l1.line_bytes;
         const double ic = c.interconnect_latency;
         m_lat_l1 = c.l1.latency;
@@ -120,10 +121,58 @@ private:
         return m_p.sample_rays > 0 ? double(m_p.rays) / m_p.sample_rays : 0.0;
     }
     double plan_steps() const {
-        const double x1 = AnalyticProfile::plan_step_work(m_p.work), x2 = m_p.work[size_t(WorkField::tri_tests)];
+        const double x1 = AnalyticProfile::plan_step_work(m_p.work) * m_step_scale;
+        const double x2 = m_p.work[size_t(WorkField::tri_tests)] * m_work_scale[size_t(WorkField::tri_tests)];
         const double fit = m_p.plan_steps_per[0] * x1 + m_p.plan_steps_per[1] * x2;
         if (fit > 0) return fit;
-        return m_p.sample_rays > 0 ? m_p.sample_plan_steps * double(m_p.rays) / m_p.sample_rays : 0.0;
+        return m_p.sample_rays > 0 ? m_step_scale * m_p.sample_plan_steps * double(m_p.rays) / m_p.sample_rays : 0.0;
+    }
+    /// Lock-step kinds (warps, packets): what their groups do differently, from the profile's
+    /// functional group stepping (profile.h): the rays' share of the group steps they take part
+    /// in (SIMD efficiency), reads per read asked for after coalescing, and the groups' work
+    /// against the rays walked alone (a packet's walk tests boxes for rays the node does not
+    /// serve). Contexts running alone: 1, 1, 1.
+    void group_factors() {
+        m_work_scale.fill(1.0);
+        if (!m_p.has_group) return;
+        const GroupProfile& g = m_p.group;
+        if (g.lane_slots > 0 && g.active_lanes > 0) m_active = g.active_lanes / g.lane_slots;
+        if (g.lane_requests > 0) m_coalesce = g.requests / g.lane_requests;
+        for (size_t f = 0; f < m_work_scale.size(); ++f)
+            if (g.single_work[f] > 0) m_work_scale[f] = g.work[f] / g.single_work[f];
+        double steps = 0, single = 0;
+        for (size_t f = 0; f < m_work_scale.size(); ++f)
+            if (kWorkFields[f].plan_step) steps += g.work[f], single += g.single_work[f];
+        if (single > 0) m_step_scale = steps / single;
+    }
+    /// The data a structure's step reads (what a warp coalesces, a packet fetches once).
+    static bool structure_data(DataKind kind) {
+        return kind == DataKind::node || kind == DataKind::triangle || kind == DataKind::prim_ref ||
+               kind == DataKind::cell || kind == DataKind::instance;
+    }
+    /// Expected slowest of `n` independent accesses drawn from a histogram's (a warp step waits
+    /// for the slowest of its lanes' reads): E[max] over the three unloaded latencies. With
+    /// `coalesce` < 1 the accesses are fewer than the rays' but their misses as many (the reads a
+    /// group merges are the rays' hits on each other's lines): each miss share grows by 1 / coalesce.
+    double max_latency(const JointHistogram& h, double n, double coalesce) const {
+        double total = 0, at[3] = {0, 0, 0};  // mass at the L1, L2 and DRAM latencies
+        for (const auto& [key, count] : h.cells) {
+            const auto [m1, m12] = m_miss.cell(key);
+            at[0] += count * (1.0 - m1), at[1] += count * (m1 - m12), at[2] += count * m12;
+            total += count;
+        }
+        if (total <= 0) return m_lat_l1;
+        at[2] = std::min(total, at[2] / coalesce);
+        at[1] = std::min(total - at[2], at[1] / coalesce);
+        at[0] = total - at[1] - at[2];
+        const double lat[3] = {m_lat_l1, m_lat_l2, m_lat_dram};
+        double below = 0, e = 0;
+        for (int i = 0; i < 3; ++i) {
+            const double upto = below + at[i] / total;
+            e += lat[i] * (std::pow(std::min(upto, 1.0), n) - std::pow(below, n));
+            below = upto;
+        }
+        return e;
     }
     /// Mean unloaded latency of the accesses of a histogram (their slowest lines).
     double mean_latency(const JointHistogram& h) const {
@@ -143,6 +192,10 @@ private:
     const AnalyticProfile& m_p;
     MissTables m_miss;
     double m_lat_l1, m_lat_l2, m_lat_dram, m_dram;
+    double m_active = 1.0;    ///< SIMD efficiency of a lock-step kind's groups (group_factors)
+    double m_coalesce = 1.0;  ///< structure reads after coalescing per read asked for
+    double m_step_scale = 1.0;  ///< the groups' plan steps per the rays' own
+    std::array<double, kWorkFieldCount> m_work_scale{};  ///< the groups' work per field per the rays' own
     std::array<KindCounts, kDataKindCount> m_kinds;
     AnalyticDemands m_d;
     double m_tests[kOpKindCount] = {};
@@ -180,7 +233,7 @@ void Estimator::ops(double* op_latency) {
             tests += f * n, issues += f * i;
             if (i > 0) latency += f * ((i - 1) * pc.initiation_interval + pc.latency);
         }
-        const double total = m_p.work[size_t(work_field_of(kind))];
+        const double total = m_p.work[size_t(work_field_of(kind))] * m_work_scale[size_t(work_field_of(kind))];
         const double s = tests > 0 ? total / tests : 0.0;
         m_d.issues[k] = tests > 0 ? issues * s : std::ceil(total / pc.width);
         m_tests[k] = total;
@@ -195,8 +248,11 @@ ClosedForm Estimator::form() {
     const double rays = double(m_p.rays), steps = plan_steps();
     m_d.rays = rays;
     m_d.scheduler_steps = rays * kSchedulerSlotsPerRay + steps * kSchedulerSlotsPerStep;
-    for (const KindCounts& kc : m_kinds) {
-        m_d.l1_accesses += kc.reads + kc.writes;
+    // A lock-step kind's scheduler takes a group's steps, not each ray's.
+    if (m_p.has_group && m_p.group.rays > 0) m_d.scheduler_steps = m_p.group.scheduler_steps * rays / m_p.group.rays;
+    for (int k = 0; k < kDataKindCount; ++k) {
+        const KindCounts& kc = m_kinds[size_t(k)];
+        m_d.l1_accesses += kc.reads * (structure_data(DataKind(k)) ? m_coalesce : 1.0) + kc.writes;
         m_d.l2_accesses += kc.l1_misses + kc.writes;
         m_d.dram_bytes += kc.l2_misses * m_c.l1.line_bytes + kc.write_bytes;
         m_d.l1_hold += kc.l1_misses * (m_lat_l2 - m_lat_l1) + kc.l2_misses * m_dram;
@@ -206,10 +262,36 @@ ClosedForm Estimator::form() {
     const double ray_start = m_c.dispatch.latency + mean_latency(m_p.ray_critical);
     const double fetch = mean_latency(m_p.step_critical);
     m_d.latency_sum = rays * ray_start + steps * fetch + op_latency;
+    if (m_p.has_group && m_p.group.group_steps > 0 && steps > 0) {
+        // A lock-step group (warp, packet) holds its rays for every group step: the rays'
+        // residence is the group's slots times its steps' time. A group step waits for the
+        // slowest of its rays' distinct reads (a packet's one fetch, a warp's coalesced lines)
+        // and runs its rays' operations one after another on the unit's pipelines.
+        const GroupProfile& g = m_p.group;
+        const double groups = g.group_steps * rays / g.rays;  // group steps over the whole trace
+        const double slots = g.lane_slots / g.group_steps, active = g.active_lanes / g.group_steps;
+        // A group step runs one operation kind for its rays (a warp's, a packet's node or leaf):
+        // that pipeline's latency and its rays' issues one after another.
+        double group_ops = 0, kind_steps = 0;
+        for (OpKind kind : m_p.op_kinds) {
+            const double n = g.kind_steps[size_t(kind)] * rays / g.rays;  // over the whole trace
+            if (n <= 0) continue;
+            const PipelineConfig& pc = m_c.pipeline(kind);
+            const double issues = m_d.issues[size_t(kind)] / n;  // per group step of this kind
+            group_ops += n * (pc.latency + std::max(0.0, issues - 1.0) * pc.initiation_interval);
+            kind_steps += n;
+        }
+        group_ops = kind_steps > 0 ? group_ops / groups : op_latency / steps;
+        const double group_fetch = max_latency(m_p.step_critical, std::max(1.0, active * m_coalesce), m_coalesce);
+        m_d.latency_sum = rays * ray_start + slots * groups * (group_fetch + group_ops);
+        // The groups circulate, one visit per group step, each with what its rays' steps ask.
+        m_d.customers = double(m_c.traversal.contexts()) / slots;
+        m_d.visits = groups;
+    }
     // The longest ray: its planned steps at the mean cost of a step.
     const double per_step = steps > 0 ? (steps * fetch + op_latency) / steps : 0.0;
     const double longest = m_p.plan_steps_per[0] * m_p.longest_ray_steps + m_p.plan_steps_per[1] * m_p.longest_ray_tests;
-    m_d.latency_max = ray_start + longest * per_step;
+    m_d.latency_max = ray_start + longest * per_step / m_active;
     return closed_form(m_c, m_p.op_kinds, m_d);
 }
 
@@ -234,14 +316,18 @@ AnalyticEstimate Estimator::run() {
         .set("steals", nullptr)
         .done();
     json unit;  // every unit the average unit
-    StatsWriter(unit_stats(), unit)
-        .set("rays", rays / units)
+    StatsWriter uw(unit_stats_of(m_c.traversal.model), unit);
+    uw.set("rays", rays / units)
         .set("steps", m_d.scheduler_steps / units)
         .set("stack_spill_writes", m_p.spill_writes * scale(DataKind::stack) / units)
         .set("stack_spill_reads", m_p.spill_reads * scale(DataKind::stack) / units)
-        .set("rejected_rays", nullptr)
-        .untimed()
-        .done();
+        .set("rejected_rays", nullptr);
+    if (m_p.has_group && m_p.group.rays > 0) {  // a lock-step kind's groups, from the profile
+        const double s = rays / m_p.group.rays / units;
+        uw.set("lane_slots", m_p.group.lane_slots * s).set("active_lanes", m_p.group.active_lanes * s);
+        uw.set("simd_efficiency", m_active);
+    }
+    uw.untimed().done();
     for (uint32_t u = 0; u < m_c.traversal.units; ++u) m["units"]["tu" + std::to_string(u)] = unit;
     json memory = memory_json(e.form.cycles);
     for (auto& [k, v] : memory.items()) m[k] = std::move(v);

@@ -96,7 +96,8 @@ json AnalyticProfile::to_json() const {
             {"validation", validation},
             {"workload", workload},
             {"stepped_rays", stepped_rays},
-            {"analysis_seconds", analysis_seconds}};
+            {"analysis_seconds", analysis_seconds},
+            {"group", has_group ? group.to_json() : json(nullptr)}};
 }
 
 AnalyticProfile AnalyticProfile::from_json(const json& j) {
@@ -136,6 +137,10 @@ AnalyticProfile AnalyticProfile::from_json(const json& j) {
     p.workload = j.at("workload");
     p.stepped_rays = j.at("stepped_rays");
     p.analysis_seconds = j.at("analysis_seconds");
+    if (j.contains("group") && !j.at("group").is_null()) {
+        p.has_group = true;
+        p.group = GroupProfile::from_json(j.at("group"));
+    }
     return p;
 }
 

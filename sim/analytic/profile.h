@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/traversal/unit_kind.h"
 #include "traces/accel/step_plan.h"
 #include "traces/common/data_kind.h"
 
@@ -67,6 +68,11 @@ struct AnalyticProfile {
     double spill_writes = 0, spill_reads = 0;        ///< stack entries
     // Reuse distance curves (events and censored by bin), all measured reads.
     std::vector<double> unit_events, unit_censored, global_events, global_censored;
+
+    // Lock-step unit kinds (SIMT warps, packets): the sample's rays stepped in the kind's groups,
+    // functionally (UnitKind::group_profile): SIMD efficiency, coalescing, the groups' work.
+    bool has_group = false;
+    GroupProfile group;
 
     // Sampled rays checked against the reference (every stepped ray, warm-up included).
     nlohmann::json validation;

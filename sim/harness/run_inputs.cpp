@@ -67,7 +67,9 @@ UnitTraits unit_traits(const RunSetup& setup) {
     UnitTraits u;
     u.name = setup.unit->name;
     for (const UnitKnob& k : setup.unit->knobs) u.knobs.push_back({k.key, k.halve, k.resource, k.estimated});
-    if (setup.unit->needs.lock_step) u.estimate_as = setup.unit->estimate_as;  // the analytic level has no lock-step groups
+    // The verdict estimates with the analytic level, which costs a lock-step kind's groups only
+    // from its functional group profile: without one, the stand-in kind's estimate.
+    if (setup.unit->needs.lock_step && !setup.unit->group_profile) u.estimate_as = setup.unit->estimate_as;
     return u;
 }
 

@@ -115,6 +115,7 @@ json capability_table() {
         levels.push_back({{"name", l.name},
                           {"timed", l.timed},
                           {"lock_step", l.lock_step},
+                          {"group_profiles", l.group_profiles},
                           {"treelets", l.treelets},
                           {"frames", l.frames},
                           {"steps_rays", l.steps_rays}});
@@ -167,8 +168,9 @@ std::string capability_markdown() {
     md << "\n### Levels and what they cost\n\n| level | timed | lock-step groups | treelet queues | frames | steps "
           "the rays |\n|---|---|---|---|---|---|\n";
     for (const json& l : t["levels"])
-        md << "| " << l["name"].get<std::string>() << " | " << yes(l["timed"]) << " | " << yes(l["lock_step"]) << " | "
-           << yes(l["treelets"]) << " | " << yes(l["frames"]) << " | " << yes(l["steps_rays"]) << " |\n";
+        md << "| " << l["name"].get<std::string>() << " | " << yes(l["timed"]) << " | "
+           << (l["lock_step"].get<bool>() ? "yes" : l["group_profiles"].get<bool>() ? "from a group profile" : "-")
+           << " | " << yes(l["treelets"]) << " | " << yes(l["frames"]) << " | " << yes(l["steps_rays"]) << " |\n";
     md << "\n### The rules\n\nEach refusal a run can meet, from the one resolution step; the example is a run it "
           "refuses (the tests run every one through the CLI).\n\n| rule | asks | needs | of the | why | change |\n"
           "|---|---|---|---|---|---|\n";

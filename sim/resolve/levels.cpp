@@ -12,9 +12,10 @@ LevelCapabilities level_capabilities(const SimConfig& c) {
             l.lock_step = l.treelets = l.frames = l.steps_rays = true;
             break;
         case Fidelity::analytic: {
-            // A closed form over a per-trace analysis: each ray context costed on its own, plain
-            // dispatch, one frame (sim/analytic/analytic.h).
+            // A closed form over a per-trace analysis: plain dispatch, one frame; a lock-step kind's
+            // groups from its functional group profile (sim/analytic/estimate.cpp).
             const bool functional = c.analytic.caches == AnalyticCaches::functional;
+            l.group_profiles = !functional;
             l.name += std::string(" (analytic.caches=") + (functional ? "functional" : "statistical") + ")";
             l.steps_rays = functional;
             break;

@@ -12,7 +12,10 @@ namespace rtsim {
 struct LevelCapabilities {
     std::string name;        ///< "approx", "analytic (analytic.caches=statistical)", ...
     bool timed = false;      ///< the SystemC model times it (approx, detailed)
-    bool lock_step = false;  ///< it costs groups of rays stepping in lock-step (warps, packets)
+    bool lock_step = false;  ///< it times groups of rays stepping in lock-step (warps, packets)
+    /// It costs lock-step groups from the unit kind's functional group profile
+    /// (UnitKind::group_profile) where the kind has one.
+    bool group_profiles = false;
     bool treelets = false;   ///< it models treelet admission and queues
     bool frames = false;     ///< it replays an animated trace's frames
     /// It steps rays itself, so it counts work the trace's records hold none of (mailbox lookups,

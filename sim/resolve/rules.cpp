@@ -44,10 +44,13 @@ std::vector<Rule> make_rules() {
          "bvh2", {"traversal.model=simt", "traversal.ray_contexts=20"}});
     add({"unit/lock_step", "traversal.model (a kind whose rays step in lock-step groups)",
          [](const RunFacts& f) { return f.unit.needs.lock_step; }, RuleSide::level, "a level that costs lock-step groups",
-         [](const RunFacts& f) { return f.level.lock_step; },
-         "the analytic closed form costs each ray context on its own, with no lock-step warps or packets",
-         "fidelity=approx or detailed, or traversal.model=mimd", "bvh2",
-         {"traversal.model=simt", "fidelity=analytic"}});
+         [](const RunFacts& f) {
+             return f.level.lock_step || (f.level.group_profiles && f.unit.group_profile != nullptr);
+         },
+         "the analytic level's functional caches cost each ray context on its own (its statistical caches cost "
+         "warps and packets from the kind's functional group profile)",
+         "analytic.caches=statistical, fidelity=approx or detailed, or traversal.model=mimd", "bvh2",
+         {"traversal.model=simt", "fidelity=analytic", "analytic.caches=functional"}});
 
     // Treelet scheduling.
     add({"treelets/unit", "treelets.enabled=true", treelets, RuleSide::unit,

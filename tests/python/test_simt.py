@@ -114,8 +114,10 @@ def test_sorted_dispatch_hands_out_every_ray_once(
             "traversal.ray_contexts",
         ),
         (("traversal.model=packet", "treelets.enabled=true"), "treelets.enabled"),
-        (("traversal.model=packet", "fidelity=analytic"), "traversal.model"),
-        (("traversal.model=simt", "fidelity=analytic"), "traversal.model"),
+        (
+            ("traversal.model=simt", "fidelity=analytic", "analytic.caches=functional"),
+            "traversal.model",
+        ),
         (("traversal.simt.policy=while",), "traversal.simt.policy"),
         (("dispatch.sort=hilbert",), "dispatch.sort"),
         (("dispatch.sort_window=1",), "dispatch.sort_window"),
@@ -233,3 +235,26 @@ def test_simt_with_treelets_hands_every_ray_out_once(
     )
     assert sum(u["rays_parked"] for u in units) == buffer["parked"] > 0
     assert 0.0 < s["simd_efficiency"] <= 1.0
+
+
+@pytest.mark.parametrize("model", ["simt", "packet"])
+def test_the_analytic_level_costs_lock_step_groups(
+    sim_exe: Path, small_cornell_rays: Path, tmp_path: Path, model: str
+) -> None:
+    """The analytic level prices warps and packets from the kind's functional group profile:
+    its sampled rays are checked, its SIMD efficiency is the groups' and its scheduler takes
+    group steps (fewer than a MIMD machine's ray steps)."""
+    trace = small_cornell_rays / "trace.rtt"
+    mimd = sim_stats(
+        sim_exe, trace, tmp_path / "mimd", "fidelity=analytic", "traversal.ray_contexts=32"
+    )
+    stats = sim_stats(
+        sim_exe, trace, tmp_path / "run", "fidelity=analytic", f"traversal.model={model}",
+        "traversal.ray_contexts=32",
+    )  # fmt: skip
+    s = stats["summary"]
+    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+    assert 0.0 < s["simd_efficiency"] < 1.0
+    steps = sum(u["steps"] for u in stats["model"]["units"].values())
+    assert steps < sum(u["steps"] for u in mimd["model"]["units"].values())
+    assert s["cycles"] > mimd["summary"]["cycles"]  # lanes idle, group steps wait for the slowest

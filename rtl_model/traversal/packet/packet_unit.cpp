@@ -1,4 +1,5 @@
 #include "rtl_model/traversal/packet/packet_unit.h"
+#include "rtl_model/traversal/packet/packet_profile.h"
 
 #include <algorithm>
 #include <string>
@@ -202,25 +203,25 @@ const StatTable<PacketUnit>& PacketUnit::kind_stats() {
     static const StatTable<PacketUnit> table{
         "model.units.<unit> (packet)",
         {
-            {{"packets", "packets", "packets traced (each up to `traversal.packet.lanes` rays taken from dispatch together)"},
+            {{"packets", "packets", "packets traced (each up to `traversal.packet.lanes` rays taken from dispatch together)", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_packets_traced; }},
-            {{"packet_steps", "steps", "packet steps (one node or leaf fetch serving the packet's active rays)"},
+            {{"packet_steps", "steps", "packet steps (one node or leaf fetch serving the packet's active rays)", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_packet_steps; }},
-            {{"packet_node_fetches", "fetches", "node fetches, one per packet node step"},
+            {{"packet_node_fetches", "fetches", "node fetches, one per packet node step", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_node_fetches; }},
-            {{"node_fetches_per_packet", "fetches", "`packet_node_fetches / packets`"},
+            {{"node_fetches_per_packet", "fetches", "`packet_node_fetches / packets`", /*timed=*/true},
              [](const PacketUnit& u) {
                  return json(u.m_packets_traced ? double(u.m_node_fetches) / double(u.m_packets_traced) : 0.0);
              }},
-            {{"packet_occupancy", "rays", "active rays per packet step (`active_lanes / packet_steps`; Wald et al. 2001's packets keep it near `traversal.packet.lanes` on coherent rays)"},
+            {{"packet_occupancy", "rays", "active rays per packet step (`active_lanes / packet_steps`; Wald et al. 2001's packets keep it near `traversal.packet.lanes` on coherent rays)", /*timed=*/true},
              [](const PacketUnit& u) {
                  return json(u.m_packet_steps ? double(u.m_active_rays) / double(u.m_packet_steps) : 0.0);
              }},
-            {{"packet_active_histogram", "steps", "packet steps by active rays, index 0 .. `traversal.packet.lanes`"},
+            {{"packet_active_histogram", "steps", "packet steps by active rays, index 0 .. `traversal.packet.lanes`", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_active_histogram; }},
-            {{"packet_splits", "packets", "packets that split into single rays (`traversal.packet.split_below`, Benthin et al. 2012's hybrid)"},
+            {{"packet_splits", "packets", "packets that split into single rays (`traversal.packet.split_below`, Benthin et al. 2012's hybrid)", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_splits; }},
-            {{"packet_split_steps", "steps", "of `packet_steps`, the single-ray steps after a split (one ray active each)"},
+            {{"packet_split_steps", "steps", "of `packet_steps`, the single-ray steps after a split (one ray active each)", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_split_steps; }},
         }};
     return table;
@@ -259,6 +260,7 @@ UnitKind packet_kind() {
     k.needs.treelet_queues = false;
     k.knobs = {{"traversal.packet.lanes", /*halve=*/true, "divergence", /*estimated=*/false}};
     k.estimate_as = "mimd";
+    k.group_profile = packet_group_profile;
     k.packet_reference = [](const TraversalConfig& t) {
         const PacketConfig& p = t.kinds.of<PacketConfig>("packet");
         return PacketReference{p.lanes, float(p.split_below)};

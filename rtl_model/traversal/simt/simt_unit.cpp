@@ -1,4 +1,5 @@
 #include "rtl_model/traversal/simt/simt_unit.h"
+#include "rtl_model/traversal/simt/simt_profile.h"
 
 #include <algorithm>
 #include <array>
@@ -364,19 +365,19 @@ const StatTable<SimtUnit>& SimtUnit::kind_stats() {
     static const StatTable<SimtUnit> table{
         "model.units.<unit> (simt)",
         {
-            {{"warp_steps", "steps", "warp steps (one operation kind for the warp, or the new rays' record fetch)"},
+            {{"warp_steps", "steps", "warp steps (one operation kind for the warp, or the new rays' record fetch)", /*timed=*/true},
              [](const SimtUnit& u) { return u.m_warp_steps; }},
-            {{"ray_fetch_steps", "steps", "warp steps that fetched new rays' records"},
+            {{"ray_fetch_steps", "steps", "warp steps that fetched new rays' records", /*timed=*/true},
              [](const SimtUnit& u) { return u.m_fetch_steps; }},
-            {{"active_lane_histogram", "steps", "warp steps by active lanes, index 0 .. `traversal.simt.lanes`"},
+            {{"active_lane_histogram", "steps", "warp steps by active lanes, index 0 .. `traversal.simt.lanes`", /*timed=*/true},
              [](const SimtUnit& u) { return u.m_active_histogram; }},
-            {{"simd_efficiency_by_kind", "fraction", "`{ray kind: lanes of that kind that stepped / lanes holding a ray of that kind}` over warp steps (empty lanes are in no kind)"},
+            {{"simd_efficiency_by_kind", "fraction", "`{ray kind: lanes of that kind that stepped / lanes holding a ray of that kind}` over warp steps (empty lanes are in no kind)", /*timed=*/true},
              [](const SimtUnit& u) { return u.efficiency_by_kind(); }},
-            {{"simd_efficiency_over_time", "fraction", "`[{cycle, value}]`, active lanes / lane slots of the warp steps issued in each interval (at most 256 points)"},
+            {{"simd_efficiency_over_time", "fraction", "`[{cycle, value}]`, active lanes / lane slots of the warp steps issued in each interval (at most 256 points)", /*timed=*/true},
              [](const SimtUnit& u) { return u.efficiency_over_time(); }},
-            {{"lane_requests", "requests", "reads the stepping lanes asked for (a MIMD unit's requests for the same steps)"},
+            {{"lane_requests", "requests", "reads the stepping lanes asked for (a MIMD unit's requests for the same steps)", /*timed=*/true},
              [](const SimtUnit& u) { return u.m_coalescer.lane_requests(); }},
-            {{"coalesced_requests", "requests", "read requests after coalescing a warp step's reads per L1 line"},
+            {{"coalesced_requests", "requests", "read requests after coalescing a warp step's reads per L1 line", /*timed=*/true},
              [](const SimtUnit& u) { return u.m_coalescer.requests(); }},
         }};
     return table;
@@ -418,6 +419,7 @@ UnitKind simt_kind() {
     // Narrower warps diverge less; the analytic level has no warps, so only a re-run measures it.
     k.knobs = {{"traversal.simt.lanes", /*halve=*/true, "divergence", /*estimated=*/false}};
     k.estimate_as = "mimd";
+    k.group_profile = simt_group_profile;
     return k;
 }
 

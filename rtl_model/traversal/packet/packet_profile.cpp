@@ -1,0 +1,64 @@
+#include "rtl_model/traversal/packet/packet_profile.h"
+
+#include <algorithm>
+
+#include "rtl_model/common/interfaces.h"
+#include "rtl_model/traversal/packet/packet_config.h"
+#include "rtl_model/traversal/traversal_config.h"
+#include "traces/accel/accel.h"
+
+namespace rtsim {
+
+namespace {
+
+/// One unit's rays in packets of pc.lanes, in the order dispatch deals them.
+GroupProfile packets_of(const Accel& accel, const StepOptions& step, const PacketConfig& pc,
+                        const std::vector<RayJob>& rays) {
+    GroupProfile p;
+    p.rays = double(rays.size());
+    std::vector<Ray> group;
+    std::vector<TraversalMode> modes;
+    std::vector<Hit> hits(pc.lanes);
+    std::vector<WorkCounts> work(pc.lanes);
+    for (size_t first = 0; first < rays.size(); first += pc.lanes) {
+        const size_t n = std::min<size_t>(pc.lanes, rays.size() - first);
+        group.clear(), modes.clear();
+        for (size_t i = 0; i < n; ++i) {
+            group.push_back(rays[first + i].ray);
+            modes.push_back(rays[first + i].any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+        }
+        PacketCounts counts;
+        accel.trace_packet(group.data(), modes.data(), uint32_t(n), hits.data(), work.data(), &counts,
+                           float(pc.split_below));
+        const double steps = double(counts.node_steps + counts.leaf_steps);
+        p.group_steps += steps;
+        p.scheduler_steps += 1 + 2 * steps;  // the packet's ray fetch, then each step and its operations
+        p.lane_slots += steps * pc.lanes;
+        p.active_lanes += double(counts.active_rays);
+        p.requests += steps;  // one fetch serves the packet's active rays
+        p.kind_steps[size_t(OpKind::box)] += double(counts.node_steps);
+        p.kind_steps[size_t(OpKind::triangle)] += double(counts.leaf_steps);
+        for (size_t i = 0; i < n; ++i) {
+            WorkCounts alone;
+            accel.trace(group[i], modes[i], &alone, step);
+            for (size_t f = 0; f < p.work.size(); ++f) {
+                p.work[f] += work[i].*kWorkFields[f].member;
+                p.single_work[f] += alone.*kWorkFields[f].member;
+            }
+            p.lane_requests += plan_step_work(alone);
+        }
+    }
+    return p;
+}
+
+}  // namespace
+
+GroupProfile packet_group_profile(const Accel& accel, const StepOptions& step, const TraversalConfig& traversal,
+                                  const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t) {
+    const PacketConfig& pc = traversal.kind_config<PacketConfig>();
+    GroupProfile p;
+    for (const std::vector<RayJob>& rays : rays_by_unit) p += packets_of(accel, step, pc, rays);
+    return p;
+}
+
+}  // namespace rtsim

@@ -1,0 +1,17 @@
+#pragma once
+// The SIMT kind's warps stepped functionally, for the analytic level (unit_kind.h, GroupProfile):
+// the warp-step rules of simt_unit.h (one operation kind per warp step by traversal.simt.policy,
+// lanes refilled by traversal.simt.refill, new rays' records fetched in a warp step of their
+// own, reads coalesced per line) without time: every warp takes one warp step in turn, and a
+// unit's lanes take the rays dispatch deals that unit, in order, when the policy lets them.
+#include <cstdint>
+#include <vector>
+
+#include "rtl_model/traversal/unit_kind.h"
+
+namespace rtsim {
+
+GroupProfile simt_group_profile(const Accel& accel, const StepOptions& step, const TraversalConfig& traversal,
+                                const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t line_bytes);
+
+}  // namespace rtsim
