@@ -11,7 +11,7 @@
 
 // The unit kinds (linked in so traversal.model and their sections exist) bring SystemC, whose
 // library wants an sc_main; libFuzzer's main runs instead, so this one is never called.
-int sc_main(int, char**) { return 0; }
+extern "C" int sc_main(int, char**) { return 0; }  // as <systemc> declares it
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
