@@ -81,6 +81,13 @@ json analysis_key(const SimConfig& c, const AnalyticConfig& s, const std::string
     if (c.mailbox.entries) key["mailbox_entries"] = c.mailbox.entries;
     if (c.traversal.stack_overflow != StackOverflow::spill) key["short_stack_entries"] = c.traversal.stack_entries;
     if (c.traversal.box_precision_bits) key["box_precision_bits"] = c.traversal.box_precision_bits;
+    // Treelet scheduling orders the sample's steps (sample.h): its settings, when on.
+    if (c.treelets.enabled) {
+        const json t = config_to_json(c)["treelets"];
+        key["treelets"] = {{"treelet_kib", t["treelet_kib"]}, {"buffer_kib", t["buffer_kib"]},
+                           {"policy", t["policy"]},         {"max_rays_in_flight", t["max_rays_in_flight"]},
+                           {"stack_entries", c.traversal.stack_entries}};
+    }
     // A lock-step kind's groups are profiled with its own settings (UnitKind::group_profile).
     if (c.traversal.kind().group_profile)
         key["unit"] = {{"model", c.traversal.model},

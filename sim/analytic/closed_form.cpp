@@ -53,6 +53,7 @@ json bounds_of(const SimConfig& c, const std::vector<OpKind>& ops, const Analyti
         b["l2_mshrs"] = std::max(d.l2_hold / double(c.l2.mshrs), l2_loop_bound(c, d));
     }
     b["scheduler"] = d.scheduler_steps * t.issue_cycles / t.units;
+    if (c.treelets.enabled) b["ray_buffer"] = d.ray_buffer_bytes / c.treelets.bytes_per_cycle;
     b["latency"] = std::max(d.latency_sum / (double(t.units) * t.contexts()), d.latency_max);
     return b;
 }
@@ -76,7 +77,7 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
     std::vector<std::pair<std::string, bool>> kinds;  // station, shared by all units
     for (OpKind kind : ops) kinds.push_back({op_kind_name(kind), c.pipeline(kind).shared()});
     for (const char* name : {"scheduler", "l1_banks", "l1_mshrs"}) kinds.push_back({name, false});
-    for (const char* name : {"dram", "l2_banks", "l2_mshrs"}) kinds.push_back({name, true});
+    for (const char* name : {"dram", "l2_banks", "l2_mshrs", "ray_buffer"}) kinds.push_back({name, true});
     std::vector<Station> stations;
     // Unloaded latency per visit: the rays' residence over the visits, shared by each customer's
     // rays (a group's rays wait together).

@@ -38,6 +38,8 @@ struct AnalyticDemands {
     /// each visiting once per ray (0, 0: the config's contexts and d.rays); a lock-step kind's
     /// groups, each visiting once per group step (its rays step, wait and issue together).
     double customers = 0, visits = 0;
+    /// Treelet scheduling: bytes through the ray buffer's SRAM port, and the takes' latency.
+    double ray_buffer_bytes = 0, latency_sum_extra = 0;
 };
 
 struct ClosedForm {

@@ -259,9 +259,27 @@ ClosedForm Estimator::form() {
         m_d.l2_hold += kc.l2_misses * m_dram;
     }
     if (m_c.ideal_memory) m_d.l1_accesses = m_d.l2_accesses = m_d.dram_bytes = m_d.l1_hold = m_d.l2_hold = 0;
+    double buffer_latency = 0;  // per take from the ray buffer (treelet scheduling)
+    if (m_c.treelets.enabled && m_p.sample_rays > 0) {
+        // Each take reads a ray's state from the buffer's SRAM and each park writes one (its one
+        // port: bandwidth, then latency); a state beyond the SRAM overflows to DRAM and back.
+        const TreeletConfig& t = m_c.treelets;
+        const double per = rays / m_p.sample_rays;
+        const double state = ray_state_bytes(m_c.traversal.stack_entries, m_c.traversal.stack_entry_bytes,
+                                             m_c.mailbox.entries * MailboxConfig::kEntryBytes);
+        const double takes = m_p.treelet_takes * per, parks = m_p.treelet_parks * per;
+        m_d.ray_buffer_bytes = (takes + parks + rays) * state;  // admitted rays are written once too
+        const double overflow = m_p.treelet_overflows * per * state * 2;
+        m_d.dram_bytes += overflow;
+        buffer_latency = t.latency + std::ceil(state / t.bytes_per_cycle);
+        m_d.latency_sum_extra = takes * buffer_latency;
+        // The step that finds its ray leaving the treelet is a scheduler slot of its own (the
+        // context parks the ray and takes the next, whose first step is another).
+        m_d.scheduler_steps += parks;
+    }
     const double ray_start = m_c.dispatch.latency + mean_latency(m_p.ray_critical);
     const double fetch = mean_latency(m_p.step_critical);
-    m_d.latency_sum = rays * ray_start + steps * fetch + op_latency;
+    m_d.latency_sum = rays * ray_start + steps * fetch + op_latency + m_d.latency_sum_extra;
     if (m_p.has_group && m_p.group.group_steps > 0 && steps > 0) {
         // A lock-step group (warp, packet) holds its rays for every group step: the rays'
         // residence is the group's slots times its steps' time. A group step waits for the
@@ -283,7 +301,7 @@ ClosedForm Estimator::form() {
         }
         group_ops = kind_steps > 0 ? group_ops / groups : op_latency / steps;
         const double group_fetch = max_latency(m_p.step_critical, std::max(1.0, active * m_coalesce), m_coalesce);
-        m_d.latency_sum = rays * ray_start + slots * groups * (group_fetch + group_ops);
+        m_d.latency_sum = rays * ray_start + slots * groups * (group_fetch + group_ops) + m_d.latency_sum_extra;
         // The groups circulate, one visit per group step, each with what its rays' steps ask.
         m_d.customers = double(m_c.traversal.contexts()) / slots;
         m_d.visits = groups;

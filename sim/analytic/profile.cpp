@@ -97,7 +97,8 @@ json AnalyticProfile::to_json() const {
             {"workload", workload},
             {"stepped_rays", stepped_rays},
             {"analysis_seconds", analysis_seconds},
-            {"group", has_group ? group.to_json() : json(nullptr)}};
+            {"group", has_group ? group.to_json() : json(nullptr)},
+            {"treelets", {{"takes", treelet_takes}, {"parks", treelet_parks}, {"overflows", treelet_overflows}}}};
 }
 
 AnalyticProfile AnalyticProfile::from_json(const json& j) {
@@ -137,6 +138,10 @@ AnalyticProfile AnalyticProfile::from_json(const json& j) {
     p.workload = j.at("workload");
     p.stepped_rays = j.at("stepped_rays");
     p.analysis_seconds = j.at("analysis_seconds");
+    if (j.contains("treelets")) {
+        const json& t = j.at("treelets");
+        p.treelet_takes = t.at("takes"), p.treelet_parks = t.at("parks"), p.treelet_overflows = t.at("overflows");
+    }
     if (j.contains("group") && !j.at("group").is_null()) {
         p.has_group = true;
         p.group = GroupProfile::from_json(j.at("group"));

@@ -69,6 +69,10 @@ struct AnalyticProfile {
     // Reuse distance curves (events and censored by bin), all measured reads.
     std::vector<double> unit_events, unit_censored, global_events, global_censored;
 
+    // Treelet scheduling (the sample stepped in treelet order, sample.h): the measured rays'
+    // takes from the ray buffer, parks in other treelets' queues, and overflows of its SRAM.
+    double treelet_takes = 0, treelet_parks = 0, treelet_overflows = 0;
+
     // Lock-step unit kinds (SIMT warps, packets): the sample's rays stepped in the kind's groups,
     // functionally (UnitKind::group_profile): SIMD efficiency, coalescing, the groups' work.
     bool has_group = false;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "rtl_model/common/ray_state.h"
+
 
 namespace rtsim {
 
@@ -16,11 +18,23 @@ SampleProfiler::SampleProfiler(const SimConfig& config, const Accel& accel, cons
       m_units(config.traversal.units),
       m_slots(config.traversal.contexts()),
       m_shift(0),
-      m_unit_pos(config.traversal.units, 0),
+      m_unit_pos(config.traversal.units + 1, 0),  // + the ray buffer's admission stream
       m_reads(kDataKindCount),
-      m_op_sizes(profile.op_sizes.size()) {
+      m_op_sizes(profile.op_sizes.size()),
+      m_accel(&accel),
+      m_step(step) {
     for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper(step);
     while ((1u << m_shift) < config.l1.line_bytes) ++m_shift;
+    const TreeletConfig& t = config.treelets;
+    if (!t.enabled) return;
+    m_partition = std::make_unique<LocalityPartition>(accel.partition(uint64_t(t.treelet_kib) * 1024));
+    m_queues.resize(m_partition->treelets.size());
+    m_unit_treelet.assign(m_units, -1);
+    const uint32_t state = ray_state_bytes(config.traversal.stack_entries, config.traversal.stack_entry_bytes,
+                                           config.mailbox.entries * MailboxConfig::kEntryBytes);
+    m_capacity = std::max<uint64_t>(1, uint64_t(t.buffer_kib) * 1024 / state);
+    m_admit_limit = t.max_rays_in_flight ? t.max_rays_in_flight : m_capacity + m_contexts.size();
+    for (Context& ctx : m_contexts) m_free.push_back(std::move(ctx.stepper));  // steppers move with rays
 }
 
 void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint64_t measure_end, RaySinkIf& sink) {
@@ -31,6 +45,7 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
     m_global_pos = 0;
     std::fill(m_unit_pos.begin(), m_unit_pos.end(), 0);
     RayDealer dealer(m_c.dispatch, m_units, stream);
+    if (m_partition) return run_treelets(dealer, sink);
     for (uint32_t c = 0; c < m_slots; ++c)
         for (uint32_t u = 0; u < m_units; ++u) start_ray(dealer, u, c, sink);
     // Rounds: every active context takes one step, context-major then unit.
@@ -48,6 +63,94 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
             any = true;
         }
     }
+}
+
+void SampleProfiler::run_treelets(RayDealer& dealer, RaySinkIf& sink) {
+    for (auto& q : m_queues) q.clear();
+    std::fill(m_unit_treelet.begin(), m_unit_treelet.end(), -1);
+    m_in_machine = m_waiting = 0;
+    admit(dealer);
+    const size_t n = m_contexts.size();
+    auto index = [&](size_t p) { return (p % m_units) * m_slots + p / m_units; };
+    // Rounds as without treelets: every context with a ray takes one step; an idle one takes a
+    // ray of its unit's treelet first (other units' parks refill the queues).
+    for (bool any = true; any;) {
+        any = false;
+        for (size_t p = 0; p < n; ++p) {
+            const size_t i = index(p);
+            const uint32_t unit = uint32_t(i / m_slots), slot = uint32_t(i % m_slots);
+            if (!m_contexts[i].active && !take_ray(unit, slot)) continue;
+            step(dealer, unit, slot, sink);
+            any = true;
+        }
+    }
+}
+
+void SampleProfiler::admit(RayDealer& dealer) {
+    // As the ray buffer admits (ray_buffer.cpp, has_room): below the limit and, without an
+    // explicit one, only while the SRAM has room (one entry kept free for a park), so it never
+    // overflows.
+    const bool may_overflow = m_c.treelets.max_rays_in_flight != 0;
+    const uint64_t reserve = m_capacity > 1 ? 1 : 0;
+    RayJob job;
+    while (m_in_machine < m_admit_limit && (may_overflow || m_waiting + reserve < m_capacity) &&
+           dealer.next_ray(RaySourceIf::kAnyUnit, &job)) {
+        Ray r;
+        if (m_free.empty()) {
+            r.stepper = m_accel->make_stepper(m_step);
+        } else {
+            r.stepper = std::move(m_free.back());
+            m_free.pop_back();
+        }
+        r.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+        r.id = job.id;
+        r.measured = job.id >= m_measure_first && job.id < m_measure_end;
+        // The ray buffer reads the record as it admits the ray: the shared stream only.
+        const Access a = read(m_units, m_map.ray(job.id), sizeof(RayRecord), DataKind::ray, r.measured);
+        if (r.measured) m_ray_critical.add(a.key);
+        const uint32_t first = r.stepper->plan().locality;
+        park(std::move(r), first == kNoLocality ? m_partition->root_group : m_partition->group_of[first]);
+        ++m_in_machine;
+    }
+}
+
+int64_t SampleProfiler::pick() const {
+    // As the ray buffer's scheduler: the largest queue, the oldest front, or round robin.
+    int64_t best = -1;
+    const TreeletPolicy policy = m_c.treelets.policy;
+    for (size_t k = 0; k < m_queues.size(); ++k) {
+        const size_t t = policy == TreeletPolicy::round_robin ? (m_round_robin + 1 + k) % m_queues.size() : k;
+        if (m_queues[t].empty()) continue;
+        if (policy == TreeletPolicy::round_robin) return int64_t(t);
+        if (best < 0 || m_queues[t].size() > m_queues[size_t(best)].size()) best = int64_t(t);
+    }
+    return best;
+}
+
+bool SampleProfiler::take_ray(uint32_t unit, uint32_t slot) {
+    int64_t& current = m_unit_treelet[unit];
+    if (current < 0 || m_queues[size_t(current)].empty()) {
+        current = pick();
+        if (current < 0) return false;
+        m_round_robin = uint32_t(current);
+    }
+    Context& ctx = m_contexts[size_t(unit) * m_slots + slot];
+    if (ctx.stepper) m_free.push_back(std::move(ctx.stepper));
+    static_cast<Ray&>(ctx) = std::move(m_queues[size_t(current)].front());
+    m_queues[size_t(current)].pop_front();
+    --m_waiting;
+    ctx.treelet = uint32_t(current);
+    ctx.active = true;
+    if (ctx.measured) m_p.treelet_takes += 1;
+    m_ahead[size_t(unit) * m_slots + slot].note(*ctx.stepper);
+    return true;
+}
+
+void SampleProfiler::park(Ray&& ray, uint32_t treelet) {
+    // Beyond the SRAM's rays a queued ray's state overflows to memory (written, read back).
+    if (m_waiting >= m_capacity && ray.measured) m_p.treelet_overflows += 1;
+    m_queues[treelet].push_back(std::move(ray));
+    ++m_waiting;
 }
 
 void SampleProfiler::prefetch_ahead(size_t index) const {
@@ -98,7 +201,22 @@ void SampleProfiler::step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySi
     const StepPlan& plan = stepper.plan();
     if (plan.done) {
         finish_ray(ctx, unit, slot, sink);
+        if (m_partition) {  // the ray leaves the machine: room for another
+            ctx.active = false;
+            --m_in_machine;
+            admit(dealer);
+            take_ray(unit, slot);
+            return;
+        }
         start_ray(dealer, unit, slot, sink);
+        return;
+    }
+    if (m_partition && plan.locality != kNoLocality && m_partition->group_of[plan.locality] != ctx.treelet) {
+        // It leaves its treelet: parked in the other's queue; the context takes the next ray.
+        if (ctx.measured) m_p.treelet_parks += 1;
+        park(std::move(static_cast<Ray&>(ctx)), m_partition->group_of[plan.locality]);
+        ctx.active = false;
+        take_ray(unit, slot);
         return;
     }
     ++ctx.plan_steps;

@@ -8,7 +8,16 @@
 // it) and in the stream of all units (the L2). Clusters are contiguous in trace order, so the
 // local reuse (neighbouring pixels) is the full run's; each starts with warm-up rays whose
 // accesses only build history (as SMARTS warms caches, Wunderlich et al. 2003).
+//
+// With treelet scheduling (treelets.enabled) the rays are stepped in the order the ray buffer
+// would run them, functionally: rays enter the queue of their first step's treelet while fewer
+// than the admission limit are in the machine (their record read in the shared stream), each
+// unit's contexts take rays from the queue of the unit's current treelet, a ray whose next step
+// lies in another treelet is parked in that treelet's queue (the context takes the next), and a
+// unit whose queue runs dry picks another by treelets.policy. The reuse distances are then those
+// of the treelet order; takes, parks and overflows (queued rays beyond the SRAM) are counted.
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <vector>
 
@@ -36,12 +45,16 @@ public:
     void finish();
 
 private:
-    struct Context {
+    struct Ray {
         std::unique_ptr<Stepper> stepper;
         uint64_t id = 0;
         StackSplit stack;
         uint32_t plan_steps = 0;
-        bool active = false, measured = false;
+        bool measured = false;
+    };
+    struct Context : Ray {
+        bool active = false;
+        uint32_t treelet = 0;  ///< treelet scheduling: the treelet its ray is in
     };
     /// A line read's reuse key (JointHistogram::pack) and its ordering weight for "slowest".
     struct Access {
@@ -49,6 +62,12 @@ private:
         uint64_t rank = 0;
     };
     bool start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink);
+    /// Treelet scheduling: the cluster stepped in treelet order (the header's comment).
+    void run_treelets(RayDealer& dealer, RaySinkIf& sink);
+    void admit(RayDealer& dealer);
+    bool take_ray(uint32_t unit, uint32_t slot);
+    void park(Ray&& ray, uint32_t treelet);
+    int64_t pick() const;
     void step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink);
     Access read(uint32_t unit, uint64_t addr, uint32_t bytes, DataKind kind, bool measured);
     Access read_line(uint32_t unit, uint64_t line, DataKind kind, bool measured);
@@ -75,6 +94,15 @@ private:
     // The profile's histograms as counted (finish() moves them into the profile).
     std::vector<KeyCounts> m_reads, m_op_sizes;  ///< per DataKind, per OpKind
     KeyCounts m_step_critical, m_ray_critical;
+    // Treelet scheduling only (treelets.enabled).
+    std::unique_ptr<LocalityPartition> m_partition;
+    std::vector<std::deque<Ray>> m_queues;
+    std::vector<int64_t> m_unit_treelet;
+    std::vector<std::unique_ptr<Stepper>> m_free;  ///< steppers of finished rays, reused
+    const Accel* m_accel = nullptr;
+    StepOptions m_step;
+    uint64_t m_in_machine = 0, m_waiting = 0, m_admit_limit = 0, m_capacity = 0;
+    uint32_t m_round_robin = 0;
     double m_fit[5] = {};  ///< sums x1x1, x1x2, x2x2, x1y, x2y of the steps regression
 };
 

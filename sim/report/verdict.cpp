@@ -258,9 +258,6 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
 
 /// Why the estimates do not describe this machine ("" when they do).
 std::string coverage_gap(const SimConfig& c, const UnitTraits& unit) {
-    if (c.treelets.enabled)
-        return "not estimated: the analytic level does not model treelet admission and queues, so the knobs "
-               "are ranked by the cycle accounting; measure them with --check-verdict";
     if (!unit.estimate_as.empty()) {
         std::string stand_in = unit.estimate_as;
         for (char& ch : stand_in) ch = char(std::toupper(static_cast<unsigned char>(ch)));

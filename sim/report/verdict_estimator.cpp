@@ -21,7 +21,7 @@ public:
 
 SimConfig analytic_config(SimConfig config, const std::string& estimate_as) {
     config.fidelity = Fidelity::analytic;
-    config.treelets.enabled = false;
+    config.analytic.caches = AnalyticCaches::statistical;  // the level that costs every kind and treelets
     config.sampling = SamplingConfig{};
     // The closed form times each ray context on its own: a lock-step kind's relaxations are
     // estimated for the kind that stands in for it with the same contexts (divergence is not in it).
@@ -68,7 +68,7 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
     const std::unique_ptr<RayStream> sample = c.sample_stream(c.first_ray, rays, c.sample_rays);
     RayStream& stream = *sample;
     m_method = "analytic level on " + std::to_string(stream.total_rays()) + " sampled rays" +
-               (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " (treelets off)" : "");
+               (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " in treelet order" : "");
     // Else the verdict's own sample analysis: stored beside the trace by the first run that
     // needs it (under a lock, as a sweep's processes share it), loaded by every later one.
     const nlohmann::json key =

@@ -19,9 +19,9 @@ namespace rtsim {
 
 struct VerdictContext;
 
-/// The config the analytic level can run: no treelets (its closed form models plain dispatch),
-/// no sampling (it runs on its own analysis), and the unit kind `estimate_as` instead of one it
-/// cannot cost ("" keeps the config's).
+/// The config the analytic level runs the estimates at: its statistical caches (they cost
+/// lock-step groups and treelet scheduling), no sampling (it runs on its own analysis), and the
+/// unit kind `estimate_as` instead of one it cannot cost ("" keeps the config's).
 SimConfig analytic_config(SimConfig config, const std::string& estimate_as);
 
 class VerdictEstimator {

@@ -16,6 +16,8 @@ LevelCapabilities level_capabilities(const SimConfig& c) {
             // groups from its functional group profile (sim/analytic/estimate.cpp).
             const bool functional = c.analytic.caches == AnalyticCaches::functional;
             l.group_profiles = !functional;
+            // Its sample stepped in treelet order, the ray buffer's traffic priced (sample.h).
+            l.treelets = !functional;
             l.name += std::string(" (analytic.caches=") + (functional ? "functional" : "statistical") + ")";
             l.steps_rays = functional;
             break;

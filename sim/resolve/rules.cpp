@@ -60,8 +60,11 @@ std::vector<Rule> make_rules() {
          "treelets.enabled=false",
          "bvh2", {"traversal.model=packet", "treelets.enabled=true"}});
     add({"treelets/level", "treelets.enabled=true", treelets, RuleSide::level, "a level that models treelet queues",
-         [](const RunFacts& f) { return f.level.treelets; }, "the analytic closed form models plain dispatch",
-         "fidelity=approx or detailed", "bvh2", {"treelets.enabled=true", "fidelity=analytic"}});
+         [](const RunFacts& f) { return f.level.treelets; },
+         "the analytic level's functional caches step rays in plain dispatch order (its statistical caches step "
+         "the sample in treelet order)",
+         "analytic.caches=statistical, or fidelity=approx or detailed", "bvh2",
+         {"treelets.enabled=true", "fidelity=analytic", "analytic.caches=functional"}});
     add({"sort/treelets", "dispatch.sort (ray sorting)", [](const RunFacts& f) { return f.config.dispatch.sort != RaySort::none; },
          RuleSide::technique, "treelets.enabled=false", [](const RunFacts& f) { return !treelets(f); },
          "the ray buffer takes rays from dispatch in its own order and reorders them by treelet itself",

@@ -87,3 +87,25 @@ def test_stats_report_the_partition(hairball_diffuse: Path, tmp_path: Path) -> N
     blocks = {b["block"]: b for b in stats["instantiated"]}
     assert blocks["ray_buffer"]["instantiated"] is True
     assert "treelets" in blocks["ray_buffer"]["why"]
+
+
+def test_the_analytic_level_steps_its_sample_in_treelet_order(
+    hairball_diffuse: Path, tmp_path: Path
+) -> None:
+    """At the analytic level treelet scheduling orders the sample's steps (the ray buffer run
+    functionally), so treelets cut the BVH's DRAM traffic there too, and the ray buffer's SRAM
+    port is a bound; every sampled ray is checked."""
+    small_l2 = ("l2.size_kib=128", "fidelity=analytic")
+    base = simulate(hairball_diffuse, tmp_path / "base", *small_l2)
+    treelets = simulate(
+        hairball_diffuse, tmp_path / "treelets", *small_l2, "treelets.enabled=true",
+        "treelets.buffer_kib=1024",
+    )  # fmt: skip
+    assert treelets["validation"]["hit_mismatches"] == 0
+    assert treelets["validation"]["work_mismatches"] == 0
+    assert "ray_buffer" in treelets["model"]["analytic"]["bounds"]
+    bvh = [
+        sum(s["model"]["dram"]["by_kind"][k]["read_bytes"] for k in ("node", "triangle"))
+        for s in (base, treelets)
+    ]
+    assert bvh[1] < 0.8 * bvh[0], bvh

@@ -45,16 +45,20 @@ def test_every_knob_is_weighed(hairball: Path, sim: Sim, tmp_path: Path) -> None
     assert v["coverage"]["estimated"] is True
 
 
-def test_treelet_runs_are_not_answered_with_a_wrong_estimate(
+def test_treelet_runs_estimate_resources_and_measure_treelet_knobs(
     hairball: Path, sim: Sim, tmp_path: Path  # noqa: F811
 ) -> None:  # fmt: skip
+    """The analytic level steps its sample in treelet order, so a treelet design's resource knobs
+    are estimated; the ray buffer's own knobs change the order itself and are left to measure."""
     v = run_stats(sim, hairball, tmp_path / "run", "treelets.enabled=true")["verdict"]
-    assert v["coverage"]["estimated"] is False and "treelet" in v["coverage"]["why_not"]
-    assert all(c["speedup"] is None for c in v["candidates"])
-    assert v["co_limits"] == []
-    keys = {c["key"] for c in v["candidates"]}
-    assert {"treelets.admit_outstanding", "treelets.buffer_kib", "treelets.policy"} <= keys
-    assert "--check-verdict" in v["text"]
+    assert v["coverage"]["estimated"] is True
+    by_key = {c["key"]: c for c in v["candidates"]}
+    assert {"treelets.admit_outstanding", "treelets.buffer_kib", "treelets.policy"} <= set(by_key)
+    assert all(by_key[k]["speedup"] is None for k in ("treelets.buffer_kib", "treelets.policy"))
+    assert (
+        by_key["l2.size_kib"]["speedup"] is not None
+        and by_key["traversal.units"]["speedup"] is not None
+    )
 
 
 def test_check_verdict_measures_the_top_knobs(hairball: Path, sim: Sim, tmp_path: Path) -> None:  # noqa: F811
