@@ -269,19 +269,28 @@ INACTIVE_UNLESS: tuple[tuple[str, str, Any], ...] = (
     *_unit_kind_sections(),
 )
 
+#: Fields under an inactive prefix that act without its switch: treelet prefetching also runs
+#: without treelet queues (a ray stepping into a treelet triggers it; docs/treelets.md).
+ACTIVE_WITHOUT_SWITCH = ("treelets.prefetch",)
+
+
+def key_inactive(key: str, flat: dict[str, Any]) -> bool:
+    """True for a key whose section's switch is off in this flat config (treelets.buffer_kib
+    without treelets.enabled, traversal.simt.lanes under traversal.model mimd)."""
+    if key.startswith(ACTIVE_WITHOUT_SWITCH):
+        return False
+    return any(
+        key.startswith(prefix) and key != switch and switch in flat and flat[switch] != on
+        for prefix, switch, on in INACTIVE_UNLESS
+    )
+
 
 def effective_dict(config: SimConfig) -> dict[str, Any]:
     """The config as the simulator sees it: fields of a switched-off section (a ray-buffer size
     with treelets off) at their defaults, so two configs that differ only there compare equal
     (a sweep simulates them once)."""
-    data = config.to_dict()
-    flat, default = flatten(data), flatten(SimConfig().to_dict())
-    for prefix, switch, on in INACTIVE_UNLESS:
-        if switch in flat and flat[switch] != on:
-            for key in flat:
-                if key.startswith(prefix) and key != switch:
-                    flat[key] = default[key]
-    return unflatten(flat)
+    flat, default = flatten(config.to_dict()), flatten(SimConfig().to_dict())
+    return unflatten({k: default[k] if key_inactive(k, flat) else v for k, v in flat.items()})
 
 
 def config_keys() -> list[str]:

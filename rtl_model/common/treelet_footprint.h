@@ -41,6 +41,13 @@ public:
         const size_t n = m_max_lines ? std::min<size_t>(m_max_lines, lines.size()) : lines.size();
         for (size_t i = 0; i < n; ++i) f(lines[i]);
     }
+    /// How many lines a prefetch on entering `treelet` now takes, and the i-th of them (the
+    /// list only grows, so an index taken at entry stays valid).
+    uint32_t prefetch_count(uint32_t treelet) const {
+        const size_t n = m_lines[treelet].size();
+        return uint32_t(m_max_lines ? std::min<size_t>(m_max_lines, n) : n);
+    }
+    const FootprintLine& line(uint32_t treelet, uint32_t i) const { return m_lines[treelet][i]; }
     uint32_t line_bytes() const { return 1u << m_line_shift; }
     uint32_t line_shift() const { return m_line_shift; }
     ServedBy into() const { return m_into; }

@@ -70,6 +70,9 @@ struct UnitNeeds {
     bool per_ray_stack = true;
     /// It takes rays one at a time from treelet queues and parks each alone: treelet scheduling.
     bool treelet_queues = true;
+    /// Its rays trigger a treelet's prefetch as they step into it (treelet prefetching, with
+    /// treelet queues or without).
+    bool treelet_prefetch = true;
 };
 
 /// A knob of the kind's own the verdict may turn (sim/report/verdict_knobs.cpp).

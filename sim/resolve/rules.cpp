@@ -153,6 +153,10 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
         out.push_back({"mailbox.entries", f.structure.name() + " lists no primitive twice along a ray"});
     if (f.config.treelets.prefetch && f.config.ideal_memory)
         out.push_back({"treelets.prefetch", "with ideal_memory every access hits: there is nothing to prefetch"});
+    else if (f.config.treelets.prefetch && !f.unit.needs.treelet_prefetch)
+        out.push_back({"treelets.prefetch", "the " + f.unit.name + " unit's rays share one walk, which does not trigger treelet prefetches"});
+    else if (f.config.treelets.prefetch && !f.level.timed)
+        out.push_back({"treelets.prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
     return out;
 }
 

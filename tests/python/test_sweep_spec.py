@@ -161,3 +161,20 @@ def test_switched_off_sections_are_simulated_once() -> None:
     [base] = [r for r in plain.runs() if not r.config.treelets.enabled]
     expected = {"trace": base.trace.trace_id, "config": base.config.to_dict()}
     assert base.run_id == stable_hash(expected)
+
+
+def test_treelet_prefetching_counts_without_treelet_queues() -> None:
+    # Prefetching also runs without treelet queues, so it is not folded into the treelets-off
+    # run, while a prefetch setting beside it still is not a second machine when both are off.
+    text = """\
+    name: t
+    scenes: [cornell]
+    workloads:
+      - {name: primary, rays: [primary], resolution: 32x24}
+    grid:
+      treelets.prefetch: [false, true]
+      treelets.buffer_kib: [128, 2048]
+    """
+    runs = parse_spec(textwrap.dedent(text), "s.yaml").runs()
+    assert len({r.run_id for r in runs}) == 2
+    assert {r.config.treelets.prefetch for r in runs} == {False, True}

@@ -10,7 +10,7 @@ from typing import Any
 
 import yaml
 
-from rtsim.config import INACTIVE_UNLESS, ConfigError, field_info, flatten
+from rtsim.config import ConfigError, field_info, flatten, key_inactive
 from rtsim.sweep.results import sram_bytes
 from rtsim.sweep.store import RunRecord, open_store
 
@@ -36,11 +36,7 @@ FLAG_KEYS: dict[str, str] = {"treelets.enabled": "treelets", "ideal_memory": "id
 def key_active(key: str, config: dict[str, Any]) -> bool:
     """False for a key whose switch is off in this run's config (treelets.buffer_kib without
     treelets.enabled, traversal.simt.lanes under traversal.model mimd)."""
-    flat = flatten(config) if config else {}
-    for prefix, switch, on in INACTIVE_UNLESS:
-        if key.startswith(prefix) and key != switch and switch in flat and flat[switch] != on:
-            return False
-    return True
+    return not key_inactive(key, flatten(config) if config else {})
 
 
 def is_categorical(values: list[Any]) -> bool:

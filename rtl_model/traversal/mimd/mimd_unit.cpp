@@ -14,9 +14,10 @@ MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
 
 void MimdUnit::run() {
     m_treelet_mode = ray_buffer.size() > 0;
-    // Prefetching follows the unit's treelet queue (replace), or without queues each ray's entry
-    // into a treelet (append: the unit's rays are in many treelets at once).
-    if (m_treelets && m_treelets->footprints()) m_prefetcher.attach(m_treelets->footprints(), m_treelet_mode);
+    // Prefetching follows the unit's treelet queue (one stream), or without queues each ray
+    // context's entries into treelets (a stream per context).
+    if (m_treelets && m_treelets->footprints())
+        m_prefetcher.attach(m_treelets->footprints(), m_treelet_mode ? 1 : uint32_t(m_contexts.size()), !m_treelet_mode);
     if (!m_treelet_mode)
         for (Context& ctx : m_contexts) ctx.ray.stepper = m_steppers.acquire();
     Cycle now = 0;
@@ -114,7 +115,7 @@ bool MimdUnit::take_parked_ray(uint32_t c, Cycle t) {
     const Stepper& s = *ctx.ray.stepper;
     if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_tally.rejected;
     ++m_takes;
-    if (m_prefetcher.on()) m_prefetcher.enter(ctx.treelet, t);
+    if (m_prefetcher.on()) m_prefetcher.enter(0, ctx.treelet, t);
     m_ahead[c].note(*ctx.ray.stepper);
     activate(c, t);
     account(c, CycleUse::ray_buffer, ready);
@@ -146,7 +147,7 @@ void MimdUnit::step(uint32_t c, Cycle t) {
         if (target != ctx.treelet) {
             if (m_treelet_mode) return park_ray(c, target, t);  // leaves its treelet
             ctx.treelet = target;  // without queues: the ray walks on into it, prefetched
-            if (m_prefetcher.on()) m_prefetcher.enter(target, t);
+            if (m_prefetcher.on()) m_prefetcher.enter(c, target, t);
         }
     }
     // The step is costed (and run, with the one arithmetic) as its fetches issue; its

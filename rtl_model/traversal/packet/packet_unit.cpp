@@ -258,6 +258,7 @@ UnitKind packet_kind() {
     k.needs.lock_step = true;
     k.needs.per_ray_stack = false;
     k.needs.treelet_queues = false;
+    k.needs.treelet_prefetch = false;
     k.knobs = {{"traversal.packet.lanes", /*halve=*/true, "divergence", /*estimated=*/false}};
     k.estimate_as = "mimd";
     k.group_profile = packet_group_profile;

@@ -19,9 +19,11 @@ SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
 
 void SimtUnit::run() {
     m_treelet_mode = ray_buffer.size() > 0;
-    // Each warp runs a treelet queue of its own, so the unit's rays are in several treelets at
-    // once: prefetches append (treelet_prefetcher.h), with queues or without.
-    if (m_treelets && m_treelets->footprints()) m_prefetcher.attach(m_treelets->footprints(), false);
+    // Prefetching follows each warp's treelet queue (a stream per warp), or without queues each
+    // lane's entries into treelets (a stream per lane; treelet_prefetcher.h).
+    if (m_treelets && m_treelets->footprints())
+        m_prefetcher.attach(m_treelets->footprints(), m_treelet_mode ? uint32_t(m_warps.size()) : uint32_t(m_lanes.size()),
+                            !m_treelet_mode);
     if (!m_treelet_mode)
         for (Lane& lane : m_lanes) lane.ray.stepper = m_steppers.acquire();
     Cycle now = 0;
@@ -121,7 +123,7 @@ bool SimtUnit::take_lane(uint32_t w, uint32_t l, Cycle t, bool may_switch, Cycle
     const Stepper& s = *lane.ray.stepper;
     if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_tally.rejected;
     ++m_takes;
-    if (m_warps[w].treelet != treelet && m_prefetcher.on()) m_prefetcher.enter(treelet, t);
+    if (m_warps[w].treelet != treelet && m_prefetcher.on()) m_prefetcher.enter(w, treelet, t);
     m_warps[w].treelet = treelet;
     account_until(m_account, lane.accounted, CycleUse::starved, t);  // no ray until now
     lane.has_ray = lane.stepping = true;
@@ -154,7 +156,7 @@ void SimtUnit::note_treelet(uint32_t l, Cycle t) {
     const uint32_t treelet = m_treelets->treelet_of(plan.locality);
     if (treelet == lane.treelet) return;
     lane.treelet = treelet;
-    m_prefetcher.enter(treelet, t);
+    m_prefetcher.enter(l, treelet, t);
 }
 
 bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
