@@ -356,6 +356,43 @@ PRESETS.update(
                 "dram": {"channels": 16, "bytes_per_cycle": 18},
             },
         ),
+        # The RT unit as Vulkan-Sim models it (Saed et al., MICRO 2022), on rtsim's warp-based unit:
+        # gpgpu_rt_max_warps warps of 32 rays in a warp buffer, a warp handed back to the SM only
+        # when all its rays are done (refill=warp), over the RTX 2060's memory system above. Trace
+        # with --accel cwbvh6 (64-byte 6-wide nodes with 8-bit boxes: Mesa's Intel-style BVH6,
+        # which Vulkan-Sim traverses). docs/presets.md lists what differs.
+        "vulkansim_rtx2060": _merge(
+            _TURING_RT_UNIT,
+            {
+                "clock_ghz": 1.365,
+                "traversal": {
+                    "units": 30,
+                    "model": "simt",
+                    "ray_contexts": 128,
+                    "simt": {"lanes": 32, "refill": "warp"},
+                },
+                "l2": {"size_kib": 3072, "ways": 24, "banks": 24},
+                "dram": {"channels": 12, "bytes_per_cycle": 20},
+            },
+        ),
+        # Vulkan-Sim's mobile SoC (configs/tested-cfgs/MOBILE): 2 SMs at 1365 MHz, 16 warps per RT
+        # unit, its own 64 KiB RT cache (S:32:128:16, 256 MSHRs), 2 x 128 KiB L2 (S:64:128:16,
+        # 192 MSHRs each), two 16-bit GDDR6 channels at 7 Gbps (14 GB/s = 10 B/cycle each).
+        "vulkansim_mobile": _merge(
+            _TURING_RT_UNIT,
+            {
+                "clock_ghz": 1.365,
+                "traversal": {
+                    "units": 2,
+                    "model": "simt",
+                    "ray_contexts": 512,
+                    "simt": {"lanes": 32, "refill": "warp"},
+                },
+                "l1": {"mshrs": 256},
+                "l2": {"size_kib": 256, "ways": 16, "banks": 2, "mshrs": 384},
+                "dram": {"channels": 2, "bytes_per_cycle": 10},
+            },
+        ),
         # STRaTA (Kopta et al., HPG 2013): TRaX thread multiprocessors with treelet ray streams in
         # on-chip SRAM. Numbers from Arches' STRaTA "modern config" (src/arches/strata.hpp): 2 GHz,
         # 128 TMs with one RT core of 256 rays each, 128 KiB 4-way L1 per TM (8 banks, 30 cycles,

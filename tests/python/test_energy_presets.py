@@ -92,6 +92,46 @@ def test_turing_presets_scale_like_the_chips() -> None:
     assert compose("strata").treelets.enabled
 
 
+@pytest.mark.parametrize(
+    "name, units, warps, mshrs, l2_kib, channels, bytes_per_cycle",
+    [
+        # docs/presets.md, "The Vulkan-Sim baseline": gpgpu_rt_max_warps, gpgpu_rt_max_mshr (or
+        # the RT cache's MSHRs), the L2 and the GDDR6 channels of each Vulkan-Sim config.
+        ("vulkansim_rtx2060", 30, 4, 64, 3072, 12, 20),
+        ("vulkansim_mobile", 2, 16, 256, 256, 2, 10),
+    ],
+)
+def test_vulkansim_presets_match_their_table(
+    name: str,
+    units: int,
+    warps: int,
+    mshrs: int,
+    l2_kib: int,
+    channels: int,
+    bytes_per_cycle: int,
+    sim: Sim,
+    cornell_small: Path,
+    tmp_path: Path,
+) -> None:
+    config = tmp_path / "config.json"
+    config.write_text(compose(name).to_json())
+    stats = stats_of(sim, cornell_small, tmp_path / "run", config=config)
+    assert stats["validation"]["hit_mismatches"] == 0
+    r = json.loads((tmp_path / "run" / "config.resolved.json").read_text())
+    t = r["traversal"]
+    assert (t["units"], t["model"], t["simt"]["lanes"], t["simt"]["refill"]) == (
+        units,
+        "simt",
+        32,
+        "warp",
+    )
+    assert t["ray_contexts"] == warps * 32
+    assert r["l1"]["mshrs"] == mshrs and r["l1"]["size_kib"] == 64 and r["l1"]["line_bytes"] == 128
+    assert r["l2"]["size_kib"] == l2_kib and r["clock_ghz"] == pytest.approx(1.365)
+    assert (r["dram"]["channels"], r["dram"]["bytes_per_cycle"]) == (channels, bytes_per_cycle)
+    assert stats["summary"]["simd_efficiency"] is not None
+
+
 def test_defaults_give_each_context_an_mshr() -> None:
     # docs/presets.md, "How the defaults were chosen": at 8 L1 MSHRs for 16 contexts the L1s
     # starved Sponza diffuse (+30% from doubling them).

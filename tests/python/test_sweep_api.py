@@ -243,3 +243,23 @@ def test_spec_dict_errors_name_the_key(tmp_path: Path) -> None:
     with pytest.raises(rtsim.RtsimError, match=r"points\[1\]\.set\.l1\.size_kb: unknown key"):
         rtsim.sweep(spec, tmp_path / "never", quiet=True)
     assert not (tmp_path / "never").exists()
+
+
+def test_every_builtin_study_has_its_markers_in_docs() -> None:
+    # A study whose table has no markers in its page would write nowhere with --write-docs.
+    from rtsim import studies
+
+    docs = Path(__file__).resolve().parents[2] / "docs"
+    for name in studies.names():
+        for t in studies.load(name).tables:
+            text = (docs / t.doc).read_text()
+            assert f"<!-- {t.marker}:begin -->" in text, (name, t.doc, t.marker)
+            assert f"<!-- {t.marker}:end -->" in text, (name, t.doc, t.marker)
+
+
+def test_vulkansim_baseline_study_quick(tmp_path: Path) -> None:
+    # The warp baseline across two structures and its treelet prefetching, end to end.
+    args = ["study", "vulkansim_baseline", "--quick", "-o", str(tmp_path / "out")]
+    done = run_rtsim(*args, "--workers", "1", "--no-progress")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "warp + treelet prefetch" in done.stdout and "cwbvh6" in done.stdout

@@ -185,9 +185,9 @@ def plot(run: StudyRun, path: Path) -> None:
         ax_bvh.set_title(f"{sc}: BVH bytes read from DRAM per ray", fontsize=10)
         ax_bvh.set_ylabel("B/ray")
         for ax in (ax_speed, ax_bvh):
-            ax.set_xticks(range(len(configs)), configs, rotation=15, fontsize=8)
+            ax.set_xticks(range(len(configs)), configs, rotation=25, ha="right", fontsize=8)
             ax.grid(True, axis="y", alpha=0.3)
-            ax.legend(fontsize=8)
+            ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     fig.suptitle("Treelet scheduling and prefetching on MIMD units and SIMT warps", fontsize=12)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     fig.savefig(path, dpi=80)
