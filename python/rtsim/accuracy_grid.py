@@ -278,6 +278,41 @@ def markdown(summary: list[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _named_point(point: str) -> str:
+    """The `point` label of a run of a spec with named points, else its swept values."""
+    for token in point.split():
+        if token.startswith("point="):
+            return token.removeprefix("point=")
+    return point
+
+
+def by_point_markdown(rows: list[GridRow]) -> str:
+    """Per level and named point (or swept values): the error against detailed over every trace
+    and grid value the point ran at."""
+    groups: dict[tuple[str, str], list[float]] = {}
+    order: list[tuple[str, str]] = []
+    for r in rows:
+        if r.level == REFERENCE or r.error is None:
+            continue
+        key = (r.level, _named_point(r.point))
+        if key not in groups:
+            groups[key] = []
+            order.append(key)
+        groups[key].append(r.error)
+    lines = [
+        "| level | point | runs | median error | min / max error | max abs error |",
+        "|---|---|---:|---:|---:|---:|",
+    ]
+    for key in sorted(order, key=lambda k: (k[0], order.index(k))):
+        errs = groups[key]
+        lines.append(
+            f"| {key[0]} | {key[1]} | {len(errs)} | {100 * statistics.median(errs):+.1f}% "
+            f"| {100 * min(errs):+.1f}% / {100 * max(errs):+.1f}% "
+            f"| {100 * max(abs(e) for e in errs):.1f}% |"
+        )
+    return "\n".join(lines) + "\n"
+
+
 def write_grid(rows: list[GridRow], out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     summary = summarize_grid(rows)
@@ -290,7 +325,7 @@ def write_grid(rows: list[GridRow], out: Path) -> None:
             w.writeheader()
             for r in rows:
                 w.writerow(asdict(r))
-    (out / "grid.md").write_text(markdown(summary))
+    (out / "grid.md").write_text(markdown(summary) + "\n" + by_point_markdown(rows))
     plot_grid(rows, out / "grid.png")
 
 
