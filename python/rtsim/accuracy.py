@@ -393,9 +393,9 @@ def write_grid_docs(args: argparse.Namespace, text: str, grid: list[Any], second
     """The grid's tables between the MARKER markers of docs/fidelity.md, with how they were made."""
     from rtsim.doc_markers import write_between
 
-    doc = Path(__file__).resolve().parents[2] / "docs" / "fidelity.md"
+    doc = Path("docs") / "fidelity.md"
     if not doc.is_file():
-        raise ValueError(f"--write-docs: {doc} not found (run from a source checkout)")
+        raise ValueError(f"--write-docs: {doc} not found (run from the repository root)")
     gits = sorted(
         {
             str(json.loads(f.read_text()).get("git"))
