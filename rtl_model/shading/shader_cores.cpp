@@ -39,7 +39,7 @@ WarpResult ShaderCores::run(const std::vector<LaneProgram>& lanes, Cycle ready) 
             if (l.program == program) {
                 instructions = std::max(instructions, l.instructions);
                 samples = std::max(samples, l.samples);
-                w.lane_instructions += l.instructions;
+                w.lane_instructions += l.instructions + uint64_t(l.samples) * m_config.cost.sample_issue;
             }
         const uint64_t issued = instructions + uint64_t(samples) * m_config.cost.sample_issue;
         // Texture samples issue after the attribute interpolation (a program's first quarter).

@@ -43,6 +43,7 @@ ShadingBlock::ShadingBlock(sc_core::sc_module_name name, const ShadingConfig& co
     m_cores = std::make_unique<ShaderCores>(config, tex);
     m_shaded_at.assign(inputs.rays.size(), 0);
     m_done.assign(inputs.rays.size(), 0);
+    m_seen.assign(inputs.rays.size(), 0);
     raygen();
 }
 
@@ -58,7 +59,7 @@ void ShadingBlock::raygen() {
         lanes.assign(std::min<uint64_t>(m_config.warp_width, primaries - i), LaneProgram{program, m_config.cost.raygen});
         const WarpResult w = m_cores->run(lanes, 0);
         m_raygen_end = std::max(m_raygen_end, w.end);
-        m_issued += w.issued, m_lane_instructions += w.lane_instructions;
+        m_raygen_issued += w.issued, m_raygen_lane_instructions += w.lane_instructions;
     }
     m_release = m_raygen_end;
     m_last_end = m_raygen_end;
@@ -68,6 +69,11 @@ ShadingBlock::Lane ShadingBlock::lane_of(const RayResult& r) {
     const RayRecord& ray = m_in.rays[r.id];
     const ShadeRecord& ref = m_in.shade[r.id];
     Lane l{r.id, r.end, {}, 0xFFFFFFFFu, octant(ray.direction), uint32_t(m_texels.size())};
+    // Dependency order: a ray starts only after its parent was shaded, and is shaded once.
+    const int64_t parent = ref.parent;
+    if (parent >= 0 && (!m_done[size_t(parent)] || r.start < m_shaded_at[size_t(parent)])) ++m_order_violations;
+    if (m_done[r.id] || m_seen[r.id]) ++m_shaded_twice;
+    m_seen[r.id] = 1;
     if (ray.flags & kRayFlagAnyHit) {
         l.program = {m_in.shaders + 1, m_config.cost.shadow_result};
         ++m_shadow;

@@ -52,6 +52,8 @@ public:
     Cycle frame_end(Cycle rt_end) const;
     uint64_t texel_mismatches() const { return m_texel_mismatches; }
     uint64_t shaded() const { return m_shaded; }
+    /// Rays that started before their parent was shaded, or finished twice (0 allowed).
+    uint64_t order_violations() const { return m_order_violations + m_shaded_twice; }
     const std::vector<std::unique_ptr<Cache>>& tex_caches() const { return m_tex; }
     /// The first texel mismatch, for the validation report (empty if none).
     const std::string& first_mismatch() const { return m_first_mismatch; }
@@ -81,6 +83,7 @@ private:
     std::vector<uint64_t> m_texels;  ///< their texel addresses
     std::vector<Cycle> m_shaded_at;  ///< per ray: when its warp finished (inflight), 0 before
     std::vector<uint8_t> m_done;     ///< per ray: shaded
+    std::vector<uint8_t> m_seen;     ///< per ray: finished (handed to the shading block)
     Cycle m_raygen_end = 0;
     Cycle m_reorder_exposed = 0;  ///< sorting before the first warp of the current batch
     // Frame accounting (wavefront: serial parts that sum to the frame time).
@@ -92,6 +95,8 @@ private:
     uint64_t m_shaded = 0, m_hits = 0, m_misses = 0, m_shadow = 0, m_warps = 0, m_programs = 0;
     uint64_t m_issued = 0, m_lane_instructions = 0, m_lane_slots = 0, m_samples = 0, m_tex_lines = 0;
     uint64_t m_sorted = 0, m_texel_mismatches = 0, m_max_pending = 0;
+    uint64_t m_order_violations = 0, m_shaded_twice = 0;
+    uint64_t m_raygen_issued = 0, m_raygen_lane_instructions = 0;
     std::string m_first_mismatch;
 };
 

@@ -22,7 +22,7 @@ const StatBlock& shading_stats() {
             {"shadow", "rays", "Shadow rays whose answer a shader consumed"},
             {"warps", "warps", "Warps shaded (ray generation aside)"},
             {"divergence", "programs/warp", "Mean distinct programs per warp (1: none; SIMT runs them one after another)"},
-            {"simd_efficiency", "", "Lane instructions needed / lane slots issued (Aila & Laine 2009's SIMD efficiency)"},
+            {"simd_efficiency", "", "Hit, miss and shadow programs' lane instructions needed / lane slots issued (Aila & Laine 2009's SIMD efficiency)"},
             {"warp_instructions", "instructions", "Warp instructions issued, ray generation included"},
             {"lane_instructions", "instructions", "Instructions the lanes needed, ray generation included"},
             {"texture_samples", "samples", "Texture samples of hit shaders (4 texels each)"},
@@ -33,6 +33,7 @@ const StatBlock& shading_stats() {
             {"reorder_buffer_bytes", "bytes", "Sorting buffer SRAM (window x entry bytes); 0 without a sorting stage"},
             {"core_utilization", "", "Issue slots used / (cores x frame cycles)", true},
             {"texel_mismatches", "rays", "Rays whose texel addresses differ from the reference tracer's (0 allowed)"},
+            {"order_violations", "rays", "Rays that started before their parent was shaded, or reached shading twice (0 allowed)"},
             {"first_texel_mismatch", "", "The first such ray, or empty"},
             {"energy_pj", "pJ", "Shader cores' energy: lane instructions, texture samples, sorting (caches and DRAM are counted by their levels)"},
             {"area_mm2", "mm^2", "Shader cores' area (cores x core_mm2)"},
@@ -75,8 +76,8 @@ json ShadingBlock::stats_json(Cycle rt_end, double clock_ghz) const {
         .set("warps", m_warps)
         .set("divergence", m_warps ? double(m_programs) / double(m_warps) : 0.0)
         .set("simd_efficiency", m_lane_slots ? double(m_lane_instructions) / double(m_lane_slots) : 0.0)
-        .set("warp_instructions", m_issued)
-        .set("lane_instructions", m_lane_instructions)
+        .set("warp_instructions", m_issued + m_raygen_issued)
+        .set("lane_instructions", m_lane_instructions + m_raygen_lane_instructions)
         .set("texture_samples", m_samples)
         .set("tex_lines", m_tex_lines)
         .set("texture_model", m_tex.empty() ? std::string(m_in.has_textures() ? "ideal memory: texels at no cost"
@@ -90,8 +91,9 @@ json ShadingBlock::stats_json(Cycle rt_end, double clock_ghz) const {
                                          : uint64_t(m_config.reorder_window) * m_config.reorder_entry_bytes)
         .set("core_utilization", frame ? double(m_cores->issue_busy()) / (double(m_config.cores) * double(frame)) : 0.0)
         .set("texel_mismatches", m_texel_mismatches)
+        .set("order_violations", order_violations())
         .set("first_texel_mismatch", m_first_mismatch)
-        .set("energy_pj", double(m_lane_instructions) * m_config.alu_pj + double(m_samples) * m_config.tex_sample_pj +
+        .set("energy_pj", double(m_lane_instructions + m_raygen_lane_instructions) * m_config.alu_pj + double(m_samples) * m_config.tex_sample_pj +
                               double(m_sorted) * m_config.reorder_pj)
         .set("area_mm2", m_config.cores * m_config.core_mm2)
         .set("max_pending", m_max_pending);

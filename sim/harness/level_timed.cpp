@@ -141,6 +141,7 @@ LevelResult run_timed_level(RunInputs& in) {
         // Texel addresses are checked like node fetches: every shaded ray's against the reference.
         r.validation["texel_mismatches"] = top.shading()->texel_mismatches();
         r.validation["shaded_rays"] = top.shading()->shaded();
+        r.validation["order_violations"] = top.shading()->order_violations();
         if (top.shading()->texel_mismatches()) r.validation["first_texel_mismatch"] = top.shading()->first_mismatch();
     }
     r.latency = checker.latency().to_json();
@@ -149,7 +150,7 @@ LevelResult run_timed_level(RunInputs& in) {
     r.frame_count = built.frames.size();
     r.work = checker.work_totals();
     r.rays = checker.checked();
-    r.bad = checker.hit_mismatches() || checker.work_mismatches() || (top.shading() && top.shading()->texel_mismatches());
+    r.bad = checker.hit_mismatches() || checker.work_mismatches() || (top.shading() && (top.shading()->texel_mismatches() || top.shading()->order_violations()));
     // The verdict's estimates trace a sample of rays against the structure (kept alive by the
     // closure, as the report stage runs after this level returns).
     auto kept = std::make_shared<BuiltRun>(std::move(built));

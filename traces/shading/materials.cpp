@@ -20,7 +20,7 @@ constexpr const char* kFeatureNames[kShaderFeatureCount] = {
 constexpr const char* kSlotNames[kMaterialTextureSlots] = {"base_color", "normal", "metallic_roughness",
                                                            "emissive", "occlusion"};
 
-uint64_t round_up(uint64_t x, uint64_t a) { return (x + a - 1) / a * a; }
+uint64_t align_to(uint64_t x, uint64_t a) { return (x + a - 1) / a * a; }
 
 uint16_t mip_count(uint32_t w, uint32_t h) {
     uint16_t n = 1;
@@ -99,7 +99,7 @@ const char* texture_origin_name(TextureOrigin o) {
 
 ShadingScene build_shading_scene(const Scene& scene, const std::string& name, bool procedural, uint64_t image_end) {
     ShadingScene out;
-    out.texture_base = round_up(std::max<uint64_t>(image_end, 1), AccelImage::kGranule);
+    out.texture_base = align_to(std::max<uint64_t>(image_end, 1), AccelImage::kGranule);
     uint64_t next = out.texture_base;
     std::map<uint32_t, uint16_t> shader_of;  // feature set -> dense id, in first-use order
     for (const Material& m : scene.materials) {
@@ -117,7 +117,7 @@ ShadingScene build_shading_scene(const Scene& scene, const std::string& name, bo
             t.origin = uint8_t(st.origin);
             t.bytes = chain_bytes(t.width, t.height, t.mips, t.bytes_per_texel);
             t.base = next;
-            next = round_up(next + t.bytes, kTextureAlign);
+            next = align_to(next + t.bytes, kTextureAlign);
             r.texture[s] = int32_t(out.textures.size());
             out.textures.push_back(t);
         }
