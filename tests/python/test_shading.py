@@ -115,3 +115,29 @@ def test_refusals_and_unused(traces: dict[str, Path], tmp_path: Path) -> None:
                        "--no-progress", "--set", "shading.enabled=true",
                        "--set", "fidelity=analytic")  # fmt: skip
     assert result.returncode == 2 and "a level that times the frame" in result.stderr
+
+
+def test_older_trace_simulates_without_shading(traces: dict[str, Path], sim_exe: Path,
+                                               tmp_path: Path) -> None:  # fmt: skip
+    """A version-4 trace (no shading sections) is read as it is: shading.enabled has no effect
+    and says why; a trace of a version this build does not know is refused naming both."""
+    from trace_forge import read_sections, write_trace
+
+    sections = read_sections(traces["cornell"] / "trace.rtt")
+    old = {k: v for k, v in sections.items() if k not in ("MATL", "TEXR", "PTRI", "SHAD", "TXFT")}
+    folder = tmp_path / "v4"
+    folder.mkdir()
+    (folder / "manifest.json").write_text((traces["cornell"] / "manifest.json").read_text())
+
+    class Old(dict):
+        record_bytes = sections.record_bytes
+
+    write_trace(folder / "trace.rtt", Old(old), version=4)
+    stats = checked(sim_exe, folder, tmp_path / "run", "shading.enabled=true")
+    assert "shading" not in stats["model"]
+    unused = {u["key"]: u["why"] for u in stats["summary"]["resolved"]["unused"]}
+    assert "no shading sections" in unused["shading.enabled"]
+    write_trace(folder / "trace.rtt", Old(old), version=6)
+    result = run_rtsim("simulate", str(folder), "-o", str(tmp_path / "run6"), "--no-progress")
+    assert result.returncode == 2 and "trace version 6 is not supported" in result.stderr
+    assert "reads versions 3 to 5" in result.stderr
