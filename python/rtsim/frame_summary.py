@@ -54,8 +54,10 @@ def frame_table(stats: dict[str, Any]) -> Table:
     table.add_row("shader core issue utilisation", fmt_pct(sh.get("core_utilization")))
     table.add_row("texture model", str(sh.get("texture_model")))
     if sh.get("tex_hit_rate") is not None:
-        table.add_row("texture samples / cache hit rate",
-                      f"{fmt_int(sh.get('texture_samples'))} / {fmt_pct(sh.get('tex_hit_rate'))}")
+        table.add_row(
+            "texture samples / cache hit rate",
+            f"{fmt_int(sh.get('texture_samples'))} / {fmt_pct(sh.get('tex_hit_rate'))}",
+        )
         tex_dram = _get(stats, "model.dram.by_kind.texture.read_bytes")
         rays = _get(stats, "summary.rays")
         if _is_num(tex_dram) and _is_num(rays) and rays:

@@ -380,8 +380,8 @@ def print_mismatches(stats: dict[str, Any], console: Console | None = None) -> N
     )
     if v.get("texel_mismatches"):
         console.print(
-            f"[bold red]MISMATCH: {fmt_int(v.get('texel_mismatches'))} ray(s)' texel addresses differ "
-            f"from the reference tracer's: {v.get('first_texel_mismatch')}[/]"
+            f"[bold red]MISMATCH: {fmt_int(v.get('texel_mismatches'))} ray(s)' texel addresses "
+            f"differ from the reference tracer's: {v.get('first_texel_mismatch')}[/]"
         )
     for example in (v.get("first_mismatches") or [])[:10]:
         if isinstance(example, dict):

@@ -68,13 +68,16 @@ def test_frame_checks_and_breakdown(traces: dict[str, Path], sim_exe: Path, tmp_
     assert sum(sh["breakdown"][k] for k in BREAKDOWN) == sh["frame_cycles"]
     assert sh["frame_cycles"] >= stats["summary"]["cycles"]
     assert 0.0 < sh["shading_share"] < 1.0
-    assert stats["model"]["dram"]["by_kind"].get("texture", {}).get("reads", 0) > 0 or \
-        stats["model"]["l2"]["by_kind"]["texture"]["reads"] > 0
+    assert (
+        stats["model"]["dram"]["by_kind"].get("texture", {}).get("reads", 0) > 0
+        or stats["model"]["l2"]["by_kind"]["texture"]["reads"] > 0
+    )
     if loop == "wavefront":
         # One wavefront per depth: primaries, then each bounce's path and shadow rays, then the
         # last bounce's shadow rays (depths 0..3 for two bounces).
-        assert [w["rays"] for w in sh["wavefronts"]] == list(np.bincount(
-            rtsim.open_trace(traces["cornell"]).rays["depth"]))
+        assert [w["rays"] for w in sh["wavefronts"]] == list(
+            np.bincount(rtsim.open_trace(traces["cornell"]).rays["depth"])
+        )
 
 
 def test_no_texture_cache_without_textures(traces: dict[str, Path], sim_exe: Path,
@@ -97,7 +100,11 @@ def test_hits_unchanged_by_shading_options(traces: dict[str, Path], sim_exe: Pat
         (
             ["shading.enabled=true"],
             ["shading.enabled=true", "shading.reorder=material"],
-            ["shading.enabled=true", "shading.reorder=material_direction", "shading.frame_loop=inflight"],
+            [
+                "shading.enabled=true",
+                "shading.reorder=material_direction",
+                "shading.frame_loop=inflight",
+            ],
             ["shading.enabled=true", "shading.reorder=shader", "shading.cores=2"],
         )
     ):
