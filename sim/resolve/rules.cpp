@@ -178,8 +178,8 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
     else if (f.config.treelets.prefetch && !f.level.timed)
         out.push_back({"treelets.prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
     if (f.config.shading.enabled && !f.structure.shading_sections)
-        out.push_back({"shading.enabled", "this trace has no shading sections (written before trace version 5, or "
-                                          "from rays a caller gave): the RT unit alone is timed"});
+        out.push_back({"shading.enabled", "this trace has no shading sections (written before trace version 5): "
+                                          "the RT unit alone is timed"});
     if (!f.config.shading.enabled && f.config.shading.reorder != ShadeReorder::none)
         out.push_back({"shading.reorder", "shading.enabled is false: no hit is shaded, so none is reordered"});
     return out;

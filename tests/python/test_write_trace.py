@@ -22,16 +22,17 @@ def primary(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_same_rays_give_the_same_trace_file(primary: Path, tmp_path: Path) -> None:
     """The tracer's primary rays, given back as user rays: every section of trace.rtt is
-    byte-identical, except that given rays carry no shading sections (their ray cones and parents
-    are unknown: docs/shading.md), so a frame is modelled only from the tracer's own traces."""
+    byte-identical but the rays' shading records and texel addresses, since rays given from
+    Python carry no ray cone (width and spread 0: texels at the finest level, docs/shading.md)."""
     rays = rtsim.open_trace(primary).rays
     manifest = rtsim.write_trace(
         "cornell", rays["origin"], rays["direction"], rays["tmin"], rays["tmax"], out=tmp_path
     )
-    shading = {"MATL", "TEXR", "PTRI", "SHAD", "TXFT"}
     traced, given = read_sections(primary / "trace.rtt"), read_sections(tmp_path / "trace.rtt")
-    assert set(given) == set(traced) - shading
-    assert all(given[name] == traced[name] for name in given)
+    assert set(given) == set(traced)
+    assert all(given[name] == traced[name] for name in given if name not in ("SHAD", "TXFT"))
+    shade = rtsim.open_trace(tmp_path).section("SHAD")
+    assert (shade["parent"] == -1).all() and (shade["cone_spread"] == 0).all()
     assert manifest["counts"]["rays"] == len(rays)
     assert manifest["workload"]["requested"] == "given"
     effects = {e["name"]: e for e in manifest["workload"]["effects"]}
