@@ -62,6 +62,12 @@ def frame_table(stats: dict[str, Any]) -> Table:
         rays = _get(stats, "summary.rays")
         if _is_num(tex_dram) and _is_num(rays) and rays:
             table.add_row("texture DRAM bytes / ray", fmt_float(tex_dram / rays, 1))
+    for k in (_get(stats, "verdict.frame") or [])[:3]:
+        table.add_row(
+            f"  frame knob: --set {k.get('key')}={k.get('to')} (now {k.get('from')})",
+            f"{fmt_float(k.get('frame_speedup'), 3)}x frame ({k.get('part')} "
+            f"{fmt_float(k.get('part_speedup'), 2)}x)",
+        )
     table.add_row("texel mismatches", fmt_int(sh.get("texel_mismatches")))
     table.add_row("energy / frame (mJ)", fmt_float(frame_energy_mj(stats), 4))
     return table
