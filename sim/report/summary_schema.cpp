@@ -181,8 +181,16 @@ const StatBlock& provenance_stats() {
 }
 
 /// The summary's optional keys are a sampled run's estimate, except the one a traversal unit kind
-/// writes (simd_efficiency: runs of SIMT units only).
-static bool sampled_only(const StatDecl& d) { return d.optional && std::string(d.key) != "simd_efficiency"; }
+/// writes (simd_efficiency: runs of SIMT units only) and the frame's (runs with shading.enabled,
+/// which are never sampled).
+static bool sampled_only(const StatDecl& d) {
+    static const char* const not_sampled[] = {"simd_efficiency", "frame_ms", "shading_share", "frame_speedup_2x_rt",
+                                              "shading_divergence", "shading_simd_efficiency", "tex_hit_rate",
+                                              "energy_per_frame_mj"};
+    for (const char* k : not_sampled)
+        if (std::string(d.key) == k) return false;
+    return d.optional;
+}
 
 void check_summary(const nlohmann::json& summary, bool sampled) {
     summary_stats().check(summary);
