@@ -63,9 +63,8 @@ LEVELS = {
 def lanes_key(sim: str) -> dict[str, str]:
     """How this simulator spells each kind's lanes: traversal.<kind>.lanes, or (before the unit
     kinds had sections of their own) one traversal.lanes."""
-    schema = json.loads(
-        subprocess.run([sim, "--dump-schema"], capture_output=True, text=True, check=True).stdout
-    )
+    schema = json.loads(subprocess.run([sim, "--dump-schema"], capture_output=True, text=True,
+                                       check=True).stdout)
     fields = schema.get("traversal", {}).get("fields", {})
     own = "simt" in fields or "simt" in schema.get("traversal", {})
     return {k: f"traversal.{k}.lanes" if own else "traversal.lanes" for k in ("simt", "packet")}
@@ -105,22 +104,20 @@ def cells() -> list[dict[str, Any]]:
     ]
 
 
-def run_cell(
-    sim: str, lanes: dict[str, str], traces: dict, out: Path, i: int, cell: dict[str, Any]
-) -> dict[str, Any]:
+def run_cell(sim: str, lanes: dict[str, str], traces: dict, out: Path, i: int,
+             cell: dict[str, Any]) -> dict[str, Any]:
     trace = traces[(cell["structure"], cell["technique"] == "compressed leaves")]
     if isinstance(trace, str):
         return {**cell, "ok": False, "by": "tracer", "message": trace}
     sets = []
     for a in UNITS[cell["unit"]] + TECHNIQUES[cell["technique"]] + LEVELS[cell["level"]]:
         if a.startswith("LANES "):
-            kind, n = a[len("LANES ") :].split("=")
+            kind, n = a[len("LANES "):].split("=")
             a = f"{lanes[kind]}={n}"
         sets += ["--set", a]
     run = out / "runs" / str(i)
-    r = subprocess.run(
-        [sim, str(trace), "-o", str(run), "--no-verdict", *sets], capture_output=True, text=True
-    )
+    r = subprocess.run([sim, str(trace), "-o", str(run), "--no-verdict", *sets],
+                       capture_output=True, text=True)
     shutil.rmtree(run, ignore_errors=True)
     message = " ".join(r.stderr.split())
     if r.returncode == 0:
@@ -164,12 +161,10 @@ def summary(results: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-def markdown(
-    after: dict[str, Any], before: dict[str, Any] | None, sim: str, old: str | None
-) -> str:
+def markdown(after: dict[str, Any], before: dict[str, Any] | None, sim: str, old: str | None) -> str:
     cols = [("after", after)] + ([("before", before)] if before else [])
     lines = [
-        "Measured with `python scripts/composition_matrix.py"
+        f"Measured with `python scripts/composition_matrix.py"
         + (" --before OLD_RTSIM_SIM" if before else "")
         + f" --write-docs` ({after['combinations']:,} combinations: 3 unit kinds x 9 structures x "
         "9 techniques x 5 levels, each one `rtsim-sim` run on an 8x6 trace; after: "
@@ -180,46 +175,30 @@ def markdown(
         "| combinations run | " + " | ".join(f"{s['run']:,}" for _, s in cols) + " |",
         "| refused | " + " | ".join(f"{s['refused']:,}" for _, s in cols) + " |",
         "| run with a hit or work mismatch | "
-        + " | ".join(f"{s['unclean']:,}" for _, s in cols)
-        + " |",
+        + " | ".join(f"{s['unclean']:,}" for _, s in cols) + " |",
     ]
-    for title, key in (
-        ("unit kind", "refused_by_unit"),
-        ("level", "refused_by_level"),
-        ("technique", "refused_by_technique"),
-    ):
+    for title, key in (("unit kind", "refused_by_unit"), ("level", "refused_by_level"),
+                       ("technique", "refused_by_technique")):
         names = list(dict.fromkeys(n for _, s in cols for n in s[key]))
         for n in names:
-            lines.append(
-                f"| refused, {title} {n} | "
-                + " | ".join(f"{s[key].get(n, 0):,}" for _, s in cols)
-                + " |"
-            )
-    lines += [
-        "",
-        "What refuses the remaining combinations (after), by the setting the refusal "
-        "names and what it needs:",
-        "",
-        "| refused by | combinations |",
-        "|---|---:|",
-    ]
+            lines.append(f"| refused, {title} {n} | "
+                         + " | ".join(f"{s[key].get(n, 0):,}" for _, s in cols) + " |")
+    lines += ["", "What refuses the remaining combinations (after), by the setting the refusal "
+              "names and what it needs:", "", "| refused by | combinations |", "|---|---:|"]
     lines += [f"| {k} | {v:,} |" for k, v in after["refused_by_reason"].items()]
     return "\n".join(lines) + "\n"
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
-    )
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sim", default="rtsim-sim", help="the simulator (default: rtsim-sim)")
     ap.add_argument("--before", help="an older rtsim-sim to count the same product with")
     ap.add_argument("--out", type=Path, default=Path("out/composition"))
     ap.add_argument("--jobs", type=int, default=2, help="runs at once (default: 2)")
-    ap.add_argument(
-        "--write-docs",
-        action="store_true",
-        help="write the counts between the composition-counts markers of docs/capabilities.md",
-    )
+    ap.add_argument("--write-docs", action="store_true",
+                    help="write the counts between the composition-counts markers of "
+                    "docs/capabilities.md")
     a = ap.parse_args()
     sim = shutil.which(a.sim) or a.sim
     after_results = measure(sim, a.out / "after", a.jobs)
