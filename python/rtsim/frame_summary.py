@@ -36,6 +36,19 @@ def frame_table(stats: dict[str, Any]) -> Table:
         value = breakdown.get(part)
         share = value / frame if _is_num(value) and _is_num(frame) and frame else None
         table.add_row(f"  {part}", f"{fmt_int(value)} ({fmt_pct(share)})")
+    stalls = sh.get("stalls") or {}
+    if stalls:
+        table.add_row(
+            "stalls: RT unit on shading / cores on traversal / texture-bound shading",
+            " / ".join(
+                fmt_int(stalls.get(k))
+                for k in (
+                    "rt_waits_for_shading",
+                    "cores_wait_for_traversal",
+                    "shading_texture_bound",
+                )
+            ),
+        )
     table.add_row(
         "shading share (all but traversal)",
         f"{fmt_pct(sh.get('shading_share'))} (source text: at least 50%)",

@@ -199,6 +199,7 @@ Cycle ShadingBlock::wavefront_end(uint32_t w, Cycle end) {
     // Rays of a wavefront start at its release; it is traced until `end`, then shaded.
     const uint64_t warps0 = m_warps, programs0 = m_programs, issued0 = m_issued, slots0 = m_lane_slots;
     const uint64_t useful0 = m_lane_instructions, lines0 = m_tex_lines, rays = m_pending.size();
+    const uint64_t busy0 = m_cores->issue_busy();
     m_reorder_exposed = 0;
     m_cores->advance_to(end);
     const Cycle shaded = m_pending.empty() ? end : shade(m_pending, end, m_config.reorder != ShadeReorder::none);
@@ -208,6 +209,10 @@ Cycle ShadingBlock::wavefront_end(uint32_t w, Cycle end) {
     m_traversal += traversal;
     m_reorder += reorder;
     m_shading += shaded - end - reorder;
+    // Of the shading span, what the cores' issue slots (spread over every core) do not explain
+    // waited on texels: the texture-bound part.
+    const uint64_t issue_bound = (m_cores->issue_busy() - busy0) / m_config.cores;
+    m_texture_bound += shaded - end - reorder > issue_bound ? shaded - end - reorder - issue_bound : 0;
     m_wavefronts.push_back({{"wavefront", w},
                             {"rays", rays},
                             {"traversal_cycles", traversal},

@@ -88,7 +88,7 @@ private:
     Cycle m_reorder_exposed = 0;  ///< sorting before the first warp of the current batch
     // Frame accounting (wavefront: serial parts that sum to the frame time).
     Cycle m_release = 0;  ///< current wavefront's start
-    uint64_t m_traversal = 0, m_reorder = 0, m_shading = 0;
+    uint64_t m_traversal = 0, m_reorder = 0, m_shading = 0, m_texture_bound = 0;
     Cycle m_last_end = 0;
     nlohmann::json m_wavefronts = nlohmann::json::array();
     // Counters.

@@ -14,6 +14,7 @@ const StatBlock& shading_stats() {
             {"frame_cycles", "cycles", "Frame time: ray generation to the last ray shaded", true},
             {"frame_ms", "ms", "Frame time at the clock", true},
             {"breakdown", "cycles", "`{raygen, traversal, reorder, shading}`, summing to `frame_cycles` (inflight: traversal spans the RT unit's busy period, shading the tail after it)", true},
+            {"stalls", "cycles", "wavefront loop: `{rt_waits_for_shading, cores_wait_for_traversal, shading_texture_bound}`: the RT unit idle while a bounce is generated, sorted and shaded; the shader cores idle while it is traced; the part of shading the cores' issue does not explain (waiting for texels). Absent in flight (the two overlap)", true, true},
             {"shading_share", "", "Fraction of the frame not in traversal (raygen + reorder + shading) / frame", true},
             {"amdahl", "", "`{traversal_share, speedup_2x_rt, speedup_infinite_rt}`: what a 2x (or infinitely) faster RT unit buys the frame with shading unchanged", true},
             {"rays", "rays", "Rays shaded (every ray of the trace, once)"},
@@ -97,7 +98,12 @@ json ShadingBlock::stats_json(Cycle rt_end, double clock_ghz) const {
                               double(m_sorted) * m_config.reorder_pj)
         .set("area_mm2", m_config.cores * m_config.core_mm2)
         .set("max_pending", m_max_pending);
-    if (m_config.frame_loop == FrameLoop::wavefront) w.set("wavefronts", m_wavefronts);
+    if (m_config.frame_loop == FrameLoop::wavefront) {
+        w.set("wavefronts", m_wavefronts);
+        w.set("stalls", json{{"rt_waits_for_shading", m_raygen_end + m_reorder + m_shading},
+                             {"cores_wait_for_traversal", m_traversal},
+                             {"shading_texture_bound", m_texture_bound}});
+    }
     if (!m_tex.empty()) {
         json caches = json::object();
         for (const auto& c : m_tex) caches[c->basename()] = c->stats_json(frame);
