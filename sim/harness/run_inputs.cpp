@@ -1,8 +1,5 @@
 #include "sim/harness/run_inputs.h"
 
-#include <algorithm>
-
-#include "sim/harness/shading_run.h"
 
 #include <filesystem>
 #include <iostream>
@@ -54,8 +51,9 @@ BuiltRun build_run(RunInputs& in, bool per_ray_spills) {
     in.reader.verify_all();
     b.rays = b.workload["rays"];
     const TraversalConfig& t = c.traversal;
-    // The model's own regions start past the image and the trace's textures (shading_run.h).
-    b.map = std::make_unique<MemoryMap>(std::max(b.accel->image().end_address(), texture_end(in.reader)), b.rays,
+    // The model's own regions start past the image; a trace's textures lie far above them
+    // (from 1 TiB, traces/shading/materials.h), checked by the shading block's inputs.
+    b.map = std::make_unique<MemoryMap>(b.accel->image().end_address(), b.rays,
                                         per_ray_spills ? b.rays : uint64_t(t.units) * t.contexts(),
                                         b.accel->max_stack_entries(), t.stack_entry_bytes);
     return b;

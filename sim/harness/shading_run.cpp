@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "traces/common/error.h"
+#include "traces/shading/materials.h"
 
 namespace rtsim {
 
@@ -15,13 +16,6 @@ std::vector<T> read_section(TraceReader& reader, SectionKind kind) {
 }
 
 }  // namespace
-
-uint64_t texture_end(TraceReader& reader) {
-    uint64_t end = 0;
-    for (const TextureRecord& t : read_section<TextureRecord>(reader, SectionKind::textures))
-        end = std::max(end, t.base + t.bytes);
-    return end;
-}
 
 std::unique_ptr<ShadingInputs> load_shading_inputs(TraceReader& reader, const SimConfig& config) {
     if (!config.shading.enabled || !reader.has(SectionKind::shading) || !reader.has(SectionKind::tri_shading) ||
@@ -43,6 +37,10 @@ std::unique_ptr<ShadingInputs> load_shading_inputs(TraceReader& reader, const Si
             require(t < int32_t(in->textures.size()), where + "a material samples texture " + std::to_string(t) +
                                                           " of " + std::to_string(in->textures.size()));
     }
+    // Textures lie above every region the model adds (traces/shading/materials.h).
+    for (const TextureRecord& t : in->textures)
+        require(t.base >= kTextureBase, where + "a texture at address " + std::to_string(t.base) +
+                                            " lies below the textures' base (1 TiB), among the model's own regions");
     for (const TriShadeRecord& t : in->tris)
         require(t.material < in->materials.size(), where + "PTRI names material " + std::to_string(t.material) +
                                                         " of " + std::to_string(in->materials.size()));

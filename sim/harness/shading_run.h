@@ -16,9 +16,6 @@ namespace rtsim {
 /// addresses and the wavefronts; null when shading.enabled is false or the trace has no shading
 /// sections (the resolution step lists the setting as unused then).
 std::unique_ptr<ShadingInputs> load_shading_inputs(TraceReader& reader, const SimConfig& config);
-/// End of the trace's texture chains in the memory image (0 without textures): the memory map's
-/// own regions start past them.
-uint64_t texture_end(TraceReader& reader);
 /// The wavefronts as stream segments (each a run of rays of one depth, in trace order).
 std::vector<FrameRecord> wavefront_segments(const ShadingInputs& inputs);
 /// Wires the frame loop into dispatch: no ray before ray generation ends; wavefront: a barrier

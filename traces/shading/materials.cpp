@@ -5,7 +5,7 @@
 #include <cmath>
 #include <map>
 
-#include "traces/accel/accel_image.h"
+#include "traces/common/error.h"
 #include "traces/raygen/workload.h"
 
 namespace rtsim {
@@ -99,7 +99,9 @@ const char* texture_origin_name(TextureOrigin o) {
 
 ShadingScene build_shading_scene(const Scene& scene, const std::string& name, bool procedural, uint64_t image_end) {
     ShadingScene out;
-    out.texture_base = align_to(std::max<uint64_t>(image_end, 1), AccelImage::kGranule);
+    require(image_end < kTextureBase / 2, scene.source + ": the acceleration-structure image ends at " +
+                                              std::to_string(image_end) + ", too close to the textures' base");
+    out.texture_base = kTextureBase;
     uint64_t next = out.texture_base;
     std::map<uint32_t, uint16_t> shader_of;  // feature set -> dense id, in first-use order
     for (const Material& m : scene.materials) {

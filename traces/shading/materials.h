@@ -42,8 +42,11 @@ const char* shader_feature_name(int bit);
 enum class TextureOrigin : uint8_t { image = 0, stand_in = 1, procedural = 2 };
 const char* texture_origin_name(TextureOrigin o);
 
-/// Textures are laid out from the first 4 GiB granule after the acceleration-structure image,
-/// each chain 4 KiB aligned.
+/// Textures are laid out from 1 TiB up, each chain 4 KiB aligned: above the acceleration-structure
+/// image and every region the model adds (rays, hits, stacks: each from a 4 GiB granule past the
+/// image), so a trace's textures leave the model's own addresses where a trace without them has
+/// them and the RT unit's figures do not move with them.
+constexpr uint64_t kTextureBase = uint64_t(1) << 40;
 constexpr uint64_t kTextureAlign = 4096;
 
 /// The shading side of a scene: materials, their textures at addresses, and per primitive its
@@ -62,7 +65,7 @@ struct ShadingScene {
 };
 
 /// Materials and textures of `scene` (`procedural`: a built-in scene named `name`), textures
-/// placed from `image_end` (AccelImage::end_address()) rounded up to a 4 GiB granule.
+/// placed from kTextureBase (`image_end`, AccelImage::end_address(), must lie below it).
 ShadingScene build_shading_scene(const Scene& scene, const std::string& name, bool procedural, uint64_t image_end);
 
 /// Primitive `prim`'s shading record: TEXCOORD_0 of its corners, else the planar projection (the
