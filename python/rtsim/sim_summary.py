@@ -347,6 +347,10 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         console.print(resolved_table(stats))
     if len(stats.get("frames", []) or []) > 1:
         console.print(frames_table(stats))
+    if _get(stats, "model.shading"):
+        from rtsim.frame_summary import frame_table
+
+        console.print(frame_table(stats))
     if _get(stats, "summary.cycles") is not None:
         console.print(utilisation_table(stats))
         if stats.get("verdict") or stats.get("roofline"):
@@ -374,6 +378,11 @@ def print_mismatches(stats: dict[str, Any], console: Console | None = None) -> N
         f"{fmt_int(v.get('work_mismatches'))} work count(s) differ from the reference tracer "
         f"(of {fmt_int(v.get('rays_checked'))} rays checked)[/]"
     )
+    if v.get("texel_mismatches"):
+        console.print(
+            f"[bold red]MISMATCH: {fmt_int(v.get('texel_mismatches'))} ray(s)' texel addresses "
+            f"differ from the reference tracer's: {v.get('first_texel_mismatch')}[/]"
+        )
     for example in (v.get("first_mismatches") or [])[:10]:
         if isinstance(example, dict):
             console.print(

@@ -89,6 +89,10 @@ class Trace:
     def has(self, name: str) -> bool:
         return name in self.sections
 
+    def section(self, name: str) -> np.ndarray:
+        """Records of a record section by its name ("SHAD", "TXFT", ...; docs/trace_format.md)."""
+        return self._map(name.lower())
+
     @cached_property
     def accel(self) -> dict[str, Any]:
         """The acceleration structure's descriptor: kind, params, stats, bounds, regions."""

@@ -312,10 +312,16 @@ void bind_trace(py::module_& m) {
             const nlohmann::json j = {{"rays", layout_json(layout_of(static_cast<const RayRecord*>(nullptr)))},
                                       {"hits", layout_json(layout_of(static_cast<const HitRecord*>(nullptr)))},
                                       {"work", layout_json(layout_of(static_cast<const WorkRecord*>(nullptr)))},
-                                      {"frms", layout_json(layout_of(static_cast<const FrameRecord*>(nullptr)))}};
+                                      {"frms", layout_json(layout_of(static_cast<const FrameRecord*>(nullptr)))},
+                                      {"matl", layout_json(layout_of(static_cast<const MaterialRecord*>(nullptr)))},
+                                      {"texr", layout_json(layout_of(static_cast<const TextureRecord*>(nullptr)))},
+                                      {"ptri", layout_json(layout_of(static_cast<const TriShadeRecord*>(nullptr)))},
+                                      {"shad", layout_json(layout_of(static_cast<const ShadeRecord*>(nullptr)))},
+                                      {"txft", layout_json(scalar_layout<uint64_t>())}};
             return py::module_::import("json").attr("loads")(j.dump());
         },
-        "The record layouts of the trace's RAYS, HITS, WORK and FRMS sections as C++ declares them\n"
+        "The record layouts of the trace's RAYS, HITS, WORK, FRMS and shading sections (MATL, TEXR, PTRI,\n"
+        "SHAD, TXFT) as C++ declares them\n"
         "(traces/format/trace_format.h): {section: [{name, type, offset, shape}]}. Image regions carry\n"
         "their layouts in the ACCL descriptor.");
 

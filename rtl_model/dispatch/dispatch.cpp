@@ -130,18 +130,52 @@ void Dispatch::set_frames(std::vector<uint64_t> frame_rays, FrameEnd on_end, Fra
 }
 
 bool Dispatch::next_ray(uint32_t unit, RayJob* job) {
+    if (m_gate) return next_gated(unit, job);
     if (!RayDealer::next_ray(unit, job)) return false;
     job->not_before = std::max(job->not_before, m_release);  // sorted rays wait for their window
+    ++m_handed;
     return true;
 }
 
-bool Dispatch::exhausted() const { return m_frame + 1 >= m_frame_rays.size() && RayDealer::exhausted(); }
+bool Dispatch::next_gated(uint32_t unit, RayJob* job) {
+    // Rays wait in trace order; children follow their parents closely, so asking the oldest few
+    // finds the ready ones without a scan of every held ray.
+    constexpr size_t kAsked = 64, kMaxHeld = 1u << 16;
+    Cycle not_before = 0;
+    const size_t asked = std::min(kAsked, m_held.size());
+    for (size_t i = 0; i < asked; ++i)
+        if (m_gate(m_held[i].id, &not_before)) {
+            *job = m_held[i];
+            m_held.erase(m_held.begin() + long(i));
+            job->not_before = std::max({job->not_before, m_release, not_before});
+            ++m_handed;
+            return true;
+        }
+    RayJob next;
+    while (m_held.size() < kMaxHeld && RayDealer::next_ray(unit, &next)) {
+        if (m_gate(next.id, &not_before)) {
+            *job = next;
+            job->not_before = std::max({job->not_before, m_release, not_before});
+            ++m_handed;
+            return true;
+        }
+        m_held.push_back(next);
+    }
+    return false;
+}
+
+bool Dispatch::exhausted() const {
+    return m_frame + 1 >= m_frame_rays.size() && RayDealer::exhausted() && m_held.empty();
+}
 
 void Dispatch::ray_finished(Cycle cycle) {
+    ++m_finished_total;
     m_frame_end = std::max(m_frame_end, cycle);
     if (++m_finished < m_frame_rays[m_frame]) return;
-    // The frame's last ray is done: the next frame (skipping empty ones) starts at its cycle.
+    // The frame's last ray is done: the next frame (skipping empty ones) starts at its cycle,
+    // or when the barrier (the shading of a wavefront) releases it.
     do {
+        if (m_barrier) m_frame_end = std::max(m_frame_end, m_barrier(m_frame, m_frame_end));
         if (m_on_end) m_on_end(m_frame, m_frame_end);
         if (m_frame + 1 >= m_frame_rays.size()) return;
         ++m_frame;

@@ -103,6 +103,21 @@ public:
     /// Rays per frame (summing to the stream's rays); without a call, one frame of every ray.
     void set_frames(std::vector<uint64_t> frame_rays, FrameEnd on_end, FrameBegin on_begin);
 
+    /// A barrier's release: frame (or wavefront) f's last ray finished at `cycle`; returns the
+    /// cycle the next one's rays may start (the shading block's end of shading it).
+    using Barrier = std::function<Cycle(uint32_t f, Cycle cycle)>;
+    void set_barrier(Barrier barrier) { m_barrier = std::move(barrier); }
+    /// No ray starts before `cycle` (ray generation's end).
+    void hold_until(Cycle cycle) { m_release = std::max(m_release, cycle); }
+    /// A ray may go only when gate(id, &not_before) is true (the in-flight frame loop: its
+    /// parent is shaded); rays held back wait, the first few in trace order re-asked each time.
+    using Gate = std::function<bool(uint64_t id, Cycle* not_before)>;
+    void set_gate(Gate gate) { m_gate = std::move(gate); }
+    /// Rays held by the gate may go now: waiting units ask again.
+    void wake() { m_released.notify(sc_core::SC_ZERO_TIME); }
+    /// Rays handed to units and not yet finished.
+    uint64_t in_flight() const { return m_handed - m_finished_total; }
+
     bool next_ray(uint32_t unit, RayJob* job) override;
     bool exhausted() const override;
     uint32_t frame() const override { return m_frame; }
@@ -110,6 +125,12 @@ public:
     void ray_finished(Cycle cycle) override;
 
 private:
+    bool next_gated(uint32_t unit, RayJob* job);
+
+    Barrier m_barrier;
+    Gate m_gate;
+    std::deque<RayJob> m_held;  ///< gated rays read from the stream but not yet allowed
+    uint64_t m_handed = 0, m_finished_total = 0;
     std::vector<uint64_t> m_frame_rays;
     FrameEnd m_on_end;
     FrameBegin m_on_begin;

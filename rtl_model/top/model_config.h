@@ -14,6 +14,7 @@
 #include "rtl_model/mem/cache_config.h"
 #include "rtl_model/mem/dram_config.h"
 #include "rtl_model/ray_buffer/ray_buffer_config.h"
+#include "rtl_model/shading/shading_config.h"
 #include "rtl_model/traversal/mailbox_config.h"
 #include "rtl_model/traversal/step_demand.h"
 #include "rtl_model/traversal/traversal_config.h"
@@ -77,6 +78,7 @@ struct ModelConfig {
     }();
     DramConfig dram;
     TreeletConfig treelets;
+    ShadingConfig shading;
 
     /// The pipeline operations of `kind` go to. Adding an operation kind adds a PipelineConfig
     /// member, its visit() line and a case here (docs/accel.md, "Adding a structure"); a kind with
@@ -106,6 +108,7 @@ struct ModelConfig {
         v.section("l2", l2);
         v.section("dram", dram);
         v.section("treelets", treelets);
+        v.section("shading", shading);
     }
 };
 

@@ -7,6 +7,7 @@
 #include "rtl_model/isect/pipeline.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/ray_buffer/ray_buffer.h"
+#include "rtl_model/shading/shading_block.h"
 #include "rtl_model/traversal/traversal_unit.h"
 #include "traces/common/error.h"
 
@@ -27,6 +28,7 @@ const StatBlock& model_stats() {
                         {"cycle_accounting", "", "where ray-context time went (`model.cycle_accounting`); timed levels only", false, true},
                         {"utilization", "", "shared resources' busy fractions (`model.utilization`); timed levels only", false, true},
                         {"analytic", "", "the analytic level's closed form (`model.analytic`); analytic level only", false, true},
+                        {"shading", "", "only with `shading.enabled`: the frame, shader cores, texture caches and sorting stage (`model.shading`)", false, true},
                     }};
         for (const char* kind : kOpKindNames)
             b.stats.push_back({kind, "", "`{pipe: stats}`: the pipeline blocks of this operation kind, when built (`model.<kind>.<pipe>`)", false, true});
@@ -104,6 +106,7 @@ void check_model_stats(const nlohmann::json& m, const std::string& unit_kind) {
     if (m.contains("ray_buffer")) ray_buffer_stats().check(m.at("ray_buffer"));
     if (m.contains("cycle_accounting")) cycle_accounting_stats().check(m.at("cycle_accounting"));
     if (m.contains("utilization")) utilization_stats().check(m.at("utilization"));
+    if (m.contains("shading")) shading_stats().check(m.at("shading"));
 }
 
 RTSIM_REGISTER_STAT_BLOCK(model_stats)

@@ -31,7 +31,8 @@ private:
 };
 
 Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const StepOptions& step,
-         const MemoryMap& map, RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features)
+         const MemoryMap& map, RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features,
+         const ShadingInputs* shading)
     : sc_core::sc_module(name),
       m_config(config),
       m_unit_context{config.quantum_cycles, config.dispatch.latency, config.treelets.idle_poll_cycles},
@@ -44,6 +45,7 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
     build_memory();
     build_pipelines(accel);
     build_treelets(accel, map);
+    build_shading(shading, sink);
     // Detailed (quantum 1) with private pipelines: a unit's operations phases touch only its own
     // blocks, so they need not wait for SystemC time (docs/model.md, "Detailed level").
     bool private_ops = true;
@@ -57,7 +59,8 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
     for (uint32_t u = 0; u < config.traversal.units; ++u) {
         auto unit = kind.make_unit(("tu" + std::to_string(u)).c_str(), setup, u);
         unit->rays(*m_dispatch);
-        unit->sink(sink);
+        if (m_shading) unit->sink(*m_shading);
+        else unit->sink(sink);
         if (m_ideal) unit->mem(*m_ideal);
         else unit->mem(*m_l1[u]);
         for (int k = 0; k < kOpKindCount; ++k) {
@@ -76,6 +79,35 @@ Top::Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& a
 }
 
 Top::~Top() = default;
+
+void Top::build_shading(const ShadingInputs* shading, RaySinkIf& sink) {
+    const ShadingConfig& c = m_config.shading;
+    if (!c.enabled || !shading) {
+        m_instantiated.push_back({{"block", "shading"}, {"instantiated", false},
+                                  {"why", c.enabled ? "the trace has no shading sections (version 4 or older)"
+                                                    : "shading.enabled is false: the RT unit alone is timed"}});
+        return;
+    }
+    m_shading = std::make_unique<ShadingBlock>("shading", c, *shading, sink, m_l2.get(), m_config.interconnect_latency,
+                                               m_config.fidelity == Fidelity::detailed);
+    m_instantiated.push_back({{"block", "shading"}, {"instantiated", true},
+                              {"why", std::to_string(c.cores) + " SIMT shader cores (" + std::to_string(c.warp_width) +
+                                          " lanes), " + kFrameLoopChoices.name(c.frame_loop) + " frame loop, " +
+                                          std::to_string(shading->shaders) + " hit shaders"}});
+    m_instantiated.push_back({{"block", "texture_cache"}, {"instantiated", !m_shading->tex_caches().empty()},
+                              {"why", !shading->has_textures() ? "no material samples a texture"
+                                      : m_shading->tex_caches().empty()
+                                          ? "ideal memory"
+                                          : std::to_string(c.cores) + " x " + std::to_string(c.tex_cache.size_kib) +
+                                                " KiB, " + std::to_string(shading->textures.size()) + " textures"}});
+    m_instantiated.push_back({{"block", "shade_reorder"}, {"instantiated", c.reorder != ShadeReorder::none},
+                              {"why", c.reorder == ShadeReorder::none
+                                          ? "shading.reorder is none"
+                                          : std::string("hits sorted by ") + kShadeReorderChoices.name(c.reorder) +
+                                                " in windows of " + std::to_string(c.reorder_window)}});
+}
+
+Cycle Top::frame_cycles() const { return m_shading ? m_shading->frame_end(total_cycles()) : total_cycles(); }
 
 void Top::build_memory() {
     const ModelConfig& c = m_config;
@@ -228,6 +260,7 @@ nlohmann::json Top::stats_json() const {
     if (m_dram) j["dram"] = m_dram->stats_json(total, m_config.clock_ghz);
     j["cycle_accounting"] = cycle_accounting_json(total);
     j["utilization"] = utilization_json(total);
+    if (m_shading) j["shading"] = m_shading->stats_json(total, m_config.clock_ghz);
     check_model_stats(j, m_config.traversal.model);
     return j;
 }

@@ -17,6 +17,7 @@
 #include "rtl_model/mem/cache.h"
 #include "rtl_model/mem/dram.h"
 #include "rtl_model/ray_buffer/ray_buffer.h"
+#include "rtl_model/shading/shading_block.h"
 #include "rtl_model/traversal/traversal_unit.h"
 #include "rtl_model/traversal/unit_kind.h"
 #include "rtl_model/top/model_config.h"
@@ -41,8 +42,11 @@ class Top : public sc_core::sc_module {
 public:
     /// `config` is resolved (sim/resolve/resolve.h: ray contexts derived, the stack entry known);
     /// the steppers walk with `step` (the run's StepOptions).
+    /// `shading`: the trace's shading tables when config.shading.enabled (the resolution step
+    /// requires them then); the shading block sits between the units and `sink`.
     Top(sc_core::sc_module_name name, const ModelConfig& config, const Accel& accel, const StepOptions& step,
-        const MemoryMap& map, RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features);
+        const MemoryMap& map, RayStream& rays, RaySinkIf& sink, const WorkloadFeatures& features,
+        const ShadingInputs* shading = nullptr);
     ~Top() override;
 
     /// Cycle the last ray finished.
@@ -53,6 +57,10 @@ public:
     const nlohmann::json& instantiated() const { return m_instantiated; }
     const Dram* dram() const { return m_dram.get(); }
     Dispatch& dispatch() { return *m_dispatch; }
+    /// The shading block; null when the run does not model the frame.
+    ShadingBlock* shading() { return m_shading.get(); }
+    /// The frame's end: the last ray traced, or shaded when the frame is modelled.
+    Cycle frame_cycles() const;
     /// The memory levels' counters so far (zeros with ideal_memory).
     MemoryTotals memory_totals() const;
     uint32_t units() const { return uint32_t(m_units.size()); }
@@ -67,6 +75,7 @@ private:
     void build_memory();
     void build_pipelines(const Accel& accel);
     void build_treelets(const Accel& accel, const MemoryMap& map);
+    void build_shading(const ShadingInputs* shading, RaySinkIf& sink);
 
     const ModelConfig& m_config;
     UnitContext m_unit_context;
@@ -80,6 +89,7 @@ private:
     std::vector<std::unique_ptr<TraversalUnit>> m_units;
     std::unique_ptr<TreeletMap> m_treelets;  ///< treelet scheduling or prefetching only
     std::unique_ptr<RayBuffer> m_ray_buffer;
+    std::unique_ptr<ShadingBlock> m_shading;
     nlohmann::json m_instantiated = nlohmann::json::array();
 };
 

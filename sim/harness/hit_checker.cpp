@@ -85,6 +85,10 @@ const StatBlock& validation_stats() {
             {"work_mismatches", "rays", "hit equal, work differs: any field of the ray's work counts"},
             {"first_mismatches", "list", "up to 20 `{ray, difference}`: the ray index and the fields that differ, model/reference"},
             {"scope", "", "analytic level only: which rays were checked (the analysis's sampled rays)", false, true},
+            {"shaded_rays", "rays", "only with `shading.enabled`: rays the shading block shaded (every ray, once)", false, true},
+            {"texel_mismatches", "rays", "only with `shading.enabled`: rays whose texel addresses differ from the reference tracer's (0 allowed, else exit 3)", false, true},
+            {"first_texel_mismatch", "", "only with texel mismatches: the first such ray", false, true},
+            {"order_violations", "rays", "only with `shading.enabled`: rays started before their parent was shaded, or shaded twice (0 allowed, else exit 3)", false, true},
         }};
     return block;
 }

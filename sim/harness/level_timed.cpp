@@ -10,6 +10,7 @@
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/level.h"
 #include "sim/harness/model_errors.h"
+#include "sim/harness/shading_run.h"
 #include "sim/harness/trace_stream.h"
 #include "sim/report/summary.h"
 #include "sim/report/timeline.h"
@@ -61,16 +62,27 @@ LevelResult run_timed_level(RunInputs& in) {
     FrameRecorder frame_figures(c, built.frames, in.manifest.value("frames", json(nullptr)));
     Timeline timeline(c.clock_ghz);
     const SimConfig model_config = timed_config(c);
-    FrameRayStream stream(in.reader, built.frames);
+    // The frame (shading.enabled, shading_run.h): the wavefront loop streams bounce by bounce.
+    const std::unique_ptr<ShadingInputs> shading = load_shading_inputs(in.reader, c);
+    const bool wavefront = shading && c.shading.frame_loop == FrameLoop::wavefront;
+    const std::vector<FrameRecord> segments = wavefront ? wavefront_segments(*shading) : built.frames;
+    FrameRayStream stream(in.reader, segments);
     Top top("top", model_config, accel, s.step, map, sampled ? static_cast<RayStream&>(sampled->stream) : stream,
-            checker, built.features);
+            checker, built.features, shading.get());
     // Frame barriers: record each frame's figures, then bind the structure's next frame.
     std::vector<uint64_t> frame_rays;
-    for (const FrameRecord& f : built.frames) frame_rays.push_back(f.rays);
-    if (!sampled)
+    for (const FrameRecord& f : segments) frame_rays.push_back(f.rays);
+    if (wavefront) {
+        // One frame of bounces: each bounce's barrier is its shading; the frame's figures at the last.
+        top.dispatch().set_frames(frame_rays, nullptr, nullptr);
+        wire_frame_loop(top, c.shading, uint32_t(segments.size()),
+                        [&](Cycle end) { frame_figures.frame_end(0, end, top.memory_totals()); });
+    } else if (!sampled) {
         top.dispatch().set_frames(
             frame_rays, [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); },
             [&](uint32_t f) { accel.bind_frame(f); });
+        if (shading) wire_frame_loop(top, c.shading, 1, nullptr);
+    }
     std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
     if (in.options.timeline) {
         kind_reader = std::make_unique<TraceReader>(in.rtt);
@@ -125,13 +137,20 @@ LevelResult run_timed_level(RunInputs& in) {
                                             {"seconds", warmer ? warmer->seconds() : 0.0}};
     }
     r.validation = checker.to_json();
+    if (top.shading()) {
+        // Texel addresses are checked like node fetches: every shaded ray's against the reference.
+        r.validation["texel_mismatches"] = top.shading()->texel_mismatches();
+        r.validation["shaded_rays"] = top.shading()->shaded();
+        r.validation["order_violations"] = top.shading()->order_violations();
+        if (top.shading()->texel_mismatches()) r.validation["first_texel_mismatch"] = top.shading()->first_mismatch();
+    }
     r.latency = checker.latency().to_json();
     r.workload = built.workload;
     r.frames = frame_figures.to_json();
     r.frame_count = built.frames.size();
     r.work = checker.work_totals();
     r.rays = checker.checked();
-    r.bad = checker.hit_mismatches() || checker.work_mismatches();
+    r.bad = checker.hit_mismatches() || checker.work_mismatches() || (top.shading() && (top.shading()->texel_mismatches() || top.shading()->order_violations()));
     // The verdict's estimates trace a sample of rays against the structure (kept alive by the
     // closure, as the report stage runs after this level returns).
     auto kept = std::make_shared<BuiltRun>(std::move(built));

@@ -1,5 +1,6 @@
 #include "sim/harness/run_inputs.h"
 
+
 #include <filesystem>
 #include <iostream>
 
@@ -50,6 +51,8 @@ BuiltRun build_run(RunInputs& in, bool per_ray_spills) {
     in.reader.verify_all();
     b.rays = b.workload["rays"];
     const TraversalConfig& t = c.traversal;
+    // The model's own regions start past the image; a trace's textures lie far above them
+    // (from 1 TiB, traces/shading/materials.h), checked by the shading block's inputs.
     b.map = std::make_unique<MemoryMap>(b.accel->image().end_address(), b.rays,
                                         per_ray_spills ? b.rays : uint64_t(t.units) * t.contexts(),
                                         b.accel->max_stack_entries(), t.stack_entry_bytes);

@@ -339,6 +339,11 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
     summary["mrays_per_joule"] = mrays_per_joule;
     summary["power_w"] = power;
     summary["area_mm2"] = total_mm2;
+    // The frame's energy: the RT unit and memory per ray, plus the shader cores (docs/shading.md).
+    const json& model_stats = stats.value("model", json::object());
+    if (model_stats.contains("shading") && total_nj.is_number())
+        summary["energy_per_frame_mj"] =
+            (total_nj.get<double>() * double(rays) * 1e3 + model_stats["shading"].value("energy_pj", 0.0)) * 1e-9;
 }
 
 const StatBlock& energy_stats() {

@@ -107,6 +107,16 @@ json summarize(const SimConfig& c, uint64_t cycles, uint64_t rays, const json& m
         s["simd_efficiency"] = simd;
     s["box_utilization"] = mean_of(model.value("box", json::object()), pipeline_stats(), "utilization");
     s["triangle_utilization"] = mean_of(model.value("triangle", json::object()), pipeline_stats(), "utilization");
+    if (model.contains("shading")) {
+        // The frame (docs/shading.md): its headline figures beside the RT unit's.
+        const json& sh = model["shading"];
+        s["frame_ms"] = sh["frame_ms"];
+        s["shading_share"] = sh["shading_share"];
+        s["frame_speedup_2x_rt"] = sh["amdahl"]["speedup_2x_rt"];
+        s["shading_divergence"] = sh["divergence"];
+        s["shading_simd_efficiency"] = sh["simd_efficiency"];
+        if (!sh["tex_hit_rate"].is_null()) s["tex_hit_rate"] = sh["tex_hit_rate"];
+    }
     s["l1_hit_rate"] = model.contains("l1") ? hit_rate(model["l1"]) : json(nullptr);
     s["l2_hit_rate"] = model.contains("l2") ? hit_rate(json::array({model["l2"]})) : json(nullptr);
     if (model.contains("dram")) {

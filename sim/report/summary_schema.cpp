@@ -111,6 +111,27 @@ const StatBlock& summary_stats() {
         {"verdict", "",
          "`verdict.text`: one sentence, printed by `rtsim simulate`",
          true, false},
+        {"frame_ms", "ms",
+         "only with `shading.enabled`: `model.shading.frame_ms`, the frame from ray generation to the last ray shaded (docs/shading.md)",
+         false, true},
+        {"shading_share", "fraction",
+         "only with `shading.enabled`: the frame's share not in traversal (`model.shading.shading_share`)",
+         false, true},
+        {"frame_speedup_2x_rt", "x",
+         "only with `shading.enabled`: what a 2x faster RT unit buys the frame (`model.shading.amdahl.speedup_2x_rt`)",
+         false, true},
+        {"shading_divergence", "programs/warp",
+         "only with `shading.enabled`: `model.shading.divergence`",
+         false, true},
+        {"shading_simd_efficiency", "fraction",
+         "only with `shading.enabled`: `model.shading.simd_efficiency`",
+         false, true},
+        {"tex_hit_rate", "fraction",
+         "only with `shading.enabled` and a texture model: `model.shading.tex_hit_rate`",
+         false, true},
+        {"energy_per_frame_mj", "mJ",
+         "only with `shading.enabled`: `energy_per_ray_nj x rays` plus the shader cores' `model.shading.energy_pj`",
+         false, true},
     }};
     return block;
 }
@@ -160,8 +181,16 @@ const StatBlock& provenance_stats() {
 }
 
 /// The summary's optional keys are a sampled run's estimate, except the one a traversal unit kind
-/// writes (simd_efficiency: runs of SIMT units only).
-static bool sampled_only(const StatDecl& d) { return d.optional && std::string(d.key) != "simd_efficiency"; }
+/// writes (simd_efficiency: runs of SIMT units only) and the frame's (runs with shading.enabled,
+/// which are never sampled).
+static bool sampled_only(const StatDecl& d) {
+    static const char* const not_sampled[] = {"simd_efficiency", "frame_ms", "shading_share", "frame_speedup_2x_rt",
+                                              "shading_divergence", "shading_simd_efficiency", "tex_hit_rate",
+                                              "energy_per_frame_mj"};
+    for (const char* k : not_sampled)
+        if (std::string(d.key) == k) return false;
+    return d.optional;
+}
 
 void check_summary(const nlohmann::json& summary, bool sampled) {
     summary_stats().check(summary);

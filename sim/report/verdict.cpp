@@ -326,7 +326,39 @@ json judge(const VerdictContext& c) {
         v["label"] = label_of(binding) + " together with " + label_of(other) + " (a co-limit)";
     }
     v["text"] = verdict_text(v, weighed, not_covered);
+    if (c.model.contains("shading")) v["frame"] = frame_knobs(c.model["shading"], weighed, c.config);
     return v;
+}
+
+json frame_knobs(const json& shading, const json& weighed, const SimConfig& config) {
+    // What each side's knob buys the frame, by Amdahl over the frame's breakdown (docs/shading.md):
+    // a part sped up by s leaves frame / (frame - part + part / s). The RT unit's best estimated
+    // knob speeds traversal; doubling the shader cores or sorting by shader speeds shading (the
+    // latter by the warps' divergence, the programs a sorted warp no longer serialises).
+    const double frame = shading["frame_cycles"].get<double>();
+    const json& b = shading["breakdown"];
+    auto buys = [frame](double part, double s) {
+        return frame > 0 && s > 0 ? frame / (frame - part + part / s) : 1.0;
+    };
+    json out = json::array();
+    for (const json& k : weighed["top"])
+        if (k["speedup"].is_number()) {
+            const double s = k["speedup"].get<double>();
+            out.push_back({{"key", k["key"]}, {"from", k["from"]}, {"to", k["to"]}, {"part", "traversal"},
+                           {"part_speedup", s}, {"frame_speedup", buys(b["traversal"].get<double>(), s)}});
+        }
+    const double shade = b["shading"].get<double>();
+    out.push_back({{"key", "shading.cores"}, {"from", config.shading.cores}, {"to", config.shading.cores * 2},
+                   {"part", "shading"}, {"part_speedup", 2.0}, {"frame_speedup", buys(shade, 2.0)}});
+    if (config.shading.reorder == ShadeReorder::none) {
+        const double div = std::max(1.0, shading["divergence"].get<double>());
+        out.push_back({{"key", "shading.reorder"}, {"from", "none"}, {"to", "shader"}, {"part", "shading"},
+                       {"part_speedup", div}, {"frame_speedup", buys(shade, div)}});
+    }
+    std::stable_sort(out.begin(), out.end(), [](const json& x, const json& y) {
+        return x["frame_speedup"].get<double>() > y["frame_speedup"].get<double>();
+    });
+    return out;
 }
 
 const StatBlock& verdict_stats() {
@@ -346,6 +378,7 @@ const StatBlock& verdict_stats() {
             {"relax", "", "the best candidate, with the same fields; `null` when no knob relaxes the binding resource"},
             {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `reused` (the analysis was loaded from beside the trace, stored there by an earlier run, instead of stepped by this one), `base_cycles` (its cycles for the run's own config), `wall_seconds` (the host time the estimates took)"},
             {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
+            {"frame", "list", "only with `shading.enabled`: the shading side's knobs beside the RT unit's, weighed by what they buy the frame (Amdahl over `model.shading.breakdown`): `key`, `from`, `to`, `part` (traversal or shading), `part_speedup` (the RT knob's estimate; 2 for doubled shader cores; the divergence for sorting by shader, an upper bound), `frame_speedup`; best first", false, true},
         }};
     return block;
 }

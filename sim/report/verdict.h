@@ -66,6 +66,9 @@ struct VerdictContext {
 /// {binding, label, evidence, relax, candidates, top, top_per_mm2, co_limits, coverage, estimate,
 /// analytic_binding, text}; null for the functional level.
 nlohmann::json judge(const VerdictContext& context);
+/// The shading side's knobs beside the RT unit's top ones, weighed by what they buy the frame
+/// (verdict "frame", only in runs that model the frame).
+nlohmann::json frame_knobs(const nlohmann::json& shading, const nlohmann::json& weighed, const SimConfig& config);
 
 /// stats.json "verdict", declared once.
 const StatBlock& verdict_stats();

@@ -24,7 +24,7 @@ LevelCapabilities level_capabilities(const SimConfig& c) {
         }
         case Fidelity::approx:
         case Fidelity::detailed:
-            l.timed = l.lock_step = l.treelets = l.frames = l.steps_rays = true;
+            l.timed = l.lock_step = l.treelets = l.frames = l.steps_rays = l.shades = true;
             break;
     }
     return l;

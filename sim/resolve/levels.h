@@ -21,6 +21,7 @@ struct LevelCapabilities {
     /// It steps rays itself, so it counts work the trace's records hold none of (mailbox lookups,
     /// restart-trail restarts, a reduced-precision walk's extra steps).
     bool steps_rays = false;
+    bool shades = false;     ///< it times the frame: shading and the frame loop (approx, detailed)
 };
 
 /// The capabilities of the level `config` runs at.

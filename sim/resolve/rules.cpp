@@ -9,6 +9,7 @@ bool reduced_boxes(const RunFacts& f) { return f.config.traversal.box_precision_
 bool treelets(const RunFacts& f) { return f.config.treelets.enabled; }
 bool sampling(const RunFacts& f) { return f.config.sampling.enabled(); }
 bool animated(const RunFacts& f) { return f.structure.frames > 1; }
+bool shading(const RunFacts& f) { return f.config.shading.enabled; }
 
 /// How a message names the side a rule matches against.
 std::string side_name(const Rule& r, const RunFacts& f) {
@@ -130,6 +131,25 @@ std::vector<Rule> make_rules() {
     add({"frames/treelets", "an animated trace (--frames)", animated, RuleSide::technique, "treelets.enabled=false",
          [](const RunFacts& f) { return !treelets(f); }, "treelet scheduling does not hold frame barriers yet",
          "treelets.enabled=false", "frames", {"treelets.enabled=true"}});
+
+    // The frame: shading and the frame loop (docs/shading.md).
+    add({"shading/level", "shading.enabled (the frame: shading and the frame loop)", shading, RuleSide::level,
+         "a level that times the frame", [](const RunFacts& f) { return f.level.shades; },
+         "shader cores, texture caches and the frame loop are SystemC blocks", "fidelity=approx or detailed",
+         "bvh2", {"shading.enabled=true", "fidelity=analytic"}});
+    add({"shading/sampling", "shading.enabled (the frame: shading and the frame loop)", shading,
+         RuleSide::technique, "no sampling (sampling.fraction and sampling.count 0)",
+         [](const RunFacts& f) { return !sampling(f); },
+         "a frame's rays depend on their parents' shading, which a sample of rays leaves out",
+         "sampling.fraction=0", "bvh2", {"shading.enabled=true", "sampling.fraction=0.2"}});
+    add({"shading/frames", "shading.enabled (the frame: shading and the frame loop)", shading,
+         RuleSide::technique, "a trace of one frame", [](const RunFacts& f) { return !animated(f); },
+         "the frame loop's bounce barriers do not compose with animated frames' barriers yet",
+         "shading.enabled=false, or trace one frame", "frames", {"shading.enabled=true"}});
+    add({"shading/treelets", "shading.enabled (the frame: shading and the frame loop)", shading,
+         RuleSide::technique, "treelets.enabled=false", [](const RunFacts& f) { return !treelets(f); },
+         "the treelet ray buffer takes rays ahead of the frame loop's barriers and parent order",
+         "treelets.enabled=false", "bvh2", {"shading.enabled=true", "treelets.enabled=true"}});
     return rules;
 }
 
@@ -157,6 +177,11 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
         out.push_back({"treelets.prefetch", "the " + f.unit.name + " unit's rays share one walk, which does not trigger treelet prefetches"});
     else if (f.config.treelets.prefetch && !f.level.timed)
         out.push_back({"treelets.prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
+    if (f.config.shading.enabled && !f.structure.shading_sections)
+        out.push_back({"shading.enabled", "this trace has no shading sections (written before trace version 5): "
+                                          "the RT unit alone is timed"});
+    if (!f.config.shading.enabled && f.config.shading.reorder != ShadeReorder::none)
+        out.push_back({"shading.reorder", "shading.enabled is false: no hit is shaded, so none is reordered"});
     return out;
 }
 

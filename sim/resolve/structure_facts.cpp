@@ -21,7 +21,8 @@ json StructureFacts::to_json() const {
             {"capabilities", caps.to_json()},
             {"stack_entry_bytes", stack_entry_bytes},
             {"compressed_leaves", compressed_leaves},
-            {"frames", frames}};
+            {"frames", frames},
+            {"shading_sections", shading_sections}};
 }
 
 StructureFacts structure_facts(const std::string& kind, const std::string& blas_kind, bool compressed_leaves) {
@@ -61,6 +62,8 @@ StructureFacts structure_facts(TraceReader& reader) {
             where + ": stats 'stack_entry_bytes' must be an integer in 1..64, got " + bytes.dump());
     f.stack_entry_bytes = bytes.get<uint32_t>();
     if (reader.has(SectionKind::frames)) f.frames = reader.section(SectionKind::frames).record_count;
+    f.shading_sections = reader.has(SectionKind::shading) && reader.has(SectionKind::tri_shading) &&
+                         reader.has(SectionKind::materials);
     return f;
 }
 

@@ -20,6 +20,7 @@ struct StructureFacts {
     uint32_t stack_entry_bytes = 8;  ///< what one stack entry holds (the trace's record, else the kind's)
     bool compressed_leaves = false;  ///< its triangles are compressed leaf blocks
     uint64_t frames = 1;             ///< frames of an animated trace
+    bool shading_sections = true;    ///< the trace carries shading sections (version 5; facts from a name: yes)
     std::string source;              ///< the trace (messages), or "" for facts from a name
 
     /// How messages name it: "this trace's structure 'kdtree'" or "structure 'kdtree'".

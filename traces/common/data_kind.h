@@ -20,8 +20,9 @@ enum class DataKind : uint8_t {
     prim_ref = 6,    ///< primitive references (index lists of grids and other spatial structures)
     cell = 7,        ///< grid cells
     instance = 8,    ///< instance records (transforms) of two-level structures
+    texture = 9,     ///< texels read by hit shaders (the shading block's texture caches)
 };
-constexpr int kDataKindCount = 9;
+constexpr int kDataKindCount = 10;
 
 /// A kind's name and what its accesses happen per: once per ray (ray records, hit records) or
 /// once per unit of one work counter of the ray (a node or stack access per step, a triangle per
@@ -42,6 +43,7 @@ inline constexpr std::array<DataKindInfo, kDataKindCount> kDataKinds{{
     {"prim_ref", false, WorkField::refs},
     {"cell", false, WorkField::cell_steps},
     {"instance", false, WorkField::transforms},
+    {"texture", true, WorkField::steps},
 }};
 
 /// "node", "triangle", ...

@@ -39,6 +39,7 @@ constexpr const char* element_type() {
     else if constexpr (std::is_same_v<T, uint32_t>) return "<u4";
     else if constexpr (std::is_same_v<T, int32_t>) return "<i4";
     else if constexpr (std::is_same_v<T, uint64_t>) return "<u8";
+    else if constexpr (std::is_same_v<T, int64_t>) return "<i8";
     else static_assert(sizeof(T) == 0, "no layout type for this field's element type");
 }
 

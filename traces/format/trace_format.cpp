@@ -24,6 +24,11 @@ std::string section_name(SectionKind kind) {
     case SectionKind::work: return "WORK";
     case SectionKind::accel: return "ACCL";
     case SectionKind::frames: return "FRMS";
+    case SectionKind::materials: return "MATL";
+    case SectionKind::textures: return "TEXR";
+    case SectionKind::tri_shading: return "PTRI";
+    case SectionKind::shading: return "SHAD";
+    case SectionKind::texel_fetches: return "TXFT";
     }
     uint32_t index;
     if (is_region_section(kind, &index)) return "RG" + std::to_string(index / 10) + std::to_string(index % 10);
@@ -37,6 +42,11 @@ uint32_t section_record_bytes(SectionKind kind) {
     case SectionKind::work: return sizeof(WorkRecord);
     case SectionKind::accel: return 1;
     case SectionKind::frames: return sizeof(FrameRecord);
+    case SectionKind::materials: return sizeof(MaterialRecord);
+    case SectionKind::textures: return sizeof(TextureRecord);
+    case SectionKind::tri_shading: return sizeof(TriShadeRecord);
+    case SectionKind::shading: return sizeof(ShadeRecord);
+    case SectionKind::texel_fetches: return sizeof(uint64_t);
     }
     return 0;
 }

@@ -11,12 +11,16 @@
 
 #include "traces/common/ray.h"
 #include "traces/common/record_layout.h"
+#include "traces/format/shading_format.h"
 
 namespace rtsim {
 
 constexpr char kTraceMagic[8] = {'R', 'T', 'S', 'I', 'M', 'T', 'R', 'C'};
-constexpr uint32_t kTraceVersion = 4;  // 4: animated frames (FRMS; a two-level image's TLAS per frame)
-/// Oldest version this build reads (version 3 has no frames; its layout is otherwise version 4's).
+/// 5: shading (MATL, TEXR, PTRI, SHAD, TXFT: traces/format/shading_format.h); 4: animated frames
+/// (FRMS; a two-level image's TLAS per frame).
+constexpr uint32_t kTraceVersion = 5;
+/// Oldest version this build reads (versions 3 and 4 have no shading sections and are simulated
+/// without shading; version 3 has no frames; their layout is otherwise version 5's).
 constexpr uint32_t kTraceVersionOldest = 3;
 
 /// Section kinds (fourcc, little-endian). Never renumber; add new kinds instead.
@@ -26,6 +30,11 @@ enum class SectionKind : uint32_t {
     work = 0x4B524F57,       // 'WORK': WorkRecord
     accel = 0x4C434341,      // 'ACCL': the acceleration structure's descriptor, JSON text (1-byte records)
     frames = 0x534D5246,     // 'FRMS': FrameRecord, one per frame (animated traces only)
+    materials = 0x4C54414D,  // 'MATL': MaterialRecord (version 5)
+    textures = 0x52584554,   // 'TEXR': TextureRecord (version 5; absent when no material has a texture)
+    tri_shading = 0x49525450,  // 'PTRI': TriShadeRecord, one per primitive (version 5)
+    shading = 0x44414853,    // 'SHAD': ShadeRecord, one per ray (version 5)
+    texel_fetches = 0x54465854,  // 'TXFT': uint64 texel addresses (version 5)
     // 'RG00'..'RG99': region i of the acceleration-structure image (record size: its descriptor)
 };
 /// The section holding region `index` (0..99) of the acceleration-structure image.
@@ -34,7 +43,8 @@ SectionKind region_section(uint32_t index);
 bool is_region_section(SectionKind kind, uint32_t* index = nullptr);
 /// "RAYS", "HITS", ..., "RG03"; "unknown" for a kind this build does not know.
 std::string section_name(SectionKind kind);
-/// Record size a kind must have (RAYS 40, HITS 20, WORK 32, ACCL 1, FRMS 16); 0 if it varies (regions)
+/// Record size a kind must have (RAYS 40, HITS 20, WORK 32, ACCL 1, FRMS 16, MATL 32, TEXR 32, PTRI 44,
+/// SHAD 32, TXFT 8); 0 if it varies (regions)
 /// or the kind is unknown.
 uint32_t section_record_bytes(SectionKind kind);
 /// Regions an image may have (the region sections' two digits).

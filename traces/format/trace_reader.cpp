@@ -50,7 +50,8 @@ tl::FileHeader check_header(std::FILE* f, const std::string& path, uint64_t file
     // The header CRC (bytes 60..63 over 0..59) is the same in every version, so it comes first.
     require(tl::header_crc_ok(head), path + ": header checksum mismatch (header is corrupt)");
     const tl::FileHeader h = tl::decode_header(head);
-    // Version 3 is version 4 without frames (no FRMS section), so both are read.
+    // Version 3 is version 4 without frames (no FRMS section), version 4 is version 5 without the
+    // shading sections: all three are read (a reader asks has() before it reads an optional section).
     require(h.version >= kTraceVersionOldest && h.version <= kTraceVersion,
             path + ": trace version " + num(h.version) + " is not supported by this build (reads versions " +
                 num(kTraceVersionOldest) + " to " + num(kTraceVersion) + ")");

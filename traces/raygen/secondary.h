@@ -19,6 +19,8 @@ struct PendingRay {
     uint16_t depth = 0;
     bool any_hit = false;
     float shade = 0.0f;  ///< shadow rays: cosine at the surface (for the preview render)
+    int64_t parent = -1;  ///< index of the parent in the previous wavefront, -1 for primary rays
+    float cone_width = 0.0f, cone_spread = 0.0f;  ///< ray cone (traces/shading/texels.h)
 };
 
 struct SpawnContext {

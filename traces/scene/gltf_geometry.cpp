@@ -69,6 +69,23 @@ std::vector<uint32_t> read_indices(const Source& src, const tinygltf::Primitive&
     return idx;
 }
 
+/// TEXCOORD_0 of the primitive's corners (float, or normalised unsigned byte/short), appended to
+/// out.uvs; a mesh gets uvs once any primitive has them (earlier corners filled with (0, 0)).
+void read_texcoords(const Source& src, const tinygltf::Primitive& prim, size_t vertex_count,
+                    const std::vector<uint32_t>& list, const std::string& where, Mesh& out) {
+    auto it = prim.attributes.find("TEXCOORD_0");
+    const size_t before = out.positions.size() - list.size();
+    if (it == prim.attributes.end()) {
+        if (!out.uvs.empty()) out.uvs.resize(out.positions.size(), glm::vec2(0.0f));
+        return;
+    }
+    AccessorView uv = view_accessor(src, it->second, where + " TEXCOORD_0");
+    if (uv.components != 2 || uv.count < vertex_count)
+        src.fail(where + ": TEXCOORD_0 must be VEC2 with one entry per vertex");
+    out.uvs.resize(before, glm::vec2(0.0f));
+    for (uint32_t i : list) out.uvs.emplace_back(uv.component(i, 0), uv.component(i, 1));
+}
+
 /// Appends one primitive's triangles (positions and material ids) to `out`.
 void read_primitive(const Source& src, const tinygltf::Primitive& prim, const std::string& where,
                     Scene& scene, Mesh& out) {
@@ -108,6 +125,7 @@ void read_primitive(const Source& src, const tinygltf::Primitive& prim, const st
         out.positions.emplace_back(xyz[0], xyz[1], xyz[2]);
     }
     out.materials.insert(out.materials.end(), list.size() / 3, material);
+    read_texcoords(src, prim, pos.count, list, where, out);
 }
 
 }  // namespace

@@ -45,11 +45,39 @@ std::vector<unsigned char> read_file(const std::string& path) {
     return bytes;
 }
 
-/// tinygltf image callback that keeps nothing: rtsim traces geometry only (alpha coverage comes
-/// from extras.textureAlphaCoverage), so images are never decoded (an 8000 x 8000 PNG would
-/// cost 256 MB per reference otherwise).
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                void*) {
+/// Width and height from a PNG (IHDR) or JPEG (first SOFn marker) header; false for other data.
+bool image_header_size(const unsigned char* d, int size, int* w, int* h) {
+    const auto be16 = [d](int i) { return int(d[i]) << 8 | int(d[i + 1]); };
+    if (size >= 24 && d[0] == 0x89 && d[1] == 'P' && d[2] == 'N' && d[3] == 'G') {
+        *w = be16(16) << 16 | be16(18);
+        *h = be16(20) << 16 | be16(22);
+        return true;
+    }
+    if (size < 4 || d[0] != 0xFF || d[1] != 0xD8) return false;
+    for (int i = 2; i + 9 < size;) {
+        if (d[i] != 0xFF) return false;
+        const int marker = d[i + 1], length = be16(i + 2);
+        const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+        if (sof) {
+            *h = be16(i + 5);
+            *w = be16(i + 7);
+            return true;
+        }
+        i += 2 + length;
+    }
+    return false;
+}
+
+/// tinygltf image callback that decodes nothing: rtsim needs only each image's size (the shader
+/// model's texture footprint; alpha coverage comes from extras.textureAlphaCoverage), read from
+/// its header, so an 8000 x 8000 PNG never costs 256 MB.
+bool skip_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes,
+                int size, void*) {
+    int w = 0, h = 0;
+    if (bytes && image_header_size(bytes, size, &w, &h)) {
+        image->width = w;
+        image->height = h;
+    }
     return true;
 }
 

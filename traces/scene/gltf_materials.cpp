@@ -19,6 +19,47 @@ glm::vec3 to_vec3(const std::vector<double>& v, glm::vec3 fallback) {
     return v.size() >= 3 ? glm::vec3(float(v[0]), float(v[1]), float(v[2])) : fallback;
 }
 
+/// glTF image index of a texture reference, -1 if it has none (the texture's source).
+int texture_image(const Source& src, int texture) {
+    if (texture < 0 || size_t(texture) >= src.model->textures.size()) return -1;
+    const int image = src.model->textures[size_t(texture)].source;
+    return image >= 0 && size_t(image) < src.model->images.size() ? image : -1;
+}
+
+/// The slots a material's textures fill: images the file has, or the slots its
+/// extras.strippedTextures names ("baseColorTexture:file.jpg", "normalTexture", ...).
+void read_texture_slots(const Source& src, const tinygltf::Material& gm, Material& m) {
+    const int refs[kTextureSlotCount] = {gm.pbrMetallicRoughness.baseColorTexture.index, gm.normalTexture.index,
+                                         gm.pbrMetallicRoughness.metallicRoughnessTexture.index,
+                                         gm.emissiveTexture.index, gm.occlusionTexture.index};
+    static const char* const names[kTextureSlotCount] = {"baseColorTexture", "normalTexture",
+                                                         "metallicRoughnessTexture", "emissiveTexture",
+                                                         "occlusionTexture"};
+    for (int s = 0; s < kTextureSlotCount; ++s) {
+        const int image = texture_image(src, refs[s]);
+        if (image < 0) continue;
+        MaterialTexture& t = m.textures[s];
+        t.source = MaterialTexture::Source::image;
+        t.image = image;
+        const tinygltf::Image& im = src.model->images[size_t(image)];
+        t.width = im.width > 0 ? uint32_t(im.width) : 0;
+        t.height = im.height > 0 ? uint32_t(im.height) : 0;
+    }
+    const tinygltf::Value& stripped = gm.extras.Get("strippedTextures");
+    if (gm.extras.IsObject() && stripped.IsArray())
+        for (size_t i = 0; i < stripped.ArrayLen(); ++i) {
+            if (!stripped.Get(int(i)).IsString()) continue;
+            const std::string entry = stripped.Get(int(i)).Get<std::string>();
+            const std::string slot = entry.substr(0, entry.find(':'));
+            for (int s = 0; s < kTextureSlotCount; ++s)
+                if (slot == names[s] && m.textures[s].source == MaterialTexture::Source::none)
+                    m.textures[s].source = MaterialTexture::Source::stripped;
+        }
+    if (gm.extras.IsObject() && gm.extras.Has("factorsBakedFromKhronosTextureMeans"))
+        m.textures_baked = gm.extras.Get("factorsBakedFromKhronosTextureMeans").IsBool() &&
+                           gm.extras.Get("factorsBakedFromKhronosTextureMeans").Get<bool>();
+}
+
 Material read_material(const Source& src, size_t index) {
     const tinygltf::Material& gm = src.model->materials[index];
     std::string where = element("material", index, gm.name);
@@ -54,6 +95,7 @@ Material read_material(const Source& src, size_t index) {
     float strength = float(value_number(extension(ext, "KHR_materials_emissive_strength"),
                                         "emissiveStrength", 1.0));
     m.emissive = to_vec3(gm.emissiveFactor, glm::vec3(0.0f)) * strength;
+    read_texture_slots(src, gm, m);
     return m;
 }
 

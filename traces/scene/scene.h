@@ -21,6 +21,19 @@ namespace rtsim {
 
 enum class AlphaMode : uint8_t { opaque = 0, mask = 1, blend = 2 };
 
+/// The glTF material texture slots a shader reads (glTF 2.0 section 3.9), in a fixed order.
+enum class TextureSlot : uint8_t { base_color = 0, normal = 1, metallic_roughness = 2, emissive = 3, occlusion = 4 };
+constexpr int kTextureSlotCount = 5;
+
+/// What a glTF material says about one texture slot; traces/shading turns it into a texture.
+struct MaterialTexture {
+    enum class Source : uint8_t { none = 0, image = 1, stripped = 2 };
+    Source source = Source::none;
+    int32_t image = -1;        ///< glTF image index (Source::image)
+    uint32_t width = 0;        ///< the image's size from its header; 0 if it could not be read
+    uint32_t height = 0;
+};
+
 struct Material {
     std::string name;
     glm::vec4 base_color{1.0f};
@@ -34,6 +47,12 @@ struct Material {
     /// Fraction of texels passing the alpha cutoff (extras.textureAlphaCoverage); 1 if unknown.
     /// Drives the deterministic stochastic alpha test of MASK materials.
     float alpha_coverage = 1.0f;
+    /// Texture slots as the file gives them: an image, a texture stripped from a shared scene
+    /// (extras.strippedTextures), or none.
+    MaterialTexture textures[kTextureSlotCount];
+    /// extras.factorsBakedFromKhronosTextureMeans: the factors are the means of textures the
+    /// file no longer carries (which ones it does not say).
+    bool textures_baked = false;
 
     bool is_emissive() const { return emissive.x > 0.0f || emissive.y > 0.0f || emissive.z > 0.0f; }
 };
@@ -69,6 +88,9 @@ struct Mesh {
     std::string name;
     std::vector<Vec3> positions;      ///< 3 per triangle (v0, v1, v2)
     std::vector<uint32_t> materials;  ///< one per triangle, index into Scene::materials
+    /// TEXCOORD_0, 3 per triangle like positions; empty when no primitive has it (a mesh with
+    /// some primitives lacking it gets (0, 0) there).
+    std::vector<glm::vec2> uvs;
     size_t triangle_count() const { return materials.size(); }
 };
 

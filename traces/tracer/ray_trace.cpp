@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "traces/common/error.h"
+#include "traces/shading/materials.h"
 #include "traces/tracer/wavefront.h"
 
 namespace rtsim {
@@ -42,6 +43,8 @@ json write_ray_trace(const Scene& scene, const SceneLabel& label, const Accel& a
     const WorkloadPlan plan = given_rays_plan(scene, rays);
 
     TraceFolderWriter folder(o.out_dir, accel.image());
+    // Given rays are one wavefront of independent rays (no parents), with the cones they carry.
+    folder.set_shading(scene, build_shading_scene(scene, label.name, label.procedural, accel.image().end_address()));
     WavefrontResult res = trace_wavefront(accel, rays, o.threads, [&](uint64_t done) {
         if (progress) progress(done, rays.size(), "trace");
     });

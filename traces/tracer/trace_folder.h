@@ -17,6 +17,7 @@
 #include "traces/format/trace_writer.h"
 #include "traces/raygen/workload.h"
 #include "traces/scene/scene.h"
+#include "traces/shading/materials.h"
 #include "traces/tracer/manifest.h"
 #include "traces/tracer/wavefront.h"
 
@@ -32,6 +33,11 @@ class TraceFolderWriter {
 public:
     /// Creates OUT and starts OUT/trace.rtt with the structure's image (traces/accel/accel_io.h).
     TraceFolderWriter(const std::string& out_dir, const AccelImage& image);
+
+    /// Writes the shading sections (materials, textures, per-primitive attributes) and, from
+    /// here on, each written ray's shading record and texel addresses (traces/shading). Without
+    /// a call the trace has no shading sections. `scene` must outlive the writer.
+    void set_shading(const Scene& scene, ShadingScene shading);
 
     /// Appends the rays of a traced wavefront that the plan wants, in order, with their hits and
     /// work; every ray is counted in the manifest's per-kind statistics (written or not).
@@ -54,10 +60,17 @@ public:
     const std::string& out_dir() const { return m_out_dir; }
 
 private:
+    ShadeRecord shade_record(const PendingRay& r, const Hit& hit, std::vector<uint64_t>* fetches);
+
     std::string m_out_dir;
     TraceWriter m_writer;
     RayCounts m_counts;
     uint64_t m_rays_written = 0;
+    const Scene* m_scene = nullptr;  ///< set by set_shading
+    ShadingScene m_shading;
+    std::vector<TriShadeRecord> m_tri;
+    std::vector<int64_t> m_wave_index;  ///< previous wavefront: position -> trace index (-1 unwritten)
+    uint64_t m_fetches = 0;             ///< texel addresses written so far
     std::chrono::steady_clock::time_point m_start;
 };
 

@@ -13,6 +13,8 @@
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
 #include "traces/scene/gltf_loader.h"
+#include "traces/shading/materials.h"
+#include "traces/shading/texels.h"
 #include "traces/tracer/frames.h"
 #include "traces/tracer/preview_render.h"
 #include "traces/tracer/trace_folder.h"
@@ -42,6 +44,7 @@ Camera choose_camera(const TraceOptions& o, const Scene& scene, const Accel& acc
 /// Every primary ray; an invalid one (NaN or infinite) is refused, never written silently.
 std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint32_t h, const std::string& source) {
     std::vector<PendingRay> rays(size_t(w) * h);
+    const RayCone cone = primary_cone(2.0f * std::atan(cam.tan_half_fov), h);
     for (uint32_t y = 0; y < h; ++y)
         for (uint32_t x = 0; x < w; ++x) {
             PendingRay& r = rays[size_t(y) * w + x];
@@ -50,6 +53,7 @@ std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint3
                                              std::to_string(y) + ") is not finite (camera eye, axes or field of view)");
             r.kind = RayKind::primary;
             r.pixel = y * w + x;
+            r.cone_spread = cone.spread;
         }
     return rays;
 }
@@ -59,8 +63,19 @@ std::vector<PendingRay> primary_rays(const PinholeCamera& cam, uint32_t w, uint3
 std::vector<PendingRay> next_wavefront(const SpawnContext& ctx, const std::vector<PendingRay>& rays,
                                        const std::vector<Hit>& hits) {
     std::vector<PendingRay> next;
-    for (size_t i = 0; i < rays.size(); ++i)
-        if (rays[i].kind != RayKind::shadow) spawn_secondaries(ctx, rays[i], hits[i], i, &next);
+    for (size_t i = 0; i < rays.size(); ++i) {
+        if (rays[i].kind == RayKind::shadow) continue;
+        const size_t first = next.size();
+        spawn_secondaries(ctx, rays[i], hits[i], i, &next);
+        // Each child records its parent and starts its ray cone where the parent's ended.
+        const RayCone parent{rays[i].cone_width, rays[i].cone_spread};
+        for (size_t c = first; c < next.size(); ++c) {
+            const RayCone cone = child_cone(parent, rays[i].ray.direction, hits[i].t, next[c].kind);
+            next[c].parent = int64_t(i);
+            next[c].cone_width = cone.width;
+            next[c].cone_spread = cone.spread;
+        }
+    }
     std::stable_sort(next.begin(), next.end(),
                      [](const PendingRay& a, const PendingRay& b) { return a.kind < b.kind; });
     return next;
@@ -152,6 +167,8 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     check_scene_reach(pinhole, scene.bounds, camera_where);
 
     TraceFolderWriter folder(o.out_dir, accel->image());
+    const std::string scene_name = procedural ? o.scene : fs::path(path).stem().string();
+    folder.set_shading(scene, build_shading_scene(scene, scene_name, procedural, accel->image().end_address()));
     uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
     PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
     std::vector<uint64_t> first_ray, frame_rays;

@@ -30,6 +30,7 @@ from rtsim.report.data import (
     short_label,
     sram_kib,
 )
+from rtsim.report.frame_section import frame_section
 from rtsim.sweep.store import RunRecord
 
 CSS = """
@@ -416,6 +417,7 @@ def render_report(data: SweepData) -> str:
             "L1 (mean over the per-unit L1s) and L2 hit rates against each swept key.",
         ),
         *accel_section(data, _table),
+        *frame_section(data, _table),
         "<h2>Validation</h2>",
         "<h3>Hit mismatches per run (must be zero)</h3>",
         _validation(data),

@@ -188,10 +188,14 @@ TEST(Tracer, GivenRaysWriteTheSameTrace) {
     trace_scene(o);
     TraceReader reader((a / "trace.rtt").string());
     std::vector<PendingRay> rays;
+    const std::vector<ShadeRecord> shade = reader.read_all<ShadeRecord>(SectionKind::shading);
     for (const RayRecord& r : reader.read_all<RayRecord>(SectionKind::rays)) {
         PendingRay p;
         p.ray = ray_from_record(r);
         p.pixel = r.pixel;
+        // The ray cones the tracer gave its primary rays (given rays carry their own).
+        p.cone_width = shade[rays.size()].cone_width;
+        p.cone_spread = shade[rays.size()].cone_spread;
         rays.push_back(p);
     }
     Scene scene = load_gltf((a / "scene" / "cornell.gltf").string());

@@ -1,0 +1,91 @@
+// The frame in the harness (shading_run.h).
+#include "sim/harness/shading_run.h"
+
+#include <algorithm>
+
+#include "traces/common/error.h"
+#include "traces/shading/materials.h"
+
+namespace rtsim {
+
+namespace {
+
+template <class T>
+std::vector<T> read_section(TraceReader& reader, SectionKind kind) {
+    return reader.has(kind) ? reader.read_all<T>(kind) : std::vector<T>{};
+}
+
+}  // namespace
+
+std::unique_ptr<ShadingInputs> load_shading_inputs(TraceReader& reader, const SimConfig& config) {
+    if (!config.shading.enabled || !reader.has(SectionKind::shading) || !reader.has(SectionKind::tri_shading) ||
+        !reader.has(SectionKind::materials))
+        return nullptr;
+    auto in = std::make_unique<ShadingInputs>();
+    in->materials = read_section<MaterialRecord>(reader, SectionKind::materials);
+    in->textures = read_section<TextureRecord>(reader, SectionKind::textures);
+    in->tris = read_section<TriShadeRecord>(reader, SectionKind::tri_shading);
+    in->rays = read_section<RayRecord>(reader, SectionKind::rays);
+    in->shade = read_section<ShadeRecord>(reader, SectionKind::shading);
+    in->reference_fetches = read_section<uint64_t>(reader, SectionKind::texel_fetches);
+    const std::string where = reader.path() + ": ";
+    require(in->shade.size() == in->rays.size(), where + "SHAD has " + std::to_string(in->shade.size()) +
+                                                     " records for " + std::to_string(in->rays.size()) + " rays");
+    for (const MaterialRecord& m : in->materials) {
+        in->shaders = std::max<uint32_t>(in->shaders, uint32_t(m.shader) + 1);
+        for (int32_t t : m.texture)
+            require(t < int32_t(in->textures.size()), where + "a material samples texture " + std::to_string(t) +
+                                                          " of " + std::to_string(in->textures.size()));
+    }
+    // Textures lie above every region the model adds (traces/shading/materials.h).
+    for (const TextureRecord& t : in->textures)
+        require(t.base >= kTextureBase, where + "a texture at address " + std::to_string(t.base) +
+                                            " lies below the textures' base (1 TiB), among the model's own regions");
+    for (const TriShadeRecord& t : in->tris)
+        require(t.material < in->materials.size(), where + "PTRI names material " + std::to_string(t.material) +
+                                                        " of " + std::to_string(in->materials.size()));
+    for (uint64_t i = 0; i < in->shade.size(); ++i) {
+        const ShadeRecord& s = in->shade[i];
+        require(s.parent < int64_t(i), where + "ray " + std::to_string(i) + "'s parent " + std::to_string(s.parent) +
+                                           " does not come before it");
+        require(s.first_fetch + uint64_t(s.samples) * kTexelsPerSample <= in->reference_fetches.size(),
+                where + "ray " + std::to_string(i) + "'s texel addresses lie past TXFT's end");
+    }
+    // Wavefronts: the trace lists rays depth by depth (traces/tracer/tracer.cpp).
+    for (uint64_t i = 0; i < in->rays.size(); ++i) {
+        if (i == 0 || in->rays[i].depth != in->rays[i - 1].depth) in->wavefronts.push_back(0);
+        ++in->wavefronts.back();
+    }
+    return in;
+}
+
+std::vector<FrameRecord> wavefront_segments(const ShadingInputs& inputs) {
+    std::vector<FrameRecord> out;
+    uint64_t first = 0;
+    for (uint64_t n : inputs.wavefronts) {
+        out.push_back({first, n});
+        first += n;
+    }
+    if (out.empty()) out.push_back({0, 0});
+    return out;
+}
+
+void wire_frame_loop(Top& top, const ShadingConfig& config, uint32_t wavefronts, std::function<void(Cycle)> on_last) {
+    ShadingBlock& shading = *top.shading();
+    Dispatch& dispatch = top.dispatch();
+    dispatch.hold_until(shading.raygen_end());
+    if (config.frame_loop == FrameLoop::wavefront) {
+        dispatch.set_barrier([&shading, wavefronts, on_last](uint32_t w, Cycle end) {
+            const Cycle released = shading.wavefront_end(w, end);
+            if (w + 1 == wavefronts && on_last) on_last(released);
+            return released;
+        });
+        return;
+    }
+    dispatch.set_gate([&shading](uint64_t id, Cycle* not_before) { return shading.parent_shaded(id, not_before); });
+    // The ray finishing now is still counted in flight when the shading block sees it.
+    shading.rt_idle = [&dispatch] { return dispatch.in_flight() <= 1; };
+    shading.on_shaded = [&dispatch] { dispatch.wake(); };
+}
+
+}  // namespace rtsim

@@ -1,0 +1,27 @@
+#pragma once
+// The frame in the harness (docs/shading.md): the shading block's inputs read from a version-5
+// trace, the wavefront loop's bounces as dispatch barriers, and the in-flight loop's parent gate.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "rtl_model/shading/shading_inputs.h"
+#include "rtl_model/top/top.h"
+#include "sim/config/config.h"
+#include "traces/format/trace_reader.h"
+
+namespace rtsim {
+
+/// The trace's shading tables, every ray's record and shading record, the reference texel
+/// addresses and the wavefronts; null when shading.enabled is false or the trace has no shading
+/// sections (the resolution step lists the setting as unused then).
+std::unique_ptr<ShadingInputs> load_shading_inputs(TraceReader& reader, const SimConfig& config);
+/// The wavefronts as stream segments (each a run of rays of one depth, in trace order).
+std::vector<FrameRecord> wavefront_segments(const ShadingInputs& inputs);
+/// Wires the frame loop into dispatch: no ray before ray generation ends; wavefront: a barrier
+/// per bounce released when the shading block has shaded it (`on_last`: the frame's last bounce
+/// shaded, at that cycle); inflight: rays wait for their parent's warp.
+void wire_frame_loop(Top& top, const ShadingConfig& config, uint32_t wavefronts,
+                     std::function<void(Cycle)> on_last);
+
+}  // namespace rtsim
