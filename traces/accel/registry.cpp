@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <new>
 
 #include "traces/accel/accel.h"
 #include "traces/accel/bih/bih.h"
@@ -323,7 +324,20 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
             "build_accel: scene is not flattened (call Scene::flatten())");
     AccelOptions resolved = o;
     resolved.build = s.bvh;
-    return finish(e.build(scene, resolved, s));
+    // Each builder bounds its own work and memory before allocating (build_budget.h) and names
+    // its settings; the refusal names the scene file too. An allocation that still fails is
+    // reported the same way, not as a bare std::bad_alloc.
+    const std::string where = scene.source.empty() ? std::string("scene") : scene.source;
+    try {
+        return finish(e.build(scene, resolved, s));
+    } catch (const Error& err) {
+        const std::string what = err.what();
+        if (what.rfind(where, 0) == 0) throw;
+        throw Error(where + ": accel " + o.kind + " (builder " + o.builder + "): " + what);
+    } catch (const std::bad_alloc&) {
+        throw Error(where + ": accel " + o.kind + " (builder " + o.builder + ", settings " + values.dump() +
+                    "): out of memory while building; lower the settings that multiply nodes, cells or references");
+    }
 }
 
 std::unique_ptr<Accel> load_accel(AccelImage image, const std::string& source) {
