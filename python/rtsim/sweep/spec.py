@@ -400,11 +400,16 @@ class _Reader:
                     return self.fail(where, key, f"accel[{i}].{sub}", message)
                 return self.fail(items, i, f"accel[{i}]", message)
 
-            out.extend(parse_accel_entries(entry, kinds, fail))
-        labels = [a.label for a in out]
-        dup = next((x for x in labels if labels.count(x) > 1), None)
-        if dup:
-            raise self.fail(doc, "accel", "accel", f"two entries named '{dup}' (give one a label)")
+            # Every structure is at least one run: the axis is held to the run limit as it
+            # expands, each entry's settings product counted before it is made.
+            out.extend(parse_accel_entries(entry, kinds, fail, MAX_RUNS - len(out)))
+        seen: set[str] = set()
+        for a in out:
+            if a.label in seen:
+                raise self.fail(
+                    doc, "accel", "accel", f"two entries named '{a.label}' (give one a label)"
+                )
+            seen.add(a.label)
         return out
 
     def config_value(self, parent: Any, key: Any, path: str, config_key: str, value: Any) -> None:
