@@ -151,6 +151,12 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
         return image;
     };
     LoadFn load = [=](AccelImage image, const std::string& source) {
+        // The kind fixes the child order its slots were assigned for: an image of the other
+        // order under this name (relabelled) is refused, not walked in the wrong order.
+        const ChildOrder given = child_order_param(image, source);
+        require(given == order, source + ": " + name + " lays its children out in " + child_order_name(order) +
+                                    " order, but the image's params.order is " + child_order_name(given) +
+                                    " (an image of another kind under this name?)");
         return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
     };
     const AccelCapabilities c = single_level(kBvhStackEntryBytes)
