@@ -222,6 +222,11 @@ def _settings_arg(settings: dict[str, Any] | None) -> dict[str, Any] | None:
             raise ArgumentTypeError(
                 f"build_settings: '{name}' must be a number, a bool or text, got {value!r}"
             )
+        if isinstance(value, float) and not math.isfinite(value):
+            # As `--build-set` and sweep specs refuse it (the builder never sees NaN or inf).
+            raise ArgumentValueError(
+                f"build_settings: '{name}' must be a finite number, got {value!r}"
+            )
     return dict(settings)
 
 

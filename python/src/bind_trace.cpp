@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -117,8 +118,24 @@ std::optional<CameraOverride> camera_from(const py::object& obj) {
 nlohmann::json settings_from(const py::object& settings) {
     if (settings.is_none()) return nlohmann::json::object();
     if (!py::isinstance<py::dict>(settings)) throw ArgumentError("build_settings: expected a dict of name: value");
-    const std::string text = py::module_::import("json").attr("dumps")(settings).cast<std::string>();
-    return nlohmann::json::parse(text);
+    // Value by value, not through JSON text: a NaN or an infinity reaches the builder's range
+    // check (which names the setting and its range), as a --build-set value does.
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& [key, value] : settings.cast<py::dict>()) {
+        if (!py::isinstance<py::str>(key)) throw ArgumentError("build_settings: setting names must be text");
+        const std::string name = key.cast<std::string>();
+        if (py::isinstance<py::bool_>(value)) out[name] = value.cast<bool>();
+        else if (py::isinstance<py::int_>(value)) {
+            const py::int_ i = value.cast<py::int_>();
+            const bool fits = py::int_(INT64_MIN) <= i && i <= py::int_(INT64_MAX);
+            if (fits) out[name] = value.cast<int64_t>();
+            else out[name] = value.cast<double>();  // out of every range: the builder says so
+        }
+        else if (py::isinstance<py::float_>(value)) out[name] = value.cast<double>();
+        else if (py::isinstance<py::str>(value)) out[name] = value.cast<std::string>();
+        else throw ArgumentError("build_settings: '" + name + "' must be a number, a bool or text");
+    }
+    return out;
 }
 
 /// A JSON value as the Python object json.loads makes of it.

@@ -13,8 +13,25 @@ namespace {
 
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
+/// Refuses what numpy would cast to floats with a loss or a meaning rays do not have: complex
+/// numbers (the imaginary part dropped, with only a ComplexWarning), bools, text, objects.
+void require_real_numbers(const py::handle& obj, const char* name) {
+    py::object array;
+    try {
+        array = py::module_::import("numpy").attr("asarray")(obj);
+    } catch (const py::error_already_set&) {
+        return;  // not an array at all (ragged lists): the conversion below names the argument
+    }
+    const std::string kind = array.attr("dtype").attr("kind").cast<std::string>();
+    if (kind == "f" || kind == "i" || kind == "u") return;
+    const std::string dtype = py::str(array.attr("dtype")).cast<std::string>();
+    throw ArgumentError(std::string(name) + ": expected real numbers (float or integer), got " +
+                        (kind == "c" ? "complex numbers" : kind == "b" ? "bools" : "values") + " (dtype " + dtype + ")");
+}
+
 /// (N, 3) float array or a ValueError naming the argument.
 FloatArray as_vectors(const py::handle& obj, const char* name) {
+    require_real_numbers(obj, name);
     FloatArray a = FloatArray::ensure(obj);
     if (!a) throw ArgumentError(std::string(name) + ": expected an array of floats");
     if (a.ndim() != 2 || a.shape(1) != 3) {
@@ -28,6 +45,7 @@ FloatArray as_vectors(const py::handle& obj, const char* name) {
 
 /// A scalar (broadcast) or an (N,) array; returns the values and the stride (0 or 1).
 std::pair<FloatArray, py::ssize_t> as_limits(const py::handle& obj, py::ssize_t n, const char* name) {
+    require_real_numbers(obj, name);
     FloatArray a = FloatArray::ensure(obj);
     if (!a) throw ArgumentError(std::string(name) + ": expected a float or an array of floats");
     if (a.ndim() == 0) return {a, 0};

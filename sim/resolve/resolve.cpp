@@ -1,5 +1,7 @@
 #include "sim/resolve/resolve.h"
 
+#include "sim/harness/memory_estimate.h"
+
 #include "traces/common/error.h"
 #include "traces/common/files.h"
 
@@ -68,6 +70,9 @@ json check_runs(const std::string& path) {
             const StructureFacts f = structure_facts(run.value("accel", "bvh2"), run.value("blas_kind", ""),
                                                      run.value("compressed_leaves", false));
             const RunSetup s = resolve_run(c, f);
+            // The model's own memory estimate, as a run makes it before elaborating (here
+            // without the structure's image, which no trace holds yet).
+            check_sim_memory(s.config, 0, "the run");
             r["ok"] = true;
             r["resolved"] = s.to_json();
         } catch (const Error& e) {

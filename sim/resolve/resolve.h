@@ -48,7 +48,8 @@ RunSetup resolve_run(const SimConfig& config, const StructureFacts& structure);
 
 /// Resolves each run of the JSON list in file `path`, [{config, accel, blas_kind,
 /// compressed_leaves}] (config: a patch over the defaults), against facts made from the kind
-/// names: [{ok, error, resolved}] in the same order. Sweeps and Python check a spec this way
+/// names: [{ok, error, resolved}] in the same order; a run is refused as resolve_run and the
+/// model's memory estimate (check_sim_memory, without the image) refuse it. Sweeps check a spec this way
 /// before any trace exists. Throws rtsim::Error naming the file when it is not such a list.
 nlohmann::json check_runs(const std::string& path);
 

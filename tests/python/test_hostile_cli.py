@@ -86,6 +86,8 @@ def _store(kind: str, path: Path) -> None:
             conn.execute("CREATE TABLE photos (id INTEGER, name TEXT)")
     elif kind == "empty":
         path.write_bytes(b"")
+    elif kind == "folder":  # SQLite's "unable to open database file" traceback before
+        path.mkdir()
     else:  # a real store cut in the middle
         with sqlite3.connect(path) as conn:
             conn.execute("CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT)")
@@ -100,7 +102,7 @@ def _store(kind: str, path: Path) -> None:
 SPEC = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\n"
 
 
-@pytest.mark.parametrize("kind", ["random", "foreign", "truncated"])
+@pytest.mark.parametrize("kind", ["random", "foreign", "truncated", "folder"])
 @pytest.mark.parametrize("command", ["results", "report", "sweep"])
 def test_bad_results_store(kind: str, command: str, tmp_path: Path, capsys) -> None:
     sweep = tmp_path / "sweep"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include "traces/common/error.h"
 
@@ -196,8 +197,10 @@ std::vector<HwTriangle> decode_leaf_blocks(const Region& region, const std::stri
     const uint8_t* data = region.bytes.data();
     const uint64_t size = region.size_bytes();
     std::vector<HwTriangle> tris;
+    std::vector<std::pair<uint64_t, uint64_t>> starts;  // (first triangle, byte) of each block
     uint32_t block = 0;
     for (uint64_t at = 0; at < size; ++block) {
+        starts.emplace_back(tris.size(), at);
         auto fail = [&](const std::string& what) {
             throw Error(source + ": region '" + region.name + "' block at byte " + std::to_string(at) + ": " + what);
         };
@@ -243,6 +246,19 @@ std::vector<HwTriangle> decode_leaf_blocks(const Region& region, const std::stri
         at += uint64_t(words) * 4;
     }
     if (block_start) block_start->push_back(size);
+    // Every primitive id names a triangle of the image (a single-level image stores each scene
+    // triangle at least once, and compressed leaves are single-level only): checked here for every
+    // block, not only where a ray happens to hit (a prim_base moved out of range).
+    for (size_t b = 0; b < starts.size(); ++b) {
+        const size_t end = b + 1 < starts.size() ? starts[b + 1].first : tris.size();
+        for (size_t i = starts[b].first; i < end; ++i)
+            if (tris[i].prim >= tris.size())
+                throw Error(source + ": region '" + region.name + "' block at byte " + std::to_string(starts[b].second) +
+                            ": triangle " + std::to_string(i - starts[b].first) + " has primitive id " +
+                            std::to_string(tris[i].prim) + ", past the " + std::to_string(tris.size()) +
+                            " triangles of the image (prim_base " +
+                            std::to_string(BlockReader{data + starts[b].second, data + size}.u32(4)) + ")");
+    }
     return tris;
 }
 

@@ -92,6 +92,14 @@ private:
     std::string m_prefix;
 };
 
+/// "0000ff00": a word as 8 hex digits.
+inline std::string hex_word(uint32_t w) {
+    static const char* digits = "0123456789abcdef";
+    std::string s(8, '0');
+    for (int k = 7; k >= 0; --k, w >>= 4) s[size_t(k)] = digits[w & 15u];
+    return s;
+}
+
 /// Validates a tree of listing leaves whose children come after their parent, in one forward
 /// pass: its size, each node reachable once, each leaf's list, each child's index and depth (at
 /// most `max_depth` levels below the root, else the message `too_deep()`), then the references. Each node's cell
@@ -114,6 +122,10 @@ uint32_t validate_listed_tree(const ListedTreeView<Node>& v, const ListedChecks&
         if (!seen[i]) check.fail(node_name(i) + " is not reachable from the root");
         deepest = std::max<uint32_t>(deepest, depth[i]);
         if (n.leaf()) {
+            // Reserved bits must be 0: a reader that trusts a field must check it, and a word
+            // a later layout may give a meaning is not silently accepted with another.
+            if (n.leaf_reserved() != 0)
+                check.fail(node_name(i) + " is a leaf with non-zero reserved bits (0x" + hex_word(n.leaf_reserved()) + ")");
             check.list_in_range("node", i, n.first_ref(), n.ref_count(), v.ref_count);
             continue;
         }

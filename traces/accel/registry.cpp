@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <new>
 
 #include "traces/accel/accel.h"
 #include "traces/accel/bih/bih.h"
@@ -150,6 +151,12 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
         return image;
     };
     LoadFn load = [=](AccelImage image, const std::string& source) {
+        // The kind fixes the child order its slots were assigned for: an image of the other
+        // order under this name (relabelled) is refused, not walked in the wrong order.
+        const ChildOrder given = child_order_param(image, source);
+        require(given == order, source + ": " + name + " lays its children out in " + child_order_name(order) +
+                                    " order, but the image's params.order is " + child_order_name(given) +
+                                    " (an image of another kind under this name?)");
         return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
     };
     const AccelCapabilities c = single_level(kBvhStackEntryBytes)
@@ -323,7 +330,20 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
             "build_accel: scene is not flattened (call Scene::flatten())");
     AccelOptions resolved = o;
     resolved.build = s.bvh;
-    return finish(e.build(scene, resolved, s));
+    // Each builder bounds its own work and memory before allocating (build_budget.h) and names
+    // its settings; the refusal names the scene file too. An allocation that still fails is
+    // reported the same way, not as a bare std::bad_alloc.
+    const std::string where = scene.source.empty() ? std::string("scene") : scene.source;
+    try {
+        return finish(e.build(scene, resolved, s));
+    } catch (const Error& err) {
+        const std::string what = err.what();
+        if (what.rfind(where, 0) == 0) throw;
+        throw Error(where + ": accel " + o.kind + " (builder " + o.builder + "): " + what);
+    } catch (const std::bad_alloc&) {
+        throw Error(where + ": accel " + o.kind + " (builder " + o.builder + ", settings " + values.dump() +
+                    "): out of memory while building; lower the settings that multiply nodes, cells or references");
+    }
 }
 
 std::unique_ptr<Accel> load_accel(AccelImage image, const std::string& source) {

@@ -16,6 +16,7 @@ is never reused.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -90,11 +91,15 @@ def default_accel(kinds: dict[str, list[str]] | None = None) -> AccelSpec:
 
 
 def parse_accel_entries(
-    entry: Any, kinds: dict[str, list[str]], fail: Callable[[str, str], Exception]
+    entry: Any,
+    kinds: dict[str, list[str]],
+    fail: Callable[[str, str], Exception],
+    limit: int | None = None,
 ) -> list[AccelSpec]:
     """One entry of the axis, expanded over the lists in its `build` settings. fail(subkey,
     message) builds the error naming the entry's key (subkey "" for the entry itself,
-    "kind"/"builder"/"label"/"build" for a mapping's fields)."""
+    "kind"/"builder"/"label"/"build" for a mapping's fields). An entry that would expand into
+    more than `limit` structures is refused from the lists' lengths, before any is made."""
     build: dict[str, Any] = {}
     explicit_label = isinstance(entry, dict) and bool(entry.get("label"))
     if isinstance(entry, str):
@@ -136,6 +141,15 @@ def parse_accel_entries(
     schema = registered_settings(kind, builder) if build else {}
     names = sorted(build)
     choices = [build[n] if isinstance(build[n], list) else [build[n]] for n in names]
+    count = math.prod(len(c) for c in choices)
+    if limit is not None and count > limit:
+        sizes = " x ".join(f"{len(c)} {n}" for n, c in zip(names, choices, strict=True) if len(c) > 1)
+        raise fail(
+            "build",
+            f"{kind}:{builder} settings expand into {count:,} structures ({sizes}), each at "
+            f"least one run; the sweep has room for {limit:,} more within its run limit "
+            "(docs/sweeps.md); sweep fewer values",
+        )
     for name, values in zip(names, choices, strict=True):
         for value in values or [None]:
             problem = check_setting(str(name), value, schema)

@@ -37,6 +37,7 @@ from rtsim.sweep.accel_axis import (
     registered_kinds,
     trace_format_version,
 )
+from rtsim.sweep.run_check import CheckedRun, config_patch, describe, first_refusal
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
 SAMPLING_METHODS = ("random", "latin_hypercube")
@@ -400,11 +401,16 @@ class _Reader:
                     return self.fail(where, key, f"accel[{i}].{sub}", message)
                 return self.fail(items, i, f"accel[{i}]", message)
 
-            out.extend(parse_accel_entries(entry, kinds, fail))
-        labels = [a.label for a in out]
-        dup = next((x for x in labels if labels.count(x) > 1), None)
-        if dup:
-            raise self.fail(doc, "accel", "accel", f"two entries named '{dup}' (give one a label)")
+            # Every structure is at least one run: the axis is held to the run limit as it
+            # expands, each entry's settings product counted before it is made.
+            out.extend(parse_accel_entries(entry, kinds, fail, MAX_RUNS - len(out)))
+        seen: set[str] = set()
+        for a in out:
+            if a.label in seen:
+                raise self.fail(
+                    doc, "accel", "accel", f"two entries named '{a.label}' (give one a label)"
+                )
+            seen.add(a.label)
         return out
 
     def config_value(self, parent: Any, key: Any, path: str, config_key: str, value: Any) -> None:
@@ -582,7 +588,64 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
         spec.timeout = float(rd.number(doc, "timeout", "timeout", False, 0, above=True))
     if "baseline" in doc:
         spec.baseline = rd.baseline(doc, spec.grid)
+    _check_runs(rd, doc, spec)
     return spec
+
+
+def _check_runs(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
+    """Refuses a spec any of whose runs the simulator would refuse (its resolution step and
+    memory estimate, asked once for every distinct structure and config), naming the swept key
+    that made the run, before any trace is made."""
+    runs, seen = [], set()
+    base_sets = unflatten(spec.sets)
+    accels = spec.accels if spec.accels is not None else [default_accel()]
+    for point in spec.points():
+        preset = str(point.get(PRESET_KEY, spec.preset))
+        values = {k: v for k, v in point.items() if k not in (PRESET_KEY, POINT_KEY)}
+        patch = config_patch(apply_patch(apply_patch(compose(preset), base_sets), unflatten(values)))
+        for a in accels:
+            compressed = bool(dict(a.settings).get("compressed_leaves", False))
+            key = (a.kind, compressed, json.dumps(patch, sort_keys=True))
+            if key in seen:
+                continue
+            seen.add(key)
+            label = a.label if spec.accels is not None else None
+            runs.append(CheckedRun(a.kind, compressed, patch, label, dict(point)))
+    refused = first_refusal(runs)
+    if refused is None:
+        return
+    run, message = refused
+    container, key, path = _blame(doc, spec, run, message)
+    raise rd.fail(
+        container,
+        key,
+        path,
+        f"the run with {describe(run)} would be refused by the simulator: {message}",
+    )
+
+
+def _blame(doc: LineDict, spec: SweepSpec, run: CheckedRun, message: str) -> tuple[Any, Any, str]:
+    """Where in the spec a refused run comes from: the swept or set key its message names, else
+    the accel axis, else the first swept key, else the config."""
+    places: list[tuple[str, Any, Any, str]] = []  # (config key, container, key, path)
+    if "grid" in doc:
+        places += [(k, doc["grid"], k, f"grid.{k}") for k in doc["grid"]]
+    if spec.sampling is not None:
+        ranges = doc["sampling"]["ranges"]
+        places += [(k, ranges, k, f"sampling.ranges.{k}") for k in ranges]
+    if "points" in doc:
+        places += [(k, doc, "points", "points") for p in spec.named_points for k in p]
+    config = doc.get("config")
+    if isinstance(config, dict) and isinstance(config.get("set"), dict):
+        places += [(k, config["set"], k, f"config.set.{k}") for k in config["set"]]
+    for name, container, key, path in places:
+        if str(name) in message:
+            return container, key, path
+    if "accel" in doc:
+        return doc, "accel", "accel"
+    if places:
+        return places[0][1:]
+    return (doc, "config", "config") if "config" in doc else (doc, "scenes", "scenes")
 
 
 def _check_size(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:

@@ -143,9 +143,16 @@ class ResultsStore:
 
     def __init__(self, path: Path, readonly: bool = False) -> None:
         self.path = Path(path)
+        if self.path.exists() and not self.path.is_file():
+            # SQLite cannot open a folder, FIFO or device ("unable to open database file").
+            raise StoreError(
+                f"{self.path}: a folder, FIFO or device, not a results store; move it away "
+                "(the sweep then makes a new store there)"
+            )
         if readonly and not self.path.is_file():
             raise FileNotFoundError(f"{self.path}: no results store here (run `rtsim sweep`)")
-        self.conn = sqlite3.connect(self.path, timeout=30, isolation_level=None)
+        with _store_errors(self.path):
+            self.conn = sqlite3.connect(self.path, timeout=30, isolation_level=None)
         self.conn.row_factory = sqlite3.Row
         try:
             with _store_errors(self.path):

@@ -29,6 +29,8 @@ uint32_t validate_bih(const BihView& v, const std::string& source) {
         if (!seen[i]) fail(node_name(i) + " is not reachable from the root");
         deepest = std::max<uint32_t>(deepest, depth[i]);
         if (n.leaf()) {
+            // word2 is reserved in a leaf: 0 in every image the builder makes.
+            if (n.word2 != 0) fail(node_name(i) + " is a leaf with a non-zero reserved word (word2 = " + std::to_string(n.word2) + ")");
             covered.add(n.first(), n.count(), fail, [&] { return node_name(i); });
             continue;
         }

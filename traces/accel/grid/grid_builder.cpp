@@ -2,12 +2,14 @@
 // triangle listed in every cell its box overlaps (two passes: count, then fill).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "traces/accel/grid/grid.h"
 #include "traces/bvh/build_tree.h"
+#include "traces/common/build_budget.h"
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
 
@@ -70,6 +72,33 @@ GridGeometry make_geometry(const Aabb& bounds, uint64_t n, const GridConfig& c) 
     return g;
 }
 
+/// The grid's settings as a message names them.
+std::string settings_text(const GridConfig& c) {
+    char text[160];
+    std::snprintf(text, sizeof text, "density=%g, max_resolution=%u, max_cells=%llu", double(c.density),
+                  c.max_resolution, static_cast<unsigned long long>(c.max_cells));
+    return text;
+}
+
+/// Refuses a grid whose references overflow the 32-bit lists or whose cells and lists would not
+/// fit the memory a build may take, with the figures and the settings that made them.
+void check_grid_budget(const GridGeometry& g, const GridConfig& c, double references, size_t n) {
+    char what[200];
+    std::snprintf(what, sizeof what, "grid (%s): %u x %u x %u = %llu cells", settings_text(c).c_str(), g.res[0],
+                  g.res[1], g.res[2], static_cast<unsigned long long>(g.cell_count()));
+    const std::string advice = "lower density or max_cells (--build-set density=4)";
+    require(references < double(1ull << 32), std::string(what) + " listing " + std::to_string(uint64_t(references)) +
+                                                 " references, more than the 2^32 a list index holds; " + advice);
+    // The build holds the cells' counts (8 B), the cell records (8 B), the lists (4 B per
+    // reference), each triangle's box, range and record, then the image copies nothing more.
+    const double cells = double(g.cell_count());
+    const double bytes = cells * 16.0 + references * 4.0 + double(n) * (24.0 + 24.0 + sizeof(HwTriangle));
+    char detail[200];
+    std::snprintf(detail, sizeof detail, "%s of cells and counts, %.0f references = %s", format_bytes(cells * 16.0).c_str(),
+                  references, format_bytes(references * 4.0).c_str());
+    check_build_memory(bytes, what, detail, advice);
+}
+
 /// What the manifest records about a grid build.
 nlohmann::json build_stats(const GridGeometry& g, const GridConfig& config, const GridCell* cells, uint64_t total,
                            size_t n) {
@@ -114,21 +143,28 @@ AccelImage grid_image(const Scene& scene, const GridConfig& config) {
     if (n == 0) bounds = Aabb{Vec3(0.0f), Vec3(0.0f)};
     const GridGeometry g = make_geometry(bounds, n, config);
 
-    // Each triangle's range of cells per axis, then counts, offsets and lists (by triangle order).
+    // Each triangle's range of cells per axis; the references they make and the memory of the
+    // cells and lists are known from the ranges before anything of the grid's size is allocated.
     std::vector<uint32_t> range(6 * n);
-    std::vector<uint64_t> count(g.cell_count() + 1, 0);
+    double references = 0.0;
     for (size_t i = 0; i < n; ++i) {
         uint32_t* r = &range[6 * i];
         for (int a = 0; a < 3; ++a)
             require(g.slab_range(a, boxes[i].lo[a], boxes[i].hi[a], &r[2 * a], &r[2 * a + 1]),
                     "grid: triangle " + std::to_string(i) + " is outside the grid (internal error)");
+        references += double(r[1] - r[0] + 1) * double(r[3] - r[2] + 1) * double(r[5] - r[4] + 1);
+    }
+    check_grid_budget(g, config, references, n);
+    // Then counts, offsets and lists (by triangle order).
+    std::vector<uint64_t> count(g.cell_count() + 1, 0);
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t* r = &range[6 * i];
         for (uint32_t z = r[4]; z <= r[5]; ++z)
             for (uint32_t y = r[2]; y <= r[3]; ++y)
                 for (uint32_t x = r[0]; x <= r[1]; ++x) ++count[g.cell_index(x, y, z) + 1];
     }
     for (size_t c = 1; c < count.size(); ++c) count[c] += count[c - 1];
     const uint64_t total = count.back();
-    require(total < (1ull << 32), "grid: more than 2^32 references (lower GridConfig.density)");
 
     AccelImage image;
     image.kind = "grid";

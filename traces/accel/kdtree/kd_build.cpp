@@ -10,12 +10,14 @@
 // Every step is linear in the node's events, so the build is O(N log N).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
 #include "traces/accel/kdtree/kdtree.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/sbvh_clip.h"
+#include "traces/common/build_budget.h"
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
 
@@ -60,13 +62,25 @@ double half_area(const Aabb& b) {
     return x * y + y * z + z * x;
 }
 
+/// References a build may sweep (each node's events, summed over the nodes), per triangle and at
+/// least. Ordinary scenes take 15-43 per triangle (docs/validation.md, "third round"); a
+/// fan of triangles sharing a vertex keeps every triangle in every cell around that vertex, so
+/// the SAH splits it down to the depth limit (800 triangles: 24 s and 12,800 references each).
+constexpr double kKdWorkPerTriangle = 512.0;
+constexpr double kKdMinWork = double(1u << 23);
+
 class KdBuilder {
 public:
     KdBuilder(const Scene& scene, const KdConfig& config) : m_scene(scene), m_c(config) {}
     KdTreeBuild run();
 
 private:
-    uint32_t build(Events& ev, const Aabb& cell, uint32_t depth);
+    /// Builds the node over `cell`; `share`: its part of the root's references (the leaves'
+    /// shares add up to 1, so the work over the share finished extrapolates the whole build).
+    uint32_t build(Events& ev, const Aabb& cell, uint32_t depth, double share);
+    /// Before `n` references are swept: refuses a build whose work (so far, or extrapolated from
+    /// the share finished) passes its limit, or whose memory would not fit.
+    void check_work(uint64_t n);
     Split find_split(const Events& ev, const Aabb& cell, size_t n) const;
     double sah(const Aabb& cell, double area, int axis, float pos, size_t nl, size_t nr) const;
     void divide(Events& ev, const Split& s, Events* left, Events* right);
@@ -85,7 +99,36 @@ private:
     // What the manifest records.
     uint64_t m_leaves = 0, m_empty_leaves = 0, m_max_leaf = 0, m_depth = 0, m_clipped = 0;
     double m_sah = 0.0, m_kd_cost = 0.0;
+    double m_work = 0.0, m_done = 0.0, m_work_limit = kKdMinWork;
 };
+
+void KdBuilder::check_work(uint64_t n) {
+    m_work += double(n);
+    const double share = std::max(m_done, 1e-12);
+    // Past a quarter of the budget (more than any ordinary scene's whole build) the share
+    // finished is a fair sample, so the extrapolated whole must fit too: refused early.
+    const bool over = m_work > m_work_limit || (m_work > m_work_limit / 4 && m_work / share > m_work_limit);
+    char text[600];
+    const double tris = double(m_scene.triangles.size());
+    if (over) {
+        std::snprintf(text, sizeof text,
+                      "kdtree (max_depth=%u, empty_bonus=%g): the build would sweep about %.3g references (%.3g per "
+                      "triangle; %.3g so far for %.2g%% of the scene), more than the %.3g a build of %.0f triangles "
+                      "may; many triangles meeting in one point or line stay together in every cell around it, so "
+                      "the SAH splits them down to the depth limit: lower max_depth (--build-set max_depth=12), or "
+                      "use another structure",
+                      m_max_depth, double(m_c.empty_bonus), m_work / share, m_work / share / tris, m_work,
+                      100.0 * m_done, m_work_limit, tris);
+        throw Error(text);
+    }
+    // The reference pool, the node and list arrays held now.
+    const double bytes = double(m_box.size()) * (sizeof(Aabb) + 5.0) + double(m_out.nodes.size()) * sizeof(KdNode) +
+                         double(m_out.refs.size()) * 4.0 + double(n) * 6.0 * sizeof(Event);
+    std::snprintf(text, sizeof text, "%zu references pooled, %zu nodes, %zu listed", m_box.size(), m_out.nodes.size(),
+                  m_out.refs.size());
+    check_build_memory(bytes, "kdtree (max_depth=" + std::to_string(m_max_depth) + ")", text,
+                       "lower max_depth (--build-set max_depth=12)");
+}
 
 uint32_t KdBuilder::add_ref(const Aabb& box, uint32_t prim) {
     m_box.push_back(box);
@@ -206,7 +249,8 @@ void KdBuilder::make_leaf(const Events& ev, uint32_t index) {
     m_max_leaf = std::max<uint64_t>(m_max_leaf, prims.size());
 }
 
-uint32_t KdBuilder::build(Events& ev, const Aabb& cell, uint32_t depth) {
+uint32_t KdBuilder::build(Events& ev, const Aabb& cell, uint32_t depth, double share) {
+    check_work(ev.refs());
     const uint32_t index = uint32_t(m_out.nodes.size());
     require(index < KdNode::kMaxIndex, "kdtree: more than 2^30 nodes");
     m_out.nodes.push_back(KdNode{});
@@ -218,6 +262,7 @@ uint32_t KdBuilder::build(Events& ev, const Aabb& cell, uint32_t depth) {
     if (!s.valid || !(s.cost < double(m_c.intersection_cost) * double(n))) {
         m_sah += weight * double(n);
         m_kd_cost += weight * double(m_c.intersection_cost) * double(n);
+        m_done += share;
         make_leaf(ev, index);
         return index;
     }
@@ -231,10 +276,12 @@ uint32_t KdBuilder::build(Events& ev, const Aabb& cell, uint32_t depth) {
     // The left subtree's clipped references are garbage once it is built (the right side's
     // events name only older ones): the pool shrinks back, so it holds one root path's worth.
     const size_t pool = m_box.size();
-    build(left, lc, depth + 1);
+    const double nl = double(left.refs()), nr = double(right.refs());
+    const double left_share = nl + nr > 0 ? share * nl / (nl + nr) : share / 2;
+    build(left, lc, depth + 1, left_share);
     left = Events{};
     m_box.resize(pool), m_prim.resize(pool), m_side.resize(pool);
-    const uint32_t above = build(right, rc, depth + 1);
+    const uint32_t above = build(right, rc, depth + 1, share - left_share);
     m_out.nodes[index] = KdNode::interior(s.axis, s.pos, above);
     return index;
 }
@@ -260,7 +307,8 @@ KdTreeBuild KdBuilder::run() {
     }
     for (auto& axis : root.axis) std::sort(axis.begin(), axis.end());
     m_root_area = std::max(half_area(m_out.bounds), 1e-300);
-    build(root, m_out.bounds, 0);
+    m_work_limit = std::max(kKdMinWork, kKdWorkPerTriangle * double(n));
+    build(root, m_out.bounds, 0, 1.0);
     const double refs = double(m_out.refs.size());
     m_out.stats = {{"builder", "sah"},
                    {"width", 2},
@@ -277,7 +325,9 @@ KdTreeBuild KdBuilder::run() {
                    {"max_leaf_size", m_max_leaf},
                    {"clipped_references", m_clipped},
                    {"sah_cost", m_sah},
-                   {"kd_sah_cost", m_kd_cost}};
+                   {"kd_sah_cost", m_kd_cost},
+                   {"build_work", m_work},  // references swept, against its limit
+                   {"build_work_limit", m_work_limit}};
     return std::move(m_out);
 }
 

@@ -36,6 +36,8 @@ struct KdNode {        // 8 bytes
     uint32_t above() const { return word1 >> 2; }
     uint32_t first_ref() const { return word0; }
     uint32_t ref_count() const { return word1 >> 2; }
+    /// A leaf has no reserved bits (both words are used).
+    uint32_t leaf_reserved() const { return 0; }
 
     static KdNode interior(int axis, float split, uint32_t above) {
         KdNode n;

@@ -3,6 +3,7 @@
 // clipped into the children it reaches (conservatively, in double: traces/bvh/sbvh_clip.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "traces/accel/spatial_params.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/sbvh_clip.h"
+#include "traces/common/build_budget.h"
 #include "traces/common/error.h"
 #include "traces/scene/scene.h"
 
@@ -27,24 +29,96 @@ double half_area(const Aabb& b) {
     return x * y + y * z + z * x;
 }
 
+/// References a build may clip and list in all, per triangle and at least. Ordinary scenes take
+/// 13-50 per triangle (docs/validation.md, "third round"); overlapping coplanar triangles never
+/// thin out below max_leaf_size, so each level quadruples their references down to max_depth
+/// (4^16 cells of a plane). A 300-triangle plane is refused in about a second.
+constexpr double kOctWorkPerTriangle = 256.0;
+constexpr double kOctMinWork = double(1u << 22);
+
 class OctreeBuilder {
 public:
-    OctreeBuilder(const Scene& scene, const OctreeConfig& c) : m_scene(scene), m_c(c) {}
+    OctreeBuilder(const Scene& scene, const OctreeConfig& c)
+        : m_scene(scene),
+          m_c(c),
+          m_work_limit(std::max(kOctMinWork, kOctWorkPerTriangle * double(scene.triangles.size()))),
+          m_live(scene.triangles.size()) {}
 
-    void build(uint32_t index, const Aabb& cell, std::vector<Ref>& refs, uint32_t depth);
+    /// Builds node `index` over `cell`; `weight`: its share of the root's references (the
+    /// leaves' shares add up to 1, so the work done over the share finished extrapolates the
+    /// whole build).
+    void build(uint32_t index, const Aabb& cell, std::vector<Ref>& refs, uint32_t depth, double weight);
     std::vector<OctNode> nodes;
     std::vector<uint32_t> list;
     double root_area = 1.0, sah = 0.0;
     uint64_t leaves = 0, max_leaf = 0, deepest = 0;
+    double work() const { return m_work; }
+    double work_limit() const { return m_work_limit; }
 
 private:
-    void leaf(uint32_t index, const Aabb& cell, const std::vector<Ref>& refs);
+    void leaf(uint32_t index, const Aabb& cell, const std::vector<Ref>& refs, double weight);
+    /// Before `more` references are clipped: refuses a build whose work (so far, or extrapolated
+    /// from the share finished) passes its limit.
+    void check_work(uint64_t more);
+    /// Before `more` clipped references are kept for `new_nodes` children: refuses more nodes
+    /// than the layout indexes or more memory than a build may take.
+    void check_room(uint64_t more, uint32_t new_nodes);
+    [[noreturn]] void refuse(const std::string& why) const;
     /// The parts of `r` on either side of `plane` of `axis` (empty boxes where it does not reach).
     void split(const Ref& r, int axis, float plane, Aabb* lower, Aabb* upper) const;
 
     const Scene& m_scene;
     OctreeConfig m_c;
+    double m_work_limit;
+    double m_work = 0.0;       ///< references clipped or listed so far
+    double m_done = 0.0;       ///< the share of the root's references in finished leaves
+    uint64_t m_live = 0;       ///< references held in the lists of cells not yet finished
 };
+
+void OctreeBuilder::refuse(const std::string& why) const {
+    char settings[160];
+    std::snprintf(settings, sizeof settings, "octree (max_depth=%u, max_leaf_size=%u, clip=%s)", m_c.max_depth,
+                  m_c.max_leaf_size, m_c.clip ? "true" : "false");
+    throw Error(std::string(settings) + ": " + why +
+                "; many triangles overlapping in one plane (or one point) never thin out to max_leaf_size, so "
+                "their cells are cut down to max_depth: lower max_depth (--build-set max_depth=8) or raise "
+                "max_leaf_size, or use another structure");
+}
+
+void OctreeBuilder::check_work(uint64_t more) {
+    m_work += double(more);
+    const double share = std::max(m_done, 1e-12);
+    // Past a quarter of the budget (more than any ordinary scene's whole build) the share
+    // finished is a fair sample, so the extrapolated whole must fit too: refused early.
+    if (m_work <= m_work_limit && !(m_work > m_work_limit / 4 && m_work / share > m_work_limit)) return;
+    const double n = double(m_scene.triangles.size());
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "the build would clip about %.3g references (%.3g per triangle; %.3g so far for %.2g%% of the "
+                  "scene) into about %.3g nodes, more than the %.3g references of work a build of %.0f triangles "
+                  "may do",
+                  m_work / share, m_work / share / n, m_work, 100.0 * m_done, double(nodes.size()) / share,
+                  m_work_limit, n);
+    refuse(text);
+}
+
+void OctreeBuilder::check_room(uint64_t more, uint32_t new_nodes) {
+    char text[300];
+    if (double(nodes.size()) + new_nodes > double(OctNode::kMaxIndex)) {
+        std::snprintf(text, sizeof text, "more than 2^24 nodes (the layout's child index), about %.3g estimated",
+                      double(nodes.size()) / std::max(m_done, 1e-12));
+        refuse(text);
+    }
+    const double bytes = double(nodes.size() + new_nodes) * sizeof(OctNode) + double(list.size()) * 4.0 +
+                         double(m_live + more) * sizeof(Ref);
+    std::snprintf(text, sizeof text, "%zu nodes, %zu references listed, %llu being clipped", nodes.size(),
+                  list.size(), static_cast<unsigned long long>(m_live + more));
+    try {
+        check_build_memory(bytes, "the tree", text, "lower max_depth or raise max_leaf_size");
+    } catch (const Error& e) {
+        refuse(e.what());
+    }
+}
 
 void OctreeBuilder::split(const Ref& r, int axis, float plane, Aabb* lower, Aabb* upper) const {
     if (r.box.hi[axis] <= plane && !(r.box.lo[axis] == plane)) {  // wholly below (touching allowed)
@@ -67,7 +141,9 @@ void OctreeBuilder::split(const Ref& r, int axis, float plane, Aabb* lower, Aabb
     }
 }
 
-void OctreeBuilder::leaf(uint32_t index, const Aabb& cell, const std::vector<Ref>& refs) {
+void OctreeBuilder::leaf(uint32_t index, const Aabb& cell, const std::vector<Ref>& refs, double weight) {
+    m_done += weight;
+    m_work += double(refs.size());
     std::vector<uint32_t> prims;
     for (const Ref& r : refs) prims.push_back(r.prim);
     std::sort(prims.begin(), prims.end());
@@ -79,7 +155,7 @@ void OctreeBuilder::leaf(uint32_t index, const Aabb& cell, const std::vector<Ref
     max_leaf = std::max<uint64_t>(max_leaf, prims.size());
 }
 
-void OctreeBuilder::build(uint32_t index, const Aabb& cell, std::vector<Ref>& refs, uint32_t depth) {
+void OctreeBuilder::build(uint32_t index, const Aabb& cell, std::vector<Ref>& refs, uint32_t depth, double weight) {
     deepest = std::max<uint64_t>(deepest, depth);
     // The centre: each axis with extent is halved; one without keeps its upper bound (not cut).
     float centre[3];
@@ -90,8 +166,9 @@ void OctreeBuilder::build(uint32_t index, const Aabb& cell, std::vector<Ref>& re
         centre[a] = cut ? mid : hi;
         cut_any = cut_any || cut;
     }
-    if (refs.size() <= m_c.max_leaf_size || depth >= m_c.max_depth || !cut_any) return leaf(index, cell, refs);
+    if (refs.size() <= m_c.max_leaf_size || depth >= m_c.max_depth || !cut_any) return leaf(index, cell, refs, weight);
     // Each reference clipped into the children it reaches: one axis at a time.
+    check_work(refs.size());
     std::vector<Ref> child[8];
     for (const Ref& r : refs) {
         Aabb part[8];
@@ -116,17 +193,23 @@ void OctreeBuilder::build(uint32_t index, const Aabb& cell, std::vector<Ref>& re
         separates = separates || (!child[c].empty() && child[c].size() < refs.size());
         if (!child[c].empty()) mask |= 1u << c, ++stored;
     }
-    if (!separates && stored > 1) return leaf(index, cell, refs);
+    if (!separates && stored > 1) return leaf(index, cell, refs, weight);
+    uint64_t total = 0;
+    for (uint32_t c = 0; c < 8; ++c) total += child[c].size();
+    check_room(total, stored);
+    m_live += total;
+    m_live -= refs.size();  // a cell's list is freed once its children hold the parts
     std::vector<Ref>().swap(refs);
     const uint32_t first = uint32_t(nodes.size());
-    require(first + stored <= OctNode::kMaxIndex, "octree: more than 2^24 nodes (lower max_depth or raise max_leaf_size)");
     nodes[index] = OctNode::interior(mask, first, centre);
     nodes.resize(nodes.size() + stored);
     sah += half_area(cell) / root_area;
     uint32_t k = first;
     for (uint32_t c = 0; c < 8; ++c) {
         if (child[c].empty()) continue;
-        build(k++, octree_child_cell(cell, centre, c), child[c], depth + 1);
+        const double share = weight * double(child[c].size()) / double(total);
+        build(k++, octree_child_cell(cell, centre, c), child[c], depth + 1, share);
+        m_live -= child[c].size();  // a leaf's list (an interior child freed its own)
         std::vector<Ref>().swap(child[c]);
     }
 }
@@ -153,7 +236,7 @@ AccelImage octree_image(const Scene& scene, const OctreeConfig& config) {
     OctreeBuilder b(scene, config);
     b.root_area = std::max(half_area(bounds), 1e-300);
     b.nodes.resize(1);
-    b.build(0, bounds, refs, 0);
+    b.build(0, bounds, refs, 0, 1.0);
 
     AccelImage image;
     image.kind = "octree";
@@ -178,7 +261,9 @@ AccelImage octree_image(const Scene& scene, const OctreeConfig& config) {
                    {"references_per_triangle", total / double(n)},
                    {"avg_leaf_size", b.leaves ? total / double(b.leaves) : 0.0},
                    {"max_leaf_size", b.max_leaf},
-                   {"sah_cost", b.sah}};
+                   {"sah_cost", b.sah},
+                   {"build_work", b.work()},  // references clipped or listed, against its limit
+                   {"build_work_limit", b.work_limit()}};
     return image;
 }
 

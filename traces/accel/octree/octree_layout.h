@@ -42,6 +42,8 @@ struct OctNode {       // 16 bytes
     }
     uint32_t first_ref() const { return word1; }
     uint32_t ref_count() const { return word2; }
+    /// A leaf's reserved bits (word0's index bits and word3): 0 in every image the builder makes.
+    uint32_t leaf_reserved() const { return word0 | word3; }
 
     static OctNode interior(uint32_t mask, uint32_t first_child, const float centre[3]) {
         OctNode n{mask | first_child << 8, 0, 0, 0};
