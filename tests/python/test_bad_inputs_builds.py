@@ -30,7 +30,9 @@ MEMORY_LIMIT = 6 << 30
 SECONDS = 60
 
 
-def limited_rtsim(*args: str, seconds: float = SECONDS) -> tuple[subprocess.CompletedProcess[str], float]:
+def limited_rtsim(
+    *args: str, seconds: float = SECONDS
+) -> tuple[subprocess.CompletedProcess[str], float]:
     """`rtsim ARGS` under a 6 GB address-space limit and a timeout; (result, wall seconds)."""
 
     def limit() -> None:
@@ -115,7 +117,9 @@ def test_grid_at_its_maxima_refused_before_allocating(tmp_path: Path) -> None:
         "--build-set", "max_cells=4294967296", "--build-set", "max_resolution=65536",
         "--resolution", "16x12", "--workload", "primary",
     )  # fmt: skip
-    message = assert_refused(result, "hairball", "grid", "density=1e+06", "max_cells=4294967296", "GiB")
+    message = assert_refused(
+        result, "hairball", "grid", "density=1e+06", "max_cells=4294967296", "GiB"
+    )
     assert "lower density or max_cells" in message
     assert seconds < 30, seconds
 
@@ -154,7 +158,9 @@ def degenerate_positions(kind: str, n: int, seed: int) -> np.ndarray:
 
 
 @pytest.mark.parametrize(("kind", "builder"), structure_variants())
-@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=4, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(scene=degenerate_scenes)
 def test_degenerate_scenes_build_in_bounded_time(
     kind: str, builder: str, scene: tuple[str, int, int], tmp_path: Path

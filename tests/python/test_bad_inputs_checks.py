@@ -39,7 +39,8 @@ def _err(capsys: pytest.CaptureFixture[str]) -> str:
 def test_accel_settings_product_held_to_the_run_limit(tmp_path: Path, capsys) -> None:
     spec = tmp_path / "big.yaml"
     spec.write_text(
-        SPEC + "accel:\n  - kind: bvh2\n    build:\n      bins: [" + ", ".join(map(str, range(2, 62)))
+        SPEC + "accel:\n  - kind: bvh2\n    build:\n      bins: ["
+        + ", ".join(map(str, range(2, 62)))
         + "]\n      max_leaf_size: [" + ", ".join(map(str, range(1, 61)))
         + "]\n      traversal_cost: [" + ", ".join(map(str, range(1, 61))) + "]\n"
     )  # fmt: skip
@@ -55,9 +56,11 @@ def test_accel_settings_product_held_to_the_run_limit(tmp_path: Path, capsys) ->
 
 def test_accel_entries_together_held_to_the_run_limit() -> None:
     leaves, bins = ", ".join(map(str, range(1, 61))), ", ".join(map(str, range(2, 62)))
-    entry = f"  - {{kind: bvh2, label: L{{}}, build: {{max_leaf_size: [{leaves}], bins: [{bins}]}}}}\n"
+    entry = (
+        f"  - {{kind: bvh2, label: L{{}}, build: {{max_leaf_size: [{leaves}], bins: [{bins}]}}}}\n"
+    )
     text = SPEC + "accel:\n" + "".join(entry.replace("{}", str(i)) for i in range(30))
-    with pytest.raises(SpecError, match="accel\\[27\\].build.*room for 2,800 more"):
+    with pytest.raises(SpecError, match=r"accel\[27\].build.*room for 2,800 more"):
         parse_spec(text, source="s.yaml")
 
 
@@ -66,7 +69,10 @@ def test_accel_entries_together_held_to_the_run_limit() -> None:
 # scene, then failed in every run.
 
 REFUSED_AT_THE_CHECK = {
-    "packets_on_a_kdtree": ("accel: [kdtree]\ngrid:\n  traversal.model: [packet]\n", "traversal.model"),
+    "packets_on_a_kdtree": (
+        "accel: [kdtree]\ngrid:\n  traversal.model: [packet]\n",
+        "traversal.model",
+    ),
     "restart_trail_on_a_grid": (
         "accel: [grid]\ngrid:\n  traversal.stack_overflow: [restart_trail]\n",
         "traversal.stack_overflow",
@@ -80,16 +86,20 @@ REFUSED_AT_THE_CHECK = {
         "grid:\n  traversal.simt.lanes: [5]\n",
         "traversal.simt.lanes",
     ),
-    "mailbox_out_of_range": ("accel: [grid]\ngrid:\n  mailbox.entries: [1000000]\n", "mailbox.entries"),
+    "mailbox_out_of_range": (
+        "accel: [grid]\ngrid:\n  mailbox.entries: [1000000]\n",
+        "mailbox.entries",
+    ),
     "l1_size_not_a_cache": ("grid:\n  l1.size_kib: [16, 3]\n", "l1.size_kib"),
-    "units_past_the_memory_estimate": ("grid:\n  traversal.units: [100000000]\n", "traversal.units"),
+    "units_past_the_memory_estimate": (
+        "grid:\n  traversal.units: [100000000]\n",
+        "traversal.units",
+    ),
 }
 
 
 @pytest.mark.parametrize("case", sorted(REFUSED_AT_THE_CHECK))
-def test_spec_refused_where_the_simulator_would_refuse(
-    case: str, tmp_path: Path, capsys
-) -> None:
+def test_spec_refused_where_the_simulator_would_refuse(case: str, tmp_path: Path, capsys) -> None:
     extra, key = REFUSED_AT_THE_CHECK[case]
     spec = tmp_path / "s.yaml"
     spec.write_text(SPEC + extra)
@@ -127,22 +137,30 @@ def small_traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     return out
 
 
-@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(
     accel=st.sampled_from(ACCELS),
     grid=st.dictionaries(
         st.sampled_from(sorted(POOL)), st.just(None), min_size=1, max_size=3
     ).flatmap(
         lambda keys: st.fixed_dictionaries(
-            {k: st.lists(st.sampled_from(POOL[k]), min_size=1, max_size=2, unique=True) for k in keys}
+            {
+                k: st.lists(st.sampled_from(POOL[k]), min_size=1, max_size=2, unique=True)
+                for k in keys
+            }
         )
     ),
 )
 def test_spec_check_agrees_with_the_simulator(
     accel: str, grid: dict, small_traces: dict[str, Path], tmp_path_factory: pytest.TempPathFactory
 ) -> None:
-    text = SPEC + f"accel: [{accel}]\n" + "grid:\n" + "".join(
-        f"  {k}: {json.dumps(v)}\n" for k, v in grid.items()
+    text = (
+        SPEC
+        + f"accel: [{accel}]\n"
+        + "grid:\n"
+        + "".join(f"  {k}: {json.dumps(v)}\n" for k, v in grid.items())
     )
     try:
         spec = parse_spec(text, source="prop.yaml")
@@ -153,7 +171,9 @@ def test_spec_check_agrees_with_the_simulator(
         for run in spec.runs():
             folder = tmp_path_factory.mktemp("run")
             (folder / "config.json").write_text(run.config.to_json())
-            job = SimJob(trace=small_traces[accel], out_dir=folder / "r", config=folder / "config.json")
+            job = SimJob(
+                trace=small_traces[accel], out_dir=folder / "r", config=folder / "config.json"
+            )
             result = run_sim(job, timeout=120)
             assert result.returncode == 0, (run.params, result.stderr[-1500:])
     else:
@@ -164,7 +184,9 @@ def test_spec_check_agrees_with_the_simulator(
         for values in itertools.product(*grid.values()):
             sets = [f"{k}={v}" for k, v in zip(grid, values, strict=True)]
             folder = tmp_path_factory.mktemp("run")
-            result = run_sim(SimJob(trace=small_traces[accel], out_dir=folder, sets=sets), timeout=120)
+            result = run_sim(
+                SimJob(trace=small_traces[accel], out_dir=folder, sets=sets), timeout=120
+            )
             exits.append(result.returncode)
         assert 2 in exits, (refused, exits)
 
@@ -255,7 +277,10 @@ TRACE_EDITS = {
     "bih_leaf_word2": ("bih", (), edit_bih_leaf, "reserved word"),
     "cwbvh8_relabelled_octant": ("cwbvh8", (), relabel_octant, "params.order"),
     "prim_base_out_of_range": (
-        "bvh2", ("--build-set", "compressed_leaves=true"), move_prim_base, "primitive id",
+        "bvh2",
+        ("--build-set", "compressed_leaves=true"),
+        move_prim_base,
+        "primitive id",
     ),
 }
 

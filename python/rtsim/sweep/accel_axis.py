@@ -143,7 +143,9 @@ def parse_accel_entries(
     choices = [build[n] if isinstance(build[n], list) else [build[n]] for n in names]
     count = math.prod(len(c) for c in choices)
     if limit is not None and count > limit:
-        sizes = " x ".join(f"{len(c)} {n}" for n, c in zip(names, choices, strict=True) if len(c) > 1)
+        sizes = " x ".join(
+            f"{len(c)} {n}" for n, c in zip(names, choices, strict=True) if len(c) > 1
+        )
         raise fail(
             "build",
             f"{kind}:{builder} settings expand into {count:,} structures ({sizes}), each at "

@@ -86,5 +86,7 @@ def first_refusal(runs: list[CheckedRun]) -> tuple[CheckedRun, str] | None:
 def describe(run: CheckedRun) -> str:
     """The run as the message names it: its structure and swept values."""
     parts = [f"accel={run.accel_label}"] if run.accel_label is not None else []
-    parts += [f"{k}={json.dumps(v) if not isinstance(v, str) else v}" for k, v in run.params.items()]
+    parts += [
+        f"{k}={json.dumps(v) if not isinstance(v, str) else v}" for k, v in run.params.items()
+    ]
     return ", ".join(parts) if parts else "every run"

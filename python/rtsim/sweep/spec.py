@@ -602,7 +602,9 @@ def _check_runs(rd: _Reader, doc: LineDict, spec: SweepSpec) -> None:
     for point in spec.points():
         preset = str(point.get(PRESET_KEY, spec.preset))
         values = {k: v for k, v in point.items() if k not in (PRESET_KEY, POINT_KEY)}
-        patch = config_patch(apply_patch(apply_patch(compose(preset), base_sets), unflatten(values)))
+        patch = config_patch(
+            apply_patch(apply_patch(compose(preset), base_sets), unflatten(values))
+        )
         for a in accels:
             compressed = bool(dict(a.settings).get("compressed_leaves", False))
             key = (a.kind, compressed, json.dumps(patch, sort_keys=True))

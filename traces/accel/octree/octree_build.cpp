@@ -30,11 +30,13 @@ double half_area(const Aabb& b) {
 }
 
 /// References a build may clip and list in all, per triangle and at least. Ordinary scenes take
-/// 13-50 per triangle (docs/validation.md, "third round"); overlapping coplanar triangles never
-/// thin out below max_leaf_size, so each level quadruples their references down to max_depth
-/// (4^16 cells of a plane). A 300-triangle plane is refused in about a second.
+/// 13-50 per triangle with the default max_leaf_size of 8; a leaf size below the number of
+/// triangles meeting at a mesh vertex cuts cells down to max_depth around every vertex (the 1,034
+/// triangles of rotated_walls with max_leaf_size=2: 19 M references, 9.5 M nodes, 15 s), and
+/// overlapping coplanar triangles never thin out, so each level quadruples their references down
+/// to max_depth (4^16 cells of a plane) (docs/validation.md, "third round").
 constexpr double kOctWorkPerTriangle = 256.0;
-constexpr double kOctMinWork = double(1u << 22);
+constexpr double kOctMinWork = double(1u << 25);
 
 class OctreeBuilder {
 public:
@@ -88,9 +90,10 @@ void OctreeBuilder::refuse(const std::string& why) const {
 void OctreeBuilder::check_work(uint64_t more) {
     m_work += double(more);
     const double share = std::max(m_done, 1e-12);
-    // Past a quarter of the budget (more than any ordinary scene's whole build) the share
-    // finished is a fair sample, so the extrapolated whole must fit too: refused early.
-    if (m_work <= m_work_limit && !(m_work > m_work_limit / 4 && m_work / share > m_work_limit)) return;
+    // Past a quarter of the budget the share finished extrapolates the whole, within a factor of
+    // about 3 (depth first, the first subtrees are the deepest): one estimated at 8 times the
+    // budget is refused early.
+    if (m_work <= m_work_limit && !(m_work > m_work_limit / 4 && m_work / share > 8 * m_work_limit)) return;
     const double n = double(m_scene.triangles.size());
     char text[400];
     std::snprintf(text, sizeof text,
