@@ -229,7 +229,7 @@ def wide_table(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
 
 
 def measure_wide(args: argparse.Namespace) -> list[dict[str, Any]]:
-    """WIDE_CONFIGS on hairball and Sponza, primary and diffuse (OUT/execution_models_packets_wide.json)."""
+    """WIDE_CONFIGS on hairball and Sponza, primary and diffuse (rows also in OUT/*_wide.json)."""
     args.out.mkdir(parents=True, exist_ok=True)
     scenes_dir = Path(os.environ.get("RTSIM_SCENES", ""))
     rows = []

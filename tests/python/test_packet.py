@@ -1,8 +1,9 @@
 """Packets (traversal.model=packet, Wald et al. 2001), on the binary and the wide BVHs: every hit
-identical to single-ray traversal and every ray's work equal to the reference packet loop's, at every timed level and
-functional, with and without sorting and with the hybrid's split into single rays; occupancy
-exactly 1 when every ray of a packet is the same ray; one node fetch serves a packet; lanes'
-cycles accounted; structures without a packet kernel and bad settings refused, naming the field."""
+identical to single-ray traversal and every ray's work equal to the reference packet loop's, at
+every timed level and functional, with and without sorting and with the hybrid's split into
+single rays; occupancy exactly 1 when every ray of a packet is the same ray; one node fetch
+serves a packet; lanes' cycles accounted; structures without a packet kernel and bad settings
+refused, naming the field."""
 
 from __future__ import annotations
 
