@@ -49,11 +49,36 @@ CONFIGS = [
 ]
 
 
+#: Packets on wide BVHs (--wide): (label, accel, model, lanes, split_below, sort, extra --set).
+#: "box x16": a box pipeline as wide as the packet (box.width = 16 tests per issue) for every
+#: configuration of the row, single rays included, so neither side has more box throughput;
+#: "lanes": the hybrid's split rays walk at once on the packet's free lanes.
+BOX16 = ["box.width=16"]
+LANES = ["traversal.packet.split_walks=lanes"]
+WIDE_CONFIGS = [
+    ("MIMD", "bvh2", "mimd", 0, 0.0, "none", []),
+    ("MIMD bvh4", "bvh4", "mimd", 0, 0.0, "none", []),
+    ("MIMD bvh8", "bvh8", "mimd", 0, 0.0, "none", []),
+    ("packet 16", "bvh2", "packet", 16, 0.0, "none", []),
+    ("packet 16 bvh4", "bvh4", "packet", 16, 0.0, "none", []),
+    ("packet 16 bvh8", "bvh8", "packet", 16, 0.0, "none", []),
+    ("packet 4 bvh4", "bvh4", "packet", 4, 0.0, "none", []),
+    ("MIMD bvh4, box x16", "bvh4", "mimd", 0, 0.0, "none", BOX16),
+    ("packet 16 bvh4, box x16", "bvh4", "packet", 16, 0.0, "none", BOX16),
+    ("packet 16 bvh8, box x16", "bvh8", "packet", 16, 0.0, "none", BOX16),
+    ("hybrid 16 bvh4", "bvh4", "packet", 16, 0.5, "none", []),
+    ("hybrid 16 bvh4, lanes", "bvh4", "packet", 16, 0.5, "none", LANES),
+    ("hybrid 16, lanes", "bvh2", "packet", 16, 0.5, "none", LANES),
+]
+WIDE_SCENES = ("hairball", "sponza")
+
+
 def run(folder: Path, config: tuple, args: argparse.Namespace) -> dict[str, Any]:
-    label, accel, model, lanes, split, sort = config
-    name = f"{folder.name}_{label.replace(' ', '_').replace('+', 'plus')}"
+    label, accel, model, lanes, split, sort, *rest = config
+    extra = rest[0] if rest else []
+    name = f"{folder.name}_{label.replace(' ', '_').replace('+', 'plus').replace(',', '')}"
     sets = [f"traversal.model={model}", f"traversal.ray_contexts={CONTEXTS}",
-            f"dispatch.sort={sort}", f"dispatch.block_rays={BLOCK}"]  # fmt: skip
+            f"dispatch.sort={sort}", f"dispatch.block_rays={BLOCK}", *extra]  # fmt: skip
     if lanes:
         sets += [f"traversal.packet.lanes={lanes}", f"traversal.packet.split_below={split}"]
     result = run_sim(SimJob(trace=folder, out_dir=args.out / "packet_runs" / name, sets=sets))
@@ -170,6 +195,65 @@ def trends(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def wide_table(rows: list[dict[str, Any]], args: argparse.Namespace) -> str:
+    """Packets on wide BVHs beside MIMD and packets on the binary BVH (--wide)."""
+    mismatches = sum(r["hit_mismatches"] + r["work_mismatches"] for r in rows)
+    lines = [
+        f"Measured {datetime.date.today().isoformat()} on {platform.node()} ({os.cpu_count()} "
+        f"cores) by `python scripts/execution_models_packets.py --wide --resolution "
+        f"{args.resolution}`: the machine above (8 units x {CONTEXTS} ray contexts), approx level; "
+        "box x16: `box.width=16` (a box pipeline as wide as the packet, every configuration so "
+        "marked); hybrid splits below 0.5 of the packet's rays, its split rays walking one after "
+        "another on the packet's context, or with `lanes` at once on the packet's lanes "
+        f"(`traversal.packet.split_walks=lanes`). {len(rows)} runs, {mismatches} hit and work "
+        "mismatches in all (packet work checked against the reference packet loop of each "
+        "structure). Speed-up: against MIMD on the binary BVH, same trace.",
+        "",
+        "| trace | config | Mrays/s | speed-up | vs packet 16 | DRAM B/ray | occupancy | SIMD eff. "
+        "| node fetches / packet | split | box tests/ray | bottleneck |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|",
+    ]
+    base = {r["trace"]: r for r in rows if r["config"] == "MIMD"}
+    pk16 = {r["trace"]: r for r in rows if r["config"] == "packet 16"}
+    for r in rows:
+        speed = r["mrays_per_second"] / base[r["trace"]]["mrays_per_second"]
+        vs = r["mrays_per_second"] / pk16[r["trace"]]["mrays_per_second"]
+        lines.append(
+            f"| {r['trace']} | {r['config']} | {r['mrays_per_second']:.1f} | {speed:.2f}x | "
+            f"{vs:.2f}x | {r['dram_bytes_per_ray']:.0f} | {fmt(r['packet_occupancy'], '.1f')} | "
+            f"{fmt(r['simd_efficiency'], '.2f')} | {fmt(r['node_fetches_per_packet'], '.0f')} | "
+            f"{fmt(r['split_packets'], '.2f')} | {r['box_tests_per_ray']:.1f} | "
+            f"{r['bottleneck'] or '-'} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def measure_wide(args: argparse.Namespace) -> list[dict[str, Any]]:
+    """WIDE_CONFIGS on hairball and Sponza, primary and diffuse (rows also in OUT/*_wide.json)."""
+    args.out.mkdir(parents=True, exist_ok=True)
+    scenes_dir = Path(os.environ.get("RTSIM_SCENES", ""))
+    rows = []
+    for label, scene, extra in SCENES:
+        if label not in WIDE_SCENES:
+            continue
+        if label == "sponza" and not (scenes_dir / "sponza").is_dir():
+            print("sponza skipped: RTSIM_SCENES has no sponza", file=sys.stderr)
+            continue
+        for kind in KINDS:
+            folders = {
+                "bvh2": trace(label, scene, extra, kind, args),
+                "bvh4": trace(f"{label}_bvh4", scene, [*extra, "--accel", "bvh4"], kind, args),
+                "bvh8": trace(f"{label}_bvh8", scene, [*extra, "--accel", "bvh8"], kind, args),
+            }
+            for config in WIDE_CONFIGS:
+                row = run(folders[config[1]], config, args)
+                row["trace"] = f"{label}_{kind}"
+                rows.append(row)
+                print(json.dumps(rows[-1]), file=sys.stderr)
+    (args.out / "execution_models_packets_wide.json").write_text(json.dumps(rows, indent=2))
+    return rows
+
+
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
     plot_against_mimd(
         rows,
@@ -191,7 +275,21 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="tables and figure from OUT/execution_models_packets.json",
     )
+    p.add_argument(
+        "--wide",
+        action="store_true",
+        help="packets on bvh4/bvh8 beside MIMD and packets on bvh2 (hairball, Sponza): the "
+        "execution-models-packets-wide table",
+    )
     args = p.parse_args(argv)
+    if args.wide:
+        data = args.out / "execution_models_packets_wide.json"
+        rows = json.loads(data.read_text()) if args.replot else measure_wide(args)
+        text = wide_table(rows, args)
+        print(text)
+        if args.doc:
+            write_between(args.doc, "execution-models-packets-wide", text)
+        return 0
     data = args.out / "execution_models_packets.json"
     rows = json.loads(data.read_text()) if args.replot else measure(args)
     text, trend_text = table(rows, args), trends(rows)

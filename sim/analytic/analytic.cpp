@@ -39,6 +39,28 @@ void work_totals(TraceReader& reader, AnalyticProfile* p) {
     }
 }
 
+/// The work the steppers' techniques add to or save from the trace's (mailbox lookups and the
+/// tests they skip, restart-trail re-descents, a reduced-precision walk's extra subtrees), which
+/// a trace's work records never hold: measured on the stepped sample and scaled to the trace by
+/// the ratio of the trace's plan-step work to the sample's (a ratio estimator, as the cache
+/// sample's counts are scaled; Cochran 1977, ch. 6). A whole-trace sample scales by 1, exactly.
+void extrapolate_stepped_work(AnalyticProfile& p) {
+    auto& s = p.sample_work;
+    std::array<double, kWorkFieldCount> traced = s;
+    traced[size_t(WorkField::tri_tests)] += s[size_t(WorkField::mailbox_hits)];
+    for (int f = kTracedWorkFieldCount; f < kWorkFieldCount; ++f) traced[size_t(f)] = 0.0;
+    const double sample_steps = AnalyticProfile::plan_step_work(traced);
+    if (sample_steps <= 0) return;
+    const double r = AnalyticProfile::plan_step_work(p.work) / sample_steps;
+    // The TLAS's share is in the trace's steps already; the rest is on top of the trace's walk.
+    for (WorkField f : {WorkField::mailbox_lookups, WorkField::mailbox_hits, WorkField::stack_drops,
+                        WorkField::restarts, WorkField::restart_steps, WorkField::restart_box_tests,
+                        WorkField::rp_box_hits, WorkField::rp_steps, WorkField::rp_box_tests, WorkField::rp_tri_tests})
+        p.work[size_t(f)] = s[size_t(f)] * r;
+    p.work[size_t(WorkField::tri_tests)] =
+        std::max(0.0, p.work[size_t(WorkField::tri_tests)] - p.work[size_t(WorkField::mailbox_hits)]);
+}
+
 /// A vector of rays as a stream.
 class VectorStream : public RayStream {
 public:
@@ -218,6 +240,7 @@ AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const
         profile_groups(config, accel, step, jobs, p);
     }
     profiler.finish();
+    extrapolate_stepped_work(p);
     p.whole_trace = whole;
     p.analysis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return p;

@@ -18,8 +18,10 @@ struct LevelCapabilities {
     bool group_profiles = false;
     bool treelets = false;   ///< it models treelet admission and queues
     bool frames = false;     ///< it replays an animated trace's frames
-    /// It steps rays itself, so it counts work the trace's records hold none of (mailbox lookups,
-    /// restart-trail restarts, a reduced-precision walk's extra steps).
+    /// It steps every ray itself. A level that does not (the statistical analytic level) still
+    /// counts the work the trace's records hold none of (mailbox lookups, restart-trail
+    /// restarts, a reduced-precision walk's extra steps): measured on its stepped sample and
+    /// scaled to the trace (sim/analytic/analytic.cpp), so no technique needs this.
     bool steps_rays = false;
     bool shades = false;     ///< it times the frame: shading and the frame loop (approx, detailed)
 };

@@ -31,7 +31,8 @@ std::vector<Rule> make_rules() {
          [](const RunFacts& f) { return f.unit.needs.packet_kernel; }, RuleSide::structure, "a packet kernel",
          [](const RunFacts& f) { return f.structure.caps.packet_kernel; },
          "a packet's rays walk one shared traversal, which the structure provides as a packet stepper and a "
-         "reference packet loop (the hit checker checks each packet's work against it)",
+         "reference packet loop (the hit checker checks each packet's work against it); the binary and wide "
+         "BVHs have one, the grid, kd-tree, BIH, octree and two-level walks none built",
          "traversal.model=mimd or simt, or trace a structure with a packet kernel (rtsim capabilities)", "kdtree",
          {"traversal.model=packet"}});
     add({"unit/groups", "traversal.ray_contexts",
@@ -74,24 +75,22 @@ std::vector<Rule> make_rules() {
     // Per-ray traversal techniques.
     add({"restart_trail/structure", "traversal.stack_overflow=restart_trail", restart_trail, RuleSide::structure,
          "a restart trail", [](const RunFacts& f) { return f.structure.caps.restart_trail; },
-         "the restart trail records a BVH walk's position per level of one tree (Laine 2010)",
-         "traversal.stack_overflow=spill, or trace a structure with a restart trail (rtsim capabilities)", "kdtree",
+         "a restart re-descends a tree to the entries its short stack dropped (Laine 2010's trail on BVHs and the "
+         "BIH, kd-restart with push-down on kd-trees, Foley & Sugerman 2005): a grid's 3D-DDA keeps no stack to "
+         "shorten, and the octree's eight-child parametric walk has no trail built",
+         "traversal.stack_overflow=spill, or trace a structure with a restart trail (rtsim capabilities)", "grid",
          {"traversal.stack_overflow=restart_trail"}});
     add({"restart_trail/unit", "traversal.stack_overflow=restart_trail", restart_trail, RuleSide::unit,
          "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
          "a packet's rays share one stack, and the restart trail is a single ray's",
          "traversal.model=mimd or simt, or traversal.stack_overflow=spill", "bvh2",
          {"traversal.model=packet", "traversal.stack_overflow=restart_trail"}});
-    add({"restart_trail/level", "traversal.stack_overflow=restart_trail", restart_trail, RuleSide::level,
-         "a level that steps the rays", [](const RunFacts& f) { return f.level.steps_rays; },
-         "its per-trace analysis prices steps from the trace's work records, which hold no restarts",
-         "analytic.caches=functional, or fidelity=approx or detailed", "bvh2",
-         {"traversal.stack_overflow=restart_trail", "fidelity=analytic"}});
     add({"box_precision/structure", "traversal.box_precision_bits (reduced-precision boxes)", reduced_boxes,
          RuleSide::structure, "a reduced-precision box walk",
          [](const RunFacts& f) { return f.structure.caps.reduced_precision_boxes; },
-         "the conservative walk re-tests a BVH's child boxes rounded outward (Vaidyanathan et al. 2016); the "
-         "structure must count the extra subtrees it enters",
+         "the conservative walk re-tests a BVH's child boxes rounded outward (Vaidyanathan et al. 2016) and "
+         "counts the extra subtrees it enters; a space partition's cells are cut by planes, not bounded by "
+         "boxes, so it has no box to narrow",
          "traversal.box_precision_bits=0 (fp32), or trace a structure with a reduced-precision walk (rtsim "
          "capabilities)",
          "grid", {"traversal.box_precision_bits=7"}});
@@ -99,16 +98,6 @@ std::vector<Rule> make_rules() {
          "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
          "a packet's shared walk has no per-ray extra walk", "traversal.model=mimd or simt, or box_precision_bits=0",
          "bvh2", {"traversal.model=packet", "traversal.box_precision_bits=7"}});
-    add({"box_precision/level", "traversal.box_precision_bits (reduced-precision boxes)", reduced_boxes,
-         RuleSide::level, "a level that steps the rays", [](const RunFacts& f) { return f.level.steps_rays; },
-         "its per-trace analysis prices steps from the trace's work records, which hold no extra walk",
-         "analytic.caches=functional, fidelity=approx or detailed, or box_precision_bits=0", "bvh2",
-         {"traversal.box_precision_bits=7", "fidelity=analytic"}});
-    add({"mailbox/level", "mailbox.entries", [](const RunFacts& f) { return f.config.mailbox.entries != 0; },
-         RuleSide::level, "a level that steps the rays", [](const RunFacts& f) { return f.level.steps_rays; },
-         "its per-trace analysis prices triangle tests from the trace's work records, which hold no mailbox",
-         "analytic.caches=functional, or fidelity=approx or detailed", "kdtree",
-         {"mailbox.entries=8", "fidelity=analytic"}});
 
     // Sampling.
     add({"sampling/level", "sampling.fraction or sampling.count", sampling, RuleSide::level, "a timed level",

@@ -46,7 +46,9 @@ StructureFacts structure_facts(TraceReader& reader) {
                                  : "";
     bool compressed = false;
     for (const json& r : d.value("regions", json::array()))
-        if (r.is_object() && r.value("name", "") == kLeafBlocksRegion) compressed = true;
+        if (r.is_object() && (r.value("name", "") == kLeafBlocksRegion ||
+                              r.value("name", "") == std::string("blas_") + kLeafBlocksRegion))
+            compressed = true;
     StructureFacts f;
     try {
         f = structure_facts(d["kind"].get<std::string>(), blas, compressed);

@@ -1,8 +1,9 @@
-"""Packets (traversal.model=packet, Wald et al. 2001): every hit identical to single-ray
-traversal and every ray's work equal to the reference packet loop's, at every timed level and
-functional, with and without sorting and with the hybrid's split into single rays; occupancy
-exactly 1 when every ray of a packet is the same ray; one node fetch serves a packet; lanes'
-cycles accounted; structures without a packet kernel and bad settings refused, naming the field."""
+"""Packets (traversal.model=packet, Wald et al. 2001), on the binary and the wide BVHs: every hit
+identical to single-ray traversal and every ray's work equal to the reference packet loop's, at
+every timed level and functional, with and without sorting and with the hybrid's split into
+single rays; occupancy exactly 1 when every ray of a packet is the same ray; one node fetch
+serves a packet; lanes' cycles accounted; structures without a packet kernel and bad settings
+refused, naming the field."""
 
 from __future__ import annotations
 
@@ -112,10 +113,56 @@ def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray_trace(
 
 def test_packet_needs_a_packet_kernel(sim_exe: Path, tmp_path: Path) -> None:
     trace = tmp_path / "trace"
-    rtsim.trace_scene("cornell", trace, workload="primary", width=8, height=8, accel="bvh8")
+    rtsim.trace_scene("cornell", trace, workload="primary", width=8, height=8, accel="kdtree")
     result = simulate(sim_exe, trace / "trace.rtt", tmp_path / "run", "traversal.model=packet")
     assert result.returncode == 2, result.stderr
-    assert "traversal.model" in result.stderr and "bvh8" in result.stderr
+    assert "traversal.model" in result.stderr and "kdtree" in result.stderr
+
+
+@pytest.fixture(scope="module")
+def wide_cornell_traces(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Cornell primary and diffuse rays at 24x18 on the wide BVHs with a packet kernel."""
+    root = tmp_path_factory.mktemp("wide_cornell")
+    out = {}
+    for accel in ("bvh4", "bvh8", "cwbvh8", "cwbvh8_octant"):
+        out[accel] = root / accel
+        rtsim.trace_scene(
+            "cornell", out[accel], workload="primary,diffuse", width=24, height=18, accel=accel
+        )
+    return out
+
+
+@pytest.mark.parametrize("accel", ["bvh4", "bvh8", "cwbvh8", "cwbvh8_octant"])
+@pytest.mark.parametrize(
+    "sets",
+    [
+        ("traversal.packet.lanes=16",),
+        ("traversal.packet.lanes=16", "traversal.packet.split_below=0.5", "box.width=16"),
+        ("traversal.packet.lanes=8", "fidelity=functional"),
+    ],
+)
+def test_packets_on_wide_bvhs_match_the_reference(
+    sim_exe: Path,
+    wide_cornell_traces: dict[str, Path],
+    tmp_path: Path,
+    accel: str,
+    sets: tuple[str, ...],
+) -> None:
+    """Packets on 4- and 8-wide nodes, fp32 and compressed: every hit the trace's, every ray's
+    work the reference packet loop's; a packet step fetches one node for its rays."""
+    trace = wide_cornell_traces[accel] / "trace.rtt"
+    stats = sim_stats(sim_exe, trace, tmp_path / "run", *PACKET, *sets)
+    s = stats["summary"]
+    assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0
+    assert s["rays"] == rtsim.open_trace(wide_cornell_traces[accel]).manifest["counts"]["rays"]
+    if "fidelity=functional" in sets:
+        return
+    units = stats["model"]["units"].values()
+    node_fetches = sum(u["packet_node_fetches"] for u in units)
+    assert 0 < node_fetches < sum(u["packet_steps"] for u in units)
+    assert 0.0 < s["simd_efficiency"] < 1.0
+    if any(x.startswith("traversal.packet.split_below") for x in sets):
+        assert sum(u["packet_splits"] for u in units) > 0
 
 
 @pytest.mark.parametrize(

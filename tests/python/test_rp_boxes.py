@@ -71,10 +71,10 @@ def test_box_precision_is_refused_by_name_where_it_cannot_run(
     knob = "traversal.box_precision_bits"
     r = simulate(sim_exe, small_hairball_traces["kdtree"], tmp_path / "k", f"{knob}=8")
     assert r.returncode == 2 and knob in r.stderr and "kdtree" in r.stderr
-    r = simulate(
+    # the statistical analytic level scales the extra walk it measures on its stepped sample
+    checked(
         sim_exe, small_hairball_traces["bvh2"], tmp_path / "a", f"{knob}=8", "fidelity=analytic"
     )
-    assert r.returncode == 2 and knob in r.stderr
     for bad in ("23", "-1", "eight"):
         r = simulate(sim_exe, small_hairball_traces["bvh2"], tmp_path / f"b{bad}", f"{knob}={bad}")
         assert r.returncode == 2 and "box_precision_bits" in r.stderr, (bad, r.stderr)

@@ -72,10 +72,13 @@ def test_a_deep_enough_short_stack_never_restarts(
 def test_short_stack_is_refused_by_name_where_it_cannot_run(
     small_hairball_traces: dict[str, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
-    r = simulate(sim_exe, small_hairball_traces["kdtree"], tmp_path / "k", SHORT)
-    assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr and "kdtree" in r.stderr
-    r = simulate(sim_exe, small_hairball_traces["bvh2"], tmp_path / "a", SHORT, "fidelity=analytic")
-    assert r.returncode == 2 and "traversal.stack_overflow" in r.stderr
+    # kd-trees restart by kd-restart with push-down; the statistical analytic level scales the
+    # restarts it measures on its stepped sample
+    stats = checked(
+        sim_exe, small_hairball_traces["kdtree"], tmp_path / "k", SHORT, "traversal.stack_entries=2"
+    )
+    assert stats["short_stack"]["restarts"] > 0
+    checked(sim_exe, small_hairball_traces["bvh2"], tmp_path / "a", SHORT, "fidelity=analytic")
     r = simulate(
         sim_exe, small_hairball_traces["bvh2"], tmp_path / "c", "traversal.stack_overflow=pop"
     )

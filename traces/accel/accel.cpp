@@ -27,6 +27,7 @@ void Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n
 bool Accel::has_anyhit_triangles() const {
     for (const Region& r : m_image.regions) {
         if (r.kind != DataKind::triangle) continue;
+        if (r.name.rfind("blas_", 0) == 0) continue;  // two levels: each BLAS reads its own
         const bool blocks = r.name == kLeafBlocksRegion;  // compressed: read the decoded triangles
         const HwTriangle* t = blocks ? m_triangles.triangles() : r.records<HwTriangle>();
         const uint64_t n = blocks ? m_triangles.count() : r.count;

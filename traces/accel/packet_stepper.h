@@ -73,12 +73,28 @@ struct PacketLanes {
     void finish();
 };
 
+/// How the hybrid's rays walk after their packet split (Benthin et al. 2012).
+enum class SplitWalks : uint8_t {
+    serial = 0,  ///< one after another in lane order, on the packet's context (its plan)
+    lanes = 1,   ///< each on its own lane of the packet, all at once (lane_walker())
+};
+
 class PacketStepper : public Stepper {
 public:
     virtual void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) = 0;
     /// The hybrid (Benthin et al. 2012): from the next packet on, a packet whose active rays at a
     /// node are fewer than `fraction` of its rays splits, and they finish as single rays (0: never).
     void set_split_below(float fraction) { m_split_below = fraction; }
+    /// How split rays walk, from the next packet on. With SplitWalks::lanes the packet's plan is
+    /// done at the split, and each ray of split_lanes() walks alone as lane_walker(i): a Stepper
+    /// of its own (plan, execute, stack) that whoever drives the packet drives on ray i's lane.
+    /// Every ray's hit and work are the serial walk's (each walk is the ray's alone); the
+    /// packet's lane_hit(i) / lane_work(i) and counts() are final once every walker is done.
+    void set_split_walks(SplitWalks walks) { m_split_walks = walks; }
+    /// The rays walking alone after a split with SplitWalks::lanes (0 before, and otherwise).
+    LaneMask split_lanes() const { return m_split_lanes; }
+    /// Ray i's walker (i in split_lanes()).
+    virtual Stepper& lane_walker(uint32_t i) = 0;
     /// A packet of one ray.
     void begin(const Ray& ray, TraversalMode mode) override { begin_packet(&ray, &mode, 1); }
 
@@ -96,6 +112,8 @@ protected:
     LaneMask m_active = 0;  ///< the rays of the planned step
     PacketCounts m_counts;
     float m_split_below = 0.0f;
+    SplitWalks m_split_walks = SplitWalks::serial;
+    LaneMask m_split_lanes = 0;
 };
 
 }  // namespace rtsim

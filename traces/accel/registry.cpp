@@ -160,6 +160,7 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
         return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
     };
     const AccelCapabilities c = single_level(kBvhStackEntryBytes)
+                                    .with(&AccelCapabilities::packet_kernel)
                                     .with(&AccelCapabilities::restart_trail)
                                     .with(&AccelCapabilities::reduced_precision_boxes);
     return {{name, description, tree_builder_names(), c}, tree_settings, build, load};
@@ -196,12 +197,12 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return grid_image(scene, s.grid); },
          loader<GridAccel>()},
         {{"kdtree", "kd-tree, SAH in O(N log N) with perfect splits (Wald & Havran 2006), 8-byte nodes, plane tests",
-          {"sah"}, single_level(kKdStackEntryBytes).with(&AccelCapabilities::mailbox)},
+          {"sah"}, single_level(kKdStackEntryBytes).with(&AccelCapabilities::mailbox).with(&AccelCapabilities::restart_trail)},
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.kd.visit(v); },
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
          loader<KdAccel>()},
         {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
-          {"binned", "wachter_keller", "lbvh"}, single_level(kBihStackEntryBytes)},
+          {"binned", "wachter_keller", "lbvh"}, single_level(kBihStackEntryBytes).with(&AccelCapabilities::restart_trail)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              if (builder == "wachter_keller") s.bih.visit(v);
              else tree_settings(builder, s, v);
@@ -274,11 +275,16 @@ AccelCapabilities accel_capabilities(const std::string& kind, const std::string&
         require(e != nullptr, "accel: unknown structure '" + kind + "' (known: " + known_kinds() + ", two_level)");
         return e->info.capabilities;
     }
-    // A TLAS over BLASes of one kind: one stack holds the TLAS's entries and the BLAS kind's, and
-    // what needs one walk of one tree is not offered (two_level.h).
+    // A TLAS over BLASes of one kind: one stack holds the TLAS's entries and the BLAS kind's; a
+    // packet kernel is not offered (two_level.h).
     const AccelCapabilities blas = accel_capabilities(blas_kind);
     AccelCapabilities c;
     c.mailbox = blas.mailbox;
+    // Per-level restart trails, the BLASes' reduced-precision walks and compressed leaves (each
+    // BLAS's leaf blocks a slice of "blas_leaf_blocks", decoded by its own load; two_level.h).
+    c.restart_trail = blas.restart_trail;
+    c.reduced_precision_boxes = blas.reduced_precision_boxes;
+    c.compressed_leaves = blas.compressed_leaves;
     c.treelet_partition = blas.treelet_partition;
     c.stack_entry_bytes = std::max(kBvhStackEntryBytes, blas.stack_entry_bytes);
     return c;
@@ -311,7 +317,8 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
     const BuildSettings s = resolve_settings(e, o.builder, o, &values);  // refuses bad settings before any work
     const auto start = std::chrono::steady_clock::now();
     auto finish = [&](AccelImage image) {
-        if (s.leaves.compressed) compress_leaves(image, image.leaf_starts, s.leaves);
+        // Two levels: each BLAS compressed its own leaves as it was built (two_level_build.cpp).
+        if (s.leaves.compressed && !o.two_level) compress_leaves(image, image.leaf_starts, s.leaves);
         image.leaf_starts.clear();
         image.build_ms = ms_since(start);
         image.stats["footprint_bytes"] = image.footprint_bytes();
@@ -322,8 +329,6 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
         image.stats["build_set"] = o.settings;
         return image;
     };
-    require(!(o.two_level && s.leaves.compressed),
-            "accel: compressed_leaves is not available with two levels (the BLASes' triangles are slices of one region)");
     if (o.two_level) return finish(build_two_level(scene, o));
     require(!scene.triangles.empty(), "scene has no triangles");
     require(scene.tri_material.size() == scene.triangles.size() && scene.tri_instance.size() == scene.triangles.size(),

@@ -53,9 +53,11 @@ public:
     /// A restart that resumes at an entry of `depth` with `remaining` entries still below it on
     /// the full stack: its re-descent revisits the path's first `depth` nodes (at least the
     /// root), and the short stack refills with the newest of the pending entries it passes.
-    void restart(uint32_t depth, uint32_t remaining) {
-        m_replay_next = 0;
+    /// `first` > 0 starts the re-descent at the path's node of that depth instead of the root
+    /// (kd-restart's push-down, cell_stepper.h).
+    void restart(uint32_t depth, uint32_t remaining, uint32_t first = 0) {
         m_replay_end = std::min(std::max(depth, 1u), kMaxShortStackPath);
+        m_replay_next = std::min(first, m_replay_end - 1);
         m_on_chip = std::min(m_entries, remaining);
     }
     /// True while the re-descent has nodes left to revisit.

@@ -16,12 +16,19 @@ StepCosts packet_costs(StepCosts costs, uint32_t lanes) {
     return costs;
 }
 
+/// The scheduler's slots: one per packet, and with split rays walking on their lanes, one per lane.
+uint32_t slots(const TraversalConfig& t) {
+    const PacketConfig& p = t.kind_config<PacketConfig>();
+    return p.split_walks == SplitWalks::lanes ? t.groups() * (1 + p.lanes) : t.groups();
+}
+
 }  // namespace
 
 PacketUnit::PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_t index)
-    : ScheduledUnit(name, setup, index, setup.config.groups(),
+    : ScheduledUnit(name, setup, index, slots(setup.config),
                     packet_costs(setup.costs, setup.config.kind_config<PacketConfig>().lanes)),
       m_packet(setup.config.kind_config<PacketConfig>()),
+      m_lane_costs(setup.costs),
       m_packets(setup.config.groups()),
       m_coalescer(setup.context.line_bytes),
       m_active_histogram(m_packet.lanes + 1, 0),
@@ -33,7 +40,9 @@ PacketUnit::PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uin
         p.stepper = m_steppers.accel().make_packet_stepper();
         require(p.stepper != nullptr, "model: structure '" + m_steppers.accel().kind() + "' has no packet kernel");
         p.stepper->set_split_below(float(m_packet.split_below));
+        p.stepper->set_split_walks(m_packet.split_walks);
         p.ids.resize(m_packet.lanes);
+        if (m_packet.split_walks == SplitWalks::lanes) p.lanes.resize(m_packet.lanes);
     }
     SC_THREAD(run);
 }
@@ -48,13 +57,20 @@ void PacketUnit::run() {
             continue;
         }
         const Cycle ready = m_events.top_time();
-        const uint32_t p = m_events.begin_pop();
-        // The scheduler takes one phase of one packet per issue_cycles.
+        const uint32_t slot = m_events.begin_pop();
+        // The scheduler takes one phase of one packet (or one walking lane) per issue_cycles.
         const Cycle t = std::max(ready, m_sched_free);
         m_sched_free = t + m_config.issue_cycles;
         now = t;
-        if (m_ctx.sync_private_steps || m_packets[p].phase != Phase::ops) m_sync(t);
-        advance(p, t);
+        if (slot < m_packets.size()) {
+            if (m_ctx.sync_private_steps || m_packets[slot].phase != Phase::ops) m_sync(t);
+            advance(slot, t);
+        } else {
+            const uint32_t p = (slot - uint32_t(m_packets.size())) / m_packet.lanes;
+            const uint32_t i = (slot - uint32_t(m_packets.size())) % m_packet.lanes;
+            if (m_ctx.sync_private_steps || m_packets[p].lanes[i].phase != Phase::ops) m_sync(t);
+            advance_lane(p, i, t);
+        }
         m_events.finish_pop();
         if (rays->frame() != m_frame) {  // a frame was released: fill every idle packet
             if (!m_ctx.sync_private_steps) m_sync(t);
@@ -130,8 +146,81 @@ void PacketUnit::advance(uint32_t p, Cycle t) {
     Packet& pk = m_packets[p];
     account(p, CycleUse::issue, t);  // ready since its event, waiting for the scheduler
     if (pk.phase == Phase::ops) return run_ops(p, t);
-    if (pk.stepper->plan().done) return finish_packet(p, t);
+    if (pk.stepper->plan().done) {
+        if (pk.stepper->split_lanes() && !pk.walking) return launch_lanes(p, t);
+        return finish_packet(p, t);
+    }
     step(p, t);
+}
+
+void PacketUnit::launch_lanes(uint32_t p, Cycle t) {
+    // The packet split: each ray with steps left walks on its own lane from now on; the packet's
+    // own context waits for the last of them.
+    Packet& pk = m_packets[p];
+    account(p, CycleUse::issue, t);
+    pk.walking = pk.stepper->split_lanes();
+    for_each_lane(pk.walking, [&](uint32_t i) {
+        Lane& l = pk.lanes[i];
+        const uint32_t entries = uint32_t(pk.stepper->lane_walker(i).stack_size());
+        l.stack.local = std::min(entries, m_lane_costs.stack_entries);
+        l.stack.spilled = entries - l.stack.local;
+        l.phase = Phase::step;
+        l.accounted = t;
+        m_events.schedule(lane_slot(p, i), t);
+    });
+    pk.weight = 0;  // the lanes account for themselves until the packet ends
+}
+
+void PacketUnit::advance_lane(uint32_t p, uint32_t i, Cycle t) {
+    ++m_tally.steps;
+    Packet& pk = m_packets[p];
+    Lane& l = pk.lanes[i];
+    Stepper& walker = pk.stepper->lane_walker(i);
+    account_until(m_account, l.accounted, CycleUse::issue, t);
+    if (l.phase == Phase::ops) {
+        // As run_ops, for one ray: its tests, then its spilled entries read back.
+        Cycle ready = t;
+        const StepDemand& d = l.demand;
+        for (int k = 0; k < d.issue_count; ++k) {
+            ready = pipes[size_t(d.issues[k].kind)]->issue(ready, d.issues[k].issues, d.issues[k].tests);
+            account_until(m_account, l.accounted, pipe_use(d.issues[k].kind), ready);
+        }
+        const uint64_t owner = uint64_t(m_index) * m_config.contexts() + p * m_packet.lanes + i;
+        ready = issue_stack_traffic(*mem[0], m_map, d, owner, m_lane_costs.stack_entry_bytes, t, ready,
+                                    &m_tally.spill_writes, &m_tally.spill_reads, [&] {
+                                        if (!m_ctx.sync_private_steps) m_sync(t);
+                                    });
+        account_until(m_account, l.accounted, CycleUse::stack, ready);
+        l.phase = Phase::step;
+        m_events.schedule(lane_slot(p, i), ready);
+        return;
+    }
+    if (walker.plan().done) return lane_done(p, i, t);
+    // As step, for one ray: its one fetch, then its operations once the data is in.
+    ++m_packet_steps;
+    ++m_active_rays;
+    ++m_active_histogram[1];
+    StepReads reads(*mem[0], t);
+    take_step_reading(walker, l.stack, m_lane_costs, l.demand, [&](const Fetch& f) {
+        m_node_fetches += f.kind == DataKind::node;
+        reads.read(f);
+    });
+    account_read_until(m_account, l.accounted, reads.ready(), reads.slowest());
+    l.phase = Phase::ops;
+    m_events.schedule(lane_slot(p, i), reads.ready());
+}
+
+void PacketUnit::lane_done(uint32_t p, uint32_t i, Cycle t) {
+    Packet& pk = m_packets[p];
+    pk.walking &= ~lane_bit(i);
+    if (pk.walking) return;
+    // The last lane is done: every lane not walking was idle since it stopped (or the split).
+    for (uint32_t k = 0; k < m_packet.lanes; ++k) {
+        const Cycle since = pk.stepper->split_lanes() & lane_bit(k) ? pk.lanes[k].accounted : pk.accounted;
+        if (t > since) m_account.add(CycleUse::idle_lane, t - since);
+    }
+    pk.accounted = t;
+    finish_packet(p, t);
 }
 
 void PacketUnit::step(uint32_t p, Cycle t) {

@@ -21,8 +21,14 @@
 // With traversal.packet.split_below (Benthin et al. 2012's hybrid), a packet whose active rays at
 // a node fall below that fraction splits: the stepper then plans one ray's step at a time (one
 // ray active), each ray finishing alone, so the same costing prices the single-ray tail.
+// With traversal.packet.split_walks = lanes, the split rays instead walk at once, each on its own
+// lane of the packet (the lanes its masked-off rays left free): every walking ray's lane is then
+// scheduled as a context of its own (the stepper's lane_walker(), costed by the same step-demand
+// function with a single ray's stack entry), and the packet takes new rays when its last lane is
+// done. A lane's walk starts with its part of the shared stack on chip (the copy is not costed).
 // Cycle accounting: a packet's `lanes` ray contexts spend each cycle on what the packet waits
-// for, the rays masked off in its step (and empty lanes) as idle_lane.
+// for, the rays masked off in its step (and empty lanes) as idle_lane; walking lanes their own
+// cycles, and lanes done or without a walk idle_lane until the packet ends.
 #include <cstdint>
 #include <vector>
 
@@ -52,6 +58,13 @@ public:
 
 private:
     enum class Phase : uint8_t { step, ops };
+    /// A ray walking alone on its lane after its packet split (split_walks = lanes).
+    struct Lane {
+        StackSplit stack;
+        StepDemand demand;
+        Phase phase = Phase::step;
+        Cycle accounted = 0;  ///< this lane's cycles up to here are in m_account
+    };
     struct Packet {
         std::unique_ptr<PacketStepper> stepper;
         std::vector<uint64_t> ids;  ///< trace indices of its rays
@@ -62,6 +75,8 @@ private:
         bool active = false;
         uint32_t weight = 0;  ///< rays taking part in what the packet does now (the rest: idle_lane)
         Cycle accounted = 0;  ///< its lanes' cycles up to here are in m_account
+        std::vector<Lane> lanes;  ///< split_walks = lanes: its lanes' walks
+        LaneMask walking = 0;     ///< lanes still walking alone (0: the packet steps)
     };
 
     void run();
@@ -71,6 +86,11 @@ private:
     void step(uint32_t p, Cycle t);
     void run_ops(uint32_t p, Cycle t);
     void finish_packet(uint32_t p, Cycle t);
+    /// split_walks = lanes: the slot of packet p's lane i, and the lanes' walks.
+    uint32_t lane_slot(uint32_t p, uint32_t i) const { return uint32_t(m_packets.size()) + p * m_packet.lanes + i; }
+    void launch_lanes(uint32_t p, Cycle t);
+    void advance_lane(uint32_t p, uint32_t i, Cycle t);
+    void lane_done(uint32_t p, uint32_t i, Cycle t);
     /// Packet p's lanes' cycles from its last accounted cycle to `until`: `weight` of them on
     /// `use`, the others idle_lane.
     void account(uint32_t p, CycleUse use, Cycle until);
@@ -78,6 +98,7 @@ private:
     void account_read(uint32_t p, Cycle ready, const AccessInfo& info);
 
     const PacketConfig& m_packet;
+    const StepCosts m_lane_costs;  ///< a lane walking alone: the machine's costs, a single ray's stack entry
     std::vector<Packet> m_packets;
     LineCoalescer m_coalescer;  ///< a new packet's ray records, per line
     uint64_t m_packets_traced = 0, m_packet_steps = 0, m_node_fetches = 0, m_active_rays = 0;

@@ -109,9 +109,6 @@ TEST(CompressedLeaves, BadSettingsAndBlocksAreNamed) {
     o.settings["leaf_block_bytes"] = 16;
     EXPECT_NE(test::error_of([&] { build_accel(scene, o); }).find("leaf_block_bytes"), std::string::npos);
     o.settings = {{"compressed_leaves", true}};
-    o.two_level = true;
-    EXPECT_NE(test::error_of([&] { build_accel(scene, o); }).find("compressed_leaves"), std::string::npos);
-    o.two_level = false;
     AccelImage image = build_accel(scene, o);
     Region& r = image.region(kLeafBlocksRegion);
     const uint8_t tris = r.records<uint8_t>()[0];

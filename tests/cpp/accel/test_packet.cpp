@@ -1,4 +1,4 @@
-// Packets on the binary BVH (Wald et al. 2001): every ray's closest hit equals single-ray
+// Packets on the binary and the wide BVHs (Wald et al. 2001): every ray's closest hit equals single-ray
 // traversal bit for bit and every any-hit ray agrees on occlusion, on the procedural scenes, an
 // alpha-masked soup and the hard cases (rays from inside closed meshes, aimed at shared vertices,
 // invalid rays); the packet stepper and the fused packet loop agree on hits, work and counts;
@@ -170,20 +170,144 @@ TEST(Packets, CopiesOfOneRayDoItsSingleRayWorkFullyActive) {
     }
 }
 
-TEST(Packets, OnlyTheBinaryBvhHasAPacketKernel) {
-    const Scene& scene = test::procedural("cornell");
+/// The wide kinds with a packet kernel, every codec and child order.
+const char* const kWideKinds[] = {"bvh4", "bvh6", "bvh8", "cwbvh6", "cwbvh8", "bvh8_octant", "cwbvh8_octant"};
+
+std::unique_ptr<Accel> accel_of(const Scene& scene, const std::string& kind) {
     AccelOptions o;
-    o.kind = "bvh8";
-    const std::unique_ptr<Accel> wide = load_accel(build_accel(scene, o), "bvh8");
-    EXPECT_EQ(wide->make_packet_stepper(), nullptr);
+    o.kind = kind;
+    return load_accel(build_accel(scene, o), "test " + kind);
+}
+
+TEST(Packets, WideBvhsHitsEqualSingleRaysAndStepperEqualsFusedLoop) {
+    // Packets on 4- and 8-wide nodes (Dammertz et al. 2008, Ernst & Greiner 2008), with and
+    // without the hybrid's split: the same checks as the binary BVH's.
+    for (const std::string name : {"cornell", "hairball"}) {
+        const Scene& scene = test::procedural(name);
+        const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+        const std::vector<Ray> random = test::random_rays(scene, tris, 13, 512), camera = camera_rays(tris, 576, 7);
+        for (const char* kind : kWideKinds) {
+            const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+            ASSERT_TRUE(accel->capabilities().packet_kernel) << kind;
+            for (uint32_t lanes : {1u, 8u, 16u, 64u})
+                for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+                    const std::string what = name + " " + kind + " lanes " + std::to_string(lanes) + " mode " +
+                                             std::to_string(int(mode));
+                    check_packets(*accel, random, lanes, mode, what + " random");
+                    const PacketCounts c = check_packets(*accel, camera, lanes, mode, what + " camera");
+                    if (lanes == 64 && mode == TraversalMode::closest_hit) {
+                        uint64_t single_steps = 0;
+                        for (const Ray& r : camera) {
+                            WorkCounts w;
+                            accel->trace(r, mode, &w);
+                            single_steps += w.steps;
+                        }
+                        // Coherent packets share steps (fewer per ray on wide nodes than on binary ones).
+                        EXPECT_LT(c.node_steps * 3, single_steps) << what;
+                    }
+                }
+            for (float split : {0.25f, 0.5f}) {
+                const PacketCounts r =
+                    check_packets(*accel, random, 16, TraversalMode::closest_hit, name + " " + kind + " split", split);
+                EXPECT_GT(r.splits, 0u) << kind;
+                check_packets(*accel, camera, 16, TraversalMode::any_hit, name + " " + kind + " split camera", split);
+            }
+        }
+    }
+}
+
+TEST(Packets, WideBvhsCopiesOfOneRayDoItsSingleRayWorkFullyActive) {
+    const Scene& scene = test::procedural("hairball");
+    const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 23, 48);
+    for (const char* kind : kWideKinds) {
+        const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+        for (const Ray& r : rays) {
+            if (!ray_is_valid(r)) continue;
+            WorkCounts single;
+            const Hit h = accel->trace(r, TraversalMode::closest_hit, &single);
+            const std::vector<Ray> same(16, r);
+            const std::vector<TraversalMode> modes(16, TraversalMode::closest_hit);
+            std::vector<WorkCounts> work(16);
+            std::vector<Hit> hits(16);
+            PacketCounts c;
+            accel->trace_packet(same.data(), modes.data(), 16, hits.data(), work.data(), &c);
+            for (uint32_t i = 0; i < 16; ++i) {
+                EXPECT_EQ(work[i], single) << kind;
+                EXPECT_TRUE(test::same_hit(hits[i], h, TraversalMode::closest_hit)) << kind;
+            }
+            EXPECT_EQ(c.node_steps, single.steps) << kind;
+            EXPECT_EQ(c.active_rays, 16 * (c.node_steps + c.leaf_steps)) << kind;
+        }
+    }
+}
+
+/// Packets of 16 with the hybrid's split rays walking on their own lanes (SplitWalks::lanes),
+/// the walkers stepped round robin as a unit's lanes would: each ray's hit and work, and the
+/// packet's counts, are the serial walk's (the fused loop's).
+void check_lane_walks(const Accel& accel, const std::vector<Ray>& rays, TraversalMode mode, float split,
+                      const std::string& what, bool expect_split) {
+    std::unique_ptr<PacketStepper> s = accel.make_packet_stepper();
+    s->set_split_below(split);
+    s->set_split_walks(SplitWalks::lanes);
+    uint64_t launched = 0;
+    for (size_t first = 0; first + 16 <= rays.size(); first += 16) {
+        const std::vector<TraversalMode> modes(16, mode);
+        std::vector<Hit> hits(16);
+        std::vector<WorkCounts> work(16);
+        PacketCounts fused;
+        accel.trace_packet(&rays[first], modes.data(), 16, hits.data(), work.data(), &fused, split);
+        s->begin_packet(&rays[first], modes.data(), 16);
+        while (!s->done()) s->execute();
+        for (LaneMask walking = s->split_lanes(); walking;) {
+            launched += lane_count(walking);
+            for_each_lane(walking, [&](uint32_t r) {
+                Stepper& w = s->lane_walker(r);
+                EXPECT_GT(w.plan().fetch_count, 0) << what;  // a walker's step fetches its node or leaf
+                w.execute();
+                if (w.done()) walking &= ~lane_bit(r);
+            });
+        }
+        EXPECT_EQ(s->counts(), fused) << what;
+        for (uint32_t i = 0; i < 16; ++i) {
+            EXPECT_TRUE(test::same_hit(s->lane_hit(i), hits[i], TraversalMode::closest_hit)) << what << " ray " << i;
+            EXPECT_EQ(s->lane_work(i), work[i]) << what << " ray " << i;
+        }
+    }
+    if (expect_split) {
+        EXPECT_GT(launched, 0u) << what;
+    }
+}
+
+TEST(Packets, SplitRaysOnTheirOwnLanesWalkAsTheSerialHybrid) {
+    for (const std::string name : {"cornell", "hairball"}) {
+        const Scene& scene = test::procedural(name);
+        const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+        const std::vector<Ray> random = test::random_rays(scene, tris, 31, 512), camera = camera_rays(tris, 576, 9);
+        for (const std::string kind : {"bvh2", "bvh4", "bvh8", "cwbvh8", "cwbvh8_octant"}) {
+            const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+            for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit})
+                for (float split : {0.25f, 0.5f, 1.0f}) {
+                    const std::string what = name + " " + kind + " split " + std::to_string(split);
+                    check_lane_walks(*accel, random, mode, split, what + " random", true);
+                    check_lane_walks(*accel, camera, mode, split, what + " camera", false);
+                }
+        }
+    }
+}
+
+TEST(Packets, TreesOfOtherShapesHaveNoPacketKernel) {
+    const Scene& scene = test::procedural("cornell");
+    const std::unique_ptr<Accel> kd = accel_of(scene, "kdtree");
+    EXPECT_EQ(kd->make_packet_stepper(), nullptr);
     const Ray r = test::make_ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f));
     const TraversalMode m = TraversalMode::closest_hit;
-    EXPECT_THROW(wide->trace_packet(&r, &m, 1, nullptr, nullptr, nullptr), Error);
-    const std::unique_ptr<Accel> bvh2 = test::bvh2_of(scene);
-    std::unique_ptr<PacketStepper> s = bvh2->make_packet_stepper();
-    std::vector<Ray> many(65, r);
-    std::vector<TraversalMode> modes(65, m);
-    EXPECT_THROW(s->begin_packet(many.data(), modes.data(), 65), Error);
+    EXPECT_THROW(kd->trace_packet(&r, &m, 1, nullptr, nullptr, nullptr), Error);
+    for (const std::string kind : {"bvh2", "bvh4"}) {
+        std::unique_ptr<PacketStepper> s = accel_of(scene, kind)->make_packet_stepper();
+        std::vector<Ray> many(65, r);
+        std::vector<TraversalMode> modes(65, m);
+        EXPECT_THROW(s->begin_packet(many.data(), modes.data(), 65), Error);
+    }
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// Short stacks with a restart trail (traces/accel/short_stack.h): on every BVH kind and any stack
-// size, every ray keeps its hit bit for bit and its reference work exactly (the restarts' work is
+// Short stacks with a restart trail (traces/accel/short_stack.h): on every BVH kind, the kd-tree
+// (kd-restart with push-down) and the BIH, and any stack size, every ray keeps its hit bit for bit and its reference work exactly (the restarts' work is
 // counted only in the model's own fields), the plans ask for exactly the work counted (revisits
 // included), a stack as deep as the structure can need never restarts, and a short stack on a
 // deep scene does restart.
@@ -17,6 +17,7 @@ struct Totals {
 
 /// Checks every ray of `rays` (both modes) against the full stack; returns the restarts' totals.
 Totals check_short_stack(Accel& accel, uint32_t entries, const std::vector<Ray>& rays, const std::string& what) {
+    const bool planes = accel.kind() == "kdtree" || accel.kind() == "bih";
     StepOptions shorter;
     shorter.short_stack_entries = entries;
     std::unique_ptr<Stepper> full = accel.make_stepper();
@@ -30,10 +31,10 @@ Totals check_short_stack(Accel& accel, uint32_t entries, const std::vector<Ray>&
             const WorkCounts planned = test::tally_plans(*shortened, r, mode);
             got = shortened->work();
             const Hit hg = shortened->hit();
-            // The plans show revisits as node steps with box tests.
+            // The plans show revisits as node steps with box tests (a space partition's: plane tests).
             WorkCounts folded = got;
             folded.steps += got.restart_steps;
-            folded.box_tests += got.restart_box_tests;
+            (planes ? folded.plane_tests : folded.box_tests) += got.restart_box_tests;
             const bool ok = test::same_hit(hg, hw, TraversalMode::closest_hit) && got.traced() == want &&
                             planned == folded.traced() && got.restart_steps >= got.restarts;
             if (!ok && ++diffs <= 3)
@@ -53,7 +54,7 @@ TEST(ShortStack, ChangesNoHitNorReferenceWorkAndRestartsOnlyWhenShort) {
     for (const char* scene_name : {"soup", "hairball"}) {
         const Scene& scene = std::string(scene_name) == "soup" ? soup : test::procedural(scene_name);
         const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 7, 1500);
-        for (const std::string kind : {"bvh2", "bvh4", "bvh8", "cwbvh8"}) {
+        for (const std::string kind : {"bvh2", "bvh4", "bvh8", "cwbvh8", "kdtree", "bih"}) {
             const auto accel = test::build_kind(scene, kind);
             ASSERT_TRUE(accel->capabilities().restart_trail) << kind;
             const std::string what = std::string(scene_name) + " " + kind;
@@ -70,9 +71,34 @@ TEST(ShortStack, ChangesNoHitNorReferenceWorkAndRestartsOnlyWhenShort) {
     }
 }
 
+TEST(ShortStack, KdRestartPushesDownBelowTheRoot) {
+    // kd-restart with push-down (Foley & Sugerman 2005) re-descends from the deepest node that
+    // holds what is left, the BIH's trail from the root: the kd-tree revisits fewer nodes per
+    // restart than a walk from the root would (the path to the resumed entry).
+    const Scene& scene = test::procedural("hairball");
+    const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 17, 800);
+    const auto kd = test::build_kind(scene, "kdtree");
+    StepOptions o;
+    o.short_stack_entries = 1;
+    std::unique_ptr<Stepper> s = kd->make_stepper(o);
+    uint64_t restarts = 0, revisits = 0, root_revisits = 0;
+    for (const Ray& r : rays) {
+        s->begin(r, TraversalMode::closest_hit);
+        while (!s->done()) {
+            if (s->plan().locality == 0 && s->work().restarts > 0) ++root_revisits;
+            s->execute();
+        }
+        restarts += s->work().restarts;
+        revisits += s->work().restart_steps;
+    }
+    EXPECT_GT(restarts, 0u);
+    EXPECT_GE(revisits, restarts);
+    EXPECT_LT(root_revisits, restarts);  // many restarts start below the root
+}
+
 TEST(ShortStack, OtherStructuresDoNotOfferIt) {
     const Scene scene = test::random_soup(3, 500);
-    for (const std::string kind : {"grid", "kdtree", "octree", "bih"})
+    for (const std::string kind : {"grid", "octree"})
         EXPECT_FALSE(test::build_kind(scene, kind)->capabilities().restart_trail) << kind;
 }
 

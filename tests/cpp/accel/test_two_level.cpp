@@ -214,6 +214,47 @@ TEST(TwoLevel, UnflattenedSceneGivesTheFlattenedTrianglesAndTheSameStructure) {
             << a.regions[r].name;
 }
 
+TEST(TwoLevel, PerLevelTrailsReducedPrecisionBlasesAndCompressedLeavesKeepHitsAndWork) {
+    // Restart trails per level, reduced-precision BLAS boxes and compressed BLAS leaves change no
+    // hit and no reference work (their work is the model's own fields); a one-entry short stack
+    // restarts, and the narrower boxes enter extra subtrees.
+    const Scene scene = instanced_scene(4);
+    const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 41, 800);
+    for (const std::string blas : {"bvh2", "bvh4", "cwbvh8"}) {
+        const std::unique_ptr<Accel> plain = two_level(scene, blas);
+        AccelOptions o;
+        o.kind = blas;
+        o.two_level = true;
+        o.settings["compressed_leaves"] = true;
+        const std::unique_ptr<Accel> packed = load_accel(build_accel(scene, o), "compressed two-level " + blas);
+        ASSERT_TRUE(packed->image().has_region(std::string("blas_") + kLeafBlocksRegion)) << blas;
+        const AccelCapabilities caps = plain->capabilities();
+        EXPECT_TRUE(caps.restart_trail && caps.reduced_precision_boxes && caps.compressed_leaves) << blas;
+        StepOptions trail, rp;
+        trail.short_stack_entries = 1;
+        rp.box_precision_bits = 7;
+        uint64_t restarts = 0, rp_steps = 0;
+        int diffs = 0;
+        for (const Ray& r : rays)
+            for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+                WorkCounts want, got, got_rp, got_packed;
+                const Hit h = plain->trace(r, mode, &want);
+                const Hit ht = plain->trace(r, mode, &got, trail);
+                const Hit hr = plain->trace(r, mode, &got_rp, rp);
+                const Hit hp = packed->trace(r, mode, &got_packed);
+                const bool ok = test::same_hit(ht, h, mode) && test::same_hit(hr, h, mode) &&
+                                test::same_hit(hp, h, mode) && got.traced() == want.traced() &&
+                                got_rp.traced() == want.traced() && got_packed == want;
+                if (!ok && ++diffs <= 3) ADD_FAILURE() << blas << ": ray differs, prim " << h.prim;
+                restarts += got.restarts;
+                rp_steps += got_rp.rp_steps + got_rp.rp_box_hits;
+            }
+        EXPECT_EQ(diffs, 0) << blas;
+        EXPECT_GT(restarts, 0u) << blas;
+        EXPECT_GT(rp_steps, 0u) << blas;
+    }
+}
+
 TEST(TwoLevel, ValidationRefusesBadInstanceRecords) {
     const Scene scene = instanced_scene(2);
     AccelOptions o;

@@ -95,10 +95,12 @@ BihAccel::BihAccel(AccelImage image, const std::string& source) : Accel(std::mov
     m_depth = validate_bih(m_view, source);
 }
 
-std::unique_ptr<Stepper> BihAccel::make_stepper(const StepOptions&) const { return std::make_unique<BihStepper>(m_view); }
+std::unique_ptr<Stepper> BihAccel::make_stepper(const StepOptions& options) const {
+    return std::make_unique<BihStepper>(m_view, options.short_stack_entries);
+}
 
-Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions&) const {
-    BihStepper stepper(m_view);  // on the stack: no allocation, no virtual calls
+Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
+    BihStepper stepper(m_view, options.short_stack_entries);  // on the stack: no allocation, no virtual calls
     return trace_with_stepper(stepper, ray, mode, work);
 }
 

@@ -7,12 +7,14 @@
 namespace rtsim {
 
 void BihStepper::begin(const Ray& ray, TraversalMode mode) {
+    begin_walk();
     if (start(ray, mode, m_view.node_count == 0)) m_phase = Phase::clip;
 }
 
 StepOutcome BihStepper::execute() {
     StepOutcome out;
     if (m_plan.done) return out;
+    if (replaying()) return replay_step(), out;
     switch (m_phase) {
         case Phase::clip:
             clip(m_view.bounds);
@@ -44,6 +46,10 @@ void BihStepper::visit(uint32_t node, const detail::SlabInterval& cell) {
     m_node = node;
     m_cell = cell;
     m_phase = Phase::node;
+    plan_node(node);
+}
+
+void BihStepper::plan_node(uint32_t node) {
     m_plan.reset(node);
     m_plan.add_fetch(m_view.node_base + uint64_t(node) * sizeof(BihNode), sizeof(BihNode), DataKind::node);
     if (!m_view.nodes[node].leaf()) m_plan.add_op(OpKind::plane, 2);

@@ -35,8 +35,12 @@ struct BihView {
 class BihStepper final : public BinaryCellStepper<BihStepper, kBihMaxDepth> {
 public:
     static constexpr const char* kName = "BIH";
+    static constexpr uint32_t kNodeTests = 2;  ///< an interior node's two clip-plane tests
+    static constexpr bool kPushDown = false;   ///< overlapping children: a restart trail from the root
 
-    explicit BihStepper(const BihView& view) : m_view(view) {}
+    explicit BihStepper(const BihView& view, uint32_t short_stack_entries = 0) : m_view(view) {
+        configure_short_stack(short_stack_entries);
+    }
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
@@ -45,6 +49,7 @@ private:
     friend class BinaryCellStepper<BihStepper, kBihMaxDepth>;
     enum class Phase : uint8_t { clip, node, leaf };
     void visit(uint32_t node, const detail::SlabInterval& cell);
+    void plan_node(uint32_t node);
     void interior(const BihNode& node);
     uint32_t leaf();  ///< returns the alpha tests run
 

@@ -13,6 +13,7 @@ void Bvh2PacketStepper::begin_packet(const Ray* rays, const TraversalMode* modes
     m_work = WorkCounts{};
     m_stack_size = 0;
     m_split = false;
+    m_split_lanes = 0;
     m_active = m_lanes.live;
     if (m_active == 0 || m_view.node_count == 0) return finish();
     m_ref = 0;  // the root: every valid ray starts there
@@ -20,8 +21,34 @@ void Bvh2PacketStepper::begin_packet(const Ray* rays, const TraversalMode* modes
     plan_next();
 }
 
+void detail::Bvh2LaneRules::plan(StepPlan& plan, uint32_t ref, uint32_t count) const {
+    if (count == 0) {
+        plan.reset(ref);
+        plan.add_fetch(view.node_base + uint64_t(ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+        plan.add_op(OpKind::box, 2);
+    } else {
+        plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
+        const TriangleAddressing::Span span = view.tri_at.span(ref, count);
+        plan.add_fetch(span.address, span.bytes, DataKind::triangle);
+        plan.add_op(OpKind::triangle, count);
+    }
+}
+
+void Bvh2PacketStepper::launch_lanes() {
+    ++m_counts.splits;
+    if (m_walkers.empty())
+        m_walkers.assign(kMaxPacketLanes, LaneWalker<detail::Bvh2LaneRules>(detail::Bvh2LaneRules{m_view},
+                                                                           size_t(kTraversalStackSize)));
+    m_split_lanes =
+        launch_lane_walks(m_lanes, m_counts, m_walkers, m_stack, m_stack_size, m_active, m_ref, m_count);
+    m_active = 0;
+    m_stack_size = 0;
+    m_plan.finish();
+}
+
 void Bvh2PacketStepper::plan_next() {
     if (!m_split && m_count == 0 && detail::should_split(m_lanes, m_active, m_split_below)) {
+        if (m_split_walks == SplitWalks::lanes) return launch_lanes();
         detail::begin_split(m_lanes, m_stack, m_stack_size, m_ref, m_count, m_active, m_walk);
         m_split = true;
         ++m_counts.splits;

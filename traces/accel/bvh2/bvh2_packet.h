@@ -8,11 +8,27 @@
 // the node), or fetches a leaf's HwTriangles once and runs one triangle test per triangle and
 // active ray, plus the alpha tests the hits call for.
 #include <cstdint>
+#include <vector>
 
 #include "traces/accel/bvh2/bvh2_packet_kernel.h"
 #include "traces/accel/bvh2/bvh2_stepper.h"
 
 namespace rtsim {
+
+namespace detail {
+/// The binary BVH's single-ray rules for a ray walking alone on its lane (LaneWalker).
+struct Bvh2LaneRules {
+    using Entry = Bvh2StackEntry;
+    Bvh2View view;
+    bool descend(PacketLanes& p, uint32_t r, uint32_t* ref, uint32_t* count, std::vector<Entry>& stack,
+                 int& size) const {
+        return detail::descend(p.box[r], view.nodes[*ref], p.ray[r].tmin, p.cull[r], p.work[r], stack.data(), size,
+                               ref, count);
+    }
+    void plan(StepPlan& plan, uint32_t ref, uint32_t count) const;
+    const HwTriangle* leaf(uint32_t ref) const { return view.triangles + ref; }
+};
+}  // namespace detail
 
 class Bvh2PacketStepper final : public PacketStepper {
 public:
@@ -20,10 +36,12 @@ public:
 
     void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) override;
     StepOutcome execute() override;
+    Stepper& lane_walker(uint32_t i) override { return m_walkers[i]; }
 
 private:
     void pop_next();
     void plan_next();
+    void launch_lanes();
     void finish();
 
     Bvh2View m_view;
@@ -32,6 +50,7 @@ private:
     bool m_split = false;  ///< the hybrid: the packet split, its rays walk alone (m_walk)
     detail::SplitWalk m_walk;
     detail::PacketStackEntry m_stack[kTraversalStackSize];
+    std::vector<LaneWalker<detail::Bvh2LaneRules>> m_walkers;  ///< SplitWalks::lanes: one per lane
 };
 
 /// The fused packet loop: rays[0, n) traced as one packet; each ray's hit and work, and the

@@ -22,17 +22,9 @@
 #include <cstdint>
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
-#include "traces/accel/packet_stepper.h"
+#include "traces/accel/packet_kernel.h"
 
 namespace rtsim::detail {
-
-/// A packet's traversal-stack entry: the child to resume at, its rays, their entry distances.
-struct PacketStackEntry {
-    uint32_t ref;    ///< node index, or first triangle of a leaf
-    uint32_t count;  ///< 0: node; else the leaf's triangle count
-    LaneMask mask;
-    float tnear[kMaxPacketLanes];
-};
 
 /// The packet's node step over `active` rays: pushes the second child entered onto
 /// stack[size++] and names the first in *ref / *count / *mask. Returns false when no active ray
@@ -70,44 +62,6 @@ inline bool packet_descend(PacketLanes& p, LaneMask active, const HwNode& node, 
     return true;
 }
 
-/// The packet's leaf step over `active` rays; returns the alpha tests it ran.
-inline uint32_t packet_leaf(PacketLanes& p, LaneMask active, const HwTriangle* triangles, uint32_t count) {
-    uint32_t alpha = 0;
-    for_each_lane(active, [&](uint32_t r) {
-        WorkCounts& w = p.work[r];
-        w.tri_tests += count;
-        const uint32_t before = w.anyhit_calls;
-        const Ray& ray = p.ray[r];
-        if (p.mode[r] == TraversalMode::any_hit) {
-            if (leaf_step<true>(p.tri[r], ray.tmin, ray.tmax, triangles, count, p.hit[r], p.cull[r], w.anyhit_calls))
-                p.live &= ~lane_bit(r);
-        } else {
-            leaf_step<false>(p.tri[r], ray.tmin, ray.tmax, triangles, count, p.hit[r], p.cull[r], w.anyhit_calls);
-        }
-        alpha += w.anyhit_calls - before;
-    });
-    return alpha;
-}
-
-/// Pops the next entry with a ray left in it (its mask in *mask); false when the stack ran out.
-inline bool packet_pop(const PacketLanes& p, const PacketStackEntry* stack, int& size, uint32_t* ref,
-                       uint32_t* count, LaneMask* mask) {
-    while (size > 0) {
-        const PacketStackEntry& e = stack[--size];
-        LaneMask m = 0;
-        // As the single ray's pop: kept unless entered beyond the best hit (a NaN is kept).
-        for_each_lane(e.mask & p.live, [&](uint32_t r) {
-            if (!(e.tnear[r] > p.cull[r])) m |= lane_bit(r);
-        });
-        if (m == 0) continue;
-        *ref = e.ref;
-        *count = e.count;
-        *mask = m;
-        return true;
-    }
-    return false;
-}
-
 /// The hybrid's single-ray walks after a split: the shared stack and the packet's node frozen,
 /// the ray walking now and its own stack.
 struct SplitWalk {
@@ -119,11 +73,6 @@ struct SplitWalk {
     int size = 0;
     Bvh2StackEntry stack[kTraversalStackSize];
 };
-
-/// True when the packet's step over `active` rays (a node step) should split instead.
-inline bool should_split(const PacketLanes& p, LaneMask active, float split_below) {
-    return split_below > 0.0f && float(lane_count(active)) < split_below * float(p.n);
-}
 
 /// Freezes the packet at its node (ref, count, active) over the shared stack's `size` entries.
 inline void begin_split(const PacketLanes& p, const PacketStackEntry* shared, int size, uint32_t ref, uint32_t count,

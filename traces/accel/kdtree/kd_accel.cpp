@@ -55,11 +55,11 @@ KdAccel::KdAccel(AccelImage image, const std::string& source) : Accel(std::move(
 }
 
 std::unique_ptr<Stepper> KdAccel::make_stepper(const StepOptions& options) const {
-    return std::make_unique<KdStepper>(m_view, options.mailbox_entries);
+    return std::make_unique<KdStepper>(m_view, options.mailbox_entries, options.short_stack_entries);
 }
 
 Hit KdAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
-    KdStepper stepper(m_view, options.mailbox_entries);  // on the stack: no allocation, no virtual calls
+    KdStepper stepper(m_view, options.mailbox_entries, options.short_stack_entries);  // on the stack: no allocation, no virtual calls
     return trace_with_stepper(stepper, ray, mode, work);
 }
 

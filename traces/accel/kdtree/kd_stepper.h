@@ -16,6 +16,8 @@
 // in the current leaf"), while a hit that lies beyond the leaf (its triangle extends into later
 // cells) or on its far boundary lets the cells up to it be visited, so the closest hit by
 // (t, prim) is the binary BVH's bit for bit. Any hit stops at the first accepted hit.
+// With a short stack, restarts follow kd-restart with push-down (cell_stepper.h): each revisit
+// is a node step of the same shape (fetch, one plane test), counted in the restart fields.
 #include <cstdint>
 
 #include "traces/accel/cell_stepper.h"
@@ -31,8 +33,13 @@ using KdView = ListedTreeView<KdNode>;
 class KdStepper final : public BinaryCellStepper<KdStepper, kKdMaxDepth, ListCellStepper> {
 public:
     static constexpr const char* kName = "kd-tree";
+    static constexpr uint32_t kNodeTests = 1;  ///< an interior node's plane test
+    static constexpr bool kPushDown = true;    ///< kd-restart with push-down (cell_stepper.h)
 
-    KdStepper(const KdView& view, uint32_t mailbox_entries) : BinaryCellStepper(mailbox_entries), m_view(view) {}
+    KdStepper(const KdView& view, uint32_t mailbox_entries, uint32_t short_stack_entries = 0)
+        : BinaryCellStepper(mailbox_entries), m_view(view) {
+        configure_short_stack(short_stack_entries);
+    }
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
@@ -41,6 +48,7 @@ private:
     friend class BinaryCellStepper<KdStepper, kKdMaxDepth, ListCellStepper>;
     enum class Phase : uint8_t { clip, node, list };
     void visit(uint32_t node, const detail::SlabInterval& cell);
+    void plan_node(uint32_t node);
     void interior(const KdNode& node);
 
     KdView m_view;

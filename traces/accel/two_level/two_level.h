@@ -60,8 +60,9 @@ public:
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override;
     /// The BLAS kind's, the stack entry the larger of the TLAS's 8 bytes and the BLAS kind's (the
-    /// stack holds both); nothing that needs one walk of one tree (a packet kernel, a restart
-    /// trail, reduced-precision boxes, compressed leaves).
+    /// stack holds both); restart trails per level, the BLASes' reduced-precision walks
+    /// (two_level_stepper.h) and compressed leaves (each BLAS built with its own leaf blocks, a
+    /// slice of "blas_leaf_blocks"); no packet kernel built (its rays would part at every instance).
     AccelCapabilities capabilities() const override;
 
     uint32_t frame_count() const override { return uint32_t(m_frames.size()); }

@@ -10,6 +10,7 @@ using detail::cull_distance;
 
 TwoLevelStepper::TwoLevelStepper(const TwoLevelAccel& accel, const StepOptions& options) : m_accel(accel) {
     for (const auto& blas : accel.blases()) m_blas_steppers.push_back(blas->make_stepper(options));
+    m_short.configure(options.short_stack_entries);
 }
 
 void TwoLevelStepper::begin(const Ray& ray, TraversalMode mode) {
@@ -19,6 +20,8 @@ void TwoLevelStepper::begin(const Ray& ray, TraversalMode mode) {
     m_work = WorkCounts{};
     m_stack_size = m_tlas_size = 0;
     m_inner = nullptr;
+    m_depth = 0;
+    m_short.begin();
     if (!ray_is_valid(ray) || m_accel.tlas().node_count == 0) {
         finish();
         return;
@@ -55,7 +58,8 @@ void TwoLevelStepper::plan_blas() {
 StepOutcome TwoLevelStepper::execute() {
     if (m_plan.done) return StepOutcome{};
     if (m_inner) return blas_step();
-    if (m_count == 0) visit_node(m_accel.tlas().nodes[m_ref]);
+    if (m_short.replaying()) replay_step();
+    else if (m_count == 0) visit_node(m_accel.tlas().nodes[m_ref]);
     else enter_instance(m_accel.instances().records[m_ref]);
     return StepOutcome{};
 }
@@ -64,8 +68,17 @@ void TwoLevelStepper::visit_node(const HwNode& node) {
     // The binary BVH's node step (bvh2_kernel.h): nearer child next, the farther pushed.
     m_work.tlas_steps += 1;  // the TLAS's share of steps and box tests (descend counts both)
     m_work.tlas_box_tests += 2;
+    const int before = m_tlas_size;
+    if (m_short.enabled()) m_short.visit(m_ref, m_depth);
     if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_tlas_size, &m_ref, &m_count))
         return pop_next();
+    if (m_short.enabled()) {
+        if (m_tlas_size > before) {
+            m_entry_depth[m_tlas_size - 1] = m_depth + 1;
+            if (m_short.push()) m_work.stack_drops += 1;
+        }
+        m_depth += 1;
+    }
     plan_tlas();
 }
 
@@ -108,15 +121,46 @@ void TwoLevelStepper::leave_instance() {
 }
 
 void TwoLevelStepper::pop_next() {
+    // With the TLAS's short stack, reaching an entry it dropped means a restart (short_stack.h).
+    bool restart = false;
     while (m_tlas_size > 0) {
         const detail::Bvh2StackEntry& e = m_stack[--m_tlas_size];
+        if (m_short.enabled()) restart |= m_short.pop();
         if (e.tnear > m_cull_t) continue;  // entered beyond the (widened) best hit
         m_ref = e.ref;
         m_count = e.count;
+        if (m_short.enabled()) m_depth = m_entry_depth[m_tlas_size];
+        if (restart) return begin_restart(m_depth, true);
         plan_tlas();
         return;
     }
+    if (restart) return begin_restart(0, false);
     finish();
+}
+
+void TwoLevelStepper::begin_restart(uint32_t depth, bool resume) {
+    m_work.restarts += 1;
+    m_short.restart(depth, uint32_t(m_tlas_size));
+    m_resume = resume;
+    plan_replay();
+}
+
+void TwoLevelStepper::plan_replay() {
+    const uint32_t node = m_short.replay_node();
+    m_plan.reset(m_accel.tlas_key_base() + node);
+    m_plan.add_fetch(m_accel.tlas().node_base + uint64_t(node) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+    m_plan.add_op(OpKind::box, 2);
+    m_stack_size = m_tlas_size;
+}
+
+void TwoLevelStepper::replay_step() {
+    // A revisit re-tests the TLAS node's child boxes to follow the trail; the walk is unchanged.
+    m_work.restart_steps += 1;
+    m_work.restart_box_tests += 2;
+    m_short.replay_advance();
+    if (m_short.replaying()) plan_replay();
+    else if (m_resume) plan_tlas();
+    else finish();
 }
 
 void TwoLevelStepper::finish() {

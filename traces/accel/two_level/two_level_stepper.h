@@ -11,10 +11,18 @@
 // sum). Locality keys: TLAS nodes keep their index, BLAS b's keys are offset by
 // TwoLevelAccel::locality_offset(b). Work counts: TLAS node steps and box tests, one transform
 // per instance entered, plus every BLAS walk's own counts.
+//
+// Restart trails are per level (Laine 2010 on each tree): with a short stack each level keeps
+// traversal.stack_entries entries of its own and its own trail. The TLAS walk's shadow
+// (short_stack.h) restarts at the TLAS root and re-descends the TLAS; a BLAS walk's restarts
+// re-descend that BLAS from its root in the instance's object space (its kind's stepper), so a
+// restart never re-enters an instance it is walking. Reduced-precision boxes are the BLASes'
+// (their kinds' walks); the TLAS's boxes stay fp32, as instance boxes are few and refit per frame.
 #include <memory>
 #include <vector>
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
+#include "traces/accel/short_stack.h"
 #include "traces/accel/stepper.h"
 #include "traces/accel/two_level/instance_record.h"
 
@@ -38,6 +46,9 @@ private:
     void pop_next();
     void plan_tlas();
     void plan_blas();
+    void begin_restart(uint32_t depth, bool resume);
+    void plan_replay();
+    void replay_step();
     void finish();
 
     const TwoLevelAccel& m_accel;
@@ -51,6 +62,11 @@ private:
     const InstanceRecord* m_instance = nullptr;
     uint32_t m_inner_offset = 0;         ///< locality offset of the BLAS being walked
     detail::Bvh2StackEntry m_stack[kTraversalStackSize];  ///< TLAS entries (ref: node or instance record)
+    // The TLAS's short stack only: the current node's depth, each entry's, and the shadow.
+    uint32_t m_depth = 0;
+    bool m_resume = false;  ///< after the re-descent: m_ref/m_count (true) or the end (false)
+    uint32_t m_entry_depth[kTraversalStackSize];
+    ShortStack m_short;
 };
 
 }  // namespace rtsim

@@ -15,6 +15,7 @@
 
 #include "traces/accel/accel.h"
 #include "traces/accel/leaf_coverage.h"
+#include "traces/accel/wide/wide_packet.h"
 #include "traces/accel/wide/wide_stepper.h"
 #include "traces/common/error.h"
 
@@ -148,6 +149,13 @@ public:
                 return Codec::fused(m_view, ray, mode, work);
         }
         return Accel::trace(ray, mode, work, options);
+    }
+    std::unique_ptr<PacketStepper> make_packet_stepper() const override {
+        return std::make_unique<WidePacketStepper<Codec>>(m_view);
+    }
+    void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
+                      PacketCounts* counts, float split_below = 0.0f) const override {
+        trace_packet_wide<Codec>(m_view, rays, modes, n, hits, work, counts, split_below);
     }
     LocalityPartition partition(uint64_t budget_bytes) const override {
         require(budget_bytes >= Codec::kBytes, "treelet budget must be at least one node (" +
