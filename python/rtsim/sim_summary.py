@@ -148,6 +148,18 @@ def _knob(k: dict[str, Any]) -> str:
     return f"--set {k.get('key')}={k.get('to')} (now {k.get('from')})"
 
 
+def not_estimated(why: Any) -> str:
+    """ "not estimated (why)", never "not estimated (not estimated: ...)"."""
+    text = str(why or "").strip()
+    for lead in ("not estimated: ", "not estimated (", "not estimated"):
+        if text.startswith(lead):
+            text = text[len(lead) :]
+            if lead.endswith("(") and text.endswith(")"):
+                text = text[:-1]
+            break
+    return f"not estimated ({text})" if text else "not estimated"
+
+
 def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
     """The verdict's top three knobs (estimated, or to be measured), the best gains per mm^2,
     co-limits, what the estimator does not cover and, with --check-verdict, what re-runs
@@ -157,7 +169,7 @@ def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
         est = (
             f"{_gain(k.get('speedup'))} estimated"
             if _is_num(k.get("speedup"))
-            else f"not estimated ({k.get('why_not', '?')})"
+            else not_estimated(k.get("why_not"))
         )
         rows.append(("  try" if i == 0 else "", f"{_knob(k)}: {est}"))
     for i, k in enumerate(verdict.get("top_per_mm2") or []):
@@ -196,7 +208,11 @@ def why_slow_table(stats: dict[str, Any]) -> Table:
     table = _two_column("why is it slow (docs/model.md)")
     verdict = stats.get("verdict") or {}
     if verdict:
-        table.add_row("bottleneck", str(verdict.get("label", verdict.get("binding", "-"))))
+        label = str(verdict.get("label", verdict.get("binding", "-")))
+        binding = verdict.get("binding")
+        table.add_row(
+            "bottleneck", label + (f" ({binding})" if binding and binding != label else "")
+        )
         evidence = (verdict.get("evidence") or {}).get("text")
         if evidence:
             table.add_row("  evidence", str(evidence))
@@ -211,11 +227,27 @@ def why_slow_table(stats: dict[str, Any]) -> Table:
     roof = stats.get("roofline") or {}
     bound = roof.get("bound_rays_per_second")
     achieved = roof.get("rays_per_second")
+    agreement = verdict.get("agreement") or {}
+    knob = agreement.get("knob")
+
+    def relaxed(flag: Any) -> str:
+        if not knob or flag is None:
+            return ""
+        return f"; {knob} relaxes it" if flag else f"; {knob} does not relax it"
+
     if _is_num(bound) and _is_num(achieved) and bound > 0:
+        name = roof.get("bound")
+        label = roof.get("bound_label") or name
         table.add_row(
             "roofline",
-            f"{achieved / 1e6:,.2f} of {bound / 1e6:,.2f} Mrays/s allowed by {roof.get('bound')} "
-            f"({achieved / bound:.0%})",
+            f"{achieved / 1e6:,.2f} of {bound / 1e6:,.2f} Mrays/s allowed by {label}"
+            f"{f' ({name})' if label != name else ''} ({achieved / bound:.0%})"
+            f"{relaxed(agreement.get('roofline_relaxed'))}",
+        )
+    if agreement.get("analytic_binding"):
+        table.add_row(
+            "analytic binding",
+            f"{agreement['analytic_binding']}{relaxed(agreement.get('analytic_relaxed'))}",
         )
     return table
 
@@ -347,6 +379,12 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         console.print(resolved_table(stats))
     if len(stats.get("frames", []) or []) > 1:
         console.print(frames_table(stats))
+    warnings = _get(stats, "summary.study_warnings") or []
+    if warnings:
+        table = _two_column("too small to answer its question (docs/treelets.md)")
+        for w in warnings:
+            table.add_row("[bold yellow]warning[/]", str(w))
+        console.print(table)
     if _get(stats, "summary.cycles") is not None:
         console.print(utilisation_table(stats))
         if stats.get("verdict") or stats.get("roofline"):

@@ -142,7 +142,8 @@ LevelResult run_statistical(RunInputs& in) {
     r.judge = [&in, p, instantiated = r.instantiated](const json& model) {
         // The verdict's analytic estimates come from this run's own analysis (no second pass).
         VerdictContext v{in.config(), model, nullptr, nullptr};
-        v.instantiated = instantiated;
+        v.instantiated = with_structure_blocks(instantiated, in.setup.structure);
+        v.structure = structure_traits(in);
         v.unit = unit_traits(in.setup);
         v.estimate = [form = std::make_shared<FormEstimator>(*p)](const SimConfig& x) {
             const ClosedForm f = (*form)(x);

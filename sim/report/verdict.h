@@ -61,6 +61,7 @@ struct VerdictContext {
     size_t frames = 1;                 ///< an animated trace's frames: the sample is the first frame's
     uint64_t first_ray = 0, frame_rays = 0;  ///< that frame's rays (0: the whole trace)
     nlohmann::json instantiated = nlohmann::json::array();  ///< the run's blocks (the area model's input)
+    StructureTraits structure = {};  ///< the run's structure, for the structural knobs
 };
 
 /// {binding, label, evidence, relax, candidates, top, top_per_mm2, co_limits, coverage, estimate,

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sim/report/energy_area.h"
+#include "sim/report/technique_cost.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -144,6 +145,53 @@ std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops,
     return out;
 }
 
+namespace {
+
+void structural(std::vector<Knob>* out, Relaxation r, const std::string& resource, bool trace = false) {
+    if (r.key.empty()) return;
+    Knob k{std::move(r), resource, false};
+    k.structural = true;
+    k.trace = trace;
+    out->push_back(std::move(k));
+}
+
+/// Another structure one step away: a wide BVH for a binary or other kind, compressed nodes for
+/// a wide fp32 one (Ylitie, Karras & Laine 2017); none for compressed nodes or two levels.
+std::vector<std::string> structure_alternatives(const std::string& kind) {
+    if (kind.rfind("cwbvh", 0) == 0 || kind == "two_level") return {};
+    if (kind == "bvh6") return {"cwbvh6"};
+    if (kind == "bvh8") return {"cwbvh8"};
+    return {"bvh8", "cwbvh8"};
+}
+
+}  // namespace
+
+std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st) {
+    std::vector<Knob> out;
+    for (const std::string& alt : structure_alternatives(st.kind)) structural(&out, {"accel", st.kind, alt}, "structure", true);
+    if (st.can_compress_leaves && !st.compressed_leaves)
+        structural(&out, {"compressed_leaves", false, true}, "structure", true);
+    if (c.treelets.enabled) structural(&out, {"treelets.enabled", true, false}, "treelets");
+    else if (st.treelet_partition) structural(&out, {"treelets.enabled", false, true}, "treelets");
+    const std::string model = c.traversal.model == "mimd" ? "simt" : "mimd";
+    structural(&out, {"traversal.model", c.traversal.model, model}, "execution_model");
+    if (c.dispatch.sort == RaySort::none) structural(&out, {"dispatch.sort", "none", "morton"}, "ray_order");
+    else structural(&out, {"dispatch.sort", kRaySortChoices.name(c.dispatch.sort), "none"}, "ray_order");
+    if (!c.ideal_memory && st.treelet_partition)
+        structural(&out, {"treelets.prefetch", c.treelets.prefetch, !c.treelets.prefetch}, "prefetch");
+    return out;
+}
+
+std::string measure_command(const Knob& k, const StructureTraits& st) {
+    const std::string trace = st.trace.empty() ? "TRACE" : st.trace;
+    const std::string to = k.relax.to.is_string() ? k.relax.to.get<std::string>() : k.relax.to.dump();
+    if (!k.trace) return "rtsim simulate " + trace + " -o RUN --config RUN0/config.resolved.json --set " + k.relax.key + "=" + to;
+    const std::string option = k.relax.key == "accel" ? "--accel " + to : "--build-set compressed_leaves=true";
+    return "rtsim trace SCENE -o NEW_TRACE " + option +
+           " (the scene, workload and resolution of " + trace + "; its manifest.json lists them), then rtsim simulate "
+           "NEW_TRACE -o RUN --config RUN0/config.resolved.json";
+}
+
 SimConfig relaxed_config(const SimConfig& config, const std::vector<Relaxation>& knobs) {
     SimConfig c = config;
     for (const Relaxation& r : knobs)
@@ -183,7 +231,39 @@ json weigh_knobs(const WeighInputs& in) {
         knobs.push_back(j);
     }
     rank(knobs);
+    // The structural alternatives: another design, not a step of a resource. The analytic level
+    // does not estimate them (a structure is the trace's; treelets, another execution model,
+    // sorting and prefetching change the order rays meet the memory); each is priced and comes
+    // with the command that measures it.
+    json structural = json::array();
+    for (const Knob& k : structural_knobs(in.config, in.structure)) {
+        json j = {{"key", k.relax.key}, {"resource", k.resource}, {"from", k.relax.from}, {"to", k.relax.to},
+                  {"speedup", nullptr}, {"added_mm2", nullptr}, {"gain_per_mm2", nullptr}, {"structural", true},
+                  {"trace", k.trace}, {"measure", measure_command(k, in.structure)}};
+        const auto e = in.evidence.find(k.resource);
+        j["evidence"] = e == in.evidence.end() ? 0.0 : e->second;
+        try {
+            if (k.trace) {
+                // The new structure's decoders (technique_cost.h) in place of this one's.
+                StructureTraits next = in.structure;
+                if (k.relax.key == "accel") next.kind = k.relax.to.get<std::string>();
+                else next.compressed_leaves = true;
+                json inst = json::array();
+                for (const json& b : in.instantiated)
+                    if (b.value("block", "") != "node_decoder" && b.value("block", "") != "leaf_decoder") inst.push_back(b);
+                for (const json& b : structure_blocks(next.kind, next.blas_kind, next.compressed_leaves)) inst.push_back(b);
+                j["added_mm2"] = area_total_mm2(in.config, inst) - base_mm2;
+            } else {
+                j["added_mm2"] = area_total_mm2(relaxed_config(in.config, {k.relax}), in.instantiated) - base_mm2;
+            }
+        } catch (const Error& e) {
+            j["refused"] = e.what();
+        }
+        j["why_not"] = "a structural change, not estimated: measure it (" + j["measure"].get<std::string>() + ")";
+        structural.push_back(j);
+    }
     return {{"knobs", knobs},
+            {"structural", structural},
             {"top", first(knobs, 3)},
             {"top_per_mm2", per_area(knobs)},
             {"co_limits", in.cycles && in.not_covered.empty() ? co_limits(in, knobs) : json::array()}};

@@ -87,7 +87,7 @@ def test_roofline_has_mshr_ceilings_by_littles_law(
 ) -> None:  # fmt: skip
     stats = run_stats(sim, hairball, tmp_path / "run", "l2.mshrs=4")
     roof = stats["roofline"]
-    assert {"l1_mshrs", "l2_mshrs", "l2_bandwidth"} <= set(roof["ceilings"])
+    assert {"l1_mshrs", "l2_mshrs", "l2_banks"} <= set(roof["ceilings"])
     l2 = roof["mshr_little"]["l2"]
     # Little's law: MSHRs x line bytes / mean hold time is the level's miss bandwidth bound.
     assert l2["bytes_per_second"] == pytest.approx(4 * 64 / l2["mean_hold_cycles"] * 1e9)
