@@ -149,7 +149,12 @@ def simulate(
         job = SimJob(trace=trace, out_dir=run, config=config, sets=sets, verdict=verdict)
         result = run_sim(job)
         if result.returncode != 0:
-            raise SystemExit(f"{run}: rtsim-sim exit {result.returncode}: {result.stderr[-600:]}")
+            if verdict:  # a design that does not run is a study error
+                raise SystemExit(
+                    f"{run}: rtsim-sim exit {result.returncode}: {result.stderr[-600:]}"
+                )
+            print(f"{run}: refused or failed ({result.stderr.strip()[-200:]})", file=sys.stderr)
+            return {}
     return json.loads(stats_file.read_text())
 
 
@@ -168,19 +173,25 @@ def slug(text: str) -> str:
     return "".join(c if c.isalnum() else "-" for c in text).strip("-")
 
 
+def knob_str(k: dict[str, Any]) -> str:
+    """`key=to` as `--set` reads it (true/false for switches)."""
+    to = k["to"]
+    return f"{k['key']}={json.dumps(to) if isinstance(to, bool) else to}"
+
+
 def knobs_to_measure(verdict: dict[str, Any], structural: bool = False) -> list[str]:
     """The verdict's top five candidates and the core knobs, as `key=to`, its first co-limit
     (both knobs, joined by a space) and, with `structural`, every structural alternative."""
     cands = verdict.get("candidates") or []
     chosen = list(cands[:5])
     chosen += [c for c in cands if any(c["key"].startswith(k) for k in CORE) and c not in chosen]
-    out = [f"{c['key']}={c['to']}" for c in chosen]
+    out = [knob_str(c) for c in chosen]
     out += [" ".join(co["sets"]) for co in (verdict.get("co_limits") or [])[:1]]
     if structural:
         out += [
-            f"{k['key']}={k['to']}"
+            knob_str(k)
             for k in verdict.get("structural") or []
-            if not k.get("refused") and f"{k['key']}={k['to']}" not in out
+            if not k.get("refused") and knob_str(k) not in out
         ]
     return out
 
@@ -220,6 +231,8 @@ def study(
                 return float("nan")
             trace, sets = traces[other], list(d.sets)
         stats = simulate(trace, run, configs[d.name], sets, False, args.fresh)
+        if not stats:
+            return float("nan")
         return rays_per_second(stats) / rays_per_second(o.base)
 
     with ThreadPoolExecutor(args.workers) as pool:
@@ -234,12 +247,12 @@ def named_knob(verdict: dict[str, Any]) -> tuple[str, float | None]:
     k = verdict.get("relax") or (verdict.get("top") or [{}])[0]
     if not k.get("key"):
         return "-", None
-    return f"{k['key']}={k['to']}", k.get("speedup")
+    return knob_str(k), k.get("speedup")
 
 
 def best_structural(o: Outcome) -> str:
     """The best measured structural alternative of the design ("-" when none was measured)."""
-    keys = {f"{k['key']}={k['to']}" for k in o.base["verdict"].get("structural") or []}
+    keys = {knob_str(k) for k in o.base["verdict"].get("structural") or []}
     measured = {k: g for k, g in o.measured.items() if k in keys and g == g}
     if not measured:
         return "-"
@@ -266,9 +279,15 @@ def table(outcomes: list[Outcome]) -> tuple[str, dict[str, Any]]:
         hits += within
         gain_hits += within_gain
         # What --check-verdict gives: the best measured of the top three.
-        top3 = [f"{k['key']}={k['to']}" for k in (v.get("top") or [])[:3]]
+        top3 = [knob_str(k) for k in (v.get("top") or [])[:3]]
         checked_knob, checked = max(
-            ((k, o.measured[k]) for k in top3 if k in o.measured), key=lambda kv: kv[1]
+            (
+                (k, o.measured[k])
+                for k in top3
+                if k in o.measured and o.measured[k] == o.measured[k]
+            ),
+            key=lambda kv: kv[1],
+            default=("-", float("nan")),
         )
         checked_hits += checked - 1 >= 0.9 * (best - 1)
         if est is not None and meas:

@@ -144,8 +144,12 @@ def _gain(x: Any) -> str:
     return f"{x:.2f}x" if _is_num(x) else "-"
 
 
+def _value(v: Any) -> str:
+    return ("true" if v else "false") if isinstance(v, bool) else str(v)
+
+
 def _knob(k: dict[str, Any]) -> str:
-    return f"--set {k.get('key')}={k.get('to')} (now {k.get('from')})"
+    return f"--set {k.get('key')}={_value(k.get('to'))} (now {_value(k.get('from'))})"
 
 
 def not_estimated(why: Any) -> str:
@@ -171,6 +175,9 @@ def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
             if _is_num(k.get("speedup"))
             else not_estimated(k.get("why_not"))
         )
+        saved = k.get("dram_nj_saved_per_ray")
+        if _is_num(saved) and saved > 0.005:
+            est += f", saves {saved:.2f} nJ/ray of DRAM energy"
         rows.append(("  try" if i == 0 else "", f"{_knob(k)}: {est}"))
     for i, k in enumerate(verdict.get("top_per_mm2") or []):
         rows.append(
@@ -187,6 +194,12 @@ def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
                 f"{' + '.join(co.get('sets', []))}: {_gain(co.get('joint'))} jointly "
                 f"(alone {alone})",
             )
+        )
+    for i, k in enumerate(k for k in verdict.get("structural") or [] if not k.get("refused")):
+        added = k.get("added_mm2")
+        price = f" ({added:+.3f} mm^2)" if _is_num(added) else ""
+        rows.append(
+            ("  structural" if i == 0 else "", f"{_knob(k)}{price}: measure: {k.get('measure')}")
         )
     coverage = verdict.get("coverage") or {}
     if coverage.get("why_not"):

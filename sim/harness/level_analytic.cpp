@@ -145,10 +145,12 @@ LevelResult run_statistical(RunInputs& in) {
         v.instantiated = with_structure_blocks(instantiated, in.setup.structure);
         v.structure = structure_traits(in);
         v.unit = unit_traits(in.setup);
-        v.estimate = [form = std::make_shared<FormEstimator>(*p)](const SimConfig& x) {
+        const auto form = std::make_shared<FormEstimator>(*p);
+        v.estimate = [form](const SimConfig& x) {
             const ClosedForm f = (*form)(x);
             return std::make_pair(f.cycles, f.binding);
         };
+        v.estimate_bytes = [form](const SimConfig& x) { return (*form)(x).dram_bytes; };
         v.estimate_method = "the analytic level's per-trace analysis (" + std::to_string(p->stepped_rays) +
                             " stepped rays)";
         return judge(v);

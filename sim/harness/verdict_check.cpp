@@ -39,8 +39,9 @@ std::vector<std::pair<std::vector<std::string>, json>> to_measure(const json& ve
     }
     // The best structural alternative a re-run can measure (one that needs no new trace): the
     // one the run's cycle accounting points at most, first listed on a tie.
+    const json structural = verdict.value("structural", json::array());
     const json* best = nullptr;
-    for (const json& k : verdict.value("structural", json::array()))
+    for (const json& k : structural)
         if (!k.value("trace", false) && !k.contains("refused") &&
             (!best || k.value("evidence", 0.0) > best->value("evidence", 0.0)))
             best = &k;

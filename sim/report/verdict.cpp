@@ -290,7 +290,8 @@ json judge(const VerdictContext& c) {
     const Evidence evidence = timed ? timed_evidence(c.config, c.model) : analytic_evidence(c.model, analytic_binding);
     const std::string not_covered = coverage_gap(c.config, c.unit);
     WeighInputs in{c.config, c.instantiated, [&](const SimConfig& x) { return estimator(x).first; }, base_cycles,
-                   not_covered, evidence.share, c.unit.knobs, c.structure};
+                   not_covered, evidence.share, c.unit.knobs, c.structure,
+                   [&](const SimConfig& x) { return estimator.dram_bytes(x); }};
     const json weighed = weigh_knobs(in);
     // The binding resource: the best knob's when it buys 2% (or, unestimated, when the
     // evidence points at it); else the largest cycle use's.
@@ -341,7 +342,7 @@ const StatBlock& verdict_stats() {
             {"label", "", "the same in words (e.g. \"DRAM bandwidth\")"},
             {"text", "", "one sentence: label, evidence and the best relaxation with its estimated speed-up"},
             {"evidence", "", "the named resource's own evidence: `use` (the cycle-accounting use that points at it; `null` when none does), `context_fraction` (that use's share of context cycles), `share` (the share of context cycles of every use that points at it; at the analytic level its bound over the largest), `utilization.<resource>` (the resource's own utilisation, else the use's), `text` (the evidence in words: says so when no use points at the resource)"},
-            {"candidates", "list", "every knob, best first (by estimated gain; unestimated ones by `evidence`), each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to); `null` without one, with `why_not`), `added_mm2` (the area model's added area), `gain_per_mm2` (`(speedup - 1) / added_mm2`; `null` for knobs the area model does not price: MSHRs, banks, channels, costs), `evidence` (the share of context cycles that points at the resource)"},
+            {"candidates", "list", "every knob, best first (by estimated gain; unestimated ones by `evidence`), each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to); `null` without one, with `why_not`), `added_mm2` (the area model's added area), `gain_per_mm2` (`(speedup - 1) / added_mm2`; `null` for knobs the area model does not price: MSHRs, banks, channels, costs), `evidence` (the share of context cycles that points at the resource), `dram_saved_fraction` (estimated: the share of DRAM traffic the knob removes) and `dram_nj_saved_per_ray` (that share of the run's DRAM energy per ray: what it saves per ray in joules), `tie_break` (present when it was named ahead of an estimate within 3 points because it also removes DRAM traffic)"},
             {"top", "list", "the first three `candidates`: what to try, printed by `rtsim simulate`"},
             {"top_per_mm2", "list", "the three best `gain_per_mm2`"},
             {"co_limits", "list", "pairs of estimated knobs whose joint relaxation gains much more than either alone (joint gain >= 1.5 x the better single gain + 5 points): `keys`, `sets` (`key=value` each), `resources`, `joint` (estimated speed-up of both), `alone` (each's)"},
@@ -433,6 +434,18 @@ ReportBlock verdict_report() {
     b.add = [](json& stats, const ReportInputs& in) {
         json verdict = in.verdict ? in.verdict() : json(nullptr);
         if (!verdict.is_null()) {
+            // Each knob's DRAM energy saved per ray: its share of DRAM traffic removed times the
+            // run's own DRAM energy per ray (the energy block runs first, report order 50).
+            const json& nj = stats.value("energy", json::object()).value("per_ray_nj", json::object());
+            auto saved = [&](json& k) {
+                if (k.is_object() && k.contains("dram_saved_fraction"))
+                    k["dram_nj_saved_per_ray"] = k["dram_saved_fraction"].get<double>() * nj["dram"].get<double>();
+            };
+            if (nj.contains("dram") && nj["dram"].is_number()) {
+                for (const char* list : {"candidates", "top", "top_per_mm2"})
+                    for (json& k : verdict[list]) saved(k);
+                saved(verdict["relax"]);
+            }
             verdict["agreement"] = agreement_json(verdict, stats.value("roofline", json(nullptr)), in.config);
             verdict["text"] = verdict["text"].get<std::string>() + agreement_text(verdict["agreement"]);
             if (verdict.contains("check")) verdict["text"] = verdict["text"].get<std::string>() + checked_clause(verdict);

@@ -98,6 +98,9 @@ struct WeighInputs {
     std::map<std::string, double> evidence;  ///< resource -> share of context cycles pointing at it
     std::vector<KindKnob> kind_knobs = {};   ///< the unit kind's own knobs
     StructureTraits structure = {};          ///< for the structural knobs
+    /// The DRAM bytes the estimator moves for a config (unset: not known): each knob's share of
+    /// DRAM energy saved, and the tie-break between knobs whose estimates are within its error.
+    CycleEstimate dram_bytes = {};
 };
 
 /// {knobs (best first), top (three), top_per_mm2 (three), co_limits, structural}; each knob {key,

@@ -75,8 +75,12 @@ def test_check_verdict_measures_the_top_knobs(hairball: Path, sim: Sim, tmp_path
         for assignment in c["sets"]:
             key, value = assignment.split("=")
             section, field = key.split(".")
-            assert str(resolved[section][field]) == value
+            got = resolved[section][field]
+            assert (json.dumps(got) if isinstance(got, bool) else str(got)) == value
         assert c["measured"] == pytest.approx(run["summary"]["rays_per_second"] / base)
+    # The best structural alternative a re-run can measure is among them (a switch flipped).
+    alts = [k for k in v["structural"] if not k["trace"]]
+    assert any(f"{k['key']}={json.dumps(k['to'])}" in c["sets"] for k in alts for c in checks)
     measured = [c["measured"] for c in checks]
     assert measured == sorted(measured, reverse=True)
     assert "re-run:" in v["text"] and "measured" in v["text"]

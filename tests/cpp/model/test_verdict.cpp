@@ -142,6 +142,30 @@ TEST(Verdict, StructuralAlternativesAreMeasuredAndPriced) {
     EXPECT_TRUE(leaves);
 }
 
+TEST(Verdict, ANearTieGoesToTheKnobThatRemovesTraffic) {
+    SimConfig c;
+    c.traversal.ray_contexts = 16;
+    // More channels estimated 2 points ahead of twice the L2, which alone removes DRAM traffic.
+    auto cycles = [](const SimConfig& x) {
+        return 1000.0 / (x.dram.channels == 4 ? 1.16 : 1.0) / (x.l2.size_kib == 2048 ? 1.14 : 1.0);
+    };
+    auto bytes = [](const SimConfig& x) { return x.l2.size_kib == 2048 ? 850.0 : 1000.0; };
+    WeighInputs in{c, nlohmann::json::array(), cycles, cycles(c), "", {}};
+    in.dram_bytes = bytes;
+    const nlohmann::json w = weigh_knobs(in);
+    EXPECT_EQ(w["knobs"][0]["key"], "l2.size_kib");
+    EXPECT_TRUE(w["knobs"][0].contains("tie_break"));
+    EXPECT_NEAR(w["knobs"][0]["dram_saved_fraction"].get<double>(), 0.15, 1e-9);
+    EXPECT_EQ(w["knobs"][1]["key"], "dram.channels");
+    // Not a tie: channels 10 points ahead stay first.
+    auto far = [](const SimConfig& x) {
+        return 1000.0 / (x.dram.channels == 4 ? 1.25 : 1.0) / (x.l2.size_kib == 2048 ? 1.14 : 1.0);
+    };
+    WeighInputs in2{c, nlohmann::json::array(), far, far(c), "", {}};
+    in2.dram_bytes = bytes;
+    EXPECT_EQ(weigh_knobs(in2)["knobs"][0]["key"], "dram.channels");
+}
+
 TEST(Verdict, TechniquesAddAreaOnlyWhenOn) {
     SimConfig c;
     c.traversal.ray_contexts = 16;
