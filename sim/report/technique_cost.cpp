@@ -65,18 +65,25 @@ double prefetch_streams(const SimConfig& s) {
     return s.treelets.enabled ? double(t.kind().treelet_consumers(t)) : double(t.contexts());
 }
 
+/// stats["model"]["units"], or an empty object when the level wrote none (functional: null).
+json units_of(const json& stats) {
+    const json& model = stats.contains("model") ? stats["model"] : json();
+    if (!model.is_object() || !model.contains("units") || !model["units"].is_object()) return json::object();
+    return model["units"];
+}
+
 /// Group steps of a lock-step kind (warp or packet steps), from the units' lane slots.
 double group_steps(const SimConfig& s, const json& stats) {
     double slots = 0;
-    for (const json& u : stats.value("model", json::object()).value("units", json::object()))
-        if (u.contains("lane_slots") && u["lane_slots"].is_number()) slots += u["lane_slots"].get<double>();
+    for (const json& u : units_of(stats))
+        if (u.is_object() && u.contains("lane_slots") && u["lane_slots"].is_number()) slots += u["lane_slots"].get<double>();
     return slots / std::max<double>(1, s.traversal.group_size());
 }
 
 double prefetched_lines(const json& stats) {
     double sent = 0;
-    for (const json& u : stats.value("model", json::object()).value("units", json::object()))
-        if (u.contains("prefetch") && u["prefetch"].is_object()) sent += u["prefetch"].value("sent", 0.0);
+    for (const json& u : units_of(stats))
+        if (u.is_object() && u.contains("prefetch") && u["prefetch"].is_object()) sent += u["prefetch"].value("sent", 0.0);
     return sent;
 }
 
@@ -139,7 +146,8 @@ TechniqueArea technique_area(const SimConfig& s, const json& inst) {
 std::map<std::string, double> technique_energy_pj(const SimConfig& s, const WorkTotals& w, const json& stats) {
     const EnergyConfig& c = s.energy;
     const TraversalConfig& t = s.traversal;
-    const json& inst = stats.value("instantiated", json::array());
+    const json inst = stats.contains("instantiated") && stats["instantiated"].is_array() ? stats["instantiated"]
+                                                                                        : json::array();
     std::map<std::string, double> pj;
     const double box_tests = double(w[work_field_of(OpKind::box)] + w[WorkField::restart_box_tests] +
                                     w[WorkField::rp_box_tests]);
@@ -161,7 +169,8 @@ std::map<std::string, double> technique_energy_pj(const SimConfig& s, const Work
     } else {
         pj["context_scheduler"] = steps * logic_pj(c, 0, 0, t.contexts());
     }
-    const double rays = double(stats.value("summary", json::object()).value("rays", 0.0));
+    const json& summary = stats.contains("summary") && stats["summary"].is_object() ? stats["summary"] : json::object();
+    const double rays = summary.contains("rays") && summary["rays"].is_number() ? summary["rays"].get<double>() : 0.0;
     if (s.dispatch.sort != RaySort::none) {
         const double stages = std::ceil(std::log2(double(std::max<uint32_t>(2, s.dispatch.sort_window))));
         const double window = double(s.dispatch.sort_window) * kSortEntryBytes;
