@@ -144,8 +144,24 @@ def _gain(x: Any) -> str:
     return f"{x:.2f}x" if _is_num(x) else "-"
 
 
+def _value(v: Any) -> str:
+    return ("true" if v else "false") if isinstance(v, bool) else str(v)
+
+
 def _knob(k: dict[str, Any]) -> str:
-    return f"--set {k.get('key')}={k.get('to')} (now {k.get('from')})"
+    return f"--set {k.get('key')}={_value(k.get('to'))} (now {_value(k.get('from'))})"
+
+
+def not_estimated(why: Any) -> str:
+    """ "not estimated (why)", never "not estimated (not estimated: ...)"."""
+    text = str(why or "").strip()
+    for lead in ("not estimated: ", "not estimated (", "not estimated"):
+        if text.startswith(lead):
+            text = text[len(lead) :]
+            if lead.endswith("(") and text.endswith(")"):
+                text = text[:-1]
+            break
+    return f"not estimated ({text})" if text else "not estimated"
 
 
 def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
@@ -157,8 +173,11 @@ def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
         est = (
             f"{_gain(k.get('speedup'))} estimated"
             if _is_num(k.get("speedup"))
-            else f"not estimated ({k.get('why_not', '?')})"
+            else not_estimated(k.get("why_not"))
         )
+        saved = k.get("dram_nj_saved_per_ray")
+        if _is_num(saved) and saved > 0.005:
+            est += f", saves {saved:.2f} nJ/ray of DRAM energy"
         rows.append(("  try" if i == 0 else "", f"{_knob(k)}: {est}"))
     for i, k in enumerate(verdict.get("top_per_mm2") or []):
         rows.append(
@@ -175,6 +194,12 @@ def verdict_rows(verdict: dict[str, Any]) -> list[tuple[str, str]]:
                 f"{' + '.join(co.get('sets', []))}: {_gain(co.get('joint'))} jointly "
                 f"(alone {alone})",
             )
+        )
+    for i, k in enumerate(k for k in verdict.get("structural") or [] if not k.get("refused")):
+        added = k.get("added_mm2")
+        price = f" ({added:+.3f} mm^2)" if _is_num(added) else ""
+        rows.append(
+            ("  structural" if i == 0 else "", f"{_knob(k)}{price}: measure: {k.get('measure')}")
         )
     coverage = verdict.get("coverage") or {}
     if coverage.get("why_not"):
@@ -196,7 +221,11 @@ def why_slow_table(stats: dict[str, Any]) -> Table:
     table = _two_column("why is it slow (docs/model.md)")
     verdict = stats.get("verdict") or {}
     if verdict:
-        table.add_row("bottleneck", str(verdict.get("label", verdict.get("binding", "-"))))
+        label = str(verdict.get("label", verdict.get("binding", "-")))
+        binding = verdict.get("binding")
+        table.add_row(
+            "bottleneck", label + (f" ({binding})" if binding and binding != label else "")
+        )
         evidence = (verdict.get("evidence") or {}).get("text")
         if evidence:
             table.add_row("  evidence", str(evidence))
@@ -211,11 +240,27 @@ def why_slow_table(stats: dict[str, Any]) -> Table:
     roof = stats.get("roofline") or {}
     bound = roof.get("bound_rays_per_second")
     achieved = roof.get("rays_per_second")
+    agreement = verdict.get("agreement") or {}
+    knob = agreement.get("knob")
+
+    def relaxed(flag: Any) -> str:
+        if not knob or flag is None:
+            return ""
+        return f"; {knob} relaxes it" if flag else f"; {knob} does not relax it"
+
     if _is_num(bound) and _is_num(achieved) and bound > 0:
+        name = roof.get("bound")
+        label = roof.get("bound_label") or name
         table.add_row(
             "roofline",
-            f"{achieved / 1e6:,.2f} of {bound / 1e6:,.2f} Mrays/s allowed by {roof.get('bound')} "
-            f"({achieved / bound:.0%})",
+            f"{achieved / 1e6:,.2f} of {bound / 1e6:,.2f} Mrays/s allowed by {label}"
+            f"{f' ({name})' if label != name else ''} ({achieved / bound:.0%})"
+            f"{relaxed(agreement.get('roofline_relaxed'))}",
+        )
+    if agreement.get("analytic_binding"):
+        table.add_row(
+            "analytic binding",
+            f"{agreement['analytic_binding']}{relaxed(agreement.get('analytic_relaxed'))}",
         )
     return table
 
@@ -351,6 +396,12 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         from rtsim.frame_summary import frame_table
 
         console.print(frame_table(stats))
+    warnings = _get(stats, "summary.study_warnings") or []
+    if warnings:
+        table = _two_column("too small to answer its question (docs/treelets.md)")
+        for w in warnings:
+            table.add_row("[bold yellow]warning[/]", str(w))
+        console.print(table)
     if _get(stats, "summary.cycles") is not None:
         console.print(utilisation_table(stats))
         if stats.get("verdict") or stats.get("roofline"):

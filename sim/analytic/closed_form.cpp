@@ -124,6 +124,7 @@ ClosedForm closed_form(const SimConfig& c, const std::vector<OpKind>& ops, const
         }
     f.queueing = mva_cycles(c, ops, d, f.bounds);
     f.cycles = std::ceil(std::max(f.roofline, f.queueing));
+    f.dram_bytes = c.ideal_memory ? 0.0 : d.dram_bytes;
     return f;
 }
 

@@ -48,6 +48,7 @@ struct ClosedForm {
     double roofline = 0;    ///< its cycles
     double queueing = 0;    ///< the MVA estimate
     double cycles = 0;      ///< max(roofline, queueing), rounded up
+    double dram_bytes = 0;  ///< the DRAM bytes behind it (the demands'): what a knob's traffic costs in energy
 };
 
 /// The roofline and the MVA estimate of a run with these demands (ideal_memory: no cache or

@@ -142,12 +142,15 @@ LevelResult run_statistical(RunInputs& in) {
     r.judge = [&in, p, instantiated = r.instantiated](const json& model) {
         // The verdict's analytic estimates come from this run's own analysis (no second pass).
         VerdictContext v{in.config(), model, nullptr, nullptr};
-        v.instantiated = instantiated;
+        v.instantiated = with_structure_blocks(instantiated, in.setup.structure);
+        v.structure = structure_traits(in);
         v.unit = unit_traits(in.setup);
-        v.estimate = [form = std::make_shared<FormEstimator>(*p)](const SimConfig& x) {
+        const auto form = std::make_shared<FormEstimator>(*p);
+        v.estimate = [form](const SimConfig& x) {
             const ClosedForm f = (*form)(x);
             return std::make_pair(f.cycles, f.binding);
         };
+        v.estimate_bytes = [form](const SimConfig& x) { return (*form)(x).dram_bytes; };
         v.estimate_method = "the analytic level's per-trace analysis (" + std::to_string(p->stepped_rays) +
                             " stepped rays)";
         return judge(v);

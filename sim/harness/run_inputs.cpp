@@ -9,6 +9,7 @@
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/run_files.h"
 #include "sim/harness/trace_stream.h"
+#include "sim/report/technique_cost.h"
 #include "traces/accel/accel_io.h"
 #include "traces/common/error.h"
 
@@ -66,6 +67,23 @@ std::function<void(uint64_t done, uint64_t total)> progress_of(const SimOptions&
     };
 }
 
+StructureTraits structure_traits(const RunInputs& in) {
+    const StructureFacts& f = in.setup.structure;
+    StructureTraits t;
+    t.kind = f.kind;
+    t.blas_kind = f.blas_kind;
+    t.compressed_leaves = f.compressed_leaves;
+    t.can_compress_leaves = f.caps.compressed_leaves;
+    t.treelet_partition = f.caps.treelet_partition;
+    t.trace = in.rtt;
+    return t;
+}
+
+json with_structure_blocks(json instantiated, const StructureFacts& s) {
+    for (json& b : structure_blocks(s.kind, s.blas_kind, s.compressed_leaves)) instantiated.push_back(std::move(b));
+    return instantiated;
+}
+
 UnitTraits unit_traits(const RunSetup& setup) {
     UnitTraits u;
     u.name = setup.unit->name;
@@ -87,7 +105,8 @@ VerdictContext verdict_context(RunInputs& in, const BuiltRun& built, const json&
     v.trace_rays = built.rays;
     v.unit = unit_traits(in.setup);
     v.trace_path = in.rtt;
-    v.instantiated = instantiated;
+    v.instantiated = with_structure_blocks(instantiated, in.setup.structure);
+    v.structure = structure_traits(in);
     v.frames = built.frames.size();
     if (built.frames.size() > 1) {
         // The estimates trace a sample of rays against one bound structure: an animated trace's

@@ -59,6 +59,11 @@ std::function<void(uint64_t done, uint64_t total)> progress_of(const SimOptions&
 
 /// The verdict's view of the run's unit kind (its knobs, the kind its estimates stand in with).
 UnitTraits unit_traits(const RunSetup& setup);
+/// What the verdict's structural knobs need of the run's structure (verdict_knobs.h).
+StructureTraits structure_traits(const RunInputs& in);
+/// A level's instantiated blocks with the structure's own (its decoders: technique_cost.h), which
+/// the area model prices.
+nlohmann::json with_structure_blocks(nlohmann::json instantiated, const StructureFacts& structure);
 /// A verdict context over `built` (the sample the verdict's own analysis steps read from the trace).
 VerdictContext verdict_context(RunInputs& in, const BuiltRun& built, const nlohmann::json& model,
                                const nlohmann::json& instantiated);

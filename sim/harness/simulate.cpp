@@ -42,7 +42,7 @@ SimOutcome report(RunInputs& in, LevelResult& level) {
                  {"validation", level.validation},
                  {"latency", level.latency},
                  {"workload", level.workload},
-                 {"instantiated", level.instantiated},
+                 {"instantiated", with_structure_blocks(level.instantiated, in.setup.structure)},
                  {"effects", in.manifest.value("workload", json::object()).value("effects", json::array())},
                  {"model", level.model},
                  {"provenance", provenance(o.command_line, in.rtt, in.manifest, in.started)}};
@@ -58,8 +58,8 @@ SimOutcome report(RunInputs& in, LevelResult& level) {
         inputs.verdict = [&]() {
             json verdict = level.judge(out.stats["model"]);
             if (o.check_verdict) {
+                // The verdict's report block adds the re-runs to its text.
                 verdict["check"] = check_verdict(o, verdict, out.stats["summary"].value("rays_per_second", 0.0));
-                verdict["text"] = checked_text(verdict);
             }
             return verdict;
         };

@@ -37,6 +37,19 @@ std::vector<std::pair<std::vector<std::string>, json>> to_measure(const json& ve
         add(co["sets"].get<std::vector<std::string>>(), co["joint"]);
         break;
     }
+    // The best structural alternative a re-run can measure (one that needs no new trace): the
+    // one the run's cycle accounting points at most, first listed on a tie.
+    const json structural = verdict.value("structural", json::array());
+    const json* best = nullptr;
+    for (const json& k : structural)
+        if (!k.value("trace", false) && !k.contains("refused") &&
+            (!best || k.value("evidence", 0.0) > best->value("evidence", 0.0)))
+            best = &k;
+    if (best) {
+        const json& k = *best;
+        const std::string to = k["to"].is_string() ? k["to"].get<std::string>() : k["to"].dump();
+        add({k["key"].get<std::string>() + "=" + to}, nullptr);
+    }
     return out;
 }
 
@@ -64,12 +77,6 @@ double rays_per_second_of(const fs::path& run) {
     if (stats.is_discarded()) return 0;
     const json& r = stats.value("summary", json::object()).value("rays_per_second", json(nullptr));
     return r.is_number() ? r.get<double>() : 0;
-}
-
-std::string gain(double speedup) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%+.0f%%", 100.0 * (speedup - 1.0));
-    return buf;
 }
 
 }  // namespace
@@ -100,20 +107,6 @@ json check_verdict(const SimOptions& o, const json& verdict, double base_rays_pe
         return x > y;
     });
     return out;
-}
-
-std::string checked_text(const json& verdict) {
-    std::string text = verdict["text"].get<std::string>() + "; re-run:";
-    bool first = true;
-    for (const json& c : verdict["check"]) {
-        std::string sets;
-        for (const json& s : c["sets"]) sets += (sets.empty() ? "" : " + ") + s.get<std::string>();
-        const std::string measured = c["measured"].is_number() ? gain(c["measured"].get<double>()) : "(failed)";
-        const std::string estimated = c["estimated"].is_number() ? gain(c["estimated"].get<double>()) : "-";
-        text += std::string(first ? " " : ", ") + sets + " measured " + measured + " (estimated " + estimated + ")";
-        first = false;
-    }
-    return text;
 }
 
 }  // namespace rtsim

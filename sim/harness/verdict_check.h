@@ -17,7 +17,4 @@ namespace rtsim {
 /// [{sets, estimated, measured, run, error}]. Throws rtsim::Error when rtsim-sim cannot be started.
 nlohmann::json check_verdict(const SimOptions& options, const nlohmann::json& verdict, double rays_per_second);
 
-/// The verdict's sentence with what the re-runs measured appended.
-std::string checked_text(const nlohmann::json& verdict);
-
 }  // namespace rtsim

@@ -8,6 +8,7 @@
 
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/ray_buffer/ray_buffer.h"
+#include "sim/report/technique_cost.h"
 
 namespace rtsim {
 
@@ -158,6 +159,9 @@ json area_json(const SimConfig& s, const json& stats) {
     bytes["stacks"] = double(t.units) * t.contexts() * t.stack_entries * t.stack_entry_bytes;
     bytes["ray_contexts"] = double(t.units) * t.contexts() * kContextStateBytes;
     if (s.mailbox.entries) bytes["mailbox"] = mailbox_bytes(s);
+    // What each technique adds (technique_cost.h): its SRAM here, its logic below.
+    const TechniqueArea added = technique_area(s, stats.value("instantiated", json::array()));
+    for (const auto& [block, b] : added.sram_bytes) bytes[block] = b;
     json mm2 = json::object();
     double sram = 0, sram_bytes = 0;
     for (auto it = bytes.begin(); it != bytes.end(); ++it) {
@@ -174,6 +178,7 @@ json area_json(const SimConfig& s, const json& stats) {
     // Blocks only some structures or configs have are listed only when built.
     if (instantiated(stats.value("instantiated", json::array()), "plane"))
         mm2["plane"] = pipeline_mm2(c, s, s.plane, kPlaneFlops);
+    for (const auto& [block, logic] : added.logic_mm2) mm2[block] = mm2.value(block, 0.0) + logic;
     double total = 0;
     for (auto it = mm2.begin(); it != mm2.end(); ++it) total += it->get<double>();
     return {{"mm2", mm2},        {"total_mm2", total},          {"sram_mm2", sram},
@@ -181,6 +186,14 @@ json area_json(const SimConfig& s, const json& stats) {
 }
 
 }  // namespace
+
+double logic_mm2(const EnergyConfig& c, double adds, double muls, double cmps) {
+    return flops_um2(c, {adds, muls, cmps, 0}) * 1e-6 * area_scale(c);
+}
+
+double logic_pj(const EnergyConfig& c, double adds, double muls, double cmps) {
+    return flops_pj(c, {adds, muls, cmps, 0}) * energy_scale(c);
+}
 
 BoxPipelineCost box_pipeline_cost(const SimConfig& config, uint32_t bits) {
     const Flops f = at_precision(kBoxFlops, bits);
@@ -292,6 +305,8 @@ void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint6
         pj["ray_buffer"] = s.treelets.enabled && !has_memory ? json(nullptr) : json(0.0);
     }
 
+    for (const auto& [block, e] : technique_energy_pj(s, w, stats)) pj[block] = pj.value(block, 0.0) + e;
+
     json area = area_json(s, stats);
     const double total_mm2 = area["total_mm2"];
     const double leak_w = total_mm2 * c.leakage_mw_per_mm2 * 1e-3;
@@ -359,7 +374,7 @@ const StatBlock& energy_stats() {
             {"dram_pj_per_bit", "pJ/bit", "its energy per bit (or the override)"},
             {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`) and one `ray_setup` at the node"},
             {"rays", "rays", "rays the energy is divided by: the rays checked (a sampled run's simulated rays, warm-up included)"},
-            {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `mailbox` (only with `mailbox.entries > 0`: lookups and recorded tests in the mailbox SRAM), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
+            {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `mailbox` (only with `mailbox.entries > 0`: lookups and recorded tests in the mailbox SRAM), the techniques' blocks as in `area.mm2` (decodes per test, scheduler picks per step or warp step, sorted rays, prefetched lines, mailbox compares), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
             {"dynamic_nj", "nJ", "dynamic energy of the blocks with counts, summed over the rays"},
             {"leakage_w", "W", "`area.total_mm2 x energy.leakage_mw_per_mm2`"},
             {"power_w", "W", "as `summary.power_w`"},
@@ -374,7 +389,7 @@ const StatBlock& area_stats() {
     static const StatBlock block{
         "area",
         {
-            {"mm2", "mm^2", "`{block: mm^2}`: `l1` (all units, tags in), `l2` (tags in), `ray_buffer` (treelets on), `stacks`, `ray_contexts`, each pipeline kind built, and `mailbox` (only with `mailbox.entries > 0`)"},
+            {"mm2", "mm^2", "`{block: mm^2}`: `l1` (all units, tags in), `l2` (tags in), `ray_buffer` (treelets on), `stacks`, `ray_contexts`, each pipeline kind built, `mailbox` (only with `mailbox.entries > 0`), and what each technique adds (docs/energy_area.md, \"What each technique adds\"): `node_decoder` (compressed nodes), `leaf_decoder` (compressed leaves: block buffers and index logic), `simt_control` (warp scheduler, lane masks, coalescer), `packet_control`, `context_scheduler` (MIMD: a scheduler entry per ray context), `sort_stage` (`dispatch.sort`), `prefetcher` (`treelets.prefetch`), `mailbox_compare`"},
             {"total_mm2", "mm^2", "all blocks"},
             {"sram_mm2", "mm^2", "the SRAM blocks"},
             {"logic_mm2", "mm^2", "the pipelines"},

@@ -38,6 +38,11 @@ double sram_access_pj(const EnergyConfig& c, double bytes, double bits);
 /// Area of an SRAM of `bytes` of data at the configured node, mm^2 (without tags).
 double sram_mm2(const EnergyConfig& c, double bytes);
 
+/// Logic of `adds` fp32 adders, `muls` multipliers and `cmps` comparators (integer adds, muxes)
+/// with the datapath overhead: its area at the configured node, mm^2, and one use's energy, pJ.
+double logic_mm2(const EnergyConfig& c, double adds, double muls, double cmps);
+double logic_pj(const EnergyConfig& c, double adds, double muls, double cmps);
+
 /// The box pipelines at a mantissa width (traversal.box_precision_bits; 0: fp32): one test's
 /// energy, pJ, and all box pipelines' area, mm^2 (docs/energy_area.md, "Reduced-precision box
 /// pipeline": adders and comparators scale with the word width, multipliers with the significand

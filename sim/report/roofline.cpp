@@ -2,6 +2,7 @@
 #include "sim/report/report_block.h"
 
 #include "rtl_model/isect/pipeline.h"
+#include "sim/report/resources.h"
 
 namespace rtsim {
 
@@ -43,7 +44,7 @@ void memory_ceilings(const SimConfig& c, const json& model, double rays, double 
     if (c.fidelity == Fidelity::analytic) {
         for (const char* name : {"l1_mshrs", "l2_mshrs", "l2_banks"})
             if (bounds.contains(name) && bounds[name].is_number() && bounds[name].get<double>() > 0)
-                (*ceilings)[std::string(name) == "l2_banks" ? "l2_bandwidth" : name] =
+                (*ceilings)[name] =
                     rays * hz / bounds[name].get<double>();
         return;
     }
@@ -57,7 +58,7 @@ void memory_ceilings(const SimConfig& c, const json& model, double rays, double 
     if (!l1.is_null()) (*ceilings)["l1_mshrs"] = l1["rays_per_second"], (*little)["l1"] = l1;
     if (!l2.is_null()) (*ceilings)["l2_mshrs"] = l2["rays_per_second"], (*little)["l2"] = l2;
     const double l2_lines = number(l2_stats, "reads") + number(l2_stats, "writes");
-    if (l2_lines > 0) (*ceilings)["l2_bandwidth"] = double(c.l2.banks) / c.l2.bank_cycles * hz / (l2_lines / rays);
+    if (l2_lines > 0) (*ceilings)["l2_banks"] = double(c.l2.banks) / c.l2.bank_cycles * hz / (l2_lines / rays);
 }
 
 }  // namespace
@@ -98,6 +99,7 @@ json roofline_json(const SimConfig& c, const json& summary, const json& model) {
             {"peak_dram_bytes_per_second", double(c.dram.bytes_per_cycle) * c.dram.channels * hz},
             {"ceilings", ceilings},
             {"bound", bound},
+            {"bound_label", bound.empty() ? json(nullptr) : json(resource_label(bound))},
             {"bound_rays_per_second", bound.empty() ? json(nullptr) : json(lowest)},
             {"mshr_little", little}};
 }
@@ -107,8 +109,9 @@ const StatBlock& roofline_stats() {
         "roofline",
         {
             {"rays_per_second", "rays/s", "achieved (`summary.rays_per_second`)"},
-            {"ceilings", "rays/s", "`{resource: rays/s}` what each resource alone allows: `dram` = peak DRAM bytes/s over `dram_bytes_per_ray`, `box`, `triangle`, ... = pipeline issue slots/s over issues per ray, `scheduler` = units x clock / (steps per ray x `issue_cycles`), `l1_mshrs` and `l2_mshrs` = Little's law, MSHRs x line bytes / the misses' mean MSHR hold time, over miss bytes per ray (`mshr_little`), `l2_bandwidth` = L2 banks / `bank_cycles` x clock over L2 line accesses per ray; at the analytic level the memory ceilings are its closed form's bounds"},
-            {"bound", "", "the lowest ceiling's name"},
+            {"ceilings", "rays/s", "`{resource: rays/s}` what each resource alone allows: `dram` = peak DRAM bytes/s over `dram_bytes_per_ray`, `box`, `triangle`, ... = pipeline issue slots/s over issues per ray, `scheduler` = units x clock / (steps per ray x `issue_cycles`), `l1_mshrs` and `l2_mshrs` = Little's law, MSHRs x line bytes / the misses' mean MSHR hold time, over miss bytes per ray (`mshr_little`), `l2_banks` = L2 banks / `bank_cycles` x clock over L2 line accesses per ray; at the analytic level the memory ceilings are its closed form's bounds"},
+            {"bound", "", "the lowest ceiling's name, in the verdict's vocabulary (`verdict.binding`, `model.analytic.bounds`)"},
+            {"bound_label", "", "the same in words, as the verdict labels it"},
             {"bound_rays_per_second", "rays/s", "the lowest ceiling; the run can never be faster (tested)"},
             {"dram_bytes_per_ray", "bytes/ray", "as `summary.dram_bytes_per_ray`"},
             {"peak_dram_bytes_per_second", "B/s", "`channels x bytes_per_cycle x clock`"},

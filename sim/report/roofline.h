@@ -6,7 +6,7 @@
 //   scheduler: units x clock / (issue_cycles x scheduler steps per ray)
 //   l1_mshrs, l2_mshrs: Little's law at each level, outstanding lines x line bytes / the
 //              misses' mean MSHR hold time, over the level's miss bytes per ray
-//   l2_bandwidth: L2 banks x line accesses per bank cycle x clock / L2 line accesses per ray
+//   l2_banks:     L2 banks x line accesses per bank cycle x clock / L2 line accesses per ray
 // A run sits under all of them; the lowest ceiling is the roofline's bound for its work.
 #include <nlohmann/json.hpp>
 

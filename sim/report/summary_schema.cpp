@@ -132,6 +132,9 @@ const StatBlock& summary_stats() {
         {"energy_per_frame_mj", "mJ",
          "only with `shading.enabled`: `energy_per_ray_nj x rays` plus the shader cores' `model.shading.energy_pj`",
          false, true},
+        {"study_warnings", "list",
+         "`study_size.findings[].text`: why the run is too small to answer its question (a ray buffer that never filled, a drain that dominates, a sample too short), each with the trace size that would do; empty when none applies. `rtsim simulate` prints them and the sweep report lists them",
+         false, false},
     }};
     return block;
 }
@@ -155,6 +158,7 @@ const StatBlock& run_stats() {
             {"area", "", "chip area by block, mm^2, from the same model (below)"},
             {"verdict", "", "why the run is slow: the binding resource, its evidence and the knob that relaxes it (below); `null` at functional or with `--no-verdict`"},
             {"roofline", "", "the run against its throughput ceilings (below); `null` at functional"},
+            {"study_size", "", "whether the run is big enough to answer its question, and the trace size that would be (below)"},
             {"mailbox", "", "only when `mailbox.entries > 0`: the mailboxes' lookups, hits and the triangle tests and fetches they saved (below)", false, true},
             {"short_stack", "", "only when `traversal.stack_overflow = restart_trail`: entries dropped, restarts and the re-traversal they cost (below)", false, true},
             {"box_precision", "", "only when `traversal.box_precision_bits > 0`: the reduced-precision box pipeline's extra walk, its energy and area beside fp32's (below)", false, true},

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <map>
 
+#include "sim/report/resources.h"
 #include "sim/report/verdict_estimator.h"
 #include "traces/common/error.h"
 
@@ -21,62 +22,7 @@ namespace {
 /// Utilisation at which a resource counts as saturated rather than merely slow.
 constexpr double kSaturated = 0.7;
 
-/// The resources the verdict can name besides the pipelines: the name the analytic bounds and
-/// stats use, what a person calls it and the utilisation that shows it busy (model.utilization;
-/// "" if none). The knobs that relax them are declared once, in verdict_knobs.cpp.
-struct ResourceInfo {
-    const char* name;
-    const char* label;
-    const char* busy;
-};
-
-const std::vector<ResourceInfo>& resource_table() {
-    static const std::vector<ResourceInfo> r = {
-        {"l1_mshrs", "L1 MSHRs", "l1_mshrs"},
-        {"l2_mshrs", "L2 MSHRs", "l2_mshrs"},
-        {"dram", "DRAM bandwidth", "dram_bandwidth"},
-        {"l1_banks", "L1 banks", "l1_banks"},
-        {"l2_banks", "L2 banks", "l2_banks"},
-        {"latency", "latency not hidden (memory and pipeline latency over too few ray contexts)", ""},
-        {"scheduler", "the traversal units' schedulers (one step per issue_cycles)", ""},
-        {"stack", "stack spills (spilled entries read back)", ""},
-        {"ray_buffer", "the ray buffer SRAM", ""},
-        {"workload", "the workload: too few rays to keep the machine busy (contexts idle)", ""},
-        {"units", "too few traversal units", ""},
-        {"l1_capacity", "L1 capacity (misses to the L2)", ""},
-        {"l2_capacity", "L2 capacity (misses to DRAM)", ""},
-        {"admission", "treelet admission (rays admitted into the ray buffer)", ""},
-        {"treelet_scheduling", "treelet scheduling (which queue a free unit runs)", ""},
-        {"divergence", "divergence (SIMT warp lanes, or packet rays, masked off while others step)", ""},
-    };
-    return r;
-}
-
-const ResourceInfo* find_resource(const std::string& name) {
-    for (const ResourceInfo& r : resource_table())
-        if (name == r.name) return &r;
-    return nullptr;
-}
-
-/// The operation kind a resource names (its pipelines), if it names one.
-bool op_kind_of(const std::string& resource, OpKind* kind) {
-    for (int k = 0; k < kOpKindCount; ++k)
-        if (resource == op_kind_name(OpKind(k))) return *kind = OpKind(k), true;
-    return false;
-}
-
-std::string label_of(const std::string& resource) {
-    const ResourceInfo* r = find_resource(resource);
-    return r ? r->label : resource + " pipelines";  // an operation kind
-}
-
-/// The utilisation that shows a resource busy ("" if none).
-std::string busy_of(const std::string& resource) {
-    OpKind kind;
-    if (op_kind_of(resource, &kind)) return std::string("pipe_") + op_kind_name(kind);
-    const ResourceInfo* r = find_resource(resource);
-    return r ? r->busy : "";
-}
+std::string label_of(const std::string& resource) { return resource_label(resource); }
 
 /// What a context waits for, in words, for each cycle use.
 std::string waiting_for(const std::string& use) {
@@ -134,12 +80,7 @@ std::vector<std::pair<std::string, double>> uses_by_size(const json& model) {
     return uses;
 }
 
-/// Whether each unit has its own `resource` (so more units relax it).
-bool per_unit(const SimConfig& c, const std::string& resource) {
-    OpKind kind;
-    if (op_kind_of(resource, &kind)) return !c.pipeline(kind).shared();
-    return resource == "latency" || resource == "scheduler" || resource == "l1_mshrs" || resource == "l1_banks";
-}
+bool per_unit(const SimConfig& c, const std::string& resource) { return resource_per_unit(c, resource); }
 
 /// What the evidence says of each resource: the share of context cycles that points at it, and
 /// the largest use that does.
@@ -173,6 +114,15 @@ Evidence timed_evidence(const SimConfig& c, const json& model) {
         // scheduler, unshared pipelines, the L1's MSHRs and banks.
         if (per_unit(c, r)) e.add("units", use, fraction);
         if (use == "ray_buffer") e.add("treelet_scheduling", use, fraction / 2);
+        // What the structural alternatives would change (they are measured, never estimated:
+        // this only orders which one --check-verdict re-runs): treelets cut DRAM waits when
+        // off and cost ray-buffer and admission time when on; prefetching and sorting shorten
+        // memory waits; another execution model removes masked-off lanes.
+        const bool memory = use == "dram" || use == "l2" || use == "l2_mshr_full" || use == "l1_mshr_full";
+        if (c.treelets.enabled ? (use == "ray_buffer" || use == "starved") : use == "dram") e.add("treelets", use, fraction);
+        if (memory && !c.treelets.prefetch) e.add("prefetch", use, fraction / 2);
+        if (memory && c.dispatch.sort == RaySort::none) e.add("ray_order", use, fraction / 4);
+        if (use == "idle_lane") e.add("execution_model", use, fraction);
     }
     return e;
 }
@@ -190,27 +140,62 @@ Evidence analytic_evidence(const json& model, const std::string& binding) {
     return e;
 }
 
-/// The evidence for `resource` in words: the use that points at it and the utilisation that
-/// confirms it.
+/// The evidence for `resource` in words, that resource's own: at the timed levels the cycle
+/// use that points at it (and the share of all uses that do) with its own utilisation; at the
+/// analytic level its bound against the largest. Where nothing points at it, the text says so
+/// and names the largest use instead of passing that use off as its evidence.
 json evidence_for(const std::string& resource, const Evidence& e, const json& model, bool timed) {
-    if (!timed) return {{"text", "the analytic level's binding bound is " + e.largest}};
-    const auto it = e.use.find(resource);
-    const std::string use = it != e.use.end() ? it->second : uses_by_size(model).front().first;
-    const double fraction = model["cycle_accounting"]["fractions"].value(use, 0.0);
-    json out = {{"use", use}, {"context_fraction", fraction}};
-    // The largest use first, so a knob named for a smaller use does not hide where time went.
+    const auto share_it = e.share.find(resource);
+    const double share = share_it == e.share.end() ? 0.0 : share_it->second;
+    if (!timed) {
+        const json& bounds = model.value("analytic", json::object()).value("bounds", json::object());
+        if (resource == e.largest) return {{"share", share}, {"text", "the analytic level's largest bound is " + resource}};
+        if (bounds.contains(resource))
+            return {{"share", share},
+                    {"text", "the analytic level's " + resource + " bound is " + percent(share) + " of its largest (" +
+                                 e.largest + ")"}};
+        return {{"share", 0.0},
+                {"text", "no bound of the analytic level is " + resource + "'s own (its largest is " + e.largest + ")"}};
+    }
     const auto [top_use, top_fraction] = uses_by_size(model).front();
-    std::string text = "contexts waited for " + waiting_for(top_use) + " " + percent(top_fraction) + " of their cycles";
-    if (top_use != use) text += ", for " + waiting_for(use) + " " + percent(fraction);
-    std::string busy;
-    resource_of_use(use, model, &busy);
-    if (busy.empty()) busy = busy_of(resource);
+    const auto it = e.use.find(resource);
+    if (it == e.use.end()) {
+        json out = {{"use", nullptr}, {"context_fraction", 0.0}, {"share", 0.0}};
+        std::string text = "no context cycle points at it";
+        const std::string own = resource_busy(resource);
+        if (!own.empty() && model.contains("utilization")) {
+            out["utilization"] = {{own, utilization(model, own)}};
+            text += " (" + own + " " + percent(utilization(model, own)) + " busy)";
+        }
+        out["text"] = text + "; the largest use: waiting for " + waiting_for(top_use) + " " + percent(top_fraction) +
+                      " of their cycles";
+        return out;
+    }
+    const std::string use = it->second;
+    const double fraction = model["cycle_accounting"]["fractions"].value(use, 0.0);
+    json out = {{"use", use}, {"context_fraction", fraction}, {"share", share}};
+    std::string text = "contexts waited for " + waiting_for(use) + " " + percent(fraction) + " of their cycles";
+    if (share > fraction + 0.005) text += " (" + percent(share) + " in all the uses that point at it)";
+    // The resource's own utilisation confirms it (DRAM bandwidth for DRAM, whatever use
+    // points there); a resource without one shows the use's (the L1 MSHRs for more units).
+    std::string busy = resource_busy(resource);
+    if (busy.empty()) resource_of_use(use, model, &busy);
     if (!busy.empty() && model.contains("utilization")) {
         out["utilization"] = {{busy, utilization(model, busy)}};
-        text += " (" + busy + " " + percent(utilization(model, busy)) + " busy)";
+        text += ", " + busy + " " + percent(utilization(model, busy)) + " busy";
     }
+    // The largest use too, so a knob named for a smaller use does not hide where time went.
+    if (top_use != use) text += "; the largest use: waiting for " + waiting_for(top_use) + " " + percent(top_fraction);
     out["text"] = text;
     return out;
+}
+
+/// "not estimated (why)", without repeating "not estimated" when the reason already says it.
+std::string not_estimated(std::string why) {
+    for (const char* lead : {"not estimated: ", "not estimated (", "not estimated"})
+        if (why.rfind(lead, 0) == 0) why = why.substr(std::string(lead).size());
+    while (!why.empty() && (why.back() == ')' && why.find('(') == std::string::npos)) why.pop_back();
+    return why.empty() ? "not estimated" : "not estimated (" + why + ")";
 }
 
 std::string gain(double speedup) {
@@ -233,7 +218,7 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
     } else if (relax["speedup"].is_number()) {
         text += "; " + knob_text(relax) + " estimated by the analytic level";
     } else if (not_covered.empty()) {
-        text += "; " + knob_text(relax) + ": not estimated (" + relax.value("why_not", std::string("?")) + ")";
+        text += "; " + knob_text(relax) + ": " + not_estimated(relax.value("why_not", std::string()));
     } else {
         text += "; try " + knob_text(relax);
     }
@@ -253,7 +238,25 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
                 " together " + gain(co["joint"].get<double>()) + " (alone " + gain(co["alone"][0].get<double>()) +
                 ", " + gain(co["alone"][1].get<double>()) + ")";
     if (!not_covered.empty()) text += "; " + not_covered;
-    return text + " (analytic binding bound: " + v["analytic_binding"].get<std::string>() + ")";
+    // Another design is not a step of a resource: name the alternatives to measure, priced.
+    std::string alternatives;
+    for (const json& k : weighed["structural"]) {
+        if (k.contains("refused")) continue;
+        char mm2[48] = "";
+        if (k["added_mm2"].is_number()) std::snprintf(mm2, sizeof mm2, " %+.3f mm^2", k["added_mm2"].get<double>());
+        const std::string to = k["to"].is_string() ? k["to"].get<std::string>() : k["to"].dump();
+        alternatives += (alternatives.empty() ? "" : ", ") + k["key"].get<std::string>() + "=" + to + mm2;
+    }
+    if (!alternatives.empty())
+        text += "; structural alternatives, not estimated, measure them (verdict.structural has each command): " +
+                alternatives;
+    // An estimate that names a resource no context cycle points at disagrees with the run's own
+    // accounting: say so rather than let the two read as one story.
+    if (!relax.is_null() && relax["speedup"].is_number() && v["evidence"].value("share", 1.0) < 0.02 &&
+        v["evidence"].contains("use"))
+        text += "; the cycle accounting does not point at " + v["binding"].get<std::string>() +
+                ": estimate and accounting disagree, measure with --check-verdict";
+    return text;
 }
 
 /// Why the estimates do not describe this machine ("" when they do).
@@ -271,7 +274,7 @@ std::string coverage_gap(const SimConfig& c, const UnitTraits& unit) {
 
 Relaxation relaxation_for(const std::string& resource, const SimConfig& c) {
     OpKind kind;
-    const bool pipeline = op_kind_of(resource, &kind);
+    const bool pipeline = resource_op_kind(resource, &kind);
     for (const Knob& k : every_knob(c, pipeline ? std::vector<OpKind>{kind} : std::vector<OpKind>{}))
         if (k.resource == resource && (resource != "scheduler" || c.traversal.issue_cycles > 1)) return k.relax;
     if (resource == "scheduler") return doubled(c, "traversal.units");
@@ -287,7 +290,8 @@ json judge(const VerdictContext& c) {
     const Evidence evidence = timed ? timed_evidence(c.config, c.model) : analytic_evidence(c.model, analytic_binding);
     const std::string not_covered = coverage_gap(c.config, c.unit);
     WeighInputs in{c.config, c.instantiated, [&](const SimConfig& x) { return estimator(x).first; }, base_cycles,
-                   not_covered, evidence.share, c.unit.knobs};
+                   not_covered, evidence.share, c.unit.knobs, c.structure,
+                   [&](const SimConfig& x) { return estimator.dram_bytes(x); }};
     const json weighed = weigh_knobs(in);
     // The binding resource: the best knob's when it buys 2% (or, unestimated, when the
     // evidence points at it); else the largest cycle use's.
@@ -307,6 +311,7 @@ json judge(const VerdictContext& c) {
               {"top", weighed["top"]},
               {"top_per_mm2", weighed["top_per_mm2"]},
               {"co_limits", weighed["co_limits"]},
+              {"structural", weighed["structural"]},
               {"coverage", {{"estimated", not_covered.empty()},
                             {"why_not", not_covered.empty() ? json(nullptr) : json(not_covered)},
                             {"frames", c.frames}}},
@@ -368,17 +373,19 @@ const StatBlock& verdict_stats() {
             {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l1_banks`, `l2_banks`, `l1_capacity`, `l2_capacity`, `units`, `<kind>` (a pipeline kind), `scheduler`, `stack`, `ray_buffer`, `admission`, `treelet_scheduling`, `latency`, `workload`, `divergence` (SIMT lanes idle)"},
             {"label", "", "the same in words (e.g. \"DRAM bandwidth\")"},
             {"text", "", "one sentence: label, evidence and the best relaxation with its estimated speed-up"},
-            {"evidence", "", "`use` (the cycle-accounting use that points at it), `context_fraction` (that use's share of context cycles), `utilization.<resource>` (the utilisations that confirm it), `text` (the evidence in words)"},
-            {"candidates", "list", "every knob, best first (by estimated gain; unestimated ones by `evidence`), each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to); `null` without one, with `why_not`), `added_mm2` (the area model's added area), `gain_per_mm2` (`(speedup - 1) / added_mm2`; `null` for knobs the area model does not price: MSHRs, banks, channels, costs), `evidence` (the share of context cycles that points at the resource)"},
+            {"evidence", "", "the named resource's own evidence: `use` (the cycle-accounting use that points at it; `null` when none does), `context_fraction` (that use's share of context cycles), `share` (the share of context cycles of every use that points at it; at the analytic level its bound over the largest), `utilization.<resource>` (the resource's own utilisation, else the use's), `text` (the evidence in words: says so when no use points at the resource)"},
+            {"candidates", "list", "every knob, best first (by estimated gain; unestimated ones by `evidence`), each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to); `null` without one, with `why_not`), `added_mm2` (the area model's added area), `gain_per_mm2` (`(speedup - 1) / added_mm2`; `null` for knobs the area model does not price: MSHRs, banks, channels, costs), `evidence` (the share of context cycles that points at the resource), `dram_saved_fraction` (estimated: the share of DRAM traffic the knob removes) and `dram_nj_saved_per_ray` (that share of the run's DRAM energy per ray: what it saves per ray in joules), `tie_break` (present when it was named ahead of an estimate within 3 points because it also removes DRAM traffic)"},
             {"top", "list", "the first three `candidates`: what to try, printed by `rtsim simulate`"},
             {"top_per_mm2", "list", "the three best `gain_per_mm2`"},
             {"co_limits", "list", "pairs of estimated knobs whose joint relaxation gains much more than either alone (joint gain >= 1.5 x the better single gain + 5 points): `keys`, `sets` (`key=value` each), `resources`, `joint` (estimated speed-up of both), `alone` (each's)"},
             {"coverage", "", "`estimated` (false where the analytic level does not model the machine: treelets), `why_not`, `frames` (an animated trace's estimates are the first frame's)"},
+            {"structural", "list", "the structural alternatives to the run's design, one step each: another structure (`accel`: a wide BVH, or compressed nodes) and `compressed_leaves` (both a new trace), `treelets.enabled` flipped, another `traversal.model`, `dispatch.sort` on or off, `treelets.prefetch` flipped; each with the candidates' fields (`speedup` null: never estimated), `structural` (true), `trace` (needs a new trace), `measure` (the command that measures it; `--check-verdict` re-runs the best config one) and `added_mm2` (its added area: the decoders of compressed nodes or leaves, a ray buffer, SIMT control, a sort stage, a prefetcher); `refused` when the config refuses it"},
             {"check", "list", "with `--check-verdict`: each top candidate and co-limit re-run at the run's level: `sets`, `estimated`, `measured` (rays/s relaxed over the run's), `run` (its folder); best measured first", false, true},
             {"relax", "", "the best candidate, with the same fields; `null` when no knob relaxes the binding resource"},
             {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `reused` (the analysis was loaded from beside the trace, stored there by an earlier run, instead of stepped by this one), `base_cycles` (its cycles for the run's own config), `wall_seconds` (the host time the estimates took)"},
             {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
             {"frame", "list", "only with `shading.enabled`: the shading side's knobs beside the RT unit's, weighed by what they buy the frame (Amdahl over `model.shading.breakdown`): `key`, `from`, `to`, `part` (traversal or shading), `part_speedup` (the RT knob's estimate; 2 for doubled shader cores; the divergence for sorting by shader, an upper bound), `frame_speedup`; best first", false, true},
+            {"agreement", "", "the run's answers in one vocabulary: `binding`, `knob` (the named knob's key), `relaxes` (the resources it relaxes, directly or by what it removes), `roofline_bound` (`roofline.bound`), `roofline_reached` (achieved over that ceiling), `roofline_relaxed`, `analytic_binding`, `analytic_relaxed` (whether the knob relaxes each)"},
         }};
     return block;
 }
@@ -387,12 +394,100 @@ RTSIM_REGISTER_STAT_BLOCK(verdict_stats)
 
 namespace {
 
+bool list_contains(const std::vector<std::string>& list, const std::string& x) {
+    return std::find(list.begin(), list.end(), x) != list.end();
+}
+
+/// The run's three answers side by side in one vocabulary (resources.h): the verdict's binding
+/// and named knob, the roofline's lowest ceiling, the analytic level's binding bound, and
+/// whether the named knob relaxes each. The roofline runs first (report order 60).
+json agreement_json(const json& v, const json& roofline, const SimConfig& c) {
+    const json& relax = v["relax"];
+    const std::string key = relax.is_null() ? std::string() : relax["key"].get<std::string>();
+    std::vector<std::string> relaxed = key.empty() ? std::vector<std::string>{} : knob_relaxes(c, key);
+    if (!relax.is_null() && !list_contains(relaxed, relax["resource"].get<std::string>()))
+        relaxed.push_back(relax["resource"].get<std::string>());
+    const std::string bound = roofline.is_object() ? roofline.value("bound", std::string()) : std::string();
+    const std::string analytic = v["analytic_binding"].get<std::string>();
+    json out = {{"binding", v["binding"]}, {"knob", key.empty() ? json(nullptr) : json(key)},
+                {"relaxes", relaxed},      {"roofline_bound", bound.empty() ? json(nullptr) : json(bound)},
+                {"analytic_binding", analytic}};
+    out["roofline_relaxed"] = bound.empty() ? json(nullptr) : json(list_contains(relaxed, bound));
+    out["analytic_relaxed"] = list_contains(relaxed, analytic);
+    double reached = 0;
+    if (!bound.empty() && roofline["bound_rays_per_second"].is_number() && roofline["rays_per_second"].is_number() &&
+        roofline["bound_rays_per_second"].get<double>() > 0)
+        reached = roofline["rays_per_second"].get<double>() / roofline["bound_rays_per_second"].get<double>();
+    out["roofline_reached"] = reached;
+    return out;
+}
+
+/// The agreement in words: the ceiling and the binding bound by name, and what the knob does
+/// to each.
+std::string agreement_text(const json& a) {
+    std::string text = " (";
+    const bool roof = a["roofline_bound"].is_string();
+    if (roof)
+        text += "roofline: lowest ceiling " + a["roofline_bound"].get<std::string>() + ", " +
+                percent(a["roofline_reached"].get<double>()) + " of it reached; ";
+    text += "analytic binding: " + a["analytic_binding"].get<std::string>();
+    if (a["knob"].is_string()) {
+        const std::string k = a["knob"].get<std::string>();
+        const bool r = roof && a["roofline_relaxed"].get<bool>(), an = a["analytic_relaxed"].get<bool>();
+        const bool same = roof && a["roofline_bound"] == a["analytic_binding"];
+        if ((r || !roof) && an) text += "; " + k + " relaxes " + (roof && !same ? "both" : "it");
+        else if (r) text += "; " + k + " relaxes the ceiling, not the analytic binding";
+        else if (an) text += "; " + k + " relaxes the analytic binding, not the ceiling";
+        else text += "; " + k + " relaxes " + (roof && !same ? "neither" : "not it") + ": it pays only by what it removes elsewhere";
+    }
+    return text + ")";
+}
+
+std::string gain_text(double speedup) { return gain(speedup); }
+
+/// "; re-run: K=V measured +x% (estimated +y%), ..." for a verdict with `check`.
+std::string checked_clause(const json& verdict) {
+    std::string text = "; re-run:";
+    bool first = true;
+    for (const json& c : verdict["check"]) {
+        std::string sets;
+        for (const json& s : c["sets"]) sets += (sets.empty() ? "" : " + ") + s.get<std::string>();
+        const std::string measured = c["measured"].is_number() ? gain_text(c["measured"].get<double>()) : "(failed)";
+        const std::string estimated = c["estimated"].is_number() ? gain_text(c["estimated"].get<double>()) : "-";
+        text += std::string(first ? " " : ", ") + sets + " measured " + measured + " (estimated " + estimated + ")";
+        first = false;
+    }
+    return text;
+}
+
 ReportBlock verdict_report() {
     ReportBlock b;
     b.name = "verdict";
     b.order = 70;
     b.add = [](json& stats, const ReportInputs& in) {
-        const json verdict = in.verdict ? in.verdict() : json(nullptr);
+        json verdict = in.verdict ? in.verdict() : json(nullptr);
+        if (!verdict.is_null()) {
+            // Each knob's DRAM energy saved per ray: its share of DRAM traffic removed times the
+            // run's own DRAM energy per ray (the energy block runs first, report order 50).
+            const json& nj = stats.value("energy", json::object()).value("per_ray_nj", json::object());
+            auto saved = [&](json& k) {
+                if (k.is_object() && k.contains("dram_saved_fraction"))
+                    k["dram_nj_saved_per_ray"] = k["dram_saved_fraction"].get<double>() * nj["dram"].get<double>();
+            };
+            if (nj.contains("dram") && nj["dram"].is_number()) {
+                for (const char* list : {"candidates", "top", "top_per_mm2"})
+                    for (json& k : verdict[list]) saved(k);
+                saved(verdict["relax"]);
+            }
+            verdict["agreement"] = agreement_json(verdict, stats.value("roofline", json(nullptr)), in.config);
+            verdict["text"] = verdict["text"].get<std::string>() + agreement_text(verdict["agreement"]);
+            if (verdict.contains("check")) verdict["text"] = verdict["text"].get<std::string>() + checked_clause(verdict);
+            // A run too small to answer its question says so in the same sentence (study_size.cpp).
+            const json& size = stats.value("study_size", json(nullptr));
+            if (size.is_object() && size.value("too_small", false))
+                for (const json& f : size["findings"])
+                    verdict["text"] = verdict["text"].get<std::string>() + "; too small: " + f["text"].get<std::string>();
+        }
         stats["verdict"] = verdict;
         stats["summary"]["bottleneck"] = verdict.is_null() ? json(nullptr) : verdict["binding"];
         stats["summary"]["verdict"] = verdict.is_null() ? json(nullptr) : verdict["text"];

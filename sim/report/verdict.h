@@ -57,10 +57,13 @@ struct VerdictContext {
     /// analytic level passes its own per-trace analysis, so it needs no second pass over rays.
     std::function<std::pair<double, std::string>(const SimConfig&)> estimate = {};
     std::string estimate_method = {};  ///< how `estimate` estimates, for the verdict's text
+    /// With `estimate`: the DRAM bytes its estimate moves for a config (unset: not known).
+    std::function<double(const SimConfig&)> estimate_bytes = {};
     std::string trace_path = {};       ///< the .rtt: a per-trace analysis stored beside it is reused
     size_t frames = 1;                 ///< an animated trace's frames: the sample is the first frame's
     uint64_t first_ray = 0, frame_rays = 0;  ///< that frame's rays (0: the whole trace)
     nlohmann::json instantiated = nlohmann::json::array();  ///< the run's blocks (the area model's input)
+    StructureTraits structure = {};  ///< the run's structure, for the structural knobs
 };
 
 /// {binding, label, evidence, relax, candidates, top, top_per_mm2, co_limits, coverage, estimate,

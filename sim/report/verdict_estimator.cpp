@@ -96,6 +96,12 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
     m_reused = true;
 }
 
+double VerdictEstimator::dram_bytes(const SimConfig& config) const {
+    const SimConfig a = analytic_config(config, m_context.unit.estimate_as);
+    if (m_context.estimate_bytes) return m_context.estimate_bytes(a);
+    return m_form ? (*m_form)(a).dram_bytes : 0.0;
+}
+
 std::pair<double, std::string> VerdictEstimator::operator()(const SimConfig& config) const {
     const SimConfig a = analytic_config(config, m_context.unit.estimate_as);
     if (m_context.estimate) return m_context.estimate(a);

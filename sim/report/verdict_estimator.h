@@ -29,6 +29,8 @@ public:
     explicit VerdictEstimator(const VerdictContext& context);
     /// The analytic level's cycles and binding bound for `config` (made analytic_config first).
     std::pair<double, std::string> operator()(const SimConfig& config) const;
+    /// The DRAM bytes the estimate moves for `config` (0 when the estimator does not say).
+    double dram_bytes(const SimConfig& config) const;
     /// How the estimates are made, for the verdict's text.
     const std::string& method() const { return m_method; }
     /// True when the analysis was loaded from beside the trace (not stepped by this run).

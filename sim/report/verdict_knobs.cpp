@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sim/report/energy_area.h"
+#include "sim/report/technique_cost.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -18,6 +19,10 @@ constexpr double kCoLimitFactor = 1.5, kCoLimitMargin = 0.05;
 /// Knobs whose pairs are tried: the best this many by estimated gain (every estimable knob of a
 /// default config: a co-limit's knobs gain little alone, so a short list by gain would miss it).
 constexpr size_t kPairPool = 24;
+/// Estimates this close are within the analytic level's error of each other (the verdict's text
+/// says so); of two such, the one that also cuts DRAM traffic by this share more is named first:
+/// it pays the same and saves energy (a larger cache against more channels).
+constexpr double kTie = 0.03, kTieSaving = 0.05;
 
 void add(std::vector<Knob>* out, Relaxation r, const std::string& resource, bool estimable = true) {
     if (!r.key.empty()) out->push_back({std::move(r), resource, estimable});
@@ -144,6 +149,55 @@ std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops,
     return out;
 }
 
+namespace {
+
+void structural(std::vector<Knob>* out, Relaxation r, const std::string& resource, bool trace = false) {
+    if (r.key.empty()) return;
+    Knob k{std::move(r), resource, false};
+    k.structural = true;
+    k.trace = trace;
+    out->push_back(std::move(k));
+}
+
+/// Another structure one step away: a wide BVH for a binary or other kind, compressed nodes for
+/// a wide fp32 one (Ylitie, Karras & Laine 2017); none for compressed nodes or two levels.
+std::vector<std::string> structure_alternatives(const std::string& kind) {
+    if (kind.rfind("cwbvh", 0) == 0 || kind == "two_level") return {};
+    if (kind == "bvh6") return {"cwbvh6"};
+    if (kind == "bvh8") return {"cwbvh8"};
+    return {"bvh8", "cwbvh8"};
+}
+
+}  // namespace
+
+std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st) {
+    std::vector<Knob> out;
+    for (const std::string& alt : structure_alternatives(st.kind)) structural(&out, {"accel", st.kind, alt}, "structure", true);
+    if (st.can_compress_leaves && !st.compressed_leaves)
+        structural(&out, {"compressed_leaves", false, true}, "structure", true);
+    if (c.treelets.enabled) structural(&out, {"treelets.enabled", true, false}, "treelets");
+    else if (st.treelet_partition) structural(&out, {"treelets.enabled", false, true}, "treelets");
+    const std::string model = c.traversal.model == "mimd" ? "simt" : "mimd";
+    structural(&out, {"traversal.model", c.traversal.model, model}, "execution_model");
+    // The ray buffer reorders rays itself: sorting is refused with treelet scheduling.
+    if (c.treelets.enabled) {
+    } else if (c.dispatch.sort == RaySort::none) structural(&out, {"dispatch.sort", "none", "morton"}, "ray_order");
+    else structural(&out, {"dispatch.sort", kRaySortChoices.name(c.dispatch.sort), "none"}, "ray_order");
+    if (!c.ideal_memory && st.treelet_partition)
+        structural(&out, {"treelets.prefetch", c.treelets.prefetch, !c.treelets.prefetch}, "prefetch");
+    return out;
+}
+
+std::string measure_command(const Knob& k, const StructureTraits& st) {
+    const std::string trace = st.trace.empty() ? "TRACE" : st.trace;
+    const std::string to = k.relax.to.is_string() ? k.relax.to.get<std::string>() : k.relax.to.dump();
+    if (!k.trace) return "rtsim simulate " + trace + " -o RUN --config RUN0/config.resolved.json --set " + k.relax.key + "=" + to;
+    const std::string option = k.relax.key == "accel" ? "--accel " + to : "--build-set compressed_leaves=true";
+    return "rtsim trace SCENE -o NEW_TRACE " + option +
+           " (the scene, workload and resolution of " + trace + "; its manifest.json lists them), then rtsim simulate "
+           "NEW_TRACE -o RUN --config RUN0/config.resolved.json";
+}
+
 SimConfig relaxed_config(const SimConfig& config, const std::vector<Relaxation>& knobs) {
     SimConfig c = config;
     for (const Relaxation& r : knobs)
@@ -159,6 +213,7 @@ json weigh_knobs(const WeighInputs& in) {
             if (b.value("block", "") == op_kind_name(OpKind(k)) && b.value("instantiated", false))
                 ops.push_back(OpKind(k));
     const double base_mm2 = area_total_mm2(in.config, in.instantiated);
+    const double base_bytes = in.dram_bytes ? in.dram_bytes(in.config) : 0.0;
     json knobs = json::array();
     for (const Knob& k : every_knob(in.config, ops, in.kind_knobs)) {
         json j = {{"key", k.relax.key}, {"resource", k.resource}, {"from", k.relax.from}, {"to", k.relax.to},
@@ -176,6 +231,8 @@ json weigh_knobs(const WeighInputs& in) {
                 const double speedup = in.base_cycles / in.cycles(relaxed);
                 j["speedup"] = speedup;
                 if (added > 1e-9) j["gain_per_mm2"] = (speedup - 1.0) / added;
+                if (in.dram_bytes && base_bytes > 0)
+                    j["dram_saved_fraction"] = 1.0 - in.dram_bytes(relaxed) / base_bytes;
             }
         } catch (const Error& e) {
             j["why_not"] = e.what();
@@ -183,7 +240,47 @@ json weigh_knobs(const WeighInputs& in) {
         knobs.push_back(j);
     }
     rank(knobs);
+    // A near tie goes to the knob that also removes DRAM traffic (same speed, less energy).
+    if (knobs.size() > 1 && knobs[0]["speedup"].is_number() && knobs[1]["speedup"].is_number() &&
+        knobs[1]["speedup"].get<double>() >= knobs[0]["speedup"].get<double>() - kTie &&
+        knobs[1].value("dram_saved_fraction", 0.0) >= knobs[0].value("dram_saved_fraction", 0.0) + kTieSaving) {
+        std::swap(knobs[0], knobs[1]);
+        knobs[0]["tie_break"] = "within the estimate's error of " + knobs[1]["key"].get<std::string>() +
+                                "'s gain, and it also removes DRAM traffic";
+    }
+    // The structural alternatives: another design, not a step of a resource. The analytic level
+    // does not estimate them (a structure is the trace's; treelets, another execution model,
+    // sorting and prefetching change the order rays meet the memory); each is priced and comes
+    // with the command that measures it.
+    json structural = json::array();
+    for (const Knob& k : structural_knobs(in.config, in.structure)) {
+        json j = {{"key", k.relax.key}, {"resource", k.resource}, {"from", k.relax.from}, {"to", k.relax.to},
+                  {"speedup", nullptr}, {"added_mm2", nullptr}, {"gain_per_mm2", nullptr}, {"structural", true},
+                  {"trace", k.trace}, {"measure", measure_command(k, in.structure)}};
+        const auto e = in.evidence.find(k.resource);
+        j["evidence"] = e == in.evidence.end() ? 0.0 : e->second;
+        try {
+            if (k.trace) {
+                // The new structure's decoders (technique_cost.h) in place of this one's.
+                StructureTraits next = in.structure;
+                if (k.relax.key == "accel") next.kind = k.relax.to.get<std::string>();
+                else next.compressed_leaves = true;
+                json inst = json::array();
+                for (const json& b : in.instantiated)
+                    if (b.value("block", "") != "node_decoder" && b.value("block", "") != "leaf_decoder") inst.push_back(b);
+                for (const json& b : structure_blocks(next.kind, next.blas_kind, next.compressed_leaves)) inst.push_back(b);
+                j["added_mm2"] = area_total_mm2(in.config, inst) - base_mm2;
+            } else {
+                j["added_mm2"] = area_total_mm2(relaxed_config(in.config, {k.relax}), in.instantiated) - base_mm2;
+            }
+        } catch (const Error& e) {
+            j["refused"] = e.what();
+        }
+        j["why_not"] = "a structural change, not estimated: measure it (" + j["measure"].get<std::string>() + ")";
+        structural.push_back(j);
+    }
     return {{"knobs", knobs},
+            {"structural", structural},
             {"top", first(knobs, 3)},
             {"top_per_mm2", per_area(knobs)},
             {"co_limits", in.cycles && in.not_covered.empty() ? co_limits(in, knobs) : json::array()}};

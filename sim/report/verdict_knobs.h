@@ -36,6 +36,22 @@ struct Knob {
     Relaxation relax;
     std::string resource;
     bool estimable = true;  ///< the analytic level models what the knob changes
+    /// A structural knob (the structure, its leaves, treelets on or off, the execution model,
+    /// sorting, prefetching): not a step of a resource but another design, measured, never
+    /// estimated; `trace` when it needs another trace (the structure is the trace's).
+    bool structural = false;
+    bool trace = false;
+};
+
+/// What the verdict knows of the run's structure (the resolution step's facts), for the
+/// structural knobs: the alternatives it offers and what they add to the area.
+struct StructureTraits {
+    std::string kind = "bvh2";        ///< the trace's structure ("two_level": its BLASes' kind below)
+    std::string blas_kind;
+    bool compressed_leaves = false;   ///< its leaves are compressed
+    bool can_compress_leaves = false; ///< the kind may store compressed leaves
+    bool treelet_partition = true;    ///< the kind partitions itself into treelets
+    std::string trace;                ///< the run's trace, for the commands that measure
 };
 
 /// A knob of the unit kind's own (its registration's UnitKnob, handed over by the run loop).
@@ -61,6 +77,15 @@ struct UnitTraits {
 std::vector<Knob> every_knob(const SimConfig& config, const std::vector<OpKind>& ops,
                              const std::vector<KindKnob>& kind_knobs = {});
 
+/// The structural alternatives to this run's design (Knob::structural), each one step: another
+/// structure (wider, or compressed nodes) and compressed leaves (both a new trace), treelets on
+/// or off, another execution model, ray sorting on or off, treelet prefetching on or off.
+std::vector<Knob> structural_knobs(const SimConfig& config, const StructureTraits& structure);
+
+/// The command that measures a structural knob: a re-run with `--set` (what --check-verdict
+/// runs), or for a new structure the trace to make first.
+std::string measure_command(const Knob& knob, const StructureTraits& structure);
+
 /// The cycles the estimator gives for a config; throws rtsim::Error for a config it refuses.
 using CycleEstimate = std::function<double(const SimConfig&)>;
 
@@ -72,10 +97,15 @@ struct WeighInputs {
     std::string not_covered;              ///< why the estimates do not describe this machine ("" if they do)
     std::map<std::string, double> evidence;  ///< resource -> share of context cycles pointing at it
     std::vector<KindKnob> kind_knobs = {};   ///< the unit kind's own knobs
+    StructureTraits structure = {};          ///< for the structural knobs
+    /// The DRAM bytes the estimator moves for a config (unset: not known): each knob's share of
+    /// DRAM energy saved, and the tie-break between knobs whose estimates are within its error.
+    CycleEstimate dram_bytes = {};
 };
 
-/// {knobs (best first), top (three), top_per_mm2 (three), co_limits}; each knob {key, resource,
-/// from, to, speedup (null without an estimate), added_mm2, gain_per_mm2, evidence, why_not}.
+/// {knobs (best first), top (three), top_per_mm2 (three), co_limits, structural}; each knob {key,
+/// resource, from, to, speedup (null without an estimate), added_mm2, gain_per_mm2, evidence,
+/// why_not, structural, measure (the command, structural knobs)}; `structural` lists those.
 nlohmann::json weigh_knobs(const WeighInputs& in);
 
 /// The relaxed config: `config` with every `key=to` of `knobs` set (validated); throws rtsim::Error.

@@ -75,8 +75,12 @@ def test_check_verdict_measures_the_top_knobs(hairball: Path, sim: Sim, tmp_path
         for assignment in c["sets"]:
             key, value = assignment.split("=")
             section, field = key.split(".")
-            assert str(resolved[section][field]) == value
+            got = resolved[section][field]
+            assert (json.dumps(got) if isinstance(got, bool) else str(got)) == value
         assert c["measured"] == pytest.approx(run["summary"]["rays_per_second"] / base)
+    # The best structural alternative a re-run can measure is among them (a switch flipped).
+    alts = [k for k in v["structural"] if not k["trace"]]
+    assert any(f"{k['key']}={json.dumps(k['to'])}" in c["sets"] for k in alts for c in checks)
     measured = [c["measured"] for c in checks]
     assert measured == sorted(measured, reverse=True)
     assert "re-run:" in v["text"] and "measured" in v["text"]
@@ -87,7 +91,7 @@ def test_roofline_has_mshr_ceilings_by_littles_law(
 ) -> None:  # fmt: skip
     stats = run_stats(sim, hairball, tmp_path / "run", "l2.mshrs=4")
     roof = stats["roofline"]
-    assert {"l1_mshrs", "l2_mshrs", "l2_bandwidth"} <= set(roof["ceilings"])
+    assert {"l1_mshrs", "l2_mshrs", "l2_banks"} <= set(roof["ceilings"])
     l2 = roof["mshr_little"]["l2"]
     # Little's law: MSHRs x line bytes / mean hold time is the level's miss bandwidth bound.
     assert l2["bytes_per_second"] == pytest.approx(4 * 64 / l2["mean_hold_cycles"] * 1e9)

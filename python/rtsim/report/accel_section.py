@@ -11,7 +11,7 @@ from typing import Any
 
 import yaml
 
-from rtsim.report.data import Group, SweepData, key_active, mrays
+from rtsim.report.data import Group, SweepData, mrays
 from rtsim.sweep.spec import ACCEL_KEY
 from rtsim.sweep.store import RunRecord
 
@@ -68,15 +68,9 @@ def trace_manifest(data: SweepData, rec: RunRecord) -> dict[str, Any]:
 
 
 def at_baseline(data: SweepData, runs: list[RunRecord]) -> RunRecord | None:
-    """The run at the baseline value of every swept key but `accel` (inactive keys ignored)."""
-    for r in runs:
-        if all(
-            r.params.get(k) == v or not key_active(k, r.config)
-            for k, v in data.baseline.items()
-            if k != ACCEL_KEY and k in r.params
-        ):
-            return r
-    return None
+    """The run at the baseline value of every swept key but `accel` (data.baseline_run: a run
+    of another spec in the same store is read by its own config, never taken for this one's)."""
+    return data.baseline_run(runs, skip=(ACCEL_KEY,))
 
 
 def axis_order(data: SweepData) -> list[str]:
@@ -139,13 +133,12 @@ def accel_section(data: SweepData, table: Any) -> list[str]:
     """The section's HTML parts (empty without an accel axis); table renders header and rows."""
     if not has_accel_axis(data):
         return []
-    others = [k for k in data.keys if k != ACCEL_KEY]
-    point = ", ".join(f"{k} = {data.baseline.get(k)}" for k in others) or "the only point"
     parts = [
         "<h2>Acceleration structures</h2>",
         "<p>Each structure of the sweep's <code>accel</code> axis at the baseline point of the "
-        f"other swept keys ({escape(point)}). Footprint, node bytes, SAH cost and work per ray "
-        "(every ray kind of the trace) come from the trace's manifest; Mrays/s, DRAM bytes per "
+        "other swept keys (each table names the configuration its rows ran). Footprint, node "
+        "bytes, SAH cost and work per ray (every ray kind of the trace) come from the trace's "
+        "manifest; Mrays/s, DRAM bytes per "
         "ray and hit rates from the simulation; <em>vs first</em> is the speed over the axis's "
         "first structure. Mismatches (hit + work) must be 0. docs/accel.md explains the "
         "structures.</p>",
@@ -155,6 +148,11 @@ def accel_section(data: SweepData, table: Any) -> list[str]:
         if not rows:
             continue
         parts.append(f"<h3>{escape(group.title)}</h3>")
+        # The configuration the rows really ran, from the runs themselves (not the spec's point:
+        # in a store holding two specs it named one spec while the rows were the other's).
+        others = [k for k in data.keys if k != ACCEL_KEY]
+        point = " · ".join(dict.fromkeys(data.label(r.run, others) for r in rows))
+        parts.append(f"<p class='muted'>at {escape(point or 'the only point')}</p>")
         numeric = set(range(1, len(HEADER)))
         parts.append(table(HEADER, [_cells(r, rows[0]) for r in rows], numeric))
     return parts

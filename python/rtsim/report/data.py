@@ -39,6 +39,19 @@ def key_active(key: str, config: dict[str, Any]) -> bool:
     return not key_inactive(key, flatten(config) if config else {})
 
 
+def param(rec: RunRecord, key: str) -> Any:
+    """A run's value of a swept key: its own swept value, else (a run of another spec in the
+    same store, which did not sweep the key) its structure, preset or config value."""
+    if key in rec.params:
+        return rec.params[key]
+    if key == "accel":
+        return rec.accel
+    if key == "preset":
+        return rec.preset
+    flat = flatten(rec.config) if rec.config else {}
+    return flat.get(key)
+
+
 def is_categorical(values: list[Any]) -> bool:
     """Switches and named choices (treelets on/off, a preset name), not numbers."""
     return bool(values) and all(isinstance(v, (bool, str)) for v in values)
@@ -91,30 +104,42 @@ class SweepData:
     # The spec's baseline point (swept key -> value) the report's speed-ups are measured against.
     baseline: dict[str, Any] = field(default_factory=dict)
 
-    def label(self, rec: RunRecord) -> str:
+    def label(self, rec: RunRecord, keys: list[str] | None = None) -> str:
+        """The run's values of the swept keys (or of `keys`), short."""
         text = " · ".join(
-            short_label(k, rec.params[k])
-            for k in self.keys
-            if k in rec.params and key_active(k, rec.config)
+            short_label(k, v)
+            for k in (self.keys if keys is None else keys)
+            if (v := param(rec, k)) is not None and key_active(k, rec.config)
         )
         return text or rec.preset
 
     def values(self, key: str) -> list[Any]:
-        """The distinct values of a swept key over the runs, in first-seen order."""
-        return list(dict.fromkeys(r.params[key] for r in self.runs if key in r.params))
+        """The distinct values of a swept key over the runs, in first-seen order (a run of
+        another spec that did not sweep it has its config's value)."""
+        vals = (param(r, key) for r in self.runs)
+        return list(dict.fromkeys(v for v in vals if v is not None))
 
     def categorical_keys(self) -> list[str]:
         return [k for k in self.keys if is_categorical(self.values(k))]
 
-    def baseline_run(self, runs: list[RunRecord]) -> RunRecord | None:
-        """The run among `runs` at the baseline point (inactive keys ignored), if there is one."""
-        for r in runs:
-            if all(
-                r.params.get(k) == v or not key_active(k, r.config)
-                for k, v in self.baseline.items()
-                if k in r.params
-            ):
-                return r
+    def baseline_run(self, runs: list[RunRecord], skip: tuple[str, ...] = ()) -> RunRecord | None:
+        """The run among `runs` at the baseline point (keys in `skip` aside), if there is one: a
+        run whose every baseline key is active and equal first; else one that differs only in
+        keys its config leaves inactive (a ray-buffer size with treelets off). A run's value of a
+        key its spec did not sweep is its config's, so a store holding two specs never takes
+        one spec's run for the other's baseline."""
+        wanted = {k: v for k, v in self.baseline.items() if k not in skip}
+
+        def matches(r: RunRecord, lenient: bool) -> bool:
+            return all(
+                param(r, k) == v or (lenient and not key_active(k, r.config))
+                for k, v in wanted.items()
+            )
+
+        for lenient in (False, True):
+            for r in runs:
+                if matches(r, lenient):
+                    return r
         return None
 
     def groups(self) -> list[Group]:
@@ -133,23 +158,44 @@ def spec_baseline(spec_text: str, runs: list[RunRecord], keys: list[str]) -> dic
     """The spec's `baseline` over the first value of each grid key; without a spec (or for keys
     it does not list), each key's first value in the runs."""
     try:
-        doc = yaml.safe_load(spec_text) if spec_text else {}
+        docs = (
+            [d for d in yaml.safe_load_all(spec_text) if isinstance(d, dict)] if spec_text else []
+        )
     except yaml.YAMLError:
-        doc = {}
-    doc = doc if isinstance(doc, dict) else {}
-    grid = doc.get("grid") if isinstance(doc.get("grid"), dict) else {}
-    named = doc.get("baseline") if isinstance(doc.get("baseline"), dict) else {}
+        docs = []
     out: dict[str, Any] = {}
+    # A store holding several specs: the first spec's point, over the keys it sweeps. Keys only
+    # another spec sweeps are left out (their runs differ in the first spec's keys anyway), so
+    # the baseline is one real run of one spec, never a mix no run has.
+    several = len(docs) > 1
+    docs = docs[:1]
     for k in keys:
-        if k in named:
-            out[k] = named[k]
-        elif isinstance(grid.get(k), list) and grid[k]:
-            out[k] = grid[k][0]
-        else:
+        for doc in docs:
+            grid = doc.get("grid") if isinstance(doc.get("grid"), dict) else {}
+            named = doc.get("baseline") if isinstance(doc.get("baseline"), dict) else {}
+            if k in named:
+                out[k] = named[k]
+            elif isinstance(grid.get(k), list) and grid[k]:
+                out[k] = grid[k][0]
+            elif k == "accel" and isinstance(doc.get("accel"), list) and doc["accel"]:
+                first = doc["accel"][0]
+                out[k] = _accel_label(first)
+            else:
+                continue
+            break
+        if k not in out and not several:
             first = next((r.params[k] for r in runs if k in r.params), None)
             if first is not None:
                 out[k] = first
     return out
+
+
+def _accel_label(entry: Any) -> str:
+    """An accel axis entry's label, as the sweep labels it (sweep/accel_axis.py)."""
+    if isinstance(entry, dict):
+        kind, builder = entry.get("kind"), entry.get("builder")
+        return str(entry.get("label") or (f"{kind}:{builder}" if builder else kind))
+    return str(entry).strip()
 
 
 def load(sweep: Path) -> SweepData:

@@ -23,6 +23,7 @@ from rtsim.report.data import (
     axis_label,
     key_active,
     mrays,
+    param,
     pareto_front,
     short_label,
 )
@@ -104,7 +105,15 @@ def _line_colors(n: int) -> list[Any]:
 def _breakdown_clusters(data: SweepData, g: Group) -> list[tuple[str, dict[str, float]]]:
     """The group's runs merged where their breakdown agrees within 1%: (label, bytes by kind)."""
     clusters: list[tuple[list[RunRecord], dict[str, float]]] = []
-    for r in sorted(g.ok, key=lambda r: sum(bytes_per_ray_by_kind(r).values())):
+    # The baseline is its own bar, never folded into another configuration's "(+N alike)".
+    base = data.baseline_run(g.ok)
+    out = (
+        []
+        if base is None
+        else [(f"{g.title}: {data.label(base)} (baseline)", bytes_per_ray_by_kind(base))]
+    )
+    rest = [r for r in g.ok if r is not base]
+    for r in sorted(rest, key=lambda r: sum(bytes_per_ray_by_kind(r).values())):
         kinds = bytes_per_ray_by_kind(r)
         for runs, ref in clusters:
             tol = 0.01 * max(sum(ref.values()), 1e-9)
@@ -113,9 +122,8 @@ def _breakdown_clusters(data: SweepData, g: Group) -> list[tuple[str, dict[str, 
                 break
         else:
             clusters.append(([r], kinds))
-    out = []
-    for runs, kinds in clusters[:MAX_BARS]:
-        if len(runs) == len(g.ok) and len(runs) > 1:
+    for runs, kinds in clusters[: MAX_BARS - len(out)]:
+        if len(runs) == len(rest) and len(runs) > 1 and base is None:
             label = f"all {len(runs)} configurations"
         else:
             label = data.label(runs[0]) + (f" (+{len(runs) - 1} alike)" if len(runs) > 1 else "")
@@ -211,7 +219,9 @@ def _categories(data: SweepData, key: str, runs: list[RunRecord]) -> dict[str, l
     out: dict[str, list[RunRecord]] = {}
     for r in runs:
         name = " · ".join(
-            short_label(k, r.params[k]) for k in cats if k in r.params and key_active(k, r.config)
+            short_label(k, v)
+            for k in cats
+            if (v := param(r, k)) is not None and key_active(k, r.config)
         )
         out.setdefault(name, []).append(r)
     return out
@@ -227,7 +237,7 @@ def _versus_key(
 ) -> None:
     """metric against one swept key: a line per group and category (the other categorical keys)
     through the median over the other numeric keys, a band from min to max."""
-    values = sorted({r.params[key] for g in groups for r in g.ok if key in r.params}, key=str)
+    values = sorted({v for g in groups for r in g.ok if (v := param(r, key)) is not None}, key=str)
     numeric = _numeric(values)
     if numeric:
         values = sorted(values)
@@ -237,9 +247,9 @@ def _versus_key(
         for (cat, runs), ls in zip(cats.items(), LINE_STYLES * 4, strict=False):
             by_value: dict[Any, list[float]] = {}
             for r in runs:
-                m = metric(r)
-                if key in r.params and m is not None:
-                    by_value.setdefault(r.params[key], []).append(m)
+                m, v = metric(r), param(r, key)
+                if v is not None and m is not None:
+                    by_value.setdefault(v, []).append(m)
             vs = [v for v in values if v in by_value]
             if not vs:
                 continue
@@ -296,7 +306,7 @@ def _tick(v: Any) -> str:
 
 def rays_per_second(data: SweepData) -> Figure | None:
     groups = [g for g in data.groups() if g.ok]
-    keys = [k for k in data.keys if any(k in r.params for g in groups for r in g.ok)]
+    keys = [k for k in data.keys if any(param(r, k) is not None for g in groups for r in g.ok)]
     if not groups or not keys:
         return None
     scenes = list(dict.fromkeys(g.scene for g in groups))
@@ -312,12 +322,11 @@ def rays_per_second(data: SweepData) -> Figure | None:
             ax.set_ylabel("simulated Mrays/s")
             ax.set_ylim(bottom=0)
             ax.set_title(f"{scene}: rays/s against {key}", fontsize=11)
-    _fig_legend(fig)
     fig.suptitle(
-        "Performance against each swept key (line: median over the other keys; band: min to max)",
-        y=1.0,
+        "Performance against each swept key (line: median over the other keys; band: min to max)"
     )
-    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.tight_layout()
+    _fig_legend(fig)
     return fig
 
 
@@ -332,11 +341,13 @@ def _fig_legend(fig: Figure) -> None:
                 names.append(n)
     if not names:
         return
+    # Below every panel: above them it ran into the panels' titles once it took two rows, and
+    # inside one it hides points. The report saves with bbox_inches="tight", which keeps it.
     fig.legend(
         handles,
         names,
         loc="upper center",
-        bbox_to_anchor=(0.5, 0.97),
+        bbox_to_anchor=(0.5, 0.0),
         ncol=min(len(names), 4),
         frameon=False,
     )
@@ -344,7 +355,7 @@ def _fig_legend(fig: Figure) -> None:
 
 def hit_rates(data: SweepData) -> Figure | None:
     groups = [g for g in data.groups() if g.ok]
-    keys = [k for k in data.keys if any(k in r.params for g in groups for r in g.ok)]
+    keys = [k for k in data.keys if any(param(r, k) is not None for g in groups for r in g.ok)]
     if not groups or not keys:
         return None
     fig, axes = plt.subplots(2, len(keys), figsize=(4.8 * len(keys), 7.4), squeeze=False)
@@ -360,9 +371,9 @@ def hit_rates(data: SweepData) -> Figure | None:
             ax.set_ylim(0, 102)
             ax.set_ylabel(f"{level.upper()} hit rate (%)")
             ax.set_title(f"{level.upper()} hit rate against {key}", fontsize=11)
+    fig.suptitle("Cache hit rates per level (reads served, including merged misses)")
+    fig.tight_layout()
     _fig_legend(fig)
-    fig.suptitle("Cache hit rates per level (reads served, including merged misses)", y=1.0)
-    fig.tight_layout(rect=(0, 0, 1, 0.94))
     return fig
 
 
@@ -414,9 +425,9 @@ def pareto(
         ax.set_ylabel("simulated Mrays/s")
         ax.set_ylim(bottom=0, top=max(mrays(r) for r in runs) * 1.15)
         ax.set_title(f"{g.title}  (numbers: table below)")
-        ax.legend(loc="lower right", fontsize=9)
     fig.suptitle(f"Performance against {cost.name}: the Pareto front (up and left is better)")
     fig.tight_layout()
+    _fig_legend(fig)
     return fig, fronts
 
 
@@ -522,8 +533,8 @@ def roofline(data: SweepData) -> Figure | None:
         ax.set_xlabel("DRAM bytes per ray")
         ax.set_ylabel("Mrays/s")
         ax.set_title(g.title)
-        ax.legend(loc="lower left", fontsize=8)
     fig.tight_layout()
+    _fig_legend(fig)  # below the panels: inside one it hid the runs at low bytes per ray
     return fig
 
 

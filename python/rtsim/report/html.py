@@ -104,6 +104,22 @@ def _overview(data: SweepData) -> str:
         ],
         ["store", escape(str((data.path / "results.sqlite").resolve()))],
     ]
+    small = [r for r in data.runs if r.summary.get("study_warnings")]
+    if small:
+        # A run too small to answer its question says so (stats `study_size`, docs/treelets.md).
+        items = "".join(
+            f"<li>{escape(data.label(r))} ({escape(r.scene)} / {escape(r.workload)}): "
+            f"{escape('; '.join(r.summary['study_warnings']))}</li>"
+            for r in small[:12]
+        )
+        more = f"<li>and {len(small) - 12} more</li>" if len(small) > 12 else ""
+        rows.append(
+            [
+                "<span class='bad'>too small</span>",
+                f"{len(small)} of {len(data.runs)} runs are too small to answer their question:"
+                f"<ul>{items}{more}</ul>",
+            ]
+        )
     spec = data.meta.get("spec", "")
     return _table(["", ""], rows) + (
         f"<details><summary>sweep spec</summary><pre>{escape(spec)}</pre></details>" if spec else ""
@@ -155,6 +171,15 @@ def _front_table(data: SweepData, fronts: dict[str, list[RunRecord]], cost: str)
 
 
 def _baseline_text(data: SweepData) -> str:
+    """The baseline the bars are over: each group's own baseline run, by its label (the spec's
+    point alone could name a run of another spec in a store holding two)."""
+    named = []
+    for g in data.groups():
+        base = data.baseline_run(g.ok)
+        if base is not None:
+            named.append(f"{g.title}: {data.label(base)}")
+    if named:
+        return escape("; ".join(dict.fromkeys(named)))
     if not data.baseline:
         return "the first configuration"
     return escape(" · ".join(short_label(k, v) for k, v in data.baseline.items()))
@@ -297,6 +322,25 @@ def _effects(data: SweepData) -> str:
     )
 
 
+def _agreement_cell(a: dict[str, Any]) -> str:
+    """The roofline's lowest ceiling and the analytic binding, in the verdict's names, and
+    whether the named knob relaxes each (stats `verdict.agreement`)."""
+    if not a:
+        return "-"
+
+    def mark(flag: Any) -> str:
+        return (
+            ""
+            if flag is None or not a.get("knob")
+            else (" (relaxed)" if flag else " (not relaxed)")
+        )
+
+    roof = a.get("roofline_bound")
+    parts = [f"{roof}{mark(a.get('roofline_relaxed'))}" if roof else "-"]
+    parts.append(f"{a.get('analytic_binding', '-')}{mark(a.get('analytic_relaxed'))}")
+    return " / ".join(parts)
+
+
 def _why_slow(data: SweepData) -> str:
     """Per scene and workload: how many configurations each resource binds, and every run's
     verdict (stats `verdict`: the bottleneck, its evidence, the knob to relax and its estimate)."""
@@ -321,16 +365,25 @@ def _why_slow(data: SweepData) -> str:
                 [
                     escape(data.label(r)),
                     f"{r.summary['rays_per_second'] / 1e6:,.2f}",
-                    escape(str(v.get("label", "-"))),
+                    escape(f"{v.get('label', '-')} ({v.get('binding', '?')})"),
                     escape(str((v.get("evidence") or {}).get("text", ""))),
                     escape(f"{relax.get('key')} {relax.get('from')} -> {relax.get('to')}")
                     if relax
                     else "-",
                     f"{speedup:.2f}x" if isinstance(speedup, (int, float)) else "-",
+                    escape(_agreement_cell(v.get("agreement") or {})),
                 ]
             )
         table = _table(
-            ["configuration", "Mrays/s", "bottleneck", "evidence", "relax", "estimated"],
+            [
+                "configuration",
+                "Mrays/s",
+                "bottleneck",
+                "its evidence",
+                "relax",
+                "estimated",
+                "roofline ceiling / analytic binding",
+            ],
             rows,
             numeric={1, 5},
         )

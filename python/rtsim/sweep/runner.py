@@ -24,6 +24,8 @@ from rtsim.sweep.store import ResultsStore, RunRecord, open_store
 from rtsim.sweep.tasks import SimTask, TraceTask, make_trace, run_sim, utc_now
 
 DEFAULT_TIMEOUT = 3600.0
+#: Between the specs of a store's `spec` meta (a YAML document separator).
+SPEC_SEPARATOR = "\n---\n"
 TRACE_TIMEOUT = 3600.0
 
 
@@ -154,12 +156,18 @@ def _run_locked(
     timeout = opts.timeout if opts.timeout is not None else (spec.timeout or DEFAULT_TIMEOUT)
     swept = list(dict.fromkeys(k for s in specs for k in s.swept_keys))
     with open_store(out) as store:
+        # A store may hold several specs' runs (docs/sweeps.md): keep every spec swept into it
+        # and every key they swept, so the report reads each run against its own spec.
+        before = store.meta()
+        texts = [t for t in before.get("spec", "").split(SPEC_SEPARATOR) if t.strip()]
+        texts += [s.text for s in specs if s.text not in texts]
+        old_keys = [k for k in before.get("swept_keys", "").split(",") if k]
         store.set_meta(
             {
                 "name": spec.name,
-                "spec": "\n---\n".join(s.text for s in specs),
+                "spec": SPEC_SEPARATOR.join(texts),
                 "rtsim_version": __version__,
-                "swept_keys": ",".join(swept),
+                "swept_keys": ",".join(dict.fromkeys([*old_keys, *swept])),
             }
         )
         if "created_utc" not in store.meta():

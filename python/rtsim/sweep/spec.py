@@ -465,11 +465,22 @@ class _Reader:
             out.append(point)
         return out
 
-    def baseline(self, doc: LineDict, grid: dict[str, list[Any]]) -> dict[str, Any]:
-        """The report's baseline point: each key swept by the grid, each value one of its grid's."""
+    def baseline(
+        self, doc: LineDict, grid: dict[str, list[Any]], accels: list[str] | None = None
+    ) -> dict[str, Any]:
+        """The report's baseline point: each key swept by the grid, each value one of its grid's;
+        `accel` names one of the accel axis's labels (docs/sweeps.md)."""
         b = self.mapping(doc, "baseline", "baseline")
         for key, value in b.items():
             path = f"baseline.{key}"
+            if key == ACCEL_KEY:
+                if accels is None:
+                    raise self.fail(b, key, path, "the spec has no accel axis")
+                if str(value) not in accels:
+                    raise self.fail(
+                        b, key, path, f"{value!r} is not one of the accel axis's {accels}"
+                    )
+                continue
             if key not in grid:
                 known = ", ".join(grid) or "(no grid)"
                 raise self.fail(b, key, path, f"not a grid key (grid keys: {known})")
@@ -587,7 +598,8 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
     if "timeout" in doc:
         spec.timeout = float(rd.number(doc, "timeout", "timeout", False, 0, above=True))
     if "baseline" in doc:
-        spec.baseline = rd.baseline(doc, spec.grid)
+        labels = [a.label for a in spec.accels] if spec.accels is not None else None
+        spec.baseline = rd.baseline(doc, spec.grid, labels)
     _check_runs(rd, doc, spec)
     return spec
 

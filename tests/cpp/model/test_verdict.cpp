@@ -7,6 +7,8 @@
 #include <set>
 
 #include "rtl_model/traversal/cycle_accounting.h"
+#include "sim/report/resources.h"
+#include "sim/report/technique_cost.h"
 #include "sim/report/verdict.h"
 
 namespace rtsim {
@@ -107,6 +109,100 @@ TEST(Verdict, KnobsArePricedByTheAreaModel) {
     }
     ASSERT_FALSE(w["top_per_mm2"].empty());
     EXPECT_EQ(w["top_per_mm2"][0]["key"], "l2.size_kib");
+}
+
+TEST(Verdict, StructuralAlternativesAreMeasuredAndPriced) {
+    SimConfig c;
+    c.traversal.ray_contexts = 16;
+    StructureTraits st;
+    st.kind = "bvh2";
+    st.can_compress_leaves = true;
+    st.trace = "t/trace.rtt";
+    std::map<std::string, Knob> by_key;
+    for (const Knob& k : structural_knobs(c, st)) by_key[k.relax.key + "=" + k.relax.to.dump()] = k;
+    for (const char* key : {"accel=\"bvh8\"", "accel=\"cwbvh8\"", "compressed_leaves=true", "treelets.enabled=true",
+                            "traversal.model=\"simt\"", "dispatch.sort=\"morton\"", "treelets.prefetch=true"})
+        EXPECT_TRUE(by_key.count(key)) << key;
+    const Knob& cw = by_key.at("accel=\"cwbvh8\"");
+    EXPECT_TRUE(cw.structural && cw.trace && !cw.estimable);
+    EXPECT_NE(measure_command(cw, st).find("--accel cwbvh8"), std::string::npos);
+    EXPECT_NE(measure_command(by_key.at("treelets.enabled=true"), st).find("--set treelets.enabled=true"),
+              std::string::npos);
+    // Compressed nodes have no further compressed step; two levels offer no structure.
+    st.kind = "cwbvh8";
+    for (const Knob& k : structural_knobs(c, st)) EXPECT_NE(k.relax.key, "accel");
+    // Priced: compressed leaves add their decoders, every alternative is never estimated.
+    st.kind = "bvh2";
+    const nlohmann::json w = weigh_knobs({c, nlohmann::json::array(), {}, 0, "", {}, {}, st});
+    bool leaves = false;
+    for (const nlohmann::json& k : w["structural"]) {
+        EXPECT_TRUE(k["speedup"].is_null());
+        if (k["key"] == "compressed_leaves") leaves = k["added_mm2"].get<double>() > 0;
+    }
+    EXPECT_TRUE(leaves);
+}
+
+TEST(Verdict, ANearTieGoesToTheKnobThatRemovesTraffic) {
+    SimConfig c;
+    c.traversal.ray_contexts = 16;
+    // More channels estimated 2 points ahead of twice the L2, which alone removes DRAM traffic.
+    auto cycles = [](const SimConfig& x) {
+        return 1000.0 / (x.dram.channels == 4 ? 1.16 : 1.0) / (x.l2.size_kib == 2048 ? 1.14 : 1.0);
+    };
+    auto bytes = [](const SimConfig& x) { return x.l2.size_kib == 2048 ? 850.0 : 1000.0; };
+    WeighInputs in{c, nlohmann::json::array(), cycles, cycles(c), "", {}};
+    in.dram_bytes = bytes;
+    const nlohmann::json w = weigh_knobs(in);
+    EXPECT_EQ(w["knobs"][0]["key"], "l2.size_kib");
+    EXPECT_TRUE(w["knobs"][0].contains("tie_break"));
+    EXPECT_NEAR(w["knobs"][0]["dram_saved_fraction"].get<double>(), 0.15, 1e-9);
+    EXPECT_EQ(w["knobs"][1]["key"], "dram.channels");
+    // Not a tie: channels 10 points ahead stay first.
+    auto far = [](const SimConfig& x) {
+        return 1000.0 / (x.dram.channels == 4 ? 1.25 : 1.0) / (x.l2.size_kib == 2048 ? 1.14 : 1.0);
+    };
+    WeighInputs in2{c, nlohmann::json::array(), far, far(c), "", {}};
+    in2.dram_bytes = bytes;
+    EXPECT_EQ(weigh_knobs(in2)["knobs"][0]["key"], "dram.channels");
+}
+
+TEST(Verdict, TechniquesAddAreaOnlyWhenOn) {
+    SimConfig c;
+    c.traversal.ray_contexts = 16;
+    const TechniqueArea plain = technique_area(c, nlohmann::json::array());
+    EXPECT_EQ(plain.logic_mm2.count("context_scheduler"), 1u);  // MIMD's scheduler over its contexts
+    for (const char* b : {"node_decoder", "leaf_decoder", "simt_control", "sort_stage", "prefetcher"})
+        EXPECT_EQ(plain.logic_mm2.count(b), 0u) << b;
+    const nlohmann::json built = structure_blocks("cwbvh8", "", true);
+    const TechniqueArea quant = technique_area(c, built);
+    EXPECT_GT(quant.logic_mm2.at("node_decoder"), 0.0);
+    EXPECT_GT(quant.sram_bytes.at("leaf_decoder"), 0.0);
+    c.traversal.model = "simt";
+    c.dispatch.sort = RaySort::morton;
+    c.treelets.prefetch = true;
+    const TechniqueArea more = technique_area(c, nlohmann::json::array());
+    EXPECT_GT(more.logic_mm2.at("simt_control"), 0.0);
+    EXPECT_EQ(more.logic_mm2.count("context_scheduler"), 0u);
+    EXPECT_GT(more.logic_mm2.at("sort_stage"), 0.0);
+    EXPECT_GT(more.logic_mm2.at("prefetcher"), 0.0);
+    // More warps cost more scheduler; more contexts cost a MIMD unit more.
+    SimConfig wide = c;
+    wide.traversal.ray_contexts = 64;
+    EXPECT_GT(technique_area(wide, nlohmann::json::array()).logic_mm2.at("simt_control"), more.logic_mm2.at("simt_control"));
+}
+
+TEST(Verdict, KnobsSayWhichResourcesTheyRelax) {
+    SimConfig c;
+    const auto has = [](const std::vector<std::string>& v, const char* x) {
+        return std::find(v.begin(), v.end(), x) != v.end();
+    };
+    EXPECT_TRUE(has(knob_relaxes(c, "traversal.units"), "l1_mshrs"));
+    EXPECT_TRUE(has(knob_relaxes(c, "traversal.units"), "latency"));
+    EXPECT_FALSE(has(knob_relaxes(c, "traversal.units"), "dram"));
+    EXPECT_TRUE(has(knob_relaxes(c, "l2.size_kib"), "dram"));  // the traffic it removes
+    EXPECT_TRUE(has(knob_relaxes(c, "box.width"), "box"));
+    EXPECT_EQ(resource_label("l2_banks"), "L2 banks");
+    EXPECT_EQ(resource_label("box"), "box pipelines");
 }
 
 TEST(CycleAccounting, AReadsWaitIsSplitMshrsFirstThenItsLevel) {
