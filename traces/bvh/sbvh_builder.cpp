@@ -49,7 +49,7 @@ void SbvhBuilder::process(Item& item) {
     // Near max_depth only median splits (or leaves) are made, as in the binned builder.
     const bool deep = item.depth + 8 >= m_c.max_depth;
     const Aabb box = m_tree.nodes[item.node].box;
-    Candidate best = deep ? Candidate{} : object_split(item.refs);
+    Candidate best = deep || !m_s.object_splits ? Candidate{} : object_split(item.refs);
     // Spatial splits only where the object split leaves the children overlapping (section 4.5).
     const bool overlapping = best.kind == Candidate::none ||
                              (m_root_area > 0 && overlap(best.left, best.right).half_area() > m_s.alpha * m_root_area);
@@ -68,7 +68,7 @@ void SbvhBuilder::process(Item& item) {
     } else if (best.kind == Candidate::spatial) {
         // The spatial split did not hold up (a side empty or too deep): the best object split.
         left.clear(), right.clear();
-        const Candidate object = object_split(item.refs);
+        const Candidate object = m_s.object_splits ? object_split(item.refs) : Candidate{};
         if (object.kind == Candidate::object && apply_object(item, object, &left, &right)) {
             ++m_stats.object_splits;
         } else {
