@@ -9,7 +9,7 @@
 #include "traces/common/error.h"
 
 namespace rtsim {
-namespace {
+namespace sweep_detail {
 
 /// The traversal stack's size (kTraversalStackSize): deeper trees could overflow it.
 constexpr uint32_t kMaxSupportedDepth = 64;
@@ -159,16 +159,16 @@ void validate(const std::vector<Triangle>& triangles, const BuildConfig& c) {
                                      std::to_string(triangles.size()) + " triangles (needs " + std::to_string(need) + ")");
 }
 
-}  // namespace
+}  // namespace sweep_detail
 
 BuildTree build_sweep_sah(const std::vector<Triangle>& triangles, const BuildConfig& config) {
-    validate(triangles, config);
-    return ObjectBuilder(triangles, config, true).build();
+    sweep_detail::validate(triangles, config);
+    return sweep_detail::ObjectBuilder(triangles, config, true).build();
 }
 
 BuildTree build_median(const std::vector<Triangle>& triangles, const BuildConfig& config) {
-    validate(triangles, config);
-    return ObjectBuilder(triangles, config, false).build();
+    sweep_detail::validate(triangles, config);
+    return sweep_detail::ObjectBuilder(triangles, config, false).build();
 }
 
 }  // namespace rtsim

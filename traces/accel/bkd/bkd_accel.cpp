@@ -13,7 +13,7 @@
 
 namespace rtsim {
 
-namespace {
+namespace bkd_detail {
 
 /// Child `side`'s cell: its parent's cut to the child's interval on the node's axis.
 Aabb child_cell(Aabb cell, const BkdNode& n, int side) {
@@ -22,7 +22,9 @@ Aabb child_cell(Aabb cell, const BkdNode& n, int side) {
     return cell;
 }
 
-}  // namespace
+}  // namespace bkd_detail
+
+using bkd_detail::child_cell;
 
 uint32_t validate_bkd(const BkdView& v, const std::string& source) {
     // Messages are built only on failure: this pass runs over every node of every trace opened.

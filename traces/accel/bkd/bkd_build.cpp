@@ -11,7 +11,7 @@
 #include "traces/scene/scene.h"
 
 namespace rtsim {
-namespace {
+namespace bkd_detail {
 
 double half_area(const Aabb& b) {
     const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
@@ -25,7 +25,7 @@ Aabb cut(Aabb cell, int axis, float lo, float hi) {
     return cell;
 }
 
-}  // namespace
+}  // namespace bkd_detail
 
 BkdTree bkd_from_build_tree(const BuildTree& tree) {
     require(tree.nodes.size() <= BkdNode::kMaxIndex && tree.prim_ids.size() <= BkdNode::kMaxIndex,
@@ -57,8 +57,8 @@ BkdTree bkd_from_build_tree(const BuildTree& tree) {
         double best = std::numeric_limits<double>::infinity();
         int axis = 0;
         for (int a = 0; a < 3; ++a) {
-            const double cost = half_area(cut(cell[i], a, b0.lo[a], b0.hi[a])) * refs[n.first] +
-                                half_area(cut(cell[i], a, b1.lo[a], b1.hi[a])) * refs[n.first + 1];
+            const double cost = bkd_detail::half_area(bkd_detail::cut(cell[i], a, b0.lo[a], b0.hi[a])) * refs[n.first] +
+                                bkd_detail::half_area(bkd_detail::cut(cell[i], a, b1.lo[a], b1.hi[a])) * refs[n.first + 1];
             if (cost < best) best = cost, axis = a;
         }
         // The child lower on the axis first: the stepper's near child for rays running up it.
@@ -68,8 +68,8 @@ BkdTree bkd_from_build_tree(const BuildTree& tree) {
         t.nodes[slot[i]] = BkdNode::interior(axis, n.first, lb.lo[axis], lb.hi[axis], rb.lo[axis], rb.hi[axis]);
         slot[l] = n.first;
         slot[r] = n.first + 1;
-        cell[l] = cut(cell[i], axis, lb.lo[axis], lb.hi[axis]);
-        cell[r] = cut(cell[i], axis, rb.lo[axis], rb.hi[axis]);
+        cell[l] = bkd_detail::cut(cell[i], axis, lb.lo[axis], lb.hi[axis]);
+        cell[r] = bkd_detail::cut(cell[i], axis, rb.lo[axis], rb.hi[axis]);
     }
     return t;
 }
@@ -91,21 +91,21 @@ AccelImage bkd_image(const BkdTree& tree, const Scene& scene, const std::string&
     std::vector<Aabb> cell(tree.nodes.size());
     std::vector<uint32_t> depth(tree.nodes.size(), 0);
     cell[0] = tree.bounds;
-    const double root = std::max(half_area(tree.bounds), 1e-300);
+    const double root = std::max(bkd_detail::half_area(tree.bounds), 1e-300);
     double sah = 0.0;
     uint64_t leaves = 0, max_leaf = 0, deepest = 0;
     for (size_t i = 0; i < tree.nodes.size(); ++i) {
         const BkdNode& n = tree.nodes[i];
         deepest = std::max<uint64_t>(deepest, depth[i]);
         if (n.leaf()) {
-            sah += half_area(cell[i]) / root * n.count();
+            sah += bkd_detail::half_area(cell[i]) / root * n.count();
             leaves += 1;
             max_leaf = std::max<uint64_t>(max_leaf, n.count());
             continue;
         }
-        sah += half_area(cell[i]) / root;
+        sah += bkd_detail::half_area(cell[i]) / root;
         for (int side = 0; side < 2; ++side) {
-            cell[n.left() + side] = cut(cell[i], n.axis(), n.bound(side, 0), n.bound(side, 1));
+            cell[n.left() + side] = bkd_detail::cut(cell[i], n.axis(), n.bound(side, 0), n.bound(side, 1));
             depth[n.left() + side] = depth[i] + 1;
         }
     }

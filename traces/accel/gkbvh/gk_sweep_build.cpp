@@ -12,7 +12,7 @@
 #include "traces/common/error.h"
 
 namespace rtsim {
-namespace {
+namespace gk_detail {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 /// The traversal stack's size (kTraversalStackSize): deeper trees could overflow it.
@@ -211,14 +211,14 @@ private:
     std::vector<float> m_planes;
 };
 
-}  // namespace
+}  // namespace gk_detail
 
 BuildTree build_gk_boxes(const std::vector<Triangle>& triangles, const BuildConfig& config, const GkConfig& gk,
                          GkStats* stats) {
     require(!triangles.empty(), "scene has no triangles");
     require(config.max_leaf_size >= 1, "BuildConfig.max_leaf_size must be at least 1");
-    require(config.max_depth >= 1 && config.max_depth <= kMaxSupportedDepth,
-            "BuildConfig.max_depth must be in 1.." + std::to_string(kMaxSupportedDepth));
+    require(config.max_depth >= 1 && config.max_depth <= gk_detail::kMaxSupportedDepth,
+            "BuildConfig.max_depth must be in 1.." + std::to_string(gk_detail::kMaxSupportedDepth));
     require(config.traversal_cost >= 0.0f && config.intersection_cost > 0.0f,
             "BuildConfig.traversal_cost must be >= 0 and intersection_cost > 0");
     require(gk.reference_budget >= 0.0f && gk.reference_budget <= 16.0f, "GkConfig.reference_budget must be in [0, 16]");
@@ -226,7 +226,7 @@ BuildTree build_gk_boxes(const std::vector<Triangle>& triangles, const BuildConf
     const uint32_t need = median_levels_needed(uint32_t(triangles.size()), config.max_leaf_size);
     require(need <= config.max_depth, "BuildConfig.max_depth = " + std::to_string(config.max_depth) + " cannot hold " +
                                           std::to_string(triangles.size()) + " triangles");
-    return GkSweepBuilder(triangles, config, gk).build(stats);
+    return gk_detail::GkSweepBuilder(triangles, config, gk).build(stats);
 }
 
 }  // namespace rtsim
