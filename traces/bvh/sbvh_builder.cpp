@@ -61,6 +61,9 @@ void SbvhBuilder::process(Item& item) {
     const float leaf_cost = m_c.intersection_cost * float(n);
     const float split_cost = node_area > 0 ? m_c.traversal_cost + m_c.intersection_cost * best.cost / node_area : kInf;
     if (n <= m_c.max_leaf_size && (best.kind == Candidate::none || !(split_cost < leaf_cost))) return make_leaf(item);
+    // Space subdivision alone (object_splits off): a split the SAH does not pay for, forced by the
+    // leaf size, is an object median, which duplicates nothing.
+    if (!m_s.object_splits && !(split_cost < leaf_cost)) best = Candidate{};
 
     std::vector<Ref> left, right;
     if (best.kind == Candidate::spatial && apply_spatial(item, best, &left, &right)) {

@@ -83,7 +83,9 @@ private:
         const float split_cost = area > 0 ? m_c.traversal_cost + m_c.intersection_cost * best.cost / area : kInf;
         if (n <= m_c.max_leaf_size && (best.axis < 0 || !(split_cost < leaf_cost))) return make_leaf(item);
         std::vector<Ref> left, right;
-        if (best.axis >= 0 && apply(item, best, &left, &right)) {
+        // A plane only where the SAH pays for it; a split forced by the leaf size is an object
+        // median, which duplicates nothing.
+        if (best.axis >= 0 && split_cost < leaf_cost && apply(item, best, &left, &right)) {
             ++m_stats.spatial_splits;
         } else {
             left.clear(), right.clear();
