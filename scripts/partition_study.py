@@ -55,7 +55,8 @@ WORK = ("steps", "box_tests", "plane_tests", "tri_tests", "refs")
 
 def trace(scene: str, accel: str, workload: str, args: argparse.Namespace) -> Path:
     # Instanced scenes flattened: the space-partitioning structures have no two-level form.
-    return accel_study.trace(scene, accel, workload, args, extra=("--flatten",))
+    lights = ("--lights", args.lights) if args.lights != "none" else ()
+    return accel_study.trace(scene, accel, workload, args, extra=("--flatten", *lights))
 
 
 def simulate(folder: Path, tag: str, sets: list[str], args: argparse.Namespace) -> dict[str, Any]:
@@ -215,7 +216,9 @@ def tables(results: dict[str, Any], args: argparse.Namespace) -> str:
     command = (
         f"python scripts/partition_study.py --resolution {args.resolution} --repeats "
         f"{args.repeats} --mailbox {args.mailbox} --scenes {','.join(args.scenes)} "
-        f"--accels {','.join(args.accels)}"
+        f"--accels {','.join(args.accels)} --workloads {','.join(args.workloads)}"
+        + (f" --lights {args.lights}" if args.lights != "none" else "")
+        + (f" --doc-marker {args.doc_marker}" if args.doc_marker != "partition-study" else "")
     )
     return "\n".join(
         [
@@ -256,10 +259,21 @@ def main() -> int:
         "--frame-rays", default="1e6,8e6", type=lambda s: [float(x) for x in s.split(",")]
     )
     p.add_argument("--sim-timeout", type=float, default=1800.0, help="seconds per simulation")
+    p.add_argument(
+        "--lights",
+        choices=("none", "sun"),
+        default="none",
+        help="lights added to scenes without any (rtsim trace --lights), so shadow rays exist",
+    )
+    p.add_argument(
+        "--doc-marker",
+        default="partition-study",
+        help="the docs/accel.md markers the tables go between (another comparison's section)",
+    )
     args = p.parse_args()
     if "bvh2" not in args.accels:
         args.accels.insert(0, "bvh2")  # the reference every structure is compared with
-    run_and_write(args, study, tables, "partition-study")
+    run_and_write(args, study, tables, args.doc_marker)
     return 0
 
 

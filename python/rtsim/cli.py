@@ -82,6 +82,7 @@ class TraceJob:
     build_settings: dict[str, Any] | None = None  # --build-set overrides
     flatten: bool | None = None  # instanced scenes: one world-space structure instead of two levels
     frames: int | None = None  # animated frames of an instanced scene (docs/accel.md, "Frames")
+    lights: str | None = None  # lights added to a scene without any (none, sun)
 
 
 def parse_workload(text: str) -> list[str]:
@@ -192,6 +193,7 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             build_settings=job.build_settings,
             flatten=job.flatten,
             frames=job.frames,
+            lights=job.lights,
         )
     trace = open_trace(job.out_dir)
     width, height = manifest["workload"]["resolution"]
@@ -224,6 +226,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         build_settings=dict(args.build_set) if args.build_set else None,
         flatten=args.flatten or None,
         frames=args.frames,
+        lights=args.lights,
     )
     run_trace(job, console)
     return 0
@@ -410,6 +413,13 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         "--build-set max_leaf_size=2 (repeatable; each structure's and builder's settings, "
         "defaults and ranges: docs/accel.md, Builder settings); recorded in the manifest's "
         "accel.build_settings",
+    )
+    p.add_argument(
+        "--lights",
+        choices=("none", "sun"),
+        default=None,
+        help="lights added to a scene without any: sun (a directional light, so shadow rays "
+        "are traced; the manifest lists it) or none (default)",
     )
     p.add_argument(
         "--flatten",

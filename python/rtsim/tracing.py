@@ -155,6 +155,7 @@ def trace_scene(
     flatten: bool | None = None,
     frames: int | None = None,
     build_settings: dict[str, Any] | None = None,
+    lights: str | None = None,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. Every option left None takes the tracer's default
@@ -169,7 +170,9 @@ def trace_scene(
     frames > 1
     animates an instanced scene by the documented motion (docs/accel.md, "Frames"): the BLASes
     are built once, a TLAS per frame, and the workload is traced once per frame;
-    manifest["frames"] lists each frame's rays and TLAS build time."""
+    manifest["frames"] lists each frame's rays and TLAS build time. lights="sun" adds a
+    directional light to a scene without lights (so it gets shadow rays; the manifest's
+    workload.lights_added says what was added)."""
     from rtsim import _core
 
     checks: dict[str, Callable[[Any], Any]] = {
@@ -186,12 +189,13 @@ def trace_scene(
         "flatten": lambda v: bool_arg(v, "flatten"),
         "frames": lambda v: int_arg(v, "frames", 1, MAX_FRAMES),
         "build_settings": _settings_arg,
+        "lights": _lights_arg,
     }
     values = {
         "workload": workload, "width": width, "height": height, "bounces": bounces, "seed": seed,
         "camera": camera, "threads": threads, "hairball_triangles": hairball_triangles,
         "accel": accel, "builder": builder, "flatten": flatten, "frames": frames,
-        "build_settings": build_settings,
+        "build_settings": build_settings, "lights": lights,
     }  # fmt: skip
     # Only the options given are passed: the others take the tracer's defaults (trace_defaults).
     given = {k: checks[k](v) for k, v in values.items() if v is not None}
@@ -207,6 +211,16 @@ def trace_scene(
     return _core.trace_scene(
         _scene_arg(scene), path_arg(out_dir, "out_dir"), progress=progress, **given
     )
+
+
+#: The choices of lights= (traces/raygen/added_lights.h).
+ADDED_LIGHTS = ("none", "sun")
+
+
+def _lights_arg(lights: str) -> str:
+    if lights not in ADDED_LIGHTS:
+        raise ArgumentValueError(f"lights: {lights!r} is not one of {', '.join(ADDED_LIGHTS)}")
+    return lights
 
 
 def _settings_arg(settings: dict[str, Any] | None) -> dict[str, Any] | None:

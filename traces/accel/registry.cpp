@@ -8,9 +8,11 @@
 
 #include "traces/accel/accel.h"
 #include "traces/accel/bih/bih.h"
+#include "traces/accel/bkd/bkd.h"
 #include "traces/accel/build_settings.h"
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/accel/cwbvh/cwbvh.h"
+#include "traces/accel/gkbvh/gkbvh.h"
 #include "traces/accel/grid/grid.h"
 #include "traces/accel/kdtree/kdtree.h"
 #include "traces/accel/leaf_blocks.h"
@@ -21,6 +23,7 @@
 #include "traces/bvh/builder.h"
 #include "traces/bvh/lbvh_builder.h"
 #include "traces/bvh/sbvh_builder.h"
+#include "traces/bvh/sweep_builder.h"
 #include "traces/common/error.h"
 #include "traces/common/stopwatch.h"
 #include "traces/scene/scene.h"
@@ -38,6 +41,7 @@ struct BuildSettings {
     KdConfig kd;
     BihConfig bih;
     OctreeConfig octree;
+    GkConfig gk;
     LeafConfig leaves;  ///< every kind's leaf layout (plain or compressed)
 };
 
@@ -97,6 +101,11 @@ const std::vector<TreeBuilder>& tree_builders() {
         {"binned", build_binned, [](BuildSettings&, SettingsVisitor&) {}, true},
         {"sbvh", build_spatial_splits, [](BuildSettings& s, SettingsVisitor& v) { s.sbvh.visit(v); }, true},
         {"lbvh", build_morton, [](BuildSettings& s, SettingsVisitor& v) { s.lbvh.visit(v); }, false},
+        // Full sweeping-plane SAH and equal-count (median) splits (sweep_builder.h): no bins.
+        {"sweep", [](const Scene& sc, const BuildSettings& s, unsigned, nlohmann::json*) { return build_sweep_sah(sc.triangles, s.bvh); },
+         [](BuildSettings&, SettingsVisitor&) {}, false},
+        {"median", [](const Scene& sc, const BuildSettings& s, unsigned, nlohmann::json*) { return build_median(sc.triangles, s.bvh); },
+         [](BuildSettings&, SettingsVisitor&) {}, false},
     };
     return b;
 }
@@ -202,7 +211,7 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
          loader<KdAccel>()},
         {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
-          {"binned", "wachter_keller", "lbvh"}, single_level(kBihStackEntryBytes).with(&AccelCapabilities::restart_trail)},
+          {"binned", "wachter_keller", "lbvh", "sweep", "median"}, single_level(kBihStackEntryBytes).with(&AccelCapabilities::restart_trail)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              if (builder == "wachter_keller") s.bih.visit(v);
              else tree_settings(builder, s, v);
@@ -213,6 +222,25 @@ const std::vector<Entry>& registry() {
              return bih_image(bih_from_build_tree(build_tree(scene, o, s, &unused)), scene, o.builder);
          },
          loader<BihAccel>()},
+        {{"gkbvh", "GK-BVH: a binary BVH by space subdivision alone, straddlers referenced on both sides (Popov et al. 2009)",
+          {"clipped", "boxes"}, single_level(kBvhStackEntryBytes)
+                                    .with(&AccelCapabilities::packet_kernel)
+                                    .with(&AccelCapabilities::restart_trail)
+                                    .with(&AccelCapabilities::reduced_precision_boxes)},
+         [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
+             s.bvh.visit(v, false);
+             s.gk.visit(v, builder == "clipped");
+         },
+         [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) { return gkbvh_image(scene, o.builder, s.bvh, s.gk); },
+         loader<Bvh2Accel>()},
+        {{"bkd", "B-Kd tree: two intervals per 20-byte node on one axis, no duplicates (Woop et al. 2006)",
+          tree_builder_names(), single_level(kBkdStackEntryBytes)},
+         tree_settings,
+         [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
+             nlohmann::json unused;
+             return bkd_image(bkd_from_build_tree(build_tree(scene, o, s, &unused)), scene, o.builder);
+         },
+         loader<BkdAccel>()},
         {{"octree", "adaptive octree, 16-byte nodes, parametric traversal (Revelles et al. 2000)", {"adaptive"},
           single_level(kOctStackEntryBytes).with(&AccelCapabilities::mailbox)},
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.octree.visit(v); },

@@ -49,7 +49,7 @@ void SbvhBuilder::process(Item& item) {
     // Near max_depth only median splits (or leaves) are made, as in the binned builder.
     const bool deep = item.depth + 8 >= m_c.max_depth;
     const Aabb box = m_tree.nodes[item.node].box;
-    Candidate best = deep ? Candidate{} : object_split(item.refs);
+    Candidate best = deep || !m_s.object_splits ? Candidate{} : object_split(item.refs);
     // Spatial splits only where the object split leaves the children overlapping (section 4.5).
     const bool overlapping = best.kind == Candidate::none ||
                              (m_root_area > 0 && overlap(best.left, best.right).half_area() > m_s.alpha * m_root_area);
@@ -61,6 +61,9 @@ void SbvhBuilder::process(Item& item) {
     const float leaf_cost = m_c.intersection_cost * float(n);
     const float split_cost = node_area > 0 ? m_c.traversal_cost + m_c.intersection_cost * best.cost / node_area : kInf;
     if (n <= m_c.max_leaf_size && (best.kind == Candidate::none || !(split_cost < leaf_cost))) return make_leaf(item);
+    // Space subdivision alone (object_splits off): a split the SAH does not pay for, forced by the
+    // leaf size, is an object median, which duplicates nothing.
+    if (!m_s.object_splits && !(split_cost < leaf_cost)) best = Candidate{};
 
     std::vector<Ref> left, right;
     if (best.kind == Candidate::spatial && apply_spatial(item, best, &left, &right)) {
@@ -68,7 +71,7 @@ void SbvhBuilder::process(Item& item) {
     } else if (best.kind == Candidate::spatial) {
         // The spatial split did not hold up (a side empty or too deep): the best object split.
         left.clear(), right.clear();
-        const Candidate object = object_split(item.refs);
+        const Candidate object = m_s.object_splits ? object_split(item.refs) : Candidate{};
         if (object.kind == Candidate::object && apply_object(item, object, &left, &right)) {
             ++m_stats.object_splits;
         } else {

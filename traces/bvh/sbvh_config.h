@@ -26,6 +26,11 @@ struct SbvhConfig {
     /// reference goes whole to one side when that is cheaper by the SAH than duplicating it.
     /// Costs one SAH evaluation per straddling reference; saves references and usually SAH cost.
     bool unsplit = true;
+    /// Object splits compete with spatial ones (Stich et al.). False: every split cuts space, as
+    /// in the GK-BVH with clipped triangles (Popov et al. 2009, traces/accel/gkbvh); object
+    /// median splits remain the fallback where no spatial split makes progress or depth runs out.
+    /// Not a command-line setting of the sbvh builder: the gkbvh structure sets it.
+    bool object_splits = true;
 
     /// The settings as data (traces/accel/build_settings.h).
     template <class V>

@@ -10,6 +10,7 @@
 #include "traces/common/error.h"
 #include "traces/common/files.h"
 #include "traces/common/stopwatch.h"
+#include "traces/raygen/added_lights.h"
 #include "traces/raygen/auto_framing.h"
 #include "traces/raygen/camera.h"
 #include "traces/scene/gltf_loader.h"
@@ -109,6 +110,7 @@ void validate(const TraceOptions& o) {
         require(c.eye != c.target, "camera eye " + vec_text(c.eye) + " equals the target: no view direction");
     }
     validate_accel_options(o.accel);
+    require(known_added_lights(o.lights), "lights: unknown choice '" + o.lights + "' (choose none or sun)");
     require(o.frames >= 1 && o.frames <= kMaxFrames,
             "frames " + std::to_string(o.frames) + " is out of range (1.." + std::to_string(kMaxFrames) + ")");
 }
@@ -141,6 +143,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     // Kept as instances: flattened only for a single-level structure (so an instanced scene too
     // large to flatten still traces two-level).
     Scene scene = load_gltf(path, false);
+    const json lights_added = add_lights(scene, o.lights);
     AccelOptions accel_options = o.accel;
     accel_options.two_level = !o.flatten && shares_geometry(scene);
     // The build may use the tracing threads too: its image does not depend on their number.
@@ -158,6 +161,9 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     else animated.image = build_accel(scene, accel_options);
     const std::unique_ptr<Accel> accel = load_accel(std::move(animated.image), path + ": built " + o.accel.kind);
     WorkloadPlan plan = plan_workload(scene, o.workload);
+    if (!lights_added["added"].empty())
+        for (Effect& e : plan.effects)
+            if (e.name == "shadow") e.why += " (added by --lights " + o.lights + ")";
     if (accel_options.two_level) mark_instancing_simulated(plan, accel->image());
     std::string camera_source;
     Camera camera = choose_camera(o, scene, *accel, &camera_source);
@@ -206,7 +212,8 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
           {"resolution", {o.width, o.height}},
           {"bounces", o.bounces},
           {"seed", o.seed},
-          {"effects", effects_json(plan)}}},
+          {"effects", effects_json(plan)},
+          {"lights_added", lights_added}}},
         {"files", {{"render", "render.png"}}},
     };
     if (o.frames > 1) {

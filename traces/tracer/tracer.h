@@ -48,6 +48,9 @@ struct TraceOptions {
     /// (traces/scene/scene_motion.h), the BLASes are built once, a TLAS per frame, and the
     /// workload is traced once per frame. Needs an instanced scene traced two-level (not --flatten).
     uint32_t frames = 1;
+    /// Lights added to a scene without any (traces/raygen/added_lights.h): "none" or "sun" (a
+    /// directional light, so the scene's traces hold shadow rays; the manifest says so).
+    std::string lights = "none";
 
     /// The options a caller chooses, each with its name and meaning (scene and out_dir aside):
     /// the Python bindings read the defaults and apply keyword arguments through this, so every
@@ -67,6 +70,7 @@ struct TraceOptions {
         v("hairball_triangles", procedural.hairball_triangles, "triangles of the built-in hairball");
         v("threads", threads, "tracing threads, 0 for all cores (the trace is the same for any)");
         v("frames", frames, "animated frames of an instanced scene");
+        v("lights", lights, "lights added to a scene without any: none or sun (the manifest lists them)");
     }
 };
 

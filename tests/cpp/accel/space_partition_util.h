@@ -13,9 +13,12 @@
 
 namespace rtsim::test {
 
-/// The structures this tests sweep: KIND or KIND:BUILDER.
+/// The structures these tests sweep: KIND or KIND:BUILDER.
 inline const std::vector<std::string>& partition_kinds() {
-    static const std::vector<std::string> kinds = {"kdtree", "bih", "bih:wachter_keller", "bih:lbvh", "octree", "bvh2:lbvh"};
+    static const std::vector<std::string> kinds = {"kdtree",      "bih",          "bih:wachter_keller", "bih:lbvh",
+                                                   "octree",      "bvh2:lbvh",    "bvh2:sweep",         "bvh2:median",
+                                                   "bkd",         "bkd:sweep",    "bkd:median",         "gkbvh",
+                                                   "gkbvh:boxes", "bih:sweep"};
     return kinds;
 }
 

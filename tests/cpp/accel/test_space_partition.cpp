@@ -8,6 +8,7 @@
 
 #include "space_partition_util.h"
 #include "traces/accel/bih/bih.h"
+#include "traces/accel/bkd/bkd.h"
 #include "traces/accel/kdtree/kdtree.h"
 #include "traces/accel/octree/octree.h"
 #include "traces/bvh/builder.h"
@@ -103,6 +104,12 @@ std::vector<std::pair<int, float>> split_planes(const Accel& a) {
             const BihNode& n = bih->view().nodes[i];
             if (!n.leaf()) planes.insert(planes.end(), {{n.axis(), n.clip(0)}, {n.axis(), n.clip(1)}});
         }
+    } else if (const auto* bkd = dynamic_cast<const BkdAccel*>(&a)) {
+        for (uint64_t i = 0; i < bkd->view().node_count; ++i) {
+            const BkdNode& n = bkd->view().nodes[i];
+            if (!n.leaf())
+                for (int p = 0; p < 4; ++p) planes.push_back({n.axis(), n.bound(p / 2, p % 2)});
+        }
     } else if (const auto* oct = dynamic_cast<const OctreeAccel*>(&a)) {
         for (uint64_t i = 0; i < oct->view().node_count; ++i)
             if (!oct->view().nodes[i].leaf())
@@ -115,7 +122,7 @@ TEST(SpacePartitionHardCases, RaysInTheStructuresOwnPlanes) {
     for (const char* scene_name : {"soup", "cornell", "rotated_walls"}) {
         const Scene soup = test::random_soup(8, 800);
         const Scene& scene = std::string(scene_name) == "soup" ? soup : test::procedural(scene_name);
-        for (const char* name : {"kdtree", "bih", "bih:wachter_keller", "octree"}) {
+        for (const char* name : {"kdtree", "bih", "bih:wachter_keller", "octree", "bkd", "bkd:median"}) {
             const auto a = build_named(scene, name);
             const std::vector<std::pair<int, float>> planes = split_planes(*a);
             ASSERT_FALSE(planes.empty()) << name;
