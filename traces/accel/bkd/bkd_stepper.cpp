@@ -44,6 +44,10 @@ void BkdStepper::visit(uint32_t node, const detail::SlabInterval& cell) {
     m_node = node;
     m_cell = cell;
     m_phase = Phase::node;
+    plan_node(node);
+}
+
+void BkdStepper::plan_node(uint32_t node) {
     m_plan.reset(node);
     m_plan.add_fetch(m_view.node_base + uint64_t(node) * sizeof(BkdNode), sizeof(BkdNode), DataKind::node);
     if (!m_view.nodes[node].leaf()) m_plan.add_op(OpKind::plane, 4);

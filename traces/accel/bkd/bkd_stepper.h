@@ -35,6 +35,9 @@ struct BkdView {
 class BkdStepper final : public BinaryCellStepper<BkdStepper, kBkdMaxDepth> {
 public:
     static constexpr const char* kName = "B-Kd tree";
+    /// The cell stepper's restart path needs these; B-Kd trees offer no restart trail (their
+    /// capabilities do not declare one), so the resolution step never lets a restart happen.
+    static constexpr bool kPushDown = false;
 
     explicit BkdStepper(const BkdView& view) : m_view(view) {}
 
@@ -45,6 +48,7 @@ private:
     friend class BinaryCellStepper<BkdStepper, kBkdMaxDepth>;
     enum class Phase : uint8_t { clip, node, leaf };
     void visit(uint32_t node, const detail::SlabInterval& cell);
+    void plan_node(uint32_t node);
     void interior(const BkdNode& node);
     uint32_t leaf();  ///< returns the alpha tests run
 
