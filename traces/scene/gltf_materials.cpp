@@ -45,8 +45,10 @@ void read_texture_slots(const Source& src, const tinygltf::Material& gm, Materia
         t.width = im.width > 0 ? uint32_t(im.width) : 0;
         t.height = im.height > 0 ? uint32_t(im.height) : 0;
     }
+    // Value::Get(key) asserts on a non-object, and a material without extras has a null one.
+    if (!gm.extras.IsObject()) return;
     const tinygltf::Value& stripped = gm.extras.Get("strippedTextures");
-    if (gm.extras.IsObject() && stripped.IsArray())
+    if (stripped.IsArray())
         for (size_t i = 0; i < stripped.ArrayLen(); ++i) {
             if (!stripped.Get(int(i)).IsString()) continue;
             const std::string entry = stripped.Get(int(i)).Get<std::string>();
@@ -55,7 +57,7 @@ void read_texture_slots(const Source& src, const tinygltf::Material& gm, Materia
                 if (slot == names[s] && m.textures[s].source == MaterialTexture::Source::none)
                     m.textures[s].source = MaterialTexture::Source::stripped;
         }
-    if (gm.extras.IsObject() && gm.extras.Has("factorsBakedFromKhronosTextureMeans"))
+    if (gm.extras.Has("factorsBakedFromKhronosTextureMeans"))
         m.textures_baked = gm.extras.Get("factorsBakedFromKhronosTextureMeans").IsBool() &&
                            gm.extras.Get("factorsBakedFromKhronosTextureMeans").Get<bool>();
 }
