@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "traces/accel/bih/bih.h"
+#include "traces/accel/cell_tree_invariants.h"
 #include "traces/accel/leaf_coverage.h"
 #include "traces/accel/spatial_params.h"
 #include "traces/common/error.h"
@@ -50,31 +51,13 @@ uint32_t validate_bih(const BihView& v, const std::string& source) {
 
 void check_bih_invariants(const BihView& v, const Scene& scene) {
     auto fail = [](const std::string& what) { throw Error("BIH invariant: " + what); };
-    std::vector<uint8_t> seen(scene.triangles.size(), 0);
-    for (uint64_t k = 0; k < v.triangle_count; ++k) {
-        const uint32_t prim = v.triangles[k].prim;
-        if (prim >= seen.size() || seen[prim]++) fail("triangle records are not a permutation of the scene's");
-        const HwTriangle want = make_hw_triangle(scene, prim);
-        if (std::memcmp(&want, &v.triangles[k], sizeof want) != 0) fail("record " + std::to_string(k) + " is not the scene's");
-    }
-    // Every triangle lies in its leaf's cell: the root box cut by its ancestors' clip planes.
-    std::vector<Aabb> cell(v.node_count);
-    cell[0] = v.bounds;
-    for (uint64_t i = 0; i < v.node_count; ++i) {
-        const BihNode& n = v.nodes[i];
-        if (n.leaf()) {
-            for (uint32_t k = n.first(); k < n.first() + n.count(); ++k) {
-                Aabb box;
-                const HwTriangle& t = v.triangles[k];
-                for (const float* p : {t.v0, t.v1, t.v2}) box.grow(Vec3(p[0], p[1], p[2]));
-                if (!cell[i].contains(box)) fail("triangle record " + std::to_string(k) + " lies outside the cell of leaf " + std::to_string(i));
-            }
-            continue;
-        }
-        cell[n.left()] = cell[n.left() + 1] = cell[i];
-        cell[n.left()].hi[n.axis()] = std::min(cell[i].hi[n.axis()], n.clip(0));
-        cell[n.left() + 1].lo[n.axis()] = std::max(cell[i].lo[n.axis()], n.clip(1));
-    }
+    // A child's cell: the parent's cut at its clip plane.
+    auto cut = [](const BihNode& n, const Aabb& parent, Aabb& left, Aabb& right) {
+        left = right = parent;
+        left.hi[n.axis()] = std::min(parent.hi[n.axis()], n.clip(0));
+        right.lo[n.axis()] = std::max(parent.lo[n.axis()], n.clip(1));
+    };
+    check_cell_tree_invariants(v.nodes, v.node_count, v.triangles, v.triangle_count, v.bounds, scene, cut, fail);
 }
 
 BihAccel::BihAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "traces/accel/bkd/bkd.h"
+#include "traces/accel/cell_tree_invariants.h"
 #include "traces/accel/leaf_coverage.h"
 #include "traces/accel/spatial_params.h"
 #include "traces/common/error.h"
@@ -62,29 +63,12 @@ uint32_t validate_bkd(const BkdView& v, const std::string& source) {
 
 void check_bkd_invariants(const BkdView& v, const Scene& scene) {
     auto fail = [](const std::string& what) { throw Error("B-Kd invariant: " + what); };
-    std::vector<uint8_t> seen(scene.triangles.size(), 0);
-    for (uint64_t k = 0; k < v.triangle_count; ++k) {
-        const uint32_t prim = v.triangles[k].prim;
-        if (prim >= seen.size() || seen[prim]++) fail("triangle records are not a permutation of the scene's");
-        const HwTriangle want = make_hw_triangle(scene, prim);
-        if (std::memcmp(&want, &v.triangles[k], sizeof want) != 0) fail("record " + std::to_string(k) + " is not the scene's");
-    }
-    // Every triangle lies in its leaf's cell: the root box cut by its ancestors' intervals.
-    std::vector<Aabb> cell(v.node_count);
-    cell[0] = v.bounds;
-    for (uint64_t i = 0; i < v.node_count; ++i) {
-        const BkdNode& n = v.nodes[i];
-        if (n.leaf()) {
-            for (uint32_t k = n.first(); k < n.first() + n.count(); ++k) {
-                Aabb box;
-                const HwTriangle& t = v.triangles[k];
-                for (const float* p : {t.v0, t.v1, t.v2}) box.grow(Vec3(p[0], p[1], p[2]));
-                if (!cell[i].contains(box)) fail("triangle record " + std::to_string(k) + " lies outside the cell of leaf " + std::to_string(i));
-            }
-            continue;
-        }
-        for (int side = 0; side < 2; ++side) cell[n.left() + side] = child_cell(cell[i], n, side);
-    }
+    // A child's cell: the parent's cut to the child's interval.
+    auto cut = [](const BkdNode& n, const Aabb& parent, Aabb& left, Aabb& right) {
+        left = child_cell(parent, n, 0);
+        right = child_cell(parent, n, 1);
+    };
+    check_cell_tree_invariants(v.nodes, v.node_count, v.triangles, v.triangle_count, v.bounds, scene, cut, fail);
 }
 
 BkdAccel::BkdAccel(AccelImage image, const std::string& source) : Accel(std::move(image)) {
