@@ -14,6 +14,7 @@ import pytest
 
 from rtsim.accuracy_grid import (
     GridRow,
+    by_point_markdown,
     compare,
     kendall_tau,
     largest_misordered_gap,
@@ -106,3 +107,24 @@ def test_figure_with_more_traces_than_markers(tmp_path: Path) -> None:
         rows[-1].trace = rows[-2].trace = f"trace{t}"
     plot_grid(rows, tmp_path / "grid.png")
     assert (tmp_path / "grid.png").stat().st_size > 0
+
+
+def test_by_point_table_groups_errors_by_named_point() -> None:
+    # A spec with named points: each level's rows grouped by the point's label, over its traces.
+    rows = [
+        GridRow(
+            "t1", "dram.bytes_per_cycle=8 point=simt8 traversal.model=simt", "analytic", error=0.04
+        ),
+        GridRow(
+            "t2",
+            "dram.bytes_per_cycle=16 point=simt8 traversal.model=simt",
+            "analytic",
+            error=-0.02,
+        ),
+        GridRow("t1", "dram.bytes_per_cycle=8 point=mimd", "analytic", error=-0.10),
+        GridRow("t1", "dram.bytes_per_cycle=8 point=mimd", "detailed", error=0.0),
+    ]
+    lines = by_point_markdown(rows).splitlines()
+    assert len(lines) == 4  # header, rule, simt8, mimd: the reference level is left out
+    assert lines[2].startswith("| analytic | simt8 | 2 | +1.0% | -2.0% / +4.0% | 4.0% |")
+    assert lines[3].startswith("| analytic | mimd | 1 | -10.0%")
