@@ -10,12 +10,14 @@
 // triangle lists first). The primitive id of a triangle is instance.prim_base + its index in
 // the mesh, so ids run 0..N-1 over the whole scene and `triangles()` is indexed by them.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "traces/common/aabb.h"
+#include "traces/scene/mesh_animation.h"
 
 namespace rtsim {
 
@@ -131,6 +133,8 @@ struct Scene {
     std::vector<Light> lights;
     std::vector<Camera> cameras;
     std::vector<std::string> warnings;  ///< non-fatal oddities (ignored extensions, ...)
+    /// Meshes that deform over frames (skins, morph targets, procedural motion), or null.
+    std::shared_ptr<const MeshAnimation> animation;
 
     // Flattened world space, indexed by primitive id (filled by flatten()).
     std::vector<Triangle> triangles;
