@@ -23,6 +23,18 @@
 namespace rtsim {
 
 struct Scene;
+struct BuildTree;
+
+/// A build's binary tree kept or reused across frames of moving geometry (docs/accel.md,
+/// "Moving scenes"; traces/bvh/refit.h).
+struct TreeReuse {
+    /// When set, no builder runs: the binary tree is this one refitted to the scene's triangles
+    /// (kinds whose capabilities() offer refit; others refuse).
+    std::shared_ptr<const BuildTree> refit_from;
+    /// The binary tree the build made or refitted (the next frame's topology); null for kinds
+    /// built without one.
+    std::shared_ptr<const BuildTree> built;
+};
 
 /// Bytes of a BVH's traversal stack entry in hardware: a node reference and its entry distance.
 constexpr uint32_t kBvhStackEntryBytes = 8;
@@ -99,6 +111,9 @@ struct AccelOptions {
     /// Threads the build may use where its builder can ("binned": the binary build tree). The
     /// image is the same, byte for byte, for any count; 1 builds on the calling thread only.
     unsigned build_threads = 1;
+    /// Moving geometry: the tree to refit and where the built tree goes (null: build afresh,
+    /// keep nothing).
+    TreeReuse* tree_reuse = nullptr;
 };
 
 struct AccelKindInfo {

@@ -25,6 +25,9 @@ struct AccelCapabilities {
     bool blas = false;
     /// It partitions itself into treelets or cell blocks (Accel::partition): treelet scheduling.
     bool treelet_partition = true;
+    /// It is built from a binary build tree that can be refitted to moved geometry (refit.h):
+    /// --frame-policy refit and adaptive.
+    bool refit = false;
     /// Bytes of one traversal stack entry (Accel::stack_entry_bytes; 0: no stack).
     uint32_t stack_entry_bytes = 8;
 
@@ -44,6 +47,7 @@ struct AccelCapabilities {
                 {"compressed_leaves", compressed_leaves},
                 {"blas", blas},
                 {"treelet_partition", treelet_partition},
+                {"refit", refit},
                 {"stack_entry_bytes", stack_entry_bytes}};
     }
 };

@@ -22,6 +22,7 @@
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/builder.h"
 #include "traces/bvh/lbvh_builder.h"
+#include "traces/bvh/refit.h"
 #include "traces/bvh/sbvh_builder.h"
 #include "traces/bvh/sweep_builder.h"
 #include "traces/common/error.h"
@@ -131,8 +132,13 @@ void tree_settings(const std::string& builder, BuildSettings& s, SettingsVisitor
 
 /// The binary build tree of the chosen builder (on o.build_threads); what the builder reports
 /// beyond the tree's own statistics goes to `stats`.
+/// With o.tree_reuse: its refit_from refitted instead of a build, and the tree kept in its built.
 BuildTree build_tree(const Scene& scene, const AccelOptions& o, const BuildSettings& s, nlohmann::json* stats) {
-    return tree_builder(o.builder).build(scene, s, o.build_threads, stats);
+    TreeReuse* reuse = o.tree_reuse;
+    BuildTree tree = reuse && reuse->refit_from ? refit_build_tree(*reuse->refit_from, scene.triangles)
+                                                : tree_builder(o.builder).build(scene, s, o.build_threads, stats);
+    if (reuse) reuse->built = std::make_shared<const BuildTree>(tree);
+    return tree;
 }
 
 AccelImage build_bvh2(const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
@@ -171,7 +177,8 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
     const AccelCapabilities c = single_level(kBvhStackEntryBytes)
                                     .with(&AccelCapabilities::packet_kernel)
                                     .with(&AccelCapabilities::restart_trail)
-                                    .with(&AccelCapabilities::reduced_precision_boxes);
+                                    .with(&AccelCapabilities::reduced_precision_boxes)
+                                    .with(&AccelCapabilities::refit);
     return {{name, description, tree_builder_names(), c}, tree_settings, build, load};
 }
 
@@ -186,7 +193,8 @@ const std::vector<Entry>& registry() {
           single_level(kBvhStackEntryBytes)
               .with(&AccelCapabilities::packet_kernel)
               .with(&AccelCapabilities::restart_trail)
-              .with(&AccelCapabilities::reduced_precision_boxes)},
+              .with(&AccelCapabilities::reduced_precision_boxes)
+              .with(&AccelCapabilities::refit)},
          tree_settings, build_bvh2, loader<Bvh2Accel>()},
         wide_entry("bvh4", "4-wide BVH, 128-byte fp32 nodes, SAH-optimal collapse of the binary tree (docs/accel.md)", 4,
                    false, ChildOrder::distance),
@@ -211,7 +219,7 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
          loader<KdAccel>()},
         {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
-          {"binned", "wachter_keller", "lbvh", "sweep", "median"}, single_level(kBihStackEntryBytes).with(&AccelCapabilities::restart_trail)},
+          {"binned", "wachter_keller", "lbvh", "sweep", "median"}, single_level(kBihStackEntryBytes).with(&AccelCapabilities::restart_trail).with(&AccelCapabilities::refit)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              if (builder == "wachter_keller") s.bih.visit(v);
              else tree_settings(builder, s, v);
@@ -234,7 +242,7 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) { return gkbvh_image(scene, o.builder, s.bvh, s.gk); },
          loader<Bvh2Accel>()},
         {{"bkd", "B-Kd tree: two intervals per 20-byte node on one axis, no duplicates (Woop et al. 2006)",
-          tree_builder_names(), single_level(kBkdStackEntryBytes)},
+          tree_builder_names(), single_level(kBkdStackEntryBytes).with(&AccelCapabilities::refit)},
          tree_settings,
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
              nlohmann::json unused;
@@ -367,8 +375,15 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
     // its settings; the refusal names the scene file too. An allocation that still fails is
     // reported the same way, not as a bare std::bad_alloc.
     const std::string where = scene.source.empty() ? std::string("scene") : scene.source;
+    if (o.tree_reuse) o.tree_reuse->built.reset();  // set again by the build, if it makes a tree
     try {
-        return finish(e.build(scene, resolved, s));
+        AccelImage image = e.build(scene, resolved, s);
+        // A kind (or builder) that makes no binary tree cannot refit: refused, not rebuilt unseen.
+        require(!o.tree_reuse || !o.tree_reuse->refit_from || o.tree_reuse->built,
+                "accel " + o.kind + " (builder " + o.builder + ") is not built from a binary tree, so it cannot be "
+                "refitted to moved geometry; use --frame-policy rebuild, or a kind that refits (bvh2, bvh4-8, "
+                "cwbvh6/8, bih, bkd)");
+        return finish(std::move(image));
     } catch (const Error& err) {
         const std::string what = err.what();
         if (what.rfind(where, 0) == 0) throw;

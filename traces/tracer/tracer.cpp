@@ -113,6 +113,10 @@ void validate(const TraceOptions& o) {
     require(known_added_lights(o.lights), "lights: unknown choice '" + o.lights + "' (choose none or sun)");
     require(o.frames >= 1 && o.frames <= kMaxFrames,
             "frames " + std::to_string(o.frames) + " is out of range (1.." + std::to_string(kMaxFrames) + ")");
+    parse_frame_policy(o.frame_policy);  // refuses an unknown one, listing the choices
+    require(std::isfinite(o.rebuild_threshold) && o.rebuild_threshold >= 1.0,
+            "rebuild_threshold " + std::to_string(o.rebuild_threshold) + " must be at least 1 (a refitted tree's SAH "
+            "cost over its rebuilt cost)");
 }
 
 /// The instancing effect of a two-level trace: simulated (BLASes, TLAS, transform stage).
@@ -145,7 +149,9 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     Scene scene = load_gltf(path, false);
     const json lights_added = add_lights(scene, o.lights);
     AccelOptions accel_options = o.accel;
-    accel_options.two_level = !o.flatten && shares_geometry(scene);
+    // Deforming geometry is traced two-level too over frames: a BLAS per frame for what moves.
+    const bool deforming = o.frames > 1 && has_deforming_geometry(scene);
+    accel_options.two_level = !o.flatten && (shares_geometry(scene) || deforming);
     // The build may use the tracing threads too: its image does not depend on their number.
     accel_options.build_threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
     check_frames(o.frames, o.flatten, accel_options.two_level, path);
@@ -157,7 +163,8 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     report(0, 1, "accel");
     // Animated frames: BLASes once, a TLAS per frame (frames.h); else one structure.
     AnimatedImage animated;
-    if (o.frames > 1) animated = build_animated(scene, accel_options, o.frames);
+    const FramePolicyOptions policy{parse_frame_policy(o.frame_policy), o.rebuild_threshold};
+    if (o.frames > 1) animated = build_animated(scene, accel_options, o.frames, policy);
     else animated.image = build_accel(scene, accel_options);
     const std::unique_ptr<Accel> accel = load_accel(std::move(animated.image), path + ": built " + o.accel.kind);
     WorkloadPlan plan = plan_workload(scene, o.workload);
@@ -181,7 +188,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     for (uint32_t f = 0; f < o.frames; ++f) {
         // Frame f: the instances posed, its TLAS bound, the same camera, its own seed.
         if (o.frames > 1) {
-            pose_scene(scene, animated.motion, f);
+            pose_frame(scene, animated.motion, f);
             accel->bind_frame(f);
         }
         const std::string prefix = o.frames > 1 ? "frame " + std::to_string(f) + " " : "";
@@ -217,8 +224,8 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
         {"files", {{"render", "render.png"}}},
     };
     if (o.frames > 1) {
-        pose_scene(scene, animated.motion, 0);  // the manifest describes the rest pose
-        extra["frames"] = frames_json(accel->image(), animated.timing, first_ray, frame_rays);
+        pose_frame(scene, animated.motion, 0);  // the manifest describes frame 0
+        extra["frames"] = frames_json(accel->image(), animated.timing, first_ray, frame_rays, scene, policy);
     }
     SceneLabel label{procedural ? o.scene : fs::path(path).stem().string(), procedural};
     render.write_png((fs::path(o.out_dir) / "render.png").string());

@@ -45,9 +45,15 @@ struct TraceOptions {
     ProceduralOptions procedural;
     unsigned threads = 0;  ///< 0: all hardware threads. Output does not depend on it.
     /// Animated frames (docs/accel.md, "Frames"): the instances move by the documented motion
-    /// (traces/scene/scene_motion.h), the BLASes are built once, a TLAS per frame, and the
-    /// workload is traced once per frame. Needs an instanced scene traced two-level (not --flatten).
+    /// (traces/scene/scene_motion.h), deforming meshes take their animation's pose (a BLAS per
+    /// frame, built or refitted by frame_policy), a TLAS per frame, and the workload is traced
+    /// once per frame. Needs instancing or deforming geometry, traced two-level (not --flatten).
     uint32_t frames = 1;
+    /// Moving scenes (docs/accel.md, "Moving scenes"): how each frame's structures follow the
+    /// previous frame's (traces/accel/two_level/frame_policy.h): "rebuild", "refit", "adaptive".
+    std::string frame_policy = "rebuild";
+    /// adaptive: rebuild once a refitted tree's SAH cost exceeds this many times its rebuilt cost.
+    double rebuild_threshold = 1.25;
     /// Lights added to a scene without any (traces/raygen/added_lights.h): "none" or "sun" (a
     /// directional light, so the scene's traces hold shadow rays; the manifest says so).
     std::string lights = "none";
@@ -69,7 +75,9 @@ struct TraceOptions {
         v("flatten", flatten, "instanced scenes: one world-space structure instead of two levels");
         v("hairball_triangles", procedural.hairball_triangles, "triangles of the built-in hairball");
         v("threads", threads, "tracing threads, 0 for all cores (the trace is the same for any)");
-        v("frames", frames, "animated frames of an instanced scene");
+        v("frames", frames, "animated frames of an instanced or deforming scene");
+        v("frame_policy", frame_policy, "each frame's structures: rebuild, refit or adaptive (docs/accel.md, Moving scenes)");
+        v("rebuild_threshold", rebuild_threshold, "adaptive: rebuild once the refitted SAH cost exceeds this ratio");
         v("lights", lights, "lights added to a scene without any: none or sun (the manifest lists them)");
     }
 };

@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "accel_test_util.h"
+#include "structure_test_util.h"
 #include "traces/accel/two_level/two_level.h"
 #include "traces/scene/gltf_loader.h"
 #include "traces/scene/scene.h"

@@ -17,7 +17,9 @@
 
 #include "traces/accel/accel.h"
 #include "traces/accel/bvh2/bvh2_stepper.h"
+#include "traces/accel/two_level/frame_policy.h"
 #include "traces/accel/two_level/instance_record.h"
+#include "traces/scene/mesh_animation.h"
 
 namespace rtsim {
 
@@ -38,6 +40,7 @@ AccelImage build_two_level(const Scene& scene, const AccelOptions& options);
 struct TwoLevelTiming {
     double blas_ms = 0.0;         ///< every BLAS, built once
     std::vector<double> tlas_ms;  ///< each frame's TLAS and instance records
+    std::vector<double> blas_frame_ms;  ///< frames 1..N-1: the deforming meshes' BLASes
 };
 
 /// Animated frames (docs/accel.md, "Frames"): the BLASes built once, then a TLAS and instance
@@ -46,8 +49,18 @@ struct TwoLevelTiming {
 /// own addresses, like a driver writing a new top-level buffer); params "frames" lists each
 /// frame's slices [{"tlas_first", "tlas_count", "instances_first", "instances_count"}] when
 /// there is more than one. One pose is exactly build_two_level().
+/// Geometry that deforms over frames (docs/accel.md, "Moving scenes") and the policy its
+/// structures follow: each deforming mesh gets a BLAS per frame from animation->pose() (frames
+/// after the first appended to the BLAS regions), built or refitted by `policy`, which the
+/// TLAS follows too. Each frame's slice then carries "build": {"blas": [{"mesh", "blas",
+/// "action", "tree_nodes", "sah_cost", "sah_ratio", "triangles", "bytes"}], "tlas": {...}}.
+struct FrameGeometry {
+    const MeshAnimation* animation = nullptr;  ///< null: only instances move
+    FramePolicyOptions policy;
+};
 AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& options,
-                                  const std::vector<std::vector<glm::dmat4>>& poses, TwoLevelTiming* timing);
+                                  const std::vector<std::vector<glm::dmat4>>& poses, TwoLevelTiming* timing,
+                                  const FrameGeometry& geometry = {});
 
 class TwoLevelAccel final : public Accel {
 public:

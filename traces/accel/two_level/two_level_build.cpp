@@ -6,10 +6,12 @@
 #include <chrono>
 #include <limits>
 #include <numeric>
+#include <functional>
 #include <unordered_map>
 
 #include "traces/accel/two_level/two_level.h"
 #include "traces/bvh/build_tree.h"
+#include "traces/bvh/refit.h"
 #include "traces/common/error.h"
 #include "traces/common/stopwatch.h"
 #include "traces/scene/scene.h"
@@ -126,6 +128,23 @@ Scene box_scene(const std::vector<Aabb>& boxes) {
 
 namespace {
 
+/// For each mesh, the mesh whose BLAS it uses: geometry_classes(), except that a deforming mesh
+/// has a BLAS of its own (its vertices move each frame) and no other mesh shares it.
+std::vector<uint32_t> blas_classes(const Scene& scene, const std::vector<bool>& deforming) {
+    std::vector<uint32_t> cls = geometry_classes(scene);
+    std::vector<int64_t> moved(scene.meshes.size(), -1);  // a static class whose representative deforms
+    for (uint32_t m = 0; m < cls.size(); ++m) {
+        if (deforming[m]) {
+            cls[m] = m;
+            continue;
+        }
+        if (!deforming[cls[m]]) continue;
+        if (moved[cls[m]] < 0) moved[cls[m]] = m;
+        cls[m] = uint32_t(moved[cls[m]]);
+    }
+    return cls;
+}
+
 /// The BLASes of a scene: one per geometry some instance places, and which instances place one.
 struct BlasSet {
     std::vector<AccelImage> images;
@@ -133,10 +152,11 @@ struct BlasSet {
     std::vector<uint32_t> placed;        ///< instances with geometry, scene order
 };
 
-BlasSet build_blases(const Scene& scene, const AccelOptions& options) {
+/// `reuse_of(mesh)`: the tree reuse for a deforming mesh's build (null for static meshes).
+BlasSet build_blases(const Scene& scene, const AccelOptions& options, const std::vector<uint32_t>& cls,
+                     const std::function<TreeReuse*(uint32_t)>& reuse_of) {
     // Meshes without triangles are skipped; meshes of equal vertices and alpha tests share one
     // BLAS, whatever their materials.
-    const std::vector<uint32_t> cls = geometry_classes(scene);
     std::vector<int32_t> blas_of_class(scene.meshes.size(), -1);
     AccelOptions blas_options = options;
     blas_options.two_level = false;
@@ -148,6 +168,7 @@ BlasSet build_blases(const Scene& scene, const AccelOptions& options) {
         if (scene.meshes[mesh].triangle_count() == 0) continue;
         if (blas_of_class[cls[mesh]] < 0) {
             blas_of_class[cls[mesh]] = int32_t(set.images.size());
+            blas_options.tree_reuse = reuse_of(cls[mesh]);
             set.images.push_back(build_accel(mesh_scene(scene, cls[mesh]), blas_options));
         }
         set.blas_of_mesh[mesh] = uint32_t(blas_of_class[cls[mesh]]);
@@ -164,19 +185,26 @@ struct TlasFrame {
     Aabb bounds;
 };
 
-TlasFrame build_tlas(const Scene& scene, const BlasSet& blases, const std::vector<glm::dmat4>& pose,
-                     const AccelOptions& options) {
+/// `blas_of_mesh`: the frame's BLAS of each mesh; `reuse`: the TLAS's tree to refit and keep
+/// (frame_policy.h), or null to build afresh.
+TlasFrame build_tlas(const Scene& scene, const BlasSet& blases, const std::vector<uint32_t>& blas_of_mesh,
+                     const std::vector<glm::dmat4>& pose, const AccelOptions& options, TreeReuse* reuse) {
     TlasFrame out;
     std::vector<Aabb> boxes(blases.placed.size());
     for (size_t k = 0; k < blases.placed.size(); ++k) {
         const uint32_t id = blases.placed[k];
-        boxes[k] = world_box(blases.images[blases.blas_of_mesh[scene.instances[id].mesh]].bounds, pose[id]);
+        boxes[k] = world_box(blases.images[blas_of_mesh[scene.instances[id].mesh]].bounds, pose[id]);
         out.bounds.grow(boxes[k]);
     }
     BuildConfig tlas_config = options.build;
     tlas_config.max_leaf_size = 1;
     const Scene tlas_input = box_scene(boxes);
-    out.tlas = flatten_bvh(build_binned_sah(tlas_input.triangles, tlas_config), tlas_input, tlas_config);
+    // A box's "triangle" (lo, hi, centre) has the box as its bounds: a refit over them refits
+    // the TLAS to the instances' new boxes.
+    BuildTree tree = reuse && reuse->refit_from ? refit_build_tree(*reuse->refit_from, tlas_input.triangles)
+                                                : build_binned_sah(tlas_input.triangles, tlas_config);
+    out.tlas = flatten_bvh(tree, tlas_input, tlas_config);
+    if (reuse) reuse->built = std::make_shared<const BuildTree>(std::move(tree));
     out.records.resize(blases.placed.size());
     for (size_t k = 0; k < blases.placed.size(); ++k) {
         const uint32_t id = blases.placed[out.tlas.triangles[k].prim];
@@ -184,7 +212,7 @@ TlasFrame build_tlas(const Scene& scene, const BlasSet& blases, const std::vecto
         InstanceRecord& rec = out.records[k];
         store_affine_rows(glm::inverse(pose[id]), rec.world_to_object);
         store_affine_rows(pose[id], rec.object_to_world);
-        rec.blas = blases.blas_of_mesh[inst.mesh];
+        rec.blas = blas_of_mesh[inst.mesh];
         rec.prim_base = inst.prim_base;
         rec.instance = id;
     }
@@ -228,20 +256,79 @@ AccelImage build_two_level(const Scene& scene, const AccelOptions& options) {
 }
 
 AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& options,
-                                  const std::vector<std::vector<glm::dmat4>>& poses, TwoLevelTiming* timing) {
+                                  const std::vector<std::vector<glm::dmat4>>& poses, TwoLevelTiming* timing,
+                                  const FrameGeometry& geometry) {
     require(!poses.empty(), scene.source + ": no frame to build");
-    auto t0 = std::chrono::steady_clock::now();
-    const BlasSet blases = build_blases(scene, options);
-    if (timing) timing->blas_ms = ms_since(t0);
+    const MeshAnimation* animation = geometry.animation;
+    std::vector<bool> deforming(scene.meshes.size(), false);
+    for (uint32_t m = 0; animation && m < scene.meshes.size(); ++m)
+        deforming[m] = scene.meshes[m].triangle_count() > 0 && animation->deforms(m);
+    const std::vector<uint32_t> cls = blas_classes(scene, deforming);
+    // A deforming mesh's BLAS per frame, followed by the frame policy (frame_policy.h).
+    std::vector<std::unique_ptr<FrameTree>> blas_tree(scene.meshes.size());
+    for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+        if (deforming[m]) blas_tree[m] = std::make_unique<FrameTree>(geometry.policy);
+    FrameTree tlas_tree(geometry.policy);
+    std::vector<json> frame_build(poses.size(), json::object());
+    for (json& b : frame_build) b["blas"] = json::array();
 
-    // Every frame's TLAS over the same BLASes (a driver rebuilding the top level each frame).
+    // The mesh's positions in frame f (deforming meshes only): the scene posed.
+    auto posed = [&](uint32_t f) {
+        Scene s = scene;
+        for (uint32_t m = 0; m < s.meshes.size(); ++m)
+            if (deforming[m]) animation->pose(m, f, &s.meshes[m].positions);
+        return s;
+    };
+    // What a deforming BLAS's frame did: its action, tree, SAH cost and the bytes it wrote.
+    auto record_blas = [&](uint32_t f, uint32_t mesh, uint32_t blas, const AccelImage& img) {
+        json r = blas_tree[mesh]->done(f, options.build);
+        r["mesh"] = mesh;
+        r["blas"] = blas;
+        r["triangles"] = scene.meshes[mesh].triangle_count();
+        r["bytes"] = img.footprint_bytes();
+        frame_build[f]["blas"].push_back(r);
+    };
+
+    auto t0 = std::chrono::steady_clock::now();
+    const bool any_deforming = std::find(deforming.begin(), deforming.end(), true) != deforming.end();
+    BlasSet blases = build_blases(any_deforming ? posed(0) : scene, options, cls, [&](uint32_t m) {
+        return deforming[m] ? blas_tree[m]->reuse_for(0) : nullptr;
+    });
+    if (timing) timing->blas_ms = ms_since(t0);
+    std::vector<std::vector<uint32_t>> blas_of_mesh(poses.size(), blases.blas_of_mesh);
+    for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+        if (deforming[m]) record_blas(0, m, blases.blas_of_mesh[m], blases.images[blases.blas_of_mesh[m]]);
+
+    // Later frames: each deforming mesh's BLAS built or refitted from its frame's positions,
+    // at its own addresses (appended), like a driver writing the frame's acceleration structure.
+    AccelOptions blas_options = options;
+    blas_options.two_level = false;
+    for (uint32_t f = 1; f < poses.size() && any_deforming; ++f) {
+        t0 = std::chrono::steady_clock::now();
+        const Scene frame_scene = posed(f);
+        for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+            if (!deforming[m]) continue;
+            blas_options.tree_reuse = blas_tree[m]->reuse_for(f);
+            blases.images.push_back(build_accel(mesh_scene(frame_scene, m), blas_options));
+            blas_of_mesh[f][m] = uint32_t(blases.images.size() - 1);
+            record_blas(f, m, blas_of_mesh[f][m], blases.images.back());
+        }
+        if (timing) timing->blas_frame_ms.push_back(ms_since(t0));
+    }
+
+    // Every frame's TLAS over its BLASes (a driver rebuilding, or refitting, the top level).
     std::vector<TlasFrame> frames;
-    for (const std::vector<glm::dmat4>& pose : poses) {
+    for (uint32_t f = 0; f < poses.size(); ++f) {
+        const std::vector<glm::dmat4>& pose = poses[f];
         require(pose.size() == scene.instances.size(), scene.source + ": a frame poses " +
                                                            std::to_string(pose.size()) + " of " +
                                                            std::to_string(scene.instances.size()) + " instances");
         t0 = std::chrono::steady_clock::now();
-        frames.push_back(build_tlas(scene, blases, pose, options));
+        frames.push_back(build_tlas(scene, blases, blas_of_mesh[f], pose, options, tlas_tree.reuse_for(f)));
+        frame_build[f]["tlas"] = tlas_tree.done(f, options.build);
+        frame_build[f]["tlas"]["instances"] = frames.back().records.size();
+        frame_build[f]["tlas"]["bytes"] =
+            frames.back().tlas.nodes.size() * sizeof(HwNode) + frames.back().records.size() * sizeof(InstanceRecord);
         if (timing) timing->tlas_ms.push_back(ms_since(t0));
     }
 
@@ -251,9 +338,11 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
     image.bounds = frames[0].bounds;
     uint64_t node_total = 0, record_total = 0;
     json frame_list = json::array();
-    for (const TlasFrame& f : frames) {
+    for (size_t k = 0; k < frames.size(); ++k) {
+        const TlasFrame& f = frames[k];
         frame_list.push_back({{"tlas_first", node_total}, {"tlas_count", f.tlas.nodes.size()},
-                              {"instances_first", record_total}, {"instances_count", f.records.size()}});
+                              {"instances_first", record_total}, {"instances_count", f.records.size()},
+                              {"build", frame_build[k]}});
         node_total += f.tlas.nodes.size();
         record_total += f.records.size();
     }

@@ -23,6 +23,7 @@
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
 #include "traces/accel/short_stack.h"
+#include "traces/accel/step_options.h"
 #include "traces/accel/stepper.h"
 #include "traces/accel/two_level/instance_record.h"
 
