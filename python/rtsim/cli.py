@@ -82,6 +82,8 @@ class TraceJob:
     build_settings: dict[str, Any] | None = None  # --build-set overrides
     flatten: bool | None = None  # instanced scenes: one world-space structure instead of two levels
     frames: int | None = None  # animated frames of an instanced scene (docs/accel.md, "Frames")
+    frame_policy: str | None = None  # each frame's structures: rebuild, refit, adaptive
+    rebuild_threshold: float | None = None  # adaptive: the SAH ratio that triggers a rebuild
     lights: str | None = None  # lights added to a scene without any (none, sun)
 
 
@@ -193,6 +195,8 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             build_settings=job.build_settings,
             flatten=job.flatten,
             frames=job.frames,
+            frame_policy=job.frame_policy,
+            rebuild_threshold=job.rebuild_threshold,
             lights=job.lights,
         )
     trace = open_trace(job.out_dir)
@@ -226,6 +230,8 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         build_settings=dict(args.build_set) if args.build_set else None,
         flatten=args.flatten or None,
         frames=args.frames,
+        frame_policy=args.frame_policy,
+        rebuild_threshold=args.rebuild_threshold,
         lights=args.lights,
     )
     run_trace(job, console)
@@ -434,10 +440,33 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         action=LazyHelpStore,
         metavar="N",
         help_text=lambda: (
-            "animate an instanced scene over N frames: instances of shared geometry spin "
-            "about their up axis and bob (docs/accel.md, Frames); the BLASes are built once, "
-            "the TLAS rebuilt and the workload traced per frame; rtsim simulate replays the "
-            f"frames in order with caches warm (default: {tracer_default('frames')})"
+            "animate an instanced or deforming scene over N frames: instances of shared "
+            "geometry spin about their up axis and bob (docs/accel.md, Frames), skinned, "
+            "morphed and procedural meshes deform (Moving scenes); a deforming mesh's BLAS "
+            "and the TLAS follow --frame-policy and the workload is traced per frame; rtsim "
+            "simulate replays the frames in order with caches warm and prices each frame's "
+            f"build on the build unit (default: {tracer_default('frames')})"
+        ),
+    )
+    p.add_argument(
+        "--frame-policy",
+        choices=["rebuild", "refit", "adaptive"],
+        action=LazyHelpStore,
+        help_text=lambda: (
+            "with --frames: each frame's structures built afresh (rebuild), the first "
+            "frame's refitted to the moved geometry (refit), or refitted until the refitted "
+            "SAH cost exceeds --rebuild-threshold times the rebuilt one (adaptive) "
+            f"(default: {tracer_default('frame_policy')})"
+        ),
+    )
+    p.add_argument(
+        "--rebuild-threshold",
+        type=float,
+        action=LazyHelpStore,
+        metavar="RATIO",
+        help_text=lambda: (
+            "--frame-policy adaptive: rebuild once a refitted tree's SAH cost exceeds this "
+            f"ratio of its cost after the last rebuild (default: {tracer_default('rebuild_threshold')})"
         ),
     )
     p.set_defaults(func=cmd_trace)

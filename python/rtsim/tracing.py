@@ -138,6 +138,26 @@ def trace_defaults() -> dict[str, Any]:
     return dict(_core.trace_defaults())
 
 
+FRAME_POLICIES = ("rebuild", "refit", "adaptive")
+
+
+def _frame_policy_arg(value: Any) -> str:
+    if value not in FRAME_POLICIES:
+        raise ArgumentValueError(
+            f"frame_policy: {value!r} is not one of {', '.join(FRAME_POLICIES)}"
+        )
+    return str(value)
+
+
+def _rebuild_threshold_arg(value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 1.0:
+        raise ArgumentValueError(
+            f"rebuild_threshold: {value!r} must be a number of at least 1 (a refitted tree's "
+            "SAH cost over its rebuilt cost)"
+        )
+    return float(value)
+
+
 def trace_scene(
     scene: SceneLike,
     out_dir: str | os.PathLike[str],
@@ -156,6 +176,8 @@ def trace_scene(
     frames: int | None = None,
     build_settings: dict[str, Any] | None = None,
     lights: str | None = None,
+    frame_policy: str | None = None,
+    rebuild_threshold: float | None = None,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. Every option left None takes the tracer's default
@@ -170,7 +192,10 @@ def trace_scene(
     frames > 1
     animates an instanced scene by the documented motion (docs/accel.md, "Frames"): the BLASes
     are built once, a TLAS per frame, and the workload is traced once per frame;
-    manifest["frames"] lists each frame's rays and TLAS build time. lights="sun" adds a
+    manifest["frames"] lists each frame's rays and TLAS build time. Deforming meshes (skins,
+    morph targets, the procedural moving scenes) get a BLAS per frame: frame_policy "rebuild",
+    "refit" or "adaptive" (rebuild once the refitted SAH cost exceeds rebuild_threshold times
+    the rebuilt one; docs/accel.md, "Moving scenes"). lights="sun" adds a
     directional light to a scene without lights (so it gets shadow rays; the manifest's
     workload.lights_added says what was added)."""
     from rtsim import _core
@@ -190,12 +215,15 @@ def trace_scene(
         "frames": lambda v: int_arg(v, "frames", 1, MAX_FRAMES),
         "build_settings": _settings_arg,
         "lights": _lights_arg,
+        "frame_policy": _frame_policy_arg,
+        "rebuild_threshold": _rebuild_threshold_arg,
     }
     values = {
         "workload": workload, "width": width, "height": height, "bounces": bounces, "seed": seed,
         "camera": camera, "threads": threads, "hairball_triangles": hairball_triangles,
         "accel": accel, "builder": builder, "flatten": flatten, "frames": frames,
-        "build_settings": build_settings, "lights": lights,
+        "build_settings": build_settings, "lights": lights, "frame_policy": frame_policy,
+        "rebuild_threshold": rebuild_threshold,
     }  # fmt: skip
     # Only the options given are passed: the others take the tracer's defaults (trace_defaults).
     given = {k: checks[k](v) for k, v in values.items() if v is not None}

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "rtl_model/build_unit/build_unit_config.h"
 #include "rtl_model/common/choice.h"
 #include "rtl_model/dispatch/dispatch_config.h"
 #include "rtl_model/isect/pipeline_config.h"
@@ -79,6 +80,7 @@ struct ModelConfig {
     DramConfig dram;
     TreeletConfig treelets;
     ShadingConfig shading;
+    BuildUnitConfig build_unit;  ///< moving scenes: each frame's build or refit (rtl_model/build_unit)
 
     /// The pipeline operations of `kind` go to. Adding an operation kind adds a PipelineConfig
     /// member, its visit() line and a case here (docs/accel.md, "Adding a structure"); a kind with
@@ -109,6 +111,7 @@ struct ModelConfig {
         v.section("dram", dram);
         v.section("treelets", treelets);
         v.section("shading", shading);
+        v.section("build_unit", build_unit);
     }
 };
 

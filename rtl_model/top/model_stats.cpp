@@ -29,6 +29,7 @@ const StatBlock& model_stats() {
                         {"utilization", "", "shared resources' busy fractions (`model.utilization`); timed levels only", false, true},
                         {"analytic", "", "the analytic level's closed form (`model.analytic`); analytic level only", false, true},
                         {"shading", "", "only with `shading.enabled`: the frame, shader cores, texture caches and sorting stage (`model.shading`)", false, true},
+                        {"build_unit", "", "only for animated traces whose frames record their builds, with `build_unit.enabled`: the frames' builds and refits (`model.build_unit`)", false, true},
                     }};
         for (const char* kind : kOpKindNames)
             b.stats.push_back({kind, "", "`{pipe: stats}`: the pipeline blocks of this operation kind, when built (`model.<kind>.<pipe>`)", false, true});

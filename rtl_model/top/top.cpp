@@ -109,6 +109,11 @@ void Top::build_shading(const ShadingInputs* shading, RaySinkIf& sink) {
 
 Cycle Top::frame_cycles() const { return m_shading ? m_shading->frame_end(total_cycles()) : total_cycles(); }
 
+MemIf& Top::shared_memory() {
+    if (m_l2) return *m_l2;
+    return *m_ideal;
+}
+
 void Top::build_memory() {
     const ModelConfig& c = m_config;
     if (c.ideal_memory) {

@@ -67,6 +67,9 @@ public:
     /// Functional warming with a read of [addr, addr + bytes) by unit `unit`: its L1, and the L2
     /// for the lines the L1 missed (Cache::warm; nothing with ideal_memory).
     void warm(uint32_t unit, uint64_t addr, uint32_t bytes);
+    /// The memory level the units share (the L2, or ideal memory): where the build unit reads
+    /// and writes (rtl_model/build_unit/build_unit.h).
+    MemIf& shared_memory();
 
 private:
     using PipelineSet = std::vector<std::unique_ptr<Pipeline>>;

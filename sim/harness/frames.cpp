@@ -44,7 +44,8 @@ void FrameRecorder::untimed() {
     for (uint32_t f = 0; f < m_frames.size(); ++f) {
         frame_end(f, 0, MemoryTotals{});
         for (const char* key : {"start_cycle", "end_cycle", "cycles", "mrays_per_second", "dram_bytes",
-                                "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate"})
+                                "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate", "build_cycles", "build_share",
+                                "build_read_bytes", "build_written_bytes"})
             m_out.back()[key] = nullptr;
     }
 }
@@ -55,12 +56,24 @@ void FrameRecorder::frame_end(uint32_t f, Cycle cycle, const MemoryTotals& total
     const double seconds = double(cycles) / (m_config.clock_ghz * 1e9);
     const double dram = double(totals.dram.read_bytes + totals.dram.write_bytes - m_last.dram.read_bytes -
                                m_last.dram.write_bytes);
-    json tlas_ms = nullptr, tlas_nodes = nullptr;
+    json tlas_ms = nullptr, tlas_nodes = nullptr, sah_ratio = nullptr;
+    uint64_t blas_rebuilt = 0, blas_refit = 0;
     if (m_manifest_frames.is_object() && m_manifest_frames.contains("per_frame") &&
         f < m_manifest_frames["per_frame"].size()) {
-        tlas_ms = m_manifest_frames["per_frame"][f].value("tlas_build_ms", json(nullptr));
-        tlas_nodes = m_manifest_frames["per_frame"][f].value("tlas_nodes", json(nullptr));
+        const json& mf = m_manifest_frames["per_frame"][f];
+        tlas_ms = mf.value("tlas_build_ms", json(nullptr));
+        tlas_nodes = mf.value("tlas_nodes", json(nullptr));
+        // The deforming BLASes' policy decisions (traces/accel/two_level/frame_policy.h).
+        if (mf.contains("build") && mf["build"].contains("blas"))
+            for (const json& b : mf["build"]["blas"]) {
+                (b.value("action", std::string()) == "refit" ? blas_refit : blas_rebuilt) += 1;
+                if (b["sah_ratio"].is_number())
+                    sah_ratio = sah_ratio.is_null() ? b["sah_ratio"].get<double>()
+                                                    : std::max(sah_ratio.get<double>(), b["sah_ratio"].get<double>());
+            }
     }
+    const FrameBuild build = f < m_builds.size() ? m_builds[f] : FrameBuild{};
+    const Cycle build_cycles = build.end - build.start;
     const bool memory = !m_config.ideal_memory;
     m_out.push_back({{"frame", f},
                      {"rays", rays},
@@ -74,7 +87,14 @@ void FrameRecorder::frame_end(uint32_t f, Cycle cycle, const MemoryTotals& total
                      {"l1_hit_rate", memory ? hit_rate(totals.l1, m_last.l1) : json(nullptr)},
                      {"l2_hit_rate", memory ? hit_rate(totals.l2, m_last.l2) : json(nullptr)},
                      {"tlas_nodes", tlas_nodes},
-                     {"tlas_build_ms", tlas_ms}});
+                     {"tlas_build_ms", tlas_ms},
+                     {"blas_rebuilt", blas_rebuilt},
+                     {"blas_refit", blas_refit},
+                     {"blas_sah_ratio", sah_ratio},
+                     {"build_cycles", build_cycles},
+                     {"build_share", cycles ? double(build_cycles) / double(cycles) : 0.0},
+                     {"build_read_bytes", build.read_bytes},
+                     {"build_written_bytes", build.written_bytes}});
     m_last = totals;
     m_last_cycle = cycle;
 }
@@ -96,6 +116,13 @@ const StatBlock& frame_stats() {
             {"l2_hit_rate", "fraction", "the L2's the same way", true},
             {"tlas_nodes", "nodes", "the frame's TLAS nodes (from the trace's manifest; `null` without frames)"},
             {"tlas_build_ms", "ms", "host wall time the tracer took to build the frame's TLAS and instance records (manifest; `null` without frames): not simulated"},
+            {"blas_rebuilt", "structures", "deforming meshes' BLASes the frame built afresh (trace manifest; --frame-policy)"},
+            {"blas_refit", "structures", "deforming meshes' BLASes the frame refitted"},
+            {"blas_sah_ratio", "ratio", "largest SAH cost of the frame's deforming BLASes over their cost at their last rebuild; `null` without deforming geometry"},
+            {"build_cycles", "cycles", "the build unit's time before the frame's rays (its structures built or refitted; 0 for frame 0, whose exist before the run)", true},
+            {"build_share", "fraction", "`build_cycles / cycles`", true},
+            {"build_read_bytes", "bytes", "bytes the build unit read for the frame", true},
+            {"build_written_bytes", "bytes", "bytes the build unit wrote for the frame", true},
         }};
     return block;
 }

@@ -8,6 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
+#include "rtl_model/build_unit/build_unit.h"
 #include "rtl_model/common/stats.h"
 #include "rtl_model/top/top.h"
 #include "sim/config/config.h"
@@ -41,6 +44,10 @@ public:
     void frame_end(uint32_t f, Cycle cycle, const MemoryTotals& totals);
     /// The functional level: each frame's rays and TLAS build time, no timing.
     void untimed();
+    /// Frame f's build on the build unit (rtl_model/build_unit/build_unit.h), before its rays.
+    void set_build(uint32_t f, const FrameBuild& build) { m_builds.resize(std::max<size_t>(m_builds.size(), f + 1)); m_builds[f] = build; }
+    /// True once frame f's figures are recorded.
+    bool recorded(uint32_t f) const { return f < m_out.size(); }
     /// [{frame, rays, start_cycle, cycles, mrays_per_second, dram_bytes_per_ray, l1_hit_rate,
     ///   l2_hit_rate, tlas_build_ms, ...}] (docs/stats.md, "Frames").
     const nlohmann::json& to_json() const { return m_out; }
@@ -52,6 +59,7 @@ private:
     MemoryTotals m_last;
     Cycle m_last_cycle = 0;
     nlohmann::json m_out = nlohmann::json::array();
+    std::vector<FrameBuild> m_builds;  ///< per frame (missing: no build priced)
 };
 
 /// One entry of stats.json "frames", declared once.

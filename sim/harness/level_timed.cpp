@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "rtl_model/top/top.h"
+#include "sim/harness/frame_builds.h"
 #include "sim/harness/frames.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/level.h"
@@ -69,6 +70,12 @@ LevelResult run_timed_level(RunInputs& in) {
     FrameRayStream stream(in.reader, segments);
     Top top("top", model_config, accel, s.step, map, sampled ? static_cast<RayStream&>(sampled->stream) : stream,
             checker, built.features, shading.get());
+    // The build unit, where the trace's frames record their builds (frame_builds.h).
+    const std::vector<std::vector<BuildJob>> build_jobs =
+        c.build_unit.enabled && !sampled && !wavefront ? frame_build_jobs(accel) : std::vector<std::vector<BuildJob>>{};
+    std::unique_ptr<BuildUnit> build_unit;
+    if (!build_jobs.empty())
+        build_unit = std::make_unique<BuildUnit>(c.build_unit, top.shared_memory(), c.l2.line_bytes);
     // Frame barriers: record each frame's figures, then bind the structure's next frame.
     std::vector<uint64_t> frame_rays;
     for (const FrameRecord& f : segments) frame_rays.push_back(f.rays);
@@ -79,8 +86,21 @@ LevelResult run_timed_level(RunInputs& in) {
                         [&](Cycle end) { frame_figures.frame_end(0, end, top.memory_totals()); });
     } else if (!sampled) {
         top.dispatch().set_frames(
-            frame_rays, [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); },
+            frame_rays,
+            [&](uint32_t f, Cycle end) {
+                if (!frame_figures.recorded(f)) frame_figures.frame_end(f, end, top.memory_totals());
+            },
             [&](uint32_t f) { accel.bind_frame(f); });
+        // Moving scenes: the next frame's structures are built at the barrier, before its rays
+        // (rtl_model/build_unit/build_unit.h); the frame's figures are taken before the build.
+        if (build_unit)
+            top.dispatch().set_barrier([&](uint32_t f, Cycle end) {
+                frame_figures.frame_end(f, end, top.memory_totals());
+                if (f + 1 >= build_jobs.size() || build_jobs[f + 1].empty()) return end;
+                const FrameBuild b = build_unit->run(build_jobs[f + 1], end);
+                frame_figures.set_build(f + 1, b);
+                return b.end;
+            });
         if (shading) wire_frame_loop(top, c.shading, 1, nullptr);
     }
     std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
@@ -121,6 +141,7 @@ LevelResult run_timed_level(RunInputs& in) {
     LevelResult r;
     r.cycles = top.total_cycles();
     r.model = top.stats_json();
+    if (build_unit) r.model["build_unit"] = build_unit->stats_json();
     r.instantiated = top.instantiated();
     if (in.options.timeline && top.dram())
         timeline.write((fs::path(in.options.out_dir) / "timeline.json").string(), top.units(),

@@ -1,0 +1,69 @@
+// Each frame's build jobs (frame_builds.h).
+#include "sim/harness/frame_builds.h"
+
+#include <string>
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// BLAS b's slices of the image's "blas_R" regions: written all, read where they hold triangles.
+BuildJob blas_job(const AccelImage& image, const json& blas, const json& record) {
+    BuildJob job;
+    job.refit = record.value("action", std::string()) == "refit";
+    job.triangles = record.value("triangles", uint64_t(0));
+    job.tree_nodes = record["tree_nodes"].is_number() ? record["tree_nodes"].get<uint64_t>() : 0;
+    for (const auto& [name, first] : blas.at("first").items()) {
+        const Region* r = nullptr;
+        for (const Region& reg : image.regions)
+            if (reg.name == "blas_" + name) r = &reg;
+        if (!r) continue;
+        const uint64_t count = blas.at("count").at(name).get<uint64_t>();
+        const BuildJob::Range range{r->address(first.get<uint64_t>()), count * r->record_bytes};
+        job.writes.push_back(range);
+        if (r->kind == DataKind::triangle) job.reads.push_back(range);
+    }
+    return job;
+}
+
+/// The frame's TLAS: its nodes and instance records written, the records read (the instances'
+/// boxes and transforms its build starts from).
+BuildJob tlas_job(const AccelImage& image, const json& slice) {
+    BuildJob job;
+    const json& rec = slice["build"]["tlas"];
+    job.refit = rec.value("action", std::string()) == "refit";
+    job.triangles = slice.at("instances_count").get<uint64_t>();
+    job.tree_nodes = rec["tree_nodes"].is_number() ? rec["tree_nodes"].get<uint64_t>() : 0;
+    const Region& nodes = image.region("tlas_nodes");
+    const Region& records = image.region("instances");
+    const BuildJob::Range node_range{nodes.address(slice.at("tlas_first").get<uint64_t>()),
+                                     slice.at("tlas_count").get<uint64_t>() * nodes.record_bytes};
+    const BuildJob::Range record_range{records.address(slice.at("instances_first").get<uint64_t>()),
+                                       job.triangles * records.record_bytes};
+    job.writes = {node_range, record_range};
+    job.reads = {record_range};
+    return job;
+}
+
+}  // namespace
+
+std::vector<std::vector<BuildJob>> frame_build_jobs(const Accel& accel) {
+    const AccelImage& image = accel.image();
+    std::vector<std::vector<BuildJob>> out;
+    if (image.kind != "two_level" || !image.params.contains("frames")) return out;
+    const json& frames = image.params.at("frames");
+    const json& blases = image.params.at("blas");
+    out.resize(frames.size());
+    for (size_t f = 1; f < frames.size(); ++f) {
+        const json& slice = frames[f];
+        if (!slice.contains("build")) return {};  // a trace from before frames recorded builds
+        for (const json& record : slice["build"].value("blas", json::array()))
+            out[f].push_back(blas_job(image, blases.at(record.at("blas").get<size_t>()), record));
+        out[f].push_back(tlas_job(image, slice));
+    }
+    return out;
+}
+
+}  // namespace rtsim
