@@ -13,6 +13,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "traces/common/files.h"
+#include "traces/scene/gltf_animation.h"
 #include "traces/scene/gltf_internal.h"
 #include "traces/scene/procedural_motion.h"
 
@@ -285,7 +286,6 @@ private:
                 m_src, gltf::as_index(gltf::value_number(light->second, "light", -1.0)), world, int(index)));
         if (node.camera >= 0)
             m_scene.cameras.push_back(gltf::read_camera(m_src, node.camera, world, int(index), m_scene));
-        if (node.skin >= 0) m_scene.warnings.push_back(where + ": skin ignored (bind pose used)");
         return world;
     }
 
@@ -328,6 +328,7 @@ void read_motions(const Source& src, const std::vector<int>& mesh_of, Scene& sce
             motions.emplace_back(uint32_t(mesh_of[i]), motion);
     }
     if (!motions.empty()) scene.animation = make_procedural_animation(scene, std::move(motions));
+    else scene.animation = gltf::read_gltf_animation(src, mesh_of, scene);
 }
 
 Scene load_gltf_checked(const std::string& path, bool flatten) {
