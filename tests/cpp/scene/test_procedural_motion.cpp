@@ -80,7 +80,9 @@ TEST(MovingScene, ClothIsAGridWithATravellingWave) {
     for (size_t i = 0; i < rest.size(); ++i) {
         EXPECT_EQ(pose[i].x, rest[i].x);
         EXPECT_EQ(pose[i].z, rest[i].z);
-        if (rest[i].x == x_min) EXPECT_NEAR(pose[i].y, rest[i].y, 1e-6f);
+        if (rest[i].x == x_min) {
+            EXPECT_NEAR(pose[i].y, rest[i].y, 1e-6f);
+        }
         max_dy = std::max(max_dy, std::abs(pose[i].y - rest[i].y));
     }
     EXPECT_GT(max_dy, 0.05f);
