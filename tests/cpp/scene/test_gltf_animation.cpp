@@ -40,9 +40,8 @@ struct SkinFile {
                                   1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
         int ib = data(b, ibm, 5126, "MAT4", 2);
         int times = data(b, std::vector<float>{0.0f, 1.0f}, 5126, "SCALAR", 2);
-        float c = std::sqrt(std::max(0.0f, 1.0f - last_angle_sin * last_angle_sin));
-        float half_s = std::sqrt(0.5f * (1.0f - c)), half_c = std::sqrt(0.5f * (1.0f + c));
-        if (!std::isfinite(last_angle_sin)) half_s = last_angle_sin;
+        // 90 degrees about z: (0, 0, sin 45, cos 45); a NaN `last_angle_sin` poisons it.
+        float half_s = std::isfinite(last_angle_sin) ? kS : last_angle_sin, half_c = kS;
         int rot = data(b, std::vector<float>{0, 0, 0, 1, 0, 0, half_s, half_c}, 5126, "VEC4", 2);
         b.mesh("skinned", {{{"attributes", {{"POSITION", pos}, {"JOINTS_0", j}, {"WEIGHTS_0", wt}}}}});
         b.node({{"name", "body"}, {"mesh", 0}, {"skin", 0}, {"translation", {5, 0, 0}}});
