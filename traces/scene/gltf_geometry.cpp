@@ -130,6 +130,12 @@ void read_primitive(const Source& src, const tinygltf::Primitive& prim, const st
 
 }  // namespace
 
+std::vector<uint32_t> primitive_corners(const Source& src, const tinygltf::Primitive& prim,
+                                        size_t vertex_count, const std::string& where) {
+    return triangle_list(read_indices(src, prim, vertex_count, where),
+                         prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode);
+}
+
 uint32_t read_mesh(const Source& src, int mesh_index, Scene& scene) {
     const tinygltf::Mesh& gm = src.model->meshes[size_t(mesh_index)];
     std::string mesh_name = element("mesh", size_t(mesh_index), gm.name);
@@ -138,8 +144,6 @@ uint32_t read_mesh(const Source& src, int mesh_index, Scene& scene) {
     for (size_t p = 0; p < gm.primitives.size(); ++p) {
         const tinygltf::Primitive& prim = gm.primitives[p];
         std::string where = mesh_name + " primitive " + std::to_string(p);
-        if (!prim.targets.empty())
-            scene.warnings.push_back(where + ": morph targets ignored (base positions used)");
         read_primitive(src, prim, where, scene, mesh);
     }
     scene.meshes.push_back(std::move(mesh));

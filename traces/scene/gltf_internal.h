@@ -48,6 +48,12 @@ AccessorView view_accessor(const Source& src, int index, const std::string& wher
 /// converted to lists) and returns its index in scene.meshes.
 uint32_t read_mesh(const Source& src, int mesh_index, Scene& scene);
 
+/// The vertex index of each triangle corner of a triangle primitive, in the order read_mesh
+/// appends them to Mesh::positions (strips and fans converted). The animation reads skin
+/// weights and morph deltas per corner through it.
+std::vector<uint32_t> primitive_corners(const Source& src, const tinygltf::Primitive& prim,
+                                        size_t vertex_count, const std::string& where);
+
 /// Reads every glTF material into scene.materials, in order (glTF index == rtsim index).
 void read_materials(const Source& src, Scene& scene);
 

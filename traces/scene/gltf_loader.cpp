@@ -13,7 +13,9 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "traces/common/files.h"
+#include "traces/scene/gltf_animation.h"
 #include "traces/scene/gltf_internal.h"
+#include "traces/scene/procedural_motion.h"
 
 namespace rtsim {
 
@@ -234,6 +236,9 @@ public:
         : m_src(src), m_scene(scene), m_state(src.model->nodes.size(), 0),
           m_mesh_of(src.model->meshes.size(), -1) {}
 
+    /// glTF mesh index -> Scene::meshes index (-1: not placed by the default scene).
+    const std::vector<int>& mesh_of() const { return m_mesh_of; }
+
     void walk_root(int node) {
         check_index(node, "scene root");
         // Explicit stack: deep hierarchies cannot overflow the call stack.
@@ -281,7 +286,6 @@ private:
                 m_src, gltf::as_index(gltf::value_number(light->second, "light", -1.0)), world, int(index)));
         if (node.camera >= 0)
             m_scene.cameras.push_back(gltf::read_camera(m_src, node.camera, world, int(index), m_scene));
-        if (node.skin >= 0) m_scene.warnings.push_back(where + ": skin ignored (bind pose used)");
         return world;
     }
 
@@ -312,6 +316,21 @@ private:
     uint64_t m_flat = 0;           ///< triangles placed so far (at least one per instance)
 };
 
+/// Meshes the project's own procedural scenes mark as deforming (extras.rtsimMotion) become
+/// Scene::animation.
+void read_motions(const Source& src, const std::vector<int>& mesh_of, Scene& scene) {
+    std::vector<std::pair<uint32_t, ProceduralMotion>> motions;
+    for (size_t i = 0; i < mesh_of.size(); ++i) {
+        ProceduralMotion motion;
+        const tinygltf::Mesh& mesh = src.model->meshes[i];
+        if (mesh_of[i] >= 0 &&
+            read_procedural_motion(mesh.extras, src.file + ": " + element("mesh", i, mesh.name), &motion))
+            motions.emplace_back(uint32_t(mesh_of[i]), motion);
+    }
+    if (!motions.empty()) scene.animation = make_procedural_animation(scene, std::move(motions));
+    else scene.animation = gltf::read_gltf_animation(src, mesh_of, scene);
+}
+
 Scene load_gltf_checked(const std::string& path, bool flatten) {
     Scene scene;
     scene.source = path;
@@ -340,6 +359,7 @@ Scene load_gltf_checked(const std::string& path, bool flatten) {
     for (int r : roots) walker.walk_root(r);
 
     if (scene.materials.empty()) scene.default_material();
+    read_motions(src, walker.mesh_of(), scene);
     check_instance_transforms(scene, false);
     if (flatten) scene.flatten();
     else scene.index_instances();

@@ -110,6 +110,10 @@ int GltfWriter::add_material(const Material& m) {
     return int(m_impl->model.materials.size() - 1);
 }
 
+void GltfWriter::set_mesh_motion(int mesh, const ProceduralMotion& motion) {
+    m_impl->model.meshes.at(size_t(mesh)).extras = procedural_motion_to_value(motion);
+}
+
 int GltfWriter::add_mesh(const std::string& name,
                          const std::vector<std::pair<const TriangleSoup*, int>>& parts) {
     tinygltf::Mesh mesh;

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "traces/scene/procedural_motion.h"
 #include "traces/scene/scene.h"
 
 namespace rtsim {
@@ -40,6 +41,8 @@ public:
     int add_material(const Material& m);
     /// Adds a mesh with one primitive per (soup, material) pair; returns the glTF mesh index.
     int add_mesh(const std::string& name, const std::vector<std::pair<const TriangleSoup*, int>>& parts);
+    /// Marks glTF mesh `mesh` as deforming with `motion` (written as its extras.rtsimMotion).
+    void set_mesh_motion(int mesh, const ProceduralMotion& motion);
     /// Adds a root node placing `mesh` with `transform` (identity: no matrix written).
     void add_mesh_node(const std::string& name, int mesh, const glm::dmat4& transform = glm::dmat4(1.0));
     /// Perspective camera at `eye` looking at `target`.

@@ -19,6 +19,8 @@ const Entry kScenes[] = {
     {"teapot_stadium", write_teapot_stadium},
     {"rotated_walls", write_rotated_walls},
     {"aligned_walls", write_aligned_walls},
+    {"cloth", write_cloth},
+    {"exploding_hairball", write_exploding_hairball},
 };
 
 /// Instanced scenes: not in procedural_scene_names(), which the per-structure tests sweep

@@ -12,7 +12,8 @@ struct ProceduralOptions {
     uint64_t seed = 1;
 };
 
-/// Names of the built-in flat scenes: "cornell", "hairball", "teapot_stadium", "rotated_walls".
+/// Names of the built-in flat scenes: "cornell", "hairball", "teapot_stadium", "rotated_walls",
+/// "aligned_walls", and the deforming "cloth" and "exploding_hairball" (Scene::animation set).
 std::vector<std::string> procedural_scene_names();
 /// Names of the built-in instanced scenes (procedural_forest.cpp): "forest" (72 x 72 instances,
 /// about 4.6 x 10^8 triangles if flattened: two-level only) and "grove" (6 x 6 instances).

@@ -63,19 +63,24 @@ uint32_t add_strand(TriangleSoup& soup, Rng& rng, uint32_t budget) {
 
 }  // namespace
 
-std::string write_hairball(const std::string& dir, const ProceduralOptions& options) {
-    uint32_t total = options.hairball_triangles;
-    if (total == 0) throw Error("procedural scene 'hairball': hairball_triangles must be > 0");
-    check_flat_size("procedural scene 'hairball'", total, "hairball_triangles=" + std::to_string(total));
+TriangleSoup hairball_strands(uint32_t total, uint64_t seed) {
     TriangleSoup hair;
     uint64_t strands = (uint64_t(total) + 2 * kSegments - 1) / (2 * kSegments);
     hair.vertices.reserve(size_t(strands) * 2 * (kSegments + 1));
     hair.indices.reserve(size_t(total) * 3);
     uint32_t done = 0;
     for (uint64_t s = 0; done < total; ++s) {
-        Rng rng(hash_combine(options.seed, 0x68616972ull /*"hair"*/, s));
+        Rng rng(hash_combine(seed, 0x68616972ull /*"hair"*/, s));
         done += add_strand(hair, rng, total - done);
     }
+    return hair;
+}
+
+std::string write_hairball(const std::string& dir, const ProceduralOptions& options) {
+    uint32_t total = options.hairball_triangles;
+    if (total == 0) throw Error("procedural scene 'hairball': hairball_triangles must be > 0");
+    check_flat_size("procedural scene 'hairball'", total, "hairball_triangles=" + std::to_string(total));
+    TriangleSoup hair = hairball_strands(total, options.seed);
 
     GltfWriter w;
     int mat = w.add_material(make_material("hair", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));

@@ -26,6 +26,9 @@ void add_torus(TriangleSoup& soup, float major, float minor, int major_segs, int
 void add_tube(TriangleSoup& soup, const std::vector<Vec3>& path, const std::vector<float>& radius,
               int sides);
 
+/// The hairball's strands (procedural_hairball.cpp): exactly `total` triangles, from `seed`.
+TriangleSoup hairball_strands(uint32_t total, uint64_t seed);
+
 /// Builds a Material in one line.
 Material make_material(const std::string& name, const Vec3& color, float metallic, float roughness,
                        const Vec3& emissive = Vec3(0.0f));
@@ -38,5 +41,8 @@ std::string write_rotated_walls(const std::string& dir, const ProceduralOptions&
 std::string write_aligned_walls(const std::string& dir, const ProceduralOptions& options);
 std::string write_forest(const std::string& dir, const ProceduralOptions& options);
 std::string write_grove(const std::string& dir, const ProceduralOptions& options);
+// Deforming scenes (procedural_moving.cpp): their meshes move over frames (Scene::animation).
+std::string write_cloth(const std::string& dir, const ProceduralOptions& options);
+std::string write_exploding_hairball(const std::string& dir, const ProceduralOptions& options);
 
 }  // namespace rtsim
