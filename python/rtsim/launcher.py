@@ -68,6 +68,7 @@ class SimJob:
     config: Path | None = None  # config JSON over the defaults
     sets: list[str] = field(default_factory=list)  # key.path=value, applied after config
     timeline: bool = False  # also write RUN/timeline.json
+    dram_trace: bool = False  # also write RUN/dram_trace.* (the requests that reached DRAM)
     progress: bool = False  # JSON progress lines on stderr
     verdict: bool = True  # False: --no-verdict (no bottleneck estimates after the run)
     check_verdict: bool = False  # --check-verdict: re-run the verdict's top knobs (RUN/check/N)
@@ -82,6 +83,8 @@ class SimJob:
             cmd += ["--set", assignment]
         if self.timeline:
             cmd.append("--timeline")
+        if self.dram_trace:
+            cmd.append("--dram-trace")
         if self.progress:
             cmd.append("--progress")
         if not self.verdict:
