@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rtsim's DRAM model against DRAMsim3 on the same request stream (docs/dram.md).
+"""rtsim's DRAM model against DRAMsim3 on the same request stream (docs/model.md, "DRAM").
 
 Each run simulates a trace with `--dram-trace` (RUN/dram_trace.dramsim3.txt: every request that
 reached DRAM, with the core cycle it was issued), converts the stream to DRAMsim3's memory clock
@@ -14,6 +14,8 @@ project) and pass its `dramsim3main` and a config:
 
     python scripts/dram_compare.py --dramsim3 /tmp/dramsim3/build/dramsim3main \\
         --ini /tmp/dramsim3/configs/DDR4_8Gb_x8_2133.ini [--out out/dram_compare] [--docs docs]
+
+With --docs the table goes into DOCS/model.md between the `dram-compare` markers.
 
 Without --dramsim3 it writes the traces and rtsim's figures only.
 """
@@ -212,7 +214,7 @@ def main() -> None:
     p.add_argument("--resolution", default="160x120")
     p.add_argument("--dramsim3", type=Path, help="DRAMsim3's dramsim3main (built outside rtsim)")
     p.add_argument("--ini", type=Path, help="the DRAMsim3 config to compare with")
-    p.add_argument("--docs", type=Path, help="write the table into DOCS/dram.md")
+    p.add_argument("--docs", type=Path, help="write the table into DOCS/model.md")
     args = p.parse_args()
     if args.dramsim3 and not args.ini:
         p.error("--dramsim3 needs --ini (a DRAMsim3 config)")
@@ -230,7 +232,7 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "figures.json").write_text(json.dumps(rows, indent=2))
     if args.docs:
-        write_between(args.docs / "dram.md", "dram-compare", text)
+        write_between(args.docs / "model.md", "dram-compare", text)
     print(text)
 
 

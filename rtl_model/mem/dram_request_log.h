@@ -1,6 +1,6 @@
 #pragma once
 // The requests that reached DRAM, kept when a run asks for them (rtsim-sim --dram-trace), so
-// another DRAM simulator can replay the same stream (docs/dram.md, "Against DRAMsim3"). Written
+// another DRAM simulator can replay the same stream (docs/model.md, "Against DRAMsim3"). Written
 // in DRAMsim3's text trace (Li et al., "DRAMsim3: a cycle-accurate, thermal-capable DRAM
 // simulator", IEEE CAL 2020): `0xADDR READ|WRITE CYCLE`, one transaction a line, in issue order;
 // and as rtsim's own record (CSV: address, write, bytes, issue and ready cycle), which carries
