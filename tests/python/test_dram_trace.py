@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -19,6 +20,7 @@ def dram_compare():
     spec = importlib.util.spec_from_file_location("dram_compare", path)
     assert spec and spec.loader
     module = importlib.util.module_from_spec(spec)
+    sys.modules["dram_compare"] = module  # its dataclasses look their module up there
     spec.loader.exec_module(module)
     return module
 
@@ -43,7 +45,11 @@ def test_dram_trace_matches_the_runs_dram_counters(
     lines = (run / "dram_trace.dramsim3.txt").read_text().splitlines()
     cycles = [int(line.split()[2]) for line in lines]
     assert cycles == sorted(cycles)  # DRAMsim3 reads its trace in time order
-    assert len(lines) == summary["bytes"] // 64  # one 64-byte transaction a line
+    # One 64-byte transaction a line: a request of n bytes is ceil(n / 64) lines (a 20-byte hit
+    # record write is one).
+    rows = (run / "dram_requests.csv").read_text().splitlines()[1:]
+    assert len(rows) == summary["requests"]
+    assert len(lines) == sum(-(-int(r.split(",")[2]) // 64) for r in rows)
     assert {line.split()[1] for line in lines} <= {"READ", "WRITE"}
 
 
