@@ -128,6 +128,8 @@ int sc_main(int argc, char** argv) {
         const auto& s = r.stats["summary"];
         std::cerr << "rtsim-sim: " << s["rays"] << " rays, " << s["hit_mismatches"] << " hit mismatches, "
                   << s["work_mismatches"] << " work mismatches -> " << out_dir << "/stats.json\n";
+        if (s.contains("sampling_note"))
+            std::cerr << "rtsim-sim: note: " << s["sampling_note"].get<std::string>() << "\n";
         if (r.stats.contains("sampling"))
             for (const auto& why : r.stats["sampling"]["caveats"])
                 std::cerr << "rtsim-sim: warning: sample too small to trust: " << why.get<std::string>() << "\n";
