@@ -26,7 +26,14 @@ from typing import Any
 SIM_EXE = "rtsim-sim"
 EXIT_OK, EXIT_BAD_INPUT, EXIT_MISMATCH = 0, 2, 3
 #: What rtsim-sim writes into the run folder (removed before a run: never stale).
-RUN_OUTPUTS = ("stats.json", "config.resolved.json", "provenance.json")
+RUN_OUTPUTS = (
+    "stats.json",
+    "config.resolved.json",
+    "provenance.json",
+    "dram_trace.dramsim3.txt",  # --dram-trace: a later run without it must not leave them behind
+    "dram_requests.csv",
+    "dram_trace.json",
+)
 
 
 class SimNotFoundError(OSError):
