@@ -7,7 +7,7 @@
 // find theirs open (a hit: no activate, `t_rcd` less), and each waits for its bank. That time is
 // latency as far as the MSHRs and the ray contexts are concerned, and it is not bus time, so
 // more channels do not remove it: charging only the closed-bank latency made the analytic level
-// 15-25% faster than the runs it judged, put DRAM at saturation where the run measured 80%,
+// 11-26% faster than the runs it judged, put DRAM at saturation where the run measured 80%,
 // and so promised more channels far more than they give (+14% estimated, +8% measured, where a
 // larger L2 gave +40%). Charging the run's measured row outcome and bank wait instead keeps the
 // estimate's DRAM at the run's own utilisation (Jacob, Ng & Wang, "Memory Systems", 2008, ch. 11
