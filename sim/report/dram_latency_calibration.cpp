@@ -6,7 +6,8 @@
 namespace rtsim {
 
 uint32_t DramLatencyCalibration::added_cycles() const {
-    return measured ? uint32_t(std::lround(std::max(0.0, row_cycles + bank_wait))) : 0u;
+    // The bank wait is queueing, not charged (dram_latency_calibration.h).
+    return measured ? uint32_t(std::lround(std::max(0.0, row_cycles))) : 0u;
 }
 
 SimConfig DramLatencyCalibration::apply(SimConfig config) const {
