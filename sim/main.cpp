@@ -61,6 +61,10 @@ int sc_main(int argc, char** argv) {
     app.add_option("--set", sets, "Override a config key: key.path=value (repeatable)");
     app.add_option("-o,--out", out_dir, "Run folder for stats.json, config.resolved.json, provenance.json");
     app.add_flag("--timeline", timeline, "Also write timeline.json (Chrome/Perfetto trace events)");
+    bool dram_trace = false;
+    app.add_flag("--dram-trace", dram_trace,
+                 "Also write the requests that reached DRAM as a DRAMsim3 trace and a CSV (RUN/dram_trace.*; "
+                 "approx and detailed levels)");
     app.add_flag("--progress", progress, "Print JSON progress lines on stderr");
     app.add_flag("--no-verdict", no_verdict, "Skip the bottleneck verdict (its analytic estimates on a sample of the trace)");
     app.add_flag("--check-verdict", check_verdict,
@@ -111,6 +115,11 @@ int sc_main(int argc, char** argv) {
         rtsim::make_output_folder(out_dir, "run");
         o.out_dir = out_dir;
         o.timeline = timeline;
+        o.dram_trace = dram_trace;
+        // Only the timed levels send requests to a DRAM model; elsewhere the flag would do nothing.
+        rtsim::require(!dram_trace || o.config.fidelity == rtsim::Fidelity::approx ||
+                           o.config.fidelity == rtsim::Fidelity::detailed,
+                       "--dram-trace needs a timed level (fidelity approx or detailed)");
         o.progress = progress;
         o.verdict = !no_verdict;
         o.check_verdict = check_verdict && !no_verdict;
@@ -119,6 +128,8 @@ int sc_main(int argc, char** argv) {
         const auto& s = r.stats["summary"];
         std::cerr << "rtsim-sim: " << s["rays"] << " rays, " << s["hit_mismatches"] << " hit mismatches, "
                   << s["work_mismatches"] << " work mismatches -> " << out_dir << "/stats.json\n";
+        if (s.contains("sampling_note"))
+            std::cerr << "rtsim-sim: note: " << s["sampling_note"].get<std::string>() << "\n";
         if (r.stats.contains("sampling"))
             for (const auto& why : r.stats["sampling"]["caveats"])
                 std::cerr << "rtsim-sim: warning: sample too small to trust: " << why.get<std::string>() << "\n";

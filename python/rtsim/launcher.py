@@ -26,7 +26,14 @@ from typing import Any
 SIM_EXE = "rtsim-sim"
 EXIT_OK, EXIT_BAD_INPUT, EXIT_MISMATCH = 0, 2, 3
 #: What rtsim-sim writes into the run folder (removed before a run: never stale).
-RUN_OUTPUTS = ("stats.json", "config.resolved.json", "provenance.json")
+RUN_OUTPUTS = (
+    "stats.json",
+    "config.resolved.json",
+    "provenance.json",
+    "dram_trace.dramsim3.txt",  # --dram-trace: a later run without it must not leave them behind
+    "dram_requests.csv",
+    "dram_trace.json",
+)
 
 
 class SimNotFoundError(OSError):
@@ -68,6 +75,7 @@ class SimJob:
     config: Path | None = None  # config JSON over the defaults
     sets: list[str] = field(default_factory=list)  # key.path=value, applied after config
     timeline: bool = False  # also write RUN/timeline.json
+    dram_trace: bool = False  # also write RUN/dram_trace.* (the requests that reached DRAM)
     progress: bool = False  # JSON progress lines on stderr
     verdict: bool = True  # False: --no-verdict (no bottleneck estimates after the run)
     check_verdict: bool = False  # --check-verdict: re-run the verdict's top knobs (RUN/check/N)
@@ -82,6 +90,8 @@ class SimJob:
             cmd += ["--set", assignment]
         if self.timeline:
             cmd.append("--timeline")
+        if self.dram_trace:
+            cmd.append("--dram-trace")
         if self.progress:
             cmd.append("--progress")
         if not self.verdict:

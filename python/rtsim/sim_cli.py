@@ -106,6 +106,8 @@ def run_and_report(
     console.print(f"run:      {job.out_dir}  (stats.json, config.resolved.json, provenance.json)")
     if job.timeline and (job.out_dir / "timeline.json").is_file():
         console.print(f"timeline: {job.out_dir / 'timeline.json'}  (open in ui.perfetto.dev)")
+    if job.dram_trace and (job.out_dir / "dram_trace.dramsim3.txt").is_file():
+        console.print(f"dram:     {job.out_dir / 'dram_trace.dramsim3.txt'}  (DRAMsim3 trace)")
     if result.returncode == EXIT_MISMATCH:
         print_mismatches(result.stats, err_console)
     return result.returncode
@@ -143,6 +145,7 @@ def cmd_simulate(args: argparse.Namespace, console: Any) -> int:
         config=config,
         sets=list(args.set or []),
         timeline=args.timeline,
+        dram_trace=args.dram_trace,
         check_verdict=args.check_verdict,
     )
     return run_and_report(job, console, show_progress=not args.no_progress, timeout=args.timeout)
@@ -199,6 +202,12 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-a
     p.add_argument("-o", "--output", required=True, metavar="RUN", help="run folder")
     p.add_argument(
         "--timeline", action="store_true", help="also write RUN/timeline.json (Perfetto)"
+    )
+    p.add_argument(
+        "--dram-trace",
+        action="store_true",
+        help="also write the requests that reached DRAM (RUN/dram_trace.dramsim3.txt, "
+        "dram_requests.csv, dram_trace.json) for DRAMsim3 or Ramulator 2 (approx, detailed)",
     )
     p.add_argument(
         "--timeout",

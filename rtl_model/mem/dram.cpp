@@ -49,6 +49,7 @@ Cycle Dram::access(const MemRequest& req) {
         data = start;
     }
     m_queue_cycles += start - req.time;
+    if (m_log) m_log->add({req.addr, req.time, ready, req.bytes, req.write});
     if (req.info) req.info->level = ServedBy::dram;
     // Bytes are counted when they move on the channel, at its rate (with the bank model, on the
     // data bus after the column command, not when the bank started): a transfer straddling a

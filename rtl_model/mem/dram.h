@@ -16,6 +16,7 @@
 #include "rtl_model/mem/dram_banks.h"
 #include "rtl_model/mem/mem_stats.h"
 #include "rtl_model/mem/dram_config.h"
+#include "rtl_model/mem/dram_request_log.h"
 
 namespace rtsim {
 
@@ -36,6 +37,8 @@ public:
     nlohmann::json stats_json(Cycle total_cycles, double clock_ghz) const;
     /// The bank model (model "banks"), else null.
     const DramBanks* banks() const { return m_banks.get(); }
+    /// Keeps every request from now on in `log` (null: stop); the log outlives the run.
+    void record_requests(DramRequestLog* log) { m_log = log; }
 
 private:
     DramConfig m_config;
@@ -45,6 +48,7 @@ private:
     MemStats m_stats;
     UsageSeries m_bytes_use;  ///< bytes moved over time
     uint64_t m_queue_cycles = 0;
+    DramRequestLog* m_log = nullptr;  ///< the requests kept for another simulator (--dram-trace)
 };
 
 }  // namespace rtsim

@@ -56,6 +56,7 @@ public:
     /// [{block, instantiated, why}]
     const nlohmann::json& instantiated() const { return m_instantiated; }
     const Dram* dram() const { return m_dram.get(); }
+    Dram* dram() { return m_dram.get(); }
     Dispatch& dispatch() { return *m_dispatch; }
     /// The shading block; null when the run does not model the frame.
     ShadingBlock* shading() { return m_shading.get(); }

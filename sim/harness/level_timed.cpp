@@ -3,9 +3,11 @@
 // traces replayed frame after frame with caches warm.
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 
 #include "rtl_model/top/top.h"
+#include "sim/config/config.h"
 #include "sim/harness/frame_builds.h"
 #include "sim/harness/frames.h"
 #include "sim/harness/hit_checker.h"
@@ -35,6 +37,21 @@ SimConfig timed_config(const SimConfig& c) {
     if (c.fidelity == Fidelity::detailed) t.quantum_cycles = 1;
     else if (c.treelets.enabled) t.quantum_cycles = std::min(t.quantum_cycles, c.treelets.quantum_cycles);
     return t;
+}
+
+/// RUN/dram_trace.dramsim3.txt, dram_requests.csv and dram_trace.json (the summary and the
+/// DRAM config the stream was timed with, for the replaying script).
+void write_dram_trace(const DramRequestLog& log, const SimConfig& c, bool has_dram, const std::string& out_dir) {
+    require(has_dram, "--dram-trace: this run has no DRAM (ideal_memory)");
+    const fs::path dir(out_dir);
+    log.write_dramsim3((dir / "dram_trace.dramsim3.txt").string());
+    log.write_csv((dir / "dram_requests.csv").string());
+    json j = log.summary();
+    j["clock_ghz"] = c.clock_ghz;
+    j["dram"] = config_to_json(c)["dram"];
+    j["dramsim3_bytes_per_transaction"] = DramRequestLog::kDramsim3Bytes;
+    j["cycles_are"] = "rtsim core cycles (clock_ghz)";
+    std::ofstream((dir / "dram_trace.json").string()) << j.dump(2) << "\n";
 }
 
 }  // namespace
@@ -119,6 +136,8 @@ LevelResult run_timed_level(RunInputs& in) {
             sampled->estimator.ray_done(r);
             if (hook) hook(r);
         };
+    DramRequestLog dram_log;  // outlives the run (the DRAM writes into it during sc_start)
+    if (in.options.dram_trace && top.dram()) top.dram()->record_requests(&dram_log);
     std::unique_ptr<FunctionalWarmer> warmer;  // sampled runs with functional warming
     if (sampled && c.sampling.warming_rays > 0) {
         warmer = std::make_unique<FunctionalWarmer>(
@@ -146,6 +165,7 @@ LevelResult run_timed_level(RunInputs& in) {
     if (in.options.timeline && top.dram())
         timeline.write((fs::path(in.options.out_dir) / "timeline.json").string(), top.units(),
                        top.dram()->bytes_over_time(), Dram::bucket_cycles());
+    if (in.options.dram_trace) write_dram_trace(dram_log, c, top.dram() != nullptr, in.options.out_dir);
     const double wall = in.wall_seconds();
     r.summary = summarize(c, r.cycles, built.rays, r.model,
                           {checker.hit_mismatches(), checker.work_mismatches(), checker.latency().mean()}, wall);

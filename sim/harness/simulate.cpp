@@ -12,6 +12,7 @@
 #include "sim/report/report_block.h"
 #include "sim/report/stats_schema.h"
 #include "sim/report/summary.h"
+#include "sim/sampling/sampling.h"
 
 namespace rtsim {
 
@@ -51,6 +52,16 @@ SimOutcome report(RunInputs& in, LevelResult& level) {
     if (sampled) out.stats["sampling"] = level.sampling;
     json& summary = out.stats["summary"];
     summary["sampled"] = sampled;
+    // A sample that would be the whole trace is not taken (sample_covers_trace): say so, or a
+    // sampling request ends in a full, exact run that reads like one that was never asked for.
+    const bool timed = c.fidelity == Fidelity::approx || c.fidelity == Fidelity::detailed;
+    if (!sampled && timed && c.sampling.enabled())
+        summary["sampling_note"] = "sampling (" +
+                                   (c.sampling.count ? "sampling.count " + std::to_string(c.sampling.count)
+                                                     : "sampling.fraction " + json(c.sampling.fraction).dump()) +
+                                   ") would cover the whole trace of " + std::to_string(level.rays) +
+                                   " rays (or no sample of it fits two clusters of warm-up and measured rays): "
+                                   "every ray was simulated, the figures are exact";
     summary["frames"] = level.frame_count;
     summary["resolved"] = in.setup.to_json();
     ReportInputs inputs{c, level.work, level.rays, in.setup.structure.kind, {}};

@@ -16,6 +16,9 @@ struct SimOptions {
     SimConfig config;
     std::string out_dir;  ///< created if missing
     bool timeline = false;
+    /// Also write the requests that reached DRAM (RUN/dram_trace.dramsim3.txt, dram_requests.csv,
+    /// dram_trace.json), for replaying in another DRAM simulator (docs/model.md, "Against DRAMsim3"); timed levels only.
+    bool dram_trace = false;
     bool progress = false;  ///< JSON progress lines on stderr: {"progress": done, "total": n}
     bool verdict = true;    ///< name the bottleneck and estimate what relaxing it buys (sim/report/verdict.h)
     /// Re-run the verdict's top knobs and co-limit, each in its own process (verdict_check.h)

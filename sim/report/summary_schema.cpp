@@ -81,6 +81,9 @@ const StatBlock& summary_stats() {
         {"sampled", "bool",
          "true when only a sample of the rays was simulated ([fidelity.md](fidelity.md#sampling))",
          false, false},
+        {"sampling_note", "",
+         "timed runs that asked for sampling but were not sampled: why (the sample would cover the whole trace, or no sample fits it); every ray was simulated and the figures are exact. `rtsim-sim` also prints it",
+         false, true},
         {"resolved", "",
          "what the run's resolution step settled ([capabilities.md](capabilities.md)): `derived`, the fields the config left to the run (`[{key, value, why}]`: `traversal.ray_contexts` 0 follows the unit kind's warps or packets, `traversal.stack_entry_bytes` 0 the structure's), and `unused`, settings that have no effect on this run (`[{key, why}]`)",
          false, false},
@@ -190,7 +193,7 @@ const StatBlock& provenance_stats() {
 static bool sampled_only(const StatDecl& d) {
     static const char* const not_sampled[] = {"simd_efficiency", "frame_ms", "shading_share", "frame_speedup_2x_rt",
                                               "shading_divergence", "shading_simd_efficiency", "tex_hit_rate",
-                                              "energy_per_frame_mj"};
+                                              "energy_per_frame_mj", "sampling_note"};
     for (const char* k : not_sampled)
         if (std::string(d.key) == k) return false;
     return d.optional;

@@ -45,6 +45,9 @@ nlohmann::json verdict_sample_key(const SimConfig& base, const std::string& iden
 }  // namespace
 
 VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
+    // A timed run's own DRAM figures: the row outcomes and bank waits the closed form leaves out.
+    if (c.config.fidelity == Fidelity::approx || c.config.fidelity == Fidelity::detailed)
+        m_dram = calibrate_dram_latency(c.config, c.model.contains("dram") ? c.model["dram"] : nlohmann::json());
     if (c.estimate) {
         m_method = c.estimate_method;
         return;
@@ -96,14 +99,19 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
     m_reused = true;
 }
 
+
+SimConfig VerdictEstimator::estimated_config(const SimConfig& config) const {
+    return m_dram.apply(analytic_config(config, m_context.unit.estimate_as));
+}
+
 double VerdictEstimator::dram_bytes(const SimConfig& config) const {
-    const SimConfig a = analytic_config(config, m_context.unit.estimate_as);
+    const SimConfig a = estimated_config(config);
     if (m_context.estimate_bytes) return m_context.estimate_bytes(a);
     return m_form ? (*m_form)(a).dram_bytes : 0.0;
 }
 
 std::pair<double, std::string> VerdictEstimator::operator()(const SimConfig& config) const {
-    const SimConfig a = analytic_config(config, m_context.unit.estimate_as);
+    const SimConfig a = estimated_config(config);
     if (m_context.estimate) return m_context.estimate(a);
     const ClosedForm form = (*m_form)(a);
     return {form.cycles, form.binding};

@@ -14,6 +14,7 @@
 #include "sim/analytic/estimate.h"
 #include "sim/analytic/profile.h"
 #include "sim/config/config.h"
+#include "sim/report/dram_latency_calibration.h"
 
 namespace rtsim {
 
@@ -35,6 +36,9 @@ public:
     const std::string& method() const { return m_method; }
     /// True when the analysis was loaded from beside the trace (not stepped by this run).
     bool reused() const { return m_reused; }
+    /// The DRAM latency the estimates charge beyond dram.latency, from the judged run's bank
+    /// model (dram_latency_calibration.h); nothing measured when the run is not timed.
+    const DramLatencyCalibration& dram_calibration() const { return m_dram; }
 
 private:
     const VerdictContext& m_context;
@@ -43,6 +47,9 @@ private:
     std::unique_ptr<FormEstimator> m_form;  ///< the closed form of each config against m_profile
     std::string m_method;
     bool m_reused = false;
+    DramLatencyCalibration m_dram;
+    /// analytic_config of `config` with the calibrated DRAM latency: what every estimate times.
+    SimConfig estimated_config(const SimConfig& config) const;
 };
 
 }  // namespace rtsim

@@ -35,6 +35,9 @@ def test_every_knob_is_weighed(hairball: Path, sim: Sim, tmp_path: Path) -> None
         assert key in keys, key
     assert len(v["top"]) == 3 and v["top"] == v["candidates"][:3]
     gains = [c["speedup"] for c in v["candidates"]]
+    if "tie_break" in v["candidates"][0]:  # a near tie went to the knob that also removes traffic
+        assert gains[0] >= gains[1] - 0.03 and v["candidates"][0]["dram_saved_fraction"] > 0
+        gains[0], gains[1] = gains[1], gains[0]
     assert all(g is not None for g in gains) and gains == sorted(gains, reverse=True)
     assert v["relax"]["key"] == v["top"][0]["key"]
     # Area: SRAM and pipelines are priced, MSHRs are not.
