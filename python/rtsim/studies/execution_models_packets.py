@@ -87,21 +87,15 @@ def packet_counters(rec: Any) -> dict[str, Any]:
     }
 
 
-def packet_rows(run: StudyRun) -> list[dict[str, Any]]:
-    """The rows in configuration order per trace, with `trace` (scene_rays) and `config`."""
-    order = {c[0]: i for i, c in enumerate(CONFIGS + _wide_configs())}
+def packet_rows(run: StudyRun, configs: list[tuple] = CONFIGS) -> list[dict[str, Any]]:
+    """The rows in the order of `configs` per trace, with `trace` (scene_rays) and `config`."""
+    order = {c[0]: i for i, c in enumerate(configs)}
     rows = []
     for r in run.rows():
         trace = f"{r['part'].split('-')[1]}_{r['workload']}"  # the part: PREFIX-SCENE-ACCEL
         rows.append({**r, **r["packet"], "trace": trace, "config": r["point"]})
     traces = list(dict.fromkeys(r["trace"] for r in rows))
     return sorted(rows, key=lambda r: (traces.index(r["trace"]), order[r["config"]]))
-
-
-def _wide_configs() -> list[tuple]:
-    from rtsim.studies.execution_models_packets_wide import WIDE_CONFIGS
-
-    return WIDE_CONFIGS
 
 
 def mismatches(rows: list[dict[str, Any]]) -> int:

@@ -44,7 +44,7 @@ def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def table(run: StudyRun) -> str:
-    rows, m = packet_rows(run), run.measured()
+    rows, m = packet_rows(run, WIDE_CONFIGS), run.measured()
     lines = [
         f"Measured {m['date']} on {m['host']} by `{run.command}`: the machine above (8 units x "
         f"{CONTEXTS} ray contexts), approx level; box x16: `box.width=16` (a box pipeline as wide "
