@@ -181,6 +181,8 @@ def trends(run: StudyRun) -> str:
 def sorting(run: StudyRun) -> str:
     """Sorting on a larger batch (Sponza diffuse): does a bigger window buy coherence?"""
     rows = run.rows(part="execution-models-sorting")
+    if not rows:
+        return "Not measured in this run (it needs Sponza and `--option sort_study=true`).\n"
     lines = [
         f"Sponza diffuse at {run.options['sort_resolution']}, same machine and method as above; "
         "`dispatch.sort_window` as given (4,096 is the default; `dispatch.chunk_rays` at least "
