@@ -1,7 +1,7 @@
 """Generated text between `<!-- NAME:begin -->` and `<!-- NAME:end -->` markers in a doc.
 
 The studies (`rtsim study NAME`, rtsim/study) and the doc-generator scripts
-(scripts/gen_stats_doc.py, scripts/frames_study.py) write their tables this way, so the prose
+(scripts/gen_stats_doc.py) write their tables this way, so the prose
 around a table stays hand written and the table stays reproducible.
 """
 
