@@ -29,6 +29,9 @@ using nlohmann::json;
 
 namespace {
 
+/// Most placed triangles whose shading records a trace holds (about 1.5 GiB of them).
+constexpr uint64_t kMaxShadedTriangles = uint64_t(1) << 25;
+
 /// The camera the user gave, else the scene's first camera, else automatic framing.
 Camera choose_camera(const TraceOptions& o, const Scene& scene, const Accel& accel, std::string* source) {
     if (o.camera) {
@@ -181,7 +184,16 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
 
     TraceFolderWriter folder(o.out_dir, accel->image());
     const std::string scene_name = procedural ? o.scene : fs::path(path).stem().string();
-    folder.set_shading(scene, build_shading_scene(scene, scene_name, procedural, accel->image().end_address()));
+    // The shading tables hold a record per *placed* triangle (44 bytes): an instanced scene too
+    // large to flatten (the forest: hundreds of millions placed) would need tens of GiB, so its
+    // trace is written without them, and says so (shading.enabled then refuses it by name).
+    if (scene.triangle_count() <= kMaxShadedTriangles)
+        folder.set_shading(scene, build_shading_scene(scene, scene_name, procedural, accel->image().end_address()));
+    else
+        scene.warnings.push_back("shading tables not written: the scene places " +
+                                 std::to_string(scene.triangle_count()) + " triangles, more than the " +
+                                 std::to_string(kMaxShadedTriangles) + " a trace's shading tables hold (44 bytes "
+                                 "each); the frame (shading.enabled) cannot be replayed from this trace");
     uint32_t light_count = uint32_t(scene.lights.size() + (plan.emissive_prims.empty() ? 0 : 1));
     PreviewRender render(o.width, o.height, plan.wants(RayKind::shadow) ? light_count : 0);
     std::vector<uint64_t> first_ray, frame_rays;
