@@ -111,6 +111,12 @@ std::vector<Rule> make_rules() {
          "a packet's shared walk orders children for all its rays by entry distance",
          "traversal.model=mimd or simt, or traversal.anyhit_order=nearest", "bvh2",
          {"traversal.model=packet", "traversal.anyhit_order=largest_box"}});
+    add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::level,
+         "an untimed level", [](const RunFacts& f) { return !f.level.timed; },
+         "the timed levels check each ray's hit and work against the trace's, traced nearest first; another "
+         "order finds other occluders with other work (a trace traced in the run's order is not built yet)",
+         "fidelity=analytic or functional, or traversal.anyhit_order=nearest", "bvh2",
+         {"traversal.anyhit_order=fixed", "fidelity=approx"}});
 
     // Sampling.
     add({"sampling/level", "sampling.fraction or sampling.count", sampling, RuleSide::level, "a timed level",
