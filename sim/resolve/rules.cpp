@@ -112,10 +112,11 @@ std::vector<Rule> make_rules() {
          "traversal.model=mimd or simt, or traversal.anyhit_order=nearest", "bvh2",
          {"traversal.model=packet", "traversal.anyhit_order=largest_box"}});
     add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::level,
-         "an untimed level", [](const RunFacts& f) { return !f.level.timed; },
-         "the timed levels check each ray's hit and work against the trace's, traced nearest first; another "
-         "order finds other occluders with other work (a trace traced in the run's order is not built yet)",
-         "fidelity=analytic or functional, or traversal.anyhit_order=nearest", "bvh2",
+         "the functional level", [](const RunFacts& f) { return f.config.fidelity == Fidelity::functional; },
+         "the other levels check each ray's hit and work against the trace's (or take the work from it), "
+         "traced nearest first; another order finds other occluders with other work. The functional level "
+         "checks its any-hit rays' occlusion alone (a trace traced in the run's order is not built yet)",
+         "fidelity=functional, or traversal.anyhit_order=nearest", "bvh2",
          {"traversal.anyhit_order=fixed", "fidelity=approx"}});
 
     // Sampling.
