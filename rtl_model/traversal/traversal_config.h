@@ -7,6 +7,7 @@
 
 #include "rtl_model/common/choice.h"
 #include "rtl_model/traversal/unit_kind.h"
+#include "traces/accel/step_options.h"
 
 namespace rtsim {
 
@@ -19,6 +20,11 @@ namespace rtsim {
 enum class StackOverflow : uint8_t { spill = 0, restart_trail = 1 };
 inline constexpr Choices<StackOverflow, 2> kStackOverflowChoices{{"spill", "restart_trail"}};
 
+/// Which hit child an any-hit (shadow) ray visits first at a node (traces/accel/step_options.h):
+/// nearest (entry distance, the closest-hit order), largest_box (larger surface area first: more
+/// likely to hold an occluder) or fixed (child 0 first, no sort). Hit/miss never changes.
+inline constexpr Choices<AnyHitOrder, 3> kAnyHitOrderChoices{{"nearest", "largest_box", "fixed"}};
+
 /// Ray contexts per unit when traversal.ray_contexts is 0 and each context runs alone.
 inline constexpr uint32_t kDefaultRayContexts = 16;
 
@@ -30,6 +36,7 @@ struct TraversalConfig {
     uint32_t stack_entry_bytes = 0;  ///< bytes per stack entry; 0: the structure's (8 for a BVH, 12 for a kd-tree, ...)
     StackOverflow stack_overflow = StackOverflow::spill;  ///< a push onto a full on-chip stack: spill or drop and restart
     uint32_t box_precision_bits = 0;  ///< box tests' mantissa bits; 0: fp32 (docs/accel.md, "Reduced-precision box tests")
+    AnyHitOrder anyhit_order = AnyHitOrder::nearest;  ///< any-hit rays' child order at a node
     uint32_t issue_cycles = 1;       ///< cycles the unit's scheduler needs per traversal step
     /// Each unit kind's own section (traversal.simt, traversal.packet, ...): the kinds' fields.
     UnitSections kinds;
@@ -64,6 +71,7 @@ struct TraversalConfig {
         v.field("stack_entry_bytes", stack_entry_bytes, "bytes", "Bytes per stack entry (on-chip stack and spill traffic); 0: the structure's own (a BVH's 8: node and entry distance; a kd-tree's or BIH's 12; an octree's 32), resolved from the trace", 0, 64);
         v.choice("stack_overflow", stack_overflow, kStackOverflowChoices, "A push onto a full on-chip stack: spill (the oldest entry goes to memory and is read back) or restart_trail (a short stack: the oldest entry is dropped; an empty stack with dropped entries restarts at the root along a restart trail, Laine 2010; structures with a restart trail: rtsim capabilities)");
         v.field("box_precision_bits", box_precision_bits, "bits", "Explicit mantissa bits of a reduced-precision, conservative box pipeline (Keely 2014; Vaidyanathan et al. 2016): boxes, differences and slab distances rounded outward, so it accepts every box fp32 does and some more, whose subtrees are walked as extra work (hits unchanged); 0: fp32 (23 bits). Structures with a reduced-precision walk: rtsim capabilities", 0, 22);
+        v.choice("anyhit_order", anyhit_order, kAnyHitOrderChoices, "Which hit child an any-hit (shadow) ray visits first at a node: nearest (entry distance, as closest-hit rays), largest_box (the larger child box surface area first: more likely to hold an occluder) or fixed (child 0 first, no sort). Occlusion (hit or miss) never changes; the occluder found and the work may. Structures with the setting: rtsim capabilities");
         v.field("issue_cycles", issue_cycles, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100);
         kinds.visit(v);
     }

@@ -115,6 +115,7 @@ std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& acc
     add(&step.mailbox_entries, sizeof step.mailbox_entries);
     add(&step.short_stack_entries, sizeof step.short_stack_entries);
     add(&step.box_precision_bits, sizeof step.box_precision_bits);
+    add(&step.anyhit_order, sizeof step.anyhit_order);
     for (const RayJob& j : jobs) {
         add(&j.id, sizeof j.id);
         add(&j.ray, sizeof j.ray);

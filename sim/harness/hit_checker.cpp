@@ -51,6 +51,15 @@ void HitChecker::packet_done(const RayResult* results, const Ray* rays, const Tr
     }
 }
 
+void HitChecker::occlusion_done(const RayResult& r) {
+    HitRecord want = m_reference.hit(r.id);
+    if ((want.prim >= 0) == r.hit.valid()) {
+        want.prim = r.hit.prim;
+        want.t = r.hit.t;
+    }
+    check(r, want, WorkRecord::of(r.work.traced()));
+}
+
 void HitChecker::check(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work) {
     bool hit_differs = false;
     std::string diff = compare_with_reference(r, ref_hit, ref_work, &hit_differs);

@@ -35,6 +35,11 @@ public:
     using PacketReference = std::function<void(const Ray*, const TraversalMode*, uint32_t, Hit*, WorkCounts*)>;
     void set_packet_reference(PacketReference reference) { m_packet_reference = std::move(reference); }
 
+    /// A ray whose walk the trace was not traced with (an any-hit ray in another child order,
+    /// StepOptions::anyhit_order): its occlusion is checked against the trace, its hit primitive
+    /// and work are the model's own (the stepper tests check them against trace()).
+    void occlusion_done(const RayResult& r);
+
     uint64_t checked() const { return m_checked; }
     uint64_t hit_mismatches() const { return m_hit_mismatches; }
     uint64_t work_mismatches() const { return m_work_mismatches; }

@@ -65,17 +65,19 @@ void trace_all(Accel& accel, const StepOptions& step, TraceReader& reader, HitCh
             }
             RayResult r;
             r.id = job.id;
+            const TraversalMode mode = job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
             try {
                 if (packets) {
                     packets->add(job);
                     continue;
                 }
-                const TraversalMode mode = job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
                 r.hit = accel.trace(job.ray, mode, &r.work, step);
             } catch (const Error& e) {
                 throw Error(reader.path() + ": ray " + std::to_string(job.id) + ": " + e.what());
             }
-            checker.ray_done(r);
+            // Any-hit rays in another child order than the trace's: occlusion checked alone.
+            if (mode == TraversalMode::any_hit && step.anyhit_order != AnyHitOrder::nearest) checker.occlusion_done(r);
+            else checker.ray_done(r);
         }
         jobs.clear();
     }

@@ -35,6 +35,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& techniques(
         {"prefetching, no queues", {"treelets.prefetch=true"}},
         {"restart trail", {"traversal.stack_overflow=restart_trail"}},
         {"8-bit boxes", {"traversal.box_precision_bits=7"}},
+        {"any-hit largest box first", {"traversal.anyhit_order=largest_box"}},
         {"mailbox", {"mailbox.entries=8"}},
         {"ray sorting", {"dispatch.sort=morton"}},
         {"20% sampling", {"sampling.fraction=0.2"}},
@@ -151,11 +152,12 @@ std::string capability_markdown() {
     std::ostringstream md;
     auto yes = [](const json& b) { return b.get<bool>() ? "yes" : "-"; };
     md << "### Structures and what they offer\n\n| structure | packet kernel | restart trail | reduced-precision boxes | "
-          "mailbox | compressed leaves | treelet partition | stack entry (bytes) |\n|---|---|---|---|---|---|---|---|\n";
+          "any-hit order | mailbox | compressed leaves | treelet partition | stack entry (bytes) |\n|---|---|---|---|---|---|---|---|---|\n";
     for (const json& s : t["structures"]) {
         const json& c = s["capabilities"];
         md << "| " << s["name"].get<std::string>() << " | " << yes(c["packet_kernel"]) << " | "
-           << yes(c["restart_trail"]) << " | " << yes(c["reduced_precision_boxes"]) << " | " << yes(c["mailbox"])
+           << yes(c["restart_trail"]) << " | " << yes(c["reduced_precision_boxes"]) << " | " << yes(c["anyhit_order"])
+           << " | " << yes(c["mailbox"])
            << " | " << yes(c["compressed_leaves"]) << " | " << yes(c["treelet_partition"]) << " | "
            << c["stack_entry_bytes"].get<uint32_t>() << " |\n";
     }

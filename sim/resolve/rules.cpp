@@ -6,6 +6,7 @@ namespace {
 
 bool restart_trail(const RunFacts& f) { return f.config.traversal.stack_overflow == StackOverflow::restart_trail; }
 bool reduced_boxes(const RunFacts& f) { return f.config.traversal.box_precision_bits != 0; }
+bool anyhit_reordered(const RunFacts& f) { return f.config.traversal.anyhit_order != AnyHitOrder::nearest; }
 bool treelets(const RunFacts& f) { return f.config.treelets.enabled; }
 bool sampling(const RunFacts& f) { return f.config.sampling.enabled(); }
 bool animated(const RunFacts& f) { return f.structure.frames > 1; }
@@ -98,6 +99,25 @@ std::vector<Rule> make_rules() {
          "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
          "a packet's shared walk has no per-ray extra walk", "traversal.model=mimd or simt, or box_precision_bits=0",
          "bvh2", {"traversal.model=packet", "traversal.box_precision_bits=7"}});
+
+    add({"anyhit_order/structure", "traversal.anyhit_order (any-hit child order)", anyhit_reordered,
+         RuleSide::structure, "an any-hit child order", [](const RunFacts& f) { return f.structure.caps.anyhit_order; },
+         "the order is chosen between a binary BVH node's two child boxes; other structures order their "
+         "children by their own rules",
+         "traversal.anyhit_order=nearest, or trace a structure with the setting (rtsim capabilities)", "grid",
+         {"traversal.anyhit_order=fixed"}});
+    add({"anyhit_order/unit", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::unit,
+         "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
+         "a packet's shared walk orders children for all its rays by entry distance",
+         "traversal.model=mimd or simt, or traversal.anyhit_order=nearest", "bvh2",
+         {"traversal.model=packet", "traversal.anyhit_order=largest_box"}});
+    add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::level,
+         "the functional level", [](const RunFacts& f) { return f.config.fidelity == Fidelity::functional; },
+         "the other levels check each ray's hit and work against the trace's (or take the work from it), "
+         "traced nearest first; another order finds other occluders with other work. The functional level "
+         "checks its any-hit rays' occlusion alone (a trace traced in the run's order is not built yet)",
+         "fidelity=functional, or traversal.anyhit_order=nearest", "bvh2",
+         {"traversal.anyhit_order=fixed", "fidelity=approx"}});
 
     // Sampling.
     add({"sampling/level", "sampling.fraction or sampling.count", sampling, RuleSide::level, "a timed level",

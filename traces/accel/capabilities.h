@@ -17,6 +17,8 @@ struct AccelCapabilities {
     bool restart_trail = false;
     /// A conservative reduced-precision box walk (rp_boxes.h): traversal.box_precision_bits.
     bool reduced_precision_boxes = false;
+    /// Any-hit rays' child order at a node (StepOptions::anyhit_order): traversal.anyhit_order.
+    bool anyhit_order = false;
     /// References that repeat along a ray, which its steppers look up in a mailbox (mailbox.h).
     bool mailbox = false;
     /// Its triangles may be stored as compressed leaf blocks (leaf_blocks.h).
@@ -43,6 +45,7 @@ struct AccelCapabilities {
         return {{"packet_kernel", packet_kernel},
                 {"restart_trail", restart_trail},
                 {"reduced_precision_boxes", reduced_precision_boxes},
+                {"anyhit_order", anyhit_order},
                 {"mailbox", mailbox},
                 {"compressed_leaves", compressed_leaves},
                 {"blas", blas},

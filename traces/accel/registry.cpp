@@ -194,6 +194,7 @@ const std::vector<Entry>& registry() {
               .with(&AccelCapabilities::packet_kernel)
               .with(&AccelCapabilities::restart_trail)
               .with(&AccelCapabilities::reduced_precision_boxes)
+              .with(&AccelCapabilities::anyhit_order)
               .with(&AccelCapabilities::refit)},
          tree_settings, build_bvh2, loader<Bvh2Accel>()},
         wide_entry("bvh4", "4-wide BVH, 128-byte fp32 nodes, SAH-optimal collapse of the binary tree (docs/accel.md)", 4,

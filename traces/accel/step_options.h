@@ -9,6 +9,15 @@
 
 namespace rtsim {
 
+/// Which hit child an any-hit (occlusion) ray visits first at a binary BVH node. Closest-hit rays
+/// always go nearest first. Any order gives the same occlusion answer (hit or miss); only the
+/// work to find an occluder and which occluder is found differ.
+enum class AnyHitOrder : uint8_t {
+    nearest = 0,      ///< nearer entry distance first (child 0 on ties): the closest-hit order
+    largest_box = 1,  ///< larger child box surface area first: more likely to hold an occluder
+    fixed = 2,        ///< child 0 first, no sort
+};
+
 struct StepOptions {
     /// Primitive ids remembered per ray (mailbox.h; structures whose references repeat along a
     /// ray); 0: none. Hits never change; the mailbox's counts go to the model-only work fields.
@@ -19,10 +28,15 @@ struct StepOptions {
     /// Mantissa bits of a conservative reduced-precision box test (rp_boxes.h); 0: fp32 alone.
     /// Hits and the reference work never change; the extra walk is model-only work.
     uint32_t box_precision_bits = 0;
+    /// Child order of any-hit rays (binary BVH steppers); hit/miss never changes, the occluder
+    /// found and the work may. The fused loops walk nearest first, so other orders use a stepper.
+    AnyHitOrder anyhit_order = AnyHitOrder::nearest;
 
     /// True when a structure's fused reference loop walks as its steppers do: no short stack or
-    /// reduced-precision walk whose extra work only a stepper counts.
-    bool fused_loop_walks_alike() const { return short_stack_entries == 0 && box_precision_bits == 0; }
+    /// reduced-precision walk whose extra work only a stepper counts, and any-hit rays nearest first.
+    bool fused_loop_walks_alike() const {
+        return short_stack_entries == 0 && box_precision_bits == 0 && anyhit_order == AnyHitOrder::nearest;
+    }
 };
 
 }  // namespace rtsim

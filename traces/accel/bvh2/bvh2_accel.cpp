@@ -188,7 +188,8 @@ Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::m
 }
 
 std::unique_ptr<Stepper> Bvh2Accel::make_stepper(const StepOptions& options) const {
-    return std::make_unique<Bvh2Stepper>(m_view, options.short_stack_entries, options.box_precision_bits);
+    return std::make_unique<Bvh2Stepper>(m_view, options.short_stack_entries, options.box_precision_bits,
+                                         options.anyhit_order);
 }
 
 Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {

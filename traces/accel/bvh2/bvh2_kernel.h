@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "traces/accel/step_options.h"
 #include "traces/bvh/hw_layout.h"
 #include "traces/common/ray.h"
 #include "traces/isect/leaf_kernel.h"
@@ -59,6 +60,23 @@ inline unsigned next_slot(unsigned mask, const float tnear[2]) {
     return mask >> 1;
 }
 
+/// Half the surface area of a child slot's box (enough to compare two boxes).
+inline float half_area(const HwNode& node, int child) {
+    const float dx = node.hi(child, 0) - node.lo(child, 0);
+    const float dy = node.hi(child, 1) - node.lo(child, 1);
+    const float dz = node.hi(child, 2) - node.lo(child, 2);
+    return dx * dy + dy * dz + dz * dx;
+}
+
+/// The slot to visit next by an any-hit order (AnyHitOrder): a larger box is more likely to
+/// hold an occluder (the surface-area argument of MacDonald & Booth 1990 applied to shadow
+/// rays), and a fixed order saves the sort. Child 0 on equal areas.
+inline unsigned next_slot(unsigned mask, const float tnear[2], const HwNode& node, AnyHitOrder order) {
+    if (mask != 3 || order == AnyHitOrder::nearest) return next_slot(mask, tnear);
+    if (order == AnyHitOrder::fixed) return 0u;
+    return half_area(node, 1) > half_area(node, 0) ? 1u : 0u;
+}
+
 /// A traversal-stack entry of a binary walk: the child to resume at and its entry distance.
 struct Bvh2StackEntry {
     uint32_t ref;    ///< node index, or first record of a leaf
@@ -68,15 +86,16 @@ struct Bvh2StackEntry {
 
 /// One node step of a binary walk (the BVH's stepper and the two-level TLAS walk): counts the
 /// step and its two box tests, pushes the farther hit child onto stack[size++] and names the
-/// nearer in *ref / *count. Returns false when no child is hit (the caller pops).
+/// nearer (or the first by an any-hit `order`) in *ref / *count. Returns false when no child is hit (the caller pops).
 inline bool descend(const RayBoxPre& pre, const HwNode& node, float tmin, float cull, WorkCounts& work,
-                    Bvh2StackEntry* stack, int& size, uint32_t* ref, uint32_t* count) {
+                    Bvh2StackEntry* stack, int& size, uint32_t* ref, uint32_t* count,
+                    AnyHitOrder order = AnyHitOrder::nearest) {
     work.steps += 1;
     work.box_tests += 2;
     float tnear[2];
     const unsigned mask = node_step(pre, node, tmin, cull, tnear);
     if (mask == 0) return false;
-    const unsigned next = next_slot(mask, tnear);
+    const unsigned next = next_slot(mask, tnear, node, order);
     if (mask == 3) {
         const unsigned far = next ^ 1u;
         if (size >= kTraversalStackSize) throw_stack_overflow();

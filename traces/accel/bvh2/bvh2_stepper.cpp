@@ -93,12 +93,13 @@ StepOutcome Bvh2Stepper::execute() {
 }
 
 void Bvh2Stepper::visit_node(const HwNode& node) {
-    // Nearer child next (child 0 on equal entry distances); the farther one pushed.
+    // Nearer child next (child 0 on equal entry distances; any-hit rays by their order); the other pushed.
     const int before = m_stack_size;
     if (m_short.enabled()) m_short.visit(m_ref, m_depth);
     float rp_tnear[2];
     if (m_rp.enabled()) rp_tests(node, rp_tnear);
-    if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count))
+    const AnyHitOrder order = m_mode == TraversalMode::any_hit ? m_anyhit_order : AnyHitOrder::nearest;
+    if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count, order))
         return pop_next();
     if (m_rp.enabled() && m_stack_size > before) {
         const detail::Bvh2StackEntry& pushed = m_stack[m_stack_size - 1];

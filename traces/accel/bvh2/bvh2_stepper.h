@@ -38,8 +38,9 @@ struct Bvh2View {
 
 class Bvh2Stepper final : public Stepper {
 public:
-    explicit Bvh2Stepper(const Bvh2View& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0)
-        : m_view(view) {
+    explicit Bvh2Stepper(const Bvh2View& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0,
+                         AnyHitOrder anyhit_order = AnyHitOrder::nearest)
+        : m_view(view), m_anyhit_order(anyhit_order) {
         m_short.configure(short_stack_entries);
         m_rp.configure(box_precision_bits);
     }
@@ -63,6 +64,7 @@ private:
     void finish();  ///< the plan is done; a ray without a hit reports Hit{} (t = +inf)
 
     Bvh2View m_view;
+    AnyHitOrder m_anyhit_order;  ///< child order of any-hit rays (closest-hit: nearest first)
     RayBoxPre m_box;
     RayTrianglePre m_tri;
     float m_cull_t = 0.0f;  ///< boxes entered beyond this are culled: best t widened
