@@ -466,7 +466,8 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         metavar="RATIO",
         help_text=lambda: (
             "--frame-policy adaptive: rebuild once a refitted tree's SAH cost exceeds this "
-            f"ratio of its cost after the last rebuild (default: {tracer_default('rebuild_threshold')})"
+            "ratio of its cost after the last rebuild "
+            f"(default: {tracer_default('rebuild_threshold')})"
         ),
     )
     p.set_defaults(func=cmd_trace)
