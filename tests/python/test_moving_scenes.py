@@ -1,0 +1,72 @@
+"""Moving scenes through the whole chain (docs/accel.md, "Moving scenes"): a deforming
+procedural scene traced over frames under each --frame-policy replays with every hit checked,
+the build unit prices each frame's build, and the policies differ where they should (a refit
+never rebuilds; a refit's build is cheaper than a rebuild's)."""
+
+from __future__ import annotations
+
+import itertools
+import json
+from pathlib import Path
+
+import pytest
+
+from conftest import run_rtsim, sim_stats
+
+FRAMES, RESOLUTION = 4, "24x18"
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory, sim_exe: Path) -> dict[str, dict]:
+    root = tmp_path_factory.mktemp("moving")
+    out: dict[str, dict] = {}
+    for policy in ("rebuild", "refit", "adaptive"):
+        trace = root / policy
+        result = run_rtsim("trace", "exploding_hairball", "-o", str(trace), "--resolution",
+                           RESOLUTION, "--frames", str(FRAMES), "--frame-policy", policy,
+                           "--workload", "primary,shadow")  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        manifest = json.loads((trace / "manifest.json").read_text())
+        stats = sim_stats(sim_exe, trace, root / f"s_{policy}")
+        out[policy] = {"manifest": manifest, "stats": stats}
+    return out
+
+
+def test_every_policy_replays_with_every_hit_checked(runs: dict[str, dict]) -> None:
+    for policy, run in runs.items():
+        summary = run["stats"]["summary"]
+        assert summary["hit_mismatches"] == 0 and summary["work_mismatches"] == 0, policy
+        frames = run["manifest"]["frames"]
+        assert frames["policy"] == policy and "deformation" in frames
+        assert len(run["stats"]["frames"]) == FRAMES
+
+
+def test_build_unit_prices_each_later_frame(runs: dict[str, dict]) -> None:
+    for policy, run in runs.items():
+        unit = run["stats"]["model"]["build_unit"]
+        assert unit["frames"] == FRAMES - 1, policy
+        per = run["stats"]["frames"]
+        assert per[0]["build_cycles"] == 0
+        assert all(f["build_cycles"] > 0 and 0 < f["build_share"] < 1 for f in per[1:]), policy
+        assert unit["written_bytes"] > 0 and unit["read_bytes"] > 0
+    refit = runs["refit"]["stats"]["model"]["build_unit"]
+    rebuild = runs["rebuild"]["stats"]["model"]["build_unit"]
+    assert refit["rebuilds"] == 0 and refit["refits"] == 2 * (FRAMES - 1)  # BLAS and TLAS
+    assert rebuild["refits"] == 0
+    assert refit["busy_cycles"] < rebuild["busy_cycles"]
+
+
+def test_refitted_tree_loosens_over_frames(runs: dict[str, dict]) -> None:
+    per = runs["refit"]["manifest"]["frames"]["per_frame"]
+    ratios = [f["build"]["blas"][0]["sah_ratio"] for f in per]
+    assert ratios[0] == 1.0 and all(b > a for a, b in itertools.pairwise(ratios))
+    assert all(f["build"]["blas"][0]["action"] == "refit" for f in per[1:])
+
+
+def test_bad_policy_and_threshold_are_refused(tmp_path: Path) -> None:
+    bad = run_rtsim("trace", "cloth", "-o", str(tmp_path / "a"), "--frames", "2",
+                    "--frame-policy", "sometimes")  # fmt: skip
+    assert bad.returncode != 0 and "sometimes" in bad.stderr
+    low = run_rtsim("trace", "cloth", "-o", str(tmp_path / "b"), "--frames", "2",
+                    "--rebuild-threshold", "0.5")  # fmt: skip
+    assert low.returncode != 0 and "rebuild_threshold" in low.stderr
