@@ -26,9 +26,10 @@ NOT_YET_MOVED = {
     "two_level_study.py",
     "verdict_study.py",
 }
-#: Benchmarks and doc generators: they time or describe the binaries one process at a time.
+#: Benchmarks, doc generators and comparisons with other simulators (dram_compare: DRAMsim3):
+#: they time, describe or export from the binaries one process at a time.
 KEPT_SCRIPTS = re.compile(r"^(bench_|gen_|analytic_sweep_speed|sampling_coverage|stats_identity|"
-                          r"make_fuzz_corpus|technique_costs_doc)")  # fmt: skip
+                          r"make_fuzz_corpus|technique_costs_doc|dram_compare)")  # fmt: skip
 PRIVATE = re.compile(
     r"^def (trace|simulate|run_sim\w*)\(|rtsim-sim|rtsim-trace|from rtsim\.launcher import|"
     r"\"-m\", \"rtsim\", \"trace\"",
