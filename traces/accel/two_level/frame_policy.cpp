@@ -44,10 +44,9 @@ TreeReuse* FrameTree::reuse_for(uint32_t frame) {
     return &m_reuse;
 }
 
-nlohmann::json FrameTree::done(uint32_t frame, const BuildConfig& config) {
+nlohmann::json FrameTree::done(const BuildConfig& config) {
     // A kind built without a binary tree (kd-tree, grid, octree, GK-BVH) only rebuilds: no cost.
     if (!m_reuse.built) return {{"action", "build"}, {"tree_nodes", nullptr}, {"sah_cost", nullptr}, {"sah_ratio", nullptr}};
-    (void)frame;
     const double cost = sah_cost(*m_reuse.built, config);
     if (m_rebuilt) m_rebuilt_cost = cost;
     m_ratio = m_rebuilt_cost > 0.0 ? cost / m_rebuilt_cost : 1.0;

@@ -46,7 +46,7 @@ public:
     TreeReuse* reuse_for(uint32_t frame);
     /// After the frame's build (with reuse_for's reuse): records its SAH cost; returns the frame's
     /// record {"action": "build"|"refit", "tree_nodes", "sah_cost", "sah_ratio"}.
-    nlohmann::json done(uint32_t frame, const BuildConfig& config);
+    nlohmann::json done(const BuildConfig& config);
 
 private:
     FramePolicyOptions m_options;

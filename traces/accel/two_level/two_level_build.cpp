@@ -6,6 +6,7 @@
 #include <chrono>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <functional>
 #include <unordered_map>
 
@@ -281,7 +282,7 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
     };
     // What a deforming BLAS's frame did: its action, tree, SAH cost and the bytes it wrote.
     auto record_blas = [&](uint32_t f, uint32_t mesh, uint32_t blas, const AccelImage& img) {
-        json r = blas_tree[mesh]->done(f, options.build);
+        json r = blas_tree[mesh]->done(options.build);
         r["mesh"] = mesh;
         r["blas"] = blas;
         r["triangles"] = scene.meshes[mesh].triangle_count();
@@ -291,7 +292,10 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
 
     auto t0 = std::chrono::steady_clock::now();
     const bool any_deforming = std::find(deforming.begin(), deforming.end(), true) != deforming.end();
-    BlasSet blases = build_blases(any_deforming ? posed(0) : scene, options, cls, [&](uint32_t m) {
+    // Frame 0 of a deforming scene is its first pose (a copy); a still scene is used as it is.
+    std::optional<Scene> first_pose;
+    if (any_deforming) first_pose = posed(0);
+    BlasSet blases = build_blases(first_pose ? *first_pose : scene, options, cls, [&](uint32_t m) {
         return deforming[m] ? blas_tree[m]->reuse_for(0) : nullptr;
     });
     if (timing) timing->blas_ms = ms_since(t0);
@@ -325,7 +329,7 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
                                                            std::to_string(scene.instances.size()) + " instances");
         t0 = std::chrono::steady_clock::now();
         frames.push_back(build_tlas(scene, blases, blas_of_mesh[f], pose, options, tlas_tree.reuse_for(f)));
-        frame_build[f]["tlas"] = tlas_tree.done(f, options.build);
+        frame_build[f]["tlas"] = tlas_tree.done(options.build);
         frame_build[f]["tlas"]["instances"] = frames.back().records.size();
         frame_build[f]["tlas"]["bytes"] =
             frames.back().tlas.nodes.size() * sizeof(HwNode) + frames.back().records.size() * sizeof(InstanceRecord);
