@@ -59,7 +59,7 @@ def measure(run: StudyRun, r: dict[str, Any]) -> dict[str, Any]:
         return {"error": short_error(str(r.get("error") or ""))}
     m = manifest(folder)
     work = run.cached(
-        f"work-{folder.name}",
+        f"work-{folder.name}-all-rays",
         lambda: work_stats(folder, None, ("steps", "transforms", "tri_tests")),
     )
     timing = run.cached(
