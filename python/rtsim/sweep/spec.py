@@ -41,6 +41,8 @@ from rtsim.sweep.run_check import CheckedRun, config_patch, describe, first_refu
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
 SAMPLING_METHODS = ("random", "latin_hypercube")
+#: What `lights` on a scene may add (rtsim trace --lights): a sun gives a lightless scene shadows.
+SCENE_LIGHTS = ("none", "sun")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
 POINT_KEY = "point"  # the swept key under which a `points` entry's label is recorded
 TOP_KEYS = (
@@ -81,6 +83,7 @@ class SceneSpec:
     hairball_triangles: int = 200_000
     seed: int = 1
     flatten: bool = False  # instanced scenes: one world-space structure (rtsim trace --flatten)
+    lights: str = ""  # lights added to a scene without any (rtsim trace --lights); "": none
 
     def key(self) -> dict[str, Any]:
         key: dict[str, Any] = {
@@ -90,6 +93,8 @@ class SceneSpec:
         }
         if self.flatten:  # (absent when off: the keys of earlier sweeps stay valid)
             key["flatten"] = True
+        if self.lights:
+            key["lights"] = self.lights
         return key
 
 
@@ -317,7 +322,7 @@ class _Reader:
             d = LineDict({"name": items[i]})
             d.line = items.item_line(i)
         else:
-            allowed = ("name", "label", "hairball_triangles", "seed", "flatten")
+            allowed = ("name", "label", "hairball_triangles", "seed", "flatten", "lights")
             d = self.mapping(items, i, f"scenes[{i}]", allowed)
         if not isinstance(d.get("name"), str) or not d["name"]:
             raise self.fail(items, i, f"scenes[{i}].name", "a scene needs a name or path")
@@ -344,7 +349,15 @@ class _Reader:
             raise self.fail(
                 d, "flatten", f"scenes[{i}].flatten", f"expected true or false, got {flat!r}"
             )
-        return SceneSpec(label, source, tris, seed, flat)
+        lights = d.get("lights", "none")
+        if lights not in SCENE_LIGHTS:
+            raise self.fail(
+                d,
+                "lights",
+                f"scenes[{i}].lights",
+                f"expected one of {', '.join(SCENE_LIGHTS)}, got {lights!r}",
+            )
+        return SceneSpec(label, source, tris, seed, flat, "" if lights == "none" else lights)
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
         allowed = ("name", "rays", "resolution", "bounces", "seed", "frames")
