@@ -6,6 +6,7 @@ The format is documented in docs/sweeps.md; python/rtsim/specs/demo.yaml is an e
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import json
@@ -156,7 +157,7 @@ class RunPlan:
     params: dict[str, Any]  # the swept values of this point
     config: SimConfig
 
-    @property
+    @functools.cached_property
     def run_id(self) -> str:
         # The effective config: points that differ only in a switched-off section's fields
         # (ray-buffer sizes with treelets off) are one simulation.
@@ -225,12 +226,15 @@ class SweepSpec:
         that resolve to one config on one trace are two plans of one run (a study's table has
         a row for each)."""
         base_sets = unflatten(self.sets)
+        bases: dict[str, SimConfig] = {}  # each preset with the spec's sets, composed once
         plans = []
         for trace in self.traces():
             for point in self.points():
                 preset = str(point.get(PRESET_KEY, self.preset))
                 values = {k: v for k, v in point.items() if k not in (PRESET_KEY, POINT_KEY)}
-                config = apply_patch(apply_patch(compose(preset), base_sets), unflatten(values))
+                if preset not in bases:
+                    bases[preset] = apply_patch(compose(preset), base_sets)
+                config = apply_patch(bases[preset], unflatten(values))
                 params = dict(point)
                 if self.accels is not None:
                     params = {ACCEL_KEY: trace.accel.label, **params}
