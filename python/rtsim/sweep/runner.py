@@ -81,6 +81,8 @@ def trace_task(plan: TracePlan, out: Path) -> TraceTask:
         builder=plan.accel.builder,
         build_settings=dict(plan.accel.settings),
         frames=w.frames,
+        frame_policy=w.frame_policy,
+        rebuild_threshold=w.rebuild_threshold,
         flatten=plan.scene.flatten,
         lights=plan.scene.lights,
     )

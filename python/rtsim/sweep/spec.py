@@ -42,6 +42,8 @@ from rtsim.sweep.run_check import CheckedRun, config_patch, describe, first_refu
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
 SAMPLING_METHODS = ("random", "latin_hypercube")
+#: rtsim trace --frame-policy: how a moving scene's structures are made per frame.
+FRAME_POLICIES = ("rebuild", "refit", "adaptive")
 #: What `lights` on a scene may add (rtsim trace --lights): a sun gives a lightless scene shadows.
 SCENE_LIGHTS = ("none", "sun")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
@@ -108,6 +110,10 @@ class WorkloadSpec:
     bounces: int = 1
     seed: int = 1
     frames: int = 1  # an animated trace of N frames (rtsim trace --frames N)
+    # How each frame's deforming BLASes and TLAS are made (rtsim trace --frame-policy, and
+    # --rebuild-threshold for adaptive); defaults as the tracer's.
+    frame_policy: str = "rebuild"
+    rebuild_threshold: float = 1.25
 
     def key(self) -> dict[str, Any]:
         key: dict[str, Any] = {
@@ -119,6 +125,10 @@ class WorkloadSpec:
         }
         if self.frames != 1:  # (absent for one frame: the keys of earlier sweeps stay valid)
             key["frames"] = self.frames
+        if self.frame_policy != "rebuild":  # (absent at the default, likewise)
+            key["frame_policy"] = self.frame_policy
+        if self.rebuild_threshold != 1.25:
+            key["rebuild_threshold"] = self.rebuild_threshold
         return key
 
 
@@ -364,7 +374,8 @@ class _Reader:
         return SceneSpec(label, source, tris, seed, flat, "" if lights == "none" else lights)
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
-        allowed = ("name", "rays", "resolution", "bounces", "seed", "frames")
+        allowed = ("name", "rays", "resolution", "bounces", "seed", "frames", "frame_policy",
+                   "rebuild_threshold")  # fmt: skip
         d = self.mapping(items, i, f"workloads[{i}]", allowed)
         path = f"workloads[{i}]"
         rays = d.get("rays", [])  # absent: what the scene calls for
@@ -394,8 +405,23 @@ class _Reader:
         )
         seed = self.number(d, "seed", f"{path}.seed", True) if "seed" in d else 1
         frames = self.number(d, "frames", f"{path}.frames", True, 1) if "frames" in d else 1
+        policy = d.get("frame_policy", "rebuild")
+        if policy not in FRAME_POLICIES:
+            raise self.fail(
+                d,
+                "frame_policy",
+                f"{path}.frame_policy",
+                f"expected one of {', '.join(FRAME_POLICIES)}, got {policy!r}",
+            )
+        threshold = (
+            self.number(d, "rebuild_threshold", f"{path}.rebuild_threshold", False, 1.0)
+            if "rebuild_threshold" in d
+            else 1.25
+        )
         label = str(d.get("name") or "-".join(rays) or "scene")
-        return WorkloadSpec(label, tuple(rays), int(w), int(h), bounces, seed, frames)
+        return WorkloadSpec(
+            label, tuple(rays), int(w), int(h), bounces, seed, frames, policy, float(threshold)
+        )
 
     def accels(self, doc: LineDict) -> list[AccelSpec]:
         """The `accel` axis: a list (or one entry) of KIND, KIND:BUILDER or {kind, builder,

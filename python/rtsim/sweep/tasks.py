@@ -47,6 +47,8 @@ class TraceTask:
     builder: str = ""  # its builder; empty: the structure's default
     build_settings: dict[str, Any] = field(default_factory=dict)  # rtsim trace --build-set
     frames: int = 1  # rtsim trace --frames N (an animated trace)
+    frame_policy: str = "rebuild"  # rtsim trace --frame-policy
+    rebuild_threshold: float = 1.25  # rtsim trace --rebuild-threshold (adaptive)
     flatten: bool = False  # rtsim trace --flatten (instanced scenes: one world-space structure)
     lights: str = ""  # rtsim trace --lights (a scene without lights given some); "": none
 
@@ -78,6 +80,12 @@ class TraceTask:
                 for a in ("--build-set", f"{k}={_text(v)}")
             ],
             *(["--frames", str(self.frames)] if self.frames != 1 else []),
+            *(["--frame-policy", self.frame_policy] if self.frame_policy != "rebuild" else []),
+            *(
+                ["--rebuild-threshold", str(self.rebuild_threshold)]
+                if self.rebuild_threshold != 1.25
+                else []
+            ),
             *(["--flatten"] if self.flatten else []),
             *(["--lights", self.lights] if self.lights else []),
         ]
