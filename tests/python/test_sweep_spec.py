@@ -178,3 +178,15 @@ def test_treelet_prefetching_counts_without_treelet_queues() -> None:
     runs = parse_spec(textwrap.dedent(text), "s.yaml").runs()
     assert len({r.run_id for r in runs}) == 2
     assert {r.config.treelets.prefetch for r in runs} == {False, True}
+
+
+def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
+    # A study counting refusals (rtsim study composition) needs the refused runs as failed runs.
+    text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [kdtree]\n"
+    text += "grid:\n  traversal.model: [mimd, packet]\n"
+    with pytest.raises(SpecError, match="would be refused by the simulator"):
+        parse_spec(text, source="s.yaml")
+    spec = parse_spec(text + "check_runs: false\n", source="s.yaml")
+    assert [p.params["traversal.model"] for p in spec.plans()] == ["mimd", "packet"]
+    with pytest.raises(SpecError, match="s.yaml:6: check_runs: expected true or false"):
+        parse_spec(text + "check_runs: 1\n", source="s.yaml")

@@ -156,18 +156,26 @@ def before(folder: str) -> dict[str, Any] | None:
 
     frame = pd.read_csv(path).astype(object)
     rows = frame.where(frame.notna(), None).to_dict("records")
-    return summary([cell(r) for r in rows])
+    return summary(ordered([cell(r) for r in rows]))
+
+
+def ordered(cells: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Unit, structure, technique, level: the product's order (ties in the counts keep it)."""
+    order = [list(UNITS), STRUCTURES, list(TECHNIQUES), list(LEVELS)]
+    keys = ("unit", "structure", "technique", "level")
+    return sorted(cells, key=lambda c: [o.index(c[k]) for o, k in zip(order, keys, strict=True)])
 
 
 def table(run: StudyRun) -> str:
-    after = summary([cell(r) for r in run.rows()])
+    after = summary(ordered([cell(r) for r in run.rows()]))
     old = before(run.options["before"])
     cols = [("after", after)] + ([("before", old)] if old else [])
-    m = run.measured()
+    # Refused runs have no provenance: the git of the runs that ran.
+    git = ", ".join(g for g in run.measured()["git"].split(", ") if g != "None")
     lines = [
         f"Measured with `{run.command}` ({after['combinations']:,} combinations: 3 unit kinds x "
         f"9 structures x 9 techniques x 5 levels, each one `rtsim-sim` run on an "
-        f"{run.options['resolution']} trace; after: rtsim-sim git {m['git']}"
+        f"{run.options['resolution']} trace; after: rtsim-sim git {git}"
         + (f", before: the runs in `{run.options['before']}`" if old else "")
         + ").",
         "",

@@ -12,7 +12,7 @@ The `unseen` designs are the check on designs the verdict was not tuned on: the 
 no tuned design uses), under three structures, SIMT, treelets and DRAM-bound points, with every
 structural alternative measured too (another structure and compressed leaves on their own
 traces, treelets flipped, the other execution model, sorting, prefetching); between the
-`verdict-unseen` markers. Table code: rtsim.studies._verdict_table.py."""
+`verdict-unseen` markers. Table code: rtsim/studies/_verdict_table.py."""
 
 from __future__ import annotations
 
@@ -21,9 +21,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from rtsim.studies._verdict_table import Outcome, knob_str, note, table
 from rtsim.study import Study, StudyRun, Table
 from rtsim.study.core import StudyError
-from rtsim.studies._verdict_table import Outcome, knob_str, note, table
 from rtsim.sweep.spec import SpecError, spec_from_dict
 
 #: Knobs measured in every design besides the verdict's top candidates (prefixes of keys).
