@@ -188,5 +188,5 @@ def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
         parse_spec(text, source="s.yaml")
     spec = parse_spec(text + "check_runs: false\n", source="s.yaml")
     assert [p.params["traversal.model"] for p in spec.plans()] == ["mimd", "packet"]
-    with pytest.raises(SpecError, match="s.yaml:6: check_runs: expected true or false"):
+    with pytest.raises(SpecError, match=r"s\.yaml:6: check_runs: expected true or false"):
         parse_spec(text + "check_runs: 1\n", source="s.yaml")
