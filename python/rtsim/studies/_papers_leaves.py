@@ -17,7 +17,7 @@ from rtsim.study import StudyRun
 
 PART = "papers-leaves"
 SCENE = "sponza"
-#: (label, --accel, --build-set compressed_leaves)
+#: (label, structure, built with compressed leaves)
 STRUCTURES = [
     ("bvh2", "bvh2", False),
     ("bvh2 + compressed leaves", "bvh2", True),
