@@ -200,7 +200,7 @@ def knob_specs(o: dict[str, Any], kind: str, d: Design, knobs: list[str]) -> lis
 
 def _runnable(spec_dict: dict[str, Any]) -> list[dict[str, Any]]:
     """The spec if the sweep's check takes it, else its points one by one, leaving out those the
-    simulator refuses (a refused knob is not measured: '-' in the table, as a failed run)."""
+    simulator refuses (a refused knob is not measured, like a knob whose run failed: nan)."""
     try:
         spec_from_dict(spec_dict, "study verdict")
         return [spec_dict]
@@ -275,6 +275,6 @@ STUDY = Study(
         "hairball_triangles": 200_000,
     },
     quick={"resolution": "32x24", "unseen_resolution": "32x24", "hairball_triangles": 20_000},
-    # A knob run that fails is a '-' in the table; a design that fails stops the study.
+    # A knob run that fails is not measured (nan); a design that fails stops the study.
     allow_failed=True,
 )
