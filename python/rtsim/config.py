@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import json
 import math
 import numbers
@@ -64,7 +65,7 @@ class _Root:
     sections: ClassVar[tuple[str, ...]]
 
     def to_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)  # type: ignore[call-overload]
+        return _as_dict(self)
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SimConfig:
@@ -183,7 +184,36 @@ def _check_value(f: dataclasses.Field[Any], value: Any, path: str) -> Any:
     return value
 
 
-def _read(cls: type[T], data: Any, prefix: str, base: Any = None) -> T:
+def _as_dict(value: Any) -> Any:
+    """dataclasses.asdict for the config tree, without its deep copy of every leaf (a sweep
+    hashes tens of thousands of configs: asdict was most of its planning time)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _as_dict(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, list | tuple):
+        return [_as_dict(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _as_dict(v) for k, v in value.items()}
+    return value
+
+
+def _clone(value: Any) -> Any:
+    """A copy of a config (sub)tree: sections and containers copied, leaves shared (they are
+    immutable scalars and strings)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        out = copy.copy(value)
+        for f in dataclasses.fields(value):
+            v = getattr(value, f.name)
+            if isinstance(v, list | dict) or dataclasses.is_dataclass(v):
+                object.__setattr__(out, f.name, _clone(v))
+        return out
+    if isinstance(value, list):
+        return [_clone(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _clone(v) for k, v in value.items()}
+    return value
+
+
+def _read(cls: type[T], data: Any, prefix: str, base: Any = None, copied: bool = False) -> T:
     if not isinstance(data, dict):
         raise ConfigError(f"config: '{prefix or '(root)'}' must be a mapping, got {data!r}")
     fields = _names(cls)
@@ -192,12 +222,13 @@ def _read(cls: type[T], data: Any, prefix: str, base: Any = None) -> T:
         raise ConfigError(
             f"config: unknown key '{_join(prefix, unknown[0])}' (known here: {', '.join(fields)})"
         )
-    obj = copy.deepcopy(base) if base is not None else cls()
+    # The base is copied once, at the root (its sections come with it).
+    obj = (base if copied else _clone(base)) if base is not None else cls()
     for name, value in data.items():
         f, path = fields[name], _join(prefix, name)
         current = getattr(obj, name)
         if dataclasses.is_dataclass(current):
-            setattr(obj, name, _read(type(current), value, path, current))
+            setattr(obj, name, _read(type(current), value, path, current, copied=True))
         else:
             setattr(obj, name, _check_value(f, value, path))
     return obj
@@ -289,8 +320,14 @@ def effective_dict(config: SimConfig) -> dict[str, Any]:
     """The config as the simulator sees it: fields of a switched-off section (a ray-buffer size
     with treelets off) at their defaults, so two configs that differ only there compare equal
     (a sweep simulates them once)."""
-    flat, default = flatten(config.to_dict()), flatten(SimConfig().to_dict())
+    flat, default = flatten(config.to_dict()), _default_flat()
     return unflatten({k: default[k] if key_inactive(k, flat) else v for k, v in flat.items()})
+
+
+@functools.cache
+def _default_flat() -> dict[str, Any]:
+    """The default config, flattened (read only: effective_dict takes its values)."""
+    return flatten(SimConfig().to_dict())
 
 
 def config_keys() -> list[str]:

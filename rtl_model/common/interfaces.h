@@ -81,8 +81,11 @@ public:
     virtual bool exhausted() const = 0;
     /// The frame whose rays are being handed out (0 without frames).
     virtual uint32_t frame() const { return 0; }
-    /// Notified when a frame's rays are released; null for a source without frames.
+    /// Notified when a frame's rays are released, or rays held back may go; null for a source
+    /// without frames.
     virtual const sc_core::sc_event* released() const { return nullptr; }
+    /// Counts those releases: a unit that saw it change fills its idle slots again.
+    virtual uint64_t releases() const { return frame(); }
     /// A ray the source handed out finished at `cycle` (its hit was written).
     virtual void ray_finished(Cycle cycle) {}
 };

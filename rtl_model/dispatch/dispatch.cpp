@@ -138,34 +138,48 @@ bool Dispatch::next_ray(uint32_t unit, RayJob* job) {
 }
 
 bool Dispatch::next_gated(uint32_t unit, RayJob* job) {
-    // Rays wait in trace order; children follow their parents closely, so asking the oldest few
-    // finds the ready ones without a scan of every held ray.
-    constexpr size_t kAsked = 64, kMaxHeld = 1u << 16;
+    // Released rays first (their parents are shaded), then the stream, holding back each ray
+    // whose parent is not; the stream is read ahead at most kMaxHeld held rays.
+    constexpr uint64_t kMaxHeld = 1u << 16;
     Cycle not_before = 0;
-    const size_t asked = std::min(kAsked, m_held.size());
-    for (size_t i = 0; i < asked; ++i)
-        if (m_gate(m_held[i].id, &not_before)) {
-            *job = m_held[i];
-            m_held.erase(m_held.begin() + long(i));
-            job->not_before = std::max({job->not_before, m_release, not_before});
-            ++m_handed;
-            return true;
-        }
+    auto hand = [&](const RayJob& ray) {
+        *job = ray;
+        job->not_before = std::max({job->not_before, m_release, not_before});
+        ++m_handed;
+        return true;
+    };
+    auto hold = [&](const RayJob& ray) {
+        m_waiting[m_waits_for(ray.id)].push_back(ray);
+        ++m_waiting_rays;
+    };
+    while (!m_ready.empty()) {
+        const RayJob ray = m_ready.front();
+        m_ready.pop_front();
+        if (m_gate(ray.id, &not_before)) return hand(ray);
+        hold(ray);  // released for a ray that was not the one it waits for: wait again
+    }
     RayJob next;
-    while (m_held.size() < kMaxHeld && RayDealer::next_ray(unit, &next)) {
-        if (m_gate(next.id, &not_before)) {
-            *job = next;
-            job->not_before = std::max({job->not_before, m_release, not_before});
-            ++m_handed;
-            return true;
-        }
-        m_held.push_back(next);
+    while (m_waiting_rays < kMaxHeld && RayDealer::next_ray(unit, &next)) {
+        if (m_gate(next.id, &not_before)) return hand(next);
+        hold(next);
     }
     return false;
 }
 
+void Dispatch::release(const std::vector<uint64_t>& ids) {
+    for (uint64_t id : ids) {
+        auto it = m_waiting.find(id);
+        if (it == m_waiting.end()) continue;
+        m_ready.insert(m_ready.end(), it->second.begin(), it->second.end());
+        m_waiting_rays -= it->second.size();
+        m_waiting.erase(it);
+    }
+    ++m_releases;
+    m_released.notify(sc_core::SC_ZERO_TIME);
+}
+
 bool Dispatch::exhausted() const {
-    return m_frame + 1 >= m_frame_rays.size() && RayDealer::exhausted() && m_held.empty();
+    return m_frame + 1 >= m_frame_rays.size() && RayDealer::exhausted() && m_waiting_rays == 0 && m_ready.empty();
 }
 
 void Dispatch::ray_finished(Cycle cycle) {
@@ -185,6 +199,7 @@ void Dispatch::ray_finished(Cycle cycle) {
     } while (m_frame_rays[m_frame] == 0);
     m_release = m_frame_end;
     resume_stream();
+    ++m_releases;
     m_released.notify(sc_core::SC_ZERO_TIME);
 }
 

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <unordered_map>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -110,11 +111,18 @@ public:
     /// No ray starts before `cycle` (ray generation's end).
     void hold_until(Cycle cycle) { m_release = std::max(m_release, cycle); }
     /// A ray may go only when gate(id, &not_before) is true (the in-flight frame loop: its
-    /// parent is shaded); rays held back wait, the first few in trace order re-asked each time.
+    /// parent is shaded); a ray held back waits under the ray `waits_for(id)` names, until
+    /// release() names that one. Rays are read from the stream in the dealer's order, which is
+    /// not parents first (each unit deals from its own chunk), so held rays are found by what
+    /// they wait for, never by scanning them in order.
     using Gate = std::function<bool(uint64_t id, Cycle* not_before)>;
-    void set_gate(Gate gate) { m_gate = std::move(gate); }
-    /// Rays held by the gate may go now: waiting units ask again.
-    void wake() { m_released.notify(sc_core::SC_ZERO_TIME); }
+    using WaitsFor = std::function<uint64_t(uint64_t id)>;
+    void set_gate(Gate gate, WaitsFor waits_for) {
+        m_gate = std::move(gate);
+        m_waits_for = std::move(waits_for);
+    }
+    /// The rays held for `ids` may go now: waiting units ask again.
+    void release(const std::vector<uint64_t>& ids);
     /// Rays handed to units and not yet finished.
     uint64_t in_flight() const { return m_handed - m_finished_total; }
 
@@ -122,6 +130,7 @@ public:
     bool exhausted() const override;
     uint32_t frame() const override { return m_frame; }
     const sc_core::sc_event* released() const override { return &m_released; }
+    uint64_t releases() const override { return m_releases; }
     void ray_finished(Cycle cycle) override;
 
 private:
@@ -129,7 +138,12 @@ private:
 
     Barrier m_barrier;
     Gate m_gate;
-    std::deque<RayJob> m_held;  ///< gated rays read from the stream but not yet allowed
+    WaitsFor m_waits_for;
+    /// Gated rays read from the stream but not yet allowed, by the ray each waits for.
+    std::unordered_map<uint64_t, std::vector<RayJob>> m_waiting;
+    uint64_t m_waiting_rays = 0;
+    std::deque<RayJob> m_ready;  ///< released rays, handed out first
+    uint64_t m_releases = 0;     ///< frames released plus release() calls (RaySourceIf::releases)
     uint64_t m_handed = 0, m_finished_total = 0;
     std::vector<uint64_t> m_frame_rays;
     FrameEnd m_on_end;

@@ -135,9 +135,11 @@ void ShadingBlock::flush_inflight(Cycle now) {
     for (const Lane& l : m_pending) ready = std::max(ready, l.ready);
     const Cycle end = shade(m_pending, ready, m_config.reorder != ShadeReorder::none);
     m_last_end = std::max(m_last_end, end);
+    m_shaded_ids.clear();
+    for (const Lane& l : m_pending) m_shaded_ids.push_back(l.id);
     m_pending.clear();
     m_texels.clear();
-    if (on_shaded) on_shaded();
+    if (on_shaded) on_shaded(m_shaded_ids);
 }
 
 Cycle ShadingBlock::shade(std::vector<Lane>& lanes, Cycle ready, bool sort) {
@@ -237,6 +239,10 @@ bool ShadingBlock::parent_shaded(uint64_t id, Cycle* not_before) const {
     if (!m_done[size_t(parent)]) return false;
     *not_before = m_shaded_at[size_t(parent)];
     return true;
+}
+
+uint64_t ShadingBlock::parent_of(uint64_t id) const {
+    return id < m_in.shade.size() && m_in.shade[id].parent >= 0 ? uint64_t(m_in.shade[id].parent) : id;
 }
 
 Cycle ShadingBlock::frame_end(Cycle rt_end) const { return std::max(rt_end, m_last_end); }

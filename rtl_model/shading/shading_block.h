@@ -42,10 +42,12 @@ public:
     Cycle wavefront_end(uint32_t w, Cycle end);
     /// inflight: when ray `id`'s parent is shaded, true and *not_before = that cycle.
     bool parent_shaded(uint64_t id, Cycle* not_before) const;
+    /// inflight: the ray whose shading ray `id` waits for (its parent).
+    uint64_t parent_of(uint64_t id) const;
     /// inflight: the RT unit has no ray in flight (every ray handed out has finished).
     std::function<bool()> rt_idle;
-    /// inflight: called when warps were shaded (rays held back may now go).
-    std::function<void()> on_shaded;
+    /// inflight: called with the rays whose warps were shaded (their children may now go).
+    std::function<void(const std::vector<uint64_t>& shaded)> on_shaded;
 
     /// The frame: its time and breakdown, the shader cores', texture caches' and sorting stage's figures.
     nlohmann::json stats_json(Cycle rt_end, double clock_ghz) const;
@@ -81,6 +83,7 @@ private:
     std::unique_ptr<ShaderCores> m_cores;
     std::vector<Lane> m_pending;     ///< finished rays not yet shaded
     std::vector<uint64_t> m_texels;  ///< their texel addresses
+    std::vector<uint64_t> m_shaded_ids;  ///< inflight: the rays of the last flush
     std::vector<Cycle> m_shaded_at;  ///< per ray: when its warp finished (inflight), 0 before
     std::vector<uint8_t> m_done;     ///< per ray: shaded
     std::vector<uint8_t> m_seen;     ///< per ray: finished (handed to the shading block)

@@ -41,7 +41,7 @@ protected:
     ContextQueue m_events;  ///< each slot's next phase, earliest first
     QuantumSync m_sync;
     Cycle m_sched_free = 0;  ///< the scheduler's next free cycle
-    uint32_t m_frame = 0;    ///< the dispatch frame the unit last filled its slots from
+    uint64_t m_release = 0;  ///< the dispatch's release count when the unit last filled its slots
     UnitTally m_tally;
     CycleAccount m_account;
 };

@@ -184,13 +184,14 @@ Cycle issue_stack_traffic(MemIf& mem, const MemoryMap& map, const StepDemand& d,
 }
 
 /// A unit with no ray in flight: false when dispatch is done; otherwise waits until dispatch
-/// releases the next frame's rays, held until this frame's last ray finishes (docs/model.md,
-/// "Frames"), records that frame and returns true.
-inline bool await_next_frame(sc_core::sc_port<RaySourceIf>& rays, uint32_t& frame) {
+/// releases rays (the next frame's, held until this frame's last ray finishes, docs/model.md
+/// "Frames"; or rays the in-flight frame loop held for their parents' shading), unless it did
+/// since `release` (the count the unit last saw, updated), and returns true.
+inline bool await_next_release(sc_core::sc_port<RaySourceIf>& rays, uint64_t& release) {
     const sc_core::sc_event* released = rays->released();
     if (rays->exhausted() || !released) return false;
-    if (rays->frame() == frame) sc_core::wait(*released);
-    frame = rays->frame();
+    if (rays->releases() == release) sc_core::wait(*released);
+    release = rays->releases();
     return true;
 }
 

@@ -162,6 +162,9 @@ LevelResult run_timed_level(RunInputs& in) {
     r.model = top.stats_json();
     if (build_unit) r.model["build_unit"] = build_unit->stats_json();
     r.instantiated = top.instantiated();
+    if (build_unit)
+        r.instantiated.push_back({{"block", "build_unit"}, {"instantiated", true},
+                                  {"why", "a moving scene: each frame's structures are built or refit at its barrier"}});
     if (in.options.timeline && top.dram())
         timeline.write((fs::path(in.options.out_dir) / "timeline.json").string(), top.units(),
                        top.dram()->bytes_over_time(), Dram::bucket_cycles());

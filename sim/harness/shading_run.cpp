@@ -82,10 +82,11 @@ void wire_frame_loop(Top& top, const ShadingConfig& config, uint32_t wavefronts,
         });
         return;
     }
-    dispatch.set_gate([&shading](uint64_t id, Cycle* not_before) { return shading.parent_shaded(id, not_before); });
+    dispatch.set_gate([&shading](uint64_t id, Cycle* not_before) { return shading.parent_shaded(id, not_before); },
+                      [&shading](uint64_t id) { return shading.parent_of(id); });
     // The ray finishing now is still counted in flight when the shading block sees it.
     shading.rt_idle = [&dispatch] { return dispatch.in_flight() <= 1; };
-    shading.on_shaded = [&dispatch] { dispatch.wake(); };
+    shading.on_shaded = [&dispatch](const std::vector<uint64_t>& shaded) { dispatch.release(shaded); };
 }
 
 }  // namespace rtsim

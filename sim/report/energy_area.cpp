@@ -374,7 +374,7 @@ const StatBlock& energy_stats() {
             {"dram_pj_per_bit", "pJ/bit", "its energy per bit (or the override)"},
             {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`) and one `ray_setup` at the node"},
             {"rays", "rays", "rays the energy is divided by: the rays checked (a sampled run's simulated rays, warm-up included)"},
-            {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `mailbox` (only with `mailbox.entries > 0`: lookups and recorded tests in the mailbox SRAM), the techniques' blocks as in `area.mm2` (decodes per test, scheduler picks per step or warp step, sorted rays, prefetched lines, mailbox compares), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
+            {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `mailbox` (only with `mailbox.entries > 0`: lookups and recorded tests in the mailbox SRAM), the techniques' blocks as in `area.mm2` (decodes per test, scheduler picks per step or warp step, sorted rays, prefetched lines, mailbox compares, the build unit's rebuilt triangles and refit nodes), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
             {"dynamic_nj", "nJ", "dynamic energy of the blocks with counts, summed over the rays"},
             {"leakage_w", "W", "`area.total_mm2 x energy.leakage_mw_per_mm2`"},
             {"power_w", "W", "as `summary.power_w`"},
@@ -389,7 +389,7 @@ const StatBlock& area_stats() {
     static const StatBlock block{
         "area",
         {
-            {"mm2", "mm^2", "`{block: mm^2}`: `l1` (all units, tags in), `l2` (tags in), `ray_buffer` (treelets on), `stacks`, `ray_contexts`, each pipeline kind built, `mailbox` (only with `mailbox.entries > 0`), and what each technique adds (docs/energy_area.md, \"What each technique adds\"): `node_decoder` (compressed nodes), `leaf_decoder` (compressed leaves: block buffers and index logic), `simt_control` (warp scheduler, lane masks, coalescer), `packet_control`, `context_scheduler` (MIMD: a scheduler entry per ray context), `sort_stage` (`dispatch.sort`), `prefetcher` (`treelets.prefetch`), `mailbox_compare`"},
+            {"mm2", "mm^2", "`{block: mm^2}`: `l1` (all units, tags in), `l2` (tags in), `ray_buffer` (treelets on), `stacks`, `ray_contexts`, each pipeline kind built, `mailbox` (only with `mailbox.entries > 0`), and what each technique adds (docs/energy_area.md, \"What each technique adds\"): `node_decoder` (compressed nodes), `leaf_decoder` (compressed leaves: block buffers and index logic), `simt_control` (warp scheduler, lane masks, coalescer), `packet_control`, `context_scheduler` (MIMD: a scheduler entry per ray context), `sort_stage` (`dispatch.sort`), `prefetcher` (`treelets.prefetch`), `mailbox_compare`, `build_unit` (moving scenes whose frames build: its SRAM and datapath)"},
             {"total_mm2", "mm^2", "all blocks"},
             {"sram_mm2", "mm^2", "the SRAM blocks"},
             {"logic_mm2", "mm^2", "the pipelines"},

@@ -44,6 +44,15 @@ constexpr double kSortEntryBytes = 48;
 /// the treelet's root: no table SRAM); and its request queue per unit.
 constexpr double kPrefetchStreamBytes = 16, kPrefetchQueueEntries = 16, kPrefetchQueueEntryBytes = 8;
 
+/// The build unit (rtl_model/build_unit, an LBVH-style builder after Viitanen et al. 2017) per
+/// triangle a rebuild streams: its box (twelve min/max over three vertices), centroid (three
+/// adds; the halving is an exponent decrement), the Morton quantisation against the scene box
+/// (three adds, three multiplies; the bit interleave is wiring); and per read pass one key compare
+/// in the sort's merge, and its key and index (12 bytes) read and written in the unit's SRAM.
+constexpr double kBuildTriAdds = 6, kBuildTriMuls = 3, kBuildTriCmps = 12, kBuildKeyBytes = 12;
+/// A refitted node: its box is the union of its two children's (six min/max), staged in the SRAM.
+constexpr double kRefitCmps = 6, kRefitNodeBytes = 24;
+
 bool is_built(const json& list, const char* block) {
     for (const json& b : list)
         if (b.value("block", "") == block) return b.value("instantiated", false);
@@ -138,6 +147,13 @@ TechniqueArea technique_area(const SimConfig& s, const json& inst) {
         const double bytes = prefetch_streams(s) * kPrefetchStreamBytes + kPrefetchQueueEntries * kPrefetchQueueEntryBytes;
         a.logic_mm2["prefetcher"] = t.units * (flop_mm2(c, bytes) + logic_mm2(c, 0, 0, 2));  // line address adder, end compare
     }
+    if (is_built(inst, "build_unit")) {
+        const BuildUnitConfig& b = s.build_unit;
+        a.sram_bytes["build_unit"] = double(b.sram_kib) * 1024.0;
+        a.logic_mm2["build_unit"] =
+            std::ceil(b.rebuild_triangles_per_cycle) * logic_mm2(c, kBuildTriAdds, kBuildTriMuls, kBuildTriCmps + 1) +
+            std::ceil(b.refit_nodes_per_cycle) * logic_mm2(c, 0, 0, kRefitCmps);
+    }
     if (s.mailbox.entries)  // a lookup compares the reference with every entry at once, per unit
         a.logic_mm2["mailbox_compare"] = t.units * logic_mm2(c, 0, 0, s.mailbox.entries);
     return a;
@@ -180,6 +196,17 @@ std::map<std::string, double> technique_energy_pj(const SimConfig& s, const Work
         const double state = prefetch_streams(s) * kPrefetchStreamBytes;
         pj["prefetcher"] = prefetched_lines(stats) * (2 * sram_access_pj(c, state, kPrefetchStreamBytes * 8) +
                                                       logic_pj(c, 0, 0, 2));
+    }
+    const json& model = stats.contains("model") && stats["model"].is_object() ? stats["model"] : json::object();
+    if (is_built(inst, "build_unit") && model.contains("build_unit") && model["build_unit"].is_object()) {
+        const BuildUnitConfig& b = s.build_unit;
+        const double sram = double(b.sram_kib) * 1024.0, passes = double(b.rebuild_read_passes);
+        const double triangles = model["build_unit"].value("rebuilt_triangles", 0.0);
+        const double nodes = model["build_unit"].value("refit_nodes", 0.0);
+        pj["build_unit"] =
+            triangles * (logic_pj(c, kBuildTriAdds, kBuildTriMuls, kBuildTriCmps) +
+                         passes * (logic_pj(c, 0, 0, 1) + 2 * sram_access_pj(c, sram, kBuildKeyBytes * 8))) +
+            nodes * (logic_pj(c, 0, 0, kRefitCmps) + sram_access_pj(c, sram, kRefitNodeBytes * 8));
     }
     if (s.mailbox.entries) pj["mailbox_compare"] = double(w[WorkField::mailbox_lookups]) * logic_pj(c, 0, 0, s.mailbox.entries);
     return pj;

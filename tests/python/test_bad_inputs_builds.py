@@ -92,7 +92,9 @@ def test_octree_on_coplanar_triangles_refused_in_seconds(
     )  # fmt: skip
     message = assert_refused(result, "plane.gltf", "octree", "max_depth=16", "max_leaf_size=8")
     assert "references" in message and "per triangle" in message
-    assert seconds < 30, seconds
+    # A bound against the endless build (past 400 s), loose enough for a loaded CI machine
+    # (about 15 s alone here, 50 s beside the rest of the suite).
+    assert seconds < 150, seconds
     assert not (tmp_path / "o" / "trace.rtt").exists()
 
 

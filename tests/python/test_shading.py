@@ -80,6 +80,24 @@ def test_frame_checks_and_breakdown(traces: dict[str, Path], sim_exe: Path, tmp_
         )
 
 
+@pytest.mark.parametrize("model", ["mimd", "simt", "packet"])
+def test_inflight_finishes_when_rays_arrive_children_first(sim_exe: Path, tmp_path: Path,
+                                                           model: str) -> None:  # fmt: skip
+    """At 16x12 the dealer's chunks hand a unit children before other units reach their parents
+    (the trace order is not parents first across chunks): every ray must still be traced, each
+    after its parent's warp, and the in-flight loop beats the wavefront loop's barriers."""
+    trace = tmp_path / "cornell"
+    made = run_rtsim("trace", "cornell", "-o", str(trace), "--resolution", "16x12",
+                     "--bounces", "2")  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    sets = ("shading.enabled=true", f"traversal.model={model}")
+    inflight = checked(sim_exe, trace, tmp_path / "inflight", *sets, "shading.frame_loop=inflight")
+    wavefront = checked(sim_exe, trace, tmp_path / "wavefront", *sets)
+    v = inflight["validation"]
+    assert v["order_violations"] == 0 and v["shaded_rays"] == inflight["summary"]["rays"]
+    assert shading_of(inflight)["frame_cycles"] < shading_of(wavefront)["frame_cycles"]
+
+
 def test_no_texture_cache_without_textures(traces: dict[str, Path], sim_exe: Path,
                                            tmp_path: Path) -> None:  # fmt: skip
     stats = checked(sim_exe, traces["hairball"], tmp_path / "run", "shading.enabled=true")

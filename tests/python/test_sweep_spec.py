@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import textwrap
+from pathlib import Path
 
 import pytest
 
+from rtsim.sweep.runner import trace_task
 from rtsim.sweep.spec import SpecError, parse_spec
 
 GOOD = """\
@@ -178,6 +180,19 @@ def test_treelet_prefetching_counts_without_treelet_queues() -> None:
     runs = parse_spec(textwrap.dedent(text), "s.yaml").runs()
     assert len({r.run_id for r in runs}) == 2
     assert {r.config.treelets.prefetch for r in runs} == {False, True}
+
+
+def test_scene_lights_are_a_trace_of_their_own() -> None:
+    text = "scenes:\n  - cornell\n  - {name: cornell, label: sun, lights: sun}\n"
+    spec = parse_spec(text + "workloads: [{rays: [primary, shadow]}]\n", "s.yaml")
+    plain, sun = spec.traces()
+    assert (plain.scene.lights, sun.scene.lights) == ("", "sun")
+    assert "lights" not in plain.scene.key() and plain.trace_id != sun.trace_id
+    command = trace_task(sun, Path("out")).command("t")
+    assert command[command.index("--lights") + 1] == "sun"
+    assert "--lights" not in trace_task(plain, Path("out")).command("t")
+    bad = "scenes: [{name: cornell, lights: moon}]\nworkloads: [{rays: [primary]}]\n"
+    assert "s.yaml:1: scenes[0].lights: expected one of none, sun" in spec_error(bad)
 
 
 def test_check_runs_false_leaves_refusals_to_the_runs() -> None:

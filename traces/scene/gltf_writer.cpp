@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <tiny_gltf.h>
 
@@ -56,7 +57,7 @@ struct GltfWriter::Impl {
         bv.buffer = 0;
         bv.byteOffset = bin.size();
         bv.byteLength = bytes;
-        bv.target = target;
+        if (target >= 0) bv.target = target;  // animation and skin data name no target
         bin.resize(bin.size() + bytes);
         if (bytes) std::memcpy(bin.data() + bv.byteOffset, data, bytes);
         model.bufferViews.push_back(bv);
@@ -71,6 +72,23 @@ struct GltfWriter::Impl {
         acc.count = count;
         model.accessors.push_back(acc);
         return int(model.accessors.size() - 1);
+    }
+    /// A triangle primitive of `soup` (POSITION with the min/max glTF 2.0 section 3.6.2.4 asks for).
+    tinygltf::Primitive add_primitive(const TriangleSoup& soup, int material) {
+        Aabb box;
+        for (const Vec3& v : soup.vertices) box.grow(v);
+        const int pa = add_accessor(add_view(soup.vertices.data(), soup.vertices.size() * sizeof(Vec3), TINYGLTF_TARGET_ARRAY_BUFFER),
+                                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, soup.vertices.size());
+        model.accessors[size_t(pa)].minValues = {box.lo.x, box.lo.y, box.lo.z};
+        model.accessors[size_t(pa)].maxValues = {box.hi.x, box.hi.y, box.hi.z};
+        tinygltf::Primitive prim;
+        prim.attributes["POSITION"] = pa;
+        prim.indices =
+            add_accessor(add_view(soup.indices.data(), soup.indices.size() * sizeof(uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, soup.indices.size());
+        prim.material = material;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        return prim;
     }
     void add_root(tinygltf::Node node) {
         model.nodes.push_back(std::move(node));
@@ -118,29 +136,83 @@ int GltfWriter::add_mesh(const std::string& name,
                          const std::vector<std::pair<const TriangleSoup*, int>>& parts) {
     tinygltf::Mesh mesh;
     mesh.name = name;
-    for (const auto& [soup, material] : parts) {
-        // POSITION needs min/max (glTF 2.0 section 3.6.2.4).
-        Aabb box;
-        for (const Vec3& v : soup->vertices) box.grow(v);
-        int pv = m_impl->add_view(soup->vertices.data(), soup->vertices.size() * sizeof(Vec3),
-                                  TINYGLTF_TARGET_ARRAY_BUFFER);
-        int pa = m_impl->add_accessor(pv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
-                                      soup->vertices.size());
-        m_impl->model.accessors[size_t(pa)].minValues = {box.lo.x, box.lo.y, box.lo.z};
-        m_impl->model.accessors[size_t(pa)].maxValues = {box.hi.x, box.hi.y, box.hi.z};
-        int iv = m_impl->add_view(soup->indices.data(), soup->indices.size() * sizeof(uint32_t),
-                                  TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-        int ia = m_impl->add_accessor(iv, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                                      soup->indices.size());
-        tinygltf::Primitive prim;
-        prim.attributes["POSITION"] = pa;
-        prim.indices = ia;
-        prim.material = material;
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
-        mesh.primitives.push_back(prim);
-    }
+    for (const auto& [soup, material] : parts) mesh.primitives.push_back(m_impl->add_primitive(*soup, material));
     m_impl->model.meshes.push_back(mesh);
     return int(m_impl->model.meshes.size() - 1);
+}
+
+void GltfWriter::add_skinned_mesh_node(const std::string& name, const TriangleSoup& soup, int material,
+                                       const SkinWeights& weights, const Skeleton& skeleton) {
+    Impl& g = *m_impl;
+    const size_t nv = soup.vertices.size(), nj = skeleton.joints.size(), nk = skeleton.key_times.size();
+    if (weights.joints.size() != nv || weights.weights.size() != nv || nj == 0 || nk == 0)
+        throw Error("skinned mesh '" + name + "': joints and weights need one entry per vertex, and joints and key times");
+    tinygltf::Primitive prim = g.add_primitive(soup, material);
+    prim.attributes["JOINTS_0"] =
+        g.add_accessor(g.add_view(weights.joints.data(), nv * sizeof(glm::u16vec4), TINYGLTF_TARGET_ARRAY_BUFFER),
+                       TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, nv);
+    prim.attributes["WEIGHTS_0"] =
+        g.add_accessor(g.add_view(weights.weights.data(), nv * sizeof(glm::vec4), TINYGLTF_TARGET_ARRAY_BUFFER),
+                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, nv);
+    tinygltf::Mesh mesh;
+    mesh.name = name;
+    mesh.primitives.push_back(prim);
+    g.model.meshes.push_back(mesh);
+
+    // The joints as nodes (the root joint a root of the scene), and their bind-pose world matrices.
+    tinygltf::Skin skin;
+    skin.name = name + "_skin";
+    std::vector<glm::mat4> inverse_bind(nj);
+    std::vector<glm::dmat4> bind(nj);
+    for (size_t j = 0; j < nj; ++j) {
+        const SkinJoint& joint = skeleton.joints[j];
+        if (joint.parent >= int(j) || joint.rotations.size() != nk)
+            throw Error("skinned mesh '" + name + "': joint " + std::to_string(j) + " needs an earlier parent and a rotation per key");
+        tinygltf::Node node;
+        node.name = joint.name;
+        node.translation = {joint.translation.x, joint.translation.y, joint.translation.z};
+        const glm::dmat4 local = glm::translate(glm::dmat4(1.0), glm::dvec3(joint.translation));
+        bind[j] = joint.parent < 0 ? local : bind[size_t(joint.parent)] * local;
+        inverse_bind[j] = glm::mat4(glm::inverse(bind[j]));
+        g.model.nodes.push_back(node);
+        const int index = int(g.model.nodes.size() - 1);
+        skin.joints.push_back(index);
+        if (joint.parent < 0) g.model.scenes[0].nodes.push_back(index);
+        else g.model.nodes[size_t(skin.joints[size_t(joint.parent)])].children.push_back(index);
+    }
+    skin.inverseBindMatrices = g.add_accessor(g.add_view(inverse_bind.data(), nj * sizeof(glm::mat4), -1),
+                                              TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4, nj);
+    g.model.skins.push_back(skin);
+
+    tinygltf::Node node;
+    node.name = name;
+    node.mesh = int(g.model.meshes.size() - 1);
+    node.skin = int(g.model.skins.size() - 1);
+    g.add_root(node);
+
+    // One LINEAR rotation channel per joint, all on the same key times (input needs min/max).
+    tinygltf::Animation anim;
+    anim.name = name + "_motion";
+    const int input = g.add_accessor(g.add_view(skeleton.key_times.data(), nk * sizeof(float), -1),
+                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, nk);
+    g.model.accessors[size_t(input)].minValues = {skeleton.key_times.front()};
+    g.model.accessors[size_t(input)].maxValues = {skeleton.key_times.back()};
+    for (size_t j = 0; j < nj; ++j) {
+        std::vector<float> xyzw;
+        for (const glm::quat& q : skeleton.joints[j].rotations) xyzw.insert(xyzw.end(), {q.x, q.y, q.z, q.w});
+        tinygltf::AnimationSampler sampler;
+        sampler.input = input;
+        sampler.output = g.add_accessor(g.add_view(xyzw.data(), xyzw.size() * sizeof(float), -1),
+                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, nk);
+        sampler.interpolation = "LINEAR";
+        anim.samplers.push_back(sampler);
+        tinygltf::AnimationChannel channel;
+        channel.sampler = int(anim.samplers.size() - 1);
+        channel.target_node = skin.joints[j];
+        channel.target_path = "rotation";
+        anim.channels.push_back(channel);
+    }
+    g.model.animations.push_back(anim);
 }
 
 void GltfWriter::add_mesh_node(const std::string& name, int mesh, const glm::dmat4& transform) {

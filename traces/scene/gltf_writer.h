@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "traces/scene/procedural_motion.h"
 #include "traces/scene/scene.h"
@@ -30,6 +31,27 @@ struct TriangleSoup {
     void add_box(const glm::dmat4& m);
 };
 
+/// A skin's joint: its bind pose is `translation` from its parent (identity rotation); its motion
+/// is one rotation per key time of its Skeleton (written as a LINEAR glTF animation channel).
+struct SkinJoint {
+    std::string name;
+    int parent = -1;                   ///< index of the parent joint (parents come first), -1: root
+    Vec3 translation{0.0f};            ///< from the parent joint (the root's: in the scene)
+    std::vector<glm::quat> rotations;  ///< one per key time
+};
+
+/// The joints of a skinned mesh and the key times (seconds) their rotations are given at.
+struct Skeleton {
+    std::vector<SkinJoint> joints;
+    std::vector<float> key_times;
+};
+
+/// Up to four joint influences per vertex of a skinned soup (glTF JOINTS_0 / WEIGHTS_0).
+struct SkinWeights {
+    std::vector<glm::u16vec4> joints;
+    std::vector<glm::vec4> weights;
+};
+
 class GltfWriter {
 public:
     GltfWriter();
@@ -45,6 +67,10 @@ public:
     void set_mesh_motion(int mesh, const ProceduralMotion& motion);
     /// Adds a root node placing `mesh` with `transform` (identity: no matrix written).
     void add_mesh_node(const std::string& name, int mesh, const glm::dmat4& transform = glm::dmat4(1.0));
+    /// Adds `soup` skinned by `skeleton`: a mesh node with its skin (the joints as nodes, the
+    /// inverse bind matrices of the bind pose) and one animation of the joints' rotations.
+    void add_skinned_mesh_node(const std::string& name, const TriangleSoup& soup, int material,
+                               const SkinWeights& weights, const Skeleton& skeleton);
     /// Perspective camera at `eye` looking at `target`.
     void add_camera(const std::string& name, const Vec3& eye, const Vec3& target, float yfov,
                     float aspect);

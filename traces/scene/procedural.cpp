@@ -21,6 +21,7 @@ const Entry kScenes[] = {
     {"aligned_walls", write_aligned_walls},
     {"cloth", write_cloth},
     {"exploding_hairball", write_exploding_hairball},
+    {"skinned_tube", write_skinned_tube},
 };
 
 /// Instanced scenes: not in procedural_scene_names(), which the per-structure tests sweep

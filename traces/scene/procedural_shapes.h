@@ -44,5 +44,6 @@ std::string write_grove(const std::string& dir, const ProceduralOptions& options
 // Deforming scenes (procedural_moving.cpp): their meshes move over frames (Scene::animation).
 std::string write_cloth(const std::string& dir, const ProceduralOptions& options);
 std::string write_exploding_hairball(const std::string& dir, const ProceduralOptions& options);
+std::string write_skinned_tube(const std::string& dir, const ProceduralOptions& options);
 
 }  // namespace rtsim

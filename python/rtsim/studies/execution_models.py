@@ -16,7 +16,7 @@ from typing import Any
 
 from rtsim.study import Figure, Study, StudyRun, Table
 from rtsim.study.plots import bars_against_mimd
-from rtsim.study.tables import fmt, scene, units
+from rtsim.study.tables import ByConfig, fmt, mismatches, scene, units
 
 KINDS = ["primary", "diffuse"]
 CONTEXTS = 64
@@ -110,10 +110,6 @@ def main_rows(run: StudyRun) -> list[dict[str, Any]]:
     return rows
 
 
-def _mismatches(rows: list[dict[str, Any]]) -> int:
-    return sum((r["hit_mismatches"] or 0) + (r["work_mismatches"] or 0) for r in rows)
-
-
 def table(run: StudyRun) -> str:
     rows, m = main_rows(run), run.measured()
     lines = [
@@ -122,19 +118,18 @@ def table(run: StudyRun) -> str:
         f"ray contexts, `dispatch.block_rays={BLOCK}` (a warp gets neighbouring rays), defaults "
         "otherwise; SIMT while-while with lane refill unless named; sort = "
         f"`dispatch.sort=origin_direction`; rtsim-sim git {m['git']}. {len(rows)} runs, "
-        f"{_mismatches(rows)} hit and work mismatches in all. Speed-up: Mrays/s against MIMD "
+        f"{mismatches(rows)} hit and work mismatches in all. Speed-up: Mrays/s against MIMD "
         "without sorting on the same trace.",
         "",
         "| trace | rays | config | Mrays/s | speed-up | DRAM B/ray | nJ/ray | SIMD eff. "
         "| requests after coalescing | L1 hit | bottleneck |",
         "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|",
     ]
-    base = {r["trace"]: r for r in rows if r["config"] == "MIMD"}
+    by = ByConfig(rows)
     for r in rows:
-        speed = r["mrays_per_second"] / base[r["trace"]]["mrays_per_second"]
         lines.append(
             f"| {r['trace']} | {r['rays']:,} | {r['config']} | {r['mrays_per_second']:.1f} | "
-            f"{speed:.2f}x | {r['dram_bytes_per_ray']:.0f} | "
+            f"{by.against(r):.2f}x | {r['dram_bytes_per_ray']:.0f} | "
             f"{fmt(r.get('energy_per_ray_nj'), '.1f')} | {fmt(r.get('simd_efficiency'), '.2f')} "
             f"| {fmt(r['coalesced_fraction'], '.2f')} | {r['l1_hit_rate']:.3f} | "
             f"{r.get('bottleneck') or '-'} |"
@@ -144,15 +139,8 @@ def table(run: StudyRun) -> str:
 
 def trends(run: StudyRun) -> str:
     """Our figures beside the published trends, per scene."""
-    by = {(r["trace"], r["config"]): r for r in main_rows(run)}
-
-    def eff(trace: str, cfg: str) -> str:
-        return fmt(by[(trace, cfg)].get("simd_efficiency"), ".2f")
-
-    def speed(trace: str, cfg: str, base: str) -> str:
-        a, b = by[(trace, cfg)], by[(trace, base)]
-        return f"{a['mrays_per_second'] / b['mrays_per_second']:.2f}x"
-
+    by = ByConfig(main_rows(run))
+    eff, speed = by.efficiency, by.speed
     lines = [
         "| scene | SIMD eff. SIMT 32, primary -> diffuse | SIMT 32 / MIMD, primary -> diffuse "
         "| sorting, MIMD diffuse | sorting, SIMT 32 diffuse | SIMD eff. SIMT 32 diffuse, "
@@ -161,7 +149,7 @@ def trends(run: StudyRun) -> str:
     ]
     for sc in run.options["scenes"]:
         p, d = f"{sc}_primary", f"{sc}_diffuse"
-        if (p, "MIMD") not in by or (d, "MIMD") not in by:
+        if (p, "MIMD") not in by.rows or (d, "MIMD") not in by.rows:
             continue
         lines.append(
             f"| {sc} | {eff(p, 'SIMT 32')} -> {eff(d, 'SIMT 32')} | "
@@ -200,7 +188,7 @@ def sorting(run: StudyRun) -> str:
             f"| {config} | {window} | {r['rays']:,} | {r['mrays_per_second']:.1f} | "
             f"{r['mrays_per_second'] / b['mrays_per_second']:.2f}x | "
             f"{r['dram_bytes_per_ray']:.0f} | {fmt(r.get('simd_efficiency'), '.2f')} | "
-            f"{_mismatches([r])} |"
+            f"{mismatches([r])} |"
         )
     return "\n".join(lines) + "\n"
 

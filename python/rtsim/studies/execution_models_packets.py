@@ -18,7 +18,7 @@ from typing import Any
 from rtsim.studies.execution_models import BLOCK, CONTEXTS, KINDS, machine
 from rtsim.study import Figure, Study, StudyRun, Table
 from rtsim.study.plots import bars_against_mimd
-from rtsim.study.tables import fmt, scene, units
+from rtsim.study.tables import ByConfig, fmt, mismatches, scene, units
 
 SORT = "origin_direction"
 #: (label, accel, model, lanes, split_below, sort, extra sets)
@@ -98,10 +98,6 @@ def packet_rows(run: StudyRun, configs: list[tuple] = CONFIGS) -> list[dict[str,
     return sorted(rows, key=lambda r: (traces.index(r["trace"]), order[r["config"]]))
 
 
-def mismatches(rows: list[dict[str, Any]]) -> int:
-    return sum((r["hit_mismatches"] or 0) + (r["work_mismatches"] or 0) for r in rows)
-
-
 def table(run: StudyRun) -> str:
     rows, m = packet_rows(run), run.measured()
     lines = [
@@ -119,11 +115,11 @@ def table(run: StudyRun) -> str:
         "/ packet | split | box tests/ray | tri tests/ray | bottleneck |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|",
     ]
-    base = {r["trace"]: r for r in rows if r["config"] == "MIMD"}
+    by = ByConfig(rows)
     for r in rows:
-        speed = r["mrays_per_second"] / base[r["trace"]]["mrays_per_second"]
         lines.append(
-            f"| {r['trace']} | {r['config']} | {r['mrays_per_second']:.1f} | {speed:.2f}x | "
+            f"| {r['trace']} | {r['config']} | {r['mrays_per_second']:.1f} | "
+            f"{by.against(r):.2f}x | "
             f"{r['dram_bytes_per_ray']:.0f} | {fmt(r['occupancy'], '.1f')} | "
             f"{fmt(r.get('simd_efficiency'), '.2f')} | {fmt(r['fetches'], '.0f')} | "
             f"{fmt(r['splits'], '.2f')} | {r['box_per_ray']:.1f} | "
@@ -134,17 +130,8 @@ def table(run: StudyRun) -> str:
 
 def trends(run: StudyRun) -> str:
     """Our figures beside the published packet trends, per scene."""
-    by = {(r["trace"], r["config"]): r for r in packet_rows(run)}
-
-    def speed(trace: str, cfg: str, base: str = "MIMD") -> str:
-        if (trace, cfg) not in by or (trace, base) not in by:
-            return "-"
-        a, b = by[(trace, cfg)], by[(trace, base)]
-        return f"{a['mrays_per_second'] / b['mrays_per_second']:.2f}x"
-
-    def eff(trace: str, cfg: str) -> str:
-        return fmt(by[(trace, cfg)].get("simd_efficiency"), ".2f") if (trace, cfg) in by else "-"
-
+    by = ByConfig(packet_rows(run))
+    speed, eff = by.speed, by.efficiency
     lines = [
         "| scene | packet 16 / MIMD, primary -> diffuse | SIMD eff. packet 16, primary -> "
         "diffuse | MIMD bvh8 / packet 16, diffuse | hybrid 16 / packet 16, diffuse | re-formed "

@@ -10,14 +10,9 @@ from __future__ import annotations
 from typing import Any
 
 from rtsim.studies.execution_models import CONTEXTS
-from rtsim.studies.execution_models_packets import (
-    mismatches,
-    packet_counters,
-    packet_rows,
-    packet_specs,
-)
+from rtsim.studies.execution_models_packets import packet_counters, packet_rows, packet_specs
 from rtsim.study import Study, StudyRun, Table
-from rtsim.study.tables import fmt
+from rtsim.study.tables import ByConfig, fmt, mismatches
 
 BOX16 = {"box.width": 16}
 LANES = {"traversal.packet.split_walks": "lanes"}
@@ -59,14 +54,13 @@ def table(run: StudyRun) -> str:
         "| node fetches / packet | split | box tests/ray | bottleneck |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|",
     ]
-    base = {r["trace"]: r for r in rows if r["config"] == "MIMD"}
-    pk16 = {r["trace"]: r for r in rows if r["config"] == "packet 16"}
+    by = ByConfig(rows)
     for r in rows:
-        speed = r["mrays_per_second"] / base[r["trace"]]["mrays_per_second"]
-        vs = r["mrays_per_second"] / pk16[r["trace"]]["mrays_per_second"]
         lines.append(
-            f"| {r['trace']} | {r['config']} | {r['mrays_per_second']:.1f} | {speed:.2f}x | "
-            f"{vs:.2f}x | {r['dram_bytes_per_ray']:.0f} | {fmt(r['occupancy'], '.1f')} | "
+            f"| {r['trace']} | {r['config']} | {r['mrays_per_second']:.1f} | "
+            f"{by.against(r):.2f}x | "
+            f"{by.against(r, 'packet 16'):.2f}x | {r['dram_bytes_per_ray']:.0f} | "
+            f"{fmt(r['occupancy'], '.1f')} | "
             f"{fmt(r.get('simd_efficiency'), '.2f')} | {fmt(r['fetches'], '.0f')} | "
             f"{fmt(r['splits'], '.2f')} | {r['box_per_ray']:.1f} | {r.get('bottleneck') or '-'} |"
         )

@@ -1,6 +1,7 @@
-"""What the studies' tables and figures share: number formats, the stats.json figures several
-studies read (BVH bytes per ray, ray-buffer counters, prefetch totals), the `rtsim trace` scene
-entries of the project's scenes, and matplotlib set up for files."""
+"""What the studies' tables and figures share: number formats, markdown tables, mismatch totals
+and configurations set against each other per trace, the stats.json figures several studies
+read (BVH bytes per ray, ray-buffer counters, prefetch totals), the `rtsim trace` scene entries
+of the project's scenes, and matplotlib set up for files."""
 
 from __future__ import annotations
 
@@ -42,6 +43,33 @@ def markdown(header: list[str], align: str, rows: list[list[str]]) -> str:
     lines = ["| " + " | ".join(header) + " |", rule]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
     return "\n".join(lines) + "\n"
+
+
+def mismatches(rows: list[dict[str, Any]]) -> int:
+    """Hit and work mismatches summed over the rows."""
+    return sum((r["hit_mismatches"] or 0) + (r["work_mismatches"] or 0) for r in rows)
+
+
+class ByConfig:
+    """Rows by trace and configuration (their `trace` and `config` columns), for tables that
+    set each configuration against another on the same trace (the execution-model studies)."""
+
+    def __init__(self, rows: list[dict[str, Any]]) -> None:
+        self.rows = {(r["trace"], r["config"]): r for r in rows}
+
+    def against(self, row: dict[str, Any], base: str = "MIMD") -> float:
+        """The row's Mrays/s over `base`'s on its trace."""
+        return row["mrays_per_second"] / self.rows[(row["trace"], base)]["mrays_per_second"]
+
+    def speed(self, trace: str, config: str, base: str = "MIMD") -> str:
+        """`config`'s Mrays/s over `base`'s on `trace` (`1.25x`; `-` when either is missing)."""
+        if (trace, config) not in self.rows or (trace, base) not in self.rows:
+            return "-"
+        return f"{self.against(self.rows[(trace, config)], base):.2f}x"
+
+    def efficiency(self, trace: str, config: str) -> str:
+        """`config`'s SIMD efficiency on `trace` (`-` when missing)."""
+        return fmt((self.rows.get((trace, config)) or {}).get("simd_efficiency"), ".2f")
 
 
 # Figures of stats.json several studies read, as extra columns of their DataFrame.

@@ -82,6 +82,7 @@ def trace_task(plan: TracePlan, out: Path) -> TraceTask:
         build_settings=dict(plan.accel.settings),
         frames=w.frames,
         flatten=plan.scene.flatten,
+        lights=plan.scene.lights,
     )
 
 

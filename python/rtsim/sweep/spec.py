@@ -6,6 +6,7 @@ The format is documented in docs/sweeps.md; python/rtsim/specs/demo.yaml is an e
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import json
@@ -41,6 +42,8 @@ from rtsim.sweep.run_check import CheckedRun, config_patch, describe, first_refu
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
 
 SAMPLING_METHODS = ("random", "latin_hypercube")
+#: What `lights` on a scene may add (rtsim trace --lights): a sun gives a lightless scene shadows.
+SCENE_LIGHTS = ("none", "sun")
 PRESET_KEY = "preset"  # a grid key whose values are preset+modifier names
 POINT_KEY = "point"  # the swept key under which a `points` entry's label is recorded
 TOP_KEYS = (
@@ -82,6 +85,7 @@ class SceneSpec:
     hairball_triangles: int = 200_000
     seed: int = 1
     flatten: bool = False  # instanced scenes: one world-space structure (rtsim trace --flatten)
+    lights: str = ""  # lights added to a scene without any (rtsim trace --lights); "": none
 
     def key(self) -> dict[str, Any]:
         key: dict[str, Any] = {
@@ -91,6 +95,8 @@ class SceneSpec:
         }
         if self.flatten:  # (absent when off: the keys of earlier sweeps stay valid)
             key["flatten"] = True
+        if self.lights:
+            key["lights"] = self.lights
         return key
 
 
@@ -152,7 +158,7 @@ class RunPlan:
     params: dict[str, Any]  # the swept values of this point
     config: SimConfig
 
-    @property
+    @functools.cached_property
     def run_id(self) -> str:
         # The effective config: points that differ only in a switched-off section's fields
         # (ray-buffer sizes with treelets off) are one simulation.
@@ -221,12 +227,15 @@ class SweepSpec:
         that resolve to one config on one trace are two plans of one run (a study's table has
         a row for each)."""
         base_sets = unflatten(self.sets)
+        bases: dict[str, SimConfig] = {}  # each preset with the spec's sets, composed once
         plans = []
         for trace in self.traces():
             for point in self.points():
                 preset = str(point.get(PRESET_KEY, self.preset))
                 values = {k: v for k, v in point.items() if k not in (PRESET_KEY, POINT_KEY)}
-                config = apply_patch(apply_patch(compose(preset), base_sets), unflatten(values))
+                if preset not in bases:
+                    bases[preset] = apply_patch(compose(preset), base_sets)
+                config = apply_patch(bases[preset], unflatten(values))
                 params = dict(point)
                 if self.accels is not None:
                     params = {ACCEL_KEY: trace.accel.label, **params}
@@ -318,7 +327,7 @@ class _Reader:
             d = LineDict({"name": items[i]})
             d.line = items.item_line(i)
         else:
-            allowed = ("name", "label", "hairball_triangles", "seed", "flatten")
+            allowed = ("name", "label", "hairball_triangles", "seed", "flatten", "lights")
             d = self.mapping(items, i, f"scenes[{i}]", allowed)
         if not isinstance(d.get("name"), str) or not d["name"]:
             raise self.fail(items, i, f"scenes[{i}].name", "a scene needs a name or path")
@@ -345,7 +354,15 @@ class _Reader:
             raise self.fail(
                 d, "flatten", f"scenes[{i}].flatten", f"expected true or false, got {flat!r}"
             )
-        return SceneSpec(label, source, tris, seed, flat)
+        lights = d.get("lights", "none")
+        if lights not in SCENE_LIGHTS:
+            raise self.fail(
+                d,
+                "lights",
+                f"scenes[{i}].lights",
+                f"expected one of {', '.join(SCENE_LIGHTS)}, got {lights!r}",
+            )
+        return SceneSpec(label, source, tris, seed, flat, "" if lights == "none" else lights)
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
         allowed = ("name", "rays", "resolution", "bounces", "seed", "frames")

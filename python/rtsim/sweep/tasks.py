@@ -48,6 +48,7 @@ class TraceTask:
     build_settings: dict[str, Any] = field(default_factory=dict)  # rtsim trace --build-set
     frames: int = 1  # rtsim trace --frames N (an animated trace)
     flatten: bool = False  # rtsim trace --flatten (instanced scenes: one world-space structure)
+    lights: str = ""  # rtsim trace --lights (a scene without lights given some); "": none
 
     def command(self, out: str) -> list[str]:
         workload = ["--workload", ",".join(self.rays)] if self.rays else []
@@ -78,6 +79,7 @@ class TraceTask:
             ],
             *(["--frames", str(self.frames)] if self.frames != 1 else []),
             *(["--flatten"] if self.flatten else []),
+            *(["--lights", self.lights] if self.lights else []),
         ]
 
 

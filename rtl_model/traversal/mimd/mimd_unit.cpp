@@ -24,7 +24,7 @@ void MimdUnit::run() {
     fill_idle_contexts(0);
     for (;;) {
         if (m_events.empty() && !m_treelet_mode) {
-            if (!await_next_frame(rays, m_frame)) break;  // no ray in flight here
+            if (!await_next_release(rays, m_release)) break;  // no ray in flight here
             fill_idle_contexts(now);
             continue;
         }
@@ -55,9 +55,9 @@ void MimdUnit::run() {
         if (!m_events.empty() && m_events.top() != after) m_ahead[m_events.top()].prefetch(*mem[0]);
         if (m_prefetcher.on()) m_prefetcher.drain(*mem[0], t);
         if (m_treelet_mode && t >= m_next_fill) fill_idle_contexts(t);
-        if (!m_treelet_mode && rays->frame() != m_frame) {  // a frame was released: fill every context
+        if (!m_treelet_mode && rays->releases() != m_release) {  // a frame or held rays were released: fill every context
             if (!m_ctx.sync_private_steps) m_sync(t);  // dispatch is shared: in time order at detailed
-            m_frame = rays->frame();
+            m_release = rays->releases();
             fill_idle_contexts(t);
         }
     }

@@ -52,7 +52,7 @@ void PacketUnit::run() {
     fill_idle_packets(0);
     for (;;) {
         if (m_events.empty()) {
-            if (!await_next_frame(rays, m_frame)) break;  // no packet in flight
+            if (!await_next_release(rays, m_release)) break;  // no packet in flight
             fill_idle_packets(now);
             continue;
         }
@@ -72,9 +72,9 @@ void PacketUnit::run() {
             advance_lane(p, i, t);
         }
         m_events.finish_pop();
-        if (rays->frame() != m_frame) {  // a frame was released: fill every idle packet
+        if (rays->releases() != m_release) {  // a frame or held rays were released: fill every idle packet
             if (!m_ctx.sync_private_steps) m_sync(t);
-            m_frame = rays->frame();
+            m_release = rays->releases();
             fill_idle_packets(t);
         }
     }

@@ -30,7 +30,7 @@ void SimtUnit::run() {
     fill_idle_warps(0);
     for (;;) {
         if (m_events.empty() && !m_treelet_mode) {
-            if (!await_next_frame(rays, m_frame)) break;  // no warp has a ray
+            if (!await_next_release(rays, m_release)) break;  // no warp has a ray
             fill_idle_warps(now);
             continue;
         }
@@ -55,8 +55,8 @@ void SimtUnit::run() {
         if (m_prefetcher.on()) m_prefetcher.drain(*mem[0], t);
         if (m_treelet_mode) {
             if (t >= m_next_fill) fill_when_idle(t);
-        } else if (rays->frame() != m_frame) {  // a frame was released: fill the idle warps
-            m_frame = rays->frame();
+        } else if (rays->releases() != m_release) {  // a frame or held rays were released: fill the idle warps
+            m_release = rays->releases();
             fill_idle_warps(t);
         }
     }
