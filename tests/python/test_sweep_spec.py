@@ -193,3 +193,15 @@ def test_scene_lights_are_a_trace_of_their_own() -> None:
     assert "--lights" not in trace_task(plain, Path("out")).command("t")
     bad = "scenes: [{name: cornell, lights: moon}]\nworkloads: [{rays: [primary]}]\n"
     assert "s.yaml:1: scenes[0].lights: expected one of none, sun" in spec_error(bad)
+
+
+def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
+    # A study counting refusals (rtsim study composition) needs the refused runs as failed runs.
+    text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [kdtree]\n"
+    text += "grid:\n  traversal.model: [mimd, packet]\n"
+    with pytest.raises(SpecError, match="would be refused by the simulator"):
+        parse_spec(text, source="s.yaml")
+    spec = parse_spec(text + "check_runs: false\n", source="s.yaml")
+    assert [p.params["traversal.model"] for p in spec.plans()] == ["mimd", "packet"]
+    with pytest.raises(SpecError, match=r"s\.yaml:6: check_runs: expected true or false"):
+        parse_spec(text + "check_runs: 1\n", source="s.yaml")

@@ -79,7 +79,8 @@ def bytes_per_ray_by_kind(rec: RunRecord) -> dict[str, float]:
     """DRAM bytes (read + written) per ray for each data kind the run moved."""
     stats = rec.stats or {}
     rays = stats.get("summary", {}).get("rays") or 0
-    kinds = stats.get("model", {}).get("dram", {}).get("by_kind", {})
+    # A functional run has no model: its `model` is null.
+    kinds = ((stats.get("model") or {}).get("dram") or {}).get("by_kind", {})
     if not rays:
         return {}
     return {k: (v.get("read_bytes", 0) + v.get("write_bytes", 0)) / rays for k, v in kinds.items()}

@@ -59,6 +59,7 @@ TOP_KEYS = (
     "sampling",
     "timeout",
     "baseline",
+    "check_runs",
 )
 #: The swept key (a store column, a report axis) under which the `accel` axis is recorded.
 ACCEL_KEY = "accel"
@@ -643,7 +644,12 @@ def parse_spec(text: str, source: str = "<spec>", base: Path | None = None) -> S
     if "baseline" in doc:
         labels = [a.label for a in spec.accels] if spec.accels is not None else None
         spec.baseline = rd.baseline(doc, spec.grid, labels)
-    _check_runs(rd, doc, spec)
+    if "check_runs" in doc and not isinstance(doc["check_runs"], bool):
+        raise rd.fail(doc, "check_runs", "check_runs", "expected true or false")
+    # false: a run the simulator refuses is a failed run with its message (a study counting
+    # refusals), not a refused spec.
+    if doc.get("check_runs", True):
+        _check_runs(rd, doc, spec)
     return spec
 
 

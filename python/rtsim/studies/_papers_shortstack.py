@@ -1,19 +1,33 @@
-"""Short stacks' rows of the papers page (docs/papers.md): Vaidyanathan, Woop & Benthin 2019 and
+"""Short stacks' rows of the papers study (docs/papers.md): Vaidyanathan, Woop & Benthin 2019 and
 Laine 2010 set beside our short stack with a restart trail (docs/accel.md, "Short stacks").
 
-`rows(out_dir, quick)` runs the shortstack study's points (`rtsim study shortstack`, through the
-sweep engine into out_dir) and returns one dict per published figure with the keys technique,
-paper, published, setup, ours and why. quick: Sponza diffuse at 64x48 on cwbvh8 and bvh2 (under
-a minute on two cores); otherwise Sponza and a 50k-triangle hairball at 160x120.
-"""
+The shortstack study's points (rtsim/studies/shortstack.py) on cwbvh8 and bvh2: Sponza and a
+50k-triangle hairball at 160x120 (`short`: Sponza at 64x48, entries 1, 2 and 5)."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from rtsim.studies import shortstack
-from rtsim.study import run_study
+from rtsim.study import StudyRun
+
+PART = "papers-shortstack"
+
+
+def options(o: dict[str, Any]) -> dict[str, Any]:
+    """The shortstack study's options these rows run with."""
+    short = o["short"]
+    return {
+        **shortstack.STUDY.options,
+        "accels": ["cwbvh8", "bvh2"],
+        "resolution": o["shortstack_resolution"],
+        "scenes": ["sponza"] if short else ["sponza", "hairball"],
+        "entries": [1, 2, 5] if short else [1, 2, 3, 5, 8],
+    }
+
+
+def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
+    return shortstack.spec_of(options(o), PART)
 
 
 def _pick(rows: list[dict[str, Any]], scene: str, accel: str, run: str) -> dict[str, Any]:
@@ -41,17 +55,12 @@ def _extra(rows: list[dict[str, Any]], scene: str, entries: int) -> str:
     )
 
 
-def rows(out_dir: Path, quick: bool) -> list[dict[str, str]]:
-    options = {"accels": "cwbvh8,bvh2", "resolution": "64x48", "scenes": "sponza",
-               "entries": "1,2,5"} if quick else {"accels": "cwbvh8,bvh2",
-                                                  "entries": "1,2,3,5,8",
-                                                  "resolution": "160x120"}  # fmt: skip
-    run = run_study(shortstack.STUDY, Path(out_dir) / "shortstack", options=options,
-                    progress=False)  # fmt: skip
-    found = shortstack.rows(run)
-    scenes = run.options["scenes"]
+def rows(run: StudyRun) -> list[dict[str, str]]:
+    found = shortstack.rows(run, PART)
+    opts = options(run.options)
+    scenes = opts["scenes"]
     setup = (
-        f"{run.options['workload']} rays at {run.options['resolution']}, default machine (approx "
+        f"{opts['workload']} rays at {opts['resolution']}, default machine (approx "
         "level), restart trail against a 64-entry stack that never spills"
     )
     return [

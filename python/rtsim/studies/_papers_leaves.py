@@ -1,32 +1,23 @@
-"""Compressed structures against their papers: rows of docs/papers.md, and the compressed-leaves
-table of docs/accel.md.
+"""Compressed structures against their papers: rows of the papers study (docs/papers.md), and the
+compressed-leaves table of docs/accel.md.
 
-`rows(out_dir, quick)` traces Sponza's diffuse bounce with the binary BVH (`bvh2`), the
-compressed 8-wide BVH (`cwbvh8`) and `cwbvh8` with compressed leaves (`--build-set
-compressed_leaves=true`, traces/accel/leaf_blocks.h), simulates each at the default configuration
-and on the `rtx2060` preset, and returns one dict per published figure:
-{"technique", "paper", "published", "setup", "ours", "why"}. quick=True keeps it under a minute
-(a 32x24 camera); quick=False uses 96x72.
-
-Run as a script it also writes the compressed-leaves table into docs/accel.md (between the
-`compressed-leaves` markers) and prints the rows:
-
-    python scripts/papers/leaves_rows.py --out out/leaves [--quick]
-"""
+Sponza's diffuse bounce traced with the binary BVH (`bvh2`), `bvh2` with compressed leaves, the
+8-wide BVH (`bvh8`), the compressed 8-wide BVH (`cwbvh8`) and `cwbvh8` with compressed leaves
+(`build: {compressed_leaves: true}`, traces/accel/leaf_blocks.h), each simulated at the default
+configuration and on the `rtx2060` preset, and `bvh2` and `cwbvh8` with 8-bit box tests. `short`
+keeps the structures the papers' rows need (bvh2, cwbvh8 and cwbvh8 with compressed leaves)."""
 
 from __future__ import annotations
 
-import argparse
 import json
-import os
-import subprocess
-import sys
-import time
 from pathlib import Path
 from typing import Any
 
+from rtsim.study import StudyRun
+
+PART = "papers-leaves"
 SCENE = "sponza"
-#: (label, --accel, --build-set compressed_leaves)
+#: (label, structure, built with compressed leaves)
 STRUCTURES = [
     ("bvh2", "bvh2", False),
     ("bvh2 + compressed leaves", "bvh2", True),
@@ -40,30 +31,38 @@ PRESETS = ("default", "rtx2060")
 RP_BITS = 8
 
 
-def _trace(out: Path, kind: str, compressed: bool, resolution: str) -> dict[str, Any]:
-    """Traces Sponza's diffuse bounce into out (reused when its manifest exists)."""
-    manifest = out / "manifest.json"
-    if not manifest.exists():
-        cmd = [sys.executable, "-m", "rtsim", "trace", SCENE, "-o", str(out), "--accel", kind,
-               "--workload", "diffuse", "--bounces", "1", "--resolution", resolution]  # fmt: skip
-        if compressed:
-            cmd += ["--build-set", "compressed_leaves=true"]
-        subprocess.run(cmd, check=True, capture_output=True, text=True)
-    return json.loads(manifest.read_text())
+def slug(label: str) -> str:
+    return label.replace(" + compressed leaves", "-cl")
 
 
-def _simulate(trace: Path, out: Path, preset: str, sets: list[str] | None = None) -> dict[str, Any]:
-    """rtsim-sim on the trace at `preset` (default: no --config) and `sets`; its stats.json."""
-    from rtsim.launcher import SimJob, find_sim
-    from rtsim.sim_cli import config_file
-
-    stats = out / "stats.json"
-    if not stats.exists():
-        config = None if preset == "default" else config_file(preset, out)
-        job = SimJob(trace=trace, out_dir=out, config=config, sets=sets or [], verdict=False)
-        cmd = job.command(find_sim())
-        subprocess.run(cmd, check=True, capture_output=True, text=True)
-    return json.loads(stats.read_text())
+def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
+    """One spec per structure: the default config, the rtx2060 preset and (bvh2, cwbvh8) the
+    reduced-precision box tests."""
+    out = []
+    for label, kind, compressed in STRUCTURES:
+        if o["short"] and label.startswith(("bvh2 +", "bvh8")):
+            continue  # the papers' rows need bvh2, cwbvh8 and cwbvh8 with compressed leaves only
+        points: list[dict[str, Any]] = [
+            {"label": "default"},
+            {"label": "rtx2060", "preset": "rtx2060"},
+        ]
+        if label in ("bvh2", "cwbvh8"):
+            points.append(
+                {"label": f"rp{RP_BITS}", "set": {"traversal.box_precision_bits": RP_BITS}}
+            )
+        entry: Any = {"kind": kind, "build": {"compressed_leaves": True}} if compressed else kind
+        out.append(
+            {
+                "name": f"{PART}-{slug(label)}",
+                "scenes": [SCENE],
+                "workloads": [
+                    {"name": "diffuse", "rays": ["diffuse"], "resolution": o["leaves_resolution"]}
+                ],
+                "accel": [entry],
+                "points": points,
+            }
+        )
+    return out
 
 
 def _dram_kind_bytes(stats: dict[str, Any], kind: str) -> float:
@@ -73,15 +72,27 @@ def _dram_kind_bytes(stats: dict[str, Any], kind: str) -> float:
     return (c.get("read_bytes", 0) + c.get("write_bytes", 0)) / rays
 
 
-def measure(out_dir: Path, quick: bool) -> dict[str, Any]:
-    """Every structure's footprint and, per preset, its run's figures."""
-    resolution = "32x24" if quick else "96x72"
-    results: dict[str, Any] = {"resolution": resolution, "structures": {}}
-    for label, kind, compressed in STRUCTURES:
-        if quick and label.startswith(("bvh2 +", "bvh8")):
-            continue  # the papers' rows need bvh2, cwbvh8 and cwbvh8 with compressed leaves only
-        slug = label.replace(" + compressed leaves", "-cl")
-        manifest = _trace(out_dir / slug / "trace", kind, compressed, resolution)
+def _figures(stats: dict[str, Any]) -> dict[str, Any]:
+    summary = stats["summary"]
+    return {
+        "mrays": summary["mrays_per_second"],
+        "dram_per_ray": summary["dram_bytes_per_ray"],
+        "tri_dram_per_ray": _dram_kind_bytes(stats, "triangle"),
+        "node_dram_per_ray": _dram_kind_bytes(stats, "node"),
+        "energy_nj": summary.get("energy_per_ray_nj"),
+        "area_mm2": summary.get("area_mm2"),
+        "rays": summary["rays"],
+    }
+
+
+def measure(run: StudyRun) -> dict[str, Any]:
+    """Every structure's footprint (its trace's manifest) and, per preset, its run's figures."""
+    results: dict[str, Any] = {"resolution": run.options["leaves_resolution"], "structures": {}}
+    for label, _, _ in STRUCTURES:
+        found = {r["point"]: r for r in run.rows(part=f"{PART}-{slug(label)}")}
+        if not found:
+            continue
+        manifest = json.loads((Path(found["default"]["trace_dir"]) / "manifest.json").read_text())
         accel = manifest["accel"]
         row: dict[str, Any] = {
             "footprint": accel["footprint_bytes"],
@@ -89,32 +100,16 @@ def measure(out_dir: Path, quick: bool) -> dict[str, Any]:
             "leaf_blocks": accel.get("leaf_blocks"),
         }
         for preset in PRESETS:
-            s = _simulate(out_dir / slug / "trace", out_dir / slug / preset, preset)
-            summary = s["summary"]
-            if summary["hit_mismatches"] or summary["work_mismatches"]:
-                raise RuntimeError(f"{slug} {preset}: mismatches")
-            row[preset] = {
-                "mrays": summary["mrays_per_second"],
-                "dram_per_ray": summary["dram_bytes_per_ray"],
-                "tri_dram_per_ray": _dram_kind_bytes(s, "triangle"),
-                "node_dram_per_ray": _dram_kind_bytes(s, "node"),
-                "energy_nj": summary.get("energy_per_ray_nj"),
-                "area_mm2": summary.get("area_mm2"),
-                "rays": summary["rays"],
-            }
-        if label in ("bvh2", "cwbvh8"):
-            row["reduced"] = _reduced(out_dir / slug, row["default"])
+            row[preset] = _figures(run.stats(found[preset]))
+        if f"rp{RP_BITS}" in found:
+            row["reduced"] = _reduced(run.stats(found[f"rp{RP_BITS}"]), row["default"])
         results["structures"][label] = row
     return results
 
 
-def _reduced(folder: Path, fp32: dict[str, Any]) -> dict[str, Any]:
+def _reduced(s: dict[str, Any], fp32: dict[str, Any]) -> dict[str, Any]:
     """The default config with RP_BITS-bit box tests against fp32 (`fp32`: the default run)."""
-    sets = [f"traversal.box_precision_bits={RP_BITS}"]
-    s = _simulate(folder / "trace", folder / f"default-rp{RP_BITS}", "default", sets)
     summary, bp = s["summary"], s["box_precision"]
-    if summary["hit_mismatches"] or summary["work_mismatches"]:
-        raise RuntimeError(f"{folder.name} {RP_BITS}-bit boxes: mismatches")
     return {
         "extra_steps": bp["extra_steps_fraction"],
         "extra_tri_tests": bp["extra_tri_tests_fraction"],
@@ -266,17 +261,11 @@ def rows_from(r: dict[str, Any]) -> list[dict[str, str]]:
     ]
 
 
-def rows(out_dir: str | os.PathLike[str], quick: bool = True) -> list[dict[str, str]]:
-    """The papers page's rows for compressed structures, measured into out_dir."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return rows_from(measure(out, quick))
-
-
-def accel_table(r: dict[str, Any], host: str, date: str) -> str:
+def accel_table(run: StudyRun) -> str:
     """The docs/accel.md table: every structure's bytes and its run's traffic and speed."""
+    r, m = measure(run), run.measured()
     lines = [
-        f"Measured with `python scripts/papers/leaves_rows.py` on {host}, {date}: Sponza, diffuse "
+        f"Measured with `{run.command}` on {m['host']}, {m['date']}: Sponza, diffuse "
         f"bounce, {r['resolution']} camera, default model config (one run each; the machine was "
         "shared). DRAM bytes per ray by kind are the model's; 0 mismatches in every run.",
         "",
@@ -296,31 +285,6 @@ def accel_table(r: dict[str, Any], host: str, date: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    ap.add_argument("--out", type=Path, default=Path("out/leaves"))
-    ap.add_argument("--quick", action="store_true", help="a 32x24 camera, papers' structures only")
-    ap.add_argument(
-        "--doc", type=Path, default=Path(__file__).resolve().parents[2] / "docs" / "accel.md"
-    )
-    args = ap.parse_args()
-    os.environ.setdefault("RTSIM_SCENES", "/work/shared/scenes")
-    args.out.mkdir(parents=True, exist_ok=True)
-    r = measure(args.out, args.quick)
-    (args.out / "leaves.json").write_text(json.dumps(r, indent=1))
-    if not args.quick:
-        from rtsim.doc_markers import write_between
-
-        write_between(
-            args.doc,
-            "compressed-leaves",
-            accel_table(r, os.uname().nodename, time.strftime("%Y-%m-%d")),
-        )
-    for row in rows_from(r):
-        print(json.dumps(row))
-
-
-if __name__ == "__main__":
-    main()
+def rows_from_run(run: StudyRun) -> list[dict[str, str]]:
+    """The papers page's rows for compressed structures and reduced-precision boxes."""
+    return rows_from(measure(run))

@@ -1,17 +1,17 @@
-"""Papers-page rows for treelets (Aila & Karras 2010) and treelet prefetching (Chou, Nowicki &
-Aamodt 2023), measured by the treelet_factors study's points (`rtsim study treelet_factors`, run
-through the sweep engine into out_dir) on diffuse rays of Sponza and a 200k-triangle hairball
-(quick: 128x96 rays, a 30k-triangle hairball and five points)."""
+"""Papers-study rows for treelets (Aila & Karras 2010) and treelet prefetching (Chou, Nowicki &
+Aamodt 2023), measured by the treelet_factors study's points (rtsim/studies/treelet_factors.py)
+on diffuse rays of Sponza and a 200k-triangle hairball at 320x240 (`short`: the options' smaller
+resolution and hairball, five points)."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from rtsim.studies import treelet_factors
 from rtsim.studies.treelet_factors import against
-from rtsim.study import run_study
+from rtsim.study import StudyRun
 
+PART = "papers-treelets"
 Row = dict[str, Any]
 
 
@@ -96,10 +96,12 @@ def chou(rows: list[Row], scenes: list[str]) -> dict[str, str]:
     }
 
 
-def rows(out_dir: Path, quick: bool) -> list[dict[str, str]]:
-    scenes = ["sponza", "hairball"]
-    resolution, triangles = ("128x96", 30_000) if quick else ("320x240", 200_000)
-    options = {"resolution": resolution, "hairball_triangles": str(triangles), "short": str(quick)}
-    run = run_study(treelet_factors.STUDY, out_dir, options=options, progress=False)
-    measured = treelet_factors.rows(run)
+def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
+    res, triangles = o["treelets_resolution"], o["treelets_hairball_triangles"]
+    return treelet_factors.spec(res, triangles, o["short"], PART)
+
+
+def rows(run: StudyRun) -> list[dict[str, str]]:
+    measured = treelet_factors.rows(run, PART)
+    scenes = treelet_factors.SCENES
     return [aila_karras(measured, scenes), chou(measured, scenes)]
