@@ -61,6 +61,8 @@ FrameBuild BuildUnit::run(const std::vector<BuildJob>& jobs, Cycle start) {
         for (uint32_t p = 0; p < passes; ++p)
             read_end = std::max(read_end, stream(job.reads, false, read_end, pace, &out.read_bytes));
         const Cycle write_end = stream(job.writes, true, read_end, pace, &out.written_bytes);
+        m_compute += Cycle(std::ceil(compute));
+        m_stream += write_end - t;
         t = std::max({write_end, t + Cycle(std::ceil(compute))});
         if (job.refit) {
             ++out.refits;
@@ -85,6 +87,8 @@ FrameBuild BuildUnit::run(const std::vector<BuildJob>& jobs, Cycle start) {
 nlohmann::json BuildUnit::stats_json() const {
     return {{"frames", m_frames},
             {"busy_cycles", m_busy},
+            {"compute_cycles", m_compute},
+            {"stream_cycles", m_stream},
             {"rebuilt_triangles", m_total.rebuilt_triangles},
             {"refit_nodes", m_total.refit_nodes},
             {"read_bytes", m_total.read_bytes},
@@ -103,12 +107,15 @@ const StatBlock& build_unit_stats() {
         {
             {"frames", "frames", "frames whose structures the unit built or refitted (frame 0's exist before the run)"},
             {"busy_cycles", "cycles", "cycles the unit worked, summed over frames (each frame's rays waited for it)", true},
+            {"compute_cycles", "cycles", "cycles its datapath needed at its throughput (triangles or nodes per cycle), summed over its jobs"},
+            {"stream_cycles", "cycles", "cycles its memory stream took (reads, then writes, through the L2), summed over its jobs: a job takes the longer of the two"},
             {"rebuilt_triangles", "triangles", "triangles of the structures it rebuilt"},
             {"refit_nodes", "nodes", "binary-tree nodes of the structures it refitted"},
             {"read_bytes", "bytes", "bytes it read through the L2 (triangles; a rebuild's passes each)"},
             {"written_bytes", "bytes", "bytes it wrote through the L2 (the frames' nodes, triangle records, instances)"},
             {"rebuilds", "structures", "structures (BLASes and TLASes) it rebuilt"},
             {"refits", "structures", "structures it refitted"},
+            {"share", "fraction", "busy_cycles over the run's cycles: the part of the run the traversal waited for builds (the verdict's `build` side)"},
         }};
     return block;
 }

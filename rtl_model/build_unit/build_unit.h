@@ -45,7 +45,7 @@ public:
     BuildUnit(const BuildUnitConfig& config, MemIf& mem, uint32_t line_bytes);
     /// Runs `jobs` from cycle `start`; returns what it did (end: the cycle the last finished).
     FrameBuild run(const std::vector<BuildJob>& jobs, Cycle start);
-    /// {"frames", "busy_cycles", "rebuilt_triangles", "refit_nodes", "read_bytes", "written_bytes",
+    /// {"frames", "busy_cycles", "compute_cycles", "stream_cycles", "rebuilt_triangles", "refit_nodes", "read_bytes", "written_bytes",
     ///  "rebuilds", "refits"} (docs/stats.md, "build_unit").
     nlohmann::json stats_json() const;
 
@@ -59,7 +59,7 @@ private:
     MemIf& m_mem;
     uint32_t m_line;
     FrameBuild m_total;
-    uint64_t m_frames = 0, m_busy = 0;
+    uint64_t m_frames = 0, m_busy = 0, m_compute = 0, m_stream = 0;
 };
 
 /// model.build_unit in stats.json, declared once.

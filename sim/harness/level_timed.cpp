@@ -160,7 +160,10 @@ LevelResult run_timed_level(RunInputs& in) {
     LevelResult r;
     r.cycles = top.total_cycles();
     r.model = top.stats_json();
-    if (build_unit) r.model["build_unit"] = build_unit->stats_json();
+    if (build_unit) {
+        r.model["build_unit"] = build_unit->stats_json();
+        r.model["build_unit"]["share"] = r.cycles ? double(r.model["build_unit"]["busy_cycles"].get<uint64_t>()) / double(r.cycles) : 0.0;
+    }
     r.instantiated = top.instantiated();
     if (build_unit)
         r.instantiated.push_back({{"block", "build_unit"}, {"instantiated", true},

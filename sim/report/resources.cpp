@@ -26,6 +26,7 @@ const std::vector<ResourceInfo>& resource_table() {
         {"execution_model", "the execution model (how a unit runs its rays)", ""},
         {"ray_order", "ray order (sorting before dispatch)", ""},
         {"prefetch", "treelet prefetching (lines requested ahead of the rays)", ""},
+        {"build", "the build unit (each frame's structures built or refit while its rays wait)", ""},
     };
     return r;
 }
@@ -93,6 +94,8 @@ std::vector<std::string> knob_relaxes(const SimConfig& c, const std::string& key
         out = {"dram", "l2_mshrs"};
     } else if (key == "traversal.stack_entries") {
         out = {"stack"};
+    } else if (key.rfind("build_unit.", 0) == 0 || key == "frame_policy") {
+        out = {"build"};
     } else if (key.rfind("treelets.", 0) == 0) {
         out = {"admission", "ray_buffer", "treelet_scheduling"};
     } else {

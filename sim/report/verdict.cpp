@@ -21,6 +21,8 @@ namespace {
 
 /// Utilisation at which a resource counts as saturated rather than merely slow.
 constexpr double kSaturated = 0.7;
+/// A run whose traversal waited for the build unit this share of its cycles is bound by it.
+constexpr double kBuildBound = 0.5;
 
 std::string label_of(const std::string& resource) { return resource_label(resource); }
 
@@ -331,9 +333,71 @@ json judge(const VerdictContext& c) {
         const std::string other = co["resources"][co["resources"][0] == binding ? 1 : 0];
         v["label"] = label_of(binding) + " together with " + label_of(other) + " (a co-limit)";
     }
+    if (c.model.contains("build_unit") && c.model["build_unit"].is_object()) {
+        v["build"] = build_knobs(c.model["build_unit"], weighed, c.config);
+        // A frame that mostly waits for its build is bound by the build unit, whatever binds
+        // its traversal: the traversal's best knob buys only its part (Amdahl).
+        const double share = c.model["build_unit"].value("share", 0.0);
+        const json& top = v["build"].empty() ? json(nullptr) : v["build"][0];
+        if (share >= kBuildBound && !top.is_null() && top["part"] == "build") {
+            v["binding"] = "build";
+            v["label"] = label_of("build");
+            v["relax"] = {{"key", top["key"]}, {"from", top["from"]}, {"to", top["to"]}, {"resource", "build"},
+                          {"speedup", nullptr}, {"run_speedup", top["run_speedup"]},
+                          {"why_not", "the analytic level does not model the build unit; at most " +
+                                          gain(top["run_speedup"].get<double>()) +
+                                          " to the run, by Amdahl over its share: measure it"}};
+            v["evidence"] = {{"use", "build"}, {"context_fraction", share}, {"share", share},
+                             {"text", "the traversal waited for the build unit " + percent(share) + " of the run's cycles"}};
+        }
+    }
     v["text"] = verdict_text(v, weighed, not_covered);
     if (c.model.contains("shading")) v["frame"] = frame_knobs(c.model["shading"], weighed, c.config);
     return v;
+}
+
+json build_knobs(const json& build_unit, const json& weighed, const SimConfig& config) {
+    // A moving scene's run is its frames' builds (the traversal waits at each barrier) and their
+    // traversal: each side's knob buys the run its part, by Amdahl, like frame_knobs. The build
+    // side is an upper bound: doubling a throughput halves the build's compute, and its memory
+    // stream only if the outstanding lines keep up.
+    const double share = build_unit.value("share", 0.0);
+    auto buys = [share](bool build, double s) {
+        const double part = build ? share : 1.0 - share;
+        return s > 0 ? 1.0 / (1.0 - part + part / s) : 1.0;
+    };
+    // A build job takes the longer of its compute and its memory stream: halving one buys the
+    // build at most busy / max(half of it, the other).
+    const double busy = build_unit.value("busy_cycles", 0.0), compute = build_unit.value("compute_cycles", 0.0),
+                 stream = build_unit.value("stream_cycles", 0.0);
+    auto halved = [busy](double part, double other) {
+        const double after = std::max(part / 2, other);
+        return after > 0 ? std::max(1.0, busy / after) : 1.0;
+    };
+    const double compute_s = halved(compute, stream), stream_s = halved(stream, compute);
+    json out = json::array();
+    for (const json& k : weighed["top"])
+        if (k["speedup"].is_number()) {
+            const double s = k["speedup"].get<double>();
+            out.push_back({{"key", k["key"]}, {"from", k["from"]}, {"to", k["to"]}, {"part", "traversal"},
+                           {"part_speedup", s}, {"run_speedup", buys(false, s)}});
+        }
+    const BuildUnitConfig& b = config.build_unit;
+    if (build_unit.value("rebuilds", 0) > 0)
+        out.push_back({{"key", "build_unit.rebuild_triangles_per_cycle"}, {"from", b.rebuild_triangles_per_cycle},
+                       {"to", b.rebuild_triangles_per_cycle * 2}, {"part", "build"}, {"part_speedup", compute_s},
+                       {"run_speedup", buys(true, compute_s)}});
+    if (build_unit.value("refits", 0) > 0)
+        out.push_back({{"key", "build_unit.refit_nodes_per_cycle"}, {"from", b.refit_nodes_per_cycle},
+                       {"to", b.refit_nodes_per_cycle * 2}, {"part", "build"}, {"part_speedup", compute_s},
+                       {"run_speedup", buys(true, compute_s)}});
+    // More lines in flight halves the stream at best (when its latency, not DRAM, paces it).
+    out.push_back({{"key", "build_unit.outstanding_lines"}, {"from", b.outstanding_lines}, {"to", b.outstanding_lines * 2},
+                   {"part", "build"}, {"part_speedup", stream_s}, {"run_speedup", buys(true, stream_s)}});
+    std::stable_sort(out.begin(), out.end(), [](const json& x, const json& y) {
+        return x["run_speedup"].get<double>() > y["run_speedup"].get<double>();
+    });
+    return out;
 }
 
 json frame_knobs(const json& shading, const json& weighed, const SimConfig& config) {
@@ -371,7 +435,7 @@ const StatBlock& verdict_stats() {
     static const StatBlock block{
         "verdict",
         {
-            {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l1_banks`, `l2_banks`, `l1_capacity`, `l2_capacity`, `units`, `<kind>` (a pipeline kind), `scheduler`, `stack`, `ray_buffer`, `admission`, `treelet_scheduling`, `latency`, `workload`, `divergence` (SIMT lanes idle)"},
+            {"binding", "", "the resource named: `dram`, `l1_mshrs`, `l2_mshrs`, `l1_banks`, `l2_banks`, `l1_capacity`, `l2_capacity`, `units`, `<kind>` (a pipeline kind), `scheduler`, `stack`, `ray_buffer`, `admission`, `treelet_scheduling`, `latency`, `workload`, `divergence` (SIMT lanes idle), `build` (the build unit: a moving scene's frames waiting for their builds)"},
             {"label", "", "the same in words (e.g. \"DRAM bandwidth\")"},
             {"text", "", "one sentence: label, evidence and the best relaxation with its estimated speed-up"},
             {"evidence", "", "the named resource's own evidence: `use` (the cycle-accounting use that points at it; `null` when none does), `context_fraction` (that use's share of context cycles), `share` (the share of context cycles of every use that points at it; at the analytic level its bound over the largest), `utilization.<resource>` (the resource's own utilisation, else the use's), `text` (the evidence in words: says so when no use points at the resource)"},
@@ -386,6 +450,7 @@ const StatBlock& verdict_stats() {
             {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `reused` (the analysis was loaded from beside the trace, stored there by an earlier run, instead of stepped by this one), `base_cycles` (its cycles for the run's own config), `dram_latency` (timed runs with the bank model: `added_cycles`, what each DRAM access is charged beyond `dram.latency`, the run's own row outcome `row_cycles` rounded; `bank_wait_cycles`, its bank wait, reported but not charged; `null` otherwise), `wall_seconds` (the host time the estimates took)"},
             {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
             {"frame", "list", "only with `shading.enabled`: the shading side's knobs beside the RT unit's, weighed by what they buy the frame (Amdahl over `model.shading.breakdown`): `key`, `from`, `to`, `part` (traversal or shading), `part_speedup` (the RT knob's estimate; 2 for doubled shader cores; the divergence for sorting by shader, an upper bound), `frame_speedup`; best first", false, true},
+            {"build", "list", "only for a moving scene whose frames build (`model.build_unit`): the build unit's knobs beside the RT unit's, weighed by what they buy the run (Amdahl over `model.build_unit.share`): `key`, `from`, `to`, `part` (traversal or build), `part_speedup` (the RT knob's estimate; for a doubled build throughput `busy / max(compute / 2, stream)`, for doubled outstanding lines `busy / max(stream / 2, compute)`, over `model.build_unit`'s cycles: upper bounds), `run_speedup`; best first. When the build holds the run at least half its cycles and a build knob leads, `binding` is `build`", false, true},
             {"agreement", "", "the run's answers in one vocabulary: `binding`, `knob` (the named knob's key), `relaxes` (the resources it relaxes, directly or by what it removes), `roofline_bound` (`roofline.bound`), `roofline_reached` (achieved over that ceiling), `roofline_relaxed`, `analytic_binding`, `analytic_relaxed` (whether the knob relaxes each)"},
         }};
     return block;

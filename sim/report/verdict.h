@@ -72,6 +72,8 @@ nlohmann::json judge(const VerdictContext& context);
 /// The shading side's knobs beside the RT unit's top ones, weighed by what they buy the frame
 /// (verdict "frame", only in runs that model the frame).
 nlohmann::json frame_knobs(const nlohmann::json& shading, const nlohmann::json& weighed, const SimConfig& config);
+/// A moving scene's build unit knobs beside the RT unit's best, by what each buys the run.
+nlohmann::json build_knobs(const nlohmann::json& build_unit, const nlohmann::json& weighed, const SimConfig& config);
 
 /// stats.json "verdict", declared once.
 const StatBlock& verdict_stats();

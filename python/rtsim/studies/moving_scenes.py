@@ -138,6 +138,9 @@ STUDY = Study(
         "resolution": "96x72",
         "policies": list(POLICIES),
     },
-    quick={"scenes": ["exploding_hairball", "skinned_tube"], "frames": [3, 3],
-           "resolution": "16x12"},  # fmt: skip
+    quick={
+        "scenes": ["exploding_hairball", "skinned_tube"],
+        "frames": [3, 3],
+        "resolution": "16x12",
+    },
 )
