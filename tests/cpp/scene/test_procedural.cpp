@@ -27,7 +27,7 @@ bool has_material(const Scene& s, float metallic, float roughness_below) {
 }
 
 TEST(Procedural, NamesAndUnknownName) {
-    EXPECT_EQ(procedural_scene_names().size(), 7u);
+    EXPECT_EQ(procedural_scene_names().size(), 8u);
     EXPECT_TRUE(is_procedural_scene("hairball"));
     EXPECT_FALSE(is_procedural_scene("sponza"));
     try {
