@@ -53,6 +53,11 @@ void HitChecker::packet_done(const RayResult* results, const Ray* rays, const Tr
 
 void HitChecker::occlusion_done(const RayResult& r) {
     HitRecord want = m_reference.hit(r.id);
+    // The same ray's work in the trace's order (nearest first) against its own: what the
+    // order changes (validation.reordered_anyhit).
+    m_reordered_reference.add(m_reference.work(r.id).counts());
+    m_reordered_own.add(r.work);
+    ++m_reordered;
     if ((want.prim >= 0) == r.hit.valid()) {
         want.prim = r.hit.prim;
         want.t = r.hit.t;
@@ -77,11 +82,22 @@ void HitChecker::check(const RayResult& r, const HitRecord& ref_hit, const WorkR
 }
 
 nlohmann::json HitChecker::to_json() const {
-    return {{"rays_checked", m_checked},
-            {"rays_expected", m_total},
-            {"hit_mismatches", m_hit_mismatches},
-            {"work_mismatches", m_work_mismatches},
-            {"first_mismatches", m_examples}};
+    nlohmann::json j = {{"rays_checked", m_checked},
+                        {"rays_expected", m_total},
+                        {"hit_mismatches", m_hit_mismatches},
+                        {"work_mismatches", m_work_mismatches},
+                        {"first_mismatches", m_examples}};
+    if (m_reordered) {
+        const double n = double(m_reordered);
+        auto per_ray = [n](const WorkTotals& w) {
+            return nlohmann::json{{"steps", double(w[WorkField::steps]) / n},
+                                  {"box_tests", double(w[WorkField::box_tests]) / n},
+                                  {"tri_tests", double(w[WorkField::tri_tests]) / n}};
+        };
+        j["reordered_anyhit"] = {{"rays", m_reordered}, {"own", per_ray(m_reordered_own)},
+                                 {"trace_order", per_ray(m_reordered_reference)}};
+    }
+    return j;
 }
 
 const StatBlock& validation_stats() {
@@ -93,6 +109,7 @@ const StatBlock& validation_stats() {
             {"hit_mismatches", "rays", "hit differs: primitive id, or the bit pattern of t for a hit"},
             {"work_mismatches", "rays", "hit equal, work differs: any field of the ray's work counts"},
             {"first_mismatches", "list", "up to 20 `{ray, difference}`: the ray index and the fields that differ, model/reference"},
+            {"reordered_anyhit", "", "only with `traversal.anyhit_order` other than `nearest` (functional level): `rays` (the any-hit rays walked in that order, their occlusion checked), and per such ray `own` and `trace_order` `{steps, box_tests, tri_tests}`: their work in the run's order and in the trace's (nearest first)", false, true},
             {"scope", "", "analytic level only: which rays were checked (the analysis's sampled rays)", false, true},
             {"shaded_rays", "rays", "only with `shading.enabled`: rays the shading block shaded (every ray, once)", false, true},
             {"texel_mismatches", "rays", "only with `shading.enabled`: rays whose texel addresses differ from the reference tracer's (0 allowed, else exit 3)", false, true},

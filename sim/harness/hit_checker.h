@@ -61,6 +61,8 @@ private:
     nlohmann::json m_examples = nlohmann::json::array();
     LatencyHistogram m_latency;
     WorkTotals m_work;
+    WorkTotals m_reordered_own, m_reordered_reference;  ///< any-hit rays walked in another order
+    uint64_t m_reordered = 0;
 };
 
 /// Compares one result with the reference; returns "" when equal, else a description.
