@@ -76,6 +76,9 @@ StructureTraits structure_traits(const RunInputs& in) {
     t.can_compress_leaves = f.caps.compressed_leaves;
     t.treelet_partition = f.caps.treelet_partition;
     t.trace = in.rtt;
+    const json frames = in.manifest.value("frames", json(nullptr));
+    if (frames.is_object() && frames.contains("policy") && frames["policy"].is_string())
+        t.frame_policy = frames["policy"].get<std::string>();
     return t;
 }
 

@@ -185,6 +185,11 @@ std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st
     else structural(&out, {"dispatch.sort", kRaySortChoices.name(c.dispatch.sort), "none"}, "ray_order");
     if (!c.ideal_memory && st.treelet_partition)
         structural(&out, {"treelets.prefetch", c.treelets.prefetch, !c.treelets.prefetch}, "prefetch");
+    // An animated trace's frames rebuild, refit or choose (traces/accel/two_level/frame_policy.h):
+    // another policy is another trace.
+    if (!st.frame_policy.empty())
+        for (const char* policy : {"rebuild", "refit", "adaptive"})
+            if (st.frame_policy != policy) structural(&out, {"frame_policy", st.frame_policy, policy}, "build", true);
     return out;
 }
 
@@ -192,7 +197,9 @@ std::string measure_command(const Knob& k, const StructureTraits& st) {
     const std::string trace = st.trace.empty() ? "TRACE" : st.trace;
     const std::string to = k.relax.to.is_string() ? k.relax.to.get<std::string>() : k.relax.to.dump();
     if (!k.trace) return "rtsim simulate " + trace + " -o RUN --config RUN0/config.resolved.json --set " + k.relax.key + "=" + to;
-    const std::string option = k.relax.key == "accel" ? "--accel " + to : "--build-set compressed_leaves=true";
+    const std::string option = k.relax.key == "accel"          ? "--accel " + to
+                               : k.relax.key == "frame_policy" ? "--frame-policy " + to
+                                                               : "--build-set compressed_leaves=true";
     return "rtsim trace SCENE -o NEW_TRACE " + option +
            " (the scene, workload and resolution of " + trace + "; its manifest.json lists them), then rtsim simulate "
            "NEW_TRACE -o RUN --config RUN0/config.resolved.json";
@@ -264,7 +271,7 @@ json weigh_knobs(const WeighInputs& in) {
                 // The new structure's decoders (technique_cost.h) in place of this one's.
                 StructureTraits next = in.structure;
                 if (k.relax.key == "accel") next.kind = k.relax.to.get<std::string>();
-                else next.compressed_leaves = true;
+                else if (k.relax.key == "compressed_leaves") next.compressed_leaves = true;
                 json inst = json::array();
                 for (const json& b : in.instantiated)
                     if (b.value("block", "") != "node_decoder" && b.value("block", "") != "leaf_decoder") inst.push_back(b);

@@ -52,6 +52,7 @@ struct StructureTraits {
     bool can_compress_leaves = false; ///< the kind may store compressed leaves
     bool treelet_partition = true;    ///< the kind partitions itself into treelets
     std::string trace;                ///< the run's trace, for the commands that measure
+    std::string frame_policy;         ///< an animated trace's --frame-policy ("" for a still trace)
 };
 
 /// A knob of the unit kind's own (its registration's UnitKnob, handed over by the run loop).

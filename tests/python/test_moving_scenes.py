@@ -89,6 +89,11 @@ def test_skinned_glTF_replays_under_each_policy(sim_exe: Path, tmp_path: Path,
     unit, verdict = stats["model"]["build_unit"], stats["verdict"]
     assert max(unit["compute_cycles"], unit["stream_cycles"]) <= unit["busy_cycles"]
     assert {k["part"] for k in verdict["build"]} == {"build", "traversal"}
+    # The other frame policies are structural alternatives (each a new trace).
+    others = {k["to"] for k in verdict["structural"] if k["key"] == "frame_policy"}
+    assert others == {"rebuild", "refit", "adaptive"} - {policy}
+    assert all("--frame-policy" in k["measure"] for k in verdict["structural"]
+               if k["key"] == "frame_policy")  # fmt: skip
     if unit["share"] >= 0.5:
         assert verdict["binding"] == "build" and "build unit" in verdict["text"]
         assert verdict["relax"]["key"] == "build_unit.outstanding_lines"
