@@ -195,6 +195,23 @@ def test_scene_lights_are_a_trace_of_their_own() -> None:
     assert "s.yaml:1: scenes[0].lights: expected one of none, sun" in spec_error(bad)
 
 
+def test_frame_policy_is_a_trace_of_its_own() -> None:
+    text = (
+        "scenes: [cloth]\nworkloads:\n  - {name: rebuild, frames: 3}\n"
+        "  - {name: adaptive, frames: 3, frame_policy: adaptive, rebuild_threshold: 1.5}\n"
+    )
+    plain, adaptive = parse_spec(text, "s.yaml").traces()
+    assert "frame_policy" not in plain.workload.key() and plain.trace_id != adaptive.trace_id
+    command = trace_task(adaptive, Path("out")).command("t")
+    assert command[command.index("--frame-policy") + 1] == "adaptive"
+    assert command[command.index("--rebuild-threshold") + 1] == "1.5"
+    assert "--frame-policy" not in trace_task(plain, Path("out")).command("t")
+    bad = "scenes: [cloth]\nworkloads: [{frames: 2, frame_policy: sometimes}]\n"
+    assert "workloads[0].frame_policy: expected one of rebuild, refit, adaptive" in spec_error(bad)
+    low = "scenes: [cloth]\nworkloads: [{frames: 2, rebuild_threshold: 0.5}]\n"
+    assert "workloads[0].rebuild_threshold" in spec_error(low)
+
+
 def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
     # A study counting refusals (rtsim study composition) needs the refused runs as failed runs.
     text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [kdtree]\n"

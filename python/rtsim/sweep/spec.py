@@ -310,6 +310,17 @@ class _Reader:
                 )
         return value
 
+    def choice(
+        self, parent: Any, key: str, path: str, choices: tuple[str, ...], default: str
+    ) -> str:
+        """parent[key] (default when absent), one of `choices`."""
+        value = parent.get(key, default)
+        if value not in choices:
+            raise self.fail(
+                parent, key, path, f"expected one of {', '.join(choices)}, got {value!r}"
+            )
+        return str(value)
+
     def number(
         self,
         parent: Any,
@@ -364,14 +375,7 @@ class _Reader:
             raise self.fail(
                 d, "flatten", f"scenes[{i}].flatten", f"expected true or false, got {flat!r}"
             )
-        lights = d.get("lights", "none")
-        if lights not in SCENE_LIGHTS:
-            raise self.fail(
-                d,
-                "lights",
-                f"scenes[{i}].lights",
-                f"expected one of {', '.join(SCENE_LIGHTS)}, got {lights!r}",
-            )
+        lights = self.choice(d, "lights", f"scenes[{i}].lights", SCENE_LIGHTS, "none")
         return SceneSpec(label, source, tris, seed, flat, "" if lights == "none" else lights)
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
@@ -406,14 +410,7 @@ class _Reader:
         )
         seed = self.number(d, "seed", f"{path}.seed", True) if "seed" in d else 1
         frames = self.number(d, "frames", f"{path}.frames", True, 1) if "frames" in d else 1
-        policy = d.get("frame_policy", "rebuild")
-        if policy not in FRAME_POLICIES:
-            raise self.fail(
-                d,
-                "frame_policy",
-                f"{path}.frame_policy",
-                f"expected one of {', '.join(FRAME_POLICIES)}, got {policy!r}",
-            )
+        policy = self.choice(d, "frame_policy", f"{path}.frame_policy", FRAME_POLICIES, "rebuild")
         threshold = (
             self.number(d, "rebuild_threshold", f"{path}.rebuild_threshold", False, 1.0)
             if "rebuild_threshold" in d
