@@ -356,16 +356,41 @@ json judge(const VerdictContext& c) {
     return v;
 }
 
+namespace {
+
+/// What a part of `share` of the whole, sped up by s, buys the whole (Amdahl).
+double amdahl(double share, double s) { return s > 0 ? 1.0 / (1.0 - share + share / s) : 1.0; }
+
+/// A knob of one side of a run split in two parts: `part` speeds by `part_speedup`, which buys
+/// the whole `whole_key` (Amdahl over `share`, the part's share of the whole).
+json side_knob(json key, json from, json to, const char* part, double part_speedup, double share,
+               const char* whole_key) {
+    return {{"key", std::move(key)}, {"from", std::move(from)}, {"to", std::move(to)}, {"part", part},
+            {"part_speedup", part_speedup}, {whole_key, amdahl(share, part_speedup)}};
+}
+
+/// The RT unit's estimated top knobs as the traversal side (`share` of the whole), then `more`,
+/// best first by what each buys the whole.
+json two_sides(const json& weighed, double share, const char* whole_key, std::vector<json> more) {
+    json out = json::array();
+    for (const json& k : weighed["top"])
+        if (k["speedup"].is_number())
+            out.push_back(side_knob(k["key"], k["from"], k["to"], "traversal", k["speedup"].get<double>(), share, whole_key));
+    for (json& k : more) out.push_back(std::move(k));
+    std::stable_sort(out.begin(), out.end(), [whole_key](const json& x, const json& y) {
+        return x[whole_key].get<double>() > y[whole_key].get<double>();
+    });
+    return out;
+}
+
+}  // namespace
+
 json build_knobs(const json& build_unit, const json& weighed, const SimConfig& config) {
     // A moving scene's run is its frames' builds (the traversal waits at each barrier) and their
     // traversal: each side's knob buys the run its part, by Amdahl, like frame_knobs. The build
     // side is an upper bound: doubling a throughput halves the build's compute, and its memory
     // stream only if the outstanding lines keep up.
     const double share = build_unit.value("share", 0.0);
-    auto buys = [share](bool build, double s) {
-        const double part = build ? share : 1.0 - share;
-        return s > 0 ? 1.0 / (1.0 - part + part / s) : 1.0;
-    };
     // A build job takes the longer of its compute and its memory stream: halving one buys the
     // build at most busy / max(half of it, the other).
     const double busy = build_unit.value("busy_cycles", 0.0), compute = build_unit.value("compute_cycles", 0.0),
@@ -375,29 +400,18 @@ json build_knobs(const json& build_unit, const json& weighed, const SimConfig& c
         return after > 0 ? std::max(1.0, busy / after) : 1.0;
     };
     const double compute_s = halved(compute, stream), stream_s = halved(stream, compute);
-    json out = json::array();
-    for (const json& k : weighed["top"])
-        if (k["speedup"].is_number()) {
-            const double s = k["speedup"].get<double>();
-            out.push_back({{"key", k["key"]}, {"from", k["from"]}, {"to", k["to"]}, {"part", "traversal"},
-                           {"part_speedup", s}, {"run_speedup", buys(false, s)}});
-        }
     const BuildUnitConfig& b = config.build_unit;
+    std::vector<json> build;
     if (build_unit.value("rebuilds", 0) > 0)
-        out.push_back({{"key", "build_unit.rebuild_triangles_per_cycle"}, {"from", b.rebuild_triangles_per_cycle},
-                       {"to", b.rebuild_triangles_per_cycle * 2}, {"part", "build"}, {"part_speedup", compute_s},
-                       {"run_speedup", buys(true, compute_s)}});
+        build.push_back(side_knob("build_unit.rebuild_triangles_per_cycle", b.rebuild_triangles_per_cycle,
+                                  b.rebuild_triangles_per_cycle * 2, "build", compute_s, share, "run_speedup"));
     if (build_unit.value("refits", 0) > 0)
-        out.push_back({{"key", "build_unit.refit_nodes_per_cycle"}, {"from", b.refit_nodes_per_cycle},
-                       {"to", b.refit_nodes_per_cycle * 2}, {"part", "build"}, {"part_speedup", compute_s},
-                       {"run_speedup", buys(true, compute_s)}});
+        build.push_back(side_knob("build_unit.refit_nodes_per_cycle", b.refit_nodes_per_cycle, b.refit_nodes_per_cycle * 2,
+                                  "build", compute_s, share, "run_speedup"));
     // More lines in flight halves the stream at best (when its latency, not DRAM, paces it).
-    out.push_back({{"key", "build_unit.outstanding_lines"}, {"from", b.outstanding_lines}, {"to", b.outstanding_lines * 2},
-                   {"part", "build"}, {"part_speedup", stream_s}, {"run_speedup", buys(true, stream_s)}});
-    std::stable_sort(out.begin(), out.end(), [](const json& x, const json& y) {
-        return x["run_speedup"].get<double>() > y["run_speedup"].get<double>();
-    });
-    return out;
+    build.push_back(side_knob("build_unit.outstanding_lines", b.outstanding_lines, b.outstanding_lines * 2, "build",
+                              stream_s, share, "run_speedup"));
+    return two_sides(weighed, 1.0 - share, "run_speedup", std::move(build));
 }
 
 json frame_knobs(const json& shading, const json& weighed, const SimConfig& config) {
@@ -407,28 +421,15 @@ json frame_knobs(const json& shading, const json& weighed, const SimConfig& conf
     // latter by the warps' divergence, the programs a sorted warp no longer serialises).
     const double frame = shading["frame_cycles"].get<double>();
     const json& b = shading["breakdown"];
-    auto buys = [frame](double part, double s) {
-        return frame > 0 && s > 0 ? frame / (frame - part + part / s) : 1.0;
-    };
-    json out = json::array();
-    for (const json& k : weighed["top"])
-        if (k["speedup"].is_number()) {
-            const double s = k["speedup"].get<double>();
-            out.push_back({{"key", k["key"]}, {"from", k["from"]}, {"to", k["to"]}, {"part", "traversal"},
-                           {"part_speedup", s}, {"frame_speedup", buys(b["traversal"].get<double>(), s)}});
-        }
-    const double shade = b["shading"].get<double>();
-    out.push_back({{"key", "shading.cores"}, {"from", config.shading.cores}, {"to", config.shading.cores * 2},
-                   {"part", "shading"}, {"part_speedup", 2.0}, {"frame_speedup", buys(shade, 2.0)}});
+    auto share_of = [frame](double part) { return frame > 0 ? part / frame : 0.0; };
+    const double shade = share_of(b["shading"].get<double>());
+    std::vector<json> shading_side = {
+        side_knob("shading.cores", config.shading.cores, config.shading.cores * 2, "shading", 2.0, shade, "frame_speedup")};
     if (config.shading.reorder == ShadeReorder::none) {
         const double div = std::max(1.0, shading["divergence"].get<double>());
-        out.push_back({{"key", "shading.reorder"}, {"from", "none"}, {"to", "shader"}, {"part", "shading"},
-                       {"part_speedup", div}, {"frame_speedup", buys(shade, div)}});
+        shading_side.push_back(side_knob("shading.reorder", "none", "shader", "shading", div, shade, "frame_speedup"));
     }
-    std::stable_sort(out.begin(), out.end(), [](const json& x, const json& y) {
-        return x["frame_speedup"].get<double>() > y["frame_speedup"].get<double>();
-    });
-    return out;
+    return two_sides(weighed, share_of(b["traversal"].get<double>()), "frame_speedup", std::move(shading_side));
 }
 
 const StatBlock& verdict_stats() {
