@@ -2,12 +2,13 @@
 // What every traversal unit kind holds (MIMD, SIMT, packets; docs/architecture.md, "Adding a
 // traversal unit kind"): its setup, the queue of its contexts', warps' or packets' next phases,
 // its scheduler's next free cycle, its quantum sync with SystemC time, the dispatch frame it last
-// filled from, its tally and its cycle account. The kinds differ in what they schedule and how
+// filled from, its tally, its cycle account and its stack prefetcher. The kinds differ in what they schedule and how
 // a phase runs, not in these.
 #include <cstdint>
 
 #include "rtl_model/traversal/context_queue.h"
 #include "rtl_model/traversal/cycle_accounting.h"
+#include "rtl_model/traversal/stack_prefetcher.h"
 #include "rtl_model/traversal/traversal_unit.h"
 #include "rtl_model/traversal/unit_parts.h"
 
@@ -32,6 +33,11 @@ protected:
           m_events(slots),
           m_sync(setup.context.quantum_cycles) {}
 
+    /// One stack prefetcher stream per ray context or lane (`streams`).
+    void attach_stack_prefetch(uint32_t streams) {
+        m_stack_prefetch.configure(m_config.stack_prefetch, streams, m_ctx.line_bytes);
+    }
+
     const TraversalConfig& m_config;
     UnitContext m_ctx;
     const MemoryMap& m_map;
@@ -44,6 +50,7 @@ protected:
     uint64_t m_release = 0;  ///< the dispatch's release count when the unit last filled its slots
     UnitTally m_tally;
     CycleAccount m_account;
+    StackPrefetcher m_stack_prefetch;  ///< traversal.stack_prefetch (TTP); off when 0
 };
 
 }  // namespace rtsim

@@ -38,6 +38,7 @@ struct TraversalConfig {
     uint32_t box_precision_bits = 0;  ///< box tests' mantissa bits; 0: fp32 (docs/accel.md, "Reduced-precision box tests")
     AnyHitOrder anyhit_order = AnyHitOrder::nearest;  ///< any-hit rays' child order at a node
     uint32_t issue_cycles = 1;       ///< cycles the unit's scheduler needs per traversal step
+    uint32_t stack_prefetch = 0;     ///< stack entries prefetched on consecutive pops (TTP); 0: off
     /// Each unit kind's own section (traversal.simt, traversal.packet, ...): the kinds' fields.
     UnitSections kinds;
 
@@ -72,6 +73,7 @@ struct TraversalConfig {
         v.choice("stack_overflow", stack_overflow, kStackOverflowChoices, "A push onto a full on-chip stack: spill (the oldest entry goes to memory and is read back) or restart_trail (a short stack: the oldest entry is dropped; an empty stack with dropped entries restarts at the root along a restart trail, Laine 2010; structures with a restart trail: rtsim capabilities)");
         v.field("box_precision_bits", box_precision_bits, "bits", "Explicit mantissa bits of a reduced-precision, conservative box pipeline (Keely 2014; Vaidyanathan et al. 2016): boxes, differences and slab distances rounded outward, so it accepts every box fp32 does and some more, whose subtrees are walked as extra work (hits unchanged); 0: fp32 (23 bits). Structures with a reduced-precision walk: rtsim capabilities", 0, 22);
         v.choice("anyhit_order", anyhit_order, kAnyHitOrderChoices, "Which hit child an any-hit (shadow) ray visits first at a node: nearest (entry distance, as closest-hit rays), largest_box (the larger child box surface area first: more likely to hold an occluder) or fixed (child 0 first, no sort). Occlusion (hit or miss) never changes; the occluder found and the work may. Structures with the setting: rtsim capabilities");
+        v.field("stack_prefetch", stack_prefetch, "entries", "Stack-driven prefetching (TTP, Tozlu, Naithani & Zhou 2026): when a ray's step pushes nothing and pops its traversal stack (the paper's second pop in a row: going back up the tree), the lines of the top this-many stack entries, whose addresses the stack holds, are prefetched into the unit's L1; 0: off. Structures whose stacks hold addresses: rtsim capabilities", 0, 8);
         v.field("issue_cycles", issue_cycles, "cycles", "Scheduler cycles per traversal step of one unit", 1, 100);
         kinds.visit(v);
     }

@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "sim/report/energy_area.h"
+#include "rtl_model/traversal/simt/simt_config.h"
+#include "rtl_model/traversal/stack_prefetcher.h"
 #include "traces/accel/leaf_blocks.h"
 
 namespace rtsim {
@@ -44,6 +46,15 @@ constexpr double kSortEntryBytes = 48;
 /// the treelet's root: no table SRAM); and its request queue per unit.
 constexpr double kPrefetchStreamBytes = 16, kPrefetchQueueEntries = 16, kPrefetchQueueEntryBytes = 8;
 
+/// Cooperative lanes (CoopRT, ISCA 2025) per SIMT lane: the lane it helps (an index and a valid
+/// bit; a helper writes its hits to the helped ray's state in the warp buffer), the pick (a
+/// compare of stack depths) and the merge (a t compare against the helped ray's best).
+constexpr double kCoopLaneCmps = 2;
+/// Stack-driven prefetching (TTP, Tozlu, Naithani & Zhou 2026): per stream an armed bit; per unit
+/// the last StackPrefetcher::kRecent line addresses sent (8 bytes each) and a request queue like
+/// the treelet prefetcher's; per line, kRecent address compares.
+constexpr double kStackPrefetchLineBytes = 8;
+
 /// The build unit (rtl_model/build_unit, an LBVH-style builder after Viitanen et al. 2017) per
 /// triangle a rebuild streams: its box (twelve min/max over three vertices), centroid (three
 /// adds; the halving is an exponent decrement), the Morton quantisation against the scene box
@@ -81,20 +92,28 @@ json units_of(const json& stats) {
     return model["units"];
 }
 
-/// Group steps of a lock-step kind (warp or packet steps), from the units' lane slots.
-double group_steps(const SimConfig& s, const json& stats) {
-    double slots = 0;
+/// A counter summed over the units' stats (0 when no unit wrote it).
+double unit_sum(const json& stats, const char* key) {
+    double sum = 0;
     for (const json& u : units_of(stats))
-        if (u.is_object() && u.contains("lane_slots") && u["lane_slots"].is_number()) slots += u["lane_slots"].get<double>();
-    return slots / std::max<double>(1, s.traversal.group_size());
+        if (u.is_object() && u.contains(key) && u[key].is_number()) sum += u[key].get<double>();
+    return sum;
 }
 
-double prefetched_lines(const json& stats) {
-    double sent = 0;
+/// A field of the units' `block` objects (prefetch, stack_prefetch), summed.
+double unit_block_sum(const json& stats, const char* block, const char* key) {
+    double sum = 0;
     for (const json& u : units_of(stats))
-        if (u.is_object() && u.contains("prefetch") && u["prefetch"].is_object()) sent += u["prefetch"].value("sent", 0.0);
-    return sent;
+        if (u.is_object() && u.contains(block) && u[block].is_object()) sum += u[block].value(key, 0.0);
+    return sum;
 }
+
+/// Group steps of a lock-step kind (warp or packet steps), from the units' lane slots.
+double group_steps(const SimConfig& s, const json& stats) {
+    return unit_sum(stats, "lane_slots") / std::max<double>(1, s.traversal.group_size());
+}
+
+double prefetched_lines(const json& stats) { return unit_block_sum(stats, "prefetch", "sent"); }
 
 }  // namespace
 
@@ -147,6 +166,16 @@ TechniqueArea technique_area(const SimConfig& s, const json& inst) {
         const double bytes = prefetch_streams(s) * kPrefetchStreamBytes + kPrefetchQueueEntries * kPrefetchQueueEntryBytes;
         a.logic_mm2["prefetcher"] = t.units * (flop_mm2(c, bytes) + logic_mm2(c, 0, 0, 2));  // line address adder, end compare
     }
+    if (t.model == "simt" && t.kind_config<SimtConfig>().cooperative) {
+        const double index_bits = std::ceil(std::log2(std::max(2.0, lanes))) + 1;
+        const double bytes = t.contexts() * index_bits / 8;
+        a.logic_mm2["cooperation"] = t.units * (flop_mm2(c, bytes) + logic_mm2(c, 0, 0, kCoopLaneCmps * lanes));
+    }
+    if (t.stack_prefetch && !s.ideal_memory) {
+        const double bytes = t.contexts() / 8.0 + StackPrefetcher::kRecent * kStackPrefetchLineBytes +
+                             kPrefetchQueueEntries * kPrefetchQueueEntryBytes;
+        a.logic_mm2["stack_prefetcher"] = t.units * (flop_mm2(c, bytes) + logic_mm2(c, 0, 0, double(StackPrefetcher::kRecent)));
+    }
     if (is_built(inst, "build_unit")) {
         const BuildUnitConfig& b = s.build_unit;
         a.sram_bytes["build_unit"] = double(b.sram_kib) * 1024.0;
@@ -196,6 +225,17 @@ std::map<std::string, double> technique_energy_pj(const SimConfig& s, const Work
         const double state = prefetch_streams(s) * kPrefetchStreamBytes;
         pj["prefetcher"] = prefetched_lines(stats) * (2 * sram_access_pj(c, state, kPrefetchStreamBytes * 8) +
                                                       logic_pj(c, 0, 0, 2));
+    }
+    if (t.model == "simt" && t.kind_config<SimtConfig>().cooperative) {
+        // Per helper step: the handed-over stack entry read from the owner's stack and written
+        // to the helper's, the pick and the merge compares.
+        const double stack = double(t.stack_entries) * t.stack_entry_bytes;
+        pj["cooperation"] = unit_sum(stats, "helper_steps") *
+                            (2 * sram_access_pj(c, stack, t.stack_entry_bytes * 8.0) + logic_pj(c, 0, 0, kCoopLaneCmps));
+    }
+    if (t.stack_prefetch && !s.ideal_memory) {
+        const double sent = unit_block_sum(stats, "stack_prefetch", "sent") + unit_block_sum(stats, "stack_prefetch", "repeats");
+        pj["stack_prefetcher"] = sent * logic_pj(c, 0, 0, double(StackPrefetcher::kRecent));
     }
     const json& model = stats.contains("model") && stats["model"].is_object() ? stats["model"] : json::object();
     if (is_built(inst, "build_unit") && model.contains("build_unit") && model["build_unit"].is_object()) {

@@ -37,6 +37,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& techniques(
         {"8-bit boxes", {"traversal.box_precision_bits=7"}},
         {"any-hit largest box first", {"traversal.anyhit_order=largest_box"}},
         {"mailbox", {"mailbox.entries=8"}},
+        {"stack prefetching (TTP)", {"traversal.stack_prefetch=2"}},
+        {"cooperative lanes (CoopRT)", {"traversal.simt.cooperative=true"}},
         {"ray sorting", {"dispatch.sort=morton"}},
         {"20% sampling", {"sampling.fraction=0.2"}},
     };
@@ -152,14 +154,14 @@ std::string capability_markdown() {
     std::ostringstream md;
     auto yes = [](const json& b) { return b.get<bool>() ? "yes" : "-"; };
     md << "### Structures and what they offer\n\n| structure | packet kernel | restart trail | reduced-precision boxes | "
-          "any-hit order | mailbox | compressed leaves | treelet partition | stack entry (bytes) |\n|---|---|---|---|---|---|---|---|---|\n";
+          "any-hit order | mailbox | compressed leaves | treelet partition | stack addresses | stack entry (bytes) |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const json& s : t["structures"]) {
         const json& c = s["capabilities"];
         md << "| " << s["name"].get<std::string>() << " | " << yes(c["packet_kernel"]) << " | "
            << yes(c["restart_trail"]) << " | " << yes(c["reduced_precision_boxes"]) << " | " << yes(c["anyhit_order"])
            << " | " << yes(c["mailbox"])
            << " | " << yes(c["compressed_leaves"]) << " | " << yes(c["treelet_partition"]) << " | "
-           << c["stack_entry_bytes"].get<uint32_t>() << " |\n";
+           << yes(c["stack_addresses"]) << " | " << c["stack_entry_bytes"].get<uint32_t>() << " |\n";
     }
     md << "\n### Unit kinds and what they need\n\n| kind | what it models | packet kernel | lock-step groups | own "
           "stack per ray | treelet queues | treelet prefetches | its knobs |\n|---|---|---|---|---|---|---|---|\n";

@@ -30,6 +30,9 @@ struct AccelCapabilities {
     /// It is built from a binary build tree that can be refitted to moved geometry (refit.h):
     /// --frame-policy refit and adaptive.
     bool refit = false;
+    /// Its steppers report the reads their stack entries would issue (Stepper::stack_reads):
+    /// stack-driven prefetching, traversal.stack_prefetch.
+    bool stack_addresses = false;
     /// Bytes of one traversal stack entry (Accel::stack_entry_bytes; 0: no stack).
     uint32_t stack_entry_bytes = 8;
 
@@ -51,6 +54,7 @@ struct AccelCapabilities {
                 {"blas", blas},
                 {"treelet_partition", treelet_partition},
                 {"refit", refit},
+                {"stack_addresses", stack_addresses},
                 {"stack_entry_bytes", stack_entry_bytes}};
     }
 };

@@ -178,7 +178,8 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
                                     .with(&AccelCapabilities::packet_kernel)
                                     .with(&AccelCapabilities::restart_trail)
                                     .with(&AccelCapabilities::reduced_precision_boxes)
-                                    .with(&AccelCapabilities::refit);
+                                    .with(&AccelCapabilities::refit)
+                                    .with(&AccelCapabilities::stack_addresses);
     return {{name, description, tree_builder_names(), c}, tree_settings, build, load};
 }
 
@@ -195,7 +196,8 @@ const std::vector<Entry>& registry() {
               .with(&AccelCapabilities::restart_trail)
               .with(&AccelCapabilities::reduced_precision_boxes)
               .with(&AccelCapabilities::anyhit_order)
-              .with(&AccelCapabilities::refit)},
+              .with(&AccelCapabilities::refit)
+              .with(&AccelCapabilities::stack_addresses)},
          tree_settings, build_bvh2, loader<Bvh2Accel>()},
         wide_entry("bvh4", "4-wide BVH, 128-byte fp32 nodes, SAH-optimal collapse of the binary tree (docs/accel.md)", 4,
                    false, ChildOrder::distance),
@@ -235,7 +237,8 @@ const std::vector<Entry>& registry() {
           {"clipped", "boxes"}, single_level(kBvhStackEntryBytes)
                                     .with(&AccelCapabilities::packet_kernel)
                                     .with(&AccelCapabilities::restart_trail)
-                                    .with(&AccelCapabilities::reduced_precision_boxes)},
+                                    .with(&AccelCapabilities::reduced_precision_boxes)
+                                    .with(&AccelCapabilities::stack_addresses)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              s.bvh.visit(v, false);
              s.gk.visit(v, builder == "clipped");

@@ -34,6 +34,16 @@ public:
     TraversalMode mode() const { return m_mode; }
     /// Entries on the traversal stack now (the model maps them onto its on-chip stack).
     int stack_size() const { return m_stack_size; }
+    /// The reads that visiting the top `max` stack entries would issue, top (next popped) first,
+    /// from the addresses a hardware stack holds: what stack-driven prefetching (TTP, Tozlu,
+    /// Naithani & Zhou 2026) requests. Entries a pop would skip are included (the stack holds
+    /// their addresses either way). Returns how many it wrote; 0 from a structure whose stack
+    /// holds no addresses (capabilities.h: stack_addresses).
+    virtual uint32_t stack_reads(Fetch* out, uint32_t max) const {
+        (void)out;
+        (void)max;
+        return 0;
+    }
 
 protected:
     StepPlan m_plan;

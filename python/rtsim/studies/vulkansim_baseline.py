@@ -18,7 +18,11 @@ from rtsim.study.tables import bvh_bytes_per_ray, fmt, prefetch_totals, scene
 
 SCENES = ["sponza", "hairball"]
 ACCELS = ["bvh2", "cwbvh6"]
-#: (label, preset, --set over it); the first is the baseline each row is against.
+#: Stack entries TTP prefetches per trigger (traversal.stack_prefetch): the top two, the next
+#: pops of an upward walk.
+TTP_ENTRIES = 2
+#: (label, preset, --set over it); the first is the baseline each row is against, except MIMD
+#: points, which are against the MIMD point.
 POINTS: list[tuple[str, str, dict[str, Any]]] = [
     ("warp baseline", "vulkansim_rtx2060", {}),
     ("warp + treelet prefetch", "vulkansim_rtx2060", {"treelets.prefetch": True}),
@@ -28,9 +32,12 @@ POINTS: list[tuple[str, str, dict[str, Any]]] = [
         "vulkansim_rtx2060",
         {"treelets.enabled": True, "treelets.prefetch": True},
     ),
+    ("warp + CoopRT", "vulkansim_rtx2060", {"traversal.simt.cooperative": True}),
+    ("warp + TTP", "vulkansim_rtx2060", {"traversal.stack_prefetch": TTP_ENTRIES}),
     ("MIMD, same resources", "rtx2060", {}),
+    ("MIMD + TTP", "rtx2060", {"traversal.stack_prefetch": TTP_ENTRIES}),
 ]
-QUICK = ["warp baseline", "warp + treelet prefetch", "MIMD, same resources"]
+QUICK = ["warp baseline", "warp + treelet prefetch", "warp + CoopRT", "warp + TTP", "MIMD, same resources"]
 
 
 def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
@@ -77,10 +84,11 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
 
 
 def _base(rs: list[dict[str, Any]], r: dict[str, Any]) -> dict[str, Any]:
+    base = "MIMD, same resources" if r["point"] == "MIMD + TTP" else POINTS[0][0]
     return next(
         b
         for b in rs
-        if b["scene"] == r["scene"] and b["accel"] == r["accel"] and b["point"] == POINTS[0][0]
+        if b["scene"] == r["scene"] and b["accel"] == r["accel"] and b["point"] == base
     )
 
 
@@ -114,23 +122,54 @@ def table(run: StudyRun) -> str:
     return _note(run) + "\n".join(out) + "\n"
 
 
-def papers_row(run: StudyRun) -> str:
-    """Treelet prefetching on the warp baseline beside Chou et al.'s +32.1%."""
-    rs = rows(run)
+#: (technique, published figure, point on the warp baseline, point on MIMD or None).
+PAPER_ROWS = [
+    (
+        "treelet prefetching, no treelet queues (Chou, Nowicki & Aamodt 2023)",
+        "+32.1% average",
+        "warp + treelet prefetch",
+        None,
+    ),
+    (
+        "cooperative lanes, `traversal.simt.cooperative` (CoopRT, ISCA 2025)",
+        "2.15x geometric mean, up to 5.11x",
+        "warp + CoopRT",
+        None,
+    ),
+    (
+        "stack-driven prefetching, `traversal.stack_prefetch` (TTP, Tozlu, Naithani & Zhou 2026)",
+        "1.48x average, up to 1.89x; 98.92% L1 accuracy, 31.54% coverage",
+        "warp + TTP",
+        "MIMD + TTP",
+    ),
+]
+
+
+def _ratios(rs: list[dict[str, Any]], point: str | None) -> str:
+    if point is None:
+        return "- (a warp technique)"
     cells = []
     for r in rs:
-        if r["point"] == "warp + treelet prefetch" and r["accel"] == "cwbvh6":
+        if r["point"] == point and r["accel"] == "cwbvh6":
             b = _base(rs, r)
-            cells.append(f"{r['scene']} {r['mrays_per_second'] / b['mrays_per_second']:.2f}x")
-    return (
-        _note(run)
-        + "| technique | published (Vulkan-Sim RTX 2060-like) "
-        + "| ours on `vulkansim_rtx2060`, cwbvh6 |\n"
-        + "|---|---|---|\n"
-        + "| treelet prefetching, no treelet queues (Chou et al. 2023) | +32.1% average | "
-        + ", ".join(cells)
-        + " |\n"
-    )
+            cell = f"{r['scene']} {r['mrays_per_second'] / b['mrays_per_second']:.2f}x"
+            if r["prefetch_useful"] is not None:
+                cell += f" ({100 * r['prefetch_useful']:.0f}% of prefetches used)"
+            cells.append(cell)
+    return ", ".join(cells) or "not run"
+
+
+def papers_row(run: StudyRun) -> str:
+    """Each warp technique on the warp baseline beside its paper, and on MIMD units."""
+    rs = rows(run)
+    out = [
+        "| technique | published (Vulkan-Sim) | ours on `vulkansim_rtx2060`, cwbvh6 "
+        "| ours on `rtx2060` (MIMD), cwbvh6 |",
+        "|---|---|---|---|",
+    ]
+    for name, published, warp, mimd in PAPER_ROWS:
+        out.append(f"| {name} | {published} | {_ratios(rs, warp)} | {_ratios(rs, mimd)} |")
+    return _note(run) + "\n".join(out) + "\n"
 
 
 def plot(run: StudyRun, path: Path) -> None:

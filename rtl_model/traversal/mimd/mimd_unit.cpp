@@ -9,6 +9,7 @@ MimdUnit::MimdUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
       m_treelets(setup.treelets),
       m_contexts(setup.config.contexts()),
       m_ahead(setup.config.contexts()) {
+    attach_stack_prefetch(setup.config.contexts());
     SC_THREAD(run);
 }
 
@@ -92,6 +93,7 @@ bool MimdUnit::start_ray(uint32_t c, Cycle t) {
     ctx.ray.start = t;
     ctx.ray.stack = StackSplit{};
     ctx.treelet = kNoTreelet;  // its first step enters one (prefetching without queues)
+    m_stack_prefetch.begin(c);
     m_ahead[c].note(*ctx.ray.stepper);
     activate(c, t);
     // The ray record is read from memory before traversal starts.
@@ -116,6 +118,7 @@ bool MimdUnit::take_parked_ray(uint32_t c, Cycle t) {
     if (s.work().steps == 0 && !ray_is_valid(s.ray())) ++m_tally.rejected;
     ++m_takes;
     if (m_prefetcher.on()) m_prefetcher.enter(0, ctx.treelet, t);
+    m_stack_prefetch.begin(c);
     m_ahead[c].note(*ctx.ray.stepper);
     activate(c, t);
     account(c, CycleUse::ray_buffer, ready);
@@ -156,10 +159,12 @@ void MimdUnit::step(uint32_t c, Cycle t) {
     // prefetcher learns the treelet's lines from them.
     StepReads reads(*mem[0], t);
     const bool learning = m_prefetcher.on() && ctx.treelet != kNoTreelet;
+    const int stack_before = ctx.ray.stepper->stack_size();
     take_step_reading(*ctx.ray.stepper, ctx.ray.stack, m_costs, ctx.demand, [&](const Fetch& f) {
         if (learning) m_prefetcher.learn(ctx.treelet, f);
         reads.read(f);
     });
+    m_stack_prefetch.after_step(c, *ctx.ray.stepper, stack_before);
     m_ahead[c].note(*ctx.ray.stepper);
     account_read(c, reads.ready(), reads.slowest());
     ctx.phase = Phase::ops;
@@ -170,6 +175,7 @@ void MimdUnit::run_ops(uint32_t c, Cycle t) {
     // The step's operations run on their pipelines in order (the plan's, then those its results
     // called for), then spilled stack entries are read back.
     const StepDemand& d = m_contexts[c].demand;
+    if (m_stack_prefetch.on()) m_stack_prefetch.issue(c, *m_contexts[c].ray.stepper, *mem[0], t);
     Cycle ready = t;
     for (int i = 0; i < d.issue_count; ++i) {
         ready = pipes[size_t(d.issues[i].kind)]->issue(ready, d.issues[i].issues, d.issues[i].tests);
@@ -218,6 +224,7 @@ nlohmann::json MimdUnit::stats_json(Cycle total_cycles) const {
     m_tally.write(w, m_sync, cycle_account(total_cycles), total_cycles);
     if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
     if (m_prefetcher.on()) w.set("prefetch", m_prefetcher.stats_json());
+    if (m_stack_prefetch.on()) w.set("stack_prefetch", m_stack_prefetch.stats_json());
     w.done();
     return j;
 }

@@ -23,12 +23,14 @@ struct SimtConfig {
     uint32_t lanes = 8;  ///< rays per warp, stepping in lock-step
     SimtPolicy policy = SimtPolicy::while_while;  ///< which operation kind a warp runs next
     SimtRefill refill = SimtRefill::lane;         ///< when a finished lane takes a new ray
+    bool cooperative = false;  ///< idle lanes step busy lanes' rays (CoopRT; simt_unit.h)
 
     template <class V>
     void visit(V& v) {
         v.field("lanes", lanes, "rays", "Rays per warp in lock-step; traversal.ray_contexts is a whole number of warps (0 there: 16 rounded up to whole warps)", 4, 64);
         v.choice("policy", policy, kSimtPolicyChoices, "while_while (a warp keeps its operation kind while any lane needs it) or if_if (kinds in turn each warp step), Aila & Laine 2009");
         v.choice("refill", refill, kSimtRefillChoices, "lane (a finished lane takes a new ray at its warp's next step) or warp (only when every lane of the warp has finished)");
+        v.flag("cooperative", cooperative, "Cooperative lanes (CoopRT, ISCA 2025): a lane without a ray of its own steps another lane's ray in the same warp step, taking an entry of that ray's traversal stack (docs/execution_models.md, 'Cooperative lanes')");
     }
 };
 

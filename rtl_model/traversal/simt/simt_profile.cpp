@@ -5,6 +5,7 @@
 
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/traversal/simt/coalescer.h"
+#include "rtl_model/traversal/simt/cooperation.h"
 #include "rtl_model/traversal/simt/simt_config.h"
 #include "rtl_model/traversal/simt/simt_unit.h"
 #include "rtl_model/traversal/traversal_config.h"
@@ -19,6 +20,8 @@ constexpr uint32_t kClasses = kOpKindCount + 1;
 struct Lane {
     std::unique_ptr<Stepper> stepper;
     bool has_ray = false;
+    bool stepped = false;  ///< stepped its own ray this warp step
+    int spare = 0;         ///< cooperative lanes: its ray's stack entries not yet handed to a helper
 };
 
 /// The warps of the whole machine and the rays they take, in turn.
@@ -98,18 +101,43 @@ private:
         uint32_t active = 0;
         for (uint32_t i = 0; i < m_simt.lanes; ++i) {
             Lane& l = lane(w, i);
-            if (!l.has_ray || SimtUnit::step_class(l.stepper->plan()) != cls) continue;
-            const StepPlan& plan = l.stepper->plan();
-            for (uint32_t f = 0; f < plan.fetch_count; ++f)
-                m_coalescer.add(plan.fetch[f].addr, plan.fetch[f].bytes, plan.fetch[f].kind);
-            l.stepper->execute();
+            l.stepped = l.has_ray && SimtUnit::step_class(l.stepper->plan()) == cls;
+            if (!l.stepped) continue;
+            l.spare = l.stepper->stack_size();
+            run_step(*l.stepper);
             ++active;
         }
+        if (m_simt.cooperative) active += lend_idle_lanes(w, cls);
         m_p.requests += m_coalescer.issue([](uint64_t, uint32_t, DataKind) {});
         m_p.group_steps += 1, m_p.scheduler_steps += 2;  // the step and its operations
         if (cls < kOpKindCount) m_p.kind_steps[cls] += 1;
         m_p.lane_slots += m_simt.lanes, m_p.active_lanes += active;
         return true;
+    }
+
+    void run_step(Stepper& s) {
+        const StepPlan& plan = s.plan();
+        for (uint32_t f = 0; f < plan.fetch_count; ++f) m_coalescer.add(plan.fetch[f].addr, plan.fetch[f].bytes, plan.fetch[f].kind);
+        s.execute();
+    }
+
+    /// Cooperative lanes, as the unit lends them (simt_unit.h): the helper steps run.
+    uint32_t lend_idle_lanes(size_t w, uint32_t cls) {
+        uint32_t helpers = 0;
+        for (uint32_t i = 0; i < m_simt.lanes; ++i) {
+            if (lane(w, i).has_ray) continue;
+            const uint32_t best = pick_helped_lane(
+                0, m_simt.lanes, [&](uint32_t l) { return lane(w, l).stepped ? lane(w, l).spare : 0; },
+                [&](uint32_t l) {
+                    const StepPlan& plan = lane(w, l).stepper->plan();
+                    return !plan.done && SimtUnit::step_class(plan) == cls;
+                });
+            if (best == m_simt.lanes) break;
+            --lane(w, best).spare;
+            run_step(*lane(w, best).stepper);
+            ++helpers;
+        }
+        return helpers;
     }
 
     const SimtConfig& m_simt;

@@ -1,5 +1,6 @@
 #include "rtl_model/traversal/simt/simt_unit.h"
 #include "rtl_model/traversal/simt/simt_profile.h"
+#include "rtl_model/traversal/simt/cooperation.h"
 
 #include <algorithm>
 #include <array>
@@ -14,6 +15,7 @@ SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
       m_warps(setup.config.groups()),
       m_coalescer(setup.context.line_bytes),
       m_active_histogram(m_simt.lanes + 1, 0) {
+    attach_stack_prefetch(uint32_t(m_lanes.size()));
     SC_THREAD(run);
 }
 
@@ -93,6 +95,7 @@ bool SimtUnit::retire_and_refill(uint32_t w, Cycle t) {
     bool any_ray = false;
     for (uint32_t l = first_lane(w); l < end; ++l) {
         m_lanes[l].stepping = false;
+        m_lanes[l].helps = kNoLane;
         if (m_lanes[l].has_ray && m_lanes[l].ray.stepper->plan().done) finish_lane(l, t);
         any_ray = any_ray || m_lanes[l].has_ray;
     }
@@ -128,6 +131,7 @@ bool SimtUnit::take_lane(uint32_t w, uint32_t l, Cycle t, bool may_switch, Cycle
     account_until(m_account, lane.accounted, CycleUse::starved, t);  // no ray until now
     lane.has_ray = lane.stepping = true;
     lane.ready = ready;
+    m_stack_prefetch.begin(l);
     m_tally.busy.enter(t);
     *fetch = std::max(*fetch, ready);
     return true;
@@ -171,6 +175,7 @@ bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
     lane.ray.start = start;
     lane.ray.stack = StackSplit{};
     lane.treelet = kNoTreelet;
+    m_stack_prefetch.begin(l);
     account_until(m_account, lane.accounted, CycleUse::starved, start);  // no ray until now
     lane.has_ray = lane.stepping = true;
     m_tally.busy.enter(start);
@@ -238,14 +243,12 @@ void SimtUnit::step(uint32_t w, Cycle t) {
         Lane& lane = m_lanes[l];
         lane.stepping = lane.has_ray && step_class(lane.ray.stepper->plan()) == cls;
         if (!lane.stepping) continue;
+        lane.spare = lane.ray.stepper->stack_size();
         account_until(m_account, lane.accounted, CycleUse::issue, t);
         if (m_prefetcher.on() && !m_treelet_mode) note_treelet(l, t);
-        const uint32_t treelet = m_treelet_mode ? warp.treelet : lane.treelet;
-        take_step_reading(*lane.ray.stepper, lane.ray.stack, m_costs, lane.demand, [&](const Fetch& f) {
-            if (m_prefetcher.on() && treelet != kNoTreelet) m_prefetcher.learn(treelet, f);
-            m_coalescer.add(f.addr, f.bytes, f.kind);
-        });
+        step_ray(l, l, m_treelet_mode ? warp.treelet : lane.treelet);
     }
+    if (m_simt.cooperative) lend_idle_lanes(w, cls, t);
     AccessInfo slowest;
     const Cycle ready = issue_reads(t, &slowest);
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l)
@@ -254,6 +257,47 @@ void SimtUnit::step(uint32_t w, Cycle t) {
     count_warp_step(w, t);
     warp.phase = Phase::ops;
     m_events.schedule(w, ready);
+}
+
+void SimtUnit::step_ray(uint32_t owner, uint32_t into, uint32_t treelet) {
+    Lane& o = m_lanes[owner];
+    const int before = o.ray.stepper->stack_size();
+    take_step_reading(*o.ray.stepper, o.ray.stack, m_costs, m_lanes[into].demand, [&](const Fetch& f) {
+        if (m_prefetcher.on() && treelet != kNoTreelet) m_prefetcher.learn(treelet, f);
+        m_coalescer.add(f.addr, f.bytes, f.kind);
+    });
+    m_stack_prefetch.after_step(owner, *o.ray.stepper, before);
+}
+
+void SimtUnit::lend_idle_lanes(uint32_t w, uint32_t cls, Cycle t) {
+    const uint32_t begin = first_lane(w), end = begin + m_simt.lanes;
+    // Idle lanes wait for the warp (warp refill) or for rays (lane refill) until now.
+    const CycleUse waited = m_simt.refill == SimtRefill::warp ? CycleUse::idle_lane : CycleUse::starved;
+    bool helped = false;
+    for (uint32_t h = begin; h < end; ++h) {
+        Lane& helper = m_lanes[h];
+        if (helper.has_ray) continue;
+        // The stepping ray with the most stack entries not yet handed over whose next step runs
+        // the warp's kind (and, with treelet queues, stays in the warp's treelet).
+        const uint32_t best = pick_helped_lane(
+            begin, m_simt.lanes, [&](uint32_t l) { return m_lanes[l].stepping && m_lanes[l].helps == kNoLane ? m_lanes[l].spare : 0; },
+            [&](uint32_t l) {
+                const StepPlan& plan = m_lanes[l].ray.stepper->plan();
+                if (plan.done || step_class(plan) != cls) return false;
+                return !m_treelet_mode || plan.locality == kNoLocality ||
+                       m_treelets->treelet_of(plan.locality) == m_warps[w].treelet;
+            });
+        if (best == end) break;  // no ray has independent work of this kind left
+        Lane& owner = m_lanes[best];
+        --owner.spare;
+        account_until(m_account, helper.accounted, waited, t);
+        helper.helps = best;
+        helper.stepping = true;
+        step_ray(best, h, m_treelet_mode ? m_warps[w].treelet : owner.treelet);
+        ++m_helper_steps;
+        helped = true;
+    }
+    if (helped) ++m_helped_warp_steps;
 }
 
 void SimtUnit::run_ops(uint32_t w, Cycle t) {
@@ -267,6 +311,8 @@ void SimtUnit::run_ops(uint32_t w, Cycle t) {
     for (uint32_t l = begin; l < end; ++l) {
         if (!m_lanes[l].stepping) continue;
         account_until(m_account, m_lanes[l].accounted, CycleUse::issue, t);
+        if (m_stack_prefetch.on() && m_lanes[l].helps == kNoLane)
+            m_stack_prefetch.issue(l, *m_lanes[l].ray.stepper, *mem[0], t);
         const StepDemand& d = m_lanes[l].demand;
         for (int i = 0; i < d.issue_count; ++i) {
             const size_t k = size_t(d.issues[i].kind);
@@ -285,8 +331,10 @@ void SimtUnit::run_ops(uint32_t w, Cycle t) {
     const Cycle ops_done = ready;
     for (uint32_t l = begin; l < end; ++l) {
         if (!m_lanes[l].stepping) continue;
-        // Spill slots belong to the lane, or with treelets to the ray (it moves between units).
-        const uint64_t owner = m_treelet_mode ? m_lanes[l].ray.ray_id : uint64_t(m_index) * m_lanes.size() + l;
+        // Spill slots belong to the lane, or with treelets to the ray (it moves between units); a
+        // helper's are its ray's.
+        const uint32_t r = ray_lane(l);
+        const uint64_t owner = m_treelet_mode ? m_lanes[r].ray.ray_id : uint64_t(m_index) * m_lanes.size() + r;
         ready = std::max(ready, issue_stack_traffic(*mem[0], m_map, m_lanes[l].demand, owner, m_costs.stack_entry_bytes, t,
                                                     ops_done, &m_tally.spill_writes, &m_tally.spill_reads, [] {}));
     }
@@ -316,9 +364,10 @@ void SimtUnit::count_warp_step(uint32_t w, Cycle t) {
     uint32_t active = 0;
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         const Lane& lane = m_lanes[l];
-        if (!lane.has_ray) continue;
-        ++m_kind_present[size_t(lane.ray.kind)];
-        if (lane.stepping) ++active, ++m_kind_active[size_t(lane.ray.kind)];
+        if (!lane.has_ray && lane.helps == kNoLane) continue;
+        const RayKind kind = m_lanes[ray_lane(l)].ray.kind;  // a helper counts in its ray's kind
+        ++m_kind_present[size_t(kind)];
+        if (lane.stepping) ++active, ++m_kind_active[size_t(kind)];
     }
     ++m_warp_steps;
     m_lane_steps += active;
@@ -377,6 +426,10 @@ const StatTable<SimtUnit>& SimtUnit::kind_stats() {
              [](const SimtUnit& u) { return u.efficiency_by_kind(); }},
             {{"simd_efficiency_over_time", "fraction", "`[{cycle, value}]`, active lanes / lane slots of the warp steps issued in each interval (at most 256 points)", /*timed=*/true},
              [](const SimtUnit& u) { return u.efficiency_over_time(); }},
+            {{"helper_steps", "steps", "cooperative lanes only (`traversal.simt.cooperative`, CoopRT): ray steps a lane without a ray of its own ran for another lane's ray (each also counted in `active_lanes`)", /*timed=*/true},
+             [](const SimtUnit& u) { return u.m_helper_steps; }},
+            {{"helped_warp_steps", "steps", "cooperative lanes only: warp steps in which at least one helper stepped", /*timed=*/true},
+             [](const SimtUnit& u) { return u.m_helped_warp_steps; }},
             {{"lane_requests", "requests", "reads the stepping lanes asked for (a MIMD unit's requests for the same steps)", /*timed=*/true},
              [](const SimtUnit& u) { return u.m_coalescer.lane_requests(); }},
             {{"coalesced_requests", "requests", "read requests after coalescing a warp step's reads per L1 line", /*timed=*/true},
@@ -395,6 +448,7 @@ nlohmann::json SimtUnit::stats_json(Cycle total_cycles) const {
         .set("simd_efficiency", slots ? double(m_lane_steps) / double(slots) : 0.0);
     if (m_treelet_mode) w.set("rays_taken", m_takes).set("rays_parked", m_parks).set("idle_polls", m_idle_polls);
     if (m_prefetcher.on()) w.set("prefetch", m_prefetcher.stats_json());
+    if (m_stack_prefetch.on()) w.set("stack_prefetch", m_stack_prefetch.stats_json());
     kind_stats().write(*this, j);
     w.done();
     return j;

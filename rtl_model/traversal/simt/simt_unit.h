@@ -19,6 +19,21 @@
 // takes a new ray then (traversal.simt.refill = lane, persistent threads) or once its whole warp
 // has finished (warp); new rays' records are fetched in a warp step of their own (the lanes that
 // fetch are its active lanes: refilling few lanes costs a mostly idle step, as on a GPU).
+//
+// Cooperative lanes (traversal.simt.cooperative; CoopRT: "Accelerating BVH Traversal for Ray
+// Tracing via Cooperative Threads", ISCA 2025): a lane with no ray of its own (its ray finished
+// and its warp has not retired, or dispatch has none) helps a lane of its warp that is stepping.
+// CoopRT hands the helper an entry of the busy ray's traversal stack, whose subtree it walks with
+// its own traversal hardware while the owner goes on. Here the ray's steps keep their sequential
+// order (so hits and every work count stay the reference's): in a warp step a helper runs the
+// ray's next step, if the ray's stack held an entry for it when the warp step began (the
+// independent subtree CoopRT would hand over; each entry feeds one helper) and that step runs the
+// warp's operation kind. A helper's fetches coalesce with the warp's, its tests issue to the
+// pipelines like any lane's, its stack traffic goes to the ray's spill slots. Idle lanes go to
+// the rays with the most stack entries left. What this leaves out: CoopRT's helpers walk their
+// subtree with the best hit the owner had at the hand-over, so they may visit nodes the
+// sequential order culls (our work is the sequential walk's, a lower bound on theirs), and the
+// merge of the helpers' hits (a t compare per hand-back) is priced, not timed.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -48,11 +63,14 @@ public:
 
 private:
     static constexpr uint32_t kClasses = kOpKindCount + 1;
+    static constexpr uint32_t kNoLane = 0xFFFFFFFFu;
     enum class Phase : uint8_t { step, ops };
     struct Lane {
         RayState ray;
         StepDemand demand;      ///< its step in the warp step in flight
         uint32_t treelet = kNoTreelet;  ///< prefetching without queues: the treelet its ray is in
+        uint32_t helps = kNoLane;  ///< cooperative lanes: the lane whose ray it steps this warp step
+        int spare = 0;             ///< cooperative lanes: its ray's stack entries not yet handed to a helper
         Cycle ready = 0;        ///< treelet scheduling: cycle its ray's state came from the ray buffer
         bool has_ray = false;
         bool stepping = false;  ///< active in the warp step in flight
@@ -81,6 +99,13 @@ private:
     void park_leavers(uint32_t w, Cycle t);
     /// Prefetching without queues: lane l's next step entered another treelet.
     void note_treelet(uint32_t l, Cycle t);
+    /// Runs the next step of lane `owner`'s ray into lane `into`'s demand (the same lane, or a
+    /// helper), its reads to the coalescer.
+    void step_ray(uint32_t owner, uint32_t into, uint32_t treelet);
+    /// Cooperative lanes: the warp's lanes without a ray of their own step its rays (above).
+    void lend_idle_lanes(uint32_t w, uint32_t cls, Cycle t);
+    /// The lane whose ray lane l steps this warp step (itself, or the lane it helps).
+    uint32_t ray_lane(uint32_t l) const { return m_lanes[l].helps == kNoLane ? l : m_lanes[l].helps; }
     void fill_when_idle(Cycle t);
     void finish_lane(uint32_t l, Cycle t);
     /// The step class the warp runs next (simt_policy), or kClasses when no lane has a ray.
@@ -107,6 +132,7 @@ private:
     LineCoalescer m_coalescer;
     Cycle m_fetch_at = 0;  ///< when the rays retire_and_refill() took may fetch their records
     uint64_t m_warp_steps = 0, m_lane_steps = 0, m_fetch_steps = 0;
+    uint64_t m_helper_steps = 0, m_helped_warp_steps = 0;  ///< cooperative lanes
     std::vector<uint64_t> m_active_histogram;  ///< warp steps by active lanes (0 .. lanes)
     /// Per ray kind: lane-steps of lanes holding a ray of that kind, and those that stepped.
     std::array<uint64_t, kRayKindCount> m_kind_present{}, m_kind_active{};

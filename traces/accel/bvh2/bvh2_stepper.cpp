@@ -92,6 +92,20 @@ StepOutcome Bvh2Stepper::execute() {
     return out;
 }
 
+uint32_t Bvh2Stepper::stack_reads(Fetch* out, uint32_t max) const {
+    uint32_t n = 0;
+    for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
+        const detail::Bvh2StackEntry& e = m_stack[i];
+        if (e.count == 0) {
+            out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * sizeof(HwNode), uint32_t(sizeof(HwNode)), DataKind::node};
+        } else {
+            const TriangleAddressing::Span s = m_view.tri_at.span(e.ref, e.count);
+            out[n] = Fetch{s.address, s.bytes, DataKind::triangle};
+        }
+    }
+    return n;
+}
+
 void Bvh2Stepper::visit_node(const HwNode& node) {
     // Nearer child next (child 0 on equal entry distances; any-hit rays by their order); the other pushed.
     const int before = m_stack_size;

@@ -47,6 +47,7 @@ public:
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
+    uint32_t stack_reads(Fetch* out, uint32_t max) const override;
 
 private:
     void visit_node(const HwNode& node);

@@ -88,6 +88,20 @@ public:
         return out;
     }
 
+    uint32_t stack_reads(Fetch* out, uint32_t max) const override {
+        uint32_t n = 0;
+        for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
+            const WideStackEntry& e = m_stack[size_t(i)];
+            if (e.count == 0) {
+                out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * Codec::kBytes, uint32_t(Codec::kBytes), DataKind::node};
+            } else {
+                const TriangleAddressing::Span s = m_view.tri_at.span(e.ref, e.count);
+                out[n] = Fetch{s.address, s.bytes, DataKind::triangle};
+            }
+        }
+        return n;
+    }
+
 private:
     using Node = typename Codec::Node;
     const Node& node(uint32_t i) const {
