@@ -81,6 +81,7 @@ json analysis_key(const SimConfig& c, const AnalyticConfig& s, const std::string
     if (c.mailbox.entries) key["mailbox_entries"] = c.mailbox.entries;
     if (c.traversal.stack_overflow != StackOverflow::spill) key["short_stack_entries"] = c.traversal.stack_entries;
     if (c.traversal.box_precision_bits) key["box_precision_bits"] = c.traversal.box_precision_bits;
+    if (c.traversal.quantized_boxes) key["quantized_boxes"] = true;
     if (c.traversal.anyhit_order != AnyHitOrder::nearest)
         key["anyhit_order"] = kAnyHitOrderChoices.name(c.traversal.anyhit_order);
     // Treelet scheduling orders the sample's steps (sample.h): its settings, when on.

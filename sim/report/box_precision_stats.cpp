@@ -11,7 +11,8 @@ const StatBlock& box_precision_stats() {
     static const StatBlock block{
         "box_precision",
         {
-            {"bits", "bits", "`traversal.box_precision_bits`: explicit mantissa bits of the box tests (fp32: 23)"},
+            {"bits", "bits", "`traversal.box_precision_bits`: explicit mantissa bits of the box tests (fp32: 23); with `traversal.quantized_boxes` 8 (the integer test's coordinates)"},
+            {"arithmetic", "", "`reduced_fp` (`traversal.box_precision_bits`) or `quantized_int` (`traversal.quantized_boxes`: AQB8-style integer tests on the nodes' 8-bit grids, conservative by one grid cell)"},
             {"box_hits", "boxes", "boxes the reduced test entered that the fp32 walk rejected or culled at a pop: the roots of the extra walk"},
             {"steps", "steps", "node steps of the extra walk (each a node fetch, counted in the caches and units)"},
             {"box_tests", "tests", "box tests of those steps"},
@@ -29,15 +30,17 @@ const StatBlock& box_precision_stats() {
 }
 
 void add_box_precision_stats(json& stats, const SimConfig& c, const WorkTotals& w, uint64_t rays) {
-    const uint32_t bits = c.traversal.box_precision_bits;
+    const bool quantized = c.traversal.quantized_boxes;
+    const uint32_t bits = quantized ? 8 : c.traversal.box_precision_bits;
     if (bits == 0) return;
     const uint64_t hits = w[WorkField::rp_box_hits], steps = w[WorkField::rp_steps];
     const uint64_t boxes = w[WorkField::rp_box_tests], tris = w[WorkField::rp_tri_tests];
     auto per_ray = [&](uint64_t x) { return rays ? json(double(x) / double(rays)) : json(nullptr); };
     auto fraction = [](uint64_t x, uint64_t of) { return of ? json(double(x) / double(of)) : json(nullptr); };
-    const BoxPipelineCost reduced = box_pipeline_cost(c, bits), fp32 = box_pipeline_cost(c, 0);
+    const BoxPipelineCost reduced = box_pipeline_cost(c), fp32 = box_pipeline_cost(c, true);
     StatsWriter(box_precision_stats(), stats["box_precision"])
         .set("bits", bits)
+        .set("arithmetic", quantized ? "quantized_int" : "reduced_fp")
         .set("box_hits", hits)
         .set("steps", steps)
         .set("box_tests", boxes)
@@ -63,7 +66,7 @@ namespace {
 
 ReportBlock box_precision_report() {
     ReportBlock b;
-    b.name = "reduced-precision boxes";
+    b.name = "reduced-precision or quantised boxes";
     b.order = 30;
     b.add = [](json& stats, const ReportInputs& in) { add_box_precision_stats(stats, in.config, in.work, in.rays); };
     b.keys = {{"box_precision", box_precision_stats}};

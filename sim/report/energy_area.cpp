@@ -110,6 +110,21 @@ Flops at_precision(const Flops& f, uint32_t bits) {
     return {f.add * word, f.mul * sig * sig, f.cmp * word, f.div * sig * sig};
 }
 
+/// One box test on an AQB8-style integer pipeline (Huang, Yang & Yeh, ISCA 2025), in fp32
+/// equivalents: per axis 2 subtracts of 9-bit integers (a child's 8-bit coordinate minus the
+/// ray's quantised origin) and 2 multiplies of 9 by 16 bits (the fixed-point inverse direction),
+/// then the slab compares at 16 bits. Integer adders and comparators as `cmp` (a 32-bit integer
+/// add) scaled by width / 32; a multiplier as fp32's scaled by its partial-product array
+/// (9 x 16 against 24 x 24). Our assumption, not the paper's figures (docs/energy_area.md).
+constexpr double kQuantAddWidth = 9.0 / 32.0, kQuantMulArray = 9.0 * 16.0 / (24.0 * 24.0), kQuantCmpWidth = 16.0 / 32.0;
+constexpr Flops kQuantizedBoxFlops{0, 6 * kQuantMulArray, 6 * kQuantAddWidth + 9 * kQuantCmpWidth, 0};
+
+/// The arithmetic of one box test on the pipeline the config builds.
+Flops box_flops(const SimConfig& s) {
+    if (s.traversal.quantized_boxes) return kQuantizedBoxFlops;
+    return at_precision(kBoxFlops, s.traversal.box_precision_bits);
+}
+
 /// A block's stat by its declared key (`block`), 0 when the level wrote null.
 double num(const StatBlock& block, const json& j, const char* key) {
     const json& v = StatsReader(block, j)[key];
@@ -170,7 +185,7 @@ json area_json(const SimConfig& s, const json& stats) {
         sram += mm2[it.key()].get<double>();
         sram_bytes += it->get<double>();
     }
-    mm2["box"] = pipeline_mm2(c, s, s.box, at_precision(kBoxFlops, t.box_precision_bits));
+    mm2["box"] = pipeline_mm2(c, s, s.box, box_flops(s));
     mm2["triangle"] = pipeline_mm2(c, s, s.triangle, kTriangleFlops);
     mm2["anyhit"] = instantiated(stats.value("instantiated", json::array()), "anyhit")
                         ? pipeline_mm2(c, s, s.anyhit, kAnyhitFlops)
@@ -195,8 +210,8 @@ double logic_pj(const EnergyConfig& c, double adds, double muls, double cmps) {
     return flops_pj(c, {adds, muls, cmps, 0}) * energy_scale(c);
 }
 
-BoxPipelineCost box_pipeline_cost(const SimConfig& config, uint32_t bits) {
-    const Flops f = at_precision(kBoxFlops, bits);
+BoxPipelineCost box_pipeline_cost(const SimConfig& config, bool fp32) {
+    const Flops f = fp32 ? kBoxFlops : box_flops(config);
     return {flops_pj(config.energy, f) * energy_scale(config.energy), pipeline_mm2(config.energy, config, config.box, f)};
 }
 
@@ -250,7 +265,7 @@ double sram_mm2(const EnergyConfig& c, double bytes) {
 void add_energy_area(json& stats, const SimConfig& s, const WorkTotals& w, uint64_t rays) {
     const EnergyConfig& c = s.energy;
     OpEnergies op = op_energies(c);
-    op.test[size_t(OpKind::box)] = box_pipeline_cost(s, s.traversal.box_precision_bits).test_pj;
+    op.test[size_t(OpKind::box)] = box_pipeline_cost(s).test_pj;
     const json& model = stats.value("model", json::object());
     json& summary = stats["summary"];
     const TraversalConfig& t = s.traversal;

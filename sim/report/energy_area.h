@@ -50,7 +50,9 @@ double logic_pj(const EnergyConfig& c, double adds, double muls, double cmps);
 struct BoxPipelineCost {
     double test_pj = 0, mm2 = 0;
 };
-BoxPipelineCost box_pipeline_cost(const SimConfig& config, uint32_t bits);
+/// The box pipeline the config builds: fp32, `traversal.box_precision_bits` wide, or with
+/// `traversal.quantized_boxes` an integer one (AQB8); `fp32` prices the fp32 one whatever is set.
+BoxPipelineCost box_pipeline_cost(const SimConfig& config, bool fp32 = false);
 
 /// Adds `energy` and `area` to stats and `energy_per_ray_nj`, `mrays_per_joule`, `area_mm2` and
 /// `power_w` to stats["summary"] (null where the level cannot know them). Reads stats["model"],

@@ -46,6 +46,11 @@ constexpr double kSortEntryBytes = 48;
 /// the treelet's root: no table SRAM); and its request queue per unit.
 constexpr double kPrefetchStreamBytes = 16, kPrefetchQueueEntries = 16, kPrefetchQueueEntryBytes = 8;
 
+/// AQB8-style quantised box tests, per node step: the ray re-expressed in the node's grid (its
+/// origin minus the node's origin, 3 fp adds; the scale by 2^-e and the inverse direction's by
+/// 2^e are exponent adds, 6 integer adds) before the child boxes' integer tests. The
+/// requantiser sits beside each box pipeline lane.
+constexpr double kRequantAdds = 3, kRequantCmps = 6;
 /// Cooperative lanes (CoopRT, ISCA 2025) per SIMT lane: the lane it helps (an index and a valid
 /// bit; a helper writes its hits to the helped ray's state in the warp buffer), the pick (a
 /// compare of stack depths) and the merge (a t compare against the helped ray's best).
@@ -133,7 +138,9 @@ TechniqueArea technique_area(const SimConfig& s, const json& inst) {
     const EnergyConfig& c = s.energy;
     const TraversalConfig& t = s.traversal;
     TechniqueArea a;
-    if (is_built(inst, "node_decoder"))
+    // An integer box pipeline tests the quantised boxes as stored: no dequantiser, a requantiser.
+    if (t.quantized_boxes) a.logic_mm2["ray_requantizer"] = lanes_of(s, s.box) * logic_mm2(c, kRequantAdds, 0, kRequantCmps);
+    else if (is_built(inst, "node_decoder"))
         a.logic_mm2["node_decoder"] = lanes_of(s, s.box) * logic_mm2(c, kDecodeAdds, 0, kDecodeCmps);
     if (is_built(inst, "leaf_decoder")) {
         // One block buffer per triangle pipeline, sized for the largest block (the default
@@ -197,13 +204,14 @@ std::map<std::string, double> technique_energy_pj(const SimConfig& s, const Work
     const double box_tests = double(w[work_field_of(OpKind::box)] + w[WorkField::restart_box_tests] +
                                     w[WorkField::rp_box_tests]);
     const double tri_tests = double(w[work_field_of(OpKind::triangle)] + w[WorkField::rp_tri_tests]);
-    if (is_built(inst, "node_decoder")) pj["node_decoder"] = box_tests * logic_pj(c, kDecodeAdds, 0, kDecodeCmps);
+    const double steps = double(w[WorkField::steps] + w[WorkField::rp_steps]);
+    if (t.quantized_boxes) pj["ray_requantizer"] = steps * logic_pj(c, kRequantAdds, 0, kRequantCmps);
+    else if (is_built(inst, "node_decoder")) pj["node_decoder"] = box_tests * logic_pj(c, kDecodeAdds, 0, kDecodeCmps);
     if (is_built(inst, "leaf_decoder")) {
         const double buffer = double(LeafConfig{}.block_bytes);
         pj["leaf_decoder"] = tri_tests * (logic_pj(c, 0, 0, kLeafCmps) +
                                           2 * sram_access_pj(c, buffer, 3 * kVertexBytes * 8));  // read + written
     }
-    const double steps = double(w[WorkField::steps] + w[WorkField::rp_steps]);
     const double groups = t.groups(), lanes = t.group_size();
     if (t.model == "simt") {
         // Each warp step: the scheduler's pick over the warps, the masks updated, the coalescer's

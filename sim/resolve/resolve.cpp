@@ -54,6 +54,7 @@ RunSetup resolve_run(const SimConfig& config, const StructureFacts& structure) {
     s.step.mailbox_entries = s.config.mailbox.entries;
     s.step.short_stack_entries = t.stack_overflow == StackOverflow::restart_trail ? t.stack_entries : 0;
     s.step.box_precision_bits = t.box_precision_bits;
+    s.step.quantized_box_tests = t.quantized_boxes;
     s.step.anyhit_order = t.anyhit_order;
     if (s.unit->needs.packet_kernel) s.packet_reference = s.unit->packet_reference(t);
     return s;

@@ -6,6 +6,7 @@ namespace {
 
 bool restart_trail(const RunFacts& f) { return f.config.traversal.stack_overflow == StackOverflow::restart_trail; }
 bool reduced_boxes(const RunFacts& f) { return f.config.traversal.box_precision_bits != 0; }
+bool quantized_boxes(const RunFacts& f) { return f.config.traversal.quantized_boxes; }
 bool anyhit_reordered(const RunFacts& f) { return f.config.traversal.anyhit_order != AnyHitOrder::nearest; }
 bool treelets(const RunFacts& f) { return f.config.treelets.enabled; }
 bool sampling(const RunFacts& f) { return f.config.sampling.enabled(); }
@@ -99,6 +100,24 @@ std::vector<Rule> make_rules() {
          "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
          "a packet's shared walk has no per-ray extra walk", "traversal.model=mimd or simt, or box_precision_bits=0",
          "bvh2", {"traversal.model=packet", "traversal.box_precision_bits=7"}});
+
+    add({"quantized_boxes/structure", "traversal.quantized_boxes (AQB8-style integer box pipeline)", quantized_boxes,
+         RuleSide::structure, "quantised nodes", [](const RunFacts& f) { return f.structure.caps.quantized_boxes; },
+         "an integer box pipeline tests child boxes stored as 8-bit integers on their node's grid, which only "
+         "the compressed wide BVHs store",
+         "traversal.quantized_boxes=false, or trace cwbvh6 or cwbvh8 (rtsim capabilities)", "bvh2",
+         {"traversal.quantized_boxes=true"}});
+    add({"quantized_boxes/unit", "traversal.quantized_boxes (AQB8-style integer box pipeline)", quantized_boxes,
+         RuleSide::unit, "a unit kind whose rays walk their own stacks",
+         [](const RunFacts& f) { return f.unit.needs.per_ray_stack; }, "a packet's shared walk has no per-ray extra walk",
+         "traversal.model=mimd or simt, or traversal.quantized_boxes=false", "cwbvh8",
+         {"traversal.model=packet", "traversal.quantized_boxes=true"}});
+    add({"quantized_boxes/precision", "traversal.quantized_boxes (AQB8-style integer box pipeline)", quantized_boxes,
+         RuleSide::technique, "traversal.box_precision_bits=0",
+         [](const RunFacts& f) { return f.config.traversal.box_precision_bits == 0; },
+         "the box pipeline is either integer on quantised boxes or a reduced-precision floating-point one",
+         "traversal.box_precision_bits=0 or traversal.quantized_boxes=false", "cwbvh8",
+         {"traversal.quantized_boxes=true", "traversal.box_precision_bits=7"}});
 
     add({"anyhit_order/structure", "traversal.anyhit_order (any-hit child order)", anyhit_reordered,
          RuleSide::structure, "an any-hit child order", [](const RunFacts& f) { return f.structure.caps.anyhit_order; },

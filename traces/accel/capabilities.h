@@ -17,6 +17,9 @@ struct AccelCapabilities {
     bool restart_trail = false;
     /// A conservative reduced-precision box walk (rp_boxes.h): traversal.box_precision_bits.
     bool reduced_precision_boxes = false;
+    /// Its nodes store child boxes as 8-bit integers on a per-node grid, which an integer box
+    /// pipeline tests directly (AQB8): traversal.quantized_boxes.
+    bool quantized_boxes = false;
     /// Any-hit rays' child order at a node (StepOptions::anyhit_order): traversal.anyhit_order.
     bool anyhit_order = false;
     /// References that repeat along a ray, which its steppers look up in a mailbox (mailbox.h).
@@ -48,6 +51,7 @@ struct AccelCapabilities {
         return {{"packet_kernel", packet_kernel},
                 {"restart_trail", restart_trail},
                 {"reduced_precision_boxes", reduced_precision_boxes},
+                {"quantized_boxes", quantized_boxes},
                 {"anyhit_order", anyhit_order},
                 {"mailbox", mailbox},
                 {"compressed_leaves", compressed_leaves},

@@ -174,12 +174,13 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
                                     " (an image of another kind under this name?)");
         return compressed ? load_cwbvh(std::move(image), width, source) : load_wide_fp32(std::move(image), width, source);
     };
-    const AccelCapabilities c = single_level(kBvhStackEntryBytes)
-                                    .with(&AccelCapabilities::packet_kernel)
-                                    .with(&AccelCapabilities::restart_trail)
-                                    .with(&AccelCapabilities::reduced_precision_boxes)
-                                    .with(&AccelCapabilities::refit)
-                                    .with(&AccelCapabilities::stack_addresses);
+    AccelCapabilities c = single_level(kBvhStackEntryBytes)
+                              .with(&AccelCapabilities::packet_kernel)
+                              .with(&AccelCapabilities::restart_trail)
+                              .with(&AccelCapabilities::reduced_precision_boxes)
+                              .with(&AccelCapabilities::refit)
+                              .with(&AccelCapabilities::stack_addresses);
+    c.quantized_boxes = compressed;
     return {{name, description, tree_builder_names(), c}, tree_settings, build, load};
 }
 

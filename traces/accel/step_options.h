@@ -28,6 +28,10 @@ struct StepOptions {
     /// Mantissa bits of a conservative reduced-precision box test (rp_boxes.h); 0: fp32 alone.
     /// Hits and the reference work never change; the extra walk is model-only work.
     uint32_t box_precision_bits = 0;
+    /// AQB8-style quantised box tests (wide_stepper.h; structures with quantised nodes): the
+    /// integer test's extra walk, in the same model-only rp_* work fields. Hits and the
+    /// reference work never change.
+    bool quantized_box_tests = false;
     /// Child order of any-hit rays (binary BVH steppers); hit/miss never changes, the occluder
     /// found and the work may. The fused loops walk nearest first, so other orders use a stepper.
     AnyHitOrder anyhit_order = AnyHitOrder::nearest;
@@ -35,7 +39,8 @@ struct StepOptions {
     /// True when a structure's fused reference loop walks as its steppers do: no short stack or
     /// reduced-precision walk whose extra work only a stepper counts, and any-hit rays nearest first.
     bool fused_loop_walks_alike() const {
-        return short_stack_entries == 0 && box_precision_bits == 0 && anyhit_order == AnyHitOrder::nearest;
+        return short_stack_entries == 0 && box_precision_bits == 0 && !quantized_box_tests &&
+               anyhit_order == AnyHitOrder::nearest;
     }
 };
 

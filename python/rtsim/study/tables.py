@@ -106,6 +106,30 @@ def prefetch_totals(rec: RunRecord) -> dict[str, int]:
     return total
 
 
+def l1_misses(rec: RunRecord) -> int:
+    """Read line accesses that missed in the L1s (merged misses count as hits, as hit_rate does)."""
+    return sum(
+        c.get("reads", 0) - c.get("read_hits", 0) - c.get("merged", 0)
+        for c in (_model(rec).get("l1") or {}).values()
+    )
+
+
+def cycle_uses(rec: RunRecord) -> dict[str, float]:
+    """Where the ray contexts' cycles went: `{use: fraction of context-cycles}`."""
+    by_use = (_model(rec).get("cycle_accounting") or {}).get("by_use") or {}
+    total = sum(by_use.values()) or 1
+    return {k: v / total for k, v in by_use.items()}
+
+
+def stack_prefetch_totals(rec: RunRecord) -> dict[str, int]:
+    """The units' stack-prefetch counters (traversal.stack_prefetch), summed."""
+    total: dict[str, int] = {}
+    for u in units(rec):
+        for k, v in (u.get("stack_prefetch") or {}).items():
+            total[k] = total.get(k, 0) + v
+    return total
+
+
 def units(rec: RunRecord) -> list[dict[str, Any]]:
     """Every traversal unit's counters."""
     return list((_model(rec).get("units") or {}).values())

@@ -24,6 +24,12 @@ struct CwCodec {
     static constexpr uint32_t kBytes = sizeof(N);
     /// CwNode8 has a fused SIMD reference loop (cwbvh_trace.cpp); CwNode6, the stepper.
     static constexpr bool kFused = W == 8;
+    /// Child boxes are 8-bit integers on the node's grid: an integer box test can run on them.
+    static constexpr bool kQuantized = true;
+    /// The node's grid cell per axis (one step of its 8-bit child coordinates).
+    static void cell(const Node& n, float cell[3]) {
+        for (int a = 0; a < 3; ++a) cell[a] = quant_scale(n.e[a]);
+    }
     static Hit fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work);
 
     static uint32_t valid_mask(const Node& n) {

@@ -48,6 +48,9 @@ struct Fp32Codec {
     static constexpr int kWidth = N;
     static constexpr uint32_t kBytes = sizeof(Node);
     static constexpr bool kFused = true;  ///< has a fused SIMD reference loop (wide_trace.cpp)
+    /// Child boxes stored as fp32: no quantisation grid for an integer box test.
+    static constexpr bool kQuantized = false;
+    static void cell(const Node&, float cell[3]) { cell[0] = cell[1] = cell[2] = 0.0f; }
     /// The fused loop (distance order only): trace_wide_fused<N> (wide_accel.h).
     static Hit fused(const WideView& view, const Ray& ray, TraversalMode mode, WorkCounts* work);
 

@@ -48,11 +48,15 @@ struct WideView {
 template <class Codec>
 class WideStepper final : public Stepper {
 public:
-    explicit WideStepper(const WideView& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0)
+    /// quantized_box_tests: the narrower test is the integer test of quantised nodes (below;
+    /// only codecs with kQuantized), instead of box_precision_bits' reduced fp test.
+    explicit WideStepper(const WideView& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0,
+                         bool quantized_box_tests = false)
         : m_view(view), m_stack(std::max<uint32_t>(1, view.max_stack)) {
         m_short.configure(short_stack_entries);
         if (m_short.enabled()) m_entry_depth.resize(m_stack.size());
-        m_rp.configure(box_precision_bits);
+        m_quantized = quantized_box_tests && Codec::kQuantized;
+        m_rp.configure(m_quantized ? kQuantizedTestBits : box_precision_bits);
         if (m_rp.enabled()) m_rp_tnear.resize(m_stack.size());
     }
 
@@ -134,7 +138,7 @@ private:
         float tnear[kMaxWideWidth];
         const uint32_t mask = detail::wide_box_tests(m_box, d, m_ray.tmin, m_cull_t, tnear);
         float rp_tnear[kMaxWideWidth];
-        if (m_rp.enabled()) rp_tests(d, mask, rp_tnear);
+        if (m_rp.enabled()) rp_tests(n, d, mask, rp_tnear);
         uint8_t order[kMaxWideWidth];
         const int hits = detail::order_children(mask, tnear, m_view.order, m_octant, order);
         if (m_short.enabled()) m_short.visit(m_ref, m_depth);
@@ -208,15 +212,30 @@ private:
         else finish();
     }
 
-    /// The narrower test on every slot of `d` (against the same interval); the slots only it
-    /// accepts (not in fp32_mask) are handed to m_rp when `enter`. Returns its hit mask.
-    uint32_t rp_tests(const DecodedNode& d, uint32_t fp32_mask, float tnear[kMaxWideWidth], bool enter = true) {
+    /// The narrower test on every slot of `d` (node `n` decoded, against the same interval); the
+    /// slots only it accepts (not in fp32_mask) are handed to m_rp when `enter`. Returns its hit
+    /// mask. With quantised box tests (AQB8: Huang, Yang & Yeh, ISCA 2025) the hardware tests
+    /// the node's 8-bit child boxes in integer arithmetic after quantising the ray into the
+    /// node's grid; we take that test as exact on the child box grown by one grid cell per side
+    /// (the ray's origin rounded outward to the grid), run in fp32 on the grown box: conservative,
+    /// since the slab test is monotone in the box under rounding.
+    uint32_t rp_tests(const Node& n, const DecodedNode& d, uint32_t fp32_mask, float tnear[kMaxWideWidth],
+                      bool enter = true) {
+        float cell[3];
+        Codec::cell(n, cell);
         uint32_t mask = 0;
         for (uint32_t v = d.valid; v; v &= v - 1) {
             const int s = __builtin_ctz(v);
-            const float lo[3] = {d.lo[0][s], d.lo[1][s], d.lo[2][s]};
-            const float hi[3] = {d.hi[0][s], d.hi[1][s], d.hi[2][s]};
-            if (!intersect_box_rp(m_box, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &tnear[s])) continue;
+            float lo[3] = {d.lo[0][s], d.lo[1][s], d.lo[2][s]};
+            float hi[3] = {d.hi[0][s], d.hi[1][s], d.hi[2][s]};
+            bool hit;
+            if (m_quantized) {
+                for (int a = 0; a < 3; ++a) lo[a] -= cell[a], hi[a] += cell[a];
+                hit = detail::box_kernel(m_box, lo, hi, m_ray.tmin, m_cull_t, &tnear[s]);
+            } else {
+                hit = intersect_box_rp(m_box, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &tnear[s]);
+            }
+            if (!hit) continue;
             mask |= 1u << s;
             if (enter && !(fp32_mask >> s & 1u)) m_work.rp_box_hits += 1, m_rp.enter(d.ref[s], d.count[s]);
         }
@@ -233,7 +252,7 @@ private:
             m_work.rp_steps += 1;
             m_work.rp_box_tests += detail::popcount8(d.valid);
             float tnear[kMaxWideWidth];
-            const uint32_t mask = rp_tests(d, 0, tnear, false);
+            const uint32_t mask = rp_tests(node(e.ref), d, 0, tnear, false);
             for (uint32_t m = mask; m; m &= m - 1) m_rp.enter(d.ref[__builtin_ctz(m)], d.count[__builtin_ctz(m)]);
         } else {
             m_work.rp_tri_tests += e.count;
@@ -247,7 +266,11 @@ private:
         m_plan.finish();
     }
 
+    /// The reduced-precision shadow's bits when it runs quantised box tests (its walk, not its width).
+    static constexpr uint32_t kQuantizedTestBits = 8;
+
     WideView m_view;
+    bool m_quantized = false;  ///< quantised (integer) box tests drive the extra walk
     RayBoxPre m_box;
     RayTrianglePre m_tri;
     uint32_t m_octant = 0;
