@@ -39,6 +39,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& techniques(
         {"mailbox", {"mailbox.entries=8"}},
         {"stack prefetching (TTP)", {"traversal.stack_prefetch=2"}},
         {"cooperative lanes (CoopRT)", {"traversal.simt.cooperative=true"}},
+        {"quantised boxes (AQB8)", {"traversal.quantized_boxes=true"}},
         {"ray sorting", {"dispatch.sort=morton"}},
         {"20% sampling", {"sampling.fraction=0.2"}},
     };
@@ -154,11 +155,12 @@ std::string capability_markdown() {
     std::ostringstream md;
     auto yes = [](const json& b) { return b.get<bool>() ? "yes" : "-"; };
     md << "### Structures and what they offer\n\n| structure | packet kernel | restart trail | reduced-precision boxes | "
-          "any-hit order | mailbox | compressed leaves | treelet partition | stack addresses | stack entry (bytes) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+          "quantised boxes | any-hit order | mailbox | compressed leaves | treelet partition | stack addresses | stack entry (bytes) |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const json& s : t["structures"]) {
         const json& c = s["capabilities"];
         md << "| " << s["name"].get<std::string>() << " | " << yes(c["packet_kernel"]) << " | "
-           << yes(c["restart_trail"]) << " | " << yes(c["reduced_precision_boxes"]) << " | " << yes(c["anyhit_order"])
+           << yes(c["restart_trail"]) << " | " << yes(c["reduced_precision_boxes"]) << " | " << yes(c["quantized_boxes"])
+           << " | " << yes(c["anyhit_order"])
            << " | " << yes(c["mailbox"])
            << " | " << yes(c["compressed_leaves"]) << " | " << yes(c["treelet_partition"]) << " | "
            << yes(c["stack_addresses"]) << " | " << c["stack_entry_bytes"].get<uint32_t>() << " |\n";

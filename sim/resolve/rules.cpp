@@ -197,6 +197,16 @@ std::string refusal(const Rule& r, const RunFacts& f) {
 
 std::vector<Unused> unused_settings(const RunFacts& f) {
     std::vector<Unused> out;
+    // A unit kind's own section set away from its defaults while another kind runs.
+    const nlohmann::json mine = config_to_json(f.config)["traversal"];
+    const nlohmann::json defaults = config_to_json(SimConfig{})["traversal"];
+    for (const UnitKind* k : unit_kinds()) {
+        if (k->name == f.config.traversal.model || !mine.contains(k->name) || !mine[k->name].is_object()) continue;
+        for (auto it = mine[k->name].begin(); it != mine[k->name].end(); ++it)
+            if (defaults[k->name].value(it.key(), nlohmann::json()) != it.value())
+                out.push_back({"traversal." + k->name + "." + it.key(),
+                               "a setting of the " + k->name + " unit kind; traversal.model is " + f.config.traversal.model});
+    }
     if (f.config.mailbox.entries && !f.structure.caps.mailbox)
         out.push_back({"mailbox.entries", f.structure.name() + " lists no primitive twice along a ray"});
     if (f.config.treelets.prefetch && f.config.ideal_memory)

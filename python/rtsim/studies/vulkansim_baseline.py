@@ -23,6 +23,7 @@ from rtsim.study.tables import (
     prefetch_totals,
     scene,
     stack_prefetch_totals,
+    units,
 )
 
 SCENES = ["sponza", "hairball"]
@@ -63,6 +64,16 @@ LABELS = [p[0] for p in POINTS] + [p[0] for p in AQB8_POINTS]
 MEMORY_USES = ("l1_hit", "l1_mshr_full", "l2", "l2_mshr_full", "dram", "stack")
 #: Uses of lanes with nothing to step: waiting for their warp, for rays, or after the last.
 IDLE_USES = ("idle_lane", "starved", "tail")
+
+
+def _lane_totals(rec: Any) -> dict[str, int]:
+    """The warp units' lane slots, active lanes and helper steps, summed."""
+    out = {"lane_slots": 0, "active_lanes": 0, "helper": 0}
+    for u in units(rec):
+        out["lane_slots"] += u.get("lane_slots") or 0
+        out["active_lanes"] += u.get("active_lanes") or 0
+        out["helper"] += u.get("helper_steps") or 0
+    return out
 
 
 def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
@@ -114,6 +125,7 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
                 "l1_misses": r["l1_misses"],
                 "uses": r["uses"],
                 "stack_prefetch": r["stack_prefetch"],
+                "lanes": r["lanes"],
                 "prefetch_redundant": pf.get("redundant"),
                 "hit_mismatches": r["hit_mismatches"],
                 "work_mismatches": r["work_mismatches"],
@@ -210,7 +222,11 @@ def _why_treelet_prefetch(r: dict[str, Any], b: dict[str, Any]) -> str:
 
 
 def _why_cooprt(r: dict[str, Any], b: dict[str, Any]) -> str:
+    slots, active, helper = (r["lanes"].get(k, 0) for k in ("lane_slots", "active_lanes", "helper"))
+    empty = slots - (active - helper)  # lane slots with no ray of their own
+    filled = helper / empty if empty else 0.0
     return (
+        f"helpers filled {100 * filled:.0f}% of the lane slots without a ray; "
         f"SIMD efficiency {b['simd_efficiency']:.2f} -> {r['simd_efficiency']:.2f}; memory waits "
         f"{100 * _memory_share(b):.0f}% -> {100 * _memory_share(r):.0f}% of working lanes' "
         f"cycles, DRAM {100 * b['dram_utilization']:.0f}% -> "
@@ -333,5 +349,6 @@ STUDY = Study(
         "l1_misses": l1_misses,
         "uses": cycle_uses,
         "stack_prefetch": stack_prefetch_totals,
+        "lanes": _lane_totals,
     },
 )
