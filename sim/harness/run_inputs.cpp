@@ -75,6 +75,8 @@ StructureTraits structure_traits(const RunInputs& in) {
     t.compressed_leaves = f.compressed_leaves;
     t.can_compress_leaves = f.caps.compressed_leaves;
     t.treelet_partition = f.caps.treelet_partition;
+    t.stack_addresses = f.caps.stack_addresses;
+    t.quantized_boxes = f.caps.quantized_boxes;
     t.trace = in.rtt;
     const json frames = in.manifest.value("frames", json(nullptr));
     if (frames.is_object() && frames.contains("policy") && frames["policy"].is_string())

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rtl_model/traversal/simt/simt_config.h"
 #include "sim/report/energy_area.h"
 #include "sim/report/technique_cost.h"
 #include "traces/common/error.h"
@@ -187,6 +188,19 @@ std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st
     else structural(&out, {"dispatch.sort", kRaySortChoices.name(c.dispatch.sort), "none"}, "ray_order");
     if (!c.ideal_memory && st.treelet_partition)
         structural(&out, {"treelets.prefetch", c.treelets.prefetch, !c.treelets.prefetch}, "prefetch");
+    // The newest RT-unit techniques, where the design can take them: stack-driven prefetching
+    // (TTP) on per-ray stacks that hold addresses, cooperative lanes (CoopRT) on warps, an integer
+    // box pipeline (AQB8) on quantised nodes.
+    const UnitKind& unit = c.traversal.kind();
+    if (!c.ideal_memory && st.stack_addresses && unit.needs.per_ray_stack)
+        structural(&out, {"traversal.stack_prefetch", c.traversal.stack_prefetch, c.traversal.stack_prefetch ? 0 : 2},
+                   "latency");
+    if (unit.name == "simt") {
+        const bool coop = c.traversal.kinds.of<SimtConfig>("simt").cooperative;
+        structural(&out, {"traversal.simt.cooperative", coop, !coop}, "divergence");
+    }
+    if (st.quantized_boxes && unit.needs.per_ray_stack && c.traversal.box_precision_bits == 0)
+        structural(&out, {"traversal.quantized_boxes", c.traversal.quantized_boxes, !c.traversal.quantized_boxes}, "box");
     // An animated trace's frames rebuild, refit or choose (traces/accel/two_level/frame_policy.h):
     // another policy is another trace.
     if (!st.frame_policy.empty())

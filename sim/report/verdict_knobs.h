@@ -51,6 +51,8 @@ struct StructureTraits {
     bool compressed_leaves = false;   ///< its leaves are compressed
     bool can_compress_leaves = false; ///< the kind may store compressed leaves
     bool treelet_partition = true;    ///< the kind partitions itself into treelets
+    bool stack_addresses = false;     ///< its stacks hold addresses (traversal.stack_prefetch)
+    bool quantized_boxes = false;     ///< its nodes hold 8-bit boxes (traversal.quantized_boxes)
     std::string trace;                ///< the run's trace, for the commands that measure
     std::string frame_policy;         ///< an animated trace's --frame-policy ("" for a still trace)
 };

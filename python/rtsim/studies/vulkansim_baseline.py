@@ -4,16 +4,27 @@ compressed BVH Vulkan-Sim traverses), beside the same resources on MIMD units (`
 diffuse rays of Sponza and a procedural hairball, each on the binary BVH and on cwbvh6; on the
 warp baseline also Chou, Nowicki & Aamodt's treelet prefetching (MICRO 2023: the treelet
 partition drives only the prefetcher, no treelet queues) and treelet scheduling with and without
-prefetching, cooperative lanes (CoopRT), stack-driven prefetching (TTP) and, against the fp32
-BVH6, AQB8-style quantised box tests on cwbvh6. Table between the `vulkansim-baseline` markers
-of docs/presets.md; the papers' rows, each with its measured reason, between the
-`papers-treelet-prefetch-warp` markers of docs/papers.md; figure docs/vulkansim_baseline.png."""
+prefetching, a short stack with a restart trail, ray sorting, cooperative lanes (CoopRT),
+stack-driven prefetching (TTP), 10% sampling, cwbvh8 against bvh2 and, against the fp32 BVH6,
+AQB8-style quantised box tests on cwbvh6. Table between the `vulkansim-baseline` markers of
+docs/presets.md; the papers' rows (_vulkansim_papers.py), each with its measured reason, between
+the `papers-treelet-prefetch-warp` markers of docs/papers.md; figure docs/vulkansim_baseline.png."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
+from rtsim.studies._vulkansim_papers import (
+    MIMD,
+    SAMPLED,
+    SAMPLING_FULL,
+    WARP,
+    base,
+    find,
+    note,
+    papers_rows,
+)
 from rtsim.study import Figure, Study, StudyRun, Table
 from rtsim.study.tables import (
     bvh_bytes_per_ray,
@@ -31,10 +42,16 @@ ACCELS = ["bvh2", "cwbvh6"]
 #: Stack entries TTP prefetches per trigger (traversal.stack_prefetch): the top two, the next
 #: pops of an upward walk.
 TTP_ENTRIES = 2
+#: Ray sorting with a window as large as the 320x240 trace (docs/execution_models.md, "Sorting").
+SORT = {
+    "dispatch.sort": "origin_direction",
+    "dispatch.sort_window": 65536,
+    "dispatch.chunk_rays": 65536,
+}
 #: (label, preset, --set over it); the first is the baseline each row is against, except MIMD
 #: points, which are against the MIMD point.
 POINTS: list[tuple[str, str, dict[str, Any]]] = [
-    ("warp baseline", "vulkansim_rtx2060", {}),
+    (WARP, "vulkansim_rtx2060", {}),
     ("warp + treelet prefetch", "vulkansim_rtx2060", {"treelets.prefetch": True}),
     ("warp + treelets", "vulkansim_rtx2060", {"treelets.enabled": True}),
     (
@@ -44,26 +61,35 @@ POINTS: list[tuple[str, str, dict[str, Any]]] = [
     ),
     ("warp + CoopRT", "vulkansim_rtx2060", {"traversal.simt.cooperative": True}),
     ("warp + TTP", "vulkansim_rtx2060", {"traversal.stack_prefetch": TTP_ENTRIES}),
-    ("MIMD, same resources", "rtx2060", {}),
+    (
+        "warp + short stack",
+        "vulkansim_rtx2060",
+        {"traversal.stack_overflow": "restart_trail", "traversal.stack_entries": 5},
+    ),
+    ("warp + ray sorting", "vulkansim_rtx2060", SORT),
+    (MIMD, "rtx2060", {}),
     ("MIMD + TTP", "rtx2060", {"traversal.stack_prefetch": TTP_ENTRIES}),
+    ("MIMD + ray sorting", "rtx2060", SORT),
 ]
 QUICK = [
-    "warp baseline",
+    WARP,
     "warp + treelet prefetch",
     "warp + CoopRT",
     "warp + TTP",
-    "MIMD, same resources",
+    MIMD,
 ]
 #: AQB8 against the fp32 6-wide BVH: the baselines on bvh6, the quantised box tests on cwbvh6.
 AQB8 = {"traversal.quantized_boxes": True}
-AQB8_BASE = ["warp baseline", "MIMD, same resources"]
+AQB8_BASE = [WARP, MIMD]
 AQB8_POINTS = [("warp + AQB8", "vulkansim_rtx2060", AQB8), ("MIMD + AQB8", "rtx2060", AQB8)]
+#: Sampling against Zatel on a trace large enough for a 10% sample to hold its clusters' warm-up
+#: and measured rays (the warp baseline's 3,840 lanes need 30,720): the full run and the sample.
+SAMPLING_POINTS = [
+    (SAMPLING_FULL, "vulkansim_rtx2060", {}),
+    (SAMPLED, "vulkansim_rtx2060", {"sampling.fraction": 0.1}),
+]
 #: Every point label in table order.
-LABELS = [p[0] for p in POINTS] + [p[0] for p in AQB8_POINTS]
-#: Context-cycle uses that wait on the memory hierarchy (docs/stats.md, cycle accounting).
-MEMORY_USES = ("l1_hit", "l1_mshr_full", "l2", "l2_mshr_full", "dram", "stack")
-#: Uses of lanes with nothing to step: waiting for their warp, for rays, or after the last.
-IDLE_USES = ("idle_lane", "starved", "tail")
+LABELS = [p[0] for p in POINTS] + [p[0] for p in AQB8_POINTS] + [p[0] for p in SAMPLING_POINTS]
 
 
 def _lane_totals(rec: Any) -> dict[str, int]:
@@ -76,6 +102,11 @@ def _lane_totals(rec: Any) -> dict[str, int]:
     return out
 
 
+def _section(rec: Any, section: str, key: str) -> Any:
+    """A key of one of stats.json's technique sections (None when the run has none)."""
+    return ((rec.stats or {}).get(section) or {}).get(key)
+
+
 def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
     points = [
         {"label": label, "preset": preset, "set": sets}
@@ -84,11 +115,14 @@ def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
     ]
     base = {label: (preset, sets) for label, preset, sets in POINTS}
 
-    def spec(name: str, s: str, accel: list[str], pts: list[dict[str, Any]]) -> dict[str, Any]:
+    def spec(
+        name: str, s: str, accel: list[str], pts: list[dict[str, Any]], resolution: str = ""
+    ) -> dict[str, Any]:
+        res = resolution or o["resolution"]
         return {
             "name": f"{name}-{s}",
             "scenes": [scene(s, o["hairball_triangles"])],
-            "workloads": [{"name": "diffuse", "rays": ["diffuse"], "resolution": o["resolution"]}],
+            "workloads": [{"name": "diffuse", "rays": ["diffuse"], "resolution": res}],
             "accel": accel,
             "points": pts,
         }
@@ -100,6 +134,11 @@ def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
         out.append(spec("vulkansim-aqb8-base", s, ["bvh6"], fp32))
         quantised = [{"label": label, "preset": p, "set": sets} for label, p, sets in AQB8_POINTS]
         out.append(spec("vulkansim-aqb8", s, ["cwbvh6"], quantised))
+        # Ylitie et al.'s compressed 8-wide BVH against the binary one of the first spec.
+        out.append(spec("vulkansim-cwbvh8", s, ["cwbvh8"], fp32))
+        if not o["short"]:
+            sampled = [{"label": label, "preset": p, "set": st} for label, p, st in SAMPLING_POINTS]
+            out.append(spec("vulkansim-sampling", s, ["cwbvh6"], sampled, o["sampling_resolution"]))
     return out
 
 
@@ -126,6 +165,10 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
                 "uses": r["uses"],
                 "stack_prefetch": r["stack_prefetch"],
                 "lanes": r["lanes"],
+                "extra_steps": r["extra_steps"],
+                "restart_steps": r["restart_steps"],
+                "restarts": r["restarts"],
+                "wall_seconds": r.get("wall_seconds"),
                 "prefetch_redundant": pf.get("redundant"),
                 "hit_mismatches": r["hit_mismatches"],
                 "work_mismatches": r["work_mismatches"],
@@ -135,38 +178,6 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
     return out
 
 
-def _find(rs: list[dict[str, Any]], scene: str, accel: str, point: str) -> dict[str, Any] | None:
-    return next(
-        (b for b in rs if b["scene"] == scene and b["accel"] == accel and b["point"] == point), None
-    )
-
-
-def _base(rs: list[dict[str, Any]], r: dict[str, Any]) -> dict[str, Any]:
-    """The point a row is against: its unit kind's baseline on the same structure."""
-    base = "MIMD, same resources" if r["point"].startswith("MIMD") else POINTS[0][0]
-    found = _find(rs, r["scene"], r["accel"], base)
-    assert found is not None, (r["scene"], r["accel"], base)
-    return found
-
-
-def _memory_share(r: dict[str, Any]) -> float:
-    """Memory waits as a share of the cycles of lanes (contexts) with a step to run."""
-    working = 1 - sum(r["uses"].get(u, 0.0) for u in IDLE_USES)
-    return sum(r["uses"].get(u, 0.0) for u in MEMORY_USES) / working if working > 0 else 0.0
-
-
-def _note(run: StudyRun) -> str:
-    o, m = run.options, run.measured()
-    return (
-        f"Measured with `{run.command}` (diffuse rays at {o['resolution']}, hairball "
-        f"{o['hairball_triangles']:,} triangles, `approx`; rtsim-sim git {m['git']}; "
-        f"{m['date']}). One run per point (the model is deterministic); each row against its "
-        "unit kind's baseline on the same structure (the warp points against `warp baseline`, "
-        "the MIMD ones against `MIMD, same resources`, which is set against the warp "
-        "baseline).\n\n"
-    )
-
-
 def table(run: StudyRun) -> str:
     rs = rows(run)
     out = [
@@ -174,12 +185,9 @@ def table(run: StudyRun) -> str:
         "DRAM busy | SIMD eff. | prefetched lines/ray | useful | hit mismatches |",
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    for r in rs:
+    for r in (r for r in rs if r["point"] not in (SAMPLING_FULL, SAMPLED)):
         # The MIMD point is set against the warp baseline, the other MIMD points against it.
-        if r["point"] == AQB8_BASE[1]:
-            b = _find(rs, r["scene"], r["accel"], POINTS[0][0])
-        else:
-            b = _base(rs, r)
+        b = find(rs, r["scene"], r["accel"], WARP) if r["point"] == MIMD else base(rs, r)
         speed = r["mrays_per_second"] / b["mrays_per_second"] if b else 0.0
         ratio = "" if b is r or b is None else f"{speed:.2f}x"
         useful = "-" if r["prefetch_useful"] is None else f"{100 * r['prefetch_useful']:.0f}%"
@@ -189,113 +197,11 @@ def table(run: StudyRun) -> str:
             f"{100 * r['dram_utilization']:.0f}% | {fmt(r['simd_efficiency'], '.2f')} | "
             f"{fmt(r['prefetch_per_ray'], '.1f')} | {useful} | {r['hit_mismatches']} |"
         )
-    return _note(run) + "\n".join(out) + "\n"
-
-
-def _speed(rs: list[dict[str, Any]], point: str, accel: str = "cwbvh6") -> str:
-    cells = []
-    for r in rs:
-        if r["point"] == point and r["accel"] == accel:
-            b = _base(rs, r)
-            cell = f"{r['scene']} {r['mrays_per_second'] / b['mrays_per_second']:.2f}x"
-            if r["prefetch_useful"] is not None:
-                cell += f" ({100 * r['prefetch_useful']:.0f}% of prefetches used)"
-            cells.append(cell)
-    return ", ".join(cells) or "not run"
-
-
-def _per_scene(rs: list[dict[str, Any]], point: str, describe: Any) -> str:
-    """`describe(row, its baseline)` for the point's cwbvh6 row of each scene."""
-    parts = []
-    for sc in SCENES:
-        r = _find(rs, sc, "cwbvh6", point)
-        if r is not None:
-            parts.append(f"{sc}: {describe(r, _base(rs, r))}")
-    return "; ".join(parts)
-
-
-def _why_treelet_prefetch(r: dict[str, Any], b: dict[str, Any]) -> str:
-    return (
-        f"{100 * (r['prefetch_useful'] or 0):.0f}% of prefetched lines used, DRAM "
-        f"{100 * b['dram_utilization']:.0f}% -> {100 * r['dram_utilization']:.0f}% busy"
-    )
-
-
-def _why_cooprt(r: dict[str, Any], b: dict[str, Any]) -> str:
-    slots, active, helper = (r["lanes"].get(k, 0) for k in ("lane_slots", "active_lanes", "helper"))
-    empty = slots - (active - helper)  # lane slots with no ray of their own
-    filled = helper / empty if empty else 0.0
-    return (
-        f"helpers filled {100 * filled:.0f}% of the lane slots without a ray; "
-        f"SIMD efficiency {b['simd_efficiency']:.2f} -> {r['simd_efficiency']:.2f}; memory waits "
-        f"{100 * _memory_share(b):.0f}% -> {100 * _memory_share(r):.0f}% of working lanes' "
-        f"cycles, DRAM {100 * b['dram_utilization']:.0f}% -> "
-        f"{100 * r['dram_utilization']:.0f}% busy"
-    )
-
-
-def _why_ttp(r: dict[str, Any], b: dict[str, Any]) -> str:
-    cover = (b["l1_misses"] - r["l1_misses"]) / b["l1_misses"] if b["l1_misses"] else 0.0
-    sent = r["stack_prefetch"].get("sent", 0)
-    present = (r["prefetch_redundant"] or 0) / sent if sent else 0.0
-    return (
-        f"coverage {100 * cover:.0f}% of L1 misses; {100 * present:.0f}% of the lines it asks "
-        f"for are in the L1 already; memory waits are {100 * _memory_share(b):.0f}% of working "
-        "lanes' cycles"
-    )
-
-
-def _ratio(r: dict[str, Any], b: dict[str, Any], key: str) -> float:
-    return r[key] / b[key] if r.get(key) and b.get(key) else float("nan")
-
-
-def _aqb8(rs: list[dict[str, Any]], point: str, baseline: str) -> str:
-    """AQB8's point on cwbvh6 against the fp32 BVH6 baseline, per scene."""
-    parts = []
-    for sc in SCENES:
-        q, b = _find(rs, sc, "cwbvh6", point), _find(rs, sc, "bvh6", baseline)
-        if q is None or b is None:
-            continue
-        parts.append(
-            f"{sc}: DRAM B/ray {_ratio(q, b, 'dram_bytes_per_ray'):.2f}x, energy/ray "
-            f"{_ratio(q, b, 'energy_nj'):.2f}x, area {_ratio(q, b, 'area_mm2'):.2f}x, speed "
-            f"{_ratio(q, b, 'mrays_per_second'):.2f}x"
-        )
-    return "; ".join(parts) or "not run"
+    return note(run) + "\n".join(out) + "\n"
 
 
 def papers_row(run: StudyRun) -> str:
-    """Each technique on the warp baseline beside its paper, on MIMD units, and why they differ."""
-    rs = rows(run)
-    out = [
-        "| technique | published (Vulkan-Sim) | ours on `vulkansim_rtx2060`, cwbvh6 "
-        "| ours on `rtx2060` (MIMD), cwbvh6 | measured on the warp baseline |",
-        "|---|---|---|---|---|",
-        "| treelet prefetching, no treelet queues (Chou, Nowicki & Aamodt 2023) | +32.1% average | "
-        f"{_speed(rs, 'warp + treelet prefetch')} | - (a warp technique) | "
-        f"{_per_scene(rs, 'warp + treelet prefetch', _why_treelet_prefetch)} |",
-        "| cooperative lanes, `traversal.simt.cooperative` (CoopRT, ISCA 2025) | 2.15x geometric "
-        f"mean, up to 5.11x | {_speed(rs, 'warp + CoopRT')} | - (lanes of a warp) | "
-        f"{_per_scene(rs, 'warp + CoopRT', _why_cooprt)} |",
-        "| stack-driven prefetching, `traversal.stack_prefetch` (TTP, Tozlu, Naithani & Zhou "
-        "2026) | 1.48x average, up to 1.89x; 98.92% L1 accuracy, 31.54% coverage | "
-        f"{_speed(rs, 'warp + TTP')} | {_speed(rs, 'MIMD + TTP')} | "
-        f"{_per_scene(rs, 'warp + TTP', _why_ttp)} |",
-        "| quantised box tests, `traversal.quantized_boxes` on cwbvh6, against fp32 bvh6 (AQB8, "
-        "Huang, Yang & Yeh, ISCA 2025) | -70% DRAM accesses, -49% energy, -27% area, 1.82x | "
-        f"{_aqb8(rs, 'warp + AQB8', 'warp baseline')} | "
-        f"{_aqb8(rs, 'MIMD + AQB8', 'MIMD, same resources')} | "
-        f"{_per_scene(rs, 'warp + AQB8', _why_aqb8)} |",
-    ]
-    return _note(run) + "\n".join(out) + "\n"
-
-
-def _why_aqb8(r: dict[str, Any], b: dict[str, Any]) -> str:
-    return (
-        f"against dequantised fp32 tests on the same cwbvh6: speed "
-        f"{_ratio(r, b, 'mrays_per_second'):.2f}x, energy/ray {_ratio(r, b, 'energy_nj'):.2f}x, "
-        f"area {_ratio(r, b, 'area_mm2'):.2f}x"
-    )
+    return papers_rows(run, rows(run))
 
 
 def plot(run: StudyRun, path: Path) -> None:
@@ -341,7 +247,12 @@ STUDY = Study(
         Table("papers.md", "papers-treelet-prefetch-warp", papers_row),
     ],
     figures=[Figure("vulkansim_baseline.png", plot)],
-    options={"resolution": "320x240", "hairball_triangles": 200_000, "short": False},
+    options={
+        "resolution": "320x240",
+        "sampling_resolution": "1024x768",
+        "hairball_triangles": 200_000,
+        "short": False,
+    },
     quick={"resolution": "32x24", "hairball_triangles": 20_000, "short": True},
     extra={
         "bvh_bytes_per_ray": bvh_bytes_per_ray,
@@ -350,5 +261,8 @@ STUDY = Study(
         "uses": cycle_uses,
         "stack_prefetch": stack_prefetch_totals,
         "lanes": _lane_totals,
+        "extra_steps": lambda rec: _section(rec, "box_precision", "extra_steps_fraction"),
+        "restart_steps": lambda rec: _section(rec, "short_stack", "extra_steps_fraction"),
+        "restarts": lambda rec: (_section(rec, "short_stack", "per_ray") or {}).get("restarts"),
     },
 )
