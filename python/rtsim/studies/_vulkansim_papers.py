@@ -174,6 +174,22 @@ def _why_short_stack(r: Row, b: Row) -> str:
     return f"{r['restarts'] or 0:.2f} restarts per ray"
 
 
+def _reduced_boxes(r: Row, b: Row) -> str:
+    return (
+        f"+{100 * (r['extra_steps'] or 0):.1f}% node steps, DRAM B/ray "
+        f"{_ratio(r, b, 'dram_bytes_per_ray'):.2f}x, speed "
+        f"{_ratio(r, b, 'mrays_per_second'):.2f}x, energy/ray {_ratio(r, b, 'energy_nj'):.2f}x, "
+        f"area {_ratio(r, b, 'area_mm2'):.2f}x"
+    )
+
+
+def _leaves(r: Row, b: Row) -> str:
+    return (
+        f"DRAM B/ray {_ratio(r, b, 'dram_bytes_per_ray'):.2f}x, speed "
+        f"{_ratio(r, b, 'mrays_per_second'):.2f}x"
+    )
+
+
 def _why_sorting(r: Row, b: Row) -> str:
     return (
         f"SIMD efficiency {b['simd_efficiency']:.2f} -> {r['simd_efficiency']:.2f}, L1 hit "
@@ -227,6 +243,27 @@ def papers_rows(run: StudyRun, rs: list[Row]) -> str:
         _per_scene(rs, "warp + short stack", _short_stack),
         "the table above (MIMD default)",
         _per_scene(rs, "warp + short stack", _why_short_stack),
+    )
+    add(
+        "short stack with a restart trail, 5 entries, binary BVH (Laine 2010), bvh2",
+        "restarts make a short stack possible (measured against a full stack on GPUs)",
+        _against(rs, "warp + short stack", "bvh2", WARP, "bvh2", _short_stack),
+        "the table above (MIMD default)",
+        _against(rs, "warp + short stack", "bvh2", WARP, "bvh2", _why_short_stack),
+    )
+    add(
+        "reduced-precision box tests, 8 bits (Keely 2014), cwbvh6",
+        "compact traversal hardware for little extra traversal (simulated GPU)",
+        _per_scene(rs, "warp + 8-bit boxes", _reduced_boxes),
+        "the table above (MIMD default)",
+        "on bvh2: " + _against(rs, "warp + 8-bit boxes", "bvh2", WARP, "bvh2", _reduced_boxes),
+    )
+    add(
+        "compressed leaves under cwbvh6 (Benthin, Wald, Woop & Afra 2018)",
+        "about the memory savings of Embree's compressed BVH, almost the speed of its fastest",
+        _against(rs, WARP, "cwbvh6+leaves", WARP, "cwbvh6", _leaves),
+        _against(rs, MIMD, "cwbvh6+leaves", MIMD, "cwbvh6", _leaves),
+        "Embree's figures are a CPU's; an RT unit's are the two columns",
     )
     add(
         "ray sorting, `dispatch.sort=origin_direction`, window 65,536 (Meister et al. 2020), "
