@@ -63,8 +63,11 @@ std::string cell(const std::string& unit, const std::vector<std::string>& sets, 
     try {
         return resolve_run(c, s).unused.empty() ? "yes" : "no effect";
     } catch (const Error& e) {
+        // Two rules may need the same thing for the same reason; what asks tells them apart.
+        const std::string what = e.what();
         for (const Rule& r : run_rules())
-            if (std::string(e.what()).find(r.needs) != std::string::npos && std::string(e.what()).find(r.reason) != std::string::npos)
+            if (what.find(r.asks) != std::string::npos && what.find(r.needs) != std::string::npos &&
+                what.find(r.reason) != std::string::npos)
                 return r.id;
         return "no";
     }
