@@ -213,9 +213,10 @@ def rows_from(r: dict[str, Any]) -> list[dict[str, str]]:
                 f"speed {_fmt(_ratio(cl[x]['mrays'], b2[x]['mrays']))}"
             ),
             "why": (
-                "our area model prices units, pipelines and SRAM, not the node format, and our "
-                "box pipeline stays fp32 (AQB8 also narrows the arithmetic, hence its area); "
-                "its baseline is the Vulkan-Sim RT unit's own BVH, ours the binary BVH"
+                "this row keeps fp32 box tests on the dequantised nodes; with AQB8's integer "
+                "box pipeline (traversal.quantized_boxes) and against the fp32 BVH6 on the warp "
+                "baseline it is the quantised-box row below the table, whose measured reasons "
+                "apply; its baseline is the Vulkan-Sim RT unit's own BVH, ours the binary BVH"
             ),
         },
         {
