@@ -43,7 +43,7 @@ def note(run: StudyRun) -> str:
     o, m = run.options, run.measured()
     return (
         f"Measured with `{run.command}` (diffuse rays at {o['resolution']}, hairball "
-        f"{o['hairball_triangles']:,} triangles, `approx`; rtsim-sim git {m['git']}; "
+        f"{o['hairball_triangles']:,} triangles, `{o['fidelity']}`; rtsim-sim git {m['git']}; "
         f"{m['date']}). One run per point (the model is deterministic); each row against its "
         "unit kind's baseline on the same structure (the warp points against `warp baseline`, "
         "the MIMD ones against `MIMD, same resources`, which is set against the warp "

@@ -122,6 +122,9 @@ def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
         name: str, s: str, accel: list[str], pts: list[dict[str, Any]], resolution: str = ""
     ) -> dict[str, Any]:
         res = resolution or o["resolution"]
+        # Every point at the study's level (detailed: approx is 4-16% fast on these warps,
+        # docs/fidelity.md "Across unit kinds and treelets").
+        pts = [{**p, "set": {**p.get("set", {}), "fidelity": o["fidelity"]}} for p in pts]
         return {
             "name": f"{name}-{s}",
             "scenes": [scene(s, o["hairball_triangles"])],
@@ -255,10 +258,16 @@ STUDY = Study(
     options={
         "resolution": "320x240",
         "sampling_resolution": "1024x768",
+        "fidelity": "detailed",
         "hairball_triangles": 200_000,
         "short": False,
     },
-    quick={"resolution": "32x24", "hairball_triangles": 20_000, "short": True},
+    quick={
+        "resolution": "32x24",
+        "hairball_triangles": 20_000,
+        "short": True,
+        "fidelity": "approx",
+    },
     extra={
         "bvh_bytes_per_ray": bvh_bytes_per_ray,
         "prefetch": prefetch_totals,
