@@ -47,38 +47,45 @@ public:
 
     /// A new ray on stream s: nothing to prefetch yet.
     void begin(uint32_t s) {
-        if (on()) m_streams[s].armed = false;
+        if (on()) m_streams[s].count = 0;
     }
 
     /// Stream s's stepper ran a step whose stack held `before` entries: a pop (the stack shrank)
-    /// arms the stream; issue() then requests its stack's top entries.
+    /// arms the stream with the reads of its stack's top entries; issue() requests them.
     void after_step(uint32_t s, const Stepper& stepper, int before) {
-        if (on()) m_streams[s].armed = stepper.stack_size() < before && !stepper.done();
+        if (!on()) return;
+        Stream& st = m_streams[s];
+        st.count = stepper.stack_size() < before && !stepper.done() ? stepper.stack_reads(st.reads, m_entries) : 0;
+    }
+    /// Arms stream s with `n` reads a recorded walk kept for its step (cooperation.h).
+    void arm(uint32_t s, const Fetch* reads, uint32_t n) {
+        if (!on()) return;
+        Stream& st = m_streams[s];
+        st.count = std::min(n, m_entries);
+        std::copy(reads, reads + st.count, st.reads);
     }
 
-    /// Stream s's operations phase at cycle t: requests the armed stream's top entries' lines.
-    void issue(uint32_t s, const Stepper& stepper, MemIf& l1, Cycle t) {
-        if (!on() || !m_streams[s].armed) return;
+    /// Stream s's operations phase at cycle t: requests the armed stream's lines.
+    void issue(uint32_t s, MemIf& l1, Cycle t) {
+        if (!on() || m_streams[s].count == 0) return;
         Stream& st = m_streams[s];
-        st.armed = false;
         ++m_triggers;
-        Fetch reads[kMaxEntries];
-        const uint32_t n = stepper.stack_reads(reads, m_entries);
-        for (uint32_t i = 0; i < n; ++i) {
+        for (uint32_t i = 0; i < st.count; ++i) {
             uint32_t lines = 0;
-            for_each_line(reads[i].addr, reads[i].bytes, m_line_shift, [&](uint64_t line, uint32_t) {
+            for_each_line(st.reads[i].addr, st.reads[i].bytes, m_line_shift, [&](uint64_t line, uint32_t) {
                 if (lines++ >= kMaxLinesPerEntry) return;
                 if (std::find(m_recent.begin(), m_recent.end(), line) != m_recent.end()) {
                     ++m_repeats;
                     return;
                 }
                 m_recent[m_next_recent++ % kRecent] = line;
-                const MemRequest req{line << m_line_shift, 1u << m_line_shift, false, reads[i].kind, t, nullptr, true,
+                const MemRequest req{line << m_line_shift, 1u << m_line_shift, false, st.reads[i].kind, t, nullptr, true,
                                      ServedBy::l1};
                 if (l1.access(req) > t) ++m_dropped;  // no free MSHR: demand misses keep priority
                 else ++m_sent;
             });
         }
+        st.count = 0;
     }
 
     /// {triggers, sent, dropped, repeats} (unit stats `stack_prefetch`).
@@ -88,7 +95,8 @@ public:
 
 private:
     struct Stream {
-        bool armed = false;  ///< its ray's step popped: prefetch in the operations phase
+        uint32_t count = 0;         ///< armed: its ray's step popped; these reads go out in its operations phase
+        Fetch reads[kMaxEntries];  ///< the stack's top entries' reads, next popped first
     };
     uint32_t m_entries = 0;
     uint32_t m_line_shift = 6;

@@ -175,7 +175,7 @@ void MimdUnit::run_ops(uint32_t c, Cycle t) {
     // The step's operations run on their pipelines in order (the plan's, then those its results
     // called for), then spilled stack entries are read back.
     const StepDemand& d = m_contexts[c].demand;
-    if (m_stack_prefetch.on()) m_stack_prefetch.issue(c, *m_contexts[c].ray.stepper, *mem[0], t);
+    if (m_stack_prefetch.on()) m_stack_prefetch.issue(c, *mem[0], t);
     Cycle ready = t;
     for (int i = 0; i < d.issue_count; ++i) {
         ready = pipes[size_t(d.issues[i].kind)]->issue(ready, d.issues[i].issues, d.issues[i].tests);

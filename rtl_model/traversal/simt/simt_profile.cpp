@@ -20,8 +20,7 @@ constexpr uint32_t kClasses = kOpKindCount + 1;
 struct Lane {
     std::unique_ptr<Stepper> stepper;
     bool has_ray = false;
-    bool stepped = false;  ///< stepped its own ray this warp step
-    int spare = 0;         ///< cooperative lanes: its ray's stack entries not yet handed to a helper
+    CooperativeWalk walk;  ///< cooperative lanes: the ray's walk, stepped ahead (cooperation.h)
 };
 
 /// The warps of the whole machine and the rays they take, in turn.
@@ -58,7 +57,7 @@ private:
         bool any_ray = false;
         for (uint32_t i = 0; i < m_simt.lanes; ++i) {
             Lane& l = lane(w, i);
-            if (l.has_ray && l.stepper->plan().done) {
+            if (l.has_ray && (m_simt.cooperative ? l.walk.done() : l.stepper->plan().done)) {
                 for (size_t f = 0; f < m_p.work.size(); ++f) m_p.work[f] += l.stepper->work().*kWorkFields[f].member;
                 l.has_ray = false;
             }
@@ -73,6 +72,10 @@ private:
             const RayJob& job = m_rays[unit][m_next[unit]++];
             l.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
             l.has_ray = true;
+            if (m_simt.cooperative) {
+                StackSplit unused;
+                l.walk.record(*l.stepper, unused, nullptr);
+            }
             ++taken;
         }
         if (taken) {  // a warp step of its own fetches the new rays' records (coalesced)
@@ -83,12 +86,20 @@ private:
     }
 
     /// One warp step of warp w (or its refill); false when it has nothing to do.
+    uint32_t lane_class(size_t w, uint32_t i) {
+        Lane& l = lane(w, i);
+        return m_simt.cooperative ? l.walk.next_class(kOpKindCount) : SimtUnit::step_class(l.stepper->plan());
+    }
+
     bool step(size_t w) {
+        if (m_simt.cooperative)
+            for (uint32_t i = 0; i < m_simt.lanes; ++i)
+                if (lane(w, i).has_ray) lane(w, i).walk.release();
         if (refill(w)) return true;
         std::array<uint32_t, kClasses> want{};
         bool any = false;
         for (uint32_t i = 0; i < m_simt.lanes; ++i)
-            if (lane(w, i).has_ray) ++want[SimtUnit::step_class(lane(w, i).stepper->plan())], any = true;
+            if (lane(w, i).has_ray) ++want[lane_class(w, i)], any = true;
         if (!any) return false;
         uint32_t cls = m_last_class[w];
         if (!(m_simt.policy == SimtPolicy::while_while && want[cls]))
@@ -101,10 +112,9 @@ private:
         uint32_t active = 0;
         for (uint32_t i = 0; i < m_simt.lanes; ++i) {
             Lane& l = lane(w, i);
-            l.stepped = l.has_ray && SimtUnit::step_class(l.stepper->plan()) == cls;
-            if (!l.stepped) continue;
-            l.spare = l.stepper->stack_size();
-            run_step(*l.stepper);
+            if (!l.has_ray || lane_class(w, i) != cls) continue;
+            if (m_simt.cooperative) take(l, cls);
+            else run_step(*l.stepper);
             ++active;
         }
         if (m_simt.cooperative) active += lend_idle_lanes(w, cls);
@@ -121,20 +131,22 @@ private:
         s.execute();
     }
 
+    void take(Lane& l, uint32_t cls) {
+        StepDemand unused;
+        l.walk.take(
+            cls, unused, [&](const Fetch& f) { m_coalescer.add(f.addr, f.bytes, f.kind); }, [](const Fetch&) {});
+    }
+
     /// Cooperative lanes, as the unit lends them (simt_unit.h): the helper steps run.
     uint32_t lend_idle_lanes(size_t w, uint32_t cls) {
         uint32_t helpers = 0;
         for (uint32_t i = 0; i < m_simt.lanes; ++i) {
             if (lane(w, i).has_ray) continue;
             const uint32_t best = pick_helped_lane(
-                0, m_simt.lanes, [&](uint32_t l) { return lane(w, l).stepped ? lane(w, l).spare : 0; },
-                [&](uint32_t l) {
-                    const StepPlan& plan = lane(w, l).stepper->plan();
-                    return !plan.done && SimtUnit::step_class(plan) == cls;
-                });
+                0, m_simt.lanes, [&](uint32_t l) { return lane(w, l).has_ray ? lane(w, l).walk.ready(cls) : 0; },
+                [](uint32_t) { return true; });
             if (best == m_simt.lanes) break;
-            --lane(w, best).spare;
-            run_step(*lane(w, best).stepper);
+            take(lane(w, best), cls);
             ++helpers;
         }
         return helpers;

@@ -1,6 +1,5 @@
 #include "rtl_model/traversal/simt/simt_unit.h"
 #include "rtl_model/traversal/simt/simt_profile.h"
-#include "rtl_model/traversal/simt/cooperation.h"
 
 #include <algorithm>
 #include <array>
@@ -21,6 +20,7 @@ SimtUnit::SimtUnit(sc_core::sc_module_name name, const UnitSetup& setup, uint32_
 
 void SimtUnit::run() {
     m_treelet_mode = ray_buffer.size() > 0;
+    m_walks = m_simt.cooperative && !m_treelet_mode;
     // Prefetching follows each warp's treelet queue (a stream per warp), or without queues each
     // lane's entries into treelets (a stream per lane; treelet_prefetcher.h).
     if (m_treelets && m_treelets->footprints())
@@ -96,7 +96,7 @@ bool SimtUnit::retire_and_refill(uint32_t w, Cycle t) {
     for (uint32_t l = first_lane(w); l < end; ++l) {
         m_lanes[l].stepping = false;
         m_lanes[l].helps = kNoLane;
-        if (m_lanes[l].has_ray && m_lanes[l].ray.stepper->plan().done) finish_lane(l, t);
+        if (m_lanes[l].has_ray && ray_done(l)) finish_lane(l, t);
         any_ray = any_ray || m_lanes[l].has_ray;
     }
     if (m_simt.refill == SimtRefill::warp && any_ray) return false;  // the warp has not retired
@@ -176,6 +176,8 @@ bool SimtUnit::start_lane(uint32_t l, Cycle t, Cycle* fetch) {
     lane.ray.stack = StackSplit{};
     lane.treelet = kNoTreelet;
     m_stack_prefetch.begin(l);
+    // Cooperative lanes: the ray's walk is stepped ahead now, as a tree of steps (cooperation.h).
+    if (m_walks) lane.walk.record(*lane.ray.stepper, lane.ray.stack, &m_costs, m_config.stack_prefetch);
     account_until(m_account, lane.accounted, CycleUse::starved, start);  // no ray until now
     lane.has_ray = lane.stepping = true;
     m_tally.busy.enter(start);
@@ -213,7 +215,7 @@ uint32_t SimtUnit::choose_class(uint32_t w) const {
     bool any = false;
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l)
         if (m_lanes[l].has_ray) {
-            ++want[step_class(m_lanes[l].ray.stepper->plan())];
+            ++want[lane_class(l)];
             any = true;
         }
     if (!any) return kClasses;
@@ -227,6 +229,10 @@ uint32_t SimtUnit::choose_class(uint32_t w) const {
 }
 
 void SimtUnit::step(uint32_t w, Cycle t) {
+    // The steps the rays' walks took in the last warp step have run: their dependants are ready.
+    if (m_walks)
+        for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l)
+            if (m_lanes[l].has_ray) m_lanes[l].walk.release();
     if (retire_and_refill(w, t)) return fetch_rays(w, t);
     if (m_treelet_mode) {
         park_leavers(w, t);
@@ -241,10 +247,14 @@ void SimtUnit::step(uint32_t w, Cycle t) {
     // arithmetic as their fetches issue); their fetches are coalesced per line.
     for (uint32_t l = first_lane(w); l < first_lane(w) + m_simt.lanes; ++l) {
         Lane& lane = m_lanes[l];
-        lane.stepping = lane.has_ray && step_class(lane.ray.stepper->plan()) == cls;
+        lane.stepping = lane.has_ray && lane_class(l) == cls;
         if (!lane.stepping) continue;
-        lane.spare = lane.ray.stepper->stack_size();
         account_until(m_account, lane.accounted, CycleUse::issue, t);
+        if (m_walks) {
+            take_walk_step(l, l, cls, t);
+            continue;
+        }
+        lane.spare = lane.ray.stepper->stack_size();
         if (m_prefetcher.on() && !m_treelet_mode) note_treelet(l, t);
         step_ray(l, l, m_treelet_mode ? warp.treelet : lane.treelet);
     }
@@ -269,6 +279,28 @@ void SimtUnit::step_ray(uint32_t owner, uint32_t into, uint32_t treelet) {
     m_stack_prefetch.after_step(owner, *o.ray.stepper, before);
 }
 
+void SimtUnit::take_walk_step(uint32_t owner, uint32_t into, uint32_t cls, Cycle t) {
+    Lane& o = m_lanes[owner];
+    Fetch reads[StepPlan::kMaxFetches];
+    Fetch prefetch[StackPrefetcher::kMaxEntries];
+    uint32_t n = 0, np = 0;
+    const uint32_t locality = o.walk.take(
+        cls, m_lanes[into].demand, [&](const Fetch& f) { reads[n++] = f; },
+        [&](const Fetch& f) {
+            if (np < StackPrefetcher::kMaxEntries) prefetch[np++] = f;
+        });
+    // Prefetching without queues: the step's node entered another treelet of this ray's.
+    if (m_prefetcher.on() && locality != kNoLocality) {
+        const uint32_t treelet = m_treelets->treelet_of(locality);
+        if (treelet != o.treelet) o.treelet = treelet, m_prefetcher.enter(owner, treelet, t);
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        if (m_prefetcher.on() && o.treelet != kNoTreelet) m_prefetcher.learn(o.treelet, reads[i]);
+        m_coalescer.add(reads[i].addr, reads[i].bytes, reads[i].kind);
+    }
+    if (np) m_stack_prefetch.arm(owner, prefetch, np);
+}
+
 void SimtUnit::lend_idle_lanes(uint32_t w, uint32_t cls, Cycle t) {
     const uint32_t begin = first_lane(w), end = begin + m_simt.lanes;
     // Idle lanes wait for the warp (warp refill) or for rays (lane refill) until now.
@@ -277,23 +309,34 @@ void SimtUnit::lend_idle_lanes(uint32_t w, uint32_t cls, Cycle t) {
     for (uint32_t h = begin; h < end; ++h) {
         Lane& helper = m_lanes[h];
         if (helper.has_ray) continue;
-        // The stepping ray with the most stack entries not yet handed over whose next step runs
-        // the warp's kind (and, with treelet queues, stays in the warp's treelet).
-        const uint32_t best = pick_helped_lane(
-            begin, m_simt.lanes, [&](uint32_t l) { return m_lanes[l].stepping && m_lanes[l].helps == kNoLane ? m_lanes[l].spare : 0; },
-            [&](uint32_t l) {
-                const StepPlan& plan = m_lanes[l].ray.stepper->plan();
-                if (plan.done || step_class(plan) != cls) return false;
-                return !m_treelet_mode || plan.locality == kNoLocality ||
-                       m_treelets->treelet_of(plan.locality) == m_warps[w].treelet;
-            });
+        // Recorded walks: the ray with the most ready steps of the warp's kind. Otherwise the
+        // stepping ray with the most stack entries not yet handed over whose next step runs the
+        // warp's kind (and, with treelet queues, stays in the warp's treelet).
+        const uint32_t best =
+            m_walks
+                ? pick_helped_lane(
+                      begin, m_simt.lanes, [&](uint32_t l) { return m_lanes[l].has_ray ? m_lanes[l].walk.ready(cls) : 0; },
+                      [](uint32_t) { return true; })
+                : pick_helped_lane(
+                      begin, m_simt.lanes,
+                      [&](uint32_t l) { return m_lanes[l].stepping && m_lanes[l].helps == kNoLane ? m_lanes[l].spare : 0; },
+                      [&](uint32_t l) {
+                          const StepPlan& plan = m_lanes[l].ray.stepper->plan();
+                          if (plan.done || step_class(plan) != cls) return false;
+                          return !m_treelet_mode || plan.locality == kNoLocality ||
+                                 m_treelets->treelet_of(plan.locality) == m_warps[w].treelet;
+                      });
         if (best == end) break;  // no ray has independent work of this kind left
         Lane& owner = m_lanes[best];
-        --owner.spare;
         account_until(m_account, helper.accounted, waited, t);
         helper.helps = best;
         helper.stepping = true;
-        step_ray(best, h, m_treelet_mode ? m_warps[w].treelet : owner.treelet);
+        if (m_walks) {
+            take_walk_step(best, h, cls, t);
+        } else {
+            --owner.spare;
+            step_ray(best, h, m_treelet_mode ? m_warps[w].treelet : owner.treelet);
+        }
         ++m_helper_steps;
         helped = true;
     }
@@ -311,8 +354,7 @@ void SimtUnit::run_ops(uint32_t w, Cycle t) {
     for (uint32_t l = begin; l < end; ++l) {
         if (!m_lanes[l].stepping) continue;
         account_until(m_account, m_lanes[l].accounted, CycleUse::issue, t);
-        if (m_stack_prefetch.on() && m_lanes[l].helps == kNoLane)
-            m_stack_prefetch.issue(l, *m_lanes[l].ray.stepper, *mem[0], t);
+        if (m_stack_prefetch.on()) m_stack_prefetch.issue(ray_lane(l), *mem[0], t);
         const StepDemand& d = m_lanes[l].demand;
         for (int i = 0; i < d.issue_count; ++i) {
             const size_t k = size_t(d.issues[i].kind);

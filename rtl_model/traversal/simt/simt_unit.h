@@ -22,18 +22,19 @@
 //
 // Cooperative lanes (traversal.simt.cooperative; CoopRT: "Accelerating BVH Traversal for Ray
 // Tracing via Cooperative Threads", ISCA 2025): a lane with no ray of its own (its ray finished
-// and its warp has not retired, or dispatch has none) helps a lane of its warp that is stepping.
-// CoopRT hands the helper an entry of the busy ray's traversal stack, whose subtree it walks with
-// its own traversal hardware while the owner goes on. Here the ray's steps keep their sequential
-// order (so hits and every work count stay the reference's): in a warp step a helper runs the
-// ray's next step, if the ray's stack held an entry for it when the warp step began (the
-// independent subtree CoopRT would hand over; each entry feeds one helper) and that step runs the
-// warp's operation kind. A helper's fetches coalesce with the warp's, its tests issue to the
-// pipelines like any lane's, its stack traffic goes to the ray's spill slots. Idle lanes go to
-// the rays with the most stack entries left. What this leaves out: CoopRT's helpers walk their
-// subtree with the best hit the owner had at the hand-over, so they may visit nodes the
-// sequential order culls (our work is the sequential walk's, a lower bound on theirs), and the
-// merge of the helpers' hits (a t compare per hand-back) is priced, not timed.
+// and its warp has not retired, or dispatch has none) helps the warp's rays. CoopRT hands the
+// helper an entry of a busy ray's traversal stack, whose subtree it walks with its own traversal
+// hardware while the owner goes on. Here each ray's walk is stepped ahead when the ray starts, as
+// a tree of steps (cooperation.h: a step depends on the step that descended into or pushed its
+// node), and in each warp step the ray's lane and any idle lanes run its ready steps of the warp's
+// operation kind, idle lanes going to the rays with the most ready steps; hits and every work
+// count are the sequential walk's. A helper's fetches coalesce with the warp's, its tests issue to
+// the pipelines like any lane's, its stack traffic goes to the ray's spill slots. With treelet
+// queues (rays park by their next step's treelet, which a tree of ready steps has no one of) a
+// helper instead runs the ray's next sequential step, if the ray's stack held an entry for it when
+// the warp step began. What this leaves out: CoopRT's helpers walk with the best hit the ray had
+// at the hand-over, so they may visit nodes the sequential order culls (our work is the sequential
+// walk's, a lower bound on theirs), and the merge of the helpers' hits is priced, not timed.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -41,6 +42,7 @@
 #include "rtl_model/common/usage_series.h"
 #include "rtl_model/traversal/scheduled_unit.h"
 #include "rtl_model/traversal/simt/coalescer.h"
+#include "rtl_model/traversal/simt/cooperation.h"
 #include "rtl_model/traversal/simt/simt_config.h"
 #include "rtl_model/traversal/treelet_prefetcher.h"
 #include "rtl_model/traversal/unit_parts.h"
@@ -59,7 +61,7 @@ public:
     static const StatTable<SimtUnit>& kind_stats();
 
     /// The step class of a plan: its first operation's kind, or kOpKindCount for a step with none.
-    static uint32_t step_class(const StepPlan& plan) { return plan.op_count ? uint32_t(plan.op[0].kind) : kOpKindCount; }
+    static uint32_t step_class(const StepPlan& plan) { return warp_step_class(plan); }
 
 private:
     static constexpr uint32_t kClasses = kOpKindCount + 1;
@@ -70,7 +72,8 @@ private:
         StepDemand demand;      ///< its step in the warp step in flight
         uint32_t treelet = kNoTreelet;  ///< prefetching without queues: the treelet its ray is in
         uint32_t helps = kNoLane;  ///< cooperative lanes: the lane whose ray it steps this warp step
-        int spare = 0;             ///< cooperative lanes: its ray's stack entries not yet handed to a helper
+        int spare = 0;             ///< cooperative lanes, treelet queues: stack entries not yet handed to a helper
+        CooperativeWalk walk;      ///< cooperative lanes: its ray's recorded walk (m_walks)
         Cycle ready = 0;        ///< treelet scheduling: cycle its ray's state came from the ray buffer
         bool has_ray = false;
         bool stepping = false;  ///< active in the warp step in flight
@@ -104,6 +107,15 @@ private:
     void step_ray(uint32_t owner, uint32_t into, uint32_t treelet);
     /// Cooperative lanes: the warp's lanes without a ray of their own step its rays (above).
     void lend_idle_lanes(uint32_t w, uint32_t cls, Cycle t);
+    /// Cooperative lanes with recorded walks: runs a ready step of class `cls` of lane `owner`'s
+    /// ray into lane `into`'s demand.
+    void take_walk_step(uint32_t owner, uint32_t into, uint32_t cls, Cycle t);
+    /// Lane l's ray is done (its walk all run, or its stepper done).
+    bool ray_done(uint32_t l) const { return m_walks ? m_lanes[l].walk.done() : m_lanes[l].ray.stepper->plan().done; }
+    /// The class lane l's ray steps next (its earliest ready step's, or its plan's).
+    uint32_t lane_class(uint32_t l) const {
+        return m_walks ? m_lanes[l].walk.next_class(kOpKindCount) : step_class(m_lanes[l].ray.stepper->plan());
+    }
     /// The lane whose ray lane l steps this warp step (itself, or the lane it helps).
     uint32_t ray_lane(uint32_t l) const { return m_lanes[l].helps == kNoLane ? l : m_lanes[l].helps; }
     void fill_when_idle(Cycle t);
@@ -124,6 +136,7 @@ private:
     const SimtConfig& m_simt;
     const TreeletMap* m_treelets;  ///< treelet scheduling or prefetching; else null
     bool m_treelet_mode = false;   ///< rays come from and park in the ray buffer's treelet queues
+    bool m_walks = false;          ///< cooperative lanes over recorded walks (no treelet queues)
     Cycle m_next_fill = 0;
     uint64_t m_parks = 0, m_takes = 0, m_idle_polls = 0;
     TreeletPrefetcher m_prefetcher;
