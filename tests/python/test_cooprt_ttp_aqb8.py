@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+import rtsim
 from conftest import checked, sim_stats, simulate
 
 WARPS = (
@@ -147,3 +148,24 @@ def test_quantized_boxes_refused_where_nodes_hold_fp32_boxes(
         "traversal.quantized_boxes=true", "traversal.box_precision_bits=7",
     )  # fmt: skip
     assert r.returncode == 2 and "box_precision_bits=0" in r.stderr
+
+
+def test_two_level_blases_take_stack_prefetch_and_quantized_boxes(
+    sim_exe: Path, tmp_path: Path
+) -> None:
+    from conftest import rtsim_trace
+
+    trace = tmp_path / "grove"
+    rtsim_trace(
+        "grove", "-o", str(trace), "--accel", "cwbvh8", "--resolution", "16x12",
+        "--workload", "primary,diffuse",
+    )  # fmt: skip
+    assert rtsim.open_trace(trace).manifest["accel"]["kind"] == "two_level"
+    for unit in (("traversal.model=mimd",), WARPS):
+        stats = checked(
+            sim_exe, trace / "trace.rtt", tmp_path / unit[0].split("=")[1], *unit, TTP,
+            "traversal.quantized_boxes=true",
+        )  # fmt: skip
+        assert stats["summary"]["resolved"]["unused"] == []
+        assert sum(u["stack_prefetch"]["triggers"] for u in _units(stats)) > 0
+        assert stats["box_precision"]["arithmetic"] == "quantized_int"

@@ -325,6 +325,10 @@ AccelCapabilities accel_capabilities(const std::string& kind, const std::string&
     // BLAS's leaf blocks a slice of "blas_leaf_blocks", decoded by its own load; two_level.h).
     c.restart_trail = blas.restart_trail;
     c.reduced_precision_boxes = blas.reduced_precision_boxes;
+    // The BLASes' quantised box tests (the TLAS's boxes stay fp32), and stack addresses: the
+    // TLAS's entries are node and instance-record addresses, the BLAS kind's its own.
+    c.quantized_boxes = blas.quantized_boxes;
+    c.stack_addresses = blas.stack_addresses;
     c.compressed_leaves = blas.compressed_leaves;
     c.treelet_partition = blas.treelet_partition;
     c.stack_entry_bytes = std::max(kBvhStackEntryBytes, blas.stack_entry_bytes);

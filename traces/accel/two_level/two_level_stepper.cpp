@@ -34,6 +34,18 @@ void TwoLevelStepper::begin(const Ray& ray, TraversalMode mode) {
     plan_tlas();
 }
 
+uint32_t TwoLevelStepper::stack_reads(Fetch* out, uint32_t max) const {
+    uint32_t n = m_inner ? m_inner->stack_reads(out, max) : 0;
+    for (int i = m_tlas_size - 1; i >= 0 && n < max; --i, ++n) {
+        const detail::Bvh2StackEntry& e = m_stack[i];
+        out[n] = e.count == 0 ? Fetch{m_accel.tlas().node_base + uint64_t(e.ref) * sizeof(HwNode), uint32_t(sizeof(HwNode)),
+                                      DataKind::node}
+                              : Fetch{m_accel.instances().base + uint64_t(e.ref) * sizeof(InstanceRecord),
+                                      kInstanceFetchBytes, DataKind::instance};
+    }
+    return n;
+}
+
 void TwoLevelStepper::plan_tlas() {
     const Bvh2View& tlas = m_accel.tlas();
     if (m_count == 0) {

@@ -38,6 +38,9 @@ public:
 
     void begin(const Ray& ray, TraversalMode mode) override;
     StepOutcome execute() override;
+    /// The BLAS's top entries first (while one is walked), then the TLAS's: nodes and instance
+    /// records (their first line, as the transform step fetches it).
+    uint32_t stack_reads(Fetch* out, uint32_t max) const override;
 
 private:
     void visit_node(const HwNode& node);
