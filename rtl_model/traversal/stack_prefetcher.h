@@ -14,9 +14,10 @@
 // hit) and shrank the stack. That is the trigger. A step's pop is known once its operations have
 // run, so the requests are issued in the step's operations phase, in time order with the unit's
 // reads. A line whose L1 has no free MSHR is dropped (demand misses keep priority; counted as
-// `dropped`). One stream per ray context (MIMD) or lane (SIMT). Assumed beyond the paper's
-// description: at most kMaxLinesPerEntry lines per entry, and the unit keeps the last kRecent
-// lines it sent so an entry still on a stack is not requested again at the next pop.
+// `dropped`). One stream per ray context (MIMD), lane (SIMT) or packet (its shared stack).
+// Assumed beyond the paper's description: at most kMaxLinesPerEntry lines per entry, and the
+// unit keeps the last kRecent lines it sent so an entry still on a stack is not requested again
+// at the next pop.
 // Prefetching changes no traversal, hit or work count: only which lines are in the L1.
 #include <algorithm>
 #include <array>

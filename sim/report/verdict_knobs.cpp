@@ -192,7 +192,7 @@ std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st
     // (TTP) on per-ray stacks that hold addresses, cooperative lanes (CoopRT) on warps, an integer
     // box pipeline (AQB8) on quantised nodes.
     const UnitKind& unit = c.traversal.kind();
-    if (!c.ideal_memory && st.stack_addresses && unit.needs.per_ray_stack)
+    if (!c.ideal_memory && st.stack_addresses)
         structural(&out, {"traversal.stack_prefetch", c.traversal.stack_prefetch, c.traversal.stack_prefetch ? 0 : 2},
                    "latency");
     if (unit.name == "simt") {

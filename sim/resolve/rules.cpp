@@ -219,8 +219,6 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
         out.push_back({"traversal.stack_prefetch", "with ideal_memory every access hits: there is nothing to prefetch"});
     else if (f.config.traversal.stack_prefetch && !f.structure.caps.stack_addresses)
         out.push_back({"traversal.stack_prefetch", f.structure.name() + "'s steppers report no stack addresses to prefetch"});
-    else if (f.config.traversal.stack_prefetch && f.unit.needs.packet_kernel)
-        out.push_back({"traversal.stack_prefetch", "the " + f.unit.name + " unit's shared packet stack is not wired to the stack prefetcher"});
     else if (f.config.traversal.stack_prefetch && !f.level.timed)
         out.push_back({"traversal.stack_prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
     if (f.config.shading.enabled && !f.structure.shading_sections)

@@ -44,6 +44,7 @@ PacketUnit::PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uin
         p.ids.resize(m_packet.lanes);
         if (m_packet.split_walks == SplitWalks::lanes) p.lanes.resize(m_packet.lanes);
     }
+    attach_stack_prefetch(uint32_t(m_packets.size()));  // one stream per packet: its shared stack
     SC_THREAD(run);
 }
 
@@ -122,6 +123,7 @@ bool PacketUnit::start_packet(uint32_t p, Cycle t) {
     }
     if (n == 0) return false;
     pk.stepper->begin_packet(m_rays.data(), m_modes.data(), n);
+    m_stack_prefetch.begin(p);
     pk.start = start;
     pk.stack = StackSplit{};
     pk.weight = m_packet.lanes;
@@ -234,10 +236,12 @@ void PacketUnit::step(uint32_t p, Cycle t) {
     ++m_active_histogram[active];
     StepDemand& d = pk.demand;
     StepReads reads(*mem[0], t);
+    const int stack_before = pk.stepper->stack_size();
     take_step_reading(*pk.stepper, pk.stack, m_costs, d, [&](const Fetch& f) {
         m_node_fetches += f.kind == DataKind::node;
         reads.read(f);
     });
+    m_stack_prefetch.after_step(p, *pk.stepper, stack_before);  // the packet's shared stack (TTP)
     account_read(p, reads.ready(), reads.slowest());
     pk.phase = Phase::ops;
     m_events.schedule(p, reads.ready());
@@ -248,6 +252,7 @@ void PacketUnit::run_ops(uint32_t p, Cycle t) {
     // their hits called for), then spilled stack entries are read back.
     Packet& pk = m_packets[p];
     const StepDemand& d = pk.demand;
+    if (m_stack_prefetch.on()) m_stack_prefetch.issue(p, *mem[0], t);
     Cycle ready = t;
     for (int i = 0; i < d.issue_count; ++i) {
         ready = pipes[size_t(d.issues[i].kind)]->issue(ready, d.issues[i].issues, d.issues[i].tests);
@@ -324,6 +329,7 @@ nlohmann::json PacketUnit::stats_json(Cycle total_cycles) const {
     w.set("lane_slots", slots)
         .set("active_lanes", m_active_rays)
         .set("simd_efficiency", slots ? double(m_active_rays) / double(slots) : 0.0);
+    if (m_stack_prefetch.on()) w.set("stack_prefetch", m_stack_prefetch.stats_json());
     kind_stats().write(*this, j);
     w.done();
     return j;

@@ -34,6 +34,21 @@ void detail::Bvh2LaneRules::plan(StepPlan& plan, uint32_t ref, uint32_t count) c
     }
 }
 
+uint32_t Bvh2PacketStepper::stack_reads(Fetch* out, uint32_t max) const {
+    if (m_split) return 0;
+    uint32_t n = 0;
+    for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
+        const detail::PacketStackEntry& e = m_stack[i];
+        if (e.count == 0) {
+            out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * sizeof(HwNode), uint32_t(sizeof(HwNode)), DataKind::node};
+        } else {
+            const TriangleAddressing::Span span = m_view.tri_at.span(e.ref, e.count);
+            out[n] = Fetch{span.address, span.bytes, DataKind::triangle};
+        }
+    }
+    return n;
+}
+
 void Bvh2PacketStepper::launch_lanes() {
     ++m_counts.splits;
     if (m_walkers.empty())

@@ -37,6 +37,8 @@ public:
     void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) override;
     StepOutcome execute() override;
     Stepper& lane_walker(uint32_t i) override { return m_walkers[i]; }
+    /// The packet's shared stack's top entries (none while a split packet's rays walk in turn).
+    uint32_t stack_reads(Fetch* out, uint32_t max) const override;
 
 private:
     void pop_next();

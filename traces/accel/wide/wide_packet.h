@@ -120,6 +120,22 @@ public:
     }
     Stepper& lane_walker(uint32_t i) override { return m_walkers[i]; }
 
+    /// The packet's shared stack's top entries (none while a split packet's rays walk in turn).
+    uint32_t stack_reads(Fetch* out, uint32_t max) const override {
+        if (m_split) return 0;
+        uint32_t n = 0;
+        for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
+            const detail::PacketStackEntry& e = m_stack[size_t(i)];
+            if (e.count == 0) {
+                out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * Codec::kBytes, uint32_t(Codec::kBytes), DataKind::node};
+            } else {
+                const TriangleAddressing::Span span = m_view.tri_at.span(e.ref, e.count);
+                out[n] = Fetch{span.address, span.bytes, DataKind::triangle};
+            }
+        }
+        return n;
+    }
+
 private:
     using Node = typename Codec::Node;
     const Node& node(uint32_t i) const {
