@@ -6,7 +6,8 @@ or message that refused them.
 The product: unit kinds mimd, simt (32 lanes, 32 ray contexts) and packet (16 rays); structures
 bvh2, bvh4, bvh8, cwbvh8, kdtree, bih, octree, grid and two levels; no technique or one of
 treelets, treelet prefetching (with queues, and without), the restart-trail short stack, 8-bit
-boxes, mailboxes, ray sorting, compressed leaves (a build setting); levels functional, analytic,
+boxes, mailboxes, ray sorting, stack-driven prefetching (TTP), cooperative lanes (CoopRT),
+quantised boxes (AQB8), compressed leaves (a build setting); levels functional, analytic,
 approx, detailed and approx with 20% sampling. The specs skip the sweep's run check
 (`check_runs: false`), so a combination the simulator refuses is a failed run (a row with its
 message: the study allows failed runs), and one whose trace the tracer refuses fails with the
@@ -51,6 +52,9 @@ TECHNIQUES: dict[str, dict[str, Any]] = {
     "8-bit boxes": {"traversal.box_precision_bits": 7},
     "mailbox": {"mailbox.entries": 8},
     "ray sorting": {"dispatch.sort": "morton"},
+    "stack prefetching (TTP)": {"traversal.stack_prefetch": 2},
+    "cooperative lanes (CoopRT)": {"traversal.simt.cooperative": True},
+    "quantised boxes (AQB8)": {"traversal.quantized_boxes": True},
     LEAVES: {},
 }
 LEVELS: dict[str, dict[str, Any]] = {
@@ -173,8 +177,9 @@ def table(run: StudyRun) -> str:
     # Refused runs have no provenance: the git of the runs that ran.
     git = ", ".join(g for g in run.measured()["git"].split(", ") if g != "None")
     lines = [
-        f"Measured with `{run.command}` ({after['combinations']:,} combinations: 3 unit kinds x "
-        f"9 structures x 9 techniques x 5 levels, each one `rtsim-sim` run on an "
+        f"Measured with `{run.command}` ({after['combinations']:,} combinations: {len(UNITS)} unit "
+        f"kinds x {len(STRUCTURES)} structures x {len(TECHNIQUES)} techniques x {len(LEVELS)} "
+        "levels, each one `rtsim-sim` run on an "
         f"{run.options['resolution']} trace; after: rtsim-sim git {git}"
         + (f", before: the runs in `{run.options['before']}`" if old else "")
         + ").",
