@@ -1,5 +1,7 @@
 #include "sim/resolve/rules.h"
 
+#include "rtl_model/traversal/packet/packet_config.h"
+
 namespace rtsim {
 
 namespace {
@@ -34,7 +36,7 @@ std::vector<Rule> make_rules() {
          [](const RunFacts& f) { return f.structure.caps.packet_kernel; },
          "a packet's rays walk one shared traversal, which the structure provides as a packet stepper and a "
          "reference packet loop (the hit checker checks each packet's work against it); the binary and wide "
-         "BVHs have one, the grid, kd-tree, BIH, octree and two-level walks none built",
+         "BVHs and two levels over them have one, the grid, kd-tree, BIH and octree walks none built",
          "traversal.model=mimd or simt, or trace a structure with a packet kernel (rtsim capabilities)", "kdtree",
          {"traversal.model=packet"}});
     add({"unit/groups", "traversal.ray_contexts",
@@ -215,6 +217,9 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
         out.push_back({"treelets.prefetch", "the " + f.unit.name + " unit's rays share one walk, which does not trigger treelet prefetches"});
     else if (f.config.treelets.prefetch && !f.level.timed)
         out.push_back({"treelets.prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
+    if (f.unit.needs.packet_kernel && f.structure.kind == "two_level" &&
+        f.config.traversal.kinds.of<PacketConfig>("packet").split_below > 0)
+        out.push_back({"traversal.packet.split_below", "a two-level packet stays whole to its end (no hybrid split)"});
     if (f.config.traversal.stack_prefetch && f.config.ideal_memory)
         out.push_back({"traversal.stack_prefetch", "with ideal_memory every access hits: there is nothing to prefetch"});
     else if (f.config.traversal.stack_prefetch && !f.structure.caps.stack_addresses)

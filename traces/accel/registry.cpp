@@ -316,11 +316,12 @@ AccelCapabilities accel_capabilities(const std::string& kind, const std::string&
         require(e != nullptr, "accel: unknown structure '" + kind + "' (known: " + known_kinds() + ", two_level)");
         return e->info.capabilities;
     }
-    // A TLAS over BLASes of one kind: one stack holds the TLAS's entries and the BLAS kind's; a
-    // packet kernel is not offered (two_level.h).
+    // A TLAS over BLASes of one kind: one stack holds the TLAS's entries and the BLAS kind's;
+    // packets walk the TLAS together and each BLAS with its kind's packet kernel (two_level.h).
     const AccelCapabilities blas = accel_capabilities(blas_kind);
     AccelCapabilities c;
     c.mailbox = blas.mailbox;
+    c.packet_kernel = blas.packet_kernel;
     // Per-level restart trails, the BLASes' reduced-precision walks and compressed leaves (each
     // BLAS's leaf blocks a slice of "blas_leaf_blocks", decoded by its own load; two_level.h).
     c.restart_trail = blas.restart_trail;

@@ -69,13 +69,16 @@ public:
     TwoLevelAccel(AccelImage image, const std::string& source);
 
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    /// Packets walk the TLAS together and each instance's BLAS as a packet of the rays that
+    /// entered it (two_level_packet.h), where the BLAS kind has a packet kernel.
+    std::unique_ptr<PacketStepper> make_packet_stepper() const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override;
     /// The BLAS kind's, the stack entry the larger of the TLAS's 8 bytes and the BLAS kind's (the
     /// stack holds both); restart trails per level, the BLASes' reduced-precision walks
     /// (two_level_stepper.h) and compressed leaves (each BLAS built with its own leaf blocks, a
-    /// slice of "blas_leaf_blocks"); no packet kernel built (its rays would part at every instance).
+    /// slice of "blas_leaf_blocks"); the BLAS kind's packet kernel (two_level_packet.h).
     AccelCapabilities capabilities() const override;
 
     uint32_t frame_count() const override { return uint32_t(m_frames.size()); }

@@ -7,6 +7,7 @@
 
 #include "traces/accel/bvh2/bvh2.h"
 #include "traces/accel/two_level/two_level.h"
+#include "traces/accel/two_level/two_level_packet.h"
 #include "traces/accel/two_level/two_level_stepper.h"
 #include "traces/common/error.h"
 
@@ -152,6 +153,11 @@ void TwoLevelAccel::bind_frame(uint32_t f) {
 
 std::unique_ptr<Stepper> TwoLevelAccel::make_stepper(const StepOptions& options) const {
     return std::make_unique<TwoLevelStepper>(*this, options);
+}
+
+std::unique_ptr<PacketStepper> TwoLevelAccel::make_packet_stepper() const {
+    if (!capabilities().packet_kernel) return nullptr;
+    return std::make_unique<TwoLevelPacketStepper>(*this);
 }
 
 LocalityPartition TwoLevelAccel::partition(uint64_t budget_bytes) const {
