@@ -30,6 +30,27 @@ CASES = [
     ("Morton sort stage", "bvh2", False, ["dispatch.sort=morton"], ["sort_stage"]),
     ("treelet prefetching", "bvh2", False, ["treelets.prefetch=true"], ["prefetcher"]),
     ("grid with mailboxes, 8 entries", "grid", False, ["mailbox.entries=8"], ["mailbox_compare"]),
+    (
+        "stack-driven prefetching (TTP)",
+        "bvh2",
+        False,
+        ["traversal.stack_prefetch=2"],
+        ["stack_prefetcher"],
+    ),
+    (
+        "SIMT 8 lanes, warp refill, cooperative lanes (CoopRT)",
+        "bvh2",
+        False,
+        ["traversal.model=simt", "traversal.simt.refill=warp", "traversal.simt.cooperative=true"],
+        ["cooperation"],
+    ),
+    (
+        "cwbvh8, quantised box tests (AQB8)",
+        "cwbvh8",
+        False,
+        ["traversal.quantized_boxes=true"],
+        ["box", "ray_requantizer"],
+    ),
 ]
 
 

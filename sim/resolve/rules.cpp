@@ -201,7 +201,7 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
     std::vector<Unused> out;
     // A unit kind's own section set away from its defaults while another kind runs.
     const nlohmann::json mine = config_to_json(f.config)["traversal"];
-    const nlohmann::json defaults = config_to_json(SimConfig{})["traversal"];
+    static const nlohmann::json defaults = config_to_json(SimConfig{})["traversal"];  // once per process
     for (const UnitKind* k : unit_kinds()) {
         if (k->name == f.config.traversal.model || !mine.contains(k->name) || !mine[k->name].is_object()) continue;
         for (auto it = mine[k->name].begin(); it != mine[k->name].end(); ++it)

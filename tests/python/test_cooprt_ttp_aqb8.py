@@ -97,6 +97,16 @@ def test_stack_prefetch_keeps_hits_and_work_and_is_read(
         assert "stack_prefetcher" in ttp["energy"]["per_ray_nj"]
 
 
+def test_stack_prefetch_with_cooperative_lanes_prefetches_from_the_recorded_walks(
+    sim_exe: Path, small_hairball_traces: dict[str, Path], tmp_path: Path
+) -> None:
+    trace = small_hairball_traces["cwbvh8"] / "trace.rtt"
+    both = checked(sim_exe, trace, tmp_path / "both", *WARPS, COOP, TTP)
+    sp = [u["stack_prefetch"] for u in _units(both)]
+    assert sum(p["triggers"] for p in sp) > 0 and sum(p["sent"] for p in sp) > 0
+    assert sum(u["helper_steps"] for u in _units(both)) > 0
+
+
 def test_stack_prefetch_unused_where_no_stack_holds_addresses(
     sim_exe: Path, small_hairball_traces: dict[str, Path], tmp_path: Path
 ) -> None:

@@ -137,6 +137,27 @@ def test_structural_alternatives_with_commands(
     assert "structural alternatives" in stats["verdict"]["text"]
 
 
+def test_the_newest_techniques_are_structural_alternatives_where_they_apply(
+    trace_of: Callable[..., Path], sim_exe: Path, tmp_path: Path
+) -> None:
+    warp = ("traversal.model=simt", "traversal.simt.lanes=8")
+    quant = sim_stats(sim_exe, trace_of("cwbvh8"), tmp_path / "cw", *warp)
+    alts = {k["key"]: k for k in quant["verdict"]["structural"]}
+    assert {
+        "traversal.stack_prefetch",
+        "traversal.simt.cooperative",
+        "traversal.quantized_boxes",
+    } <= set(alts)
+    assert alts["traversal.stack_prefetch"]["to"] == 2
+    assert alts["traversal.simt.cooperative"]["added_mm2"] > 0
+    assert alts["traversal.quantized_boxes"]["added_mm2"] < 0  # an integer pipeline, no dequantiser
+    # MIMD on fp32 nodes: no cooperative lanes, no quantised boxes; stack prefetching still.
+    plain = sim_stats(sim_exe, trace_of("bvh2"), tmp_path / "bvh2")
+    keys = {k["key"] for k in plain["verdict"]["structural"]}
+    assert "traversal.stack_prefetch" in keys
+    assert not {"traversal.simt.cooperative", "traversal.quantized_boxes"} & keys
+
+
 def test_a_treelet_run_says_when_it_is_too_small(
     trace_of: Callable[..., Path], sim_exe: Path, tmp_path: Path
 ) -> None:

@@ -108,6 +108,29 @@ public:
     const PacketCounts& counts() const { return m_counts; }
 
 protected:
+    /// What every begin_packet() starts with: the rays' lanes, the counts and the Stepper's
+    /// state; the live rays are the first step's.
+    void start_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) {
+        m_lanes.begin(rays, modes, n);
+        m_counts = PacketCounts{};
+        m_ray = rays[0];
+        m_mode = modes[0];
+        m_hit = Hit{};
+        m_work = WorkCounts{};
+        m_stack_size = 0;
+        m_split_lanes = 0;
+        m_active = m_lanes.live;
+    }
+    /// Ends the walk: rays without a hit report Hit{}; the Stepper's hit and work are ray 0's.
+    void end_packet() {
+        m_lanes.finish();
+        m_active = 0;
+        m_stack_size = 0;
+        m_hit = m_lanes.hit[0];
+        m_work = m_lanes.work[0];
+        m_plan.finish();
+    }
+
     PacketLanes m_lanes;
     LaneMask m_active = 0;  ///< the rays of the planned step
     PacketCounts m_counts;

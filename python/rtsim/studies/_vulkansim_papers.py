@@ -18,6 +18,7 @@ MIMD = "MIMD, same resources"
 #: The sampling comparison's points, on a larger trace of their own (vulkansim_baseline.specs).
 SAMPLING_FULL = "warp baseline, sampling's trace"
 SAMPLED = "warp, 10% sampled"
+#: The study's scenes (vulkansim_baseline.specs), in table order.
 SCENES = ["sponza", "hairball"]
 #: Context-cycle uses that wait on the memory hierarchy (docs/stats.md, cycle accounting).
 MEMORY_USES = ("l1_hit", "l1_mshr_full", "l2", "l2_mshr_full", "dram", "stack")

@@ -19,6 +19,7 @@ from rtsim.studies._vulkansim_papers import (
     MIMD,
     SAMPLED,
     SAMPLING_FULL,
+    SCENES,
     WARP,
     base,
     find,
@@ -37,7 +38,6 @@ from rtsim.study.tables import (
     units,
 )
 
-SCENES = ["sponza", "hairball"]
 ACCELS = ["bvh2", "cwbvh6"]
 #: Stack entries TTP prefetches per trigger (traversal.stack_prefetch): the top two, the next
 #: pops of an upward walk.

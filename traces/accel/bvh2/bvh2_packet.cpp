@@ -2,19 +2,13 @@
 // pop and split rules (bvh2_packet_kernel.h), one driven step by step, one in a loop.
 #include "traces/accel/bvh2/bvh2_packet.h"
 
+#include "traces/accel/stack_reads.h"
+
 namespace rtsim {
 
 void Bvh2PacketStepper::begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) {
-    m_lanes.begin(rays, modes, n);
-    m_counts = PacketCounts{};
-    m_ray = rays[0];
-    m_mode = modes[0];
-    m_hit = Hit{};
-    m_work = WorkCounts{};
-    m_stack_size = 0;
+    start_packet(rays, modes, n);
     m_split = false;
-    m_split_lanes = 0;
-    m_active = m_lanes.live;
     if (m_active == 0 || m_view.node_count == 0) return finish();
     m_ref = 0;  // the root: every valid ray starts there
     m_count = 0;
@@ -36,17 +30,7 @@ void detail::Bvh2LaneRules::plan(StepPlan& plan, uint32_t ref, uint32_t count) c
 
 uint32_t Bvh2PacketStepper::stack_reads(Fetch* out, uint32_t max) const {
     if (m_split) return 0;
-    uint32_t n = 0;
-    for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
-        const detail::PacketStackEntry& e = m_stack[i];
-        if (e.count == 0) {
-            out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * sizeof(HwNode), uint32_t(sizeof(HwNode)), DataKind::node};
-        } else {
-            const TriangleAddressing::Span span = m_view.tri_at.span(e.ref, e.count);
-            out[n] = Fetch{span.address, span.bytes, DataKind::triangle};
-        }
-    }
-    return n;
+    return tree_stack_reads(m_stack, m_stack_size, m_view.node_base, uint32_t(sizeof(HwNode)), m_view.tri_at, out, max);
 }
 
 void Bvh2PacketStepper::launch_lanes() {
@@ -123,14 +107,7 @@ void Bvh2PacketStepper::pop_next() {
     finish();
 }
 
-void Bvh2PacketStepper::finish() {
-    m_lanes.finish();
-    m_active = 0;
-    m_stack_size = 0;
-    m_hit = m_lanes.hit[0];
-    m_work = m_lanes.work[0];
-    m_plan.finish();
-}
+void Bvh2PacketStepper::finish() { end_packet(); }
 
 void trace_packet_bvh2(const Bvh2View& bvh, const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits,
                        WorkCounts* work, PacketCounts* counts, float split_below) {

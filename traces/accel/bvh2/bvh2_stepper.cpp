@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "traces/accel/stack_reads.h"
 #include "traces/common/error.h"
 #include "traces/isect/ray_box_rp.h"
 
@@ -93,17 +94,7 @@ StepOutcome Bvh2Stepper::execute() {
 }
 
 uint32_t Bvh2Stepper::stack_reads(Fetch* out, uint32_t max) const {
-    uint32_t n = 0;
-    for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
-        const detail::Bvh2StackEntry& e = m_stack[i];
-        if (e.count == 0) {
-            out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * sizeof(HwNode), uint32_t(sizeof(HwNode)), DataKind::node};
-        } else {
-            const TriangleAddressing::Span s = m_view.tri_at.span(e.ref, e.count);
-            out[n] = Fetch{s.address, s.bytes, DataKind::triangle};
-        }
-    }
-    return n;
+    return tree_stack_reads(m_stack, m_stack_size, m_view.node_base, uint32_t(sizeof(HwNode)), m_view.tri_at, out, max);
 }
 
 void Bvh2Stepper::visit_node(const HwNode& node) {

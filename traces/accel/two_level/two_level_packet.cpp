@@ -26,14 +26,8 @@ Stepper& TwoLevelPacketStepper::lane_walker(uint32_t) {
 }
 
 void TwoLevelPacketStepper::begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) {
-    m_lanes.begin(rays, modes, n);
-    m_counts = PacketCounts{};
-    m_ray = rays[0];
-    m_mode = modes[0];
-    m_hit = Hit{};
-    m_work = WorkCounts{};
-    m_stack_size = m_tlas_size = 0;
-    m_split_lanes = 0;
+    start_packet(rays, modes, n);
+    m_tlas_size = 0;
     m_inner = nullptr;
     m_tlas_active = m_lanes.live;
     if (m_tlas_active == 0 || m_accel.tlas().node_count == 0) return finish();
@@ -143,12 +137,9 @@ void TwoLevelPacketStepper::pop_next() {
 }
 
 void TwoLevelPacketStepper::finish() {
-    m_lanes.finish();
-    m_active = m_tlas_active = 0;
-    m_stack_size = m_tlas_size = 0;
-    m_hit = m_lanes.hit[0];
-    m_work = m_lanes.work[0];
-    m_plan.finish();
+    m_tlas_active = 0;
+    m_tlas_size = 0;
+    end_packet();
 }
 
 }  // namespace rtsim

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "traces/accel/stack_reads.h"
 #include "traces/accel/wide/wide_packet_kernel.h"
 #include "traces/accel/wide/wide_stepper.h"
 
@@ -77,16 +78,8 @@ public:
     }
 
     void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) override {
-        m_lanes.begin(rays, modes, n);
-        m_counts = PacketCounts{};
-        m_ray = rays[0];
-        m_mode = modes[0];
-        m_hit = Hit{};
-        m_work = WorkCounts{};
-        m_stack_size = 0;
+        start_packet(rays, modes, n);
         m_split = false;
-        m_split_lanes = 0;
-        m_active = m_lanes.live;
         if (m_active == 0 || m_view.node_count == 0) return finish();
         m_ref = 0;  // the root: every valid ray starts there
         m_count = 0;
@@ -123,17 +116,7 @@ public:
     /// The packet's shared stack's top entries (none while a split packet's rays walk in turn).
     uint32_t stack_reads(Fetch* out, uint32_t max) const override {
         if (m_split) return 0;
-        uint32_t n = 0;
-        for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
-            const detail::PacketStackEntry& e = m_stack[size_t(i)];
-            if (e.count == 0) {
-                out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * Codec::kBytes, uint32_t(Codec::kBytes), DataKind::node};
-            } else {
-                const TriangleAddressing::Span span = m_view.tri_at.span(e.ref, e.count);
-                out[n] = Fetch{span.address, span.bytes, DataKind::triangle};
-            }
-        }
-        return n;
+        return tree_stack_reads(m_stack.data(), m_stack_size, m_view.node_base, Codec::kBytes, m_view.tri_at, out, max);
     }
 
 private:
@@ -190,14 +173,7 @@ private:
         finish();
     }
 
-    void finish() {
-        m_lanes.finish();
-        m_active = 0;
-        m_stack_size = 0;
-        m_hit = m_lanes.hit[0];
-        m_work = m_lanes.work[0];
-        m_plan.finish();
-    }
+    void finish() { end_packet(); }
 
     WideView m_view;
     uint32_t m_ref = 0;    ///< node index, or first triangle of a leaf

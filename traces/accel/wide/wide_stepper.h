@@ -20,6 +20,7 @@
 #include "traces/accel/leaf_blocks.h"
 #include "traces/accel/rp_boxes.h"
 #include "traces/accel/short_stack.h"
+#include "traces/accel/stack_reads.h"
 #include "traces/accel/stepper.h"
 #include "traces/accel/wide/wide_kernel.h"
 #include "traces/common/error.h"
@@ -93,17 +94,7 @@ public:
     }
 
     uint32_t stack_reads(Fetch* out, uint32_t max) const override {
-        uint32_t n = 0;
-        for (int i = m_stack_size - 1; i >= 0 && n < max; --i, ++n) {
-            const WideStackEntry& e = m_stack[size_t(i)];
-            if (e.count == 0) {
-                out[n] = Fetch{m_view.node_base + uint64_t(e.ref) * Codec::kBytes, uint32_t(Codec::kBytes), DataKind::node};
-            } else {
-                const TriangleAddressing::Span s = m_view.tri_at.span(e.ref, e.count);
-                out[n] = Fetch{s.address, s.bytes, DataKind::triangle};
-            }
-        }
-        return n;
+        return tree_stack_reads(m_stack.data(), m_stack_size, m_view.node_base, Codec::kBytes, m_view.tri_at, out, max);
     }
 
 private:
