@@ -35,6 +35,8 @@ public:
     }
     /// The structure the steppers walk (a packet unit makes packet steppers from it).
     const Accel& accel() const { return m_accel; }
+    /// What the steppers walk with (a packet unit's packet steppers too).
+    const StepOptions& options() const { return m_options; }
 
 private:
     const Accel& m_accel;

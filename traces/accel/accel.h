@@ -58,9 +58,13 @@ public:
     /// `options` let it (StepOptions::fused_loop_walks_alike); the default drives a stepper.
     virtual Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
                       const StepOptions& options = {}) const;
-    /// A packet stepper (rays sharing one traversal stack, packet_stepper.h), or null where the
+    /// A packet stepper (rays sharing one traversal stack, packet_stepper.h) walking with
+    /// `options` (the rays' mailboxes; the others a packet unit never sets), or null where the
     /// kind has no packet kernel (capabilities().packet_kernel false).
-    virtual std::unique_ptr<PacketStepper> make_packet_stepper() const { return nullptr; }
+    virtual std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const {
+        (void)options;
+        return nullptr;
+    }
     /// The reference packet loop: rays[0, n) traced as one packet, each ray's hit and work and the
     /// packet's counts (any output may be null); `split_below` as PacketStepper::set_split_below.
     /// The default drives make_packet_stepper(); throws rtsim::Error where the kind has none.

@@ -49,28 +49,44 @@ public:
     /// untouched) when the list is used up.
     bool plan_batch(const RefListView& v, const Mailbox& mailbox, WorkCounts& work, StepPlan& plan) {
         m_batch_size = 0;
-        while (m_batch_size == 0 && m_next < m_count) {
-            const uint32_t end = std::min(m_count, m_next + kBatch);
-            for (; m_next < end; ++m_next) {
-                const uint32_t tri = v.refs[m_first + m_next];
-                if (mailbox.enabled()) {
-                    work.mailbox_lookups += 1;
-                    if (mailbox.contains(tri)) {
-                        work.mailbox_hits += 1;
-                        continue;
-                    }
-                }
-                m_batch[m_batch_size++] = tri;
-            }
-        }
+        while (m_batch_size == 0 && more()) take_window(v, mailbox, work);
         if (m_batch_size == 0) return false;
         plan.reset(kNoLocality);
-        for (uint32_t i = 0; i < m_batch_size; ++i) {
-            const TriangleAddressing::Span s = v.tri_at.span(m_batch[i], 1);
-            plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-        }
+        add_triangle_fetches(v, m_batch, m_batch_size, plan);
         plan.add_op(OpKind::triangle, m_batch_size);
         return true;
+    }
+
+    /// True while the list has windows left.
+    bool more() const { return m_next < m_count; }
+    /// Takes the list's next window as the batch (the mailbox's lookups and hits counted), which
+    /// may be empty when the mailbox holds it whole. Packets take windows in lock step with it
+    /// (cell_packet.h); plan_batch() is this until a window has triangles.
+    uint32_t take_window(const RefListView& v, const Mailbox& mailbox, WorkCounts& work) {
+        m_batch_size = 0;
+        const uint32_t end = std::min(m_count, m_next + kBatch);
+        for (; m_next < end; ++m_next) {
+            const uint32_t tri = v.refs[m_first + m_next];
+            if (mailbox.enabled()) {
+                work.mailbox_lookups += 1;
+                if (mailbox.contains(tri)) {
+                    work.mailbox_hits += 1;
+                    continue;
+                }
+            }
+            m_batch[m_batch_size++] = tri;
+        }
+        return m_batch_size;
+    }
+    /// The batch taken: triangle indices in list order.
+    const uint32_t* batch() const { return m_batch; }
+    uint32_t batch_size() const { return m_batch_size; }
+    /// One fetch per triangle of tris[0, n), in that order.
+    static void add_triangle_fetches(const RefListView& v, const uint32_t* tris, uint32_t n, StepPlan& plan) {
+        for (uint32_t i = 0; i < n; ++i) {
+            const TriangleAddressing::Span s = v.tri_at.span(tris[i], 1);
+            plan.add_fetch(s.address, s.bytes, DataKind::triangle);
+        }
     }
 
     /// Tests the planned triangles against the ray's own [tmin, tmax] (the shared hit rules) and

@@ -218,12 +218,20 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return grid_image(scene, s.grid); },
          loader<GridAccel>()},
         {{"kdtree", "kd-tree, SAH in O(N log N) with perfect splits (Wald & Havran 2006), 8-byte nodes, plane tests",
-          {"sah"}, single_level(kKdStackEntryBytes).with(&AccelCapabilities::mailbox).with(&AccelCapabilities::restart_trail)},
+          {"sah"},
+          single_level(kKdStackEntryBytes)
+              .with(&AccelCapabilities::packet_kernel)
+              .with(&AccelCapabilities::mailbox)
+              .with(&AccelCapabilities::restart_trail)},
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.kd.visit(v); },
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
          loader<KdAccel>()},
         {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
-          {"binned", "wachter_keller", "lbvh", "sweep", "median"}, single_level(kBihStackEntryBytes).with(&AccelCapabilities::restart_trail).with(&AccelCapabilities::refit)},
+          {"binned", "wachter_keller", "lbvh", "sweep", "median"},
+          single_level(kBihStackEntryBytes)
+              .with(&AccelCapabilities::packet_kernel)
+              .with(&AccelCapabilities::restart_trail)
+              .with(&AccelCapabilities::refit)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              if (builder == "wachter_keller") s.bih.visit(v);
              else tree_settings(builder, s, v);
@@ -255,7 +263,7 @@ const std::vector<Entry>& registry() {
          },
          loader<BkdAccel>()},
         {{"octree", "adaptive octree, 16-byte nodes, parametric traversal (Revelles et al. 2000)", {"adaptive"},
-          single_level(kOctStackEntryBytes).with(&AccelCapabilities::mailbox)},
+          single_level(kOctStackEntryBytes).with(&AccelCapabilities::packet_kernel).with(&AccelCapabilities::mailbox)},
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.octree.visit(v); },
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return octree_image(scene, s.octree); },
          loader<OctreeAccel>()},

@@ -37,7 +37,7 @@ PacketUnit::PacketUnit(sc_core::sc_module_name name, const UnitSetup& setup, uin
       m_modes(m_packet.lanes) {
     // The run's resolution step refused structures without a packet kernel (capabilities.h).
     for (Packet& p : m_packets) {
-        p.stepper = m_steppers.accel().make_packet_stepper();
+        p.stepper = m_steppers.accel().make_packet_stepper(m_steppers.options());
         require(p.stepper != nullptr, "model: structure '" + m_steppers.accel().kind() + "' has no packet kernel");
         p.stepper->set_split_below(float(m_packet.split_below));
         p.stepper->set_split_walks(m_packet.split_walks);

@@ -1,4 +1,4 @@
-// Packets on the binary and the wide BVHs (Wald et al. 2001): every ray's closest hit equals single-ray
+// Packets on the binary and the wide BVHs and the space-partitioning trees (Wald et al. 2001): every ray's closest hit equals single-ray
 // traversal bit for bit and every any-hit ray agrees on occlusion, on the procedural scenes, an
 // alpha-masked soup and the hard cases (rays from inside closed meshes, aimed at shared vertices,
 // invalid rays); the packet stepper and the fused packet loop agree on hits, work and counts;
@@ -295,18 +295,183 @@ TEST(Packets, SplitRaysOnTheirOwnLanesWalkAsTheSerialHybrid) {
     }
 }
 
-TEST(Packets, TreesOfOtherShapesHaveNoPacketKernel) {
+TEST(Packets, TheGridHasNoPacketKernel) {
     const Scene& scene = test::procedural("cornell");
-    const std::unique_ptr<Accel> kd = accel_of(scene, "kdtree");
-    EXPECT_EQ(kd->make_packet_stepper(), nullptr);
+    const std::unique_ptr<Accel> grid = accel_of(scene, "grid");
+    EXPECT_EQ(grid->make_packet_stepper(), nullptr);
     const Ray r = test::make_ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f));
     const TraversalMode m = TraversalMode::closest_hit;
-    EXPECT_THROW(kd->trace_packet(&r, &m, 1, nullptr, nullptr, nullptr), Error);
-    for (const std::string kind : {"bvh2", "bvh4"}) {
+    EXPECT_THROW(grid->trace_packet(&r, &m, 1, nullptr, nullptr, nullptr), Error);
+    for (const std::string kind : {"bvh2", "bvh4", "kdtree", "octree"}) {
         std::unique_ptr<PacketStepper> s = accel_of(scene, kind)->make_packet_stepper();
         std::vector<Ray> many(65, r);
         std::vector<TraversalMode> modes(65, m);
         EXPECT_THROW(s->begin_packet(many.data(), modes.data(), 65), Error);
+    }
+}
+
+/// The space-partitioning trees with a packet kernel (cell_packet.h).
+const char* const kCellKinds[] = {"kdtree", "bih", "octree"};
+
+/// Packets of `lanes` consecutive rays on a space-partitioning tree: each ray's hit against the
+/// single ray's, the plans' operations against the rays' work, and (with a mailbox) the work
+/// counted back equal to the work without one. Returns the packets' counts.
+PacketCounts check_cell_packets(const Accel& accel, const std::vector<Ray>& rays, uint32_t lanes, TraversalMode mode,
+                                const std::string& what, float split_below = 0.0f, uint32_t mailbox = 0) {
+    StepOptions options;
+    options.mailbox_entries = mailbox;
+    std::unique_ptr<PacketStepper> s = accel.make_packet_stepper(options);
+    s->set_split_below(split_below);
+    PacketCounts total;
+    int diffs = 0;
+    for (size_t first = 0; first < rays.size(); first += lanes) {
+        const uint32_t n = uint32_t(std::min<size_t>(lanes, rays.size() - first));
+        const std::vector<TraversalMode> modes(n, mode);
+        std::vector<Hit> hits(n);
+        std::vector<WorkCounts> work(n);
+        PacketCounts plain;
+        accel.trace_packet(&rays[first], modes.data(), n, hits.data(), work.data(), &plain, split_below);
+        s->begin_packet(&rays[first], modes.data(), n);
+        uint64_t ops[kOpKindCount] = {}, alpha = 0, steps = 0;
+        while (!s->done()) {
+            const StepPlan& p = s->plan();
+            EXPECT_GT(s->active(), 0u) << what;
+            ++steps;
+            for (int i = 0; i < p.op_count; ++i) ops[size_t(p.op[i].kind)] += p.op[i].count;
+            const StepOutcome out = s->execute();
+            for (int i = 0; i < out.op_count; ++i) alpha += out.op[i].count;
+        }
+        EXPECT_EQ(steps, s->counts().node_steps + s->counts().leaf_steps) << what;
+        if (mailbox == 0) EXPECT_EQ(s->counts(), plain) << what;
+        WorkCounts sum;
+        for (uint32_t i = 0; i < n; ++i) {
+            const WorkCounts& w = s->lane_work(i);
+            EXPECT_EQ(w.traced(), work[i]) << what << ": a mailbox skips only retests";
+            EXPECT_TRUE(test::same_hit(s->lane_hit(i), hits[i], TraversalMode::closest_hit)) << what;
+            sum.box_tests += w.box_tests, sum.plane_tests += w.plane_tests, sum.tri_tests += w.tri_tests;
+            sum.anyhit_calls += w.anyhit_calls;
+            const Hit single = accel.trace(rays[first + i], mode);
+            if (!test::same_hit(hits[i], single, mode) && ++diffs <= 3)
+                ADD_FAILURE() << what << ": ray " << first + i << " packet prim " << hits[i].prim << " t " << hits[i].t
+                              << ", single prim " << single.prim << " t " << single.t;
+        }
+        EXPECT_EQ(ops[size_t(OpKind::box)], sum.box_tests) << what;
+        EXPECT_EQ(ops[size_t(OpKind::plane)], sum.plane_tests) << what;
+        EXPECT_EQ(ops[size_t(OpKind::triangle)], sum.tri_tests) << what;
+        EXPECT_EQ(alpha, sum.anyhit_calls) << what;
+        total += s->counts();
+    }
+    EXPECT_EQ(diffs, 0) << what;
+    return total;
+}
+
+TEST(Packets, CellTreesHitsEqualSingleRays) {
+    // Packets on the kd-tree (Wald et al. 2001's own structure), the BIH and the octree, with
+    // and without mailboxes and the hybrid's split.
+    for (const std::string name : {"cornell", "hairball", "teapot_stadium"}) {
+        const Scene& scene = test::procedural(name);
+        const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+        const std::vector<Ray> random = test::random_rays(scene, tris, 37, 512), camera = camera_rays(tris, 576, 11);
+        for (const char* kind : kCellKinds) {
+            const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+            ASSERT_TRUE(accel->capabilities().packet_kernel) << kind;
+            for (uint32_t lanes : {1u, 8u, 16u, 64u})
+                for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+                    const std::string what = name + " " + kind + " lanes " + std::to_string(lanes) + " mode " +
+                                             std::to_string(int(mode));
+                    check_cell_packets(*accel, random, lanes, mode, what + " random");
+                    const PacketCounts c = check_cell_packets(*accel, camera, lanes, mode, what + " camera");
+                    check_cell_packets(*accel, camera, lanes, mode, what + " camera mailbox", 0.0f, 8);
+                    if (lanes == 64 && mode == TraversalMode::closest_hit) {
+                        uint64_t single_steps = 0;
+                        for (const Ray& r : camera) {
+                            WorkCounts w;
+                            accel->trace(r, mode, &w);
+                            single_steps += w.steps;
+                        }
+                        // Coherent packets share their node fetches (less on the dense hairball,
+                        // whose small cells neighbouring rays share only near the root).
+                        EXPECT_LT(c.node_steps * 2, single_steps) << what;
+                    }
+                }
+            for (float split : {0.25f, 0.5f}) {
+                const PacketCounts r =
+                    check_cell_packets(*accel, random, 16, TraversalMode::closest_hit, name + " " + kind + " split", split);
+                EXPECT_GT(r.splits, 0u) << kind;
+                EXPECT_GT(r.split_steps, 0u) << kind;
+                check_cell_packets(*accel, camera, 16, TraversalMode::any_hit, name + " " + kind + " split camera", split, 8);
+            }
+        }
+    }
+}
+
+TEST(Packets, CellTreesCopiesOfOneRayDoItsSingleRayWorkFullyActive) {
+    const Scene& scene = test::procedural("hairball");
+    const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 41, 48);
+    for (const char* kind : kCellKinds)
+        for (uint32_t mailbox : {0u, 8u}) {
+            const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+            StepOptions options;
+            options.mailbox_entries = mailbox;
+            std::unique_ptr<PacketStepper> s = accel->make_packet_stepper(options);
+            for (const Ray& r : rays) {
+                if (!ray_is_valid(r)) continue;
+                WorkCounts single;
+                const Hit h = accel->trace(r, TraversalMode::closest_hit, &single, options);
+                const std::vector<Ray> same(16, r);
+                const std::vector<TraversalMode> modes(16, TraversalMode::closest_hit);
+                s->begin_packet(same.data(), modes.data(), 16);
+                while (!s->done()) s->execute();
+                for (uint32_t i = 0; i < 16; ++i) {
+                    EXPECT_EQ(s->lane_work(i), single) << kind;
+                    EXPECT_TRUE(test::same_hit(s->lane_hit(i), h, TraversalMode::closest_hit)) << kind;
+                }
+                EXPECT_EQ(s->counts().active_rays, 16 * (s->counts().node_steps + s->counts().leaf_steps)) << kind;
+            }
+        }
+}
+
+TEST(Packets, CellTreesSplitRaysOnTheirOwnLanesWalkAsTheSerialHybrid) {
+    for (const std::string name : {"cornell", "hairball"}) {
+        const Scene& scene = test::procedural(name);
+        const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+        const std::vector<Ray> random = test::random_rays(scene, tris, 43, 512), camera = camera_rays(tris, 576, 13);
+        for (const char* kind : kCellKinds) {
+            const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+            for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit})
+                for (float split : {0.25f, 1.0f}) {
+                    const std::string what = name + " " + kind + " split " + std::to_string(split);
+                    check_lane_walks(*accel, random, mode, split, what + " random", true);
+                    check_lane_walks(*accel, camera, mode, split, what + " camera", false);
+                }
+        }
+    }
+}
+
+TEST(Packets, CellTreesHardCases) {
+    // Rays from inside a closed sphere, aimed along the axes through shared vertices, invalid rays.
+    const std::vector<Vec3> sphere = test::icosphere(3);
+    const Scene scene = test::make_scene(sphere);
+    std::vector<Ray> rays;
+    for (size_t t = 0; t < sphere.size(); ++t) rays.push_back(test::make_ray(Vec3(0.0f), sphere[t]));
+    for (int a = 0; a < 3; ++a)
+        for (float s : {-1.0f, 1.0f}) {
+            Vec3 d(0.0f);
+            d[a] = s;
+            rays.push_back(test::make_ray(Vec3(0.0f), d));
+        }
+    rays[5].tmin = std::numeric_limits<float>::quiet_NaN();
+    rays[9].direction = Vec3(0.0f);
+    for (const char* kind : kCellKinds) {
+        const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+        for (uint32_t lanes : {4u, 16u, 64u})
+            for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit})
+                check_cell_packets(*accel, rays, lanes, mode, std::string("sphere ") + kind, 0.0f, 8);
+        std::unique_ptr<PacketStepper> st = accel->make_packet_stepper();
+        const Ray bad = test::make_ray(Vec3(0.0f), Vec3(0.0f));
+        const TraversalMode m = TraversalMode::closest_hit;
+        st->begin_packet(&bad, &m, 1);
+        EXPECT_TRUE(st->done()) << kind;  // an invalid ray alone: no step at all
     }
 }
 

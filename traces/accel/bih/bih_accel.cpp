@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "traces/accel/bih/bih.h"
+#include "traces/accel/bih/bih_packet.h"
 #include "traces/accel/cell_tree_invariants.h"
 #include "traces/accel/leaf_coverage.h"
 #include "traces/accel/spatial_params.h"
@@ -80,6 +81,10 @@ BihAccel::BihAccel(AccelImage image, const std::string& source) : Accel(std::mov
 
 std::unique_ptr<Stepper> BihAccel::make_stepper(const StepOptions& options) const {
     return std::make_unique<BihStepper>(m_view, options.short_stack_entries);
+}
+
+std::unique_ptr<PacketStepper> BihAccel::make_packet_stepper(const StepOptions&) const {
+    return std::make_unique<CellPacketStepper<detail::BihPacketRules>>(detail::BihPacketRules{m_view}, 0);
 }
 
 Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {

@@ -49,7 +49,7 @@ public:
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
               const StepOptions& options = {}) const override;
-    std::unique_ptr<PacketStepper> make_packet_stepper() const override;
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override;
     void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
                       PacketCounts* counts, float split_below = 0.0f) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;

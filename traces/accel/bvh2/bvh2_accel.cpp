@@ -197,7 +197,7 @@ Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const
     return trace_bvh2(m_view, ray, mode, work);
 }
 
-std::unique_ptr<PacketStepper> Bvh2Accel::make_packet_stepper() const {
+std::unique_ptr<PacketStepper> Bvh2Accel::make_packet_stepper(const StepOptions&) const {
     return std::make_unique<Bvh2PacketStepper>(m_view);
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "traces/accel/kdtree/kdtree.h"
+#include "traces/accel/kdtree/kd_packet.h"
 #include "traces/accel/spatial_params.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/common/error.h"
@@ -56,6 +57,11 @@ KdAccel::KdAccel(AccelImage image, const std::string& source) : Accel(std::move(
 
 std::unique_ptr<Stepper> KdAccel::make_stepper(const StepOptions& options) const {
     return std::make_unique<KdStepper>(m_view, options.mailbox_entries, options.short_stack_entries);
+}
+
+std::unique_ptr<PacketStepper> KdAccel::make_packet_stepper(const StepOptions& options) const {
+    return std::make_unique<CellPacketStepper<detail::KdPacketRules>>(detail::KdPacketRules{m_view},
+                                                                      options.mailbox_entries);
 }
 
 Hit KdAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {

@@ -36,6 +36,8 @@ public:
     OctreeAccel(AccelImage image, const std::string& source);
 
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    /// Packets of rays sharing one walk (cell_packet.h), each ray with its own mailbox.
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override;
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
               const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;

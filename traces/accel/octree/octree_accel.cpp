@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "traces/accel/octree/octree.h"
+#include "traces/accel/octree/octree_packet.h"
 #include "traces/accel/spatial_params.h"
 #include "traces/bvh/build_tree.h"
 #include "traces/bvh/sbvh_clip.h"
@@ -107,6 +108,11 @@ OctreeAccel::OctreeAccel(AccelImage image, const std::string& source) : Accel(st
 
 std::unique_ptr<Stepper> OctreeAccel::make_stepper(const StepOptions& options) const {
     return std::make_unique<OctreeStepper>(m_view, options.mailbox_entries);
+}
+
+std::unique_ptr<PacketStepper> OctreeAccel::make_packet_stepper(const StepOptions& options) const {
+    return std::make_unique<CellPacketStepper<detail::OctreePacketRules>>(detail::OctreePacketRules{m_view},
+                                                                          options.mailbox_entries);
 }
 
 Hit OctreeAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {

@@ -71,7 +71,7 @@ public:
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
     /// Packets walk the TLAS together and each instance's BLAS as a packet of the rays that
     /// entered it (two_level_packet.h), where the BLAS kind has a packet kernel.
-    std::unique_ptr<PacketStepper> make_packet_stepper() const override;
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override;

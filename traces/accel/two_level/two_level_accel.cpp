@@ -155,9 +155,9 @@ std::unique_ptr<Stepper> TwoLevelAccel::make_stepper(const StepOptions& options)
     return std::make_unique<TwoLevelStepper>(*this, options);
 }
 
-std::unique_ptr<PacketStepper> TwoLevelAccel::make_packet_stepper() const {
+std::unique_ptr<PacketStepper> TwoLevelAccel::make_packet_stepper(const StepOptions& options) const {
     if (!capabilities().packet_kernel) return nullptr;
-    return std::make_unique<TwoLevelPacketStepper>(*this);
+    return std::make_unique<TwoLevelPacketStepper>(*this, options);
 }
 
 LocalityPartition TwoLevelAccel::partition(uint64_t budget_bytes) const {

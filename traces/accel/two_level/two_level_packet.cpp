@@ -14,9 +14,10 @@ LaneMask low_lanes(uint32_t n) { return n >= kMaxPacketLanes ? ~LaneMask(0) : (L
 
 }  // namespace
 
-TwoLevelPacketStepper::TwoLevelPacketStepper(const TwoLevelAccel& accel) : m_accel(accel) {
+TwoLevelPacketStepper::TwoLevelPacketStepper(const TwoLevelAccel& accel, const StepOptions& options)
+    : m_accel(accel) {
     for (const auto& blas : accel.blases()) {
-        m_blas_packets.push_back(blas->make_packet_stepper());
+        m_blas_packets.push_back(blas->make_packet_stepper(options));
         require(m_blas_packets.back() != nullptr, "two-level packets need a BLAS kind with a packet kernel");
     }
 }

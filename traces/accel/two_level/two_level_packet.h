@@ -18,6 +18,7 @@
 
 #include "traces/accel/bvh2/bvh2_packet_kernel.h"
 #include "traces/accel/packet_stepper.h"
+#include "traces/accel/step_options.h"
 #include "traces/accel/two_level/instance_record.h"
 
 namespace rtsim {
@@ -26,7 +27,7 @@ class TwoLevelAccel;
 
 class TwoLevelPacketStepper final : public PacketStepper {
 public:
-    explicit TwoLevelPacketStepper(const TwoLevelAccel& accel);
+    TwoLevelPacketStepper(const TwoLevelAccel& accel, const StepOptions& options);
 
     void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) override;
     StepOutcome execute() override;

@@ -151,7 +151,7 @@ public:
         }
         return Accel::trace(ray, mode, work, options);
     }
-    std::unique_ptr<PacketStepper> make_packet_stepper() const override {
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& = {}) const override {
         return std::make_unique<WidePacketStepper<Codec>>(m_view);
     }
     void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
