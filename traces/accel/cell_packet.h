@@ -37,7 +37,7 @@
 #include "traces/accel/mailbox.h"
 #include "traces/accel/packet_kernel.h"
 #include "traces/accel/packet_stepper.h"
-#include "traces/accel/ref_list.h"
+#include "traces/accel/packet_lists.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -56,6 +56,7 @@ namespace rtsim {
 template <class Rules>
 class CellPacketWalk final : public Stepper {
 public:
+    using RulesType = Rules;
     using Cell = typename Rules::Cell;
     struct Entry {
         uint32_t node = 0;
@@ -83,25 +84,26 @@ public:
         m_plan.add_op(OpKind::box, lane_count(m_active));
         count_step(true);
     }
-    /// Ray r's walk alone after a split: its part of the shared stack's `frozen` entries, then the
-    /// packet's node `node` in `cell` if the ray was active there.
-    void launch(uint32_t r, const Entry* shared, int frozen, bool at_node, uint32_t node, const Cell& cell) {
+    /// Ray r's walk alone after `packet` split: its part of the shared stack's entries, then the
+    /// packet's node if the ray was active there.
+    void launch(uint32_t r, const CellPacketWalk& packet) {
         m_split_below = 0.0f;
         m_split = false;
         m_size = 0;
         m_r = r;
         const LaneMask bit = lane_bit(r);
-        for (int i = 0; i < frozen; ++i) {
-            if (!(shared[i].mask & bit)) continue;
+        for (int i = 0; i < packet.m_size; ++i) {
+            const Entry& shared = packet.m_stack[size_t(i)];
+            if (!(shared.mask & bit)) continue;
             Entry& e = push();
-            e.node = shared[i].node;
+            e.node = shared.node;
             e.mask = bit;
-            e.cell[r] = shared[i].cell[r];
+            e.cell[r] = shared.cell[r];
         }
         if (!(m_p->live & bit)) return finish();
-        if (at_node) {
-            m_cell[r] = cell;
-            return go(node, bit);
+        if (packet.split_rays() & bit) {
+            m_cell[r] = packet.m_cell[r];
+            return go(packet.m_node, bit);
         }
         pop_next();
     }
@@ -139,9 +141,12 @@ public:
     bool split() const { return m_split; }
     /// The rays at the node where it split (0 unless split()).
     LaneMask split_rays() const { return m_split ? m_active : 0; }
-    uint32_t node() const { return m_node; }
-    const Cell& cell(uint32_t r) const { return m_cell[r]; }
-    const Entry* stack() const { return m_stack.data(); }
+    /// The rays left to walk alone after the split: those at its node or in a pending entry.
+    LaneMask split_todo() const {
+        LaneMask todo = split_rays();
+        for (int i = 0; i < m_size; ++i) todo |= m_stack[size_t(i)].mask;
+        return todo & m_p->live;
+    }
     int size() const { return m_size; }
 
 private:
@@ -184,20 +189,8 @@ private:
         PacketLanes& p = *m_p;
         uint32_t alpha = 0;
         if constexpr (Rules::kListLeaves) {
-            if (m_phase == Phase::list) {
-                for_each_lane(m_active, [&](uint32_t r) { m_walk[r].list_fetched(p.work[r]); });
-            } else {
-                for_each_lane(m_active, [&](uint32_t r) {
-                    bool done = false;
-                    const Ray& ray = p.ray[r];
-                    alpha += p.mode[r] == TraversalMode::any_hit
-                                 ? m_walk[r].template test_batch<true>(m_rules.list(), p.tri[r], ray.tmin, ray.tmax,
-                                                                       p.hit[r], p.cull[r], m_mail[r], p.work[r], &done)
-                                 : m_walk[r].template test_batch<false>(m_rules.list(), p.tri[r], ray.tmin, ray.tmax,
-                                                                        p.hit[r], p.cull[r], m_mail[r], p.work[r], &done);
-                    if (done) p.live &= ~lane_bit(r);  // an any-hit ray with its hit leaves the packet
-                });
-            }
+            if (m_phase == Phase::list) m_lists.arrived(p);
+            else alpha = m_lists.test(m_active, m_rules.list(), p, m_mail);
             next_window();
         } else {
             uint32_t first = 0, count = 0;
@@ -256,10 +249,8 @@ private:
         uint32_t first = 0, count = 0;
         m_rules.leaf_span(m_node, &first, &count);
         if (count == 0) return pop_next();
-        m_leaf_lanes = m_active;
         if constexpr (Rules::kListLeaves) {
-            // Every ray's list walk starts on the same list: the one fetch planned is the same.
-            for_each_lane(m_active, [&](uint32_t r) { m_walk[r].plan_list(m_rules.list(), first, count, m_plan); });
+            m_lists.open(m_active, m_rules.list(), first, count, m_plan);
             m_phase = Phase::list;
         } else {
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
@@ -271,33 +262,15 @@ private:
         count_step(false);
     }
 
-    /// The leaf's rays take the list's next window together; the step fetches what any of them
-    /// tests. Pops when the list is used up (or every ray left with its hit).
+    /// The leaf's rays take the list's next window together (packet_lists.h); pops when the
+    /// list is used up or every ray left with its hit.
     void next_window() {
-        if constexpr (Rules::kListLeaves) next_window_of(m_rules.list());
-    }
-    void next_window_of(const RefListView& view) {
-        for (;;) {
-            const LaneMask rays = m_leaf_lanes & m_p->live;
-            if (rays == 0 || !m_walk[__builtin_ctzll(rays)].more()) return pop_next();
-            LaneMask testing = 0;
-            uint32_t tris[RefListWalk::kBatch], n = 0, tests = 0;
-            for_each_lane(rays, [&](uint32_t r) {
-                RefListWalk& w = m_walk[r];
-                if (w.take_window(view, m_mail[r], m_p->work[r]) == 0) return;
-                testing |= lane_bit(r);
-                tests += w.batch_size();
-                for (uint32_t i = 0; i < w.batch_size(); ++i)
-                    if (std::find(tris, tris + n, w.batch()[i]) == tris + n) tris[n++] = w.batch()[i];
-            });
-            if (testing == 0) continue;  // every ray's mailbox held the window
+        if constexpr (Rules::kListLeaves) {
+            const LaneMask testing = m_lists.plan_window(m_rules.list(), *m_p, m_mail, m_plan);
+            if (testing == 0) return pop_next();
             m_active = testing;
             m_phase = Phase::window;
-            m_plan.reset(kNoLocality);
-            RefListWalk::add_triangle_fetches(view, tris, n, m_plan);
-            m_plan.add_op(OpKind::triangle, tests);
             count_step(false);
-            return;
         }
     }
 
@@ -337,22 +310,22 @@ private:
     Phase m_phase = Phase::clip;
     uint32_t m_node = 0;
     LaneMask m_active = 0;
-    LaneMask m_leaf_lanes = 0;  ///< the rays in the leaf being tested
     int m_size = 0;
     std::vector<Entry> m_stack;
     Cell m_cell[kMaxPacketLanes];
     Cell m_child_cell[Rules::kMaxChildren][kMaxPacketLanes];
-    RefListWalk m_walk[kMaxPacketLanes];
+    PacketLists m_lists;
 };
 
-/// The packet stepper of a space-partitioning tree: its packet's walk, and the rays' walks alone
-/// after the hybrid's split.
-template <class Rules>
-class CellPacketStepper final : public PacketStepper {
+/// A packet stepper over a packet walk (`Walk`: CellPacketWalk, GridPacketWalk): the packet's
+/// walk, and its rays' walks alone after the hybrid's split, each a Walk of one ray on the
+/// packet's lanes (Walk::launch(r, packet)).
+template <class Walk>
+class WalkPacketStepper final : public PacketStepper {
 public:
-    using Walk = CellPacketWalk<Rules>;
+    using Rules = typename Walk::RulesType;
 
-    CellPacketStepper(const Rules& rules, uint32_t mailbox_entries) : m_rules(rules), m_walk(rules, false) {
+    WalkPacketStepper(const Rules& rules, uint32_t mailbox_entries) : m_rules(rules), m_walk(rules, false) {
         for (Mailbox& m : m_mail) m.set_entries(mailbox_entries);
         m_walk.bind(&m_lanes, &m_counts, m_mail);
     }
@@ -404,13 +377,11 @@ private:
 
     void split() {
         ++m_counts.splits;
-        LaneMask todo = m_walk.split_rays();
-        for (int i = 0; i < m_walk.size(); ++i) todo |= m_walk.stack()[i].mask;
-        todo &= m_lanes.live;
+        const LaneMask todo = m_walk.split_todo();
         if (m_split_walks == SplitWalks::lanes) {
             LaneMask walking = 0;
             for_each_lane(todo, [&](uint32_t r) {
-                launch(r);
+                walker(r).launch(r, m_walk);
                 if (!walker(r).done()) walking |= lane_bit(r);
             });
             for (uint32_t i = 0; i < m_lanes.n; ++i)
@@ -426,16 +397,11 @@ private:
         next_serial_ray();
     }
 
-    void launch(uint32_t r) {
-        walker(r).launch(r, m_walk.stack(), m_walk.size(), (m_walk.split_rays() & lane_bit(r)) != 0, m_walk.node(),
-                         m_walk.cell(r));
-    }
-
     void next_serial_ray() {
         while (m_todo) {
             const uint32_t r = uint32_t(__builtin_ctzll(m_todo));
             m_todo &= m_todo - 1;
-            launch(r);
+            walker(r).launch(r, m_walk);
             if (walker(r).done()) continue;
             m_serial_ray = r;
             return follow(walker(r));
@@ -451,5 +417,9 @@ private:
     uint32_t m_serial_ray = 0;
     LaneMask m_todo = 0;  ///< rays still to walk alone
 };
+
+/// The packet stepper of a space-partitioning tree.
+template <class Rules>
+using CellPacketStepper = WalkPacketStepper<CellPacketWalk<Rules>>;
 
 }  // namespace rtsim

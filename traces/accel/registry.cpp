@@ -213,7 +213,7 @@ const std::vector<Entry>& registry() {
         wide_entry("cwbvh8_octant", "cwbvh8 with children in octant slots, visited in a fixed per-octant order", 8,
                    true, ChildOrder::octant),
         {{"grid", "uniform grid, cells of lambda x N by density, 3D-DDA traversal, no stack (docs/accel.md)",
-          {"uniform"}, single_level(kBvhStackEntryBytes).with(&AccelCapabilities::mailbox)},  // no stack: the machine's entry size is moot
+          {"uniform"}, single_level(kBvhStackEntryBytes).with(&AccelCapabilities::packet_kernel).with(&AccelCapabilities::mailbox)},  // no stack: the machine's entry size is moot
          [](const std::string&, BuildSettings& s, SettingsVisitor& v) { s.grid.visit(v); },
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return grid_image(scene, s.grid); },
          loader<GridAccel>()},

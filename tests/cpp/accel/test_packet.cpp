@@ -60,8 +60,9 @@ PacketCounts check_packets(const Accel& accel, const std::vector<Ray>& rays, uin
     return total;
 }
 
-/// Coherent rays: from one point outside the scene into a narrow cone, in pixel order.
-std::vector<Ray> camera_rays(const std::vector<HwTriangle>& tris, int n, uint64_t seed) {
+/// Coherent rays: from one point outside the scene into a narrow cone, in pixel order, over
+/// `span` of the scene's extent (1: all of it).
+std::vector<Ray> camera_rays(const std::vector<HwTriangle>& tris, int n, uint64_t seed, float span = 1.0f) {
     Aabb bounds;
     for (const HwTriangle& t : tris)
         for (const float* v : {t.v0, t.v1, t.v2}) bounds.grow(Vec3(v[0], v[1], v[2]));
@@ -72,7 +73,7 @@ std::vector<Ray> camera_rays(const std::vector<HwTriangle>& tris, int n, uint64_
     const int side = int(std::sqrt(float(n)));
     for (int y = 0; y < side; ++y)
         for (int x = 0; x < side; ++x) {
-            const Vec3 target = bounds.lo + Vec3((x + rng.next()) / side, (y + rng.next()) / side, 0.5f) * e;
+            const Vec3 target = c + (Vec3((x + rng.next()) / side, (y + rng.next()) / side, 0.5f) - 0.5f) * span * e;
             rays.push_back(test::make_ray(eye, target - eye));
         }
     return rays;
@@ -295,14 +296,11 @@ TEST(Packets, SplitRaysOnTheirOwnLanesWalkAsTheSerialHybrid) {
     }
 }
 
-TEST(Packets, TheGridHasNoPacketKernel) {
+TEST(Packets, PacketsOfMoreThan64RaysAreRefused) {
     const Scene& scene = test::procedural("cornell");
-    const std::unique_ptr<Accel> grid = accel_of(scene, "grid");
-    EXPECT_EQ(grid->make_packet_stepper(), nullptr);
     const Ray r = test::make_ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f));
     const TraversalMode m = TraversalMode::closest_hit;
-    EXPECT_THROW(grid->trace_packet(&r, &m, 1, nullptr, nullptr, nullptr), Error);
-    for (const std::string kind : {"bvh2", "bvh4", "kdtree", "octree"}) {
+    for (const std::string kind : {"bvh2", "bvh4", "kdtree", "octree", "grid"}) {
         std::unique_ptr<PacketStepper> s = accel_of(scene, kind)->make_packet_stepper();
         std::vector<Ray> many(65, r);
         std::vector<TraversalMode> modes(65, m);
@@ -310,8 +308,8 @@ TEST(Packets, TheGridHasNoPacketKernel) {
     }
 }
 
-/// The space-partitioning trees with a packet kernel (cell_packet.h).
-const char* const kCellKinds[] = {"kdtree", "bih", "octree"};
+/// The space-partitioning structures with a packet kernel (cell_packet.h, grid_packet.h).
+const char* const kCellKinds[] = {"kdtree", "bih", "octree", "grid"};
 
 /// Packets of `lanes` consecutive rays on a space-partitioning tree: each ray's hit against the
 /// single ray's, the plans' operations against the rays' work, and (with a mailbox) the work
@@ -383,15 +381,17 @@ TEST(Packets, CellTreesHitsEqualSingleRays) {
                     const PacketCounts c = check_cell_packets(*accel, camera, lanes, mode, what + " camera");
                     check_cell_packets(*accel, camera, lanes, mode, what + " camera mailbox", 0.0f, 8);
                     if (lanes == 64 && mode == TraversalMode::closest_hit) {
+                        // Rays closer together than the cells are wide share their fetches.
+                        const std::vector<Ray> bundle = camera_rays(tris, 64 * 9, 17, 0.05f);
                         uint64_t single_steps = 0;
-                        for (const Ray& r : camera) {
+                        for (const Ray& r : bundle) {
                             WorkCounts w;
                             accel->trace(r, mode, &w);
                             single_steps += w.steps;
                         }
-                        // Coherent packets share their node fetches (less on the dense hairball,
-                        // whose small cells neighbouring rays share only near the root).
-                        EXPECT_LT(c.node_steps * 2, single_steps) << what;
+                        const PacketCounts b = check_cell_packets(*accel, bundle, lanes, mode, what + " bundle");
+                        EXPECT_LT(b.node_steps * 4, single_steps) << what;
+                        EXPECT_LT(c.node_steps, single_steps + camera.size()) << what;
                     }
                 }
             for (float split : {0.25f, 0.5f}) {

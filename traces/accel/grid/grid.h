@@ -38,6 +38,8 @@ public:
     GridAccel(AccelImage image, const std::string& source);
 
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    /// Packets whose rays each run their own DDA, visiting cells in lock step (grid_packet.h).
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override;
     /// The stepper's own loop on a stack instance (no allocation, no virtual calls).
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
               const StepOptions& options = {}) const override;

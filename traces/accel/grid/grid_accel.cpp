@@ -2,6 +2,7 @@
 #include <string>
 
 #include "traces/accel/grid/grid.h"
+#include "traces/accel/grid/grid_packet.h"
 #include "traces/accel/listed_regions.h"
 #include "traces/common/error.h"
 
@@ -50,6 +51,10 @@ GridAccel::GridAccel(AccelImage image, const std::string& source) : Accel(std::m
 
 std::unique_ptr<Stepper> GridAccel::make_stepper(const StepOptions& options) const {
     return std::make_unique<GridStepper>(m_view, options.mailbox_entries);
+}
+
+std::unique_ptr<PacketStepper> GridAccel::make_packet_stepper(const StepOptions& options) const {
+    return std::make_unique<GridPacketStepper>(m_view, options.mailbox_entries);
 }
 
 Hit GridAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {
