@@ -204,7 +204,7 @@ void PacketUnit::advance_lane(uint32_t p, uint32_t i, Cycle t) {
     ++m_active_histogram[1];
     StepReads reads(*mem[0], t);
     take_step_reading(walker, l.stack, m_lane_costs, l.demand, [&](const Fetch& f) {
-        m_node_fetches += f.kind == DataKind::node;
+        m_node_fetches += f.kind == DataKind::node || f.kind == DataKind::cell;
         reads.read(f);
     });
     account_read_until(m_account, l.accounted, reads.ready(), reads.slowest());
@@ -238,7 +238,7 @@ void PacketUnit::step(uint32_t p, Cycle t) {
     StepReads reads(*mem[0], t);
     const int stack_before = pk.stepper->stack_size();
     take_step_reading(*pk.stepper, pk.stack, m_costs, d, [&](const Fetch& f) {
-        m_node_fetches += f.kind == DataKind::node;
+        m_node_fetches += f.kind == DataKind::node || f.kind == DataKind::cell;
         reads.read(f);
     });
     m_stack_prefetch.after_step(p, *pk.stepper, stack_before);  // the packet's shared stack (TTP)
@@ -301,7 +301,7 @@ const StatTable<PacketUnit>& PacketUnit::kind_stats() {
              [](const PacketUnit& u) { return u.m_packets_traced; }},
             {{"packet_steps", "steps", "packet steps (one node or leaf fetch serving the packet's active rays)", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_packet_steps; }},
-            {{"packet_node_fetches", "fetches", "node fetches, one per packet node step", /*timed=*/true},
+            {{"packet_node_fetches", "fetches", "node (or grid cell) fetches, one per packet node step", /*timed=*/true},
              [](const PacketUnit& u) { return u.m_node_fetches; }},
             {{"node_fetches_per_packet", "fetches", "`packet_node_fetches / packets`", /*timed=*/true},
              [](const PacketUnit& u) {

@@ -1,11 +1,15 @@
 #pragma once
 // Packets on the uniform grid (docs/accel.md, "Packets"). A grid has no stack to share: each ray
 // of the packet runs its own conservative 3D-DDA (grid_dda.h) exactly as it would alone, and the
-// packet visits the cells its rays reach in lock step. Each step serves the nearest cell any ray
-// waits at (smallest entry distance, then lowest cell index), with every ray waiting at that cell:
-// rays that fall behind are served first, so neighbouring rays meet in the cells they share, in
-// the spirit of Wald, Ize, Kensler, Knoll & Parker 2006 ("Ray tracing animated scenes using
-// coherent grid traversal"), which sweeps a packet's frustum slice by slice. Steps:
+// packet visits the cells its rays reach in lock step. Each step serves, of the cells its rays
+// wait at, the first in slice order, with every ray waiting there: slices across the packet's
+// major axis (its first ray's largest direction component) in the direction it travels, then
+// rows along the second largest, then cells along the third, as Wald, Ize, Kensler, Knoll &
+// Parker 2006 ("Ray tracing animated scenes using coherent grid traversal") sweep a packet
+// slice by slice. A ray's DDA moves one cell at a time along one axis in its direction, so for
+// rays travelling the packet's way the order rises along each ray's path: every ray that will
+// visit a cell waits there before the packet passes it, and the rays sharing a cell share its
+// fetch. Rays travelling another way are served in the same order, correctly but sharing less. Steps:
 //
 //   clip   no fetch; every ray tests the grid's bounds (1 box test each)
 //   cell   one fetch of the 8-byte GridCell for its rays; 1 cell operation each (their DDA step)
@@ -16,6 +20,8 @@
 // single ray's then), so its cells, tests and hits are the single ray's, and a packet of one ray,
 // or of copies of one ray, walks as the single ray. The hybrid's split (cell_packet.h) leaves
 // each ray to finish its own DDA alone.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "traces/accel/cell_packet.h"
@@ -42,6 +48,7 @@ public:
         m_waiting = 0;
         m_active = m_p->live;
         if (m_active == 0 || m_view.cell_count == 0) return finish();
+        set_slice_order(uint32_t(__builtin_ctzll(m_active)));
         m_phase = Phase::clip;
         m_plan.reset(kNoLocality);
         m_plan.add_op(OpKind::box, lane_count(m_active));
@@ -53,9 +60,10 @@ public:
         m_split = false;
         m_r = r;
         m_serve = lane_bit(r);
+        std::copy(packet.m_axis, packet.m_axis + 3, m_axis);
+        std::copy(packet.m_negative, packet.m_negative + 3, m_negative);
         m_dda[r] = packet.m_dda[r];
         m_next[r] = packet.m_next[r];
-        m_entry[r] = packet.m_entry[r];
         m_waiting = packet.m_waiting & m_serve;
         next_cell();
     }
@@ -119,25 +127,45 @@ private:
     /// Ray r's DDA hands it its next cell (as the single ray's next_cell, with its cull now).
     void advance(uint32_t r) {
         if (m_dda[r].next(m_p->cull[r], &m_next[r])) {
-            m_entry[r] = m_dda[r].entry();
             m_waiting |= lane_bit(r);
         } else {
             m_waiting &= ~lane_bit(r);
         }
     }
 
-    /// The nearest cell a ray waits at, with every ray waiting there; the end when none waits.
+    /// The packet's slice order from ray r's direction: axes by falling |direction|, each
+    /// walked the way the ray runs along it.
+    void set_slice_order(uint32_t r) {
+        const Vec3& d = m_p->ray[r].direction;
+        const float m[3] = {std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)};
+        int a[3] = {0, 1, 2};
+        std::sort(a, a + 3, [&](int i, int j) { return m[i] > m[j] || (m[i] == m[j] && i < j); });
+        for (int k = 0; k < 3; ++k) m_axis[k] = a[k];
+        for (int k = 0; k < 3; ++k) m_negative[k] = std::signbit(k == 0 ? d.x : k == 1 ? d.y : d.z);
+    }
+    /// A cell's place in the slice order.
+    uint64_t slice_key(uint32_t cell) const {
+        const GridGeometry& g = m_view.geometry;
+        const uint32_t c[3] = {cell % g.res[0], (cell / g.res[0]) % g.res[1], cell / (g.res[0] * g.res[1])};
+        uint64_t key = 0;
+        for (int k = 0; k < 3; ++k) {
+            const int a = m_axis[k];
+            key = key * g.res[a] + (m_negative[a] ? g.res[a] - 1 - c[a] : c[a]);
+        }
+        return key;
+    }
+
+    /// The first cell in slice order a ray waits at, with every ray waiting there; the end
+    /// when none waits.
     void next_cell() {
         const LaneMask rays = m_waiting & m_p->live & m_serve;
         if (rays == 0) return finish();
         uint32_t cell = 0;
-        float entry = 0.0f;
+        uint64_t key = 0;
         bool first = true;
         for_each_lane(rays, [&](uint32_t r) {
-            if (first || m_entry[r] < entry || (m_entry[r] == entry && m_next[r] < cell)) {
-                cell = m_next[r], entry = m_entry[r];
-                first = false;
-            }
+            const uint64_t k = slice_key(m_next[r]);
+            if (first || k < key) cell = m_next[r], key = k, first = false;
         });
         LaneMask at = 0;
         for_each_lane(rays, [&](uint32_t r) {
@@ -192,8 +220,9 @@ private:
     LaneMask m_active = 0;
     LaneMask m_cell_rays = 0;  ///< the rays in the cell being visited
     uint32_t m_cell = 0;
-    uint32_t m_next[kMaxPacketLanes];
-    float m_entry[kMaxPacketLanes];
+    int m_axis[3] = {0, 1, 2};                    ///< slice order: the axes, major first
+    bool m_negative[3] = {false, false, false};  ///< per axis: the packet walks it downwards
+    uint32_t m_next[kMaxPacketLanes];  ///< the cell each waiting ray's DDA handed it
     GridDda m_dda[kMaxPacketLanes];
     PacketLists m_lists;
 };
