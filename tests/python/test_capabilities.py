@@ -61,7 +61,7 @@ def test_every_rule_refuses_its_example(sim_exe: Path, tmp_path: Path) -> None:
 
 def test_runs_are_checked_before_any_trace(sim_exe: Path, tmp_path: Path) -> None:
     runs = [
-        {"config": {"traversal": {"model": "packet"}}, "accel": "kdtree"},
+        {"config": {"traversal": {"model": "packet"}}, "accel": "bkd"},
         {"config": {"traversal": {"model": "simt", "simt": {"lanes": 32}}}, "accel": "bvh2"},
         {
             "config": {"traversal": {"stack_overflow": "restart_trail"}},
@@ -77,7 +77,7 @@ def test_runs_are_checked_before_any_trace(sim_exe: Path, tmp_path: Path) -> Non
     )
     checked = json.loads(out.stdout)
     assert [c["ok"] for c in checked] == [False, True, False, False, False]
-    assert "packet kernel" in checked[0]["error"] and "kdtree" in checked[0]["error"]
+    assert "packet kernel" in checked[0]["error"] and "bkd" in checked[0]["error"]
     derived = {d["key"]: d["value"] for d in checked[1]["resolved"]["derived"]}
     assert derived["traversal.ray_contexts"] == 32  # contexts follow the lanes: one warp
     assert "restart trail" in checked[2]["error"] and "grid" in checked[2]["error"]

@@ -1,4 +1,5 @@
-"""Packets (traversal.model=packet, Wald et al. 2001), on the binary and the wide BVHs: every hit
+"""Packets (traversal.model=packet, Wald et al. 2001), on the binary and the wide BVHs and the
+space-partitioning structures: every hit
 identical to single-ray traversal and every ray's work equal to the reference packet loop's, at
 every timed level and functional, with and without sorting and with the hybrid's split into
 single rays; occupancy exactly 1 when every ray of a packet is the same ray; one node fetch
@@ -113,10 +114,32 @@ def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray_trace(
 
 def test_packet_needs_a_packet_kernel(sim_exe: Path, tmp_path: Path) -> None:
     trace = tmp_path / "trace"
-    rtsim.trace_scene("cornell", trace, workload="primary", width=8, height=8, accel="kdtree")
+    rtsim.trace_scene("cornell", trace, workload="primary", width=8, height=8, accel="bkd")
     result = simulate(sim_exe, trace / "trace.rtt", tmp_path / "run", "traversal.model=packet")
     assert result.returncode == 2, result.stderr
-    assert "traversal.model" in result.stderr and "kdtree" in result.stderr
+    assert "traversal.model" in result.stderr and "bkd" in result.stderr
+
+
+@pytest.mark.parametrize("accel", ["kdtree", "bih", "octree", "grid"])
+def test_packets_on_space_partitioning_structures(
+    sim_exe: Path, tmp_path: Path, accel: str
+) -> None:
+    """Packets, the hybrid on lanes and mailboxes on the kd-tree, BIH, octree and grid replay
+    with every ray's hit and work equal to each structure's reference packet loop."""
+    trace = tmp_path / "trace"
+    rtsim.trace_scene("cornell", trace, workload="primary,diffuse", width=12, height=9, accel=accel)
+    for i, sets in enumerate(
+        [
+            [],
+            ["traversal.packet.split_below=0.5", "traversal.packet.split_walks=lanes"],
+            ["traversal.packet.lanes=4"] + (["mailbox.entries=8"] if accel != "bih" else []),
+            ["fidelity=functional"],
+        ]
+    ):
+        stats = sim_stats(sim_exe, trace / "trace.rtt", tmp_path / f"run{i}", *PACKET, *sets)
+        s = stats["summary"]
+        assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0, (accel, sets)
+        assert s["rays"] == rtsim.open_trace(trace).manifest["counts"]["rays"]
 
 
 @pytest.fixture(scope="module")

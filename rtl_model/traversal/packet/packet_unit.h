@@ -40,10 +40,11 @@
 
 namespace rtsim {
 
-/// Bytes of a packet's stack entry: a structure entry of `entry_bytes` (node and one entry
-/// distance), another distance (4 bytes) for each further ray, and the active mask.
+/// Bytes of a packet's stack entry: a structure entry of `entry_bytes` (a 4-byte node index and
+/// one ray's distances: a BVH's entry distance, a kd-tree's interval, an octree's cell), each
+/// further ray's distances, and the active mask.
 inline uint32_t packet_stack_entry_bytes(uint32_t entry_bytes, uint32_t lanes) {
-    return entry_bytes + 4 * (lanes - 1) + (lanes + 7) / 8;
+    return entry_bytes + (entry_bytes - 4) * (lanes - 1) + (lanes + 7) / 8;
 }
 
 class PacketUnit : public ScheduledUnit {
