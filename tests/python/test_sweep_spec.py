@@ -214,7 +214,7 @@ def test_frame_policy_is_a_trace_of_its_own() -> None:
 
 def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
     # A study counting refusals (rtsim study composition) needs the refused runs as failed runs.
-    text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [kdtree]\n"
+    text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [bkd]\n"
     text += "grid:\n  traversal.model: [mimd, packet]\n"
     with pytest.raises(SpecError, match="would be refused by the simulator"):
         parse_spec(text, source="s.yaml")
