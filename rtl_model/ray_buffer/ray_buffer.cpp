@@ -73,9 +73,15 @@ void RayBuffer::admit_until(Cycle time, Cycle horizon) {
     // New rays enter the queue of their first step's treelet (the root treelet for a tree)
     // while the machine holds fewer than the limit.
     RayJob job;
-    while (!m_dispatch_empty && has_room() && next_admit_issue(time) <= horizon) {
+    while (!m_dispatch_empty && !m_dispatch_held && has_room() && next_admit_issue(time) <= horizon) {
         if (!rays->next_ray(RaySourceIf::kAnyUnit, &job)) {
-            m_dispatch_empty = true;
+            // At a frame barrier dispatch holds the next frame's rays until this one's are done.
+            if (rays->exhausted() || rays->released() == nullptr) {
+                m_dispatch_empty = true;
+            } else {
+                m_dispatch_held = true;
+                m_held_at = rays->releases();
+            }
             break;
         }
         RayState s;
@@ -84,7 +90,7 @@ void RayBuffer::admit_until(Cycle time, Cycle horizon) {
         s.ray_id = job.id;
         s.kind = job.kind;
         const uint32_t treelet = m_treelets.first_treelet(s.stepper->plan().locality);
-        const Cycle issue = next_admit_issue(time);
+        const Cycle issue = std::max(next_admit_issue(time), job.not_before);  // a frame starts at its barrier
         s.start = issue;
         const Cycle fetched = fetch_ray_record(job.id, issue);
         push(treelet, std::move(s), fetched, issue);
@@ -103,6 +109,12 @@ void RayBuffer::admission() {
         const Cycle now = sc_core::sc_time_stamp().value();
         admit_until(now, now + m_lookahead);
         if (m_dispatch_empty) return;
+        if (m_dispatch_held) {
+            // The next frame: dispatch releases it once every ray of this one has finished.
+            if (rays->releases() == m_held_at) wait(*rays->released());
+            m_dispatch_held = false;
+            continue;
+        }
         if (!has_room()) {
             wait(m_room);
             continue;
@@ -215,7 +227,8 @@ Cycle RayBuffer::park(uint32_t treelet, RayState&& ray, Cycle time) {
     return m_queues[treelet].back().ready;
 }
 
-void RayBuffer::finished(Cycle) {
+void RayBuffer::finished(Cycle time) {
+    rays->ray_finished(time);  // dispatch counts a frame's rays to its barrier
     --m_in_machine;
     wake_admission();
 }

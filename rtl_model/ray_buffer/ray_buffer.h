@@ -118,6 +118,8 @@ private:
     std::set<std::pair<Cycle, uint32_t>> m_by_age;  ///< oldest front first
     std::set<uint32_t> m_nonempty;                  ///< by treelet id
     bool m_dispatch_empty = false;
+    bool m_dispatch_held = false;  ///< dispatch holds the next frame's rays (a frame barrier)
+    uint64_t m_held_at = 0;        ///< dispatch's releases when it held them
     uint64_t m_occupancy = 0, m_max_occupancy = 0, m_in_machine = 0;
     uint64_t m_admitted = 0, m_parked = 0, m_taken = 0, m_overflows = 0, m_overflow_reads = 0;
     uint64_t m_picks = 0, m_drain_picks = 0, m_picked_queue_rays = 0;

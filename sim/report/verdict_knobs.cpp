@@ -176,9 +176,8 @@ std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st
     for (const std::string& alt : structure_alternatives(st.kind)) structural(&out, {"accel", st.kind, alt}, "structure", true);
     if (st.can_compress_leaves && !st.compressed_leaves)
         structural(&out, {"compressed_leaves", false, true}, "structure", true);
-    // An animated trace refuses treelet scheduling (rules.cpp, frames/treelets): not offered.
     if (c.treelets.enabled) structural(&out, {"treelets.enabled", true, false}, "treelets");
-    else if (st.treelet_partition && st.frame_policy.empty())
+    else if (st.treelet_partition)
         structural(&out, {"treelets.enabled", false, true}, "treelets");
     const std::string model = c.traversal.model == "mimd" ? "simt" : "mimd";
     structural(&out, {"traversal.model", c.traversal.model, model}, "execution_model");

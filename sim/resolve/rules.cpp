@@ -158,9 +158,6 @@ std::vector<Rule> make_rules() {
          "no sampling (sampling.fraction and sampling.count 0)", [](const RunFacts& f) { return !sampling(f); },
          "sampling does not cut frames yet: an animated trace is replayed whole", "sampling.fraction=0", "frames",
          {"sampling.fraction=0.2"}});
-    add({"frames/treelets", "an animated trace (--frames)", animated, RuleSide::technique, "treelets.enabled=false",
-         [](const RunFacts& f) { return !treelets(f); }, "treelet scheduling does not hold frame barriers yet",
-         "treelets.enabled=false", "frames", {"treelets.enabled=true"}});
 
     // The frame: shading and the frame loop (docs/shading.md).
     add({"shading/level", "shading.enabled (the frame: shading and the frame loop)", shading, RuleSide::level,
