@@ -63,12 +63,16 @@ def check_one(out: Path, rec: RunRecord, timeout: float | None = None) -> dict[s
     named = f"{top['key']}={json.dumps(top['to']) if not isinstance(top['to'], str) else top['to']}"
     mine = next((c for c in checks if c.get("sets") == [named]), None)
     best = max(checks, key=lambda c: _gain(c.get("measured")) or 0.0)
+    singles = [c for c in checks if len(c.get("sets", [])) == 1] or checks
+    best_single = max(singles, key=lambda c: _gain(c.get("measured")) or 0.0)
     row.update(
         named=named,
         estimated=_gain(top.get("speedup")),
         measured=_gain(mine.get("measured")) if mine else None,
         best=" + ".join(best.get("sets", [])),
         best_measured=_gain(best.get("measured")),
+        best_single=" + ".join(best_single.get("sets", [])),
+        best_single_measured=_gain(best_single.get("measured")),
     )
     return row
 
