@@ -38,9 +38,21 @@
 #include "traces/accel/packet_kernel.h"
 #include "traces/accel/packet_stepper.h"
 #include "traces/accel/packet_lists.h"
+#include "traces/common/aabb.h"
 #include "traces/common/error.h"
+#include "traces/isect/slab_interval.h"
 
 namespace rtsim {
+
+namespace detail {
+/// Ray r's interval in a binary partition's root cell (kd-tree, BIH), as the single ray's clip
+/// step computes it (BinaryCellStepper::clip); false when it misses the cell.
+inline bool clip_root(const PacketLanes& p, uint32_t r, const Aabb& root, SlabInterval* cell) {
+    const float lo[3] = {root.lo.x, root.lo.y, root.lo.z}, hi[3] = {root.hi.x, root.hi.y, root.hi.z};
+    *cell = slab_box(p.box[r], lo, hi, p.ray[r].tmin);
+    return slab_hit(*cell, p.cull[r]);
+}
+}  // namespace detail
 
 /// One walk of a packet's rays (or of one ray after a split) through a space-partitioning tree,
 /// on lanes, counts and mailboxes it shares with the packet it belongs to.

@@ -20,12 +20,7 @@ struct KdPacketRules {
 
     static float entry(const Cell& c) { return c.tn; }
     bool empty() const { return view.node_count == 0; }
-    bool clip(const PacketLanes& p, uint32_t r, Cell* cell) const {
-        const float lo[3] = {view.bounds.lo.x, view.bounds.lo.y, view.bounds.lo.z};
-        const float hi[3] = {view.bounds.hi.x, view.bounds.hi.y, view.bounds.hi.z};
-        *cell = slab_box(p.box[r], lo, hi, p.ray[r].tmin);
-        return slab_hit(*cell, p.cull[r]);
-    }
+    bool clip(const PacketLanes& p, uint32_t r, Cell* cell) const { return clip_root(p, r, view.bounds, cell); }
     uint64_t node_address(uint32_t node) const { return view.node_base + uint64_t(node) * sizeof(KdNode); }
     bool leaf(uint32_t node) const { return view.nodes[node].leaf(); }
     void leaf_span(uint32_t node, uint32_t* first, uint32_t* count) const {
