@@ -40,6 +40,8 @@ struct AnalyticDemands {
     double customers = 0, visits = 0;
     /// Treelet scheduling: bytes through the ray buffer's SRAM port, and the takes' latency.
     double ray_buffer_bytes = 0, latency_sum_extra = 0;
+    /// Mean wait per planned step for fills already in flight (merged misses), in latency_sum.
+    double merge_wait = 0;
 };
 
 struct ClosedForm {

@@ -184,6 +184,42 @@ private:
         }
         return n > 0 ? sum / n : m_lat_l1;
     }
+    /// The mean wait per planned step a step-critical read adds when it arrives while its line's
+    /// earlier miss is still in flight (merged misses: the reuse model calls it a hit). The run's
+    /// first read missed with its key's probabilities; the fill is due that miss's unloaded
+    /// latency after it, and the read came `gap` accesses later, at the stream's rate of reads
+    /// over `cycles` (the unit's for the L1, all units' for the L2).
+    double merge_wait(double cycles) const {
+        const double steps = m_p.step_critical.total();
+        if (m_c.ideal_memory || steps <= 0 || cycles <= 0) return 0;
+        double reads = 0;
+        for (const KindCounts& kc : m_kinds) reads += kc.reads;
+        const double l1_rate = reads / m_c.traversal.units / cycles, l2_rate = reads / cycles;
+        double wait = 0;
+        for (const auto& [k, n] : m_p.merge_l1) {  // an L1 hit on a line whose fill is due
+            uint32_t read_key, head_key;
+            int gap_bin;
+            MergeKey::unpack(k, &read_key, &head_key, &gap_bin);
+            const auto [r1, r12] = m_miss.cell(read_key);
+            const auto [h1, h12] = m_miss.cell(head_key);
+            const double t = gap_cycles(gap_bin, l1_rate);
+            wait += n * (1.0 - r1) *
+                    ((h1 - h12) * std::max(0.0, m_lat_l2 - m_lat_l1 - t) + h12 * std::max(0.0, m_lat_dram - m_lat_l1 - t));
+        }
+        for (const auto& [k, n] : m_p.merge_l2) {  // an L2 hit on a line whose DRAM fill is due
+            uint32_t read_key, head_key;
+            int gap_bin;
+            MergeKey::unpack(k, &read_key, &head_key, &gap_bin);
+            const auto [r1, r12] = m_miss.cell(read_key);
+            const double h12 = m_miss.cell(head_key).second;
+            wait += n * (r1 - r12) * h12 * std::max(0.0, m_lat_dram - m_lat_l2 - gap_cycles(gap_bin, l2_rate));
+        }
+        return wait / steps;
+    }
+    /// Cycles spanned by a gap in distance bin `b` of a stream read at `rate` lines per cycle.
+    static double gap_cycles(int b, double rate) {
+        return rate > 0 ? std::sqrt(DistanceBins::low(b) * DistanceBins::high(b)) / rate : 0.0;
+    }
     void count_kinds();
     void ops(double* op_latency);
     json memory_json(double cycles) const;
@@ -310,7 +346,18 @@ ClosedForm Estimator::form() {
     const double per_step = steps > 0 ? (steps * fetch + op_latency) / steps : 0.0;
     const double longest = m_p.plan_steps_per[0] * m_p.longest_ray_steps + m_p.plan_steps_per[1] * m_p.longest_ray_tests;
     m_d.latency_max = ray_start + longest * per_step / m_active;
-    return closed_form(m_c, m_p.op_kinds, m_d);
+    ClosedForm f = closed_form(m_c, m_p.op_kinds, m_d);
+    if (!m_p.has_group && (!m_p.merge_l1.empty() || !m_p.merge_l2.empty())) {
+        // The merged reads' wait depends on the rate of reads, hence on the cycles it adds to:
+        // a fixed point, which a few rounds reach (more wait, fewer reads per cycle, less wait).
+        const double base = m_d.latency_sum;
+        for (int round = 0; round < 4; ++round) {
+            m_d.merge_wait = merge_wait(f.cycles);
+            m_d.latency_sum = base + steps * m_d.merge_wait;
+            f = closed_form(m_c, m_p.op_kinds, m_d);
+        }
+    }
+    return f;
 }
 
 AnalyticEstimate Estimator::run() {

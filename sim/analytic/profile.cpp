@@ -21,6 +21,18 @@ JointHistogram hist_from(const json& a) {
     return h;
 }
 
+json map_json(const std::map<uint64_t, double>& m) {
+    json a = json::array();
+    for (const auto& [k, n] : m) a.push_back({k, n});
+    return a;
+}
+
+std::map<uint64_t, double> map_from(const json& a) {
+    std::map<uint64_t, double> m;
+    for (const json& e : a) m[e.at(0).get<uint64_t>()] = e.at(1).get<double>();
+    return m;
+}
+
 template <class Array>
 json array_json(const Array& a) {
     return json(std::vector<double>(a.begin(), a.end()));
@@ -85,6 +97,8 @@ json AnalyticProfile::to_json() const {
             {"read_bytes", array_json(read_bytes)},
             {"step_critical", hist_json(step_critical)},
             {"ray_critical", hist_json(ray_critical)},
+            {"merge_l1", map_json(merge_l1)},
+            {"merge_l2", map_json(merge_l2)},
             {"writes", array_json(writes)},
             {"write_bytes", array_json(write_bytes)},
             {"spill_writes", spill_writes},
@@ -126,6 +140,8 @@ AnalyticProfile AnalyticProfile::from_json(const json& j) {
     array_from(j.at("read_bytes"), &p.read_bytes);
     p.step_critical = hist_from(j.at("step_critical"));
     p.ray_critical = hist_from(j.at("ray_critical"));
+    p.merge_l1 = map_from(j.at("merge_l1"));
+    p.merge_l2 = map_from(j.at("merge_l2"));
     array_from(j.at("writes"), &p.writes);
     array_from(j.at("write_bytes"), &p.write_bytes);
     p.spill_writes = j.at("spill_writes");

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rtl_model/traversal/unit_kind.h"
+#include "sim/analytic/reuse.h"
 #include "traces/accel/step_plan.h"
 #include "traces/common/data_kind.h"
 
@@ -39,6 +40,27 @@ struct JointHistogram {
     }
     void add(uint32_t key, double n = 1) { cells[key] += n; }
     double total() const;
+};
+
+/// A merged-miss candidate's key (AnalyticProfile::merge_l1, merge_l2).
+struct MergeKey {
+    /// Reads closer than this (accesses in the stream) to a run's first read are in its run.
+    static constexpr uint64_t kRunAccesses = 4096;
+    /// Keys to octaves (each the bin at its middle): the wait varies little within one, and the
+    /// histogram stays small.
+    static uint64_t pack(uint32_t read_key, uint32_t head_key, int gap_bin) {
+        return uint64_t(octaves(head_key)) | uint64_t(octave(gap_bin)) << 18 | uint64_t(octaves(read_key)) << 26;
+    }
+    static int octave(int bin) { return bin / DistanceBins::kSubBins * DistanceBins::kSubBins + DistanceBins::kSubBins / 2; }
+    static uint32_t octaves(uint32_t key) {
+        int ub, gb;
+        bool uc, gc;
+        JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
+        return JointHistogram::pack(octave(ub), uc, octave(gb), gc);
+    }
+    static void unpack(uint64_t k, uint32_t* read_key, uint32_t* head_key, int* gap_bin) {
+        *head_key = uint32_t(k & 0x3FFFF), *gap_bin = int((k >> 18) & 0xFF), *read_key = uint32_t(k >> 26);
+    }
 };
 
 struct AnalyticProfile {
@@ -63,6 +85,12 @@ struct AnalyticProfile {
     std::array<double, kDataKindCount> read_bytes{};    ///< bytes those reads asked for
     JointHistogram step_critical;   ///< per planned step: its slowest line (largest distances)
     JointHistogram ray_critical;    ///< per ray: its ray record's slowest line
+    /// Step-critical lines read again while an earlier read of the line may still be missing
+    /// (merged misses: the read waits for the fill, not the hit latency). Key (MergeKey): the
+    /// read's joint key, the joint key of the read that began the line's run of close reads (the
+    /// one that may have missed) and the bin of the accesses between them, in the unit's stream
+    /// (the L1's MSHRs merge) and in the stream of all units (the L2's).
+    std::map<uint64_t, double> merge_l1, merge_l2;
     std::array<double, kDataKindCount> writes{};      ///< line pieces written (write-through)
     std::array<double, kDataKindCount> write_bytes{};
     double spill_writes = 0, spill_reads = 0;        ///< stack entries

@@ -80,6 +80,9 @@ public:
         slot = value;
         return old;
     }
+    /// The slot of `key` (added, `found` false, when absent): read it and store later, while no
+    /// other key is added.
+    uint64_t& slot(uint64_t key, bool& found) { return m_table.find_or_add(key, found); }
     /// Brings `key`'s first probe into the host's cache (speed only).
     void prefetch(uint64_t key) const { m_table.prefetch(key); }
     void clear() { m_table.clear(); }

@@ -22,7 +22,8 @@ SampleProfiler::SampleProfiler(const SimConfig& config, const Accel& accel, cons
       m_reads(kDataKindCount),
       m_op_sizes(profile.op_sizes.size()),
       m_accel(&accel),
-      m_step(step) {
+      m_step(step),
+      m_merges(!config.traversal.kind().group_profile) {
     for (Context& ctx : m_contexts) ctx.stepper = accel.make_stepper(step);
     while ((1u << m_shift) < config.l1.line_bytes) ++m_shift;
     const TreeletConfig& t = config.treelets;
@@ -229,7 +230,11 @@ void SampleProfiler::step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySi
         const Access a = read(unit, d.reads[i].addr, d.reads[i].bytes, d.reads[i].kind, ctx.measured);
         if (i == 0 || a.rank > critical.rank) critical = a;
     }
-    if (ctx.measured && d.read_count) m_step_critical.add(critical.key);
+    if (ctx.measured && d.read_count) {
+        m_step_critical.add(critical.key);
+        if (m_merges && critical.merge_l1) m_p.merge_l1[critical.merge_l1_key] += 1;
+        if (m_merges && critical.merge_l2) m_p.merge_l2[critical.merge_l2_key] += 1;
+    }
     if (ctx.measured)  // tests per operation: the pipelines' widths are applied per configuration
         for (int i = 0; i < d.issue_count; ++i) m_op_sizes[size_t(d.issues[i].kind)].add(d.issues[i].tests);
     stack_traffic(unit, slot, d, ctx.measured);
@@ -249,20 +254,51 @@ SampleProfiler::Access SampleProfiler::read(uint32_t unit, uint64_t addr, uint32
     return worst;
 }
 
+namespace {
+
+/// A stream's last read of a line, packed in its LastUse slot: the read's position, and the run of
+/// close reads it is in (MergeKey): the gap from the run's first read and that read's joint key.
+struct LastRead {
+    uint64_t pos = 0, gap = 0;
+    uint32_t head_key = 0;
+    static LastRead from(uint64_t v) { return {v >> 32, (v >> 18) & 0x3FFF, uint32_t(v & 0x3FFFF)}; }
+    uint64_t packed() const { return pos << 32 | gap << 18 | head_key; }
+};
+
+/// The run the read at `pos` joins (in_run) or begins, given the line's previous read.
+LastRead next_run(bool found, const LastRead& prev, uint64_t pos, uint32_t key, bool* in_run) {
+    const uint64_t gap = found ? prev.gap + (pos - prev.pos) : MergeKey::kRunAccesses;
+    *in_run = gap < MergeKey::kRunAccesses;
+    return *in_run ? LastRead{pos, gap, prev.head_key} : LastRead{pos, 0, key};
+}
+
+}  // namespace
+
 SampleProfiler::Access SampleProfiler::read_line(uint32_t unit, uint64_t line, DataKind kind, bool measured) {
     const uint64_t gpos = ++m_global_pos, upos = ++m_unit_pos[unit];
-    const uint64_t gprev = m_global_last.exchange(line, gpos);
-    const uint64_t uprev = m_unit_last.exchange(line << 16 | unit, upos);
-    if (!measured) return {};
+    bool gfound, ufound;
+    uint64_t& gslot = m_global_last.slot(line, gfound);
+    uint64_t& uslot = m_unit_last.slot(line << 16 | unit, ufound);
+    const LastRead gprev = LastRead::from(gfound ? gslot : 0), uprev = LastRead::from(ufound ? uslot : 0);
     // A distance with no earlier access in the cluster is censored at the access's position.
-    const bool gc = gprev == ~0ull, uc = uprev == ~0ull;
-    const uint64_t gd = gc ? gpos : gpos - gprev, ud = uc ? upos : upos - uprev;
+    const bool gc = !gfound, uc = !ufound;
+    const uint64_t gd = gc ? gpos : gpos - gprev.pos, ud = uc ? upos : upos - uprev.pos;
     const int gb = DistanceBins::bin(gd), ub = DistanceBins::bin(ud);
+    const uint32_t key = JointHistogram::pack(ub, uc, gb, gc);
+    Access a;
+    const LastRead gnext = next_run(gfound, gprev, gpos, key, &a.merge_l2);
+    const LastRead unext = next_run(ufound, uprev, upos, key, &a.merge_l1);
+    gslot = gnext.packed(), uslot = unext.packed();
+    if (!measured) return {};
     (uc ? m_p.unit_censored : m_p.unit_events)[ub] += 1;
     (gc ? m_p.global_censored : m_p.global_events)[gb] += 1;
-    const uint32_t key = JointHistogram::pack(ub, uc, gb, gc);
     m_reads[size_t(kind)].add(key);
-    return {key, (uint64_t(gc) << 63) | (uint64_t(uc) << 62) | (uint64_t(gb) << 8) | uint64_t(ub)};
+    a.key = key;
+    a.rank = (uint64_t(gc) << 63) | (uint64_t(uc) << 62) | (uint64_t(gb) << 8) | uint64_t(ub);
+    // The L1's merge asks of the read only whether it hits the L1 (its unit-stream bin).
+    if (a.merge_l1) a.merge_l1_key = MergeKey::pack(JointHistogram::pack(ub, uc, 0, false), unext.head_key, DistanceBins::bin(unext.gap));
+    if (a.merge_l2) a.merge_l2_key = MergeKey::pack(key, gnext.head_key, DistanceBins::bin(gnext.gap));
+    return a;
 }
 
 void SampleProfiler::write(uint64_t addr, uint32_t bytes, DataKind kind, bool measured) {

@@ -60,6 +60,8 @@ private:
     struct Access {
         uint32_t key = 0;
         uint64_t rank = 0;
+        bool merge_l1 = false, merge_l2 = false;  ///< within a line's run of close reads (MergeKey)
+        uint64_t merge_l1_key = 0, merge_l2_key = 0;
     };
     bool start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySinkIf& sink);
     /// Treelet scheduling: the cluster stepped in treelet order (the header's comment).
@@ -101,6 +103,9 @@ private:
     std::vector<std::unique_ptr<Stepper>> m_free;  ///< steppers of finished rays, reused
     const Accel* m_accel = nullptr;
     StepOptions m_step;
+    /// Merged-miss candidates are counted for contexts that run alone (a lock-step kind's
+    /// group step waits for its slowest read anyway: estimate.cpp's max_latency).
+    bool m_merges;
     uint64_t m_in_machine = 0, m_waiting = 0, m_admit_limit = 0, m_capacity = 0;
     uint32_t m_round_robin = 0;
     double m_fit[5] = {};  ///< sums x1x1, x1x2, x2x2, x1y, x2y of the steps regression

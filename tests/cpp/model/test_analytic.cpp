@@ -256,6 +256,30 @@ TEST(AnalyticLevel, SecondConfigurationOnTheSameRaysReusesTheAnalysis) {
     EXPECT_GT(slow.cycles, base.cycles);
 }
 
+TEST(AnalyticLevel, MergedMissesWaitForTheFillAndNotUnderIdealMemory) {
+    // Coherent camera rays read the top of the tree again while its first misses are in flight:
+    // the profile records those reads, and the estimate charges their wait on the fill.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    RayList rays(w.jobs);
+    Discard sink;
+    const AnalyticProfile& p = analyze_stream(c, *w.accel, w.map(c), StepOptions{}, rays, sink);
+    ASSERT_FALSE(p.merge_l1.empty());
+    ASSERT_FALSE(p.merge_l2.empty());
+    const AnalyticEstimate base = estimate_analytic(c, p);
+    const double wait = base.demands.merge_wait;
+    EXPECT_GT(wait, 0.0);
+    // Below one DRAM round trip a step: a merged read waits for part of one miss at most.
+    EXPECT_LT(wait, double(c.dram.latency + c.l2.latency));
+    SimConfig ideal = c;
+    ideal.ideal_memory = true;
+    EXPECT_EQ(estimate_analytic(ideal, p).demands.merge_wait, 0.0);
+    // A slower DRAM leaves the fills outstanding longer: more wait.
+    SimConfig slow = c;
+    slow.dram.latency *= 4;
+    EXPECT_GT(estimate_analytic(slow, p).demands.merge_wait, wait);
+}
+
 /// Demands of `misses` L2 misses of 64-byte lines (no writes) under the default DRAM config.
 AnalyticDemands l2_misses(const SimConfig& c, double misses) {
     AnalyticDemands d;
@@ -346,11 +370,15 @@ TEST(AnalyticCache, StoresLoadsAndRefusesAnotherKeyOrADamagedFile) {
     p.key = {{"k", 1}};
     p.rays = 42;
     p.reads[0].add(JointHistogram::pack(3, false, 5, true), 7);
+    p.merge_l1[MergeKey::pack(JointHistogram::pack(3, false, 5, true), JointHistogram::pack(9, true, 9, true), 12)] = 2;
+    p.merge_l2[MergeKey::pack(JointHistogram::pack(4, false, 4, false), JointHistogram::pack(9, true, 9, true), 30)] = 1;
     ASSERT_TRUE(store_analysis(path, p));
     const auto back = load_analysis(path, p.key);
     ASSERT_TRUE(back.has_value());
     EXPECT_EQ(back->rays, 42u);
     EXPECT_EQ(back->to_json(), p.to_json());
+    EXPECT_EQ(back->merge_l1, p.merge_l1);
+    EXPECT_EQ(back->merge_l2, p.merge_l2);
     EXPECT_FALSE(load_analysis(path, {{"k", 2}}).has_value());
     std::ofstream(path) << "{ not json";
     EXPECT_FALSE(load_analysis(path, p.key).has_value());
