@@ -45,7 +45,7 @@ const UnitKind& unit_kind(const std::string& name) {
 }
 
 GroupProfile& GroupProfile::operator+=(const GroupProfile& o) {
-    rays += o.rays, scheduler_steps += o.scheduler_steps, group_steps += o.group_steps;
+    rays += o.rays, scheduler_steps += o.scheduler_steps, group_steps += o.group_steps, buffer_steps += o.buffer_steps;
     lane_slots += o.lane_slots, active_lanes += o.active_lanes;
     lane_requests += o.lane_requests, requests += o.requests;
     for (size_t i = 0; i < work.size(); ++i) work[i] += o.work[i], single_work[i] += o.single_work[i];
@@ -57,6 +57,7 @@ nlohmann::json GroupProfile::to_json() const {
     return {{"rays", rays},
             {"scheduler_steps", scheduler_steps},
             {"group_steps", group_steps},
+            {"buffer_steps", buffer_steps},
             {"lane_slots", lane_slots},
             {"active_lanes", active_lanes},
             {"lane_requests", lane_requests},
@@ -69,6 +70,7 @@ nlohmann::json GroupProfile::to_json() const {
 GroupProfile GroupProfile::from_json(const nlohmann::json& j) {
     GroupProfile g;
     g.rays = j.at("rays"), g.scheduler_steps = j.at("scheduler_steps"), g.group_steps = j.at("group_steps");
+    g.buffer_steps = j.at("buffer_steps");
     g.lane_slots = j.at("lane_slots"), g.active_lanes = j.at("active_lanes");
     g.lane_requests = j.at("lane_requests"), g.requests = j.at("requests");
     g.work = j.at("work").get<std::array<double, kWorkFieldCount>>();

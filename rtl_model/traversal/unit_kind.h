@@ -27,6 +27,7 @@ struct UnitSetup;
 struct RayJob;
 struct StepOptions;
 class Accel;
+struct LocalityPartition;
 class TraversalUnit;
 
 /// What a lock-step kind's groups do on a sample of rays, stepped functionally (no time, no
@@ -35,6 +36,9 @@ struct GroupProfile {
     double rays = 0;             ///< rays of the sample
     double scheduler_steps = 0;  ///< scheduler phases the unit would take (its tally's steps)
     double group_steps = 0;      ///< warp or packet steps
+    /// Of them, steps that take rays' states from the treelet ray buffer's SRAM (no memory
+    /// read, no operation: the SRAM's latency)
+    double buffer_steps = 0;
     double lane_slots = 0;       ///< group steps x rays per group
     double active_lanes = 0;     ///< rays that took part, summed over group steps
     double lane_requests = 0;    ///< structure reads the stepping rays asked for
@@ -50,12 +54,22 @@ struct GroupProfile {
     static GroupProfile from_json(const nlohmann::json& j);
 };
 
+/// What a group profile needs of the machine beyond its traversal section.
+struct GroupSetup {
+    uint32_t line_bytes = 64;  ///< reads coalesced per line of this size
+    /// Treelet scheduling, when on: the treelets rays queue by, and the ray buffer's admission
+    /// (rays in the machine at most `admit_limit`; rays waiting in the SRAM below `capacity`
+    /// unless `may_overflow`), as the ray buffer admits.
+    const LocalityPartition* treelets = nullptr;
+    uint64_t admit_limit = 0, capacity = 0;
+    bool may_overflow = false;
+};
+
 /// A kind's functional group stepping on the machine `traversal` describes: `rays_by_unit[u]`
-/// the rays dispatch deals unit u, in order; the structure walked with `step`; reads coalesced
-/// per `line_bytes`-byte line.
+/// the rays dispatch deals unit u, in order; the structure walked with `step`.
 using GroupProfileFn =
     std::function<GroupProfile(const Accel&, const StepOptions& step, const TraversalConfig& traversal,
-                               const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t line_bytes)>;
+                               const std::vector<std::vector<RayJob>>& rays_by_unit, const GroupSetup& setup)>;
 
 /// What a unit kind needs of the rest of a run; the resolution step matches these against the
 /// structure's capabilities (traces/accel/capabilities.h), the level's and the techniques'.

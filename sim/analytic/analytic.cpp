@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rtl_model/common/ray_state.h"
 #include "sim/analytic/analysis_cache.h"
 #include "sim/analytic/estimate.h"
 #include "sim/analytic/sample.h"
@@ -142,7 +143,21 @@ void profile_groups(const SimConfig& c, const Accel& accel, const StepOptions& s
             if (dealer.next_ray(u, &job)) by_unit[u].push_back(job), dealt = true;
         }
     }
-    p.group += kind.group_profile(accel, step, c.traversal, by_unit, c.l1.line_bytes);
+    GroupSetup setup;
+    setup.line_bytes = c.l1.line_bytes;
+    LocalityPartition partition;
+    if (c.treelets.enabled && kind.needs.treelet_queues) {
+        // The ray buffer's admission, as the sample's (sample.cpp) and the model's.
+        const TreeletConfig& t = c.treelets;
+        partition = accel.partition(uint64_t(t.treelet_kib) * 1024);
+        const uint32_t state = ray_state_bytes(c.traversal.stack_entries, c.traversal.stack_entry_bytes,
+                                               c.mailbox.entries * MailboxConfig::kEntryBytes);
+        setup.treelets = &partition;
+        setup.capacity = std::max<uint64_t>(1, uint64_t(t.buffer_kib) * 1024 / state);
+        setup.admit_limit = t.max_rays_in_flight ? t.max_rays_in_flight : setup.capacity + c.traversal.contexts();
+        setup.may_overflow = t.max_rays_in_flight != 0;
+    }
+    p.group += kind.group_profile(accel, step, c.traversal, by_unit, setup);
     p.has_group = true;
 }
 

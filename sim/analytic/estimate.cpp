@@ -310,8 +310,9 @@ ClosedForm Estimator::form() {
         buffer_latency = t.latency + std::ceil(state / t.bytes_per_cycle);
         m_d.latency_sum_extra = takes * buffer_latency;
         // The step that finds its ray leaving the treelet is a scheduler slot of its own (the
-        // context parks the ray and takes the next, whose first step is another).
-        m_d.scheduler_steps += parks;
+        // context parks the ray and takes the next, whose first step is another). A lock-step
+        // kind's group profile has its parks in its group steps already.
+        if (!m_p.has_group) m_d.scheduler_steps += parks;
     }
     const double ray_start = m_c.dispatch.latency + mean_latency(m_p.ray_critical);
     const double fetch = mean_latency(m_p.step_critical);
@@ -337,7 +338,11 @@ ClosedForm Estimator::form() {
         }
         group_ops = kind_steps > 0 ? group_ops / groups : op_latency / steps;
         const double group_fetch = max_latency(m_p.step_critical, std::max(1.0, active * m_coalesce), m_coalesce);
-        m_d.latency_sum = rays * ray_start + slots * groups * (group_fetch + group_ops) + m_d.latency_sum_extra;
+        // With treelet queues the steps that take rays read their states from the ray buffer
+        // (its SRAM's latency, for the warp's slowest) instead of the memory: the takes' time.
+        const double buffer_steps = m_c.treelets.enabled ? g.buffer_steps * rays / g.rays : 0.0;
+        const double fetches = (groups - buffer_steps) * group_fetch + buffer_steps * buffer_latency;
+        m_d.latency_sum = rays * ray_start + slots * (fetches + groups * group_ops);
         // The groups circulate, one visit per group step, each with what its rays' steps ask.
         m_d.customers = double(m_c.traversal.contexts()) / slots;
         m_d.visits = groups;

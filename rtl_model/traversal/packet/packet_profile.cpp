@@ -54,7 +54,7 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
 }  // namespace
 
 GroupProfile packet_group_profile(const Accel& accel, const StepOptions& step, const TraversalConfig& traversal,
-                                  const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t) {
+                                  const std::vector<std::vector<RayJob>>& rays_by_unit, const GroupSetup&) {
     const PacketConfig& pc = traversal.kind_config<PacketConfig>();
     GroupProfile p;
     for (const std::vector<RayJob>& rays : rays_by_unit) p += packets_of(accel, step, pc, rays);

@@ -10,6 +10,6 @@
 namespace rtsim {
 
 GroupProfile packet_group_profile(const Accel& accel, const StepOptions& step, const TraversalConfig& traversal,
-                                  const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t line_bytes);
+                                  const std::vector<std::vector<RayJob>>& rays_by_unit, const GroupSetup& setup);
 
 }  // namespace rtsim

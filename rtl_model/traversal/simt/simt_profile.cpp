@@ -1,6 +1,7 @@
 #include "rtl_model/traversal/simt/simt_profile.h"
 
 #include <array>
+#include <deque>
 #include <memory>
 
 #include "rtl_model/common/interfaces.h"
@@ -10,6 +11,7 @@
 #include "rtl_model/traversal/simt/simt_unit.h"
 #include "rtl_model/traversal/traversal_config.h"
 #include "traces/accel/accel.h"
+#include "traces/accel/locality.h"
 
 namespace rtsim {
 
@@ -27,16 +29,33 @@ struct Lane {
 class FunctionalWarps {
 public:
     FunctionalWarps(const Accel& accel, const StepOptions& step, const TraversalConfig& t,
-                    const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t line_bytes)
+                    const std::vector<std::vector<RayJob>>& rays_by_unit, const GroupSetup& setup)
         : m_simt(t.kind_config<SimtConfig>()),
           m_rays(rays_by_unit),
           m_next(rays_by_unit.size(), 0),
           m_warps_per_unit(t.groups()),
           m_lanes(rays_by_unit.size() * t.groups() * m_simt.lanes),
           m_last_class(rays_by_unit.size() * t.groups(), 0),
-          m_coalescer(line_bytes) {
-        for (Lane& l : m_lanes) l.stepper = accel.make_stepper(step);
+          m_coalescer(setup.line_bytes),
+          m_setup(setup),
+          m_accel(accel),
+          m_step(step),
+          // As the unit: with treelet queues a lane's ray may leave mid-walk, so no walk ahead.
+          m_cooperative(m_simt.cooperative && !setup.treelets) {
         for (const auto& r : rays_by_unit) m_p.rays += double(r.size());
+        if (!setup.treelets) {
+            for (Lane& l : m_lanes) l.stepper = accel.make_stepper(step);
+            return;
+        }
+        m_queues.resize(setup.treelets->treelets.size());
+        m_warp_treelet.assign(m_last_class.size(), -1);
+        // The ray buffer admits from dispatch for the whole machine: the units' rays in the
+        // order they were dealt.
+        for (size_t i = 0, any = 1; any; ++i) {
+            any = 0;
+            for (const auto& r : rays_by_unit)
+                if (i < r.size()) m_admission.push_back(&r[i]), any = 1;
+        }
     }
 
     GroupProfile run() {
@@ -57,29 +76,18 @@ private:
         bool any_ray = false;
         for (uint32_t i = 0; i < m_simt.lanes; ++i) {
             Lane& l = lane(w, i);
-            if (l.has_ray && (m_simt.cooperative ? l.walk.done() : l.stepper->plan().done)) {
+            if (l.has_ray && (m_cooperative ? l.walk.done() : l.stepper->plan().done)) {
                 for (size_t f = 0; f < m_p.work.size(); ++f) m_p.work[f] += l.stepper->work().*kWorkFields[f].member;
                 l.has_ray = false;
+                if (m_setup.treelets) --m_in_machine, m_free.push_back(std::move(l.stepper));
             }
             any_ray = any_ray || l.has_ray;
         }
         if (m_simt.refill == SimtRefill::warp && any_ray) return false;
-        uint32_t taken = 0;
-        const size_t unit = w / m_warps_per_unit;
-        for (uint32_t i = 0; i < m_simt.lanes && m_next[unit] < m_rays[unit].size(); ++i) {
-            Lane& l = lane(w, i);
-            if (l.has_ray) continue;
-            const RayJob& job = m_rays[unit][m_next[unit]++];
-            l.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
-            l.has_ray = true;
-            if (m_simt.cooperative) {
-                StackSplit unused;
-                l.walk.record(*l.stepper, unused, nullptr);
-            }
-            ++taken;
-        }
-        if (taken) {  // a warp step of its own fetches the new rays' records (coalesced)
+        const uint32_t taken = m_setup.treelets ? take_from_queues(w, any_ray) : take_dealt(w);
+        if (taken) {  // a warp step of its own fetches the new rays' records (coalesced) or states
             m_p.group_steps += 1, m_p.scheduler_steps += 1;
+            if (m_setup.treelets) m_p.buffer_steps += 1;
             m_p.lane_slots += m_simt.lanes, m_p.active_lanes += taken;
         }
         return taken > 0;
@@ -88,14 +96,17 @@ private:
     /// One warp step of warp w (or its refill); false when it has nothing to do.
     uint32_t lane_class(size_t w, uint32_t i) {
         Lane& l = lane(w, i);
-        return m_simt.cooperative ? l.walk.next_class(kOpKindCount) : SimtUnit::step_class(l.stepper->plan());
+        return m_cooperative ? l.walk.next_class(kOpKindCount) : SimtUnit::step_class(l.stepper->plan());
     }
 
     bool step(size_t w) {
-        if (m_simt.cooperative)
+        if (m_cooperative)
             for (uint32_t i = 0; i < m_simt.lanes; ++i)
                 if (lane(w, i).has_ray) lane(w, i).walk.release();
         if (refill(w)) return true;
+        // Lanes whose next step is in another treelet park there; a warp they all left forms
+        // again from a queue (simt_unit.cpp, park_leavers).
+        if (m_setup.treelets && park_leavers(w) && refill(w)) return true;
         std::array<uint32_t, kClasses> want{};
         bool any = false;
         for (uint32_t i = 0; i < m_simt.lanes; ++i)
@@ -113,16 +124,109 @@ private:
         for (uint32_t i = 0; i < m_simt.lanes; ++i) {
             Lane& l = lane(w, i);
             if (!l.has_ray || lane_class(w, i) != cls) continue;
-            if (m_simt.cooperative) take(l, cls);
+            if (m_cooperative) take(l, cls);
             else run_step(*l.stepper);
             ++active;
         }
-        if (m_simt.cooperative) active += lend_idle_lanes(w, cls);
+        if (m_cooperative) active += lend_idle_lanes(w, cls);
         m_p.requests += m_coalescer.issue([](uint64_t, uint32_t, DataKind) {});
         m_p.group_steps += 1, m_p.scheduler_steps += 2;  // the step and its operations
         if (cls < kOpKindCount) m_p.kind_steps[cls] += 1;
         m_p.lane_slots += m_simt.lanes, m_p.active_lanes += active;
         return true;
+    }
+
+    /// Idle lanes take the rays dispatch dealt the warp's unit, in order.
+    uint32_t take_dealt(size_t w) {
+        uint32_t taken = 0;
+        const size_t unit = w / m_warps_per_unit;
+        for (uint32_t i = 0; i < m_simt.lanes && m_next[unit] < m_rays[unit].size(); ++i) {
+            Lane& l = lane(w, i);
+            if (l.has_ray) continue;
+            const RayJob& job = m_rays[unit][m_next[unit]++];
+            l.stepper->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+            l.has_ray = true;
+            if (m_cooperative) {
+                StackSplit unused;
+                l.walk.record(*l.stepper, unused, nullptr);
+            }
+            ++taken;
+        }
+        return taken;
+    }
+
+    /// Treelet scheduling (simt_unit.cpp, take_lane): idle lanes take rays from the warp's
+    /// treelet queue; a warp holding no ray may move to the largest queue first.
+    uint32_t take_from_queues(size_t w, bool any_ray) {
+        admit();
+        uint32_t taken = 0;
+        for (uint32_t i = 0; i < m_simt.lanes; ++i) {
+            Lane& l = lane(w, i);
+            if (l.has_ray) continue;
+            int64_t& current = m_warp_treelet[w];
+            if (current < 0 || m_queues[size_t(current)].empty()) {
+                if (any_ray || taken) break;
+                current = largest_queue();
+                if (current < 0) break;
+            }
+            l.stepper = std::move(m_queues[size_t(current)].front());
+            m_queues[size_t(current)].pop_front();
+            --m_waiting;
+            l.has_ray = true;
+            ++taken;
+        }
+        return taken;
+    }
+
+    /// New rays into the queue of their first step's treelet, as the ray buffer admits them.
+    void admit() {
+        const uint64_t reserve = m_setup.capacity > 1 ? 1 : 0;
+        while (m_admitted < m_admission.size() && m_in_machine < m_setup.admit_limit &&
+               (m_setup.may_overflow || m_waiting + reserve < m_setup.capacity)) {
+            const RayJob& job = *m_admission[m_admitted++];
+            std::unique_ptr<Stepper> s;
+            if (m_free.empty()) {
+                s = m_accel.make_stepper(m_step);
+            } else {
+                s = std::move(m_free.back());
+                m_free.pop_back();
+            }
+            s->begin(job.ray, job.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit);
+            const uint32_t first = s->plan().locality;
+            park(std::move(s), first == kNoLocality ? m_setup.treelets->root_group : m_setup.treelets->group_of[first]);
+            ++m_in_machine;
+        }
+    }
+
+    void park(std::unique_ptr<Stepper> s, uint32_t treelet) {
+        m_queues[treelet].push_back(std::move(s));
+        ++m_waiting;
+    }
+
+    /// Parks the lanes whose next step is outside the warp's treelet; true when none is left.
+    bool park_leavers(size_t w) {
+        bool any_ray = false;
+        for (uint32_t i = 0; i < m_simt.lanes; ++i) {
+            Lane& l = lane(w, i);
+            if (!l.has_ray) continue;
+            const StepPlan& plan = l.stepper->plan();
+            const uint32_t target =
+                plan.done || plan.locality == kNoLocality ? uint32_t(m_warp_treelet[w]) : m_setup.treelets->group_of[plan.locality];
+            if (int64_t(target) == m_warp_treelet[w]) {
+                any_ray = true;
+                continue;
+            }
+            park(std::move(l.stepper), target);
+            l.has_ray = false;
+        }
+        return !any_ray;
+    }
+
+    int64_t largest_queue() const {
+        int64_t best = -1;
+        for (size_t k = 0; k < m_queues.size(); ++k)
+            if (!m_queues[k].empty() && (best < 0 || m_queues[k].size() > m_queues[size_t(best)].size())) best = int64_t(k);
+        return best;
     }
 
     void run_step(Stepper& s) {
@@ -159,14 +263,25 @@ private:
     std::vector<Lane> m_lanes;
     std::vector<uint32_t> m_last_class;
     LineCoalescer m_coalescer;
+    const GroupSetup& m_setup;
+    const Accel& m_accel;
+    const StepOptions& m_step;
+    bool m_cooperative;
+    // Treelet scheduling: the ray buffer's queues, the rays it admits and the warps' treelets.
+    std::vector<std::deque<std::unique_ptr<Stepper>>> m_queues;
+    std::vector<const RayJob*> m_admission;
+    size_t m_admitted = 0;
+    uint64_t m_in_machine = 0, m_waiting = 0;
+    std::vector<int64_t> m_warp_treelet;
+    std::vector<std::unique_ptr<Stepper>> m_free;  ///< steppers of finished rays, reused
     GroupProfile m_p;
 };
 
 }  // namespace
 
 GroupProfile simt_group_profile(const Accel& accel, const StepOptions& step, const TraversalConfig& traversal,
-                                const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t line_bytes) {
-    GroupProfile p = FunctionalWarps(accel, step, traversal, rays_by_unit, line_bytes).run();
+                                const std::vector<std::vector<RayJob>>& rays_by_unit, const GroupSetup& setup) {
+    GroupProfile p = FunctionalWarps(accel, step, traversal, rays_by_unit, setup).run();
     p.single_work = p.work;  // each lane walks its ray alone: the work is the single ray's
     return p;
 }

@@ -4,6 +4,9 @@
 // lanes refilled by traversal.simt.refill, new rays' records fetched in a warp step of their
 // own, reads coalesced per line) without time: every warp takes one warp step in turn, and a
 // unit's lanes take the rays dispatch deals that unit, in order, when the policy lets them.
+// With treelet scheduling (GroupSetup::treelets) lanes take rays from their warp's treelet queue
+// instead, lanes whose next step is in another treelet park there, and a warp left without rays
+// forms again from the largest queue, as simt_unit.cpp's treelet mode does.
 #include <cstdint>
 #include <vector>
 
@@ -12,6 +15,6 @@
 namespace rtsim {
 
 GroupProfile simt_group_profile(const Accel& accel, const StepOptions& step, const TraversalConfig& traversal,
-                                const std::vector<std::vector<RayJob>>& rays_by_unit, uint32_t line_bytes);
+                                const std::vector<std::vector<RayJob>>& rays_by_unit, const GroupSetup& setup);
 
 }  // namespace rtsim

@@ -11,6 +11,7 @@
 
 #include "../bvh/bvh_test_scenes.h"
 #include "rtl_model/mem/functional_cache.h"
+#include "rtl_model/traversal/simt/simt_profile.h"
 #include "sim/analytic/analytic.h"
 #include "sim/analytic/analysis_cache.h"
 #include "sim/analytic/closed_form.h"
@@ -278,6 +279,34 @@ TEST(AnalyticLevel, MergedMissesWaitForTheFillAndNotUnderIdealMemory) {
     SimConfig slow = c;
     slow.dram.latency *= 4;
     EXPECT_GT(estimate_analytic(slow, p).demands.merge_wait, wait);
+}
+
+TEST(AnalyticLevel, SimtWarpsFormedFromTreeletQueuesWalkEveryRayOnce) {
+    // The functional warps with treelet scheduling: rays queue per treelet, lanes park when
+    // their next step leaves the warp's treelet, warps form again from the largest queue. Each
+    // ray is still walked to its end exactly once: the same work as warps without treelets.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    config_set(c, "traversal.model=simt");
+    std::vector<std::vector<RayJob>> by_unit(c.traversal.units);
+    for (size_t i = 0; i < w.jobs.size(); ++i) by_unit[i % c.traversal.units].push_back(w.jobs[i]);
+    GroupSetup plain;
+    const GroupProfile alone = simt_group_profile(*w.accel, StepOptions{}, c.traversal, by_unit, plain);
+    const LocalityPartition partition = w.accel->partition(8 * 1024);
+    ASSERT_GT(partition.treelets.size(), 4u);
+    GroupSetup queued = plain;
+    queued.treelets = &partition;
+    queued.capacity = 512;
+    queued.admit_limit = queued.capacity + c.traversal.contexts();
+    const GroupProfile tl = simt_group_profile(*w.accel, StepOptions{}, c.traversal, by_unit, queued);
+    EXPECT_EQ(tl.rays, double(w.jobs.size()));
+    EXPECT_EQ(tl.work, alone.work);
+    EXPECT_EQ(alone.buffer_steps, 0.0);
+    EXPECT_GT(tl.buffer_steps, 0.0);
+    EXPECT_LT(tl.buffer_steps, tl.group_steps);
+    EXPECT_LE(tl.active_lanes, tl.lane_slots);
+    // A profile round-trips through the analysis file.
+    EXPECT_EQ(GroupProfile::from_json(tl.to_json()).to_json(), tl.to_json());
 }
 
 /// Demands of `misses` L2 misses of 64-byte lines (no writes) under the default DRAM config.
