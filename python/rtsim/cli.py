@@ -35,7 +35,7 @@ from rtsim.kinds import RAY_KINDS
 from rtsim.sim_cli import add_parsers as add_simulate_parsers
 from rtsim.study.cli import add_parser as add_study_parser
 from rtsim.sweep.cli import add_parsers as add_sweep_parsers
-from rtsim.tracing import parse_setting_value
+from rtsim.tracing import REFLECTIONS, parse_setting_value
 
 # Start-up matters (`rtsim simulate` runs once per simulation): modules above import only the
 # standard library; rich, numpy, the C++ extension and Dask are imported by the commands.
@@ -85,6 +85,8 @@ class TraceJob:
     frame_policy: str | None = None  # each frame's structures: rebuild, refit, adaptive
     rebuild_threshold: float | None = None  # adaptive: the SAH ratio that triggers a rebuild
     lights: str | None = None  # lights added to a scene without any (none, sun)
+    reflections: str | None = None  # reflection rays: mirror or glossy (a GGX lobe)
+    roulette_after: int | None = None  # Russian roulette past this many bounces (0: off)
 
 
 def parse_workload(text: str) -> list[str]:
@@ -198,6 +200,8 @@ def run_trace(job: TraceJob, console: Console) -> dict:
             frame_policy=job.frame_policy,
             rebuild_threshold=job.rebuild_threshold,
             lights=job.lights,
+            reflections=job.reflections,
+            roulette_after=job.roulette_after,
         )
     trace = open_trace(job.out_dir)
     width, height = manifest["workload"]["resolution"]
@@ -233,6 +237,8 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         frame_policy=args.frame_policy,
         rebuild_threshold=args.rebuild_threshold,
         lights=args.lights,
+        reflections=args.reflections,
+        roulette_after=args.roulette_after,
     )
     run_trace(job, console)
     return 0
@@ -426,6 +432,22 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         default=None,
         help="lights added to a scene without any: sun (a directional light, so shadow rays "
         "are traced; the manifest lists it) or none (default)",
+    )
+    p.add_argument(
+        "--reflections",
+        choices=REFLECTIONS,
+        default=None,
+        help="reflection rays off metallic and smooth surfaces: mirror (the ideal direction, "
+        "default) or glossy (sampled from the GGX lobe of the material's glTF roughness; "
+        "docs/ray_generation.md)",
+    )
+    p.add_argument(
+        "--roulette-after",
+        type=int,
+        default=None,
+        metavar="N",
+        help="Russian roulette: each path ray past the first N bounces continues with the "
+        "surface's albedo as probability (0, the default: off; --bounces still caps the depth)",
     )
     p.add_argument(
         "--flatten",

@@ -178,6 +178,8 @@ def trace_scene(
     lights: str | None = None,
     frame_policy: str | None = None,
     rebuild_threshold: float | None = None,
+    reflections: str | None = None,
+    roulette_after: int | None = None,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. Every option left None takes the tracer's default
@@ -197,7 +199,10 @@ def trace_scene(
     "refit" or "adaptive" (rebuild once the refitted SAH cost exceeds rebuild_threshold times
     the rebuilt one; docs/accel.md, "Moving scenes"). lights="sun" adds a
     directional light to a scene without lights (so it gets shadow rays; the manifest's
-    workload.lights_added says what was added)."""
+    workload.lights_added says what was added). reflections="glossy" samples reflection rays
+    from the GGX lobe of each material's roughness instead of the mirror direction;
+    roulette_after=N plays Russian roulette on path rays past N bounces (survival: the surface's
+    albedo; docs/ray_generation.md)."""
     from rtsim import _core
 
     checks: dict[str, Callable[[Any], Any]] = {
@@ -217,13 +222,16 @@ def trace_scene(
         "lights": _lights_arg,
         "frame_policy": _frame_policy_arg,
         "rebuild_threshold": _rebuild_threshold_arg,
+        "reflections": _reflections_arg,
+        "roulette_after": lambda v: int_arg(v, "roulette_after", 0, MAX_BOUNCES),
     }
     values = {
         "workload": workload, "width": width, "height": height, "bounces": bounces, "seed": seed,
         "camera": camera, "threads": threads, "hairball_triangles": hairball_triangles,
         "accel": accel, "builder": builder, "flatten": flatten, "frames": frames,
         "build_settings": build_settings, "lights": lights, "frame_policy": frame_policy,
-        "rebuild_threshold": rebuild_threshold,
+        "rebuild_threshold": rebuild_threshold, "reflections": reflections,
+        "roulette_after": roulette_after,
     }  # fmt: skip
     # Only the options given are passed: the others take the tracer's defaults (trace_defaults).
     given = {k: checks[k](v) for k, v in values.items() if v is not None}
@@ -239,6 +247,18 @@ def trace_scene(
     return _core.trace_scene(
         _scene_arg(scene), path_arg(out_dir, "out_dir"), progress=progress, **given
     )
+
+
+#: The choices of reflections= (traces/tracer/tracer.h, TraceOptions::reflections).
+REFLECTIONS = ("mirror", "glossy")
+
+
+def _reflections_arg(reflections: str) -> str:
+    if reflections not in REFLECTIONS:
+        raise ArgumentValueError(
+            f"reflections: {reflections!r} is not one of {', '.join(REFLECTIONS)}"
+        )
+    return reflections
 
 
 #: The choices of lights= (traces/raygen/added_lights.h).

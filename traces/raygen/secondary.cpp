@@ -1,5 +1,6 @@
 #include "traces/raygen/secondary.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "traces/common/rng.h"
@@ -71,17 +72,37 @@ void spawn_secondaries(const SpawnContext& ctx, const PendingRay& parent, const 
 
     if (ctx.plan->wants(RayKind::shadow)) spawn_shadow_rays(ctx, parent, sp, rng, out);
     if (parent.depth >= ctx.bounces) return;
-    if (ctx.plan->wants(RayKind::reflection) && material_reflects(m))
-        out->push_back(path_ray(parent, RayKind::reflection, sp, glm::normalize(reflect(d, sp.normal))));
+    // Past roulette_after bounces each path ray is spawned only if it survives (its own draw,
+    // after the direction's, so traces without roulette keep their random numbers).
+    const bool roulette = ctx.roulette_after > 0 && parent.depth >= ctx.roulette_after;
+    auto survives = [&] { return !roulette || rng.next() < roulette_survival(m); };
+    if (ctx.plan->wants(RayKind::reflection) && material_reflects(m)) {
+        Vec3 r = glm::normalize(reflect(d, sp.normal));
+        bool above = true;
+        // glTF's GGX alpha is roughness squared; a perfectly smooth surface stays a mirror.
+        const float alpha = m.roughness * m.roughness;
+        if (ctx.glossy && alpha > 0.0f) {
+            const float u1 = rng.next(), u2 = rng.next();
+            above = ggx_reflect(d, sp.normal, std::max(alpha, 1e-4f), u1, u2, &r);
+        }
+        if (above && survives()) out->push_back(path_ray(parent, RayKind::reflection, sp, r));
+    }
     if (ctx.plan->wants(RayKind::refraction) && material_refracts(m)) {
         Vec3 t;
         float eta_i = sp.front ? 1.0f : m.ior, eta_t = sp.front ? m.ior : 1.0f;
-        if (refract(d, sp.normal, eta_i, eta_t, &t)) out->push_back(path_ray(parent, RayKind::refraction, sp, t));
+        if (refract(d, sp.normal, eta_i, eta_t, &t) && survives())
+            out->push_back(path_ray(parent, RayKind::refraction, sp, t));
     }
     if (ctx.plan->wants(RayKind::diffuse)) {
         float u1 = rng.next(), u2 = rng.next();
-        out->push_back(path_ray(parent, RayKind::diffuse, sp, cosine_hemisphere(sp.normal, u1, u2)));
+        const Vec3 dir = cosine_hemisphere(sp.normal, u1, u2);
+        if (survives()) out->push_back(path_ray(parent, RayKind::diffuse, sp, dir));
     }
+}
+
+float roulette_survival(const Material& m) {
+    const float albedo = std::max(m.base_color.x, std::max(m.base_color.y, m.base_color.z));
+    return std::min(0.95f, std::max(0.05f, albedo));
 }
 
 }  // namespace rtsim

@@ -75,6 +75,27 @@ Vec3 cosine_hemisphere(const Vec3& n, float u1, float u2) {
 
 Vec3 reflect(const Vec3& d, const Vec3& n) { return d - 2.0f * glm::dot(d, n) * n; }
 
+bool ggx_reflect(const Vec3& d, const Vec3& n, float alpha, float u1, float u2, Vec3* out) {
+    Vec3 b1, b2;
+    make_basis(n, &b1, &b2);
+    const Vec3 wo = -d;
+    const Vec3 ve(glm::dot(wo, b1), glm::dot(wo, b2), glm::dot(wo, n));  // in the normal's frame
+    // Heitz 2018, listing 1: the view stretched to the unit-roughness configuration, a point
+    // sampled on the projected hemisphere, and the normal unstretched.
+    const Vec3 vh = glm::normalize(Vec3(alpha * ve.x, alpha * ve.y, ve.z));
+    const float lensq = vh.x * vh.x + vh.y * vh.y;
+    const Vec3 t1 = lensq > 0.0f ? Vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : Vec3(1.0f, 0.0f, 0.0f);
+    const Vec3 t2 = glm::cross(vh, t1);
+    const float r = std::sqrt(u1), phi = 6.28318530718f * u2;
+    const float p1 = r * std::cos(phi), s = 0.5f * (1.0f + vh.z);
+    const float p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * r * std::sin(phi);
+    const Vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+    const Vec3 ne = glm::normalize(Vec3(alpha * nh.x, alpha * nh.y, std::max(1e-6f, nh.z)));
+    const Vec3 m = glm::normalize(ne.x * b1 + ne.y * b2 + ne.z * n);
+    *out = glm::normalize(reflect(d, m));
+    return glm::dot(*out, n) > 0.0f;
+}
+
 bool refract(const Vec3& d, const Vec3& n, float eta_i, float eta_t, Vec3* out) {
     float eta = eta_i / eta_t;
     float cos_i = -glm::dot(d, n);

@@ -35,6 +35,13 @@ Vec3 cosine_hemisphere(const Vec3& n, float u1, float u2);
 /// Mirror reflection of incoming direction d about unit normal n.
 Vec3 reflect(const Vec3& d, const Vec3& n);
 
+/// Glossy reflection of unit incoming direction d off a surface of unit normal n (facing d's
+/// origin) with GGX roughness `alpha` (glTF: roughness squared): a microfacet normal sampled
+/// from the distribution of normals visible from -d (Heitz 2018, "Sampling the GGX Distribution
+/// of Visible Normals", JCGT 7(4)) from u1, u2 in [0,1), and d reflected about it. Returns false
+/// when the reflected direction points into the surface (the path is absorbed there).
+bool ggx_reflect(const Vec3& d, const Vec3& n, float alpha, float u1, float u2, Vec3* out);
+
 /// Refraction of unit d through a surface with unit normal n facing d's origin side, from a
 /// medium of index eta_i into eta_t. Returns false on total internal reflection.
 bool refract(const Vec3& d, const Vec3& n, float eta_i, float eta_t, Vec3* out);

@@ -19,6 +19,7 @@ const Entry kScenes[] = {
     {"teapot_stadium", write_teapot_stadium},
     {"rotated_walls", write_rotated_walls},
     {"aligned_walls", write_aligned_walls},
+    {"terrain", write_terrain},
     {"cloth", write_cloth},
     {"exploding_hairball", write_exploding_hairball},
     {"skinned_tube", write_skinned_tube},

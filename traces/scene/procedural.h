@@ -13,7 +13,7 @@ struct ProceduralOptions {
 };
 
 /// Names of the built-in flat scenes: "cornell", "hairball", "teapot_stadium", "rotated_walls",
-/// "aligned_walls", and the deforming "cloth", "exploding_hairball" and "skinned_tube" (Scene::animation set).
+/// "aligned_walls", "terrain", and the deforming "cloth", "exploding_hairball" and "skinned_tube" (Scene::animation set).
 std::vector<std::string> procedural_scene_names();
 /// Names of the built-in instanced scenes (procedural_forest.cpp): "forest" (72 x 72 instances,
 /// about 4.6 x 10^8 triangles if flattened: two-level only) and "grove" (6 x 6 instances).

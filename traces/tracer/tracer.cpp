@@ -114,6 +114,9 @@ void validate(const TraceOptions& o) {
     }
     validate_accel_options(o.accel);
     require(known_added_lights(o.lights), "lights: unknown choice '" + o.lights + "' (choose none or sun)");
+    require(o.reflections == "mirror" || o.reflections == "glossy",
+            "reflections: unknown choice '" + o.reflections + "' (choose mirror or glossy)");
+    require(o.roulette_after <= 64, "roulette_after " + std::to_string(o.roulette_after) + " is out of range (0..64)");
     require(o.frames >= 1 && o.frames <= kMaxFrames,
             "frames " + std::to_string(o.frames) + " is out of range (1.." + std::to_string(kMaxFrames) + ")");
     parse_frame_policy(o.frame_policy);  // refuses an unknown one, listing the choices
@@ -204,7 +207,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
             accel->bind_frame(f);
         }
         const std::string prefix = o.frames > 1 ? "frame " + std::to_string(f) + " " : "";
-        SpawnContext ctx{&scene, &plan, o.bounces, frame_seed(o.seed, f)};
+        SpawnContext ctx{&scene, &plan, o.bounces, frame_seed(o.seed, f), o.reflections == "glossy", o.roulette_after};
         first_ray.push_back(folder.rays_written());
         std::vector<PendingRay> wave = primary_rays(pinhole, o.width, o.height, camera_where);
         for (uint32_t depth = 0; !wave.empty(); ++depth) {
@@ -230,6 +233,8 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
          {{"requested", requested},
           {"resolution", {o.width, o.height}},
           {"bounces", o.bounces},
+          {"reflections", o.reflections},
+          {"roulette_after", o.roulette_after},
           {"seed", o.seed},
           {"effects", effects_json(plan)},
           {"lights_added", lights_added}}},

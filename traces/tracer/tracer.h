@@ -57,6 +57,12 @@ struct TraceOptions {
     /// Lights added to a scene without any (traces/raygen/added_lights.h): "none" or "sun" (a
     /// directional light, so the scene's traces hold shadow rays; the manifest says so).
     std::string lights = "none";
+    /// Reflection rays (traces/raygen/secondary.h): "mirror" (the ideal direction) or "glossy"
+    /// (sampled from the GGX lobe of the material's glTF roughness; docs/raygen.md).
+    std::string reflections = "mirror";
+    /// Russian roulette on path rays: 0 off; N, each bounce past the first N continues with the
+    /// surface's albedo as probability (bounces still caps the depth).
+    uint32_t roulette_after = 0;
 
     /// The options a caller chooses, each with its name and meaning (scene and out_dir aside):
     /// the Python bindings read the defaults and apply keyword arguments through this, so every
@@ -79,6 +85,8 @@ struct TraceOptions {
         v("frame_policy", frame_policy, "each frame's structures: rebuild, refit or adaptive (docs/accel.md, Moving scenes)");
         v("rebuild_threshold", rebuild_threshold, "adaptive: rebuild once the refitted SAH cost exceeds this ratio");
         v("lights", lights, "lights added to a scene without any: none or sun (the manifest lists them)");
+        v("reflections", reflections, "reflection rays: mirror, or glossy (a GGX lobe of the material's roughness)");
+        v("roulette_after", roulette_after, "Russian roulette on path rays past this many bounces (0: off)");
     }
 };
 

@@ -83,6 +83,8 @@ def trace_task(plan: TracePlan, out: Path) -> TraceTask:
         frames=w.frames,
         frame_policy=w.frame_policy,
         rebuild_threshold=w.rebuild_threshold,
+        reflections=w.reflections,
+        roulette_after=w.roulette_after,
         flatten=plan.scene.flatten,
         lights=plan.scene.lights,
     )

@@ -40,6 +40,7 @@ from rtsim.sweep.accel_axis import (
 )
 from rtsim.sweep.run_check import CheckedRun, config_patch, describe, first_refusal
 from rtsim.sweep.yaml_lines import LineDict, LineList, line_of, load_yaml
+from rtsim.tracing import REFLECTIONS
 
 SAMPLING_METHODS = ("random", "latin_hypercube")
 #: rtsim trace --frame-policy: how a moving scene's structures are made per frame.
@@ -115,6 +116,8 @@ class WorkloadSpec:
     # --rebuild-threshold for adaptive); defaults as the tracer's.
     frame_policy: str = "rebuild"
     rebuild_threshold: float = 1.25
+    reflections: str = "mirror"  # rtsim trace --reflections (mirror or glossy)
+    roulette_after: int = 0  # rtsim trace --roulette-after (0: off)
 
     def key(self) -> dict[str, Any]:
         key: dict[str, Any] = {
@@ -130,6 +133,10 @@ class WorkloadSpec:
             key["frame_policy"] = self.frame_policy
         if self.rebuild_threshold != 1.25:
             key["rebuild_threshold"] = self.rebuild_threshold
+        if self.reflections != "mirror":
+            key["reflections"] = self.reflections
+        if self.roulette_after:
+            key["roulette_after"] = self.roulette_after
         return key
 
 
@@ -380,7 +387,7 @@ class _Reader:
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
         allowed = ("name", "rays", "resolution", "bounces", "seed", "frames", "frame_policy",
-                   "rebuild_threshold")  # fmt: skip
+                   "rebuild_threshold", "reflections", "roulette_after")  # fmt: skip
         d = self.mapping(items, i, f"workloads[{i}]", allowed)
         path = f"workloads[{i}]"
         rays = d.get("rays", [])  # absent: what the scene calls for
@@ -416,10 +423,17 @@ class _Reader:
             if "rebuild_threshold" in d
             else 1.25
         )
+        reflections = self.choice(d, "reflections", f"{path}.reflections", REFLECTIONS, "mirror")
+        roulette = (
+            self.number(d, "roulette_after", f"{path}.roulette_after", True, 0, MAX_BOUNCES)
+            if "roulette_after" in d
+            else 0
+        )
         label = str(d.get("name") or "-".join(rays) or "scene")
         return WorkloadSpec(
-            label, tuple(rays), int(w), int(h), bounces, seed, frames, policy, float(threshold)
-        )
+            label, tuple(rays), int(w), int(h), bounces, seed, frames, policy, float(threshold),
+            reflections, int(roulette),
+        )  # fmt: skip
 
     def accels(self, doc: LineDict) -> list[AccelSpec]:
         """The `accel` axis: a list (or one entry) of KIND, KIND:BUILDER or {kind, builder,

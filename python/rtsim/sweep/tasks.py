@@ -51,6 +51,8 @@ class TraceTask:
     rebuild_threshold: float = 1.25  # rtsim trace --rebuild-threshold (adaptive)
     flatten: bool = False  # rtsim trace --flatten (instanced scenes: one world-space structure)
     lights: str = ""  # rtsim trace --lights (a scene without lights given some); "": none
+    reflections: str = "mirror"  # rtsim trace --reflections
+    roulette_after: int = 0  # rtsim trace --roulette-after (0: off)
 
     def command(self, out: str) -> list[str]:
         workload = ["--workload", ",".join(self.rays)] if self.rays else []
@@ -88,6 +90,8 @@ class TraceTask:
             ),
             *(["--flatten"] if self.flatten else []),
             *(["--lights", self.lights] if self.lights else []),
+            *(["--reflections", self.reflections] if self.reflections != "mirror" else []),
+            *(["--roulette-after", str(self.roulette_after)] if self.roulette_after else []),
         ]
 
 

@@ -6,6 +6,7 @@
 
 #include "traces/bvh/builder.h"
 #include "traces/accel/bvh2/bvh2.h"
+#include "traces/common/rng.h"
 #include "traces/raygen/camera.h"
 #include "traces/raygen/secondary.h"
 #include "traces/raygen/surface.h"
@@ -158,4 +159,77 @@ TEST(RayGen, EmptyRequestIsWhatTheSceneCallsFor) {
             EXPECT_TRUE(e.simulated);
         }
     }
+}
+
+TEST(RayGen, GlossyReflectionsFollowTheGgxLobe) {
+    // At normal incidence the visible-normal distribution is the GGX normal distribution times
+    // cos(theta_h), whose tan^2(theta_h) has the CDF x / (alpha^2 + x): half the samples' half
+    // vectors lie within tan^2 = alpha^2, and the reflection stays above the surface when
+    // theta_h is below 45 degrees (tan^2 <= 1), for 1 / (1 + alpha^2) of them.
+    const Vec3 n(0.0f, 0.0f, 1.0f), down(0.0f, 0.0f, -1.0f);
+    for (float alpha : {0.05f, 0.3f, 0.8f}) {
+        Rng rng(5);
+        const int total = 20000;
+        int inside = 0, above = 0;
+        for (int i = 0; i < total; ++i) {
+            Vec3 out;
+            const float u1 = rng.next(), u2 = rng.next();
+            const bool up = ggx_reflect(down, n, alpha, u1, u2, &out);
+            ASSERT_NEAR(glm::length(out), 1.0f, 1e-5f);
+            ASSERT_EQ(up, out.z > 0.0f);
+            const Vec3 h = glm::normalize(out - down);  // the sampled microfacet normal
+            const float tan2 = (1.0f - h.z * h.z) / (h.z * h.z);
+            inside += tan2 <= alpha * alpha;
+            above += up;
+        }
+        EXPECT_NEAR(double(inside) / total, 0.5, 0.02) << alpha;
+        EXPECT_NEAR(double(above) / total, 1.0 / (1.0 + alpha * alpha), 0.02) << alpha;
+    }
+    // At 60 degrees the lobe widens with roughness around the mirror direction.
+    const Vec3 d = glm::normalize(Vec3(std::sin(1.047f), 0.0f, -std::cos(1.047f)));
+    const Vec3 mirror = reflect(d, n);
+    double previous = 1.0;
+    for (float alpha : {0.01f, 0.1f, 0.4f}) {
+        Rng rng(6);
+        double sum = 0;
+        int kept = 0;
+        for (int i = 0; i < 5000; ++i) {
+            Vec3 out;
+            const float u1 = rng.next(), u2 = rng.next();
+            if (ggx_reflect(d, n, alpha, u1, u2, &out)) sum += glm::dot(out, mirror), ++kept;
+        }
+        const double mean = sum / kept;
+        if (alpha == 0.01f) EXPECT_GT(mean, 0.999);
+        EXPECT_LT(mean, previous) << alpha;
+        previous = mean;
+    }
+}
+
+TEST(RayGen, RussianRouletteKeepsPathsWithTheSurfacesAlbedo) {
+    Scene scene = procedural("cornell");
+    HwBvh bvh = build_bvh(scene);
+    WorkloadPlan plan = plan_workload(scene, {RayKind::primary, RayKind::diffuse});
+    SpawnContext plain{&scene, &plan, 8, 3};
+    SpawnContext roulette = plain;
+    roulette.roulette_after = 2;
+    size_t all = 0, kept = 0;
+    double expected = 0;
+    for (auto [parent, hit] : primary_hits(scene, bvh)) {
+        std::vector<PendingRay> before, after, again;
+        parent.depth = 1;  // below roulette_after: every path goes on
+        spawn_secondaries(roulette, parent, hit, 0, &before);
+        EXPECT_EQ(before.size(), 1u);
+        parent.depth = 2;  // past it: kept with the albedo's probability
+        spawn_secondaries(plain, parent, hit, 0, &after);
+        spawn_secondaries(roulette, parent, hit, 0, &again);
+        std::vector<PendingRay> repeat;
+        spawn_secondaries(roulette, parent, hit, 0, &repeat);
+        ASSERT_EQ(again.size(), repeat.size());  // deterministic for the seed
+        all += after.size(), kept += again.size();
+        expected += roulette_survival(scene.materials[surface_point(scene, parent.ray, hit).material]);
+        if (!again.empty()) EXPECT_EQ(std::memcmp(&again[0].ray, &after[0].ray, sizeof(Ray)), 0);
+    }
+    ASSERT_GT(all, 2000u);
+    EXPECT_NEAR(double(kept), expected, 0.05 * expected);
+    EXPECT_LT(kept, all);
 }

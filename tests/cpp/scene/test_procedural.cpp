@@ -1,5 +1,6 @@
 // Procedural scenes: written as glTF, reloaded, with plausible counts, bounds, lights and cameras;
 // deterministic for a seed.
+#include <array>
 #include <chrono>
 #include <fstream>
 #include <iostream>
@@ -27,7 +28,7 @@ bool has_material(const Scene& s, float metallic, float roughness_below) {
 }
 
 TEST(Procedural, NamesAndUnknownName) {
-    EXPECT_EQ(procedural_scene_names().size(), 8u);
+    EXPECT_EQ(procedural_scene_names().size(), 9u);
     EXPECT_TRUE(is_procedural_scene("hairball"));
     EXPECT_FALSE(is_procedural_scene("sponza"));
     try {
@@ -117,6 +118,34 @@ TEST(Procedural, TeapotStadium) {
     EXPECT_LT(s.lights[0].direction.y, -0.5f);  // the sun shines down
     ASSERT_EQ(s.cameras.size(), 1u);
     EXPECT_LT(glm::length(s.cameras[0].eye - tea.center()), 10.0f);
+}
+
+TEST(Procedural, TerrainIsAnEvenlyCoveredHeightFieldUnderASun) {
+    Scene s = load_gltf(write_procedural_scene("terrain", test::test_dir()));
+    EXPECT_EQ(s.triangle_count(), 2u * 128 * 128 + 3u * 12000);
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].type, LightType::directional);
+    EXPECT_LT(s.lights[0].direction.y, -0.5f);
+    // A field 80 m across and a few metres high: blades and ground spread evenly over it, so
+    // each quarter of the field holds about a quarter of the triangles.
+    EXPECT_NEAR(s.bounds.extent().x, 80.0f, 0.5f);
+    EXPECT_LT(s.bounds.extent().y, 8.0f);
+    std::array<size_t, 4> quarter{};
+    for (size_t t = 0; t < s.triangle_count(); ++t) {
+        const Triangle& tri = s.triangles[t];
+        const Vec3 c = (tri.v0 + tri.v1 + tri.v2) / 3.0f;
+        ++quarter[size_t(c.x > 0) * 2 + size_t(c.z > 0)];
+    }
+    for (size_t q : quarter) EXPECT_NEAR(double(q) / double(s.triangle_count()), 0.25, 0.02);
+    // Deterministic for a seed, different for another.
+    const std::string dir = test::test_dir();
+    ProceduralOptions opt;
+    write_procedural_scene("terrain", dir + "/a", opt);
+    write_procedural_scene("terrain", dir + "/b", opt);
+    opt.seed = 2;
+    write_procedural_scene("terrain", dir + "/c", opt);
+    EXPECT_EQ(read_bytes(dir + "/a/terrain.bin"), read_bytes(dir + "/b/terrain.bin"));
+    EXPECT_NE(read_bytes(dir + "/a/terrain.bin"), read_bytes(dir + "/c/terrain.bin"));
 }
 
 TEST(Procedural, RotatedWalls) {
