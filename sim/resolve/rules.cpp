@@ -35,9 +35,10 @@ std::vector<Rule> make_rules() {
          [](const RunFacts& f) { return f.unit.needs.packet_kernel; }, RuleSide::structure, "a packet kernel",
          [](const RunFacts& f) { return f.structure.caps.packet_kernel; },
          "a packet's rays walk one shared traversal, which the structure provides as a packet stepper and a "
-         "reference packet loop (the hit checker checks each packet's work against it); the BVHs, kd-tree, "
-         "BIH, octree and grid and two levels over them have one, the B-Kd tree's walk none built",
-         "traversal.model=mimd or simt, or trace a structure with a packet kernel (rtsim capabilities)", "bkd",
+         "reference packet loop (the hit checker checks each packet's work against it); every registered "
+         "structure has one (the BVHs, kd-tree, BIH, B-Kd tree, octree, grid and two levels over them), so only "
+         "a structure added without one meets this rule",
+         "traversal.model=mimd or simt, or trace a structure with a packet kernel (rtsim capabilities)", "",
          {"traversal.model=packet"}});
     add({"unit/groups", "traversal.ray_contexts",
          [](const RunFacts& f) { return f.config.traversal.ray_contexts != 0 && f.unit.group_size(f.config.traversal) > 1; },

@@ -69,10 +69,6 @@ def test_accel_entries_together_held_to_the_run_limit() -> None:
 # scene, then failed in every run.
 
 REFUSED_AT_THE_CHECK = {
-    "packets_on_a_bkd_tree": (
-        "accel: [bkd]\ngrid:\n  traversal.model: [packet]\n",
-        "traversal.model",
-    ),
     "restart_trail_on_a_grid": (
         "accel: [grid]\ngrid:\n  traversal.stack_overflow: [restart_trail]\n",
         "traversal.stack_overflow",

@@ -42,6 +42,10 @@ def test_every_rule_refuses_its_example(sim_exe: Path, tmp_path: Path) -> None:
     traces: dict[str, Path] = {}
     for rule in table["rules"]:
         accel = rule["example"]["accel"]
+        if not accel:  # a rule no registered structure meets: check that none does
+            assert rule["id"] == "unit/packet_kernel", rule["id"]
+            assert all(s["capabilities"]["packet_kernel"] for s in table["structures"]), rule["id"]
+            continue
         if accel not in traces:
             scene, extra = EXAMPLE_TRACES.get(accel, ("cornell", ["--accel", accel]))
             traces[accel] = tmp_path / accel
@@ -76,8 +80,7 @@ def test_runs_are_checked_before_any_trace(sim_exe: Path, tmp_path: Path) -> Non
         [str(sim_exe), "--check-runs", str(path)], capture_output=True, text=True, check=True
     )
     checked = json.loads(out.stdout)
-    assert [c["ok"] for c in checked] == [False, True, False, False, False]
-    assert "packet kernel" in checked[0]["error"] and "bkd" in checked[0]["error"]
+    assert [c["ok"] for c in checked] == [True, True, False, False, False]  # B-Kd: a packet kernel
     derived = {d["key"]: d["value"] for d in checked[1]["resolved"]["derived"]}
     assert derived["traversal.ray_contexts"] == 32  # contexts follow the lanes: one warp
     assert "restart trail" in checked[2]["error"] and "grid" in checked[2]["error"]

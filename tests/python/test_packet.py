@@ -112,27 +112,20 @@ def test_occupancy_is_one_when_every_ray_of_a_packet_is_the_same_ray_trace(
         assert unit["packet_node_fetches"] == steps * unit["packets"]
 
 
-def test_packet_needs_a_packet_kernel(sim_exe: Path, tmp_path: Path) -> None:
-    trace = tmp_path / "trace"
-    rtsim.trace_scene("cornell", trace, workload="primary", width=8, height=8, accel="bkd")
-    result = simulate(sim_exe, trace / "trace.rtt", tmp_path / "run", "traversal.model=packet")
-    assert result.returncode == 2, result.stderr
-    assert "traversal.model" in result.stderr and "bkd" in result.stderr
-
-
-@pytest.mark.parametrize("accel", ["kdtree", "bih", "octree", "grid"])
+@pytest.mark.parametrize("accel", ["kdtree", "bih", "bkd", "octree", "grid"])
 def test_packets_on_space_partitioning_structures(
     sim_exe: Path, tmp_path: Path, accel: str
 ) -> None:
-    """Packets, the hybrid on lanes and mailboxes on the kd-tree, BIH, octree and grid replay
-    with every ray's hit and work equal to each structure's reference packet loop."""
+    """Packets, the hybrid on lanes and mailboxes on the kd-tree, BIH, B-Kd tree, octree and
+    grid replay with every ray's hit and work equal to each structure's reference packet loop."""
     trace = tmp_path / "trace"
     rtsim.trace_scene("cornell", trace, workload="primary,diffuse", width=12, height=9, accel=accel)
+    mailbox = [] if accel in ("bih", "bkd") else ["mailbox.entries=8"]  # no duplicates: none
     for i, sets in enumerate(
         [
             [],
             ["traversal.packet.split_below=0.5", "traversal.packet.split_walks=lanes"],
-            ["traversal.packet.lanes=4"] + (["mailbox.entries=8"] if accel != "bih" else []),
+            ["traversal.packet.lanes=4", *mailbox],
             ["fidelity=functional"],
         ]
     ):

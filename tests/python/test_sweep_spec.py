@@ -214,11 +214,12 @@ def test_frame_policy_is_a_trace_of_its_own() -> None:
 
 def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
     # A study counting refusals (rtsim study composition) needs the refused runs as failed runs.
-    text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [bkd]\n"
-    text += "grid:\n  traversal.model: [mimd, packet]\n"
+    text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [grid]\n"
+    text += "grid:\n  traversal.stack_overflow: [spill, restart_trail]\n"
     with pytest.raises(SpecError, match="would be refused by the simulator"):
         parse_spec(text, source="s.yaml")
     spec = parse_spec(text + "check_runs: false\n", source="s.yaml")
-    assert [p.params["traversal.model"] for p in spec.plans()] == ["mimd", "packet"]
+    overflow = [p.params["traversal.stack_overflow"] for p in spec.plans()]
+    assert overflow == ["spill", "restart_trail"]
     with pytest.raises(SpecError, match=r"s\.yaml:6: check_runs: expected true or false"):
         parse_spec(text + "check_runs: 1\n", source="s.yaml")

@@ -255,7 +255,8 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) { return gkbvh_image(scene, o.builder, s.bvh, s.gk); },
          loader<Bvh2Accel>()},
         {{"bkd", "B-Kd tree: two intervals per 20-byte node on one axis, no duplicates (Woop et al. 2006)",
-          tree_builder_names(), single_level(kBkdStackEntryBytes).with(&AccelCapabilities::refit)},
+          tree_builder_names(),
+          single_level(kBkdStackEntryBytes).with(&AccelCapabilities::packet_kernel).with(&AccelCapabilities::refit)},
          tree_settings,
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
              nlohmann::json unused;

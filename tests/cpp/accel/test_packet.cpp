@@ -309,7 +309,7 @@ TEST(Packets, PacketsOfMoreThan64RaysAreRefused) {
 }
 
 /// The space-partitioning structures with a packet kernel (cell_packet.h, grid_packet.h).
-const char* const kCellKinds[] = {"kdtree", "bih", "octree", "grid"};
+const char* const kCellKinds[] = {"kdtree", "bih", "bkd", "octree", "grid"};
 
 /// Packets of `lanes` consecutive rays on a space-partitioning tree: each ray's hit against the
 /// single ray's, the plans' operations against the rays' work, and (with a mailbox) the work

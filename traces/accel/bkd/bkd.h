@@ -49,6 +49,7 @@ public:
     BkdAccel(AccelImage image, const std::string& source);
 
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override;
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
               const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;

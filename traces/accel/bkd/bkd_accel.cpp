@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "traces/accel/bkd/bkd.h"
+#include "traces/accel/bkd/bkd_packet.h"
 #include "traces/accel/cell_tree_invariants.h"
 #include "traces/accel/leaf_coverage.h"
 #include "traces/accel/spatial_params.h"
@@ -90,6 +91,10 @@ BkdAccel::BkdAccel(AccelImage image, const std::string& source) : Accel(std::mov
 }
 
 std::unique_ptr<Stepper> BkdAccel::make_stepper(const StepOptions&) const { return std::make_unique<BkdStepper>(m_view); }
+
+std::unique_ptr<PacketStepper> BkdAccel::make_packet_stepper(const StepOptions&) const {
+    return std::make_unique<CellPacketStepper<detail::BkdPacketRules>>(detail::BkdPacketRules{m_view}, 0);
+}
 
 Hit BkdAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions&) const {
     BkdStepper stepper(m_view);  // on the stack: no allocation, no virtual calls

@@ -50,12 +50,12 @@ void BkdStepper::visit(uint32_t node, const detail::SlabInterval& cell) {
 void BkdStepper::plan_node(uint32_t node) {
     m_plan.reset(node);
     m_plan.add_fetch(m_view.node_base + uint64_t(node) * sizeof(BkdNode), sizeof(BkdNode), DataKind::node);
-    if (!m_view.nodes[node].leaf()) m_plan.add_op(OpKind::plane, 4);
+    if (!m_view.nodes[node].leaf()) m_plan.add_op(OpKind::plane, kNodeTests);
 }
 
 void BkdStepper::interior(const BkdNode& n) {
     // Four ray/plane tests: each child's cell is its parent's cut to [lo, hi] on the node's axis.
-    m_work.plane_tests += 4;
+    m_work.plane_tests += kNodeTests;
     const int axis = n.axis();
     const bool negative = detail::slab_negative(m_box, axis);
     auto child = [&](int side) {

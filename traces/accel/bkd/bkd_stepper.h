@@ -38,6 +38,7 @@ public:
     /// The cell stepper's restart path needs these; B-Kd trees offer no restart trail (their
     /// capabilities do not declare one), so the resolution step never lets a restart happen.
     static constexpr bool kPushDown = false;
+    static constexpr uint32_t kNodeTests = 4;  ///< an interior node's four interval-plane tests
 
     explicit BkdStepper(const BkdView& view) : m_view(view) {}
 
