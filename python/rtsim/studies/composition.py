@@ -4,9 +4,9 @@ Cornell box (two levels: the grove), counted as run or refused, and the refused 
 or message that refused them.
 
 The product: unit kinds mimd, simt (32 lanes, 32 ray contexts) and packet (16 rays); structures
-bvh2, bvh4, bvh8, cwbvh8, kdtree, bih, octree, grid and two levels; no technique or one of
-treelets, treelet prefetching (with queues, and without), the restart-trail short stack, 8-bit
-boxes, mailboxes, ray sorting, stack-driven prefetching (TTP), cooperative lanes (CoopRT),
+bvh2, bvh4, bvh8, cwbvh8, kdtree, bih, bkd, gkbvh, octree, grid and two levels; no technique or
+one of treelets, treelet prefetching (with queues, and without), the restart-trail short stack,
+8-bit boxes, mailboxes, ray sorting, stack-driven prefetching (TTP), cooperative lanes (CoopRT),
 quantised boxes (AQB8), compressed leaves (a build setting); levels functional, analytic,
 approx, detailed and approx with 20% sampling. The specs skip the sweep's run check
 (`check_runs: false`), so a combination the simulator refuses is a failed run (a row with its
@@ -41,7 +41,10 @@ UNITS: dict[str, dict[str, Any]] = {
         "traversal.ray_contexts": 16,
     },
 }
-STRUCTURES = ["bvh2", "bvh4", "bvh8", "cwbvh8", "kdtree", "bih", "octree", "grid", "two_level"]
+STRUCTURES = [
+    "bvh2", "bvh4", "bvh8", "cwbvh8", "kdtree", "bih", "bkd", "gkbvh", "octree", "grid",
+    "two_level",
+]  # fmt: skip
 LEAVES = "compressed leaves"  # a build setting: its runs are on a trace built with it
 TECHNIQUES: dict[str, dict[str, Any]] = {
     "(none)": {},
