@@ -212,7 +212,29 @@ AnalyticOutcome run_analytic(const SimConfig& config, const Accel& accel, const 
     return outcome_of(config, analyze_stream(config, accel, map, step, rays, sink));
 }
 
-SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig& config) {
+SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig& config,
+                         const std::vector<FrameRecord>& frames) {
+    if (frames.size() > 1) {
+        // Clusters must not cross a frame barrier (the structure changes there): one in each of
+        // K frames spread evenly, each frame planned as a trace of its own with one cluster.
+        SamplePlan plan;
+        plan.trace_rays = rays;
+        const size_t k = std::max<size_t>(1, std::min<size_t>(s.clusters, frames.size()));
+        AnalyticConfig one = s;
+        one.clusters = 1;
+        for (size_t i = 0; i < k; ++i) {
+            const FrameRecord& f = frames[(2 * i + 1) * frames.size() / (2 * k)];
+            if (f.rays == 0) continue;
+            SamplePlan sub = analysis_plan(f.rays, one, config);
+            for (SamplePlan::Cluster c : sub.clusters) {
+                c.stratum_first += f.first_ray, c.first += f.first_ray;
+                plan.clusters.push_back(c);
+                plan.simulated_rays += c.warmup + c.measured;
+            }
+            plan.warmup_rays = std::max(plan.warmup_rays, sub.warmup_rays);
+        }
+        return plan;
+    }
     SamplePlan plan;
     plan.trace_rays = rays;
     const uint64_t tail = uint64_t(config.traversal.units) * config.traversal.contexts();
@@ -236,22 +258,33 @@ SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& s, const SimConfig
 
 AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map,
                               const StepOptions& step, TraceReader& reader, RaySinkIf& sink,
-                              const AnalyticConfig& sample) {
+                              const AnalyticConfig& sample, const std::vector<FrameRecord>& frames,
+                              const std::function<void(uint32_t)>& bind_frame) {
     const auto t0 = std::chrono::steady_clock::now();
     AnalyticProfile p;
     p.accel_kind = accel.kind();
     p.op_kinds = accel.op_kinds();
     work_totals(reader, &p);
-    const SamplePlan plan = analysis_plan(p.rays, sample, config);
-    const bool whole = plan.clusters.size() == 1 && plan.clusters[0].warmup == 0;
+    const SamplePlan plan = analysis_plan(p.rays, sample, config, frames);
+    // Every ray stepped and measured: the whole trace (every frame of an animated one).
+    uint64_t covered = 0;
+    for (const SamplePlan::Cluster& c : plan.clusters)
+        if (c.warmup == 0 && c.measured == c.stratum_rays) covered += c.measured;
+    const bool whole = covered == p.rays;
     SampleProfiler profiler(config, accel, map, step, p);
     std::vector<RayRecord> buffer;
     for (const SamplePlan::Cluster& c : plan.clusters) {
+        if (frames.size() > 1) {  // the frame the cluster lies in
+            const auto f = std::upper_bound(frames.begin(), frames.end(), c.first,
+                                            [](uint64_t id, const FrameRecord& r) { return id < r.first_ray; });
+            bind_frame(uint32_t(f - frames.begin() - 1));
+        }
         std::vector<RayJob> jobs;
         read_ray_jobs(reader, c.first, size_t(c.warmup + c.measured), &buffer, &jobs);
         VectorStream stream(jobs);
         const uint64_t measure_first = c.first + c.warmup;
-        const uint64_t measure_end = whole ? c.end() : measure_first + sample.measured_rays;
+        const bool full = c.warmup == 0 && c.measured == c.stratum_rays;
+        const uint64_t measure_end = full ? c.end() : measure_first + sample.measured_rays;
         profiler.run_cluster(stream, measure_first, measure_end, sink);
         profile_groups(config, accel, step, jobs, p);
     }

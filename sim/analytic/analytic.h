@@ -16,6 +16,8 @@
 // (its chunk's CRC verified) and used as the work the model counts. The functional level checks
 // every ray in full.
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -55,14 +57,20 @@ AnalyticOutcome run_analytic_exact(const SimConfig& config, const Accel& accel, 
 
 /// The per-trace analysis of a whole trace: work counts of every ray, the sampled clusters
 /// (every stepped ray checked through `sink`).
+/// An animated trace (`frames` of more than one): each cluster lies in one frame, stepped with
+/// the structure bound to it (`bind_frame`).
 AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const MemoryMap& map,
                               const StepOptions& step, TraceReader& reader, RaySinkIf& sink,
-                              const AnalyticConfig& sample);
+                              const AnalyticConfig& sample, const std::vector<FrameRecord>& frames = {},
+                              const std::function<void(uint32_t)>& bind_frame = {});
 
 /// Which rays the analysis of a trace of `rays` rays steps: clusters of (warm-up, measured) in
-/// trace order (sim/sampling/sampling.h's plan type; measured = the cluster's rest).
+/// trace order (sim/sampling/sampling.h's plan type; measured = the cluster's rest). With
+/// `frames` (an animated trace): one cluster in each of up to `sample.clusters` frames spread
+/// over the trace, the frame's middle or, for a short frame, all of it.
 struct SamplePlan;
-SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& sample, const SimConfig& config);
+SamplePlan analysis_plan(uint64_t rays, const AnalyticConfig& sample, const SimConfig& config,
+                         const std::vector<FrameRecord>& frames = {});
 
 
 }  // namespace rtsim

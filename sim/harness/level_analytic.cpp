@@ -11,6 +11,9 @@
 #include "sim/analytic/analytic.h"
 #include "sim/analytic/closed_form.h"
 #include "sim/analytic/estimate.h"
+#include "sim/harness/analytic_frames.h"
+#include "sim/harness/frame_builds.h"
+#include "sim/harness/frames.h"
 #include "sim/harness/hit_checker.h"
 #include "sim/harness/level.h"
 #include "sim/harness/memory_estimate.h"
@@ -29,13 +32,17 @@ namespace {
 
 /// Computes the analysis of the trace (the structure's image loaded, the sample stepped and
 /// checked through `checker`).
-AnalyticProfile build_analysis(const RunInputs& in, TraceReader& reader, HitChecker& checker, const SamplePlan& plan) {
+AnalyticProfile build_analysis(const RunInputs& in, TraceReader& reader, HitChecker& checker, const SamplePlan& plan,
+                               Accel* animated, const std::vector<FrameRecord>& frames) {
     const SimConfig& c = in.config();
-    const std::unique_ptr<Accel> accel = load_accel(read_accel_image(reader), in.rtt);
+    std::unique_ptr<Accel> loaded;
+    if (!animated) loaded = load_accel(read_accel_image(reader), in.rtt);
+    Accel& accel = animated ? *animated : *loaded;
     const uint64_t total = reader.section(SectionKind::rays).record_count;
-    const MemoryMap map(accel->image().end_address(), total, uint64_t(c.traversal.units) * c.traversal.contexts(),
-                        accel->max_stack_entries(), c.traversal.stack_entry_bytes);
-    AnalyticProfile p = analyze_trace(c, *accel, map, in.setup.step, reader, checker, c.analytic);
+    const MemoryMap map(accel.image().end_address(), total, uint64_t(c.traversal.units) * c.traversal.contexts(),
+                        accel.max_stack_entries(), c.traversal.stack_entry_bytes);
+    AnalyticProfile p = analyze_trace(c, accel, map, in.setup.step, reader, checker, c.analytic, frames,
+                                      [&accel](uint32_t f) { accel.bind_frame(f); });
     require(checker.checked() == plan.simulated_rays, "analytic analysis ended with " +
                                                           std::to_string(checker.checked()) + " of " +
                                                           std::to_string(plan.simulated_rays) + " sampled rays");
@@ -97,7 +104,15 @@ LevelResult run_statistical(RunInputs& in) {
     const AnalyticConfig& sample = c.analytic;
     const json key = analysis_key(c, sample, trace_identity(in.reader));
     const std::string path = analysis_path(in.rtt, key);
-    const SamplePlan plan = analysis_plan(in.reader.section(SectionKind::rays).record_count, sample, c);
+    // An animated trace: its structure (bound frame by frame for the analysis, its builds for the
+    // estimate) and its frame table.
+    std::unique_ptr<Accel> animated;
+    std::vector<FrameRecord> frames;
+    if (in.reader.has(SectionKind::frames)) {
+        animated = load_accel(read_accel_image(in.reader), in.rtt);
+        frames = read_frame_table(in.reader, animated->frame_count());
+    }
+    const SamplePlan plan = analysis_plan(in.reader.section(SectionKind::rays).record_count, sample, c, frames);
     SampledReference reference(in.reader, plan);
     HitChecker checker("checker", reference, plan.simulated_rays);
     bool reused = true;
@@ -106,7 +121,7 @@ LevelResult run_statistical(RunInputs& in) {
         AnalysisLock lock(path);  // another process of the sweep may be computing it
         profile = load_analysis(path, key);
         if (!profile) {
-            profile = build_analysis(in, in.reader, checker, plan);
+            profile = build_analysis(in, in.reader, checker, plan, animated.get(), frames);
             profile->key = key;
             reused = false;
             store_analysis(path, *profile);
@@ -126,6 +141,24 @@ LevelResult run_statistical(RunInputs& in) {
     LevelResult r;
     r.cycles = Cycle(e.form.cycles);
     r.summary = summarize(c, r.cycles, p->rays, e.model, {}, in.wall_seconds());
+    if (frames.size() > 1) {
+        // Frames: the closed form's traversal shared out by frame, each barrier's refill, each
+        // frame's builds on the build unit (analytic_frames.h).
+        const AnalyticFrames af = estimate_frames(c, frames, frame_step_work(in.reader, frames),
+                                                  in.manifest.value("frames", json(nullptr)),
+                                                  frame_build_jobs(*animated), e.form.cycles, e.mean_latency,
+                                                  r.summary);
+        r.cycles = af.cycles;
+        r.frames = af.frames;
+        r.frame_count = frames.size();
+        if (!af.build_unit.is_null()) {
+            e.model["build_unit"] = af.build_unit;
+            e.instantiated.push_back({{"block", "build_unit"}, {"instantiated", true},
+                                      {"why", "a moving scene: each frame's structures are built or refit at its "
+                                              "barrier (closed form: the DRAM at its peak rate)"}});
+        }
+        r.summary = summarize(c, r.cycles, p->rays, e.model, {}, in.wall_seconds());
+    }
     r.summary["hit_mismatches"] = p->validation.value("hit_mismatches", 0);
     r.summary["work_mismatches"] = p->validation.value("work_mismatches", 0);
     r.summary["avg_ray_latency_cycles"] = e.mean_latency;
@@ -170,7 +203,7 @@ LevelResult run_analytic_level(RunInputs& in) {
                          ", traversal.ray_contexts=" + std::to_string(c.traversal.contexts()) + ")");
     LevelResult r = functional ? run_functional_caches(in) : run_statistical(in);
     check_analytic_model(r.model, c.traversal.model);  // the blocks' declarations, as the timed levels' model is checked
-    r.frames = nullptr;  // the analytic level replays no frames (resolve refuses animated traces)
+    if (functional) r.frames = nullptr;  // functional caches replay no frames (resolve refuses animated traces)
     return r;
 }
 

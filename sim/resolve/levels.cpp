@@ -12,12 +12,15 @@ LevelCapabilities level_capabilities(const SimConfig& c) {
             l.lock_step = l.treelets = l.frames = l.steps_rays = true;
             break;
         case Fidelity::analytic: {
-            // A closed form over a per-trace analysis: plain dispatch, one frame; a lock-step kind's
+            // A closed form over a per-trace analysis: plain dispatch; a lock-step kind's
             // groups from its functional group profile (sim/analytic/estimate.cpp).
             const bool functional = c.analytic.caches == AnalyticCaches::functional;
             l.group_profiles = !functional;
             // Its sample stepped in treelet order, the ray buffer's traffic priced (sample.h).
             l.treelets = !functional;
+            // Animated traces: the analysis's clusters frame by frame, the estimate shared out by
+            // frame with each barrier and build (sim/harness/analytic_frames.h).
+            l.frames = !functional;
             l.name += std::string(" (analytic.caches=") + (functional ? "functional" : "statistical") + ")";
             l.steps_rays = functional;
             break;

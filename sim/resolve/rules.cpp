@@ -153,8 +153,10 @@ std::vector<Rule> make_rules() {
 
     // Animated traces (docs/accel.md, "Frames").
     add({"frames/level", "an animated trace (--frames)", animated, RuleSide::level, "a level that replays frames",
-         [](const RunFacts& f) { return f.level.frames; }, "the analytic level does not replay frames yet",
-         "fidelity=functional, approx or detailed", "frames", {"fidelity=analytic"}});
+         [](const RunFacts& f) { return f.level.frames; },
+         "the analytic level's functional caches step every ray in one pass over one structure, not frame by frame",
+         "analytic.caches=statistical, or fidelity=functional, approx or detailed", "frames",
+         {"fidelity=analytic", "analytic.caches=functional"}});
     add({"frames/sampling", "an animated trace (--frames)", animated, RuleSide::technique,
          "no sampling (sampling.fraction and sampling.count 0)", [](const RunFacts& f) { return !sampling(f); },
          "sampling does not cut frames yet: an animated trace is replayed whole", "sampling.fraction=0", "frames",

@@ -150,8 +150,10 @@ size_t sample_index(const SamplePlan& plan, uint64_t id, size_t* cluster) {
             "sampling: ray " + std::to_string(id) + " is not in the sample");
     const size_t k = size_t(std::prev(it) - plan.clusters.begin());
     if (cluster) *cluster = k;
-    const uint64_t size = plan.clusters[0].warmup + plan.clusters[0].measured;
-    return size_t(k * size + (id - plan.clusters[k].first));
+    // The clusters before k (of equal sizes, but a per-frame analysis's may differ: analytic.cpp).
+    uint64_t before = 0;
+    for (size_t j = 0; j < k; ++j) before += plan.clusters[j].warmup + plan.clusters[j].measured;
+    return size_t(before + (id - plan.clusters[k].first));
 }
 
 SampledRayStream::SampledRayStream(TraceReader& reader, const SamplePlan& plan) : m_reader(reader), m_plan(plan) {

@@ -128,7 +128,7 @@ def test_one_frame_trace_has_one_frame_entry(
 @pytest.mark.parametrize(
     ("sets", "field"),
     [
-        (["fidelity=analytic"], "fidelity 'analytic"),
+        (["fidelity=analytic", "analytic.caches=functional"], "analytic.caches"),
         (["sampling.fraction=0.5"], "sampling"),
     ],
 )

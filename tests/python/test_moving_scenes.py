@@ -108,3 +108,28 @@ def test_bad_policy_and_threshold_are_refused(tmp_path: Path) -> None:
     low = run_rtsim("trace", "cloth", "-o", str(tmp_path / "b"), "--frames", "2",
                     "--rebuild-threshold", "0.5")  # fmt: skip
     assert low.returncode != 0 and "rebuild_threshold" in low.stderr
+
+
+def test_analytic_level_prices_frames_and_builds(sim_exe: Path, tmp_path: Path) -> None:
+    """The analytic level on an animated trace: each frame's traversal and build, the builds
+    within 2% of the detailed level's (the same build unit on a closed-form memory), the whole
+    run within its 10% band on these frames (docs/fidelity.md, "Frames at the analytic level")."""
+    root = tmp_path  # (48x36: the module's 24x18 frames are too few rays for a closed form)
+    for policy in ("rebuild", "refit"):
+        trace = root / policy
+        result = run_rtsim("trace", "exploding_hairball", "-o", str(trace), "--resolution",
+                           "48x36", "--frames", "3", "--frame-policy", policy)  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        detailed = sim_stats(sim_exe, trace, root / f"d_{policy}", "fidelity=detailed")
+        analytic = sim_stats(sim_exe, trace, root / f"a_{policy}", "fidelity=analytic")
+        s = analytic["summary"]
+        assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0 and s["frames"] == 3
+        frames = analytic["frames"]
+        assert [f["rays"] for f in frames] == [f["rays"] for f in detailed["frames"]]
+        assert sum(f["cycles"] for f in frames) == pytest.approx(s["cycles"], abs=3)
+        assert frames[0]["build_cycles"] == 0 and all(f["build_cycles"] > 0 for f in frames[1:])
+        for a, d in zip(frames[1:], detailed["frames"][1:], strict=True):
+            assert a["build_cycles"] == pytest.approx(d["build_cycles"], rel=0.02), policy
+        unit = analytic["model"]["build_unit"]
+        assert unit["refits" if policy == "refit" else "rebuilds"] == 4
+        assert s["cycles"] == pytest.approx(detailed["summary"]["cycles"], rel=0.10), policy

@@ -1,0 +1,125 @@
+#include "sim/harness/analytic_frames.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <unordered_set>
+
+#include "rtl_model/common/interfaces.h"
+#include "rtl_model/top/top.h"
+#include "sim/harness/frames.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// The build unit's memory without a simulation: the L2 as a FIFO of its capacity in lines, and
+/// one DRAM bus at the channels' peak rate. A read of a line in the L2 takes the L2's latency;
+/// any other waits for the bus and then the unloaded L2-miss latency. A write is posted into the
+/// L2 (its latency) and takes the bus once for its write-back. (A rebuild's second and third
+/// passes over its triangles hit the L2 where they fit.)
+class ClosedFormMemory : public MemIf {
+public:
+    explicit ClosedFormMemory(const SimConfig& c)
+        : m_line_cycles(double(c.l2.line_bytes) / (double(c.dram.bytes_per_cycle) * c.dram.channels)),
+          m_l2(c.l2.latency),
+          m_miss(double(c.l2.latency) + c.dram.latency + std::ceil(double(c.l2.line_bytes) / c.dram.bytes_per_cycle)),
+          m_line_bytes(c.l2.line_bytes),
+          m_capacity(c.l2.lines()),
+          m_ideal(c.ideal_memory) {}
+    Cycle access(const MemRequest& req) override {
+        if (m_ideal) return req.time + 1;
+        const uint64_t line = req.addr / m_line_bytes;
+        const bool present = m_lines.count(line) != 0;
+        if (!present) {
+            m_lines.insert(line);
+            m_order.push_back(line);
+            if (m_order.size() > m_capacity) m_lines.erase(m_order.front()), m_order.pop_front();
+        }
+        if (!req.write && present) return req.time + Cycle(m_l2);
+        const double start = std::max(double(req.time), m_bus);
+        m_bus = start + m_line_cycles;
+        return Cycle(std::ceil(req.write ? double(req.time) + m_l2 : start + m_miss));
+    }
+
+private:
+    double m_line_cycles, m_l2, m_miss;
+    uint32_t m_line_bytes;
+    uint64_t m_capacity;
+    bool m_ideal;
+    double m_bus = 0;
+    std::unordered_set<uint64_t> m_lines;
+    std::deque<uint64_t> m_order;
+};
+
+/// Counters whose hit rate is `rate` over `reads` reads (null rate: none).
+MemCounters counters(double reads, const json& rate) {
+    MemCounters m;
+    m.reads = uint64_t(std::llround(reads));
+    if (rate.is_number()) m.read_hits = uint64_t(std::llround(reads * rate.get<double>()));
+    return m;
+}
+
+}  // namespace
+
+std::vector<double> frame_step_work(TraceReader& reader, const std::vector<FrameRecord>& frames) {
+    std::vector<double> out;
+    std::vector<WorkRecord> buf(65536);
+    for (const FrameRecord& f : frames) {
+        double sum = 0;
+        for (uint64_t first = f.first_ray; first < f.first_ray + f.rays; first += buf.size()) {
+            const uint64_t count = std::min<uint64_t>(buf.size(), f.first_ray + f.rays - first);
+            reader.read(SectionKind::work, first, count, buf.data());
+            for (uint64_t i = 0; i < count; ++i) sum += plan_step_work(buf[i].counts());
+        }
+        out.push_back(sum);
+    }
+    return out;
+}
+
+AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameRecord>& frames,
+                               const std::vector<double>& step_work, const json& manifest_frames,
+                               const std::vector<std::vector<BuildJob>>& jobs, double traversal_cycles,
+                               double mean_latency, const json& summary) {
+    AnalyticFrames out;
+    FrameRecorder recorder(config, frames, manifest_frames);
+    ClosedFormMemory memory(config);
+    std::unique_ptr<BuildUnit> unit;
+    if (config.build_unit.enabled && !jobs.empty()) unit = std::make_unique<BuildUnit>(config.build_unit, memory, config.l2.line_bytes);
+    double work = 0;
+    for (double w : step_work) work += w;
+    const double per_work = work > 0 ? traversal_cycles / work : 0.0;
+    const double dram_per_work = work > 0 ? summary.value("dram_bytes", 0.0) / work : 0.0;
+    // A barrier empties the machine and the next frame fills it again: about one ray's latency
+    // of lost overlap (the closed form's steady state has the first frame's fill in it already).
+    const double refill = std::min(mean_latency, traversal_cycles);
+    double t = 0, done_work = 0, build_bytes = 0;
+    for (uint32_t f = 0; f < frames.size(); ++f) {
+        if (f > 0 && unit && f < jobs.size() && !jobs[f].empty()) {
+            const FrameBuild b = unit->run(jobs[f], Cycle(std::ceil(t)));
+            recorder.set_build(f, b);
+            build_bytes += double(b.read_bytes + b.written_bytes);
+            t = double(b.end);
+        }
+        t += per_work * step_work[f] + (f > 0 ? refill : 0.0);
+        done_work += step_work[f];
+        // The frame's memory figures: the closed form's shared out by work (hit rates the run's).
+        MemoryTotals totals;
+        const double reads = done_work * 16;  // any scale: only the rates are read back
+        totals.l1 = counters(reads, summary.value("l1_hit_rate", json(nullptr)));
+        totals.l2 = counters(reads, summary.value("l2_hit_rate", json(nullptr)));
+        totals.dram.read_bytes = uint64_t(std::llround(dram_per_work * done_work + build_bytes));
+        recorder.frame_end(f, Cycle(std::ceil(t)), totals);
+    }
+    out.cycles = uint64_t(std::ceil(t));
+    out.frames = recorder.to_json();
+    if (unit) {
+        out.build_unit = unit->stats_json();
+        out.build_unit["share"] = out.cycles ? double(out.build_unit["busy_cycles"].get<uint64_t>()) / double(out.cycles) : 0.0;
+    }
+    return out;
+}
+
+}  // namespace rtsim
