@@ -84,7 +84,7 @@ std::unique_ptr<Stepper> BihAccel::make_stepper(const StepOptions& options) cons
 }
 
 std::unique_ptr<PacketStepper> BihAccel::make_packet_stepper(const StepOptions&) const {
-    return std::make_unique<CellPacketStepper<detail::BihPacketRules>>(detail::BihPacketRules{m_view}, 0);
+    return std::make_unique<CellPacketStepper<detail::BihPacketRules>>(detail::BihPacketRules{{m_view}}, 0);
 }
 
 Hit BihAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions& options) const {

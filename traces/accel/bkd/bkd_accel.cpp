@@ -93,7 +93,7 @@ BkdAccel::BkdAccel(AccelImage image, const std::string& source) : Accel(std::mov
 std::unique_ptr<Stepper> BkdAccel::make_stepper(const StepOptions&) const { return std::make_unique<BkdStepper>(m_view); }
 
 std::unique_ptr<PacketStepper> BkdAccel::make_packet_stepper(const StepOptions&) const {
-    return std::make_unique<CellPacketStepper<detail::BkdPacketRules>>(detail::BkdPacketRules{m_view}, 0);
+    return std::make_unique<CellPacketStepper<detail::BkdPacketRules>>(detail::BkdPacketRules{{m_view}}, 0);
 }
 
 Hit BkdAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const StepOptions&) const {
