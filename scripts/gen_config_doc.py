@@ -50,6 +50,9 @@ SECTION_NOTES = {
     "plane": "The ray/split-plane pipeline: one operation per split plane a node tests (a "
     "kd-tree's 1, a BIH's 2, an octree's 3); built only for structures that issue plane tests "
     "(docs/accel.md).",
+    "obb": "The ray-rotation pipeline of oriented nodes: one operation per node whose child boxes "
+    "lie in a rotated frame (`obvh2`, docs/accel.md), ahead of its box tests; built only for "
+    "structures with oriented nodes.",
     "mailbox": "Mailboxes in the traversal units: a table per ray context of the primitives the "
     "ray tested, so grids, kd-trees and octrees skip retests (docs/accel.md, Mailboxes).",
     "l1": "The private per-unit L1 caches (MSHRs modelled exactly).",

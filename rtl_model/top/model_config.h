@@ -60,6 +60,10 @@ struct ModelConfig {
     /// Ray/split-plane tests of kd-trees, BIHs and octrees: (plane - origin) x 1/d and two
     /// compares, one slab of a box test; two per issue (a BIH node's pair).
     PipelineConfig plane = pipeline_of(/*latency=*/4, /*width=*/2);
+    /// Ray rotations of oriented nodes (obvh2): a 3x3 matrix from the unit's table times the
+    /// ray's origin and direction (18 multiply-adds, no translation), one per oriented node
+    /// ahead of its box tests. An assumption: no public figure prices RDNA 4's OBB transform.
+    PipelineConfig obb = pipeline_of(/*latency=*/6, /*width=*/1);
     MailboxConfig mailbox;
     // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
     // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
@@ -105,6 +109,7 @@ struct ModelConfig {
         v.section("cell", cell);
         v.section("transform", transform);
         v.section("plane", plane);
+        v.section("obb", obb);
         v.section("mailbox", mailbox);
         v.section("l1", l1);
         v.section("l2", l2);

@@ -41,7 +41,8 @@ void work_totals(TraceReader& reader, AnalyticProfile* p) {
 }
 
 /// The work the steppers' techniques add to or save from the trace's (mailbox lookups and the
-/// tests they skip, restart-trail re-descents, a reduced-precision walk's extra subtrees), which
+/// tests they skip, restart-trail re-descents, a reduced-precision walk's extra subtrees, an
+/// oriented BVH's rotations), which
 /// a trace's work records never hold: measured on the stepped sample and scaled to the trace by
 /// the ratio of the trace's plan-step work to the sample's (a ratio estimator, as the cache
 /// sample's counts are scaled; Cochran 1977, ch. 6). A whole-trace sample scales by 1, exactly.
@@ -56,7 +57,8 @@ void extrapolate_stepped_work(AnalyticProfile& p) {
     // The TLAS's share is in the trace's steps already; the rest is on top of the trace's walk.
     for (WorkField f : {WorkField::mailbox_lookups, WorkField::mailbox_hits, WorkField::stack_drops,
                         WorkField::restarts, WorkField::restart_steps, WorkField::restart_box_tests,
-                        WorkField::rp_box_hits, WorkField::rp_steps, WorkField::rp_box_tests, WorkField::rp_tri_tests})
+                        WorkField::rp_box_hits, WorkField::rp_steps, WorkField::rp_box_tests, WorkField::rp_tri_tests,
+                        WorkField::obb_rotations})
         p.work[size_t(f)] = s[size_t(f)] * r;
     p.work[size_t(WorkField::tri_tests)] =
         std::max(0.0, p.work[size_t(WorkField::tri_tests)] - p.work[size_t(WorkField::mailbox_hits)]);

@@ -22,7 +22,7 @@ RESOURCES = {
     "treelet_scheduling", "divergence", "structure", "execution_model", "ray_order", "prefetch",
     "treelets",
 }  # fmt: skip
-PIPELINES = {"box", "triangle", "anyhit", "transform", "cell", "plane"}
+PIPELINES = {"box", "triangle", "anyhit", "transform", "cell", "plane", "obb"}
 
 
 @pytest.fixture(scope="module")

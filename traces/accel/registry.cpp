@@ -16,6 +16,7 @@
 #include "traces/accel/grid/grid.h"
 #include "traces/accel/kdtree/kdtree.h"
 #include "traces/accel/leaf_blocks.h"
+#include "traces/accel/obvh/obvh.h"
 #include "traces/accel/octree/octree.h"
 #include "traces/accel/two_level/two_level.h"
 #include "traces/accel/wide/wide.h"
@@ -43,6 +44,7 @@ struct BuildSettings {
     BihConfig bih;
     OctreeConfig octree;
     GkConfig gk;
+    ObbConfig obb;
     LeafConfig leaves;  ///< every kind's leaf layout (plain or compressed)
 };
 
@@ -254,6 +256,23 @@ const std::vector<Entry>& registry() {
          },
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) { return gkbvh_image(scene, o.builder, s.bvh, s.gk); },
          loader<Bvh2Accel>()},
+        {{"obvh2", "binary BVH whose nodes may hold their child boxes in a rotated frame (oriented boxes, as RDNA 4)",
+          tree_builder_names(),
+          single_level(kBvhStackEntryBytes)
+              .with(&AccelCapabilities::anyhit_order)
+              .with(&AccelCapabilities::stack_addresses)},
+         [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
+             tree_settings(builder, s, v);
+             s.obb.visit(v);
+         },
+         [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
+             nlohmann::json extra = nlohmann::json::object();
+             const BuildTree tree = build_tree(scene, o, s, &extra);
+             AccelImage image = obvh2_image(tree, scene, s.bvh, s.obb, o.builder, std::max(1u, o.build_threads));
+             image.stats.update(extra);
+             return image;
+         },
+         loader<ObvhAccel>()},
         {{"bkd", "B-Kd tree: two intervals per 20-byte node on one axis, no duplicates (Woop et al. 2006)",
           tree_builder_names(),
           single_level(kBkdStackEntryBytes).with(&AccelCapabilities::packet_kernel).with(&AccelCapabilities::refit)},

@@ -34,7 +34,9 @@
 // the full stack's, which the reference fields keep counting unchanged. The TLAS's share of a
 // two-level walk's steps and box tests (docs/accel.md, "Two-level structures"). The extra work of
 // a reduced-precision box pipeline: the subtrees its looser test enters that the fp32 test does
-// not (docs/accel.md, "Reduced-precision box tests"), on top of the reference work.
+// not (docs/accel.md, "Reduced-precision box tests"), on top of the reference work. The rotations
+// of an oriented BVH (docs/accel.md, "Oriented boxes"): one per step at an oriented node, so the
+// steps and the image determine them and the trace need not carry them.
 #define RTSIM_MODEL_WORK_FIELDS(X)                                                                  \
     X(mailbox_lookups, kNoOpKind, false, "primitive references looked up in the ray's mailbox")    \
     X(mailbox_hits, kNoOpKind, false, "references found there: triangle neither fetched nor tested") \
@@ -47,7 +49,8 @@
     X(rp_box_hits, kNoOpKind, false, "reduced-precision boxes: entered, though fp32 rejects or culls them") \
     X(rp_steps, kNoOpKind, true, "reduced-precision boxes: node steps inside those boxes")           \
     X(rp_box_tests, kNoOpKind, false, "reduced-precision boxes: box tests of those steps")          \
-    X(rp_tri_tests, kNoOpKind, false, "reduced-precision boxes: triangle tests in their leaves (no hit)")
+    X(rp_tri_tests, kNoOpKind, false, "reduced-precision boxes: triangle tests in their leaves (no hit)") \
+    X(obb_rotations, OpKind::obb, false, "oriented boxes: ray rotations into oriented nodes' frames (obvh2)")
 
 #define RTSIM_ALL_WORK_FIELDS(X) RTSIM_WORK_FIELDS(X) RTSIM_MODEL_WORK_FIELDS(X)
 
@@ -85,12 +88,13 @@ struct WorkCounts {
     }
     /// What a trace records for the same traversal: without the mailbox, without a short
     /// stack's restarts and reduced-precision boxes' extra work (both on top of the reference
-    /// walk's) and the TLAS's share.
+    /// walk's), the TLAS's share and an oriented BVH's rotations.
     WorkCounts traced() const {
         WorkCounts w = without_mailbox();
         w.stack_drops = w.restarts = w.restart_steps = w.restart_box_tests = 0;
         w.tlas_steps = w.tlas_box_tests = 0;
         w.rp_box_hits = w.rp_steps = w.rp_box_tests = w.rp_tri_tests = 0;
+        w.obb_rotations = 0;
         return w;
     }
 };

@@ -18,7 +18,7 @@ inline const std::vector<std::string>& partition_kinds() {
     static const std::vector<std::string> kinds = {"kdtree",      "bih",          "bih:wachter_keller", "bih:lbvh",
                                                    "octree",      "bvh2:lbvh",    "bvh2:sweep",         "bvh2:median",
                                                    "bkd",         "bkd:sweep",    "bkd:median",         "gkbvh",
-                                                   "gkbvh:boxes", "bih:sweep"};
+                                                   "gkbvh:boxes", "bih:sweep",    "obvh2",              "obvh2:sbvh"};
     return kinds;
 }
 

@@ -102,9 +102,7 @@ inline WorkCounts tally_plans(Stepper& s, const Ray& ray, TraversalMode mode, in
         }
         for (int i = 0; i < p.op_count; ++i) {
             const Op& op = p.op[i];
-            (op.kind == OpKind::box ? w.box_tests : op.kind == OpKind::triangle ? w.tri_tests
-                                                  : op.kind == OpKind::cell     ? w.cell_steps
-                                                                                : w.plane_tests) += op.count;
+            w[work_field_of(op.kind)] += op.count;  // the counter declared to count the kind's tests
         }
         const StepOutcome out = s.execute();
         for (int i = 0; i < out.op_count; ++i) w.anyhit_calls += out.op[i].count;

@@ -49,6 +49,7 @@ void Bvh2Stepper::begin(const Ray& ray, TraversalMode mode) {
     // While traversing, m_hit.t is the current best distance (the shrinking tmax).
     m_hit.t = ray.tmax;
     m_cull_t = cull_distance(ray.tmax);
+    if (m_view.rotations) m_obb_pad = obb_pad(ray.origin, m_view.scene_radius);
     m_ref = 0;
     m_count = 0;
     plan_next();
@@ -61,6 +62,7 @@ void Bvh2Stepper::plan_at(uint32_t ref, uint32_t count) {
         m_plan.reset(ref);
         m_plan.set_host(&m_view.nodes[ref], sizeof(HwNode));
         m_plan.add_fetch(m_view.node_base + uint64_t(ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+        if (m_view.oriented(ref)) m_plan.add_op(OpKind::obb, 1);
         m_plan.add_op(OpKind::box, 2);
     } else {
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
@@ -97,6 +99,19 @@ uint32_t Bvh2Stepper::stack_reads(Fetch* out, uint32_t max) const {
     return tree_stack_reads(m_stack, m_stack_size, m_view.node_base, uint32_t(sizeof(HwNode)), m_view.tri_at, out, max);
 }
 
+bool Bvh2Stepper::descend_oriented(const HwNode& node, AnyHitOrder order) {
+    m_work.obb_rotations += 1;
+    const float* m = m_view.rotation_table + 9 * size_t(m_view.rotations[m_ref]);
+    Ray local = m_ray;
+    local.origin = obb_rotate(m, m_ray.origin);
+    local.direction = obb_rotate(m, m_ray.direction);
+    const RayBoxPre pre = ray_box_precompute(local);
+    HwNode widened = node;
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 2; ++c) widened.lo(c, a) -= m_obb_pad, widened.hi(c, a) += m_obb_pad;
+    return detail::descend(pre, widened, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count, order);
+}
+
 void Bvh2Stepper::visit_node(const HwNode& node) {
     // Nearer child next (child 0 on equal entry distances; any-hit rays by their order); the other pushed.
     const int before = m_stack_size;
@@ -104,8 +119,11 @@ void Bvh2Stepper::visit_node(const HwNode& node) {
     float rp_tnear[2];
     if (m_rp.enabled()) rp_tests(node, rp_tnear);
     const AnyHitOrder order = m_mode == TraversalMode::any_hit ? m_anyhit_order : AnyHitOrder::nearest;
-    if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count, order))
-        return pop_next();
+    const bool entered = m_view.oriented(m_ref)
+                             ? descend_oriented(node, order)
+                             : detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size,
+                                               &m_ref, &m_count, order);
+    if (!entered) return pop_next();
     if (m_rp.enabled() && m_stack_size > before) {
         const detail::Bvh2StackEntry& pushed = m_stack[m_stack_size - 1];
         const int slot = pushed.ref == node.child_ref[0] && pushed.count == node.child_count[0] ? 0 : 1;

@@ -9,6 +9,9 @@
 // a leaf step fetches its HwTriangles (contiguous) and runs one triangle test each, plus an
 // alpha test for each MASK triangle hit (reported by execute()).
 //
+// An oriented node (obvh2) is one step of the same fetch with a ray rotation (an `obb`
+// operation) ahead of its 2 box tests, which run in the node's frame.
+//
 // With a short stack (set by the Accel; traces/accel/short_stack.h) a restart's re-descent adds
 // node steps of the same shape, counted in the model-only restart fields. With reduced-precision
 // box tests (traces/accel/rp_boxes.h) the subtrees only the narrower test enters add node and
@@ -17,6 +20,7 @@
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
 #include "traces/accel/leaf_blocks.h"
+#include "traces/accel/obvh/obvh_rotate.h"
 #include "traces/accel/rp_boxes.h"
 #include "traces/accel/short_stack.h"
 #include "traces/accel/stepper.h"
@@ -34,6 +38,13 @@ struct Bvh2View {
     uint64_t triangle_count = 0;
     uint64_t node_base = 0;      ///< address of node 0
     TriangleAddressing tri_at;   ///< where triangles' bytes are (plain or compressed leaves)
+    /// Oriented nodes only (obvh2, traces/accel/obvh/obvh.h): node i's child boxes lie in the
+    /// frame of row-major 3x3 rotation_table[9 * rotations[i]] (kNoRotation: the world's axes).
+    const uint8_t* rotations = nullptr;
+    const float* rotation_table = nullptr;
+    float scene_radius = 0.0f;  ///< every point of the scene within it of the origin (the rotation's error bound)
+
+    bool oriented(uint32_t node) const { return rotations && rotations[node] != kNoRotation; }
 };
 
 class Bvh2Stepper final : public Stepper {
@@ -63,12 +74,15 @@ private:
     void rp_tests(const HwNode& node, float tnear[2]);
     void rp_step();  ///< one step of the extra walk (rp_boxes.h)
     void finish();  ///< the plan is done; a ray without a hit reports Hit{} (t = +inf)
+    /// An oriented node's step: the ray rotated into its frame, its boxes widened (obvh_rotate.h).
+    bool descend_oriented(const HwNode& node, AnyHitOrder order);
 
     Bvh2View m_view;
     AnyHitOrder m_anyhit_order;  ///< child order of any-hit rays (closest-hit: nearest first)
     RayBoxPre m_box;
     RayTrianglePre m_tri;
     float m_cull_t = 0.0f;  ///< boxes entered beyond this are culled: best t widened
+    float m_obb_pad = 0.0f;  ///< oriented nodes: how far their boxes are widened for this ray
     uint32_t m_ref = 0;     ///< node index, or first triangle of a leaf
     uint32_t m_count = 0;   ///< 0: m_ref is a node; else the leaf's triangle count
     detail::Bvh2StackEntry m_stack[kTraversalStackSize];

@@ -1,0 +1,191 @@
+// The oriented BVH (obvh2) beyond what the space-partitioning tests sweep (hits against brute
+// force and bvh2 on soups and the axis-aligned hard cases: test_space_partition.cpp): its
+// rotation table, the fit (every triangle inside every box on its path, in each node's frame;
+// rotated geometry gets oriented nodes and a lower SAH cost), hard cases on geometry lying in a
+// rotated frame (rays along its faces and edges, through its vertices, at large and small
+// scales), the work an oriented step adds, and validation of corrupt images.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "space_partition_util.h"
+#include "traces/accel/obvh/obvh.h"
+#include "traces/common/error.h"
+#include "traces/scene/procedural.h"
+
+namespace rtsim {
+namespace {
+
+using test::build_named;
+using test::expect_structure_correct;
+
+const ObvhAccel& obvh(const Accel& a) { return static_cast<const ObvhAccel&>(a); }
+
+TEST(Obvh, RotationTableIsOrthonormalAndFitsSevenBits) {
+    for (uint32_t steps : {2u, 16u, 32u, 43u}) {
+        const std::vector<Rotation> table = obb_rotation_table(steps);
+        EXPECT_EQ(table.size(), 3 * (steps - 1));
+        EXPECT_LT(table.size(), size_t(kNoRotation));
+        for (const Rotation& m : table)
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) {
+                    double dot = 0;
+                    for (int k = 0; k < 3; ++k) dot += double(m[3 * i + k]) * m[3 * j + k];
+                    EXPECT_NEAR(dot, i == j ? 1.0 : 0.0, 1e-6);
+                }
+    }
+    EXPECT_THROW(obb_rotation_table(44), Error);
+    EXPECT_THROW(obb_rotation_table(1), Error);
+}
+
+/// Every triangle of a subtree lies inside the box its parent holds for it, in the parent's frame
+/// (the fit's boxes bound the same float rotation, so exactly). Spatial splits clip the
+/// axis-aligned boxes to parts of triangles (`clipped`): only the oriented ones hold them whole.
+void expect_boxes_contain_triangles(const ObvhAccel& a, const std::string& what, bool clipped = false) {
+    const Bvh2View& v = a.view();
+    std::vector<std::pair<uint32_t, uint32_t>> range(v.node_count);  // each node's triangles
+    for (uint64_t i = v.node_count; i-- > 0;) {
+        uint32_t lo = UINT32_MAX, hi = 0;
+        for (int c = 0; c < 2; ++c) {
+            const uint32_t k = v.nodes[i].child_count[c], ref = v.nodes[i].child_ref[c];
+            if (k == kEmptyChild) continue;
+            const auto r = k == 0 ? range[ref] : std::make_pair(ref, ref + k);
+            lo = std::min(lo, r.first), hi = std::max(hi, r.second);
+        }
+        range[i] = {lo, hi};
+    }
+    int outside = 0;
+    for (uint64_t i = 0; i < v.node_count; ++i) {
+        const float* m = v.oriented(uint32_t(i)) ? v.rotation_table + 9 * v.rotations[i] : nullptr;
+        if (!m && clipped) continue;
+        for (int c = 0; c < 2; ++c) {
+            const HwNode& n = v.nodes[i];
+            if (n.child_count[c] == kEmptyChild) continue;
+            const auto r = n.child_count[c] == 0 ? range[n.child_ref[c]]
+                                                 : std::make_pair(n.child_ref[c], n.child_ref[c] + n.child_count[c]);
+            for (uint32_t t = r.first; t < r.second; ++t)
+                for (const float* p : {v.triangles[t].v0, v.triangles[t].v1, v.triangles[t].v2}) {
+                    const Vec3 q = m ? obb_rotate(m, Vec3(p[0], p[1], p[2])) : Vec3(p[0], p[1], p[2]);
+                    for (int ax = 0; ax < 3; ++ax) outside += q[ax] < n.lo(c, ax) || q[ax] > n.hi(c, ax);
+                }
+        }
+    }
+    EXPECT_EQ(outside, 0) << what;
+}
+
+TEST(Obvh, BoxesContainTheirTrianglesInEachFrame) {
+    expect_boxes_contain_triangles(obvh(*build_named(test::random_soup(1, 1500), "obvh2", {{"obb_min_gain", 0.0}})),
+                                   "soup");
+    for (const char* name : {"rotated_walls", "hairball", "teapot_stadium"})
+        for (const char* kind : {"obvh2", "obvh2:sbvh"})
+            expect_boxes_contain_triangles(obvh(*build_named(test::procedural(name), kind)), std::string(name) + " " + kind,
+                                           std::string(kind) == "obvh2:sbvh");
+}
+
+TEST(Obvh, RotatedGeometryGetsOrientedNodesAndALowerSah) {
+    const Scene& scene = test::procedural("rotated_walls");
+    const auto a = build_named(scene, "obvh2");
+    const nlohmann::json& s = a->image().stats["obvh2"];
+    EXPECT_GT(s["oriented_fraction"].get<double>(), 0.05);
+    EXPECT_LT(s["child_area_ratio"].get<double>(), 0.95);
+    EXPECT_LT(a->image().stats["sah_cost"].get<double>(), a->image().stats["sah_cost_aabb"].get<double>());
+    // The tree is bvh2's: the axis-aligned SAH cost is the binary BVH's.
+    EXPECT_DOUBLE_EQ(a->image().stats["sah_cost_aabb"].get<double>(),
+                     build_named(scene, "bvh2")->image().stats["sah_cost"].get<double>());
+}
+
+TEST(Obvh, WithoutOrientationsItWalksAsTheBinaryBvh) {
+    const Scene& scene = test::procedural("teapot_stadium");
+    const auto a = build_named(scene, "obvh2", {{"obb_min_gain", 1.0}});
+    EXPECT_EQ(a->image().stats["obvh2"]["oriented_nodes"].get<uint64_t>(), 0u);
+    const auto b = build_named(scene, "bvh2");
+    for (const Ray& r : test::random_rays(scene, test::hw_triangles(scene), 3, 500))
+        for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+            WorkCounts wa, wb;
+            a->trace(r, mode, &wa);
+            b->trace(r, mode, &wb);
+            EXPECT_EQ(wa, wb);
+        }
+}
+
+TEST(Obvh, AnOrientedStepAddsOneRotationAheadOfItsBoxTests) {
+    const Scene& scene = test::procedural("rotated_walls");
+    const auto a = build_named(scene, "obvh2");
+    std::unique_ptr<Stepper> s = a->make_stepper();
+    uint64_t rotations = 0;
+    for (const Ray& r : test::random_rays(scene, test::hw_triangles(scene), 4, 300)) {
+        s->begin(r, TraversalMode::closest_hit);
+        while (!s->done()) {
+            const StepPlan& p = s->plan();
+            for (int i = 0; i < p.op_count; ++i)
+                if (p.op[i].kind == OpKind::obb) {
+                    EXPECT_EQ(p.op[i].count, 1u);
+                    ASSERT_LT(i + 1, int(p.op_count));
+                    EXPECT_EQ(p.op[i + 1].kind, OpKind::box);  // the rotation first: the tests need it
+                }
+            s->execute();
+        }
+        EXPECT_LE(s->work().obb_rotations, s->work().steps);
+        rotations += s->work().obb_rotations;
+    }
+    EXPECT_GT(rotations, 0u);
+}
+
+/// A tessellated cube turned by table rotation `index` (world = m^T local) and its lattice rays
+/// turned alike: faces, edges and vertices lie on an oriented node's box planes.
+TEST(ObvhHardCases, FacesEdgesVerticesOfRotatedGeometryAndScales) {
+    const std::vector<Rotation> table = obb_rotation_table(ObbConfig{}.angle_steps);
+    const std::vector<Vec3> unit = test::tessellated_cube(8);
+    for (size_t index : {size_t(5), size_t(40), size_t(77)})
+        for (const auto& [scale, offset] : std::vector<std::pair<float, float>>{{1.0f, 0.0f}, {1e12f, 0.0f},
+                                                                              {1e-12f, 0.0f}, {1.0f, 1e6f}}) {
+            const Rotation& m = table[index];
+            const Rotation mt{m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8]};
+            std::vector<Vec3> soup;
+            for (const Vec3& v : unit) soup.push_back(Vec3(offset) + obb_rotate(mt.data(), scale * v));
+            const Scene scene = test::make_scene(soup);
+            std::vector<Ray> rays;
+            for (const Ray& r : test::lattice_rays(scale, Vec3(0.0f))) {
+                Ray t = r;
+                t.origin = Vec3(offset) + obb_rotate(mt.data(), r.origin);
+                t.direction = obb_rotate(mt.data(), r.direction);
+                rays.push_back(t);
+            }
+            const std::string what = "cube turned by rotation " + std::to_string(index) + " x " +
+                                     std::to_string(scale) + " + " + std::to_string(offset);
+            const auto a = build_named(scene, "obvh2", {{"obb_min_gain", 0.0}});
+            EXPECT_GT(a->image().stats["obvh2"]["oriented_nodes"].get<uint64_t>(), 0u) << what;
+            EXPECT_GT(expect_structure_correct(*a, scene, rays, what), 300) << what;
+        }
+}
+
+TEST(Obvh, CorruptImagesAreRefusedNamingTheCulprit) {
+    const Scene scene = test::random_soup(2, 300);
+    AccelOptions o;
+    o.kind = "obvh2";
+    const AccelImage good = build_accel(scene, o);
+    auto refused = [&](const std::function<void(AccelImage&)>& corrupt, const std::string& expect) {
+        AccelImage bad = good;
+        corrupt(bad);
+        try {
+            load_accel(std::move(bad), "bad.rtt");
+            ADD_FAILURE() << "accepted: " << expect;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+        }
+    };
+    refused([](AccelImage& i) { i.region("nodes").records<HwObbNode>()[0].rotation = 126; }, "names rotation 126");
+    refused([](AccelImage& i) { i.params["rotations"][0][4] = 2.0; }, "rotation 0 has an entry");
+    refused([](AccelImage& i) { i.params["rotations"][1] = nlohmann::json::array({1, 0}); }, "rotation 1 is not a 3x3");
+    refused([](AccelImage& i) { i.params.erase("rotations"); }, "params.rotations");
+    refused([](AccelImage& i) { i.region("nodes").records<HwObbNode>()[0].child_ref[0] = 0; }, "node 0 child 0");
+    // Short stacks and reduced-precision boxes are not built for oriented nodes.
+    const auto a = load_accel(AccelImage(good), "good");
+    StepOptions step;
+    step.box_precision_bits = 8;
+    EXPECT_THROW(a->make_stepper(step), Error);
+}
+
+}  // namespace
+}  // namespace rtsim

@@ -1,0 +1,184 @@
+// The oriented BVH's build: the binary tree flattened as a bvh2, then each node's rotation fitted
+// (obvh.h).
+#include <algorithm>
+#include <cmath>
+#include <thread>
+
+#include "traces/accel/bvh2/bvh2.h"
+#include "traces/accel/obvh/obvh.h"
+#include "traces/accel/obvh/obvh_rotate.h"
+#include "traces/common/error.h"
+#include "traces/scene/scene.h"
+
+namespace rtsim {
+
+std::vector<Rotation> obb_rotation_table(uint32_t angle_steps) {
+    require(angle_steps >= 2 && 3 * (angle_steps - 1) < kNoRotation,
+            "obvh2: obb_angle_steps must be 2 to 43 (at most 126 rotations and the 7-bit 'none')");
+    std::vector<Rotation> table;
+    for (int axis = 0; axis < 3; ++axis)
+        for (uint32_t k = 1; k < angle_steps; ++k) {
+            const double a = k * (M_PI / 2) / angle_steps;
+            const float c = float(std::cos(a)), s = float(std::sin(a));
+            // Rotation about `axis`: the other two axes (u, v) turn by the angle.
+            const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+            Rotation m{};
+            m[3 * axis + axis] = 1.0f;
+            m[3 * u + u] = c, m[3 * u + v] = -s;
+            m[3 * v + u] = s, m[3 * v + v] = c;
+            table.push_back(m);
+        }
+    return table;
+}
+
+namespace {
+
+double obb_half_area(const Aabb& b) {
+    if (b.empty()) return 0.0;
+    const glm::dvec3 e = glm::dvec3(b.hi) - glm::dvec3(b.lo);
+    return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+Aabb obb_slot_aabb(const HwNode& n, int c) {
+    Aabb b;
+    if (n.child_count[c] == kEmptyChild) return b;
+    for (int a = 0; a < 3; ++a) b.lo[a] = n.lo(c, a), b.hi[a] = n.hi(c, a);
+    return b;
+}
+
+/// The best frame found for one node: its rotation, the summed child area there, both boxes.
+struct ObbNodeFit {
+    double cost = 0.0;
+    uint8_t rotation = kNoRotation;
+    Aabb box[2];
+};
+
+/// Tries rotations [first, last) on every node, keeping in `fits` each node's best below its
+/// current cost (a lower index wins ties: the result does not depend on how rotations are split
+/// among threads).
+void fit_rotations(const HwNode* nodes, uint64_t count, const HwTriangle* tris, const std::vector<Rotation>& table,
+                   size_t first, size_t last, std::vector<ObbNodeFit>& fits) {
+    std::vector<Aabb> subtree(count);
+    for (size_t r = first; r < last; ++r) {
+        const float* m = table[r].data();
+        // Children come after their parents (depth-first layout): one backward pass is bottom-up.
+        for (uint64_t i = count; i-- > 0;) {
+            const HwNode& n = nodes[i];
+            Aabb box[2];
+            for (int c = 0; c < 2; ++c) {
+                const uint32_t k = n.child_count[c];
+                if (k == kEmptyChild) continue;
+                if (k == 0) {
+                    box[c] = subtree[n.child_ref[c]];
+                    continue;
+                }
+                for (uint32_t t = n.child_ref[c]; t < n.child_ref[c] + k; ++t) {
+                    box[c].grow(obb_rotate(m, Vec3(tris[t].v0[0], tris[t].v0[1], tris[t].v0[2])));
+                    box[c].grow(obb_rotate(m, Vec3(tris[t].v1[0], tris[t].v1[1], tris[t].v1[2])));
+                    box[c].grow(obb_rotate(m, Vec3(tris[t].v2[0], tris[t].v2[1], tris[t].v2[2])));
+                }
+            }
+            subtree[i] = box[0];
+            subtree[i].grow(box[1]);
+            const double cost = obb_half_area(box[0]) + obb_half_area(box[1]);
+            ObbNodeFit& f = fits[i];
+            if (cost < f.cost) f = ObbNodeFit{cost, uint8_t(r), {box[0], box[1]}};
+        }
+    }
+}
+
+}  // namespace
+
+AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildConfig& config, const ObbConfig& obb,
+                       const std::string& builder, unsigned threads) {
+    const std::vector<Rotation> table = obb_rotation_table(obb.angle_steps);
+    AccelImage flat = bvh2_image(tree, scene, config, builder);
+    const Region& flat_nodes = flat.region("nodes");
+    const Region& flat_tris = flat.region("triangles");
+    const HwNode* nodes = flat_nodes.records<HwNode>();
+    const HwTriangle* tris = flat_tris.records<HwTriangle>();
+    const uint64_t count = flat_nodes.count;
+
+    // Each node starts at its axis-aligned children's area, lowered by the gain it must beat.
+    std::vector<ObbNodeFit> start(count);
+    std::vector<double> aabb_cost(count);
+    for (uint64_t i = 0; i < count; ++i) {
+        aabb_cost[i] = obb_half_area(obb_slot_aabb(nodes[i], 0)) + obb_half_area(obb_slot_aabb(nodes[i], 1));
+        start[i].cost = aabb_cost[i] * (1.0 - double(obb.min_gain));
+    }
+    // Rotations split among threads, each with its own fits, merged in rotation order.
+    const size_t workers = std::max<size_t>(1, std::min<size_t>(threads ? threads : 1, table.size()));
+    std::vector<std::vector<ObbNodeFit>> fits(workers, start);
+    std::vector<std::thread> pool;
+    for (size_t w = 0; w < workers; ++w) {
+        const size_t first = table.size() * w / workers, last = table.size() * (w + 1) / workers;
+        auto job = [&, w, first, last] { fit_rotations(nodes, count, tris, table, first, last, fits[w]); };
+        if (w + 1 == workers) job();
+        else pool.emplace_back(job);
+    }
+    for (std::thread& t : pool) t.join();
+
+    AccelImage image;
+    image.kind = "obvh2";
+    image.bounds = flat.bounds;
+    Region& out = image.add_region<HwObbNode>("nodes", DataKind::node, count);
+    Region& out_tris = image.add_region<HwTriangle>("triangles", DataKind::triangle, flat_tris.count, false);
+    std::copy(tris, tris + flat_tris.count, out_tris.records<HwTriangle>());
+    HwObbNode* o = out.records<HwObbNode>();
+    uint64_t oriented = 0;
+    double area_before = 0, area_after = 0;
+    std::vector<double> slot_area(2 * count, 0.0);  // each child slot's area in its node's frame
+    for (uint64_t i = 0; i < count; ++i) {
+        const HwNode& n = nodes[i];
+        const ObbNodeFit* best = &start[i];
+        for (const std::vector<ObbNodeFit>& f : fits)
+            if (f[i].cost < best->cost) best = &f[i];  // workers in rotation order: ties keep the lower
+        const bool rotate = best->rotation != kNoRotation;
+        o[i].rotation = best->rotation;
+        for (int c = 0; c < 2; ++c) {
+            require(n.child_count[c] == kEmptyChild || n.child_count[c] < kObbEmptyChild,
+                    "obvh2: a leaf of " + std::to_string(n.child_count[c]) + " triangles (at most 65534)");
+            o[i].child_ref[c] = n.child_ref[c];
+            o[i].child_count[c] = n.child_count[c] == kEmptyChild ? kObbEmptyChild : uint16_t(n.child_count[c]);
+            const Aabb box = rotate ? best->box[c] : obb_slot_aabb(n, c);
+            for (int a = 0; a < 3; ++a) {
+                o[i].bounds[a][0][c] = n.child_count[c] == kEmptyChild ? n.lo(c, a) : box.lo[a];
+                o[i].bounds[a][1][c] = n.child_count[c] == kEmptyChild ? n.hi(c, a) : box.hi[a];
+            }
+            slot_area[2 * i + c] = obb_half_area(box);
+        }
+        oriented += rotate;
+        area_before += aabb_cost[i];
+        area_after += rotate ? best->cost : aabb_cost[i];
+    }
+    image.leaf_starts = flat.leaf_starts;
+    nlohmann::json rotations = nlohmann::json::array();
+    for (const Rotation& m : table) rotations.push_back(m);
+    image.params["rotations"] = rotations;
+    image.place_regions();
+
+    // SAH cost with each node's box as its parent holds it (in the parent's frame).
+    const double root = obb_half_area(flat.bounds);
+    auto weight = [root](double a) { return root > 0 ? a / root : 1.0; };
+    double sah = count ? config.traversal_cost : 0.0;
+    for (uint64_t i = 0; i < count; ++i)
+        for (int c = 0; c < 2; ++c) {
+            const uint32_t k = nodes[i].child_count[c];
+            if (k == kEmptyChild) continue;
+            sah += (k == 0 ? double(config.traversal_cost) : double(config.intersection_cost) * k) *
+                   weight(slot_area[2 * i + c]);
+        }
+    image.stats = flat.stats;
+    image.stats["sah_cost_aabb"] = flat.stats["sah_cost"];
+    image.stats["sah_cost"] = sah;
+    // The fit's wall time is in the build's (build_ms): a trace holds no wall times.
+    image.stats["obvh2"] = {{"rotations", table.size()},
+                            {"angle_steps", obb.angle_steps},
+                            {"min_gain", obb.min_gain},
+                            {"oriented_nodes", oriented},
+                            {"oriented_fraction", count ? double(oriented) / double(count) : 0.0},
+                            {"child_area_ratio", area_before > 0 ? area_after / area_before : 1.0}};
+    return image;
+}
+
+}  // namespace rtsim
