@@ -99,6 +99,7 @@ struct RayResult {
     Cycle end = 0;    ///< cycle its hit was written
     uint32_t unit = 0;     ///< traversal unit that traced it
     uint32_t context = 0;  ///< ray context within the unit
+    TraversalMode mode = TraversalMode::closest_hit;  ///< how it was traced (any-hit rays may be reordered)
 };
 
 /// Contract: called once per ray when it completes, in completion order.

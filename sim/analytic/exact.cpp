@@ -129,7 +129,7 @@ void AnalyticModel::step(uint32_t unit, uint32_t slot) {
     if (plan.done) {
         write(unit, m_map.hit(ctx.id), sizeof(HitRecord), DataKind::hit);  // posted
         const Cycle latency = ctx.clock - ctx.start;
-        m_sink.ray_done(RayResult{ctx.id, stepper.hit(), stepper.work(), 0, latency, unit, slot});
+        m_sink.ray_done(RayResult{ctx.id, stepper.hit(), stepper.work(), 0, latency, unit, slot, stepper.mode()});
         ++uc.rays;
         m_latency_sum += double(latency);
         m_latency_max = std::max(m_latency_max, latency);

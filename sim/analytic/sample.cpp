@@ -185,7 +185,7 @@ bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, 
 void SampleProfiler::finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink) {
     const Stepper& s = *ctx.stepper;
     write(m_map.hit(ctx.id), sizeof(HitRecord), DataKind::hit, ctx.measured);
-    sink.ray_done(RayResult{ctx.id, s.hit(), s.work(), 0, 0, unit, slot});
+    sink.ray_done(RayResult{ctx.id, s.hit(), s.work(), 0, 0, unit, slot, s.mode()});
     ++m_p.stepped_rays;
     if (!ctx.measured) return;
     const WorkCounts& w = s.work();

@@ -39,6 +39,9 @@ public:
     /// StepOptions::anyhit_order): its occlusion is checked against the trace, its hit primitive
     /// and work are the model's own (the stepper tests check them against trace()).
     void occlusion_done(const RayResult& r);
+    /// The run walks any-hit rays in another child order than the trace's: ray_done() checks
+    /// each any-hit ray by occlusion_done() (the levels that run such an order set it).
+    void set_reordered_anyhit(bool reordered) { m_reordered_anyhit = reordered; }
 
     uint64_t checked() const { return m_checked; }
     uint64_t hit_mismatches() const { return m_hit_mismatches; }
@@ -54,6 +57,7 @@ private:
     void check(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work);
 
     PacketReference m_packet_reference;
+    bool m_reordered_anyhit = false;
     ReferenceSource& m_reference;
     uint64_t m_total;
     Progress m_progress;

@@ -75,9 +75,8 @@ void trace_all(Accel& accel, const StepOptions& step, TraceReader& reader, HitCh
             } catch (const Error& e) {
                 throw Error(reader.path() + ": ray " + std::to_string(job.id) + ": " + e.what());
             }
-            // Any-hit rays in another child order than the trace's: occlusion checked alone.
-            if (mode == TraversalMode::any_hit && step.anyhit_order != AnyHitOrder::nearest) checker.occlusion_done(r);
-            else checker.ray_done(r);
+            r.mode = mode;
+            checker.ray_done(r);
         }
         jobs.clear();
     }
@@ -91,6 +90,8 @@ LevelResult run_functional_level(RunInputs& in) {
     const RunSetup& s = in.setup;
     ReferenceWindow reference(in.reader, s.config.dispatch.chunk_rays);
     HitChecker checker("checker", reference, built.rays, progress_of(in.options));
+    // Any-hit rays in another child order than the trace's: occlusion checked alone.
+    checker.set_reordered_anyhit(s.step.anyhit_order != AnyHitOrder::nearest);
     std::unique_ptr<FunctionalPackets> packets;
     if (s.packet_reference) {
         // Packets change each ray's work: it is checked against the reference packet loop.

@@ -71,6 +71,9 @@ LevelResult run_timed_level(RunInputs& in) {
     ReferenceWindow reference(in.reader, c.dispatch.chunk_rays);
     HitChecker checker("checker", sampled ? static_cast<ReferenceSource&>(sampled->reference) : reference, simulated,
                        progress_of(in.options));
+    // Any-hit rays in another child order than the trace's: occlusion checked alone, the
+    // model's own work timed and counted.
+    checker.set_reordered_anyhit(s.step.anyhit_order != AnyHitOrder::nearest);
     if (s.packet_reference) {
         // Packets change each ray's work: it is checked against the reference packet loop.
         const float split = s.packet_reference->split_below;

@@ -124,8 +124,8 @@ std::vector<Rule> make_rules() {
 
     add({"anyhit_order/structure", "traversal.anyhit_order (any-hit child order)", anyhit_reordered,
          RuleSide::structure, "an any-hit child order", [](const RunFacts& f) { return f.structure.caps.anyhit_order; },
-         "the order is chosen between a binary BVH node's two child boxes; other structures order their "
-         "children by their own rules",
+         "the order is chosen among a BVH node's child boxes (binary, wide and compressed BVHs); the kd-tree, "
+         "BIH, B-Kd tree, octree and grid visit near cells before far ones by their own rules",
          "traversal.anyhit_order=nearest, or trace a structure with the setting (rtsim capabilities)", "grid",
          {"traversal.anyhit_order=fixed"}});
     add({"anyhit_order/unit", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::unit,
@@ -134,12 +134,13 @@ std::vector<Rule> make_rules() {
          "traversal.model=mimd or simt, or traversal.anyhit_order=nearest", "bvh2",
          {"traversal.model=packet", "traversal.anyhit_order=largest_box"}});
     add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::level,
-         "the functional level", [](const RunFacts& f) { return f.config.fidelity == Fidelity::functional; },
-         "the other levels check each ray's hit and work against the trace's (or take the work from it), "
-         "traced nearest first; another order finds other occluders with other work. The functional level "
-         "checks its any-hit rays' occlusion alone (a trace traced in the run's order is not built yet)",
-         "fidelity=functional, or traversal.anyhit_order=nearest", "bvh2",
-         {"traversal.anyhit_order=fixed", "fidelity=approx"}});
+         "the functional level or a timed one (approx, detailed)",
+         [](const RunFacts& f) { return f.config.fidelity == Fidelity::functional || f.level.timed; },
+         "the analytic level takes the work of the rays it does not step from the trace, traced nearest first, "
+         "and another order finds other occluders with other work; the functional and timed levels step every "
+         "ray, check a reordered any-hit ray's occlusion against the trace and count and time its own walk",
+         "fidelity=functional, approx or detailed, or traversal.anyhit_order=nearest", "bvh2",
+         {"traversal.anyhit_order=fixed", "fidelity=analytic"}});
 
     // Sampling.
     add({"sampling/level", "sampling.fraction or sampling.count", sampling, RuleSide::level, "a timed level",

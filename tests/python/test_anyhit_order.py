@@ -1,6 +1,7 @@
-"""Any-hit child orders at the functional level (docs/accel.md, "Any-hit child order"): every
-reordered shadow ray keeps its occlusion, and the run reports its own work per ray beside the
-trace's nearest-first work, which equals the trace's own work records of those rays."""
+"""Any-hit child orders (docs/accel.md, "Any-hit child order") at the functional and timed
+levels, on a binary and an 8-wide BVH: every reordered shadow ray keeps its occlusion, and the run
+reports its own work per ray beside the trace's nearest-first work, which equals the trace's own
+work records of those rays; the timed levels walk exactly as the functional level does."""
 
 from __future__ import annotations
 
@@ -14,11 +15,11 @@ from conftest import checked, run_rtsim
 from rtsim.kinds import RAY_KINDS
 
 
-@pytest.fixture(scope="module")
-def trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    out = tmp_path_factory.mktemp("anyhit") / "cornell"
+@pytest.fixture(scope="module", params=["bvh2", "bvh8"])
+def trace(tmp_path_factory: pytest.TempPathFactory, request: pytest.FixtureRequest) -> Path:
+    out = tmp_path_factory.mktemp("anyhit") / f"cornell-{request.param}"
     made = run_rtsim("trace", "cornell", "-o", str(out), "--resolution", "24x18",
-                     "--workload", "primary,shadow")  # fmt: skip
+                     "--workload", "primary,shadow", "--accel", request.param)  # fmt: skip
     assert made.returncode == 0, made.stderr
     return out
 
@@ -26,17 +27,23 @@ def trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.mark.parametrize("order", ["largest_box", "fixed"])
 def test_reordered_rays_report_their_work(trace: Path, sim_exe: Path, tmp_path: Path,
                                           order: str) -> None:  # fmt: skip
-    stats = checked(sim_exe, trace, tmp_path / "run", "fidelity=functional",
-                    f"traversal.anyhit_order={order}")  # fmt: skip
-    v = stats["validation"]
-    assert v["hit_mismatches"] == 0
-    r = v["reordered_anyhit"]
-    t = rtsim.open_trace(trace)
-    shadow = t.rays["kind"] == RAY_KINDS.index("shadow")
-    assert r["rays"] == int(shadow.sum()) == stats["workload"]["occlusion_rays"]
-    for key in ("steps", "box_tests", "tri_tests"):
-        assert r["trace_order"][key] == pytest.approx(float(np.mean(t.work[key][shadow])))
-        assert r["own"][key] > 0
+    own = {}
+    for fidelity in ("functional", "approx", "detailed"):
+        stats = checked(sim_exe, trace, tmp_path / fidelity, f"fidelity={fidelity}",
+                        f"traversal.anyhit_order={order}")  # fmt: skip
+        v = stats["validation"]
+        assert v["hit_mismatches"] == v["work_mismatches"] == 0, fidelity
+        r = v["reordered_anyhit"]
+        t = rtsim.open_trace(trace)
+        shadow = t.rays["kind"] == RAY_KINDS.index("shadow")
+        assert r["rays"] == int(shadow.sum()) == stats["workload"]["occlusion_rays"]
+        for key in ("steps", "box_tests", "tri_tests"):
+            assert r["trace_order"][key] == pytest.approx(float(np.mean(t.work[key][shadow])))
+            assert r["own"][key] > 0
+        own[fidelity] = r["own"]
+        if fidelity != "functional":
+            assert stats["summary"]["cycles"] > 0
+    assert own["approx"] == own["detailed"] == own["functional"]
 
 
 def test_nearest_reorders_nothing(trace: Path, sim_exe: Path, tmp_path: Path) -> None:

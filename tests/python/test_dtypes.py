@@ -34,7 +34,7 @@ def test_section_records_match_the_documented_layouts() -> None:
     assert [f["name"] for f in fields if not f["traced"]] == [
         "mailbox_lookups", "mailbox_hits", "stack_drops", "restarts", "restart_steps",
         "restart_box_tests", "tlas_steps", "tlas_box_tests", "rp_box_hits", "rp_steps",
-        "rp_box_tests", "rp_tri_tests",
+        "rp_box_tests", "rp_tri_tests", "obb_rotations",
     ]  # fmt: skip
     assert [f["name"] for f in fields][: len(names)] == names
     assert list(WORK_DTYPE.names or ()) == names

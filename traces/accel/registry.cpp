@@ -181,6 +181,7 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
                               .with(&AccelCapabilities::restart_trail)
                               .with(&AccelCapabilities::reduced_precision_boxes)
                               .with(&AccelCapabilities::refit)
+                              .with(&AccelCapabilities::anyhit_order)
                               .with(&AccelCapabilities::stack_addresses);
     c.quantized_boxes = compressed;
     return {{name, description, tree_builder_names(), c}, tree_settings, build, load};

@@ -1,19 +1,20 @@
 """The any-hit child order (docs/accel.md, "Any-hit child order"): the work per shadow ray of
 each `traversal.anyhit_order` against the closest-hit order the trace walks.
 
-Each scene's camera and shadow rays (a scene without lights gets a sun: `lights: sun`) through a
-binary BVH, replayed at the functional level (the one level that runs another order: it checks
-every reordered ray's occlusion against the trace and counts its own work) with `largest_box` and
-`fixed`; `validation.reordered_anyhit` gives per shadow ray the steps, box and triangle tests in
-the run's order and in the trace's (nearest first, the default). Table between the
-`anyhit-order` markers of docs/accel.md."""
+Each scene's camera and shadow rays (a scene without lights gets a sun: `lights: sun`) through
+each structure (the binary BVH and the wide ones by default), replayed at `fidelity` (approx by
+default; the functional and timed levels step every ray, check a reordered one's occlusion
+against the trace and count and time its own walk) with `nearest`, `largest_box` and `fixed`;
+`validation.reordered_anyhit` gives per shadow ray the steps, box and triangle tests in the run's
+order and in the trace's (nearest first, the default), and the timed runs their speed. Table
+between the `anyhit-order` markers of docs/accel.md."""
 
 from __future__ import annotations
 
 from typing import Any
 
 from rtsim.study import Study, StudyRun, Table
-from rtsim.study.tables import change, markdown, scene
+from rtsim.study.tables import change, markdown, mismatches, scene
 
 ORDERS = ("largest_box", "fixed")
 #: Scenes that bring no light of their own: a sun gives them shadow rays.
@@ -31,39 +32,55 @@ def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
             "name": "anyhit-order",
             "scenes": scenes,
             "workloads": [workload],
-            "config": {"set": {"fidelity": "functional"}},
-            "grid": {"traversal.anyhit_order": list(ORDERS)},
+            "accel": list(o["accels"]),
+            "config": {"set": {"fidelity": o["fidelity"]}},
+            "grid": {"traversal.anyhit_order": ["nearest", *ORDERS]},
         }
     ]
 
 
 def table(run: StudyRun) -> str:
-    rows = []
-    for s in run.options["scenes"]:
+    rows, o = [], run.options
+    timed = o["fidelity"] in ("approx", "detailed")
+    for s, accel in ((s, a) for s in o["scenes"] for a in o["accels"]):
+        nearest = run.row(scene=s, accel=accel, **{"traversal.anyhit_order": "nearest"})
         base = None
         for order in ORDERS:
-            row = run.row(scene=s, **{"traversal.anyhit_order": order})
+            row = run.row(scene=s, accel=accel, **{"traversal.anyhit_order": order})
             v = run.stats(row)["validation"]
             r = v["reordered_anyhit"]
             if base is None:
                 base = r["trace_order"]
-                rows.append([f"`{s}`", "nearest (the trace's)", f"{r['rays']:,}",
+                rows.append([f"`{s}`", f"`{accel}`", "nearest (the trace's)", f"{r['rays']:,}",
                              *(f"{base[k]:.2f}" for k in ("steps", "box_tests", "tri_tests")),
-                             "", str(v["hit_mismatches"])])  # fmt: skip
+                             "", *([""] if timed else []),
+                             str(mismatches([nearest]))])  # fmt: skip
             own = r["own"]
-            rows.append(["", order, f"{r['rays']:,}",
+            ratio = row["mrays_per_second"] / nearest["mrays_per_second"] if timed else 0.0
+            speed = [f"{ratio:.3f}x"] if timed else []
+            rows.append(["", "", order, f"{r['rays']:,}",
                          *(f"{own[k]:.2f}" for k in ("steps", "box_tests", "tri_tests")),
                          change(own["steps"], base["steps"]) if base["steps"] else "n/a",
-                         str(v["hit_mismatches"])])  # fmt: skip
-    header = ["scene", "any-hit order", "shadow rays", "steps/ray", "box tests/ray",
-              "tri tests/ray", "steps vs nearest", "occlusion mismatches"]  # fmt: skip
+                         *speed, str(v["hit_mismatches"] + v["work_mismatches"])])  # fmt: skip
+    header = ["scene", "structure", "any-hit order", "shadow rays", "steps/ray", "box tests/ray",
+              "tri tests/ray", "steps vs nearest", *(["speed vs nearest"] if timed else []),
+              "mismatches"]  # fmt: skip
+    m = run.measured()
     note = (
-        f"Measured by `{run.command}`: `rtsim trace SCENE --workload primary,shadow "
-        f"--resolution {run.options['resolution']}` (bvh2, binned SAH; a sun added to a scene "
-        "without lights), then `rtsim-sim --set fidelity=functional --set "
-        "traversal.anyhit_order=ORDER`; per shadow ray, from `validation.reordered_anyhit`."
+        f"Measured by `{run.command}` on {m['host']} ({m['date']}): `rtsim trace SCENE --workload "
+        f"primary,shadow --resolution {o['resolution']} --accel ACCEL` (binned SAH; a sun added "
+        f"to a scene without lights), then `rtsim-sim --set fidelity={o['fidelity']} --set "
+        "traversal.anyhit_order=ORDER` at the default config; work per shadow ray, from "
+        "`validation.reordered_anyhit`"
+        + (
+            "; speed: the whole run's rays/s (camera and shadow rays) against the nearest-first "
+            "run's"
+            if timed
+            else ""
+        )
+        + "; mismatches: hit and work (a reordered any-hit ray: its occlusion against the trace)."
     )
-    return note + "\n\n" + markdown(header, "llrrrrrr", rows) + "\n"
+    return note + "\n\n" + markdown(header, "lllrrrrr" + "r" * (2 if timed else 1), rows) + "\n"
 
 
 STUDY = Study(
@@ -73,8 +90,10 @@ STUDY = Study(
     tables=[Table("accel.md", "anyhit-order", table)],
     options={
         "scenes": ["cornell", "hairball", "sponza"],
-        "resolution": "128x96",
+        "accels": ["bvh2", "bvh4", "bvh8", "cwbvh8"],
+        "fidelity": "approx",
+        "resolution": "64x48",
         "hairball_triangles": 200000,
     },
-    quick={"scenes": ["cornell"], "resolution": "16x12"},
+    quick={"scenes": ["cornell"], "accels": ["bvh2", "bvh8"], "resolution": "16x12"},
 )

@@ -205,7 +205,7 @@ Cycle MimdUnit::stack_traffic(uint32_t c, Cycle t, Cycle ready) {
 void MimdUnit::finish_ray(uint32_t c, Cycle t) {
     Context& ctx = m_contexts[c];
     const Stepper& s = *ctx.ray.stepper;
-    const RayResult r{ctx.ray.ray_id, s.hit(), s.work(), ctx.ray.start, t, m_index, c};
+    const RayResult r{ctx.ray.ray_id, s.hit(), s.work(), ctx.ray.start, t, m_index, c, s.mode()};
     m_tally.finish_ray(*mem[0], m_map, r);
     sink->ray_done(r);
     if (m_treelet_mode) ray_buffer->finished(t);

@@ -276,7 +276,8 @@ void PacketUnit::finish_packet(uint32_t p, Cycle t) {
     m_splits += s.counts().splits;
     m_split_steps += s.counts().split_steps;
     for (uint32_t i = 0; i < n; ++i) {
-        m_results[i] = RayResult{pk.ids[i], s.lane_hit(i), s.lane_work(i), pk.start, t, m_index, p * m_packet.lanes + i};
+        m_results[i] = RayResult{pk.ids[i], s.lane_hit(i), s.lane_work(i), pk.start, t, m_index, p * m_packet.lanes + i,
+                                 s.lane_mode(i)};
         m_tally.finish_ray(*mem[0], m_map, m_results[i]);
         m_rays[i] = s.lane_ray(i);
         m_modes[i] = s.lane_mode(i);

@@ -441,7 +441,7 @@ void SimtUnit::finish_lane(uint32_t l, Cycle t) {
     Lane& lane = m_lanes[l];
     account_until(m_account, lane.accounted, CycleUse::issue, t);  // done, waiting for its warp's step
     const Stepper& s = *lane.ray.stepper;
-    const RayResult r{lane.ray.ray_id, s.hit(), s.work(), lane.ray.start, t, m_index, l};
+    const RayResult r{lane.ray.ray_id, s.hit(), s.work(), lane.ray.start, t, m_index, l, s.mode()};
     m_tally.finish_ray(*mem[0], m_map, r);
     sink->ray_done(r);
     if (m_treelet_mode) ray_buffer->finished(t);

@@ -141,7 +141,7 @@ public:
 
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override {
         return std::make_unique<WideStepper<Codec>>(m_view, options.short_stack_entries, options.box_precision_bits,
-                                                    options.quantized_box_tests);
+                                                    options.quantized_box_tests, options.anyhit_order);
     }
     Hit trace(const Ray& ray, TraversalMode mode, WorkCounts* work = nullptr,
               const StepOptions& options = {}) const override {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "traces/accel/step_options.h"
 #include "traces/accel/wide/wide_layout.h"
 #include "traces/accel/wide/wide_tree.h"
 #include "traces/isect/ray_box_kernel.h"
@@ -122,6 +123,30 @@ __attribute__((always_inline)) inline int order_children(uint32_t mask, const fl
         out[i] = s;
     }
     return n;
+}
+
+/// Half the surface area of child slot s's box.
+inline float wide_half_area(const DecodedNode& n, int s) {
+    const float dx = n.hi[0][s] - n.lo[0][s], dy = n.hi[1][s] - n.lo[1][s], dz = n.hi[2][s] - n.lo[2][s];
+    return dx * dy + dy * dz + dz * dx;
+}
+
+/// The hit slots of an any-hit ray in an AnyHitOrder other than nearest (as order_children
+/// lays them out): largest_box puts larger child boxes first (more likely to hold an occluder,
+/// as the binary BVH's order), fixed keeps slot order (no sort). Equal areas keep the lower slot.
+inline int order_children_anyhit(uint32_t mask, const DecodedNode& n, AnyHitOrder order, uint8_t out[kMaxWideWidth]) {
+    int count = 0;
+    float area[kMaxWideWidth];
+    for (uint32_t m = mask; m; m &= m - 1) {
+        const uint8_t s = uint8_t(__builtin_ctz(m));
+        int i = count++;
+        if (order == AnyHitOrder::largest_box) {
+            area[s] = wide_half_area(n, s);
+            while (i > 0 && area[out[i - 1]] < area[s]) out[i] = out[i - 1], --i;
+        }
+        out[i] = s;
+    }
+    return count;
 }
 
 }  // namespace detail

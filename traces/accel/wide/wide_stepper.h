@@ -5,7 +5,8 @@
 // Steps: a node step fetches the node's bytes (several lines when it spans them: 128, 192, 256
 // bytes fp32; 64 or 80 compressed) and runs one box test per child (empty slots are neither
 // tested nor counted); its locality key is the node. The children hit are ordered
-// (wide_kernel.h): the first is visited next, the others pushed farthest first. A leaf step
+// (wide_kernel.h): the first is visited next, the others pushed farthest first; any-hit rays may
+// take another order (traversal.anyhit_order: larger boxes first, or slot order). A leaf step
 // fetches the leaf's triangles (contiguous) and runs one triangle test each, plus an alpha test
 // for each MASK triangle hit. Popped entries entered beyond the best hit are dropped unfetched.
 // Hit rules, cull distance and any-hit termination are every structure's (leaf_kernel.h).
@@ -52,8 +53,8 @@ public:
     /// quantized_box_tests: the narrower test is the integer test of quantised nodes (below;
     /// only codecs with kQuantized), instead of box_precision_bits' reduced fp test.
     explicit WideStepper(const WideView& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0,
-                         bool quantized_box_tests = false)
-        : m_view(view), m_stack(std::max<uint32_t>(1, view.max_stack)) {
+                         bool quantized_box_tests = false, AnyHitOrder anyhit_order = AnyHitOrder::nearest)
+        : m_view(view), m_anyhit_order(anyhit_order), m_stack(std::max<uint32_t>(1, view.max_stack)) {
         m_short.configure(short_stack_entries);
         if (m_short.enabled()) m_entry_depth.resize(m_stack.size());
         m_quantized = quantized_box_tests && Codec::kQuantized;
@@ -131,7 +132,9 @@ private:
         float rp_tnear[kMaxWideWidth];
         if (m_rp.enabled()) rp_tests(n, d, mask, rp_tnear);
         uint8_t order[kMaxWideWidth];
-        const int hits = detail::order_children(mask, tnear, m_view.order, m_octant, order);
+        const bool reordered = m_mode == TraversalMode::any_hit && m_anyhit_order != AnyHitOrder::nearest;
+        const int hits = reordered ? detail::order_children_anyhit(mask, d, m_anyhit_order, order)
+                                   : detail::order_children(mask, tnear, m_view.order, m_octant, order);
         if (m_short.enabled()) m_short.visit(m_ref, m_depth);
         if (hits == 0) return pop_next();
         for (int i = hits - 1; i >= 1; --i) {
@@ -261,6 +264,7 @@ private:
     static constexpr uint32_t kQuantizedTestBits = 8;
 
     WideView m_view;
+    AnyHitOrder m_anyhit_order;  ///< child order of any-hit rays (closest-hit: the view's order)
     bool m_quantized = false;  ///< quantised (integer) box tests drive the extra walk
     RayBoxPre m_box;
     RayTrianglePre m_tri;
