@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rtsim.config import MODIFIERS
 from rtsim.doc_markers import write_between
 from rtsim.launcher import SimJob, run_sim
 
@@ -61,9 +62,14 @@ class Run:
     sets: tuple[str, ...] = ()
 
 
+#: The `ddr4` modifier's second-order limits (tRAS, tRRD, tFAW, refresh) as --set assignments.
+DDR4 = tuple(f"dram.{k}={v}" for k, v in MODIFIERS["ddr4"]["dram"].items())
+
 RUNS = [
     Run("default (2 channels)"),
+    Run("ddr4 limits, 2 channels", DDR4),
     Run("1 channel", ("dram.channels=1",)),
+    Run("ddr4 limits, 1 channel", ("dram.channels=1", *DDR4)),
     Run("32 units, 1 channel", ("traversal.units=32", "dram.channels=1")),
 ]
 

@@ -7,6 +7,7 @@ namespace rtsim {
 DramBanks::DramBanks(const DramConfig& config)
     : m_config(config), m_close_page(config.page_policy == PagePolicy::close), m_banks(size_t(config.channels) * config.banks) {
     for (uint32_t c = 0; c < config.channels; ++c) m_buses.emplace_back(config.bytes_per_cycle, 1);
+    m_activates.resize(config.channels);
 }
 
 DramAddress DramBanks::map(uint64_t addr) const {
@@ -18,15 +19,6 @@ DramAddress DramBanks::map(uint64_t addr) const {
     a.bank = uint32_t((local / m_config.row_bytes) % m_config.banks);
     a.row = local / m_config.row_bytes / m_config.banks;
     return a;
-}
-
-Cycle DramBanks::to_column(RowResult r) const {
-    switch (r) {
-        case RowResult::hit: return 0;
-        case RowResult::miss: return m_config.t_rcd;
-        case RowResult::conflict: return Cycle(m_config.t_rp) + m_config.t_rcd;
-    }
-    return 0;
 }
 
 uint32_t DramBanks::Bank::upper_bound(Cycle time) {
@@ -47,8 +39,103 @@ void DramBanks::Bank::insert(uint32_t i, const Booking& b) {
     ++size;
     if (size > kKept) {  // forget the oldest (requests never arrive that far out of order)
         base_row = at(0).row;
+        base_activated = at(0).activated;
+        base_end = at(0).end;
         head = (head + 1) & (kRing - 1);
         --size;
+    }
+}
+
+namespace {
+constexpr size_t kActivatesKept = 32;  ///< per channel, for tRRD and tFAW
+}
+
+Cycle DramBanks::first_activate(uint32_t c, Cycle at) const {
+    const Cycle rrd = m_config.t_rrd, faw = m_config.t_faw;
+    if (rrd == 0 && faw == 0) return at;
+    const std::vector<Cycle>& acts = m_activates[c];
+    for (;;) {
+        bool moved = false;
+        for (const Cycle x : acts)
+            if (x + rrd > at && at + rrd > x) {  // within tRRD of another activate
+                at = x + rrd, moved = true;
+                break;
+            }
+        if (moved) continue;
+        if (faw) {
+            // Every window of tFAW cycles that would hold this activate: starting at it, or at an
+            // earlier activate less than tFAW before it. Four others in one: move past it.
+            auto others_in = [&](Cycle w) {
+                int n = 0;
+                for (const Cycle x : acts) n += x >= w && x < w + faw;
+                return n;
+            };
+            if (others_in(at) >= 4) at += 1, moved = true;
+            for (size_t i = 0; !moved && i < acts.size(); ++i)
+                if (acts[i] <= at && acts[i] + faw > at && others_in(acts[i]) >= 4) at = acts[i] + faw, moved = true;
+        }
+        if (!moved) return at;
+    }
+}
+
+void DramBanks::record_activate(uint32_t c, Cycle at) {
+    if (m_config.t_rrd == 0 && m_config.t_faw == 0) return;
+    std::vector<Cycle>& acts = m_activates[c];
+    acts.insert(std::upper_bound(acts.begin(), acts.end(), at), at);
+    if (acts.size() > kActivatesKept) acts.erase(acts.begin());
+}
+
+DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, Cycle burst, Cycle* end,
+                                  Cycle* activate) const {
+    const Cycle refi = m_config.t_refi, rfc = m_config.t_rfc;
+    Timing t;
+    for (;;) {
+        if (refi) {
+            // Refreshes at k x tREFI (k >= 1), tRFC long: start after one under way; a refresh
+            // since the bank went idle closed its row.
+            const Cycle last = s / refi * refi;
+            if (last >= refi && s < last + rfc) t.refresh_wait += last + rfc - s, s = last + rfc;
+            if (last >= refi && last >= open.idle_since) open.row = kClosed;
+        }
+        t.result = open.row == kClosed ? RowResult::miss
+                   : open.row == a.row && !m_close_page ? RowResult::hit
+                                                        : RowResult::conflict;
+        Cycle act = kNoActivate;
+        t.ras_wait = t.activate_wait = 0;
+        if (t.result == RowResult::hit) {
+            t.column = s;
+        } else {
+            Cycle want = s;
+            if (t.result == RowResult::conflict) {
+                // An access back-filled before the booking that left the row open (far out of
+                // order) has no activate before it to count tRAS from.
+                const Cycle precharge =
+                    open.activated <= s ? std::max<Cycle>(s, open.activated + m_config.t_ras) : s;
+                t.ras_wait = precharge - s;
+                want = precharge + m_config.t_rp;
+            }
+            act = first_activate(a.channel, want);
+            t.activate_wait = act - want;
+            t.column = act + m_config.t_rcd;
+        }
+        Cycle finish = t.column + burst;
+        if (m_close_page) {  // auto-precharge, no sooner than tRAS after the activate
+            const Cycle precharge = std::max<Cycle>(finish, act == kNoActivate ? 0 : act + m_config.t_ras);
+            finish = precharge + m_config.t_rp;
+        }
+        if (refi) {
+            const Cycle next = (s / refi + 1) * refi;
+            if (finish > next) {  // would run into the next refresh: after it, row closed
+                t.refresh_wait += next + rfc - s;
+                s = next + rfc;
+                open.row = kClosed;
+                continue;
+            }
+        }
+        t.start = s;
+        *end = finish;
+        *activate = act;
+        return t;
     }
 }
 
@@ -57,32 +144,30 @@ DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time) {
     Bank& bank = m_banks[size_t(a.channel) * m_config.banks + a.bank];
     const uint32_t bpc = m_config.bytes_per_cycle;
     const Cycle burst = (std::max<uint32_t>(bytes, 1) + bpc - 1) / bpc;
-    const Cycle tail = burst + (m_close_page ? m_config.t_rp : 0);  // after the column command
-    auto outcome = [&](uint64_t open) {
-        if (open == a.row && !m_close_page) return RowResult::hit;
-        return open == kClosed ? RowResult::miss : RowResult::conflict;
-    };
     // The first idle gap at or after `time` long enough for this access, given the row the
     // access before it leaves open.
     uint32_t next = bank.upper_bound(time);
-    uint64_t open = bank.base_row;
+    OpenRow open{bank.base_row, bank.base_activated, bank.base_end};
     Cycle s = time;
     if (next > 0) {
         const Booking& prev = bank.at(next - 1);
-        open = prev.row;
+        open = {prev.row, prev.activated, prev.end};
         s = std::max(s, prev.end);
     }
-    RowResult result = outcome(open);
-    for (; next < bank.size && s + to_column(result) + tail > bank.at(next).start; ++next) {
-        s = std::max(s, bank.at(next).end);
-        open = bank.at(next).row;
-        result = outcome(open);
+    Cycle end = 0, act = kNoActivate;
+    Timing t = plan(a, s, open, burst, &end, &act);
+    for (; next < bank.size && end > bank.at(next).start; ++next) {
+        const Booking& b = bank.at(next);
+        s = std::max(t.start, b.end);
+        open = {b.row, b.activated, b.end};
+        t = plan(a, s, open, burst, &end, &act);
     }
-    Timing t;
-    t.start = s;
-    t.result = result;
-    t.column = s + to_column(result);
-    bank.insert(next, Booking{s, t.column + tail, m_close_page ? kClosed : a.row});
+    const Cycle activated = act != kNoActivate ? act : open.activated;
+    bank.insert(next, Booking{t.start, end, m_close_page ? kClosed : a.row, activated});
+    if (act != kNoActivate) record_activate(a.channel, act);
+    m_ras_wait += t.ras_wait;
+    m_activate_wait += t.activate_wait;
+    m_refresh_wait += t.refresh_wait;
     // The burst takes the first free cycles of the channel's data bus from column + tCAS.
     SlotCalendar& bus = m_buses[a.channel];
     Cycle cycle = t.column + m_config.t_cas;
@@ -93,8 +178,8 @@ DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time) {
         left -= chunk;
     }
     t.done = cycle;
-    ++bank.counts[size_t(result)];
-    ++m_totals[size_t(result)];
+    ++bank.counts[size_t(t.result)];
+    ++m_totals[size_t(t.result)];
     return t;
 }
 
@@ -115,6 +200,9 @@ nlohmann::json DramBanks::stats_json() const {
             {"page_policy", kPagePolicyChoices.name(m_config.page_policy)},
             {"banks_per_channel", m_config.banks},
             {"row_bytes", m_config.row_bytes},
+            {"ras_wait_cycles", m_ras_wait},
+            {"activate_wait_cycles", m_activate_wait},
+            {"refresh_wait_cycles", m_refresh_wait},
             {"by_bank", by_bank}};
 }
 

@@ -16,6 +16,13 @@
 //   after column + tCAS; done = cycle after the last data cycle.
 //   the bank is busy from s to column + burst cycles (open page; the row stays open), or to
 //   column + burst + tRP with close page (auto-precharge: every access finds the bank closed).
+// Second-order limits, each off at 0 (dram_config.h): tRAS delays a precharge (a conflict's, or a
+// close page's auto-precharge) to at least tRAS after the row's activate; tRRD and tFAW delay an
+// activate until no other activate of the channel is within tRRD of it and no window of tFAW
+// cycles holds more than four (checked against the channel's last 32 activates, before and after
+// it in time); an all-bank refresh every tREFI cycles occupies each bank of the channel for tRFC
+// (an access that would overlap one starts after it) and closes every row. The gap a request
+// takes must fit its whole delayed service.
 // At detailed requests normally arrive in time order (units synchronise every cycle), and then
 // this is first come, first served; at approx units run up to a quantum apart, so requests
 // arrive out of order within a quantum and back-fill as below. Only the last 64 bookings per
@@ -58,6 +65,9 @@ public:
         Cycle column = 0;  ///< cycle of the column command
         Cycle done = 0;    ///< cycle after the last data cycle on the bus
         RowResult result = RowResult::miss;
+        Cycle ras_wait = 0;      ///< cycles the precharge waited for tRAS
+        Cycle activate_wait = 0; ///< cycles the activate waited for tRRD and tFAW
+        Cycle refresh_wait = 0;  ///< cycles the start waited for a refresh
     };
     /// Serves one request of `bytes` bytes arriving at `time`.
     Timing access(uint64_t addr, uint32_t bytes, Cycle time);
@@ -71,10 +81,18 @@ public:
 
 private:
     static constexpr uint64_t kClosed = ~0ull;
+    static constexpr Cycle kNoActivate = ~Cycle(0);
     struct Booking {
         Cycle start;       ///< cycle the bank starts this access
         Cycle end;         ///< first idle cycle after it
         uint64_t row;      ///< row open after it (kClosed: precharged)
+        Cycle activated = 0;  ///< activate of that row (tRAS counts from it)
+    };
+    /// The bank state an access finds: the row open, since when, and when the bank went idle.
+    struct OpenRow {
+        uint64_t row;
+        Cycle activated;
+        Cycle idle_since;
     };
     /// The bank's recent bookings sorted by start, in a ring (requests arrive nearly in time
     /// order, so a new booking goes at or near the end and the oldest is forgotten from the front).
@@ -84,6 +102,7 @@ private:
         Booking ring[kRing];
         uint32_t head = 0, size = 0;
         uint64_t base_row = kClosed;   ///< row open after the oldest forgotten access
+        Cycle base_activated = 0, base_end = 0;
         uint64_t counts[3] = {};       ///< hits, misses, conflicts
         Booking& at(uint32_t i) { return ring[(head + i) & (kRing - 1)]; }
         /// Index of the first booking starting after `time` (size if none).
@@ -91,13 +110,19 @@ private:
         /// Inserts at index i (shifting later ones), then forgets the oldest beyond kKept.
         void insert(uint32_t i, const Booking& b);
     };
-    /// Cycles from the start of service to the column command, for a row outcome.
-    Cycle to_column(RowResult r) const;
+    /// The service of an access to `a` starting no earlier than `s` with the bank as `open`
+    /// left it: its start (later past a refresh), row outcome, column command and end.
+    Timing plan(const DramAddress& a, Cycle s, OpenRow open, Cycle burst, Cycle* end, Cycle* activate) const;
+    /// The first cycle at or after `at` at which channel `c` may activate (tRRD, tFAW).
+    Cycle first_activate(uint32_t c, Cycle at) const;
+    void record_activate(uint32_t c, Cycle at);
     DramConfig m_config;
     bool m_close_page;
     std::vector<Bank> m_banks;          ///< channel-major: channel * banks + bank
     std::vector<SlotCalendar> m_buses;  ///< one data bus per channel: bytes_per_cycle per cycle
+    std::vector<std::vector<Cycle>> m_activates;  ///< per channel: its last activates, sorted
     uint64_t m_totals[3] = {};
+    Cycle m_ras_wait = 0, m_activate_wait = 0, m_refresh_wait = 0;
 };
 
 }  // namespace rtsim

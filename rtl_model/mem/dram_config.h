@@ -26,6 +26,13 @@ struct DramConfig {
     uint32_t t_rcd = 14;            ///< activate to column command, core cycles
     uint32_t t_rp = 14;             ///< precharge, core cycles
     uint32_t t_cas = 14;            ///< column command to first data, core cycles
+    // Second-order DDR limits, 0 = off (the default keeps the first-order bank model; the
+    // `ddr4` modifier sets DDR4-2133's, docs/model.md "Banks and row buffers").
+    uint32_t t_ras = 0;             ///< activate to precharge of the same bank, at least
+    uint32_t t_rrd = 0;             ///< activate to activate of two banks of a channel, at least
+    uint32_t t_faw = 0;             ///< window holding at most four activates of a channel
+    uint32_t t_refi = 0;            ///< all-bank refresh interval of a channel (0: no refresh)
+    uint32_t t_rfc = 0;             ///< refresh time: every bank busy and precharged
 
     template <class V>
     void visit(V& v) {
@@ -40,6 +47,11 @@ struct DramConfig {
         v.field("t_rcd", t_rcd, "cycles", "Activate to column command, core cycles (model banks)", 0, 10000);
         v.field("t_rp", t_rp, "cycles", "Precharge time, core cycles (model banks)", 0, 10000);
         v.field("t_cas", t_cas, "cycles", "Column command to first data, core cycles (model banks)", 0, 10000);
+        v.field("t_ras", t_ras, "cycles", "Activate to precharge of a bank, at least, core cycles (model banks; 0: no limit)", 0, 10000);
+        v.field("t_rrd", t_rrd, "cycles", "Activate to activate of two banks of a channel, at least, core cycles (model banks; 0: no limit)", 0, 10000);
+        v.field("t_faw", t_faw, "cycles", "Four-activate window: at most four activates of a channel in any window this long, core cycles (model banks; 0: no limit)", 0, 10000);
+        v.field("t_refi", t_refi, "cycles", "All-bank refresh interval of a channel, core cycles (model banks; 0: no refresh)", 0, 10000000);
+        v.field("t_rfc", t_rfc, "cycles", "Refresh time: every bank of the channel busy and precharged, core cycles (model banks, with t_refi)", 0, 100000);
     }
 };
 

@@ -72,6 +72,9 @@ const StatBlock& dram_stats() {
                  {"page_policy", "", "bank model: `open` or `close` (`dram.page_policy`)", false, true},
                  {"banks_per_channel", "banks", "bank model: banks per channel", false, true},
                  {"row_bytes", "bytes", "bank model: bytes per row", false, true},
+                 {"ras_wait_cycles", "cycles", "bank model: cycles precharges waited for `t_ras` after their row's activate, summed (0 with `t_ras` 0)", false, true},
+                 {"activate_wait_cycles", "cycles", "bank model: cycles activates waited for `t_rrd` and `t_faw`, summed (0 with both 0)", false, true},
+                 {"refresh_wait_cycles", "cycles", "bank model: cycles accesses waited for a refresh (`t_refi`, `t_rfc`), summed", false, true},
                  {"by_bank", "list", "bank model: `[{channel, bank, accesses, row_hits, row_misses, row_conflicts}]` for every bank accessed", false, true},
              })};
     return block;

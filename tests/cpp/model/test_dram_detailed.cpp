@@ -139,6 +139,61 @@ TEST(DramDetailed, BusSaturatesAtChannelBandwidthOnRowHits) {
     EXPECT_EQ(done, 16u + 16 * 4);  // first data at tRCD + tCAS = 16, then 64 bus cycles
 }
 
+TEST(DramDetailed, RasDelaysAConflictsPrecharge) {
+    DramConfig c = small();
+    c.t_ras = 30;
+    DramBanks banks(c);
+    // Row 0 of bank 0 activated at 0 (column 10, burst to 14); row 1 of bank 0 at 14 must wait
+    // for tRAS: precharge at 30, activate 38, column 48, data 54..57.
+    EXPECT_EQ(banks.access(0, 64, 0).column, 10u);
+    const DramBanks::Timing t = banks.access(2048, 64, 14);
+    EXPECT_EQ(int(t.result), int(Row::conflict));
+    EXPECT_EQ(t.column, 48u);
+    EXPECT_EQ(t.done, 58u);
+    EXPECT_EQ(t.ras_wait, 16u);
+    EXPECT_EQ(banks.stats_json()["ras_wait_cycles"], 16);
+}
+
+TEST(DramDetailed, RrdAndFawSpaceActivatesOfAChannel) {
+    DramConfig c = small();
+    c.t_rrd = 6;
+    DramBanks rrd(c);
+    EXPECT_EQ(rrd.access(0, 64, 0).column, 10u);  // bank 0 activates at 0
+    const DramBanks::Timing b = rrd.access(1024, 64, 0);  // bank 1: no sooner than 6
+    EXPECT_EQ(b.column, 16u);
+    EXPECT_EQ(b.activate_wait, 6u);
+    // Four activates in one cycle fit a 40-cycle window; the fifth waits for the window to pass.
+    c = small();
+    c.banks = 8;
+    c.t_faw = 40;
+    DramBanks faw(c);
+    for (uint64_t bank = 0; bank < 4; ++bank) EXPECT_EQ(faw.access(bank * 1024, 64, 0).column, 10u) << bank;
+    const DramBanks::Timing fifth = faw.access(4 * 1024, 64, 0);
+    EXPECT_EQ(fifth.column, 50u);
+    EXPECT_EQ(fifth.activate_wait, 40u);
+    // Back-filled before them, the window counts the later activates too.
+    EXPECT_EQ(faw.access(5 * 1024, 64, 0).column, 50u + 0u);
+}
+
+TEST(DramDetailed, RefreshBlocksTheChannelAndClosesRows) {
+    DramConfig c = small();
+    c.t_refi = 100;
+    c.t_rfc = 20;
+    DramBanks banks(c);
+    // At 95 the access would run into the refresh at 100: it starts after it (120).
+    const DramBanks::Timing a = banks.access(0, 64, 95);
+    EXPECT_EQ(a.start, 120u);
+    EXPECT_EQ(int(a.result), int(Row::miss));
+    EXPECT_EQ(a.column, 130u);
+    EXPECT_EQ(a.refresh_wait, 25u);
+    EXPECT_EQ(int(banks.access(64, 64, 141).result), int(Row::hit));  // the row stayed open
+    // At 205 the refresh at 200 is under way (to 220), and it closed the row.
+    const DramBanks::Timing b = banks.access(128, 64, 205);
+    EXPECT_EQ(b.start, 220u);
+    EXPECT_EQ(int(b.result), int(Row::miss));
+    EXPECT_EQ(b.column, 230u);
+}
+
 /// The bank model as it was before its bookings became a ring: a std::map per bank, the same
 /// rules (the reference the ring must reproduce access for access).
 class MapBanks {
