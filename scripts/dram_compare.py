@@ -24,7 +24,9 @@ pass them:
     # Ramulator 2.1: git clone https://github.com/CMU-SAFARI/ramulator2 /tmp/ram2, then
     #   cmake -S /tmp/ram2 -B /tmp/ram2/build -DRAMULATOR_PYTHON_BINDINGS=OFF
     #   ninja -C /tmp/ram2/build   (its CMake fetches yaml-cpp 0.9.0 and fmt 10.2.1 into ext/;
-    #   libramulator.so lands in /tmp/ram2; its Python DSL, python/, makes the configs)
+    #   libramulator.so lands in /tmp/ram2; its Python DSL, python/, makes the configs; with no
+    #   network, clone yaml-cpp at yaml-cpp-0.9.0 and fmt at 10.2.1 into ext/yaml-cpp and
+    #   ext/fmt and add -DFETCHCONTENT_FULLY_DISCONNECTED=ON)
     python scripts/dram_compare.py --ramulator2 /tmp/ram2 [--dramsim3 ... --ini ...]
 
 With --docs the table goes into DOCS/model.md between the `dram-compare` markers.

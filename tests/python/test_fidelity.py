@@ -157,6 +157,29 @@ def test_bank_timing_longer_than_the_latency_is_refused(
     assert analytic.returncode == 0, analytic.stderr
 
 
+def test_ddr4_limits_slow_the_banks_and_count_their_waits(
+    hairball: Path, sim: Sim, tmp_path: Path
+) -> None:
+    from rtsim.config import MODIFIERS
+
+    ddr4 = [f"dram.{k}={v}" for k, v in MODIFIERS["ddr4"]["dram"].items()]
+    runs = {}
+    for name, sets in (("first", []), ("ddr4", ddr4)):
+        result = sim(hairball, tmp_path / name, "fidelity=detailed", "dram.channels=1", *sets)
+        assert result.returncode == 0, result.stderr
+        runs[name] = stats_of(tmp_path / name)
+    first, ddr4_run = runs["first"]["model"]["dram"], runs["ddr4"]["model"]["dram"]
+    assert first["ras_wait_cycles"] == first["activate_wait_cycles"] == 0
+    assert first["refresh_wait_cycles"] == 0
+    assert ddr4_run["ras_wait_cycles"] > 0 and ddr4_run["activate_wait_cycles"] > 0
+    assert runs["ddr4"]["summary"]["cycles"] > runs["first"]["summary"]["cycles"]
+    assert runs["ddr4"]["validation"]["hit_mismatches"] == 0
+    # A refresh longer than its interval is refused, naming both fields.
+    bad = sim(hairball, tmp_path / "bad", "dram.t_refi=100", "dram.t_rfc=200")
+    assert bad.returncode == 2
+    assert "dram.t_rfc" in bad.stderr and "dram.t_refi" in bad.stderr, bad.stderr
+
+
 def test_every_level_writes_the_same_summary_keys(hairball: Path, sim: Sim, tmp_path: Path) -> None:
     keys = {}
     for level in LEVELS:

@@ -124,6 +124,13 @@ int GltfWriter::add_material(const Material& m) {
         gm.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(ext);
         m_impl->use_extension("KHR_materials_emissive_strength");
     }
+    if (m.alpha_mode == AlphaMode::mask) {
+        // The alpha test without a texture: the loader's stochastic test passes this fraction
+        // of a MASK triangle's hits (extras.textureAlphaCoverage, as the stripped shared scenes).
+        gm.alphaMode = "MASK";
+        gm.alphaCutoff = m.alpha_cutoff;
+        gm.extras = tinygltf::Value(tinygltf::Value::Object{{"textureAlphaCoverage", tinygltf::Value(double(m.alpha_coverage))}});
+    }
     m_impl->model.materials.push_back(gm);
     return int(m_impl->model.materials.size() - 1);
 }

@@ -20,6 +20,7 @@ const Entry kScenes[] = {
     {"rotated_walls", write_rotated_walls},
     {"aligned_walls", write_aligned_walls},
     {"terrain", write_terrain},
+    {"meadow", write_meadow},
     {"cloth", write_cloth},
     {"exploding_hairball", write_exploding_hairball},
     {"skinned_tube", write_skinned_tube},

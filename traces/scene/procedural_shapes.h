@@ -40,6 +40,8 @@ std::string write_teapot_stadium(const std::string& dir, const ProceduralOptions
 std::string write_rotated_walls(const std::string& dir, const ProceduralOptions& options);
 std::string write_aligned_walls(const std::string& dir, const ProceduralOptions& options);
 std::string write_terrain(const std::string& dir, const ProceduralOptions& options);
+/// The terrain's hills under alpha-tested grass cards (a MASK material; procedural_terrain.cpp).
+std::string write_meadow(const std::string& dir, const ProceduralOptions& options);
 std::string write_forest(const std::string& dir, const ProceduralOptions& options);
 std::string write_grove(const std::string& dir, const ProceduralOptions& options);
 // Deforming scenes (procedural_moving.cpp): their meshes move over frames (Scene::animation).

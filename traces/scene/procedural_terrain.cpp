@@ -2,7 +2,10 @@
 // uniform scene seed 001 names as the grid's good case: primitives of about one size spread at
 // about one density over the whole scene, so a uniform grid's cells hold similar counts and few
 // are empty, where a BVH's boxes over a flat-ish sheet overlap. The grass is geometry (three
-// thin triangles a blade), not an alpha-tested texture: the writer has no textures.
+// thin triangles a blade). The meadow is the same hills with the grass as games draw it:
+// alpha-tested cards, upright quads whose MASK material passes a fraction of their hits (the
+// stochastic alpha test of extras.textureAlphaCoverage; the writer has no textures), so every
+// ray through the grass runs any-hit tests.
 #include <cmath>
 
 #include "traces/common/rng.h"
@@ -16,6 +19,8 @@ constexpr int kTerrainCells = 128;           ///< height-field quads a side (2 x
 constexpr float kTerrainHalf = 40.0f;        ///< metres from the centre to an edge
 constexpr uint32_t kTerrainBlades = 12000;   ///< grass blades, 3 triangles each
 constexpr float kTerrainHills = 3.0f;        ///< height amplitude, metres
+constexpr uint32_t kMeadowCards = 8000;      ///< grass cards, 2 triangles each
+constexpr float kMeadowCoverage = 0.35f;     ///< fraction of a card's texels that are blades
 
 /// Value noise on an integer lattice, smoothly interpolated (a classic fBm building block).
 float lattice(int x, int z, uint64_t seed) {
@@ -77,7 +82,46 @@ void add_blade(TriangleSoup& grass, Rng& rng, uint64_t seed) {
     grass.add_triangle(l1, r1, tip);
 }
 
+/// A card: an upright quad at a random place and yaw, its foot just below the ground.
+void add_card(TriangleSoup& cards, Rng& rng, uint64_t seed) {
+    const float x = -kTerrainHalf + 2 * kTerrainHalf * rng.next(), z = -kTerrainHalf + 2 * kTerrainHalf * rng.next();
+    const float tall = 0.4f + 0.3f * rng.next(), half = 0.25f + 0.15f * rng.next();
+    const float turn = float(2 * kPi) * rng.next();
+    const Vec3 across(std::cos(turn) * half, 0.0f, std::sin(turn) * half);
+    const Vec3 foot(x, height(x, z, seed) - 0.05f, z), up(0.0f, tall, 0.0f);
+    const uint32_t a = cards.add_vertex(foot - across), b = cards.add_vertex(foot + across);
+    const uint32_t c = cards.add_vertex(foot + across + up), d = cards.add_vertex(foot - across + up);
+    cards.add_triangle(a, b, c);
+    cards.add_triangle(a, c, d);
+}
+
+/// The hills, their sun and their camera, with `grass` on them in `grass_material`.
+std::string write_hills(const std::string& dir, const std::string& name, const TriangleSoup& ground,
+                        const TriangleSoup& grass, const Material& grass_material, uint64_t seed) {
+    GltfWriter w;
+    const int m_ground = w.add_material(make_material("soil", {0.36f, 0.27f, 0.18f}, 0.0f, 0.9f));
+    const int m_grass = w.add_material(grass_material);
+    const int mesh = w.add_mesh(name, {{&ground, m_ground}, {&grass, m_grass}});
+    w.add_mesh_node(name, mesh);
+    // A low sun from the south-west: long shadows across the hills and the blades.
+    w.add_light("sun", LightType::directional, {0.0f, 50.0f, 0.0f}, {40.0f, 0.0f, 25.0f}, {1.0f, 0.93f, 0.82f}, 3.0f);
+    // Standing on a hill edge, looking across the field.
+    w.add_camera("camera", {-30.0f, height(-30.0f, -30.0f, seed) + 2.5f, -30.0f}, {10.0f, -2.0f, 10.0f}, 0.9f, 4.0f / 3.0f);
+    return w.write(dir, name);
+}
+
 }  // namespace
+
+std::string write_meadow(const std::string& dir, const ProceduralOptions& options) {
+    const uint64_t seed = hash_combine(options.seed, 0x7e77a1);  // the terrain's hills
+    TriangleSoup cards;
+    Rng rng(hash_combine(seed, 2));
+    for (uint32_t k = 0; k < kMeadowCards; ++k) add_card(cards, rng, seed);
+    Material grass = make_material("grass cards", {0.20f, 0.42f, 0.12f}, 0.0f, 0.7f);
+    grass.alpha_mode = AlphaMode::mask;
+    grass.alpha_coverage = kMeadowCoverage;
+    return write_hills(dir, "meadow", height_field(seed), cards, grass, seed);
+}
 
 std::string write_terrain(const std::string& dir, const ProceduralOptions& options) {
     const uint64_t seed = hash_combine(options.seed, 0x7e77a1);
@@ -86,16 +130,7 @@ std::string write_terrain(const std::string& dir, const ProceduralOptions& optio
     Rng rng(hash_combine(seed, 1));
     for (uint32_t b = 0; b < kTerrainBlades; ++b) add_blade(grass, rng, seed);
 
-    GltfWriter w;
-    const int m_ground = w.add_material(make_material("soil", {0.36f, 0.27f, 0.18f}, 0.0f, 0.9f));
-    const int m_grass = w.add_material(make_material("grass", {0.20f, 0.42f, 0.12f}, 0.0f, 0.7f));
-    const int mesh = w.add_mesh("terrain", {{&ground, m_ground}, {&grass, m_grass}});
-    w.add_mesh_node("terrain", mesh);
-    // A low sun from the south-west: long shadows across the hills and the blades.
-    w.add_light("sun", LightType::directional, {0.0f, 50.0f, 0.0f}, {40.0f, 0.0f, 25.0f}, {1.0f, 0.93f, 0.82f}, 3.0f);
-    // Standing on a hill edge, looking across the field.
-    w.add_camera("camera", {-30.0f, height(-30.0f, -30.0f, seed) + 2.5f, -30.0f}, {10.0f, -2.0f, 10.0f}, 0.9f, 4.0f / 3.0f);
-    return w.write(dir, "terrain");
+    return write_hills(dir, "terrain", ground, grass, make_material("grass", {0.20f, 0.42f, 0.12f}, 0.0f, 0.7f), seed);
 }
 
 }  // namespace rtsim

@@ -28,7 +28,7 @@ bool has_material(const Scene& s, float metallic, float roughness_below) {
 }
 
 TEST(Procedural, NamesAndUnknownName) {
-    EXPECT_EQ(procedural_scene_names().size(), 9u);
+    EXPECT_EQ(procedural_scene_names().size(), 10u);
     EXPECT_TRUE(is_procedural_scene("hairball"));
     EXPECT_FALSE(is_procedural_scene("sponza"));
     try {
@@ -118,6 +118,25 @@ TEST(Procedural, TeapotStadium) {
     EXPECT_LT(s.lights[0].direction.y, -0.5f);  // the sun shines down
     ASSERT_EQ(s.cameras.size(), 1u);
     EXPECT_LT(glm::length(s.cameras[0].eye - tea.center()), 10.0f);
+}
+
+TEST(Procedural, MeadowHasAlphaTestedGrassCardsOnTheTerrainsHills) {
+    Scene s = load_gltf(write_procedural_scene("meadow", test::test_dir()));
+    EXPECT_EQ(s.triangle_count(), 2u * 128 * 128 + 2u * 8000);
+    ASSERT_EQ(s.lights.size(), 1u);
+    // The cards' material is MASK with the coverage the writer gave it; the ground is opaque.
+    int masked = 0;
+    for (const Material& m : s.materials)
+        if (m.alpha_mode == AlphaMode::mask) {
+            ++masked;
+            EXPECT_NEAR(m.alpha_coverage, 0.35f, 1e-6f);
+        }
+    EXPECT_EQ(masked, 1);
+    size_t card_triangles = 0;
+    for (size_t t = 0; t < s.triangle_count(); ++t)
+        card_triangles += s.materials[s.tri_material[t]].alpha_mode == AlphaMode::mask;
+    EXPECT_EQ(card_triangles, 2u * 8000);
+    EXPECT_NEAR(s.bounds.extent().x, 80.0f, 1.5f);
 }
 
 TEST(Procedural, TerrainIsAnEvenlyCoveredHeightFieldUnderASun) {
