@@ -105,6 +105,7 @@ const StatBlock& frame_stats() {
         {
             {"frame", "", "frame index"},
             {"rays", "rays", "the frame's rays"},
+            {"sampled_rays", "rays", "sampled runs only: the frame's rays the sample simulated (its clusters'); then `cycles`, `start_cycle`, `end_cycle` and `mrays_per_second` are the estimate for all its rays and `dram_bytes` is scaled from its sampled rays' (the whole sample's for a frame without a cluster)", true, true},
             {"first_ray", "ray", "the frame's first ray's index in the trace"},
             {"start_cycle", "cycles", "the previous frame's last finish (0 for frame 0)", true},
             {"end_cycle", "cycles", "this frame's last finish", true},

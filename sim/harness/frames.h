@@ -51,6 +51,8 @@ public:
     /// [{frame, rays, start_cycle, cycles, mrays_per_second, dram_bytes_per_ray, l1_hit_rate,
     ///   l2_hit_rate, tlas_build_ms, ...}] (docs/stats.md, "Frames").
     const nlohmann::json& to_json() const { return m_out; }
+    /// The figures, to rewrite (a sampled run's estimates: apply_sampling_to_frames).
+    nlohmann::json& mutable_json() { return m_out; }
 
 private:
     const SimConfig& m_config;

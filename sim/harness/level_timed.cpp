@@ -66,7 +66,7 @@ LevelResult run_timed_level(RunInputs& in) {
     // Sampling (sim/sampling/sampling.h): only the sample's rays are simulated and checked.
     std::unique_ptr<SampledRun> sampled;
     if (c.sampling.enabled() && !sample_covers_trace(c, built.rays))
-        sampled = std::make_unique<SampledRun>(in.reader, c, built.rays);
+        sampled = std::make_unique<SampledRun>(in.reader, c, built.rays, built.frames);
     const uint64_t simulated = sampled ? sampled->plan.simulated_rays : built.rays;
     ReferenceWindow reference(in.reader, c.dispatch.chunk_rays);
     HitChecker checker("checker", sampled ? static_cast<ReferenceSource&>(sampled->reference) : reference, simulated,
@@ -92,35 +92,48 @@ LevelResult run_timed_level(RunInputs& in) {
             checker, built.features, shading.get());
     // The build unit, where the trace's frames record their builds (frame_builds.h).
     const std::vector<std::vector<BuildJob>> build_jobs =
-        c.build_unit.enabled && !sampled && !wavefront ? frame_build_jobs(accel) : std::vector<std::vector<BuildJob>>{};
+        c.build_unit.enabled && !wavefront ? frame_build_jobs(accel) : std::vector<std::vector<BuildJob>>{};
     std::unique_ptr<BuildUnit> build_unit;
     if (!build_jobs.empty())
         build_unit = std::make_unique<BuildUnit>(c.build_unit, top.shared_memory(), c.l2.line_bytes);
     // Frame barriers: record each frame's figures, then bind the structure's next frame.
     std::vector<uint64_t> frame_rays;
     for (const FrameRecord& f : segments) frame_rays.push_back(f.rays);
+    // Moving scenes: the next frame's structures are built at the barrier, before its rays
+    // (rtl_model/build_unit/build_unit.h); the frame's figures are taken before the build.
+    auto build_at_barrier = [&](uint32_t f, Cycle end) {
+        frame_figures.frame_end(f, end, top.memory_totals());
+        if (f + 1 >= build_jobs.size() || build_jobs[f + 1].empty()) return end;
+        const FrameBuild b = build_unit->run(build_jobs[f + 1], end);
+        frame_figures.set_build(f + 1, b);
+        return b.end;
+    };
     if (wavefront) {
         // One frame of bounces: each bounce's barrier is its shading; the frame's figures at the last.
         top.dispatch().set_frames(frame_rays, nullptr, nullptr);
         wire_frame_loop(top, c.shading, uint32_t(segments.size()),
                         [&](Cycle end) { frame_figures.frame_end(0, end, top.memory_totals()); });
-    } else if (!sampled) {
+    } else if (sampled) {
+        // An animated trace: each frame's clusters behind its barrier, its structure bound for them.
+        if (built.frames.size() > 1) {
+            std::vector<uint64_t> sampled_rays(built.frames.size(), 0);
+            for (const SamplePlan::Cluster& cl : sampled->plan.clusters) sampled_rays[cl.frame] += cl.end() - cl.first;
+            top.dispatch().set_frames(
+                sampled_rays,
+                [&](uint32_t f, Cycle end) {
+                    if (!frame_figures.recorded(f)) frame_figures.frame_end(f, end, top.memory_totals());
+                },
+                [&](uint32_t f) { accel.bind_frame(f); });
+            if (build_unit) top.dispatch().set_barrier(build_at_barrier);
+        }
+    } else {
         top.dispatch().set_frames(
             frame_rays,
             [&](uint32_t f, Cycle end) {
                 if (!frame_figures.recorded(f)) frame_figures.frame_end(f, end, top.memory_totals());
             },
             [&](uint32_t f) { accel.bind_frame(f); });
-        // Moving scenes: the next frame's structures are built at the barrier, before its rays
-        // (rtl_model/build_unit/build_unit.h); the frame's figures are taken before the build.
-        if (build_unit)
-            top.dispatch().set_barrier([&](uint32_t f, Cycle end) {
-                frame_figures.frame_end(f, end, top.memory_totals());
-                if (f + 1 >= build_jobs.size() || build_jobs[f + 1].empty()) return end;
-                const FrameBuild b = build_unit->run(build_jobs[f + 1], end);
-                frame_figures.set_build(f + 1, b);
-                return b.end;
-            });
+        if (build_unit) top.dispatch().set_barrier(build_at_barrier);
         if (shading) wire_frame_loop(top, c.shading, 1, nullptr);
     }
     std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
@@ -179,7 +192,18 @@ LevelResult run_timed_level(RunInputs& in) {
     r.summary = summarize(c, r.cycles, built.rays, r.model,
                           {checker.hit_mismatches(), checker.work_mismatches(), checker.latency().mean()}, wall);
     if (sampled) {
+        std::vector<double> tails;
+        if (built.frames.size() > 1) {
+            // Each frame drains at its barrier, which the strata's steady-state cost leaves out.
+            tails = frame_barrier_tails(frame_figures.to_json(), sampled->plan, sampled->estimator, built.frames.size());
+            double sum = 0;
+            for (double t : tails) sum += t;
+            sampled->estimator.set_barrier_cycles(sum);
+        }
         apply_sampling_to_summary(r.summary, c, sampled->plan, sampled->estimator);
+        if (built.frames.size() > 1)
+            apply_sampling_to_frames(frame_figures.mutable_json(), c, sampled->plan, sampled->estimator, built.frames,
+                                     tails);
         r.sampling = sampled->estimator.to_json(c, r.cycles, wall);
         r.sampling["functional_warming"] = {{"rays_per_cluster", c.sampling.warming_rays},
                                             {"warmed_rays", warmer ? warmer->warmed_rays() : 0},

@@ -158,10 +158,6 @@ std::vector<Rule> make_rules() {
          "the analytic level's functional caches step every ray in one pass over one structure, not frame by frame",
          "analytic.caches=statistical, or fidelity=functional, approx or detailed", "frames",
          {"fidelity=analytic", "analytic.caches=functional"}});
-    add({"frames/sampling", "an animated trace (--frames)", animated, RuleSide::technique,
-         "no sampling (sampling.fraction and sampling.count 0)", [](const RunFacts& f) { return !sampling(f); },
-         "sampling does not cut frames yet: an animated trace is replayed whole", "sampling.fraction=0", "frames",
-         {"sampling.fraction=0.2"}});
 
     // The frame: shading and the frame loop (docs/shading.md).
     add({"shading/level", "shading.enabled (the frame: shading and the frame loop)", shading, RuleSide::level,

@@ -68,7 +68,37 @@ json sample_caveats(const SimConfig& c, const SamplePlan& plan) {
 
 }  // namespace
 
-SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
+namespace {
+
+/// Moves each cluster into one frame: the part of its stratum within one frame that holds the
+/// cluster and contains its random start, else the largest such part.
+void fit_clusters_in_frames(SamplePlan& plan, const std::vector<FrameRecord>& frames) {
+    for (SamplePlan::Cluster& cl : plan.clusters) {
+        const uint64_t size = cl.end() - cl.first, s0 = cl.stratum_first, s1 = cl.stratum_first + cl.stratum_rays;
+        int64_t best = -1;
+        uint64_t best_rays = 0;
+        for (size_t f = 0; f < frames.size(); ++f) {
+            const uint64_t a = std::max(s0, frames[f].first_ray), b = std::min(s1, frames[f].first_ray + frames[f].rays);
+            if (b <= a || b - a < size) continue;
+            if (cl.first >= a && cl.first < b) {  // the random start's part: keep the offset there
+                best = int64_t(f), best_rays = ~0ull;
+                break;
+            }
+            if (b - a > best_rays) best = int64_t(f), best_rays = b - a;
+        }
+        require(best >= 0, "config: sampling: a cluster of " + std::to_string(size) + " rays fits in no frame of its "
+                           "stratum (rays " + std::to_string(s0) + " to " + std::to_string(s1) + "); lower "
+                           "'sampling.warmup_rays' or raise 'sampling.clusters', or trace more rays per frame");
+        const FrameRecord& fr = frames[size_t(best)];
+        const uint64_t a = std::max(s0, fr.first_ray), b = std::min(s1, fr.first_ray + fr.rays);
+        cl.first = std::min(std::max(cl.first, a), b - size);
+        cl.frame = uint32_t(best);
+    }
+}
+
+}  // namespace
+
+SamplePlan plan_sample(const SimConfig& c, uint64_t n, const std::vector<FrameRecord>& frames) {
     const SamplingConfig& s = c.sampling;
     SamplePlan plan;
     plan.trace_rays = n;
@@ -111,6 +141,10 @@ SamplePlan plan_sample(const SimConfig& c, uint64_t n) {
         plan.clusters.push_back(cl);
     }
     plan.simulated_rays = clusters * size;
+    if (frames.size() > 1) {
+        fit_clusters_in_frames(plan, frames);
+        for (const FrameRecord& f : frames) plan.frame_first.push_back(f.first_ray);
+    }
     return plan;
 }
 
@@ -167,8 +201,14 @@ void SampledRayStream::set_warming(uint64_t rays, std::function<void(uint64_t, u
 
 bool SampledRayStream::next_segment() {
     if (m_cluster >= m_plan.clusters.size()) return false;
+    if (m_plan.clusters[m_cluster].frame > m_frame) return false;  // after the frame barrier
     m_open_cluster = m_cluster;
     return true;
+}
+
+void SampledRayStream::begin_frame(uint32_t f) {
+    m_frame = f;
+    if (m_cluster < m_plan.clusters.size() && m_plan.clusters[m_cluster].frame <= f) m_open_cluster = m_cluster;
 }
 
 size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
@@ -176,7 +216,9 @@ size_t SampledRayStream::read_chunk(size_t max, std::vector<RayJob>* out) {
     const SamplePlan::Cluster& c = m_plan.clusters[m_cluster];
     if (m_next == c.first && m_warm) {
         // Functional warming of the skipped rays just before the cluster (not into the previous one).
-        const uint64_t floor = m_cluster ? m_plan.clusters[m_cluster - 1].end() : 0;
+        // Nor into the previous frame, traced through another frame's structures.
+        uint64_t floor = m_cluster ? m_plan.clusters[m_cluster - 1].end() : 0;
+        if (c.frame < m_plan.frame_first.size()) floor = std::max(floor, m_plan.frame_first[c.frame]);
         const uint64_t from = std::max(floor, c.first - std::min(c.first, m_warming_rays));
         m_warm(from, c.first, m_produced);
     }
@@ -228,8 +270,12 @@ SampleEstimator::SampleEstimator(const SamplePlan& plan, SampleMeasure measure)
     : m_plan(plan), m_measure(measure), m_start(plan.simulated_rays, 0), m_seen(plan.simulated_rays, 0) {}
 
 void SampleEstimator::ray_done(const RayResult& r) {
-    const size_t i = sample_index(m_plan, r.id);
+    size_t k = 0;
+    const size_t i = sample_index(m_plan, r.id, &k);
     m_start[i] = m_measure == SampleMeasure::starts ? r.start : r.end;
+    const uint32_t f = m_plan.clusters[k].frame;
+    if (f >= m_frame_last_start.size()) m_frame_last_start.resize(f + 1, 0);
+    m_frame_last_start[f] = std::max(m_frame_last_start[f], r.start);
     m_seen[i] = 1;
     m_done = false;
 }
@@ -267,9 +313,75 @@ void SampleEstimator::finish() const {
     m_done = true;
 }
 
-double SampleEstimator::cycles() const { return finish(), m_total; }
-double SampleEstimator::ci_low() const { return finish(), std::max(0.0, m_total - m_half); }
-double SampleEstimator::ci_high() const { return finish(), m_total + m_half; }
+double SampleEstimator::cycles() const { return finish(), m_total + m_barrier_cycles; }
+
+double SampleEstimator::cycles_of(uint64_t first, uint64_t rays) const {
+    finish();
+    double total = 0;
+    for (size_t k = 0; k < m_plan.clusters.size(); ++k) {
+        const SamplePlan::Cluster& c = m_plan.clusters[k];
+        const uint64_t a = std::max(first, c.stratum_first), b = std::min(first + rays, c.stratum_first + c.stratum_rays);
+        if (b > a) total += m_cycles_per_ray[k] * double(b - a);
+    }
+    return total;
+}
+
+std::vector<double> frame_barrier_tails(const nlohmann::json& frames, const SamplePlan& plan,
+                                        const SampleEstimator& estimator, size_t frame_count) {
+    std::vector<uint64_t> sampled(frame_count, 0);
+    for (const SamplePlan::Cluster& c : plan.clusters) sampled.at(c.frame) += c.end() - c.first;
+    std::vector<double> tails(frame_count, -1.0);
+    double sum = 0;
+    int n = 0;
+    for (const nlohmann::json& f : frames) {
+        const uint32_t i = f["frame"].get<uint32_t>();
+        if (i >= frame_count || !sampled[i]) continue;
+        const Cycle end = f.value("end_cycle", Cycle(0)), last = estimator.frame_last_start(i);
+        tails[i] = end > last ? double(end - last) : 0.0;
+        sum += tails[i], ++n;
+    }
+    for (double& t : tails)
+        if (t < 0) t = n ? sum / n : 0.0;  // a frame without a cluster drains like the others
+    // The build unit's work before a frame's rays (moving scenes) is simulated in full.
+    for (const nlohmann::json& f : frames) {
+        const uint32_t i = f["frame"].get<uint32_t>();
+        if (i < frame_count) tails[i] += f.value("build_cycles", 0.0);
+    }
+    return tails;
+}
+
+void apply_sampling_to_frames(nlohmann::json& frames, const SimConfig& config, const SamplePlan& plan,
+                              const SampleEstimator& estimator, const std::vector<FrameRecord>& table,
+                              const std::vector<double>& tails) {
+    std::vector<uint64_t> sampled(table.size(), 0);
+    for (const SamplePlan::Cluster& c : plan.clusters) sampled.at(c.frame) += c.end() - c.first;
+    // The build unit's bytes are the whole build's; the rays' bytes scale with the sample. (Its
+    // bytes as it moved them through the L2, an upper bound on its DRAM share.)
+    auto build_bytes = [](const nlohmann::json& f) {
+        return std::min(f.value("dram_bytes", 0.0), f.value("build_read_bytes", 0.0) + f.value("build_written_bytes", 0.0));
+    };
+    double all_bytes = 0;
+    for (const nlohmann::json& f : frames) all_bytes += f.value("dram_bytes", 0.0) - build_bytes(f);
+    const double bytes_per_sampled_ray = plan.simulated_rays ? all_bytes / double(plan.simulated_rays) : 0.0;
+    double start = 0;
+    for (nlohmann::json& f : frames) {
+        const uint32_t i = f["frame"].get<uint32_t>();
+        const uint64_t rays = table.at(i).rays;
+        const double cycles = estimator.cycles_of(table[i].first_ray, rays) + tails.at(i);
+        const double per_ray =
+            sampled[i] ? (f.value("dram_bytes", 0.0) - build_bytes(f)) / double(sampled[i]) : bytes_per_sampled_ray;
+        f["sampled_rays"] = sampled[i];
+        f["start_cycle"] = uint64_t(std::llround(start));
+        start += cycles;
+        f["end_cycle"] = uint64_t(std::llround(start));
+        f["cycles"] = uint64_t(std::llround(cycles));
+        f["mrays_per_second"] = cycles > 0 ? double(rays) / (cycles / (config.clock_ghz * 1e9)) / 1e6 : 0.0;
+        f["dram_bytes"] = per_ray * double(rays) + build_bytes(f);
+        f["dram_bytes_per_ray"] = rays ? f["dram_bytes"].get<double>() / double(rays) : 0.0;
+    }
+}
+double SampleEstimator::ci_low() const { return finish(), std::max(0.0, m_total - m_half) + m_barrier_cycles; }
+double SampleEstimator::ci_high() const { return finish(), m_total + m_half + m_barrier_cycles; }
 
 json SampleEstimator::to_json(const SimConfig& config, Cycle simulated_cycles, double wall) const {
     finish();
@@ -289,10 +401,11 @@ json SampleEstimator::to_json(const SimConfig& config, Cycle simulated_cycles, d
             {"trace_rays", m_plan.trace_rays},
             {"fraction", double(m_plan.simulated_rays) / n},
             {"seed", config.sampling.seed},
-            {"cycles", m_total},
+            {"cycles", cycles()},
             {"cycles_ci95", {ci_low(), ci_high()}},
-            {"relative_half_width", m_total > 0 ? m_half / m_total : 0.0},
-            {"rays_per_second", m_total > 0 ? n * hz / m_total : 0.0},
+            {"barrier_cycles", m_barrier_cycles},
+            {"relative_half_width", cycles() > 0 ? m_half / cycles() : 0.0},
+            {"rays_per_second", cycles() > 0 ? n * hz / cycles() : 0.0},
             {"rays_per_second_ci95", {n * hz / ci_high(), ci_low() > 0 ? n * hz / ci_low() : 0.0}},
             {"simulated_cycles", simulated_cycles},
             {"effective_rays_per_wall_second", wall > 0 ? n / wall : 0.0},
@@ -332,7 +445,8 @@ const StatBlock& sampling_stats() {
             {"trace_rays", "rays", "rays in the trace (= `summary.rays`)"},
             {"fraction", "fraction", "`simulated_rays / trace_rays`"},
             {"seed", "", "`sampling.seed`: picks each cluster's offset in its stratum"},
-            {"cycles", "cycles", "the estimate: sum over strata of stratum rays x cycles per ray (unrounded `summary.cycles`)"},
+            {"cycles", "cycles", "the estimate: sum over strata of stratum rays x cycles per ray, plus `barrier_cycles` (unrounded `summary.cycles`)"},
+            {"barrier_cycles", "cycles", "an animated trace: what the frame barriers add to the strata's steady-state cost, as the sample saw it: each frame's drain (its end minus its last start; a frame without a cluster takes the others' mean) plus, in moving scenes, the build unit's work before it (simulated whole); 0 for one frame"},
             {"cycles_ci95", "cycles", "`[lo, hi]`: Student t 95% interval over the strata"},
             {"relative_half_width", "fraction", "half the interval over the estimate"},
             {"rays_per_second", "rays/s", "`trace_rays` over the estimated seconds"},

@@ -42,6 +42,7 @@ struct SamplePlan {
         uint64_t first = 0;          ///< first ray of the cluster (its first warm-up ray)
         uint64_t warmup = 0;         ///< warm-up rays, [first, first + warmup)
         uint64_t measured = 0;       ///< measured rays, [first + warmup, first + warmup + measured)
+        uint32_t frame = 0;          ///< the frame its rays belong to (an animated trace)
         uint64_t end() const { return first + warmup + measured; }
     };
     uint64_t trace_rays = 0;
@@ -49,11 +50,14 @@ struct SamplePlan {
     uint64_t warmup_rays = 0;     ///< per cluster (the resolved sampling.warmup_rays)
     uint64_t warmup_target = 0;   ///< what the cluster wanted (more than warmup_rays if the sample is small)
     std::vector<Cluster> clusters;  ///< in trace order
+    std::vector<uint64_t> frame_first;  ///< an animated trace: each frame's first ray (else empty)
 };
 
 /// The plan for a trace of `trace_rays` rays; throws rtsim::Error naming the sampling field when
-/// the trace is too small for the requested clusters and warm-up.
-SamplePlan plan_sample(const SimConfig& config, uint64_t trace_rays);
+/// the trace is too small for the requested clusters and warm-up. With the frames of an animated
+/// trace each cluster lies in one frame (in the part of its stratum with the most rays that holds
+/// it: a stratum still stands for all its rays), so a frame's structure is bound for it alone.
+SamplePlan plan_sample(const SimConfig& config, uint64_t trace_rays, const std::vector<FrameRecord>& frames = {});
 
 /// True when sampling would simulate the whole trace anyway: the sample asked for is every ray
 /// (sampling.fraction = 1, a count of exactly the trace's rays), or the trace is smaller than
@@ -80,6 +84,9 @@ public:
     /// the cluster's last measured rays while some still wait in the dispatch's per-unit queues
     /// (docs/fidelity.md, "Cluster hand-off").
     bool next_segment() override;
+    /// An animated trace: the clusters of frame f may be read (the dispatch's frame barrier
+    /// calls this once frame f - 1's rays have finished and its structure is bound).
+    void begin_frame(uint32_t f) override;
 
 private:
     TraceReader& m_reader;
@@ -89,6 +96,7 @@ private:
     uint64_t m_produced = 0;  ///< rays returned so far
     size_t m_cluster = 0;       ///< the cluster being read (clusters.size() at the end)
     size_t m_open_cluster = 0;  ///< the cluster the dispatch may read (next_segment opens the next)
+    uint32_t m_frame = 0;       ///< the frame being handed out (clusters of later frames wait)
     uint64_t m_next = 0;  ///< next trace index within the current cluster
     std::vector<RayRecord> m_buffer;
 };
@@ -136,6 +144,14 @@ public:
     double cycles() const;
     double ci_low() const;
     double ci_high() const;
+    /// Estimated cycles of trace rays [first, first + rays): each stratum's cycles per ray over
+    /// its rays in that range (the frames of an animated trace sum to cycles()).
+    double cycles_of(uint64_t first, uint64_t rays) const;
+    /// An animated trace: the last start (any sampled ray's) of each frame, by cluster frame.
+    Cycle frame_last_start(uint32_t f) const { return f < m_frame_last_start.size() ? m_frame_last_start[f] : 0; }
+    /// Cycles the frame barriers add on top of the strata's steady-state throughput (each
+    /// frame drains before the next begins): added to cycles() and its interval.
+    void set_barrier_cycles(double cycles) { m_barrier_cycles = cycles; }
 
 private:
     void finish() const;
@@ -147,6 +163,8 @@ private:
     mutable bool m_done = false;
     mutable std::vector<double> m_cycles_per_ray;  ///< per cluster
     mutable double m_total = 0, m_half = 0;
+    std::vector<Cycle> m_frame_last_start;
+    double m_barrier_cycles = 0;
 };
 
 /// Index of the sample position of trace ray `id` (clusters in order); throws if not sampled.
@@ -155,8 +173,9 @@ size_t sample_index(const SamplePlan& plan, uint64_t id, size_t* cluster = nullp
 /// Everything a sampled run adds to the harness: the plan, the stream that feeds the model, the
 /// reference the hit checker reads and the estimator that records start cycles.
 struct SampledRun {
-    SampledRun(TraceReader& reader, const SimConfig& config, uint64_t trace_rays)
-        : plan(plan_sample(config, trace_rays)),
+    SampledRun(TraceReader& reader, const SimConfig& config, uint64_t trace_rays,
+               const std::vector<FrameRecord>& frames = {})
+        : plan(plan_sample(config, trace_rays, frames)),
           stream(reader, plan),
           reference(reader, plan),
           estimator(plan, config.treelets.enabled ? SampleMeasure::completions : SampleMeasure::starts) {}
@@ -170,6 +189,18 @@ struct SampledRun {
 /// (for the whole trace), cycles_ci95, rays_per_second_ci95, dram_bytes (scaled), sampled.
 void apply_sampling_to_summary(nlohmann::json& summary, const SimConfig& config, const SamplePlan& plan,
                                const SampleEstimator& estimator);
+
+/// A sampled animated run's stats.json "frames": each frame's figures as the barriers recorded
+/// them for its sampled rays (`sampled_rays`), its cycles and rays/s replaced by the estimate
+/// for all its rays (cycles_of plus its barrier tail), and its DRAM bytes scaled from its sampled rays' (from the
+/// whole sample's for a frame without a cluster).
+/// Each frame's drain at its barrier, from the sampled run: the frame's end minus its last
+/// start (a frame without a cluster: the mean of the others).
+std::vector<double> frame_barrier_tails(const nlohmann::json& frames, const SamplePlan& plan,
+                                        const SampleEstimator& estimator, size_t frame_count);
+void apply_sampling_to_frames(nlohmann::json& frames, const SimConfig& config, const SamplePlan& plan,
+                              const SampleEstimator& estimator, const std::vector<FrameRecord>& table,
+                              const std::vector<double>& tails);
 
 /// stats.json "sampling" (sampled runs only), declared once.
 const StatBlock& sampling_stats();

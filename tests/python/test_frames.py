@@ -129,7 +129,6 @@ def test_one_frame_trace_has_one_frame_entry(
     ("sets", "field"),
     [
         (["fidelity=analytic", "analytic.caches=functional"], "analytic.caches"),
-        (["sampling.fraction=0.5"], "sampling"),
     ],
 )
 def test_replay_refuses_what_does_not_hold_frames(
@@ -148,3 +147,32 @@ def test_trace_refuses_frames_without_instancing_or_with_flatten(tmp_path: Path)
     assert "--frames 4" in result.stderr and "places no geometry more than once" in result.stderr
     result = trace(tmp_path / "f", "--frames", "2", "--flatten")
     assert result.returncode != 0 and "--flatten" in result.stderr
+
+
+def test_sampling_cuts_every_frame_into_clusters_behind_its_barrier(
+    sim_exe: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "grove"
+    made = run_rtsim("trace", "grove", "-o", str(out), "--resolution", "48x36",
+                     "--workload", WORKLOAD, "--frames", "3")  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    runs = {}
+    for name, sets in (("exact", []), ("sampled", ["sampling.fraction=0.4"])):
+        result = simulate(sim_exe, out, tmp_path / name, "fidelity=approx", *sets)
+        assert result.returncode == 0, result.stderr
+        runs[name] = json.loads((tmp_path / name / "stats.json").read_text())
+    exact, sampled = runs["exact"], runs["sampled"]
+    v = sampled["validation"]
+    assert v["hit_mismatches"] == v["work_mismatches"] == 0
+    assert v["rays_checked"] == sampled["sampling"]["simulated_rays"] < exact["summary"]["rays"]
+    frames = sampled["frames"]
+    assert [f["frame"] for f in frames] == [0, 1, 2]
+    # Each frame's rays are the trace's; the sample simulated some of them; the frames' estimates
+    # (barrier drains included) add up to the run's.
+    assert [f["rays"] for f in frames] == [f["rays"] for f in exact["frames"]]
+    assert sum(f["sampled_rays"] for f in frames) == v["rays_checked"]
+    assert sum(f["cycles"] for f in frames) == pytest.approx(sampled["summary"]["cycles"], abs=3)
+    assert sampled["sampling"]["barrier_cycles"] > 0
+    low, high = sampled["summary"]["cycles_ci95"]
+    assert low < sampled["summary"]["cycles"] < high
+    assert sampled["summary"]["cycles"] == pytest.approx(exact["summary"]["cycles"], rel=0.25)
