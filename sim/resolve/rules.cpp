@@ -134,13 +134,16 @@ std::vector<Rule> make_rules() {
          "traversal.model=mimd or simt, or traversal.anyhit_order=nearest", "bvh2",
          {"traversal.model=packet", "traversal.anyhit_order=largest_box"}});
     add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::level,
-         "the functional level or a timed one (approx, detailed)",
-         [](const RunFacts& f) { return f.config.fidelity == Fidelity::functional || f.level.timed; },
-         "the analytic level takes the work of the rays it does not step from the trace, traced nearest first, "
-         "and another order finds other occluders with other work; the functional and timed levels step every "
-         "ray, check a reordered any-hit ray's occlusion against the trace and count and time its own walk",
-         "fidelity=functional, approx or detailed, or traversal.anyhit_order=nearest", "bvh2",
-         {"traversal.anyhit_order=fixed", "fidelity=analytic"}});
+         "a level that steps every ray (functional, approx, detailed, or analytic with analytic.caches=functional)",
+         [](const RunFacts& f) {
+             return f.config.fidelity == Fidelity::functional || f.level.timed ||
+                    (f.config.fidelity == Fidelity::analytic && f.config.analytic.caches == AnalyticCaches::functional);
+         },
+         "the analytic level's statistical caches take the work of the rays they do not step from the trace, "
+         "traced nearest first, and another order finds other occluders with other work; the levels that step "
+         "every ray check a reordered any-hit ray's occlusion against the trace and count and time its own walk",
+         "fidelity=functional, approx or detailed, analytic.caches=functional, or traversal.anyhit_order=nearest",
+         "bvh2", {"traversal.anyhit_order=fixed", "fidelity=analytic"}});
 
     // Sampling.
     add({"sampling/level", "sampling.fraction or sampling.count", sampling, RuleSide::level, "a timed level",

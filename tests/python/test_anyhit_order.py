@@ -28,8 +28,11 @@ def trace(tmp_path_factory: pytest.TempPathFactory, request: pytest.FixtureReque
 def test_reordered_rays_report_their_work(trace: Path, sim_exe: Path, tmp_path: Path,
                                           order: str) -> None:  # fmt: skip
     own = {}
-    for fidelity in ("functional", "approx", "detailed"):
-        stats = checked(sim_exe, trace, tmp_path / fidelity, f"fidelity={fidelity}",
+    for fidelity in ("functional", "approx", "detailed", "analytic"):
+        # The analytic level steps every ray with its functional caches (its statistical ones
+        # take unstepped rays' work from the trace: refused, the capability table's rule).
+        caches = ["analytic.caches=functional"] if fidelity == "analytic" else []
+        stats = checked(sim_exe, trace, tmp_path / fidelity, f"fidelity={fidelity}", *caches,
                         f"traversal.anyhit_order={order}")  # fmt: skip
         v = stats["validation"]
         assert v["hit_mismatches"] == v["work_mismatches"] == 0, fidelity
@@ -43,7 +46,7 @@ def test_reordered_rays_report_their_work(trace: Path, sim_exe: Path, tmp_path: 
         own[fidelity] = r["own"]
         if fidelity != "functional":
             assert stats["summary"]["cycles"] > 0
-    assert own["approx"] == own["detailed"] == own["functional"]
+    assert own["approx"] == own["detailed"] == own["analytic"] == own["functional"]
 
 
 def test_nearest_reorders_nothing(trace: Path, sim_exe: Path, tmp_path: Path) -> None:
