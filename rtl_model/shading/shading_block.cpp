@@ -44,25 +44,37 @@ ShadingBlock::ShadingBlock(sc_core::sc_module_name name, const ShadingConfig& co
     m_shaded_at.assign(inputs.rays.size(), 0);
     m_done.assign(inputs.rays.size(), 0);
     m_seen.assign(inputs.rays.size(), 0);
-    raygen();
+    // The first frame's camera rays are generated before any traversal.
+    m_raygen_end = raygen(0, inputs.frames.empty() ? inputs.rays.size() : inputs.frames[0].rays, 0);
+    m_release = m_last_end = m_raygen_end;
 }
 
 ShadingBlock::~ShadingBlock() = default;
 
-void ShadingBlock::raygen() {
-    // Primary rays are generated in warps before the first wavefront (the camera's program).
+Cycle ShadingBlock::raygen(uint64_t first, uint64_t rays, Cycle at) {
+    // Primary rays are generated in warps before their frame's first wavefront (the camera's program).
     const uint32_t program = m_in.shaders + 2;
     uint64_t primaries = 0;
-    for (const RayRecord& r : m_in.rays) primaries += r.kind == uint8_t(RayKind::primary);
+    for (uint64_t i = first; i < first + rays && i < m_in.rays.size(); ++i)
+        primaries += m_in.rays[i].kind == uint8_t(RayKind::primary);
     std::vector<LaneProgram> lanes;
+    Cycle end = at;
     for (uint64_t i = 0; i < primaries; i += m_config.warp_width) {
         lanes.assign(std::min<uint64_t>(m_config.warp_width, primaries - i), LaneProgram{program, m_config.cost.raygen});
-        const WarpResult w = m_cores->run(lanes, 0);
-        m_raygen_end = std::max(m_raygen_end, w.end);
+        const WarpResult w = m_cores->run(lanes, at);
+        end = std::max(end, w.end);
         m_raygen_issued += w.issued, m_raygen_lane_instructions += w.lane_instructions;
     }
-    m_release = m_raygen_end;
-    m_last_end = m_raygen_end;
+    m_raygen_cycles += end - at;
+    return end;
+}
+
+Cycle ShadingBlock::begin_frame(uint32_t f, Cycle at) {
+    m_cores->advance_to(at);
+    const Cycle end = raygen(m_in.frames.at(f).first_ray, m_in.frames[f].rays, at);
+    m_release = end;
+    m_last_end = std::max(m_last_end, end);
+    return end;
 }
 
 ShadingBlock::Lane ShadingBlock::lane_of(const RayResult& r) {

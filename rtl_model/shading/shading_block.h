@@ -40,6 +40,9 @@ public:
     /// wavefront: wavefront `w`'s last ray finished at `end`; shades it and returns the cycle its
     /// children may start (the shading's end).
     Cycle wavefront_end(uint32_t w, Cycle end);
+    /// wavefront, an animated trace: frame `f`'s primary rays are generated from `at` (its
+    /// camera program, after the previous frame's last bounce); returns when its rays may start.
+    Cycle begin_frame(uint32_t f, Cycle at);
     /// inflight: when ray `id`'s parent is shaded, true and *not_before = that cycle.
     bool parent_shaded(uint64_t id, Cycle* not_before) const;
     /// inflight: the ray whose shading ray `id` waits for (its parent).
@@ -74,7 +77,8 @@ private:
     Cycle shade(std::vector<Lane>& lanes, Cycle ready, bool sort);
     void run_warps(std::vector<Lane>& lanes, size_t first, size_t end, Cycle ready);
     void flush_inflight(Cycle now);
-    void raygen();
+    /// Generates the primaries among rays [first, first + rays) from cycle `at`; returns the end.
+    Cycle raygen(uint64_t first, uint64_t rays, Cycle at);
 
     const ShadingConfig& m_config;
     const ShadingInputs& m_in;
@@ -87,7 +91,8 @@ private:
     std::vector<Cycle> m_shaded_at;  ///< per ray: when its warp finished (inflight), 0 before
     std::vector<uint8_t> m_done;     ///< per ray: shaded
     std::vector<uint8_t> m_seen;     ///< per ray: finished (handed to the shading block)
-    Cycle m_raygen_end = 0;
+    Cycle m_raygen_end = 0;       ///< the first frame's ray generation
+    uint64_t m_raygen_cycles = 0;  ///< every frame's ray generation, summed (the frame accounting)
     Cycle m_reorder_exposed = 0;  ///< sorting before the first warp of the current batch
     // Frame accounting (wavefront: serial parts that sum to the frame time).
     Cycle m_release = 0;  ///< current wavefront's start

@@ -18,6 +18,10 @@ struct ShadingInputs {
     std::vector<uint64_t> reference_fetches;  ///< TXFT
     /// Rays per wavefront, in trace order (a trace lists its rays depth by depth).
     std::vector<uint64_t> wavefronts;
+    /// An animated trace: each frame's first ray and rays (empty: one frame of every ray), and
+    /// the frame of each wavefront (wavefronts never span two frames).
+    std::vector<FrameRecord> frames;
+    std::vector<uint32_t> wavefront_frame;
     uint32_t shaders = 0;  ///< distinct hit shaders (MaterialRecord::shader < shaders)
 
     bool has_textures() const { return !textures.empty(); }

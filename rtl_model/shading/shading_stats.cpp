@@ -50,7 +50,7 @@ json ShadingBlock::stats_json(Cycle rt_end, double clock_ghz) const {
     const Cycle frame = frame_end(rt_end);
     json breakdown;
     if (m_config.frame_loop == FrameLoop::wavefront) {
-        breakdown = {{"raygen", m_raygen_end}, {"traversal", m_traversal}, {"reorder", m_reorder}, {"shading", m_shading}};
+        breakdown = {{"raygen", m_raygen_cycles}, {"traversal", m_traversal}, {"reorder", m_reorder}, {"shading", m_shading}};
     } else {
         const Cycle rt = std::max(rt_end, m_raygen_end);
         breakdown = {{"raygen", m_raygen_end}, {"traversal", rt - m_raygen_end}, {"reorder", 0}, {"shading", frame - rt}};
@@ -100,7 +100,7 @@ json ShadingBlock::stats_json(Cycle rt_end, double clock_ghz) const {
         .set("max_pending", m_max_pending);
     if (m_config.frame_loop == FrameLoop::wavefront) {
         w.set("wavefronts", m_wavefronts);
-        w.set("stalls", json{{"rt_waits_for_shading", m_raygen_end + m_reorder + m_shading},
+        w.set("stalls", json{{"rt_waits_for_shading", m_raygen_cycles + m_reorder + m_shading},
                              {"cores_wait_for_traversal", m_traversal},
                              {"shading_texture_bound", m_texture_bound}});
     }

@@ -109,10 +109,15 @@ LevelResult run_timed_level(RunInputs& in) {
         return b.end;
     };
     if (wavefront) {
-        // One frame of bounces: each bounce's barrier is its shading; the frame's figures at the last.
-        top.dispatch().set_frames(frame_rays, nullptr, nullptr);
-        wire_frame_loop(top, c.shading, uint32_t(segments.size()),
-                        [&](Cycle end) { frame_figures.frame_end(0, end, top.memory_totals()); });
+        // Each bounce's barrier is its shading; a frame's figures at its last bounce, and an
+        // animated trace's next frame's structures bound before its first.
+        top.dispatch().set_frames(frame_rays, nullptr, [&, bound = -1](uint32_t w) mutable {
+            const int f = w < shading->wavefront_frame.size() ? int(shading->wavefront_frame[w]) : 0;
+            if (f != bound && built.frames.size() > 1) accel.bind_frame(uint32_t(f));
+            bound = f;
+        });
+        wire_frame_loop(top, c.shading, *shading,
+                        [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); });
     } else if (sampled) {
         // An animated trace: each frame's clusters behind its barrier, its structure bound for them.
         if (built.frames.size() > 1) {
@@ -134,7 +139,7 @@ LevelResult run_timed_level(RunInputs& in) {
             },
             [&](uint32_t f) { accel.bind_frame(f); });
         if (build_unit) top.dispatch().set_barrier(build_at_barrier);
-        if (shading) wire_frame_loop(top, c.shading, 1, nullptr);
+        if (shading) wire_frame_loop(top, c.shading, *shading, nullptr);
     }
     std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
     if (in.options.timeline) {

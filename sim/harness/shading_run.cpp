@@ -51,9 +51,17 @@ std::unique_ptr<ShadingInputs> load_shading_inputs(TraceReader& reader, const Si
         require(s.first_fetch + uint64_t(s.samples) * kTexelsPerSample <= in->reference_fetches.size(),
                 where + "ray " + std::to_string(i) + "'s texel addresses lie past TXFT's end");
     }
-    // Wavefronts: the trace lists rays depth by depth (traces/tracer/tracer.cpp).
+    // Wavefronts: the trace lists rays depth by depth (traces/tracer/tracer.cpp), frame after
+    // frame in an animated trace; a wavefront never spans two frames.
+    if (reader.has(SectionKind::frames)) in->frames = reader.read_all<FrameRecord>(SectionKind::frames);
+    size_t frame = 0;
     for (uint64_t i = 0; i < in->rays.size(); ++i) {
-        if (i == 0 || in->rays[i].depth != in->rays[i - 1].depth) in->wavefronts.push_back(0);
+        bool starts_frame = false;
+        while (frame + 1 < in->frames.size() && i >= in->frames[frame + 1].first_ray) ++frame, starts_frame = true;
+        if (i == 0 || starts_frame || in->rays[i].depth != in->rays[i - 1].depth) {
+            in->wavefronts.push_back(0);
+            in->wavefront_frame.push_back(uint32_t(frame));
+        }
         ++in->wavefronts.back();
     }
     return in;
@@ -70,14 +78,21 @@ std::vector<FrameRecord> wavefront_segments(const ShadingInputs& inputs) {
     return out;
 }
 
-void wire_frame_loop(Top& top, const ShadingConfig& config, uint32_t wavefronts, std::function<void(Cycle)> on_last) {
+void wire_frame_loop(Top& top, const ShadingConfig& config, const ShadingInputs& inputs,
+                     std::function<void(uint32_t, Cycle)> on_frame) {
     ShadingBlock& shading = *top.shading();
     Dispatch& dispatch = top.dispatch();
     dispatch.hold_until(shading.raygen_end());
     if (config.frame_loop == FrameLoop::wavefront) {
-        dispatch.set_barrier([&shading, wavefronts, on_last](uint32_t w, Cycle end) {
-            const Cycle released = shading.wavefront_end(w, end);
-            if (w + 1 == wavefronts && on_last) on_last(released);
+        dispatch.set_barrier([&shading, &inputs, on_frame](uint32_t w, Cycle end) {
+            Cycle released = shading.wavefront_end(w, end);
+            const size_t n = inputs.wavefronts.size();
+            const uint32_t frame = w < inputs.wavefront_frame.size() ? inputs.wavefront_frame[w] : 0;
+            const bool last_of_frame = w + 1 >= n || (w + 1 < inputs.wavefront_frame.size() &&
+                                                      inputs.wavefront_frame[w + 1] != frame);
+            if (last_of_frame && on_frame) on_frame(frame, released);
+            // The next frame's camera rays, after this frame's last bounce is shaded.
+            if (last_of_frame && w + 1 < n) released = shading.begin_frame(inputs.wavefront_frame[w + 1], released);
             return released;
         });
         return;

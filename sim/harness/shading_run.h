@@ -19,9 +19,10 @@ std::unique_ptr<ShadingInputs> load_shading_inputs(TraceReader& reader, const Si
 /// The wavefronts as stream segments (each a run of rays of one depth, in trace order).
 std::vector<FrameRecord> wavefront_segments(const ShadingInputs& inputs);
 /// Wires the frame loop into dispatch: no ray before ray generation ends; wavefront: a barrier
-/// per bounce released when the shading block has shaded it (`on_last`: the frame's last bounce
-/// shaded, at that cycle); inflight: rays wait for their parent's warp.
-void wire_frame_loop(Top& top, const ShadingConfig& config, uint32_t wavefronts,
-                     std::function<void(Cycle)> on_last);
+/// per bounce released when the shading block has shaded it (`on_frame(f, cycle)`: frame f's last
+/// bounce shaded; an animated trace's next frame then generates its camera rays); inflight: rays
+/// wait for their parent's warp.
+void wire_frame_loop(Top& top, const ShadingConfig& config, const ShadingInputs& inputs,
+                     std::function<void(uint32_t, Cycle)> on_frame);
 
 }  // namespace rtsim

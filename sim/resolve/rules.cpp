@@ -173,9 +173,12 @@ std::vector<Rule> make_rules() {
          "a frame's rays depend on their parents' shading, which a sample of rays leaves out",
          "sampling.fraction=0", "bvh2", {"shading.enabled=true", "sampling.fraction=0.2"}});
     add({"shading/frames", "shading.enabled (the frame: shading and the frame loop)", shading,
-         RuleSide::technique, "a trace of one frame", [](const RunFacts& f) { return !animated(f); },
-         "the frame loop's bounce barriers do not compose with animated frames' barriers yet",
-         "shading.enabled=false, or trace one frame", "frames", {"shading.enabled=true"}});
+         RuleSide::technique, "the wavefront frame loop, or a trace of one frame",
+         [](const RunFacts& f) { return !animated(f) || f.config.shading.frame_loop == FrameLoop::wavefront; },
+         "an animated trace's frames are barriers, which the wavefront loop's bounce barriers hold (each frame's "
+         "camera rays after the last bounce of the one before); the in-flight loop's per-ray gate does not yet",
+         "shading.frame_loop=wavefront, or trace one frame", "frames",
+         {"shading.enabled=true", "shading.frame_loop=inflight"}});
     add({"shading/treelets", "shading.enabled (the frame: shading and the frame loop)", shading,
          RuleSide::technique, "treelets.enabled=false", [](const RunFacts& f) { return !treelets(f); },
          "the treelet ray buffer takes rays ahead of the frame loop's barriers and parent order",
@@ -226,6 +229,10 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
         out.push_back({"traversal.stack_prefetch", f.structure.name() + "'s steppers report no stack addresses to prefetch"});
     else if (f.config.traversal.stack_prefetch && !f.level.timed)
         out.push_back({"traversal.stack_prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
+    if (f.config.build_unit.enabled && animated(f) && f.config.shading.enabled && f.structure.shading_sections &&
+        f.level.shades)
+        out.push_back({"build_unit.enabled", "with shading, an animated trace's frames are the wavefront loop's "
+                                             "barriers, where the build unit's work is not simulated yet"});
     if (f.config.shading.enabled && !f.structure.shading_sections)
         out.push_back({"shading.enabled", "this trace has no shading sections (written before trace version 5): "
                                           "the RT unit alone is timed"});

@@ -176,3 +176,28 @@ def test_sampling_cuts_every_frame_into_clusters_behind_its_barrier(
     low, high = sampled["summary"]["cycles_ci95"]
     assert low < sampled["summary"]["cycles"] < high
     assert sampled["summary"]["cycles"] == pytest.approx(exact["summary"]["cycles"], rel=0.25)
+
+
+def test_shading_runs_frame_after_frame_in_the_wavefront_loop(
+    traces: tuple[Path, Path], sim_exe: Path, tmp_path: Path
+) -> None:
+    animated, _ = traces
+    result = simulate(sim_exe, animated, tmp_path / "run", "shading.enabled=true")
+    assert result.returncode == 0, result.stderr
+    stats = json.loads((tmp_path / "run" / "stats.json").read_text())
+    v = stats["validation"]
+    assert v["hit_mismatches"] == v["work_mismatches"] == v["texel_mismatches"] == 0
+    assert v["order_violations"] == 0 and v["shaded_rays"] == v["rays_checked"]
+    shading = stats["model"]["shading"]
+    # Each frame's camera rays are generated after the frame before is shaded, and the frames'
+    # times add up to the frame loop's, whose parts add up to it.
+    assert [f["frame"] for f in stats["frames"]] == list(range(FRAMES))
+    assert sum(f["cycles"] for f in stats["frames"]) == shading["frame_cycles"]
+    assert sum(shading["breakdown"].values()) == shading["frame_cycles"]
+    # A wavefront never spans two frames: at least one per frame and depth.
+    assert len(shading["wavefronts"]) >= FRAMES * 2
+    # The in-flight loop does not hold frame barriers yet: refused, naming the setting.
+    refused = simulate(sim_exe, animated, tmp_path / "inflight", "shading.enabled=true",
+                       "shading.frame_loop=inflight")  # fmt: skip
+    assert refused.returncode == 2
+    assert "shading.frame_loop=wavefront" in refused.stderr, refused.stderr
