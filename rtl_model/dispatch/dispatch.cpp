@@ -120,13 +120,17 @@ void Dispatch::set_frames(std::vector<uint64_t> frame_rays, FrameEnd on_end, Fra
     m_frame_rays = std::move(frame_rays);
     m_on_end = std::move(on_end);
     m_on_begin = std::move(on_begin);
-    // Leading empty frames end at cycle 0: no ray of theirs will finish to end them.
+    // Leading empty frames end at cycle 0 (no ray of theirs will finish to end them), each
+    // through the barrier when one is set first (a moving scene's builds before the next frame).
+    Cycle release = 0;
     for (m_frame = 0;; ++m_frame) {
         stream().begin_frame(m_frame);
         if (m_on_begin) m_on_begin(m_frame);
         if (m_frame_rays[m_frame] != 0 || m_frame + 1 >= m_frame_rays.size()) break;
-        if (m_on_end) m_on_end(m_frame, 0);
+        if (m_barrier) release = std::max(release, m_barrier(m_frame, release));
+        if (m_on_end) m_on_end(m_frame, release);
     }
+    m_release = std::max(m_release, release);
 }
 
 bool Dispatch::next_ray(uint32_t unit, RayJob* job) {

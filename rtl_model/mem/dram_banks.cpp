@@ -89,6 +89,7 @@ DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, C
                                   Cycle* activate) const {
     const Cycle refi = m_config.t_refi, rfc = m_config.t_rfc;
     Timing t;
+    bool deferred = false;  // past one refresh already: a gap too short for it does not defer it again
     for (;;) {
         if (refi) {
             // Refreshes at k x tREFI (k >= 1), tRFC long: start after one under way; a refresh
@@ -125,7 +126,8 @@ DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, C
         }
         if (refi) {
             const Cycle next = (s / refi + 1) * refi;
-            if (finish > next) {  // would run into the next refresh: after it, row closed
+            if (finish > next && !deferred) {  // would run into the next refresh: after it, row closed
+                deferred = true;
                 t.refresh_wait += next + rfc - s;
                 s = next + rfc;
                 open.row = kClosed;

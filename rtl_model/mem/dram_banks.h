@@ -21,8 +21,10 @@
 // activate until no other activate of the channel is within tRRD of it and no window of tFAW
 // cycles holds more than four (checked against the channel's last 32 activates, before and after
 // it in time); an all-bank refresh every tREFI cycles occupies each bank of the channel for tRFC
-// (an access that would overlap one starts after it) and closes every row. The gap a request
-// takes must fit its whole delayed service.
+// (an access that would overlap one starts after it, once: an access longer than the time between
+// refreshes, outside any DDR part's timing, runs past the next) and closes every row. The gap a
+// request takes must fit its whole delayed service. Not modelled: a row left open across a
+// refresh owes no tRAS or tRP before it.
 // At detailed requests normally arrive in time order (units synchronise every cycle), and then
 // this is first come, first served; at approx units run up to a quantum apart, so requests
 // arrive out of order within a quantum and back-fill as below. Only the last 64 bookings per

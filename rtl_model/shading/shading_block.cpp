@@ -45,7 +45,11 @@ ShadingBlock::ShadingBlock(sc_core::sc_module_name name, const ShadingConfig& co
     m_done.assign(inputs.rays.size(), 0);
     m_seen.assign(inputs.rays.size(), 0);
     // The first frame's camera rays are generated before any traversal.
-    m_raygen_end = raygen(0, inputs.frames.empty() ? inputs.rays.size() : inputs.frames[0].rays, 0);
+    // (An animated trace's: the first frame with rays, leading empty frames aside.)
+    const FrameRecord first = inputs.frames.empty() || inputs.wavefront_frame.empty()
+                                  ? FrameRecord{0, inputs.rays.size()}
+                                  : inputs.frames[inputs.wavefront_frame[0]];
+    m_raygen_end = raygen(first.first_ray, first.rays, 0);
     m_release = m_last_end = m_raygen_end;
 }
 

@@ -116,6 +116,9 @@ LevelResult run_timed_level(RunInputs& in) {
             if (f != bound && built.frames.size() > 1) accel.bind_frame(uint32_t(f));
             bound = f;
         });
+        // Leading empty frames end at cycle 0, before the first frame with rays.
+        for (uint32_t f = 0; !shading->wavefront_frame.empty() && f < shading->wavefront_frame[0]; ++f)
+            frame_figures.frame_end(f, 0, top.memory_totals());
         wire_frame_loop(top, c.shading, *shading,
                         [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); });
     } else if (sampled) {
@@ -123,22 +126,22 @@ LevelResult run_timed_level(RunInputs& in) {
         if (built.frames.size() > 1) {
             std::vector<uint64_t> sampled_rays(built.frames.size(), 0);
             for (const SamplePlan::Cluster& cl : sampled->plan.clusters) sampled_rays[cl.frame] += cl.end() - cl.first;
+            if (build_unit) top.dispatch().set_barrier(build_at_barrier);  // before: leading empty frames build too
             top.dispatch().set_frames(
                 sampled_rays,
                 [&](uint32_t f, Cycle end) {
                     if (!frame_figures.recorded(f)) frame_figures.frame_end(f, end, top.memory_totals());
                 },
                 [&](uint32_t f) { accel.bind_frame(f); });
-            if (build_unit) top.dispatch().set_barrier(build_at_barrier);
         }
     } else {
+        if (build_unit) top.dispatch().set_barrier(build_at_barrier);  // before: leading empty frames build too
         top.dispatch().set_frames(
             frame_rays,
             [&](uint32_t f, Cycle end) {
                 if (!frame_figures.recorded(f)) frame_figures.frame_end(f, end, top.memory_totals());
             },
             [&](uint32_t f) { accel.bind_frame(f); });
-        if (build_unit) top.dispatch().set_barrier(build_at_barrier);
         if (shading) wire_frame_loop(top, c.shading, *shading, nullptr);
     }
     std::unique_ptr<TraceReader> kind_reader;  // outlives the hook (called during sc_start)
@@ -206,9 +209,15 @@ LevelResult run_timed_level(RunInputs& in) {
             sampled->estimator.set_barrier_cycles(sum);
         }
         apply_sampling_to_summary(r.summary, c, sampled->plan, sampled->estimator);
-        if (built.frames.size() > 1)
+        if (built.frames.size() > 1) {
             apply_sampling_to_frames(frame_figures.mutable_json(), c, sampled->plan, sampled->estimator, built.frames,
                                      tails);
+            // The run's DRAM bytes as the frames': the rays' scaled, the builds' (simulated whole) not.
+            double bytes = 0;
+            for (const json& f : frame_figures.to_json()) bytes += f.value("dram_bytes", 0.0);
+            r.summary["dram_bytes"] = bytes;
+            r.summary["dram_bytes_per_ray"] = built.rays ? bytes / double(built.rays) : 0.0;
+        }
         r.sampling = sampled->estimator.to_json(c, r.cycles, wall);
         r.sampling["functional_warming"] = {{"rays_per_cluster", c.sampling.warming_rays},
                                             {"warmed_rays", warmer ? warmer->warmed_rays() : 0},

@@ -90,7 +90,12 @@ void wire_frame_loop(Top& top, const ShadingConfig& config, const ShadingInputs&
             const uint32_t frame = w < inputs.wavefront_frame.size() ? inputs.wavefront_frame[w] : 0;
             const bool last_of_frame = w + 1 >= n || (w + 1 < inputs.wavefront_frame.size() &&
                                                       inputs.wavefront_frame[w + 1] != frame);
-            if (last_of_frame && on_frame) on_frame(frame, released);
+            if (last_of_frame && on_frame) {
+                // This frame, then any empty frames before the next one with rays (or the end).
+                const uint32_t next = w + 1 < n ? inputs.wavefront_frame[w + 1] : uint32_t(inputs.frames.size());
+                on_frame(frame, released);
+                for (uint32_t e = frame + 1; e < next; ++e) on_frame(e, released);
+            }
             // The next frame's camera rays, after this frame's last bounce is shaded.
             if (last_of_frame && w + 1 < n) released = shading.begin_frame(inputs.wavefront_frame[w + 1], released);
             return released;

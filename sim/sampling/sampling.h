@@ -55,8 +55,9 @@ struct SamplePlan {
 
 /// The plan for a trace of `trace_rays` rays; throws rtsim::Error naming the sampling field when
 /// the trace is too small for the requested clusters and warm-up. With the frames of an animated
-/// trace each cluster lies in one frame (in the part of its stratum with the most rays that holds
-/// it: a stratum still stands for all its rays), so a frame's structure is bound for it alone.
+/// trace each cluster lies in one frame (the part of its stratum in one frame that holds it and
+/// its random start, else the largest part that holds it: a stratum still stands for all its
+/// rays), so a frame's structure is bound for it alone.
 SamplePlan plan_sample(const SimConfig& config, uint64_t trace_rays, const std::vector<FrameRecord>& frames = {});
 
 /// True when sampling would simulate the whole trace anyway: the sample asked for is every ray

@@ -108,11 +108,18 @@ def test_crc_repaired_hit_edit_is_a_mismatch_not_a_pass(small: Path, tmp_path: P
 def test_empty_first_frame_simulates(animated: Path, tmp_path: Path) -> None:
     trace, _ = _forge(animated, tmp_path / "t", empty_first_frame)
     assert len(rtsim.open_trace(trace).frames) == 3
-    for fidelity in ("functional", "approx"):
-        sim = _sim(trace, tmp_path / f"run-{fidelity}", f"fidelity={fidelity}")
+    # Also through the shaded frame loop, whose first frame's camera rays are the first frame
+    # with rays (an empty frame has no wavefront: its figures are still recorded, in order).
+    for name, sets in (("functional", ["fidelity=functional"]), ("approx", ["fidelity=approx"]),
+                       ("shaded", ["fidelity=approx", "shading.enabled=true"])):  # fmt: skip
+        sim = _sim(trace, tmp_path / f"run-{name}", *sets)
         assert sim.returncode == 0, sim.stderr
-        frames = json.loads((tmp_path / f"run-{fidelity}" / "stats.json").read_text())["frames"]
-        assert frames[0]["rays"] == 0
+        stats = json.loads((tmp_path / f"run-{name}" / "stats.json").read_text())
+        frames = stats["frames"]
+        assert frames[0]["rays"] == 0 and [f["frame"] for f in frames] == [0, 1, 2]
+        if name == "shaded":
+            assert stats["validation"]["order_violations"] == 0
+            assert stats["model"]["shading"]["breakdown"]["raygen"] > 0
 
 
 def test_bad_manifest_frames_block_refused_before_the_run(animated: Path, tmp_path: Path) -> None:

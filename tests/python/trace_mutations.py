@@ -86,6 +86,13 @@ def empty_first_frame(s: Sections) -> None:
     n0 = int(f[0]["rays"])
     for name in ("rays", "hits", "work"):
         s[name] = s[name][n0 * s.record_bytes[name] :]
+    if "SHAD" in s:
+        # Shading records too, their parents renumbered (a frame's rays spawn only its own).
+        shade = np.frombuffer(bytes(s["SHAD"][n0 * 32 :]), dtype=np.uint8).copy().reshape(-1, 32)
+        parent = shade[:, :8].copy().view(np.int64).reshape(-1)
+        parent[parent >= 0] -= n0
+        shade[:, :8] = parent.view(np.uint8).reshape(-1, 8)
+        s["SHAD"] = bytearray(shade.tobytes())
     f["first_ray"][1:] -= n0
     f[0]["rays"] = 0
 

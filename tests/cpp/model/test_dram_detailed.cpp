@@ -192,6 +192,14 @@ TEST(DramDetailed, RefreshBlocksTheChannelAndClosesRows) {
     EXPECT_EQ(b.start, 220u);
     EXPECT_EQ(int(b.result), int(Row::miss));
     EXPECT_EQ(b.column, 230u);
+    // A gap between refreshes shorter than an access (outside any DDR part's timing) defers it
+    // once, then lets it run past the next refresh: it ends.
+    c.t_refi = 100;
+    c.t_rfc = 90;
+    DramBanks tight(c);
+    const DramBanks::Timing d = tight.access(0, 64, 95);
+    EXPECT_EQ(d.start, 190u);
+    EXPECT_EQ(d.column, 200u);
 }
 
 /// The bank model as it was before its bookings became a ring: a std::map per bank, the same
