@@ -275,7 +275,9 @@ void SampleEstimator::ray_done(const RayResult& r) {
     m_start[i] = m_measure == SampleMeasure::starts ? r.start : r.end;
     const uint32_t f = m_plan.clusters[k].frame;
     if (f >= m_frame_last_start.size()) m_frame_last_start.resize(f + 1, 0);
-    m_frame_last_start[f] = std::max(m_frame_last_start[f], r.start);
+    // The measure the strata use (with treelets, completions: the buffer admits rays long before
+    // it traces them, so a frame's last admission is not where its drain begins).
+    m_frame_last_start[f] = std::max(m_frame_last_start[f], m_start[i]);
     m_seen[i] = 1;
     m_done = false;
 }

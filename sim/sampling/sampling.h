@@ -148,7 +148,8 @@ public:
     /// Estimated cycles of trace rays [first, first + rays): each stratum's cycles per ray over
     /// its rays in that range (the frames of an animated trace sum to cycles()).
     double cycles_of(uint64_t first, uint64_t rays) const;
-    /// An animated trace: the last start (any sampled ray's) of each frame, by cluster frame.
+    /// An animated trace: each frame's last start (any sampled ray's; its last completion when
+    /// the strata measure completions), by cluster frame.
     Cycle frame_last_start(uint32_t f) const { return f < m_frame_last_start.size() ? m_frame_last_start[f] : 0; }
     /// Cycles the frame barriers add on top of the strata's steady-state throughput (each
     /// frame drains before the next begins): added to cycles() and its interval.
