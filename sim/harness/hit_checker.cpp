@@ -112,7 +112,7 @@ const StatBlock& validation_stats() {
             {"hit_mismatches", "rays", "hit differs: primitive id, or the bit pattern of t for a hit"},
             {"work_mismatches", "rays", "hit equal, work differs: any field of the ray's work counts"},
             {"first_mismatches", "list", "up to 20 `{ray, difference}`: the ray index and the fields that differ, model/reference"},
-            {"reordered_anyhit", "", "only with `traversal.anyhit_order` other than `nearest` (functional, approx and detailed levels): `rays` (the any-hit rays walked in that order, their occlusion checked), and per such ray `own` and `trace_order` `{steps, box_tests, tri_tests}`: their work in the run's order and in the trace's (nearest first)", false, true},
+            {"reordered_anyhit", "", "only with `traversal.anyhit_order` other than `nearest` (the levels that step every ray: functional, approx, detailed, and analytic with `analytic.caches=functional`): `rays` (the any-hit rays walked in that order, their occlusion checked), and per such ray `own` and `trace_order` `{steps, box_tests, tri_tests}`: their work in the run's order and in the trace's (nearest first)", false, true},
             {"scope", "", "analytic level only: which rays were checked (the analysis's sampled rays)", false, true},
             {"shaded_rays", "rays", "only with `shading.enabled`: rays the shading block shaded (every ray, once)", false, true},
             {"texel_mismatches", "rays", "only with `shading.enabled`: rays whose texel addresses differ from the reference tracer's (0 allowed, else exit 3)", false, true},

@@ -74,7 +74,7 @@ LevelResult run_functional_caches(RunInputs& in) {
     ReferenceWindow reference(in.reader, c.dispatch.chunk_rays);
     HitChecker checker("checker", reference, built.rays);
     // Every ray is stepped: any-hit rays in another child order are checked by occlusion.
-    checker.set_reordered_anyhit(in.setup.step.anyhit_order != AnyHitOrder::nearest);
+    checker.set_reordered_anyhit(in.setup.step.reorders_anyhit());
     TraceRayStream stream(in.reader);
     AnalyticOutcome a = run_analytic_exact(c, *built.accel, *built.map, in.setup.step, stream, checker);
     require(checker.checked() == built.rays, "analytic run ended with " + std::to_string(checker.checked()) + " of " +

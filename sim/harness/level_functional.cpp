@@ -91,7 +91,7 @@ LevelResult run_functional_level(RunInputs& in) {
     ReferenceWindow reference(in.reader, s.config.dispatch.chunk_rays);
     HitChecker checker("checker", reference, built.rays, progress_of(in.options));
     // Any-hit rays in another child order than the trace's: occlusion checked alone.
-    checker.set_reordered_anyhit(s.step.anyhit_order != AnyHitOrder::nearest);
+    checker.set_reordered_anyhit(s.step.reorders_anyhit());
     std::unique_ptr<FunctionalPackets> packets;
     if (s.packet_reference) {
         // Packets change each ray's work: it is checked against the reference packet loop.

@@ -73,7 +73,7 @@ LevelResult run_timed_level(RunInputs& in) {
                        progress_of(in.options));
     // Any-hit rays in another child order than the trace's: occlusion checked alone, the
     // model's own work timed and counted.
-    checker.set_reordered_anyhit(s.step.anyhit_order != AnyHitOrder::nearest);
+    checker.set_reordered_anyhit(s.step.reorders_anyhit());
     if (s.packet_reference) {
         // Packets change each ray's work: it is checked against the reference packet loop.
         const float split = s.packet_reference->split_below;
@@ -121,23 +121,11 @@ LevelResult run_timed_level(RunInputs& in) {
             frame_figures.frame_end(f, 0, top.memory_totals());
         wire_frame_loop(top, c.shading, *shading,
                         [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); });
-    } else if (sampled) {
-        // An animated trace: each frame's clusters behind its barrier, its structure bound for them.
-        if (built.frames.size() > 1) {
-            std::vector<uint64_t> sampled_rays(built.frames.size(), 0);
-            for (const SamplePlan::Cluster& cl : sampled->plan.clusters) sampled_rays[cl.frame] += cl.end() - cl.first;
-            if (build_unit) top.dispatch().set_barrier(build_at_barrier);  // before: leading empty frames build too
-            top.dispatch().set_frames(
-                sampled_rays,
-                [&](uint32_t f, Cycle end) {
-                    if (!frame_figures.recorded(f)) frame_figures.frame_end(f, end, top.memory_totals());
-                },
-                [&](uint32_t f) { accel.bind_frame(f); });
-        }
-    } else {
+    } else if (!sampled || built.frames.size() > 1) {
+        // A sampled animated trace: each frame's clusters behind its barrier, its structure bound for them.
         if (build_unit) top.dispatch().set_barrier(build_at_barrier);  // before: leading empty frames build too
         top.dispatch().set_frames(
-            frame_rays,
+            sampled ? sampled->plan.rays_per_frame(built.frames.size()) : frame_rays,
             [&](uint32_t f, Cycle end) {
                 if (!frame_figures.recorded(f)) frame_figures.frame_end(f, end, top.memory_totals());
             },

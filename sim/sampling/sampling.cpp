@@ -316,6 +316,8 @@ void SampleEstimator::finish() const {
 }
 
 double SampleEstimator::cycles() const { return finish(), m_total + m_barrier_cycles; }
+double SampleEstimator::ci_low() const { return finish(), std::max(0.0, m_total - m_half) + m_barrier_cycles; }
+double SampleEstimator::ci_high() const { return finish(), m_total + m_half + m_barrier_cycles; }
 
 double SampleEstimator::cycles_of(uint64_t first, uint64_t rays) const {
     finish();
@@ -327,63 +329,6 @@ double SampleEstimator::cycles_of(uint64_t first, uint64_t rays) const {
     }
     return total;
 }
-
-std::vector<double> frame_barrier_tails(const nlohmann::json& frames, const SamplePlan& plan,
-                                        const SampleEstimator& estimator, size_t frame_count) {
-    std::vector<uint64_t> sampled(frame_count, 0);
-    for (const SamplePlan::Cluster& c : plan.clusters) sampled.at(c.frame) += c.end() - c.first;
-    std::vector<double> tails(frame_count, -1.0);
-    double sum = 0;
-    int n = 0;
-    for (const nlohmann::json& f : frames) {
-        const uint32_t i = f["frame"].get<uint32_t>();
-        if (i >= frame_count || !sampled[i]) continue;
-        const Cycle end = f.value("end_cycle", Cycle(0)), last = estimator.frame_last_start(i);
-        tails[i] = end > last ? double(end - last) : 0.0;
-        sum += tails[i], ++n;
-    }
-    for (double& t : tails)
-        if (t < 0) t = n ? sum / n : 0.0;  // a frame without a cluster drains like the others
-    // The build unit's work before a frame's rays (moving scenes) is simulated in full.
-    for (const nlohmann::json& f : frames) {
-        const uint32_t i = f["frame"].get<uint32_t>();
-        if (i < frame_count) tails[i] += f.value("build_cycles", 0.0);
-    }
-    return tails;
-}
-
-void apply_sampling_to_frames(nlohmann::json& frames, const SimConfig& config, const SamplePlan& plan,
-                              const SampleEstimator& estimator, const std::vector<FrameRecord>& table,
-                              const std::vector<double>& tails) {
-    std::vector<uint64_t> sampled(table.size(), 0);
-    for (const SamplePlan::Cluster& c : plan.clusters) sampled.at(c.frame) += c.end() - c.first;
-    // The build unit's bytes are the whole build's; the rays' bytes scale with the sample. (Its
-    // bytes as it moved them through the L2, an upper bound on its DRAM share.)
-    auto build_bytes = [](const nlohmann::json& f) {
-        return std::min(f.value("dram_bytes", 0.0), f.value("build_read_bytes", 0.0) + f.value("build_written_bytes", 0.0));
-    };
-    double all_bytes = 0;
-    for (const nlohmann::json& f : frames) all_bytes += f.value("dram_bytes", 0.0) - build_bytes(f);
-    const double bytes_per_sampled_ray = plan.simulated_rays ? all_bytes / double(plan.simulated_rays) : 0.0;
-    double start = 0;
-    for (nlohmann::json& f : frames) {
-        const uint32_t i = f["frame"].get<uint32_t>();
-        const uint64_t rays = table.at(i).rays;
-        const double cycles = estimator.cycles_of(table[i].first_ray, rays) + tails.at(i);
-        const double per_ray =
-            sampled[i] ? (f.value("dram_bytes", 0.0) - build_bytes(f)) / double(sampled[i]) : bytes_per_sampled_ray;
-        f["sampled_rays"] = sampled[i];
-        f["start_cycle"] = uint64_t(std::llround(start));
-        start += cycles;
-        f["end_cycle"] = uint64_t(std::llround(start));
-        f["cycles"] = uint64_t(std::llround(cycles));
-        f["mrays_per_second"] = cycles > 0 ? double(rays) / (cycles / (config.clock_ghz * 1e9)) / 1e6 : 0.0;
-        f["dram_bytes"] = per_ray * double(rays) + build_bytes(f);
-        f["dram_bytes_per_ray"] = rays ? f["dram_bytes"].get<double>() / double(rays) : 0.0;
-    }
-}
-double SampleEstimator::ci_low() const { return finish(), std::max(0.0, m_total - m_half) + m_barrier_cycles; }
-double SampleEstimator::ci_high() const { return finish(), m_total + m_half + m_barrier_cycles; }
 
 json SampleEstimator::to_json(const SimConfig& config, Cycle simulated_cycles, double wall) const {
     finish();
@@ -432,6 +377,59 @@ void apply_sampling_to_summary(json& s, const SimConfig& config, const SamplePla
     // Simulator speed: rays actually simulated per wall second (sampling.* has the effective one).
     const double wall = s.value("wall_seconds", 0.0);
     s["simulated_rays_per_wall_second"] = wall > 0 ? sim / wall : 0.0;
+}
+
+std::vector<double> frame_barrier_tails(const nlohmann::json& frames, const SamplePlan& plan,
+                                        const SampleEstimator& estimator, size_t frame_count) {
+    const std::vector<uint64_t> sampled = plan.rays_per_frame(frame_count);
+    std::vector<double> tails(frame_count, -1.0);
+    double sum = 0;
+    int n = 0;
+    for (const nlohmann::json& f : frames) {
+        const uint32_t i = f["frame"].get<uint32_t>();
+        if (i >= frame_count || !sampled[i]) continue;
+        const Cycle end = f.value("end_cycle", Cycle(0)), last = estimator.frame_last_start(i);
+        tails[i] = end > last ? double(end - last) : 0.0;
+        sum += tails[i], ++n;
+    }
+    for (double& t : tails)
+        if (t < 0) t = n ? sum / n : 0.0;  // a frame without a cluster drains like the others
+    // The build unit's work before a frame's rays (moving scenes) is simulated in full.
+    for (const nlohmann::json& f : frames) {
+        const uint32_t i = f["frame"].get<uint32_t>();
+        if (i < frame_count) tails[i] += f.value("build_cycles", 0.0);
+    }
+    return tails;
+}
+
+void apply_sampling_to_frames(nlohmann::json& frames, const SimConfig& config, const SamplePlan& plan,
+                              const SampleEstimator& estimator, const std::vector<FrameRecord>& table,
+                              const std::vector<double>& tails) {
+    const std::vector<uint64_t> sampled = plan.rays_per_frame(table.size());
+    // The build unit's bytes are the whole build's; the rays' bytes scale with the sample. (Its
+    // bytes as it moved them through the L2, an upper bound on its DRAM share.)
+    auto build_bytes = [](const nlohmann::json& f) {
+        return std::min(f.value("dram_bytes", 0.0), f.value("build_read_bytes", 0.0) + f.value("build_written_bytes", 0.0));
+    };
+    double all_bytes = 0;
+    for (const nlohmann::json& f : frames) all_bytes += f.value("dram_bytes", 0.0) - build_bytes(f);
+    const double bytes_per_sampled_ray = plan.simulated_rays ? all_bytes / double(plan.simulated_rays) : 0.0;
+    double start = 0;
+    for (nlohmann::json& f : frames) {
+        const uint32_t i = f["frame"].get<uint32_t>();
+        const uint64_t rays = table.at(i).rays;
+        const double cycles = estimator.cycles_of(table[i].first_ray, rays) + tails.at(i);
+        const double per_ray =
+            sampled[i] ? (f.value("dram_bytes", 0.0) - build_bytes(f)) / double(sampled[i]) : bytes_per_sampled_ray;
+        f["sampled_rays"] = sampled[i];
+        f["start_cycle"] = uint64_t(std::llround(start));
+        start += cycles;
+        f["end_cycle"] = uint64_t(std::llround(start));
+        f["cycles"] = uint64_t(std::llround(cycles));
+        f["mrays_per_second"] = cycles > 0 ? double(rays) / (cycles / (config.clock_ghz * 1e9)) / 1e6 : 0.0;
+        f["dram_bytes"] = per_ray * double(rays) + build_bytes(f);
+        f["dram_bytes_per_ray"] = rays ? f["dram_bytes"].get<double>() / double(rays) : 0.0;
+    }
 }
 
 const StatBlock& sampling_stats() {

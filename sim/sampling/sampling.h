@@ -51,6 +51,13 @@ struct SamplePlan {
     uint64_t warmup_target = 0;   ///< what the cluster wanted (more than warmup_rays if the sample is small)
     std::vector<Cluster> clusters;  ///< in trace order
     std::vector<uint64_t> frame_first;  ///< an animated trace: each frame's first ray (else empty)
+
+    /// The rays the sample simulates in each of `frames` frames (its clusters', by their frame).
+    std::vector<uint64_t> rays_per_frame(size_t frames) const {
+        std::vector<uint64_t> out(frames, 0);
+        for (const Cluster& c : clusters) out.at(c.frame) += c.end() - c.first;
+        return out;
+    }
 };
 
 /// The plan for a trace of `trace_rays` rays; throws rtsim::Error naming the sampling field when

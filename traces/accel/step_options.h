@@ -36,11 +36,14 @@ struct StepOptions {
     /// found and the work may. The fused loops walk nearest first, so other orders use a stepper.
     AnyHitOrder anyhit_order = AnyHitOrder::nearest;
 
+    /// Any-hit rays walk in another child order than the trace's (nearest first): the hit
+    /// checker checks their occlusion alone (HitChecker::set_reordered_anyhit).
+    bool reorders_anyhit() const { return anyhit_order != AnyHitOrder::nearest; }
+
     /// True when a structure's fused reference loop walks as its steppers do: no short stack or
     /// reduced-precision walk whose extra work only a stepper counts, and any-hit rays nearest first.
     bool fused_loop_walks_alike() const {
-        return short_stack_entries == 0 && box_precision_bits == 0 && !quantized_box_tests &&
-               anyhit_order == AnyHitOrder::nearest;
+        return short_stack_entries == 0 && box_precision_bits == 0 && !quantized_box_tests && !reorders_anyhit();
     }
 };
 

@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include "model_test_util.h"
 #include "rtl_model/dispatch/dispatch.h"
 
 using namespace rtsim;
@@ -93,3 +94,25 @@ TEST(DispatchSegments, OnDemandReadsTheNextSegmentOnlyWhenEveryRayIsOut) {
 }
 
 }  // namespace
+
+// Leading empty frames (an animated trace whose first frames hold no rays) end at once, each
+// through the barrier set before the frames (a moving scene's build of the next frame), in order,
+// each release the next one's start; their end hooks see those releases.
+TEST(DispatchFrames, LeadingEmptyFramesPassTheirBarriersInOrder) {
+    rtsim::test::TestKernel kernel;
+    DispatchConfig config;
+    uint64_t handed = 0;
+    SegmentedStream stream({5}, handed);
+    Dispatch dispatch("dispatch", config, 2, stream);
+    std::vector<std::pair<uint32_t, Cycle>> barriers, ends;
+    std::vector<uint32_t> begins;
+    dispatch.set_barrier([&](uint32_t f, Cycle at) {
+        barriers.push_back({f, at});
+        return at + 100;  // the build takes 100 cycles
+    });
+    dispatch.set_frames({0, 0, 5}, [&](uint32_t f, Cycle at) { ends.push_back({f, at}); },
+                        [&](uint32_t f) { begins.push_back(f); });
+    EXPECT_EQ(barriers, (std::vector<std::pair<uint32_t, Cycle>>{{0, 0}, {1, 100}}));
+    EXPECT_EQ(ends, (std::vector<std::pair<uint32_t, Cycle>>{{0, 100}, {1, 200}}));
+    EXPECT_EQ(begins, (std::vector<uint32_t>{0, 1, 2}));
+}
