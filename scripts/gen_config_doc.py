@@ -53,6 +53,9 @@ SECTION_NOTES = {
     "obb": "The ray-rotation pipeline of oriented nodes: one operation per node whose child boxes "
     "lie in a rotated frame (`obvh2`, docs/accel.md), ahead of its box tests; built only for "
     "structures with oriented nodes.",
+    "sphere": "The ray/sphere pipeline of curved primitives: one operation per sphere record a "
+    "leaf tests (docs/intersection.md, Ray/sphere); built only for traces whose scenes have "
+    "spheres.",
     "mailbox": "Mailboxes in the traversal units: a table per ray context of the primitives the "
     "ray tested, so grids, kd-trees and octrees skip retests (docs/accel.md, Mailboxes).",
     "l1": "The private per-unit L1 caches (MSHRs modelled exactly).",

@@ -80,6 +80,8 @@ class Trace:
         # rtsim-sim checks them: a flipped byte raises RtsimError naming the section and chunk.
         verify_trace(self.path, name.upper())
         dtype = SECTION_DTYPES[name]
+        if section.record_bytes < dtype.itemsize:
+            dtype = _leading_fields(dtype, section.record_bytes)
         if section.record_count == 0:
             return np.zeros(0, dtype=dtype)
         return np.memmap(
@@ -183,6 +185,20 @@ class Trace:
         checks the header, table, image regions and frame table; RAYS, HITS and WORK are
         checked when first read."""
         verify_trace(self.path)
+
+
+def _leading_fields(dtype: np.dtype, itemsize: int) -> np.dtype:
+    """An older version's shorter records (WORK before version 6 has no sphere_tests): the
+    fields that fit in `itemsize` bytes; the counters it predates are absent."""
+    names = [n for n in dtype.names if dtype.fields[n][1] + dtype.fields[n][0].itemsize <= itemsize]
+    return np.dtype(
+        {
+            "names": names,
+            "formats": [dtype.fields[n][0] for n in names],
+            "offsets": [dtype.fields[n][1] for n in names],
+            "itemsize": itemsize,
+        }
+    )
 
 
 def _section_name(info: dict[str, Any]) -> str:

@@ -170,6 +170,7 @@ PyScene load_scene(const fs::path& path, uint32_t hairball_triangles, uint64_t s
         std::string known;
         for (const std::string& n : procedural_scene_names()) known += (known.empty() ? "" : ", ") + n;
         for (const std::string& n : instanced_procedural_scene_names()) known += ", " + n;
+        for (const std::string& n : sphere_procedural_scene_names()) known += ", " + n;
         throw Error(text + ": no such file, and not a built-in scene (" + known + ")");
     }
     return PyScene(load_gltf(text));
@@ -242,9 +243,10 @@ void bind_scene(py::module_& m) {
         [] {
             std::vector<std::string> names = procedural_scene_names();
             for (const std::string& n : instanced_procedural_scene_names()) names.push_back(n);
+            for (const std::string& n : sphere_procedural_scene_names()) names.push_back(n);
             return names;
         },
-        "Names of the built-in scenes (the instanced forest and grove last).");
+        "Names of the built-in scenes (the instanced forest and grove, then the sphere scenes, last).");
     m.def(
         "write_procedural_scene",
         [](const std::string& name, const fs::path& dir, uint32_t hairball_triangles, uint64_t seed) {

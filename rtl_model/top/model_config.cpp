@@ -31,6 +31,7 @@ const PipelineConfig& ModelConfig::pipeline(OpKind kind) const {
         case OpKind::transform: return transform;
         case OpKind::plane: return plane;
         case OpKind::obb: return obb;
+        case OpKind::sphere: return sphere;
         default: break;
     }
     throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");

@@ -64,6 +64,10 @@ struct ModelConfig {
     /// ray's origin and direction (18 multiply-adds, no translation), one per oriented node
     /// ahead of its box tests. An assumption: no public figure prices RDNA 4's OBB transform.
     PipelineConfig obb = pipeline_of(/*latency=*/6, /*width=*/1);
+    /// Ray/sphere tests (curved primitives; Haines et al. 2019): a square root and two divides
+    /// after the dot products, as long a pipeline as the triangle's. An assumption: NVIDIA's
+    /// Blackwell RT cores test spheres natively, but no public figure gives their latency.
+    PipelineConfig sphere = pipeline_of(/*latency=*/20, /*width=*/1);
     MailboxConfig mailbox;
     // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
     // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
@@ -110,6 +114,7 @@ struct ModelConfig {
         v.section("transform", transform);
         v.section("plane", plane);
         v.section("obb", obb);
+        v.section("sphere", sphere);
         v.section("mailbox", mailbox);
         v.section("l1", l1);
         v.section("l2", l2);

@@ -81,8 +81,14 @@ constexpr Flops kPlaneFlops{1, 1, 2, 0};
 // Oriented node (obvh2): a 3x3 rotation of the origin and the direction (18 mul + 12 add) and
 // the three reciprocals of the rotated direction the box tests need.
 constexpr Flops kObbFlops{12, 18, 0, 3};
+// Ray/sphere (traces/isect/ray_sphere_kernel.h, Haines et al. 2019): origin minus centre 3 sub,
+// d.d and f.d 6 mul + 4 add, the closest-approach vector 3 mul + 3 add and its square 3 mul + 2
+// add, r^2 - |l|^2 1 mul + 1 sub, the root's argument 1 mul, q 1 add, c 3 mul + 3 add, sign and
+// interval 5 cmp; the division b/a, the square root and c/q, q/a priced as 4 divides. The
+// reference computes in double; priced here as the fp32 unit hardware would build.
+constexpr Flops kSphereFlops{17, 17, 5, 4};
 constexpr std::array<Flops, kOpKindCount> kTestFlops{kBoxFlops, kTriangleFlops, kAnyhitFlops, kTransformFlops,
-                                                     kCellFlops, kPlaneFlops, kObbFlops};
+                                                     kCellFlops, kPlaneFlops, kObbFlops, kSphereFlops};
 // Per ray: inv_dir (3 div) for the box test; the triangle test's shear constants (RayTrianglePre:
 // the largest axis, 2 cmp; 1 / dir_kz, 1 div; sx, sy, 2 mul).
 constexpr Flops kRaySetupFlops{0, 2, 2, 4};
@@ -198,6 +204,8 @@ json area_json(const SimConfig& s, const json& stats) {
         mm2["plane"] = pipeline_mm2(c, s, s.plane, kPlaneFlops);
     if (instantiated(stats.value("instantiated", json::array()), "obb"))
         mm2["obb"] = pipeline_mm2(c, s, s.obb, kObbFlops);
+    if (instantiated(stats.value("instantiated", json::array()), "sphere"))
+        mm2["sphere"] = pipeline_mm2(c, s, s.sphere, kSphereFlops);
     for (const auto& [block, logic] : added.logic_mm2) mm2[block] = mm2.value(block, 0.0) + logic;
     double total = 0;
     for (auto it = mm2.begin(); it != mm2.end(); ++it) total += it->get<double>();
@@ -392,7 +400,7 @@ const StatBlock& energy_stats() {
             {"area_scale", "x", "Stillmaker & Baas area factor from 45 nm to the node"},
             {"dram_kind", "", "the DRAM kind (`energy.dram_kind`)"},
             {"dram_pj_per_bit", "pJ/bit", "its energy per bit (or the override)"},
-            {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`, `obb`) and one `ray_setup` at the node"},
+            {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`, `obb`, `sphere`) and one `ray_setup` at the node"},
             {"rays", "rays", "rays the energy is divided by: the rays checked (a sampled run's simulated rays, warm-up included)"},
             {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `mailbox` (only with `mailbox.entries > 0`: lookups and recorded tests in the mailbox SRAM), the techniques' blocks as in `area.mm2` (decodes per test, scheduler picks per step or warp step, sorted rays, prefetched lines, helper steps' stack hand-overs, stack prefetches' filter compares, mailbox compares, the build unit's rebuilt triangles and refit nodes), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
             {"dynamic_nj", "nJ", "dynamic energy of the blocks with counts, summed over the rays"},

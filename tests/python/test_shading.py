@@ -38,7 +38,7 @@ def shading_of(stats: dict) -> dict:
 
 def test_manifest_and_sections(traces: dict[str, Path]) -> None:
     manifest = json.loads((traces["cornell"] / "manifest.json").read_text())
-    assert manifest["trace_version"] == 5
+    assert manifest["trace_version"] == 6
     sh = manifest["shading"]
     origins = {t["origin"] for t in sh["textures"]}
     assert origins == {"procedural"} and all(t["mips"] == 10 for t in sh["textures"])
@@ -146,9 +146,10 @@ def test_older_trace_simulates_without_shading(traces: dict[str, Path], sim_exe:
                                                tmp_path: Path) -> None:  # fmt: skip
     """A version-4 trace (no shading sections) is read as it is: shading.enabled has no effect
     and says why; a trace of a version this build does not know is refused naming both."""
-    from trace_forge import read_sections, write_trace
+    from trace_forge import as_version_5_work, read_sections, write_trace
 
     sections = read_sections(traces["cornell"] / "trace.rtt")
+    as_version_5_work(sections)
     old = {k: v for k, v in sections.items() if k not in ("MATL", "TEXR", "PTRI", "SHAD", "TXFT")}
     folder = tmp_path / "v4"
     folder.mkdir()
@@ -166,7 +167,7 @@ def test_older_trace_simulates_without_shading(traces: dict[str, Path], sim_exe:
         assert stats["summary"][key] == rt_only["summary"][key], key
     unused = {u["key"]: u["why"] for u in stats["summary"]["resolved"]["unused"]}
     assert "no shading sections" in unused["shading.enabled"]
-    write_trace(folder / "trace.rtt", Old(old), version=6)
-    result = run_rtsim("simulate", str(folder), "-o", str(tmp_path / "run6"), "--no-progress")
-    assert result.returncode == 2 and "trace version 6 is not supported" in result.stderr
-    assert "reads versions 3 to 5" in result.stderr
+    write_trace(folder / "trace.rtt", Old(old), version=7)
+    result = run_rtsim("simulate", str(folder), "-o", str(tmp_path / "run7"), "--no-progress")
+    assert result.returncode == 2 and "trace version 7 is not supported" in result.stderr
+    assert "reads versions 3 to 6" in result.stderr

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 MAGIC = b"RTSIMTRC"
-VERSION = 3
+VERSION = 6
 HEADER_BYTES = 64
 ENTRY_BYTES = 64
 ALIGN = 64
@@ -30,7 +30,9 @@ FOURCC = {
     "work": 0x4B524F57,
     "accel": 0x4C434341,
 }
-RECORD_BYTES = {"rays": 40, "hits": 20, "work": 32, "accel": 1}
+RECORD_BYTES = {"rays": 40, "hits": 20, "work": 36, "accel": 1}
+#: WORK records before version 6 (no sphere_tests).
+WORK_BYTES_V5 = 32
 #: bvh2's region sections under the names older tests use.
 ALIASES = {"bvh_nodes": "RG00", "triangles": "RG01"}
 
@@ -53,6 +55,15 @@ class Sections(dict):
 
     def __setitem__(self, name: str, value: bytearray) -> None:
         super().__setitem__(ALIASES.get(name, name), value)
+
+
+def as_version_5_work(sections: Sections) -> None:
+    """Narrows the WORK records to version 5's 32 bytes (sphere_tests dropped), for a trace
+    written as an older version."""
+    rb = sections.record_bytes["work"]
+    rows = np.frombuffer(bytes(sections["work"]), np.uint8).reshape(-1, rb)
+    sections["work"] = bytearray(rows[:, :WORK_BYTES_V5].tobytes())
+    sections.record_bytes["work"] = WORK_BYTES_V5
 
 
 def _align(x: int) -> int:

@@ -24,7 +24,10 @@ void Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n
     if (counts) *counts = s->counts();
 }
 
-bool Accel::has_anyhit_triangles() const {
+bool Accel::has_anyhit_triangles() const { return has_flagged_records(kTriAnyHit); }
+bool Accel::has_spheres() const { return has_flagged_records(kPrimSphere); }
+
+bool Accel::has_flagged_records(uint32_t flag) const {
     for (const Region& r : m_image.regions) {
         if (r.kind != DataKind::triangle) continue;
         if (r.name.rfind("blas_", 0) == 0) continue;  // two levels: each BLAS reads its own
@@ -32,7 +35,7 @@ bool Accel::has_anyhit_triangles() const {
         const HwTriangle* t = blocks ? m_triangles.triangles() : r.records<HwTriangle>();
         const uint64_t n = blocks ? m_triangles.count() : r.count;
         for (uint64_t i = 0; i < n; ++i)
-            if (t[i].flags & kTriAnyHit) return true;
+            if (t[i].flags & flag) return true;
     }
     return false;
 }

@@ -85,6 +85,8 @@ public:
     uint32_t stack_entry_bytes() const { return capabilities().stack_entry_bytes; }
     /// True when some triangle is alpha-MASKed (the any-hit stage is then needed).
     bool has_anyhit_triangles() const;
+    /// True when some record is a sphere (the sphere pipeline is then needed).
+    bool has_spheres() const;
     /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
     /// two-level image traced with --frames, one TLAS per frame over the same BLASes.
     virtual uint32_t frame_count() const { return 1; }
@@ -98,6 +100,10 @@ protected:
     /// The triangles the steppers read, plain or decoded from compressed leaves (leaf_blocks.h);
     /// opened by structures that have a triangle region.
     TriangleStore m_triangles;
+
+private:
+    /// True when some record of the image's own triangle regions has `flag` (hw_triangle.h).
+    bool has_flagged_records(uint32_t flag) const;
 };
 
 /// How to build a structure: which kind, which builder for its tree, and the builder's config.

@@ -36,6 +36,10 @@ struct AccelCapabilities {
     /// Its steppers report the reads their stack entries would issue (Stepper::stack_reads):
     /// stack-driven prefetching, traversal.stack_prefetch.
     bool stack_addresses = false;
+    /// Its builders bound primitives by their boxes and its leaves test whatever records they
+    /// hold, so a scene's spheres (curved primitives) are stored and tested as spheres; kinds
+    /// that clip triangles against planes (kd-tree, grid, octree, GK-BVH) refuse them.
+    bool spheres = false;
     /// Bytes of one traversal stack entry (Accel::stack_entry_bytes; 0: no stack).
     uint32_t stack_entry_bytes = 8;
 
@@ -59,6 +63,7 @@ struct AccelCapabilities {
                 {"treelet_partition", treelet_partition},
                 {"refit", refit},
                 {"stack_addresses", stack_addresses},
+                {"spheres", spheres},
                 {"stack_entry_bytes", stack_entry_bytes}};
     }
 };

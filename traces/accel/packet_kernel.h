@@ -24,9 +24,11 @@ struct PacketStackEntry {
 /// The packet's leaf step over `active` rays; returns the alpha tests it ran.
 inline uint32_t packet_leaf(PacketLanes& p, LaneMask active, const HwTriangle* triangles, uint32_t count) {
     uint32_t alpha = 0;
+    const LeafTests kinds = leaf_tests(triangles, count, true);
     for_each_lane(active, [&](uint32_t r) {
         WorkCounts& w = p.work[r];
-        w.tri_tests += count;
+        w.tri_tests += kinds.triangles;
+        w.sphere_tests += kinds.spheres;
         const uint32_t before = w.anyhit_calls;
         const Ray& ray = p.ray[r];
         if (p.mode[r] == TraversalMode::any_hit) {

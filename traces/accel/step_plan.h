@@ -66,6 +66,12 @@ struct StepPlan {
     }
     void add_fetch(uint64_t addr, uint32_t bytes, DataKind kind) { fetch[fetch_count++] = Fetch{addr, bytes, kind}; }
     void add_op(OpKind kind, uint32_t count) { op[op_count++] = Op{kind, count}; }
+    /// A leaf's tests: triangles to the triangle pipeline, spheres to the sphere pipeline (a
+    /// kind with no test adds no operation, but a leaf always issues one).
+    void add_leaf_ops(uint32_t triangles, uint32_t spheres) {
+        if (triangles || !spheres) add_op(OpKind::triangle, triangles);
+        if (spheres) add_op(OpKind::sphere, spheres);
+    }
 };
 
 /// Operations a step's results called for beyond its plan (alpha tests of the triangles hit).

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "traces/bvh/build_tree.h"
 #include "traces/bvh/builder.h"
 #include "traces/bvh/sbvh_clip.h"
 #include "traces/common/error.h"
@@ -28,6 +29,7 @@ bool same_vertex(const float* hw, const Vec3& v) {
     float s[3] = {v.x, v.y, v.z};
     return std::memcmp(hw, s, sizeof(s)) == 0;
 }
+bool same_vertex(const float* hw, const float* want) { return std::memcmp(hw, want, 3 * sizeof(float)) == 0; }
 
 struct Checker {
     const HwBvh& bvh;
@@ -80,13 +82,17 @@ void Checker::check_leaf(uint32_t node, int slot, const Aabb& box, uint32_t dept
             if (common.empty()) fail(node, slot, triangle_name(j, t.prim) + " does not overlap the leaf box");
             covered[t.prim] += ClippedTriangle(s, box).area();
         } else {
-            if (!inside(box, t.v0) || !inside(box, t.v1) || !inside(box, t.v2))
+            // A triangle's own vertices; a sphere's box corners, from the scene (scene.h).
+            const float* p[3] = {t.v0, t.v1, t.v2};
+            if (is_sphere(t)) p[0] = &s.v0.x, p[1] = &s.v1.x, p[2] = &s.v2.x;
+            if (!inside(box, p[0]) || !inside(box, p[1]) || !inside(box, p[2]))
                 fail(node, slot, triangle_name(j, t.prim) + " outside the leaf box");
             if (prim_seen[t.prim]) fail(node, slot, triangle_name(j, t.prim) + ": primitive stored twice");
         }
         prim_seen[t.prim] = 1;
-        if (!same_vertex(t.v0, s.v0) || !same_vertex(t.v1, s.v1) || !same_vertex(t.v2, s.v2) ||
-            t.inst != scene.tri_instance[t.prim])
+        const HwTriangle want = make_hw_triangle(scene, t.prim);
+        if (!same_vertex(t.v0, want.v0) || !same_vertex(t.v1, want.v1) || !same_vertex(t.v2, want.v2) ||
+            t.inst != want.inst || is_sphere(t) != is_sphere(want))
             fail(node, slot, triangle_name(j, t.prim) + " differs from the scene's primitive");
     }
 }

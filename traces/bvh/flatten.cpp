@@ -52,6 +52,12 @@ uint32_t material_flags(const Scene& scene, uint32_t material, uint32_t prim) {
 HwTriangle triangle_record(const Scene& scene, uint32_t prim, uint32_t flags) {
     const Triangle& t = scene.triangles[prim];
     HwTriangle hw;
+    if (scene.is_sphere(prim)) {  // docs/bvh_layout.md, "Sphere records"
+        const Vec3 c = sphere_centre(t);
+        hw = HwTriangle{{c.x, c.y, c.z}, {scene.sphere_radius[prim], 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, prim,
+                        scene.tri_instance[prim], flags | kPrimSphere};
+        return hw;
+    }
     for (int a = 0; a < 3; ++a) {
         hw.v0[a] = t.v0[a];
         hw.v1[a] = t.v1[a];

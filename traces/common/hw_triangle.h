@@ -9,6 +9,9 @@ namespace rtsim {
 
 /// HwTriangle::flags bits.
 constexpr uint32_t kTriAnyHit = 1u << 0;         ///< alpha-MASK: call the any-hit (alpha) test
+/// The record is a sphere (docs/bvh_layout.md, "Sphere records"): v0 its centre, v1[0] its
+/// radius, v1[1..2] and v2 zero.
+constexpr uint32_t kPrimSphere = 1u << 1;
 constexpr uint32_t kTriCoverageShift = 8;        ///< bits 8..15: alpha coverage x 255
 constexpr uint32_t kTriMaterialShift = 16;       ///< bits 16..31: material index
 
@@ -18,9 +21,10 @@ struct HwTriangle {             // 48 bytes
     float v2[3];                // 24
     uint32_t prim;              // 36: stable primitive id (scene order, see scene.h)
     uint32_t inst;              // 40: instance id
-    uint32_t flags;             // 44: kTriAnyHit | coverage << 8 | material << 16
+    uint32_t flags;             // 44: kTriAnyHit | kPrimSphere | coverage << 8 | material << 16
 };
 static_assert(sizeof(HwTriangle) == 48, "HwTriangle must be 48 bytes");
+inline bool is_sphere(const HwTriangle& t) { return (t.flags & kPrimSphere) != 0; }
 inline RecordLayout layout_of(const HwTriangle*) {
     return {RTSIM_FIELD(HwTriangle, v0),   RTSIM_FIELD(HwTriangle, v1),   RTSIM_FIELD(HwTriangle, v2),
             RTSIM_FIELD(HwTriangle, prim), RTSIM_FIELD(HwTriangle, inst), RTSIM_FIELD(HwTriangle, flags)};

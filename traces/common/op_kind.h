@@ -18,13 +18,14 @@ enum class OpKind : uint8_t {
     cell = 4,       ///< 3D-DDA step to the next grid cell
     plane = 5,      ///< ray/split-plane test
     obb = 6,        ///< ray rotation into an oriented node's frame (its child boxes are tested there)
+    sphere = 7,     ///< ray/sphere test (curved primitives)
 };
-constexpr int kOpKindCount = 7;
+constexpr int kOpKindCount = 8;
 /// "No operation kind" in tables keyed by kind (a work counter that counts no pipeline's tests).
 constexpr OpKind kNoOpKind = OpKind(0xFF);
 
 inline constexpr std::array<const char*, kOpKindCount> kOpKindNames{
-    {"box", "triangle", "anyhit", "transform", "cell", "plane", "obb"}};
+    {"box", "triangle", "anyhit", "transform", "cell", "plane", "obb", "sphere"}};
 /// "box", "triangle", ...; "unknown" outside the enum.
 inline const char* op_kind_name(OpKind kind) {
     return size_t(kind) < kOpKindNames.size() ? kOpKindNames[size_t(kind)] : "unknown";

@@ -5,7 +5,8 @@
 // Every counter is declared once, in RTSIM_WORK_FIELDS: WorkCounts' members, the trace's WORK
 // record, the hit checker's totals and messages, the analytic level's sums, the energy model's
 // prices, the Python bindings and the trace dtypes all iterate it, so adding a counter is one
-// line here plus the code that counts it (and a trace-format version bump: WORK records grow).
+// line here plus the code that counts it (and a trace-format version bump: WORK records grow; the
+// reader widens older versions' records, trace_reader.cpp).
 // Counters of the model alone (never in a trace) are declared in RTSIM_MODEL_WORK_FIELDS.
 #include <array>
 #include <cstddef>
@@ -25,7 +26,8 @@
     X(transforms, OpKind::transform, false, "instance transforms (two-level structures)")         \
     X(cell_steps, OpKind::cell, true, "3D-DDA steps from cell to cell (grids)")                    \
     X(plane_tests, OpKind::plane, false, "ray/split-plane tests (kd-trees, BIH)")                  \
-    X(refs, kNoOpKind, false, "primitive references fetched (structures with index lists)")
+    X(refs, kNoOpKind, false, "primitive references fetched (structures with index lists)")       \
+    X(sphere_tests, OpKind::sphere, false, "ray/sphere tests (curved primitives)")
 
 // The mailbox's counts (docs/accel.md, "Mailboxes"): never in a trace (a trace's work is the
 // structure's without one). With a mailbox tri_tests counts the tests run, and

@@ -46,7 +46,7 @@ struct TriShadeRecord {
     float uv[6];        //  0: TEXCOORD_0 of v0, v1, v2 (or the planar projection, see materials.h)
     uint32_t material;  // 24
     float lod_base;     // 28: 0.5 log2(uv area / world area) (Akenine-Moller et al. 2019, Delta_0)
-    float normal[3];    // 32: unit geometric normal in world space (the LOD rule's cosine)
+    float normal[3];    // 32: unit geometric normal in world space (the LOD rule's cosine); zero for a sphere
 };
 /// Shading of one ray (32 bytes).
 struct ShadeRecord {

@@ -16,12 +16,15 @@
 namespace rtsim {
 
 constexpr char kTraceMagic[8] = {'R', 'T', 'S', 'I', 'M', 'T', 'R', 'C'};
-/// 5: shading (MATL, TEXR, PTRI, SHAD, TXFT: traces/format/shading_format.h); 4: animated frames
-/// (FRMS; a two-level image's TLAS per frame).
-constexpr uint32_t kTraceVersion = 5;
-/// Oldest version this build reads (versions 3 and 4 have no shading sections and are simulated
-/// without shading; version 3 has no frames; their layout is otherwise version 5's).
+/// 6: sphere tests in WORK records (curved primitives); 5: shading (MATL, TEXR, PTRI, SHAD, TXFT:
+/// traces/format/shading_format.h); 4: animated frames (FRMS; a two-level image's TLAS per frame).
+constexpr uint32_t kTraceVersion = 6;
+/// Oldest version this build reads (versions 3 to 5 have WORK records without sphere_tests,
+/// which the reader widens with a zero there; versions 3 and 4 have no shading sections and are
+/// simulated without shading; version 3 has no frames; their layout is otherwise version 6's).
 constexpr uint32_t kTraceVersionOldest = 3;
+/// Bytes of a WORK record before version 6 (the traced fields before sphere_tests).
+constexpr uint32_t kWorkRecordBytesV5 = 32;
 
 /// Section kinds (fourcc, little-endian). Never renumber; add new kinds instead.
 enum class SectionKind : uint32_t {
@@ -43,7 +46,7 @@ SectionKind region_section(uint32_t index);
 bool is_region_section(SectionKind kind, uint32_t* index = nullptr);
 /// "RAYS", "HITS", ..., "RG03"; "unknown" for a kind this build does not know.
 std::string section_name(SectionKind kind);
-/// Record size a kind must have (RAYS 40, HITS 20, WORK 32, ACCL 1, FRMS 16, MATL 32, TEXR 32, PTRI 44,
+/// Record size a kind must have (RAYS 40, HITS 20, WORK 36 (32 before version 6), ACCL 1, FRMS 16, MATL 32, TEXR 32, PTRI 44,
 /// SHAD 32, TXFT 8); 0 if it varies (regions)
 /// or the kind is unknown.
 uint32_t section_record_bytes(SectionKind kind);

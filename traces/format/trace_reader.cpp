@@ -70,9 +70,10 @@ tl::FileHeader check_header(std::FILE* f, const std::string& path, uint64_t file
 }
 
 /// Bounds and consistency of one section-table entry; payload and CRC table lie before the table.
-void check_entry(const std::string& path, const SectionInfo& s, uint64_t table_offset) {
+void check_entry(const std::string& path, const SectionInfo& s, uint64_t table_offset, uint32_t version) {
     const std::string where = path + ": section table: section " + tl::kind_label(s.kind) + " ";
-    const uint32_t expected = section_record_bytes(s.kind);
+    const uint32_t expected =
+        s.kind == SectionKind::work && version < 6 ? kWorkRecordBytesV5 : section_record_bytes(s.kind);
     require(s.record_bytes > 0, where + "has 0-byte records");
     require(expected == 0 || expected == s.record_bytes,
             where + "has " + num(s.record_bytes) + "-byte records, this build expects " + num(expected));
@@ -110,7 +111,7 @@ TraceReader::TraceReader(const std::string& path) : m_path(path) {
     require(stored == tl::crc32_bytes(table.data(), n), path + ": section table checksum mismatch");
     for (uint32_t i = 0; i < h.section_count; ++i) {
         const SectionInfo s = tl::decode_entry(&table[size_t(i) * tl::kEntryBytes]);
-        check_entry(path, s, h.table_offset);
+        check_entry(path, s, h.table_offset, h.version);
         for (const SectionInfo& other : m_sections)
             require(other.kind != s.kind,
                     path + ": section table: section " + tl::kind_label(s.kind) + " appears twice");
@@ -140,6 +141,20 @@ const SectionInfo& TraceReader::section(SectionKind kind) const {
 }
 
 void TraceReader::read(SectionKind kind, uint64_t first, uint64_t count, void* out) {
+    const SectionInfo& s = section(kind);
+    if (kind != SectionKind::work || s.record_bytes == sizeof(WorkRecord)) return read_raw(kind, first, count, out);
+    // An older version's WORK records (fewer fields): read as stored, widened with zeros (the
+    // counters it predates count nothing there).
+    std::vector<uint8_t> stored(size_t(count * s.record_bytes));
+    read_raw(kind, first, count, stored.data());
+    auto* dst = static_cast<WorkRecord*>(out);
+    for (uint64_t i = 0; i < count; ++i) {
+        dst[i] = WorkRecord{};
+        std::memcpy(&dst[i], stored.data() + i * s.record_bytes, s.record_bytes);
+    }
+}
+
+void TraceReader::read_raw(SectionKind kind, uint64_t first, uint64_t count, void* out) {
     const SectionInfo& s = section(kind);
     const size_t index = static_cast<size_t>(&s - m_sections.data());
     require(first <= s.record_count && count <= s.record_count - first,

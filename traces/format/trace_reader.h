@@ -34,8 +34,9 @@ public:
     bool has(SectionKind kind) const;
     const SectionInfo& section(SectionKind kind) const;  ///< throws Error if absent
 
-    /// Reads records [first, first + count) of a section into out (record_bytes each), verifying
-    /// the CRC of every chunk it touches (each chunk is verified once per reader).
+    /// Reads records [first, first + count) of a section into out (record_bytes each; WORK
+    /// records of older versions widened to this version's WorkRecord), verifying the CRC of
+    /// every chunk it touches (each chunk is verified once per reader).
     void read(SectionKind kind, uint64_t first, uint64_t count, void* out);
     template <class T>
     std::vector<T> read_all(SectionKind kind) {
@@ -50,6 +51,8 @@ public:
     void verify_section(SectionKind kind);
 
 private:
+    /// read() of the stored bytes, without widening older records.
+    void read_raw(SectionKind kind, uint64_t first, uint64_t count, void* out);
     void verify_chunk(const SectionInfo& s, size_t section_index, uint64_t chunk);
 
     std::string m_path;

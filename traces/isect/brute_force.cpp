@@ -25,7 +25,7 @@ Hit trace_ray_brute_force(const HwTriangle* triangles, size_t count, const Ray& 
     for (const HwTriangle* tri : order) {
         if (!tri) continue;
         TriangleHit th;
-        if (!intersect_triangle(pre, tri->v0, tri->v1, tri->v2, ray.tmin, ray.tmax, &th)) continue;
+        if (!detail::primitive_kernel(pre, *tri, ray.tmin, ray.tmax, &th)) continue;
         if (mode == TraversalMode::closest_hit && !closer(th.t, tri->prim, best.t, best.prim))
             continue;
         if ((tri->flags & kTriAnyHit) &&

@@ -8,6 +8,7 @@
 
 #include "traces/common/hw_triangle.h"
 #include "traces/common/ray.h"
+#include "traces/isect/ray_sphere_kernel.h"
 #include "traces/isect/ray_triangle_kernel.h"
 
 namespace rtsim {
@@ -32,14 +33,45 @@ inline bool closer(float t, uint32_t prim, float best_t, int32_t best_prim) {
 /// for boxes entered within 0.1% behind the best hit.
 inline float cull_distance(float t) { return t + std::fabs(t) * 0x1p-10f; }
 
-/// Tests one triangle against the ray's own [tmin, tmax] (so acceptance never depends on visit
+/// The primitive test of one record: a sphere's (kPrimSphere) or a triangle's.
+inline bool primitive_kernel(const RayTrianglePre& pre, const HwTriangle& rec, float tmin, float tmax,
+                             TriangleHit* hit) {
+    if (__builtin_expect(is_sphere(rec), 0)) return sphere_kernel(pre, rec.v0, rec.v1[0], tmin, tmax, hit);
+    return triangle_kernel(pre, rec.v0, rec.v1, rec.v2, tmin, tmax, hit);
+}
+
+/// Spheres among `count` records (the sphere pipeline's tests of a leaf; the rest go to the
+/// triangle pipeline).
+inline uint32_t sphere_count(const HwTriangle* records, uint32_t count) {
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < count; ++i) n += is_sphere(records[i]) ? 1u : 0u;
+    return n;
+}
+
+/// True when some of `count` records is a sphere (a structure's view notes it once, at load).
+inline bool any_sphere(const HwTriangle* records, uint64_t count) {
+    for (uint64_t i = 0; i < count; ++i)
+        if (is_sphere(records[i])) return true;
+    return false;
+}
+
+/// A leaf's tests by pipeline: spheres (counted only when the structure has some) and triangles.
+struct LeafTests {
+    uint32_t triangles = 0, spheres = 0;
+};
+inline LeafTests leaf_tests(const HwTriangle* records, uint32_t count, bool has_spheres) {
+    const uint32_t s = has_spheres ? sphere_count(records, count) : 0u;
+    return {count - s, s};
+}
+
+/// Tests one triangle (or sphere) against the ray's own [tmin, tmax] (so acceptance never depends on visit
 /// order) and makes it the best hit if it is closer (closest hit) and passes the alpha test of
 /// a MASK triangle. Returns true when the triangle became the best hit.
 template <bool kAnyHit>
 inline bool triangle_step(const RayTrianglePre& pre, float tmin, float tmax, const HwTriangle& tri,
                           Hit& best, float& cull_t, uint32_t& anyhit_calls) {
     TriangleHit th;
-    if (!triangle_kernel(pre, tri.v0, tri.v1, tri.v2, tmin, tmax, &th)) return false;
+    if (!primitive_kernel(pre, tri, tmin, tmax, &th)) return false;
     if (!kAnyHit && !closer(th.t, tri.prim, best.t, best.prim)) return false;
     // Alpha-MASK triangles: the any-hit (alpha) test decides.
     if (tri.flags & kTriAnyHit) {

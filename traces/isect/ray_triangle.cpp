@@ -24,6 +24,7 @@ RayTrianglePre ray_triangle_precompute(const Ray& ray) {
     pre.sy = d[pre.ky] / d[pre.kz];
     pre.sz = 1.0f / d[pre.kz];
     pre.origin = ray.origin;
+    pre.direction = ray.direction;
     return pre;
 }
 

@@ -11,6 +11,7 @@ struct RayTrianglePre {
     int kx = 0, ky = 1, kz = 2;  ///< axis permutation: kz is the largest |direction| component
     float sx = 0, sy = 0, sz = 1;  ///< shear constants
     Vec3 origin;
+    Vec3 direction;  ///< the ray's own direction (curved primitives test in world space)
 };
 
 RayTrianglePre ray_triangle_precompute(const Ray& ray);

@@ -1,4 +1,6 @@
-// glTF meshes to rtsim::Mesh: every primitive's triangles, in primitive order, as a triangle list.
+// glTF meshes to rtsim::Mesh: every primitive's triangles, in primitive order, as a triangle list;
+// POINTS primitives with a _RADIUS attribute as spheres.
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -38,6 +40,10 @@ std::vector<uint32_t> triangle_list(const std::vector<uint32_t>& idx, int mode) 
     } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN && n >= 3) {
         out.reserve(3 * (n - 2));
         for (size_t i = 0; i + 2 < n; ++i) out.insert(out.end(), {idx[i + 1], idx[i + 2], idx[0]});
+    } else if (mode == TINYGLTF_MODE_POINTS) {
+        // Spheres: a primitive's three corners are its centre (scene.h, Mesh::radii).
+        out.reserve(3 * n);
+        for (uint32_t i : idx) out.insert(out.end(), {i, i, i});
     }
     return out;
 }
@@ -86,14 +92,36 @@ void read_texcoords(const Source& src, const tinygltf::Primitive& prim, size_t v
     for (uint32_t i : list) out.uvs.emplace_back(uv.component(i, 0), uv.component(i, 1));
 }
 
-/// Appends one primitive's triangles (positions and material ids) to `out`.
+/// A POINTS primitive's sphere radii (docs/scenes.md, "Spheres"): its _RADIUS attribute, one
+/// positive finite float per vertex, appended to out.radii for the points `list` names (three
+/// corners each).
+void read_radii(const Source& src, const tinygltf::Primitive& prim, size_t vertex_count,
+                const std::vector<uint32_t>& list, const std::string& where, Mesh& out) {
+    auto it = prim.attributes.find("_RADIUS");
+    if (it == prim.attributes.end())
+        src.fail(where + ": a POINTS primitive is traced as spheres and needs a _RADIUS attribute (float SCALAR, "
+                         "one radius per point; docs/scenes.md)");
+    AccessorView radius = view_accessor(src, it->second, where + " _RADIUS");
+    if (radius.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT || radius.components != 1 || radius.count < vertex_count)
+        src.fail(where + ": _RADIUS must be float SCALAR with one entry per point");
+    out.radii.resize(out.triangle_count() - list.size() / 3, 0.0f);  // the mesh's earlier triangles
+    for (size_t k = 0; k < list.size(); k += 3) {
+        const float r = radius.component(list[k], 0);
+        if (!(r > 0.0f) || !std::isfinite(r))
+            src.fail(where + ": point " + std::to_string(list[k]) + " has _RADIUS " + std::to_string(r) +
+                     " (a sphere's radius must be positive and finite)");
+        out.radii.push_back(r);
+    }
+}
+
+/// Appends one primitive's triangles or spheres (positions and material ids) to `out`.
 void read_primitive(const Source& src, const tinygltf::Primitive& prim, const std::string& where,
                     Scene& scene, Mesh& out) {
     int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-        mode != TINYGLTF_MODE_TRIANGLE_FAN)
-        src.fail(where + ": unsupported primitive mode " + std::to_string(mode) + " (" +
-                 mode_name(mode) + "); only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are traced");
+        mode != TINYGLTF_MODE_TRIANGLE_FAN && mode != TINYGLTF_MODE_POINTS)
+        src.fail(where + ": unsupported primitive mode " + std::to_string(mode) + " (" + mode_name(mode) +
+                 "); only TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN and POINTS (spheres, with _RADIUS) are traced");
     auto pos_it = prim.attributes.find("POSITION");
     if (pos_it == prim.attributes.end()) src.fail(where + ": no POSITION attribute");
     AccessorView pos = view_accessor(src, pos_it->second, where + " POSITION");
@@ -125,7 +153,13 @@ void read_primitive(const Source& src, const tinygltf::Primitive& prim, const st
         out.positions.emplace_back(xyz[0], xyz[1], xyz[2]);
     }
     out.materials.insert(out.materials.end(), list.size() / 3, material);
-    read_texcoords(src, prim, pos.count, list, where, out);
+    if (mode == TINYGLTF_MODE_POINTS) {
+        read_radii(src, prim, pos.count, list, where, out);
+        if (!out.uvs.empty()) out.uvs.resize(out.positions.size(), glm::vec2(0.0f));  // spheres map their own
+    } else {
+        read_texcoords(src, prim, pos.count, list, where, out);
+    }
+    if (!out.radii.empty()) out.radii.resize(out.triangle_count(), 0.0f);  // triangles after spheres
 }
 
 }  // namespace

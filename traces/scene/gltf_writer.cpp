@@ -222,6 +222,30 @@ void GltfWriter::add_skinned_mesh_node(const std::string& name, const TriangleSo
     g.model.animations.push_back(anim);
 }
 
+int GltfWriter::add_sphere_mesh(const std::string& name, const std::vector<Vec3>& centres,
+                                const std::vector<float>& radii, int material) {
+    if (centres.size() != radii.size() || centres.empty())
+        throw Error("sphere mesh '" + name + "': one radius per centre, and at least one sphere");
+    Impl& g = *m_impl;
+    Aabb box;
+    for (const Vec3& c : centres) box.grow(c);
+    const int pa = g.add_accessor(g.add_view(centres.data(), centres.size() * sizeof(Vec3), TINYGLTF_TARGET_ARRAY_BUFFER),
+                                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, centres.size());
+    g.model.accessors[size_t(pa)].minValues = {box.lo.x, box.lo.y, box.lo.z};
+    g.model.accessors[size_t(pa)].maxValues = {box.hi.x, box.hi.y, box.hi.z};
+    tinygltf::Primitive prim;
+    prim.attributes["POSITION"] = pa;
+    prim.attributes["_RADIUS"] = g.add_accessor(g.add_view(radii.data(), radii.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER),
+                                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, radii.size());
+    prim.material = material;
+    prim.mode = TINYGLTF_MODE_POINTS;
+    tinygltf::Mesh mesh;
+    mesh.name = name;
+    mesh.primitives.push_back(prim);
+    g.model.meshes.push_back(mesh);
+    return int(g.model.meshes.size() - 1);
+}
+
 void GltfWriter::add_mesh_node(const std::string& name, int mesh, const glm::dmat4& transform) {
     tinygltf::Node node;
     node.name = name;

@@ -63,6 +63,10 @@ public:
     int add_material(const Material& m);
     /// Adds a mesh with one primitive per (soup, material) pair; returns the glTF mesh index.
     int add_mesh(const std::string& name, const std::vector<std::pair<const TriangleSoup*, int>>& parts);
+    /// Adds a mesh of spheres (docs/scenes.md, "Spheres"): one POINTS primitive whose POSITION
+    /// are the centres and whose _RADIUS the radii; returns the glTF mesh index.
+    int add_sphere_mesh(const std::string& name, const std::vector<Vec3>& centres, const std::vector<float>& radii,
+                        int material);
     /// Marks glTF mesh `mesh` as deforming with `motion` (written as its extras.rtsimMotion).
     void set_mesh_motion(int mesh, const ProceduralMotion& motion);
     /// Adds a root node placing `mesh` with `transform` (identity: no matrix written).

@@ -13,11 +13,14 @@ struct ProceduralOptions {
 };
 
 /// Names of the built-in flat scenes: "cornell", "hairball", "teapot_stadium", "rotated_walls",
-/// "aligned_walls", "terrain", and the deforming "cloth", "exploding_hairball" and "skinned_tube" (Scene::animation set).
+/// "aligned_walls", "terrain", "meadow", and the deforming "cloth", "exploding_hairball" and "skinned_tube" (Scene::animation set).
 std::vector<std::string> procedural_scene_names();
 /// Names of the built-in instanced scenes (procedural_forest.cpp): "forest" (72 x 72 instances,
 /// about 4.6 x 10^8 triangles if flattened: two-level only) and "grove" (6 x 6 instances).
 std::vector<std::string> instanced_procedural_scene_names();
+/// Names of the built-in scenes of spheres (procedural_spheres.cpp; BVH kinds only), "particles"
+/// and "furball", and their twins of icosahedra, "particles_mesh" and "furball_mesh".
+std::vector<std::string> sphere_procedural_scene_names();
 bool is_procedural_scene(const std::string& name);
 
 /// Writes scene `name` as `<dir>/<name>.gltf` (+ .bin) and returns the .gltf path.

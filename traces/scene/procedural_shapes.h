@@ -42,6 +42,11 @@ std::string write_aligned_walls(const std::string& dir, const ProceduralOptions&
 std::string write_terrain(const std::string& dir, const ProceduralOptions& options);
 /// The terrain's hills under alpha-tested grass cards (a MASK material; procedural_terrain.cpp).
 std::string write_meadow(const std::string& dir, const ProceduralOptions& options);
+// Spheres (procedural_spheres.cpp).
+std::string write_particles(const std::string& dir, const ProceduralOptions& options);
+std::string write_furball(const std::string& dir, const ProceduralOptions& options);
+std::string write_particles_mesh(const std::string& dir, const ProceduralOptions& options);
+std::string write_furball_mesh(const std::string& dir, const ProceduralOptions& options);
 std::string write_forest(const std::string& dir, const ProceduralOptions& options);
 std::string write_grove(const std::string& dir, const ProceduralOptions& options);
 // Deforming scenes (procedural_moving.cpp): their meshes move over frames (Scene::animation).

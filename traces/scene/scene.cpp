@@ -34,6 +34,35 @@ namespace {
 
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+/// Length of the longest column of the transform's linear part.
+double largest_axis_scale(const glm::dmat4& m) {
+    double s = 0.0;
+    for (int c = 0; c < 3; ++c) s = std::max(s, glm::length(glm::dvec3(m[c])));
+    return s;
+}
+
+/// x rounded to float towards -inf (down) or +inf (up).
+float round_down(double x) {
+    float f = float(x);
+    return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+}
+float round_up(double x) {
+    float f = float(x);
+    return double(f) < x ? std::nextafter(f, INFINITY) : f;
+}
+
+/// A sphere as a flattened primitive: {lo, hi, centre}, its box rounded outward so it holds the
+/// whole sphere the records store (centre and radius as floats).
+Triangle sphere_primitive(const Vec3& c, float r) {
+    Triangle t;
+    for (int a = 0; a < 3; ++a) {
+        t.v0[a] = round_down(double(c[a]) - double(r));
+        t.v1[a] = round_up(double(c[a]) + double(r));
+    }
+    t.v2 = c;
+    return t;
+}
+
 }  // namespace
 
 void Scene::flatten() {
@@ -49,6 +78,9 @@ void Scene::flatten() {
     triangles.clear();
     tri_material.clear();
     tri_instance.clear();
+    sphere_radius.clear();
+    const bool spheres = has_spheres();  // then a radius per primitive, 0 for a triangle
+    if (spheres) sphere_radius.reserve(total);
     triangles.reserve(total);
     tri_material.reserve(total);
     tri_instance.reserve(total);
@@ -62,9 +94,22 @@ void Scene::flatten() {
             glm::dvec4 w = inst.object_to_world * glm::dvec4(p.x, p.y, p.z, 1.0);
             return Vec3(float(w.x), float(w.y), float(w.z));
         };
+        // A sphere's radius scales with the transform's largest axis (a sphere under a
+        // non-uniform scale stays a sphere: the one that bounds the ellipsoid).
+        const double scale = mesh.radii.empty() ? 0.0 : largest_axis_scale(inst.object_to_world);
         for (size_t t = 0; t < mesh.triangle_count(); ++t) {
             Triangle tri{to_world(mesh.positions[3 * t]), to_world(mesh.positions[3 * t + 1]),
                          to_world(mesh.positions[3 * t + 2])};
+            float radius = 0.0f;
+            if (mesh.is_sphere(t)) {
+                const glm::dvec4 w = inst.object_to_world * glm::dvec4(glm::dvec3(mesh.positions[3 * t]), 1.0);
+                radius = float(double(mesh.radii[t]) * scale);
+                tri = sphere_primitive(Vec3(float(w.x), float(w.y), float(w.z)), radius);
+                if (!(radius > 0.0f) || !std::isfinite(radius))
+                    throw Error(source + ": mesh " + std::to_string(inst.mesh) + " '" + mesh.name + "' sphere " +
+                                std::to_string(t) + (inst.node >= 0 ? " placed by node " + std::to_string(inst.node) : "") +
+                                " has radius " + std::to_string(radius) + " in world space (it must be positive and finite)");
+            }
             if (!finite(tri.v0) || !finite(tri.v1) || !finite(tri.v2))
                 throw Error(source + ": mesh " + std::to_string(inst.mesh) + " '" + mesh.name + "' triangle " +
                             std::to_string(t) + (inst.node >= 0 ? " placed by node " + std::to_string(inst.node) : "") +
@@ -75,8 +120,22 @@ void Scene::flatten() {
             triangles.push_back(tri);
             tri_material.push_back(mesh.materials[t]);
             tri_instance.push_back(uint32_t(i));
+            if (spheres) sphere_radius.push_back(radius);
         }
     }
+}
+
+size_t Scene::sphere_count() const {
+    size_t n = 0;
+    for (float r : sphere_radius) n += r > 0.0f ? 1 : 0;
+    return n;
+}
+
+bool Scene::has_spheres() const {
+    for (const Mesh& m : meshes)
+        for (float r : m.radii)
+            if (r > 0.0f) return true;
+    return false;
 }
 
 bool Scene::uses_instancing() const {

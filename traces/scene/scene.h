@@ -93,7 +93,11 @@ struct Mesh {
     /// TEXCOORD_0, 3 per triangle like positions; empty when no primitive has it (a mesh with
     /// some primitives lacking it gets (0, 0) there).
     std::vector<glm::vec2> uvs;
+    /// Spheres (curved primitives, docs/scenes.md "Spheres"): one radius per primitive, 0 for a
+    /// triangle; empty when the mesh has none. A sphere's three positions are its centre.
+    std::vector<float> radii;
     size_t triangle_count() const { return materials.size(); }
+    bool is_sphere(size_t prim) const { return !radii.empty() && radii[prim] > 0.0f; }
 };
 
 /// One placement of a mesh in the world.
@@ -104,9 +108,13 @@ struct Instance {
     int32_t node = -1;       ///< glTF node index it came from (-1 for procedural)
 };
 
+/// A flattened primitive. A sphere is stored as its box and centre, {lo, hi, centre} (its radius
+/// in Scene::sphere_radius), so every builder that bounds primitives by their vertices bounds
+/// it right; builders that clip triangles against planes refuse scenes with spheres.
 struct Triangle {
     Vec3 v0, v1, v2;
 };
+inline Vec3 sphere_centre(const Triangle& t) { return t.v2; }
 
 /// Peak memory of tracing, per flattened triangle (scene, BVH build, hardware image, writer),
 /// measured with /usr/bin/time on 2M-triangle hairballs (docs/validation.md).
@@ -140,6 +148,9 @@ struct Scene {
     std::vector<Triangle> triangles;
     std::vector<uint32_t> tri_material;
     std::vector<uint32_t> tri_instance;
+    /// Per primitive: a sphere's world-space radius, 0 for a triangle; empty when the scene has
+    /// no spheres (filled by flatten()).
+    std::vector<float> sphere_radius;
     uint64_t placed_triangles = 0;  ///< set by index_instances() (flatten() fills triangles instead)
     Aabb bounds;
 
@@ -153,6 +164,11 @@ struct Scene {
     /// triangles. Throws rtsim::Error naming `source` if primitive ids would not fit int32.
     void index_instances();
     bool flattened() const { return !triangles.empty(); }
+    bool is_sphere(uint32_t prim) const { return !sphere_radius.empty() && sphere_radius[prim] > 0.0f; }
+    /// Spheres among the flattened primitives.
+    size_t sphere_count() const;
+    /// True if some mesh has spheres (flattened or not).
+    bool has_spheres() const;
     /// Triangles the instances place: the flattened list's size, or placed_triangles.
     size_t triangle_count() const { return flattened() ? triangles.size() : size_t(placed_triangles); }
     /// Instance that places primitive `prim` (binary search over prim_base).

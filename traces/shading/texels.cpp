@@ -20,7 +20,11 @@ RayCone child_cone(const RayCone& parent, const Vec3& dir, float t, RayKind kind
 float ray_cone_lod(const TriShadeRecord& tri, const TextureRecord& tex, const Vec3& dir, float t, const RayCone& cone) {
     const float len = glm::length(dir);
     const float width = std::abs(cone.width + cone.spread * t * len);
-    const float cosine = std::abs(tri.normal[0] * dir.x + tri.normal[1] * dir.y + tri.normal[2] * dir.z) / len;
+    // A sphere's record has no normal (materials.cpp): its cosine is the mean over the disc a
+    // ray sees, 2/3.
+    const bool sphere = tri.normal[0] == 0.0f && tri.normal[1] == 0.0f && tri.normal[2] == 0.0f;
+    const float cosine =
+        sphere ? 2.0f / 3.0f : std::abs(tri.normal[0] * dir.x + tri.normal[1] * dir.y + tri.normal[2] * dir.z) / len;
     if (!(width > 0.0f) || !(cosine > 0.0f)) return 0.0f;
     return tri.lod_base + std::log2(width) - std::log2(cosine) + 0.5f * std::log2(float(tex.width) * float(tex.height));
 }

@@ -22,7 +22,8 @@ json scene_json(const Scene& scene, const std::string& name, bool procedural) {
     return {{"name", name},
             {"source", scene.source},
             {"procedural", procedural},
-            {"triangles", scene.triangle_count()},
+            {"triangles", scene.triangle_count() - scene.sphere_count()},
+            {"spheres", scene.sphere_count()},
             {"meshes", scene.meshes.size()},
             {"instances", scene.instances.size()},
             {"uses_instancing", scene.uses_instancing()},
@@ -72,6 +73,7 @@ void RayCounts::add(RayKind kind, uint16_t depth, const Hit& hit, const WorkCoun
     k.steps += w.steps;
     k.box_tests += w.box_tests;
     k.tri_tests += w.tri_tests;
+    k.sphere_tests += w.sphere_tests;
     k.anyhit_calls += w.anyhit_calls;
     k.max_depth = std::max(k.max_depth, depth);
     m_written += written;
@@ -91,6 +93,7 @@ json RayCounts::to_json() const {
                                             {"steps_per_ray", k.steps / n},
                                             {"box_tests_per_ray", k.box_tests / n},
                                             {"tri_tests_per_ray", k.tri_tests / n},
+                                            {"sphere_tests_per_ray", k.sphere_tests / n},
                                             {"anyhit_calls_per_ray", k.anyhit_calls / n}};
     }
     return {{"rays", m_written}, {"rejected", m_rejected}, {"by_kind", kinds}};

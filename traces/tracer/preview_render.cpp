@@ -8,6 +8,8 @@
 
 #include "traces/common/error.h"
 
+#include "traces/raygen/surface.h"
+
 namespace rtsim {
 
 namespace {
@@ -18,6 +20,10 @@ Vec3 sky(const Vec3& d) {
 }
 
 float headlight(const Scene& scene, const Ray& ray, const Hit& hit) {
+    if (scene.is_sphere(uint32_t(hit.prim))) {
+        const float len = glm::length(ray.direction);
+        return len > 0.0f ? std::abs(glm::dot(surface_point(scene, ray, hit).normal, ray.direction)) / len : 0.0f;
+    }
     const Triangle t = scene.world_triangle(uint32_t(hit.prim));
     Vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);
     float len = glm::length(n) * glm::length(ray.direction);

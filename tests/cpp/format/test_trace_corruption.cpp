@@ -161,11 +161,11 @@ TEST_F(CorruptionTest, WrongVersionAndForeignFilesAreRefused) {
     h.version = kTraceVersionOldest - 1;
     tl::encode_header(h, b.data());
     EXPECT_EQ(open_error(b), m_bad + ": trace version " + std::to_string(kTraceVersionOldest - 1) + reads);
-    // Version 3 (no frames) is read as it was written.
+    // An older version's header over this version's records is refused by its WORK record
+    // size (older versions are read with theirs: TraceRoundTrip.OlderWorkRecordsAreWidened...).
     h.version = 3;
     tl::encode_header(h, b.data());
-    test::write_bytes(m_bad, b);
-    EXPECT_EQ(TraceReader(m_bad).version(), 3u);
+    EXPECT_TRUE(contains(open_error(b), "section WORK has 36-byte records, this build expects 32")) << open_error(b);
 
     const std::string text = "This is a text file, long enough to fill a whole trace header, honestly.\n";
     EXPECT_EQ(open_error(std::vector<uint8_t>(text.begin(), text.end())),

@@ -1,12 +1,15 @@
 // Trace format: record layouts, round trips of every section kind, empty sections and the
 // writer's all-or-nothing output.
 #include <cstddef>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "tests/cpp/format/format_test_util.h"
 #include "traces/bvh/hw_layout.h"
+#include "traces/common/error.h"
+#include "traces/format/trace_layout.h"
 #include "traces/format/trace_reader.h"
 #include "traces/format/trace_writer.h"
 
@@ -61,7 +64,7 @@ TEST(TraceRecords, SectionNamesAndSizes) {
     EXPECT_EQ(index, 13u);
     EXPECT_FALSE(is_region_section(SectionKind::rays));
     EXPECT_EQ(section_record_bytes(SectionKind::rays), 40u);
-    EXPECT_EQ(section_record_bytes(SectionKind::work), 32u);
+    EXPECT_EQ(section_record_bytes(SectionKind::work), 36u);
     EXPECT_EQ(section_record_bytes(region_section(0)), 0u);  // regions: size from the descriptor
     EXPECT_EQ(section_record_bytes(SectionKind(0x12345678)), 0u);
 }
@@ -114,7 +117,7 @@ TEST(TraceRecords, WorkRecordIsTheDeclaredFieldsInOrder) {
     for (int i = 0; i < kTracedWorkFieldCount; ++i) EXPECT_TRUE(kWorkFields[size_t(i)].traced);
     for (int i = kTracedWorkFieldCount; i < kWorkFieldCount; ++i) EXPECT_FALSE(kWorkFields[size_t(i)].traced);
     for (int i = 0; i < kTracedWorkFieldCount; ++i) EXPECT_EQ(record_words[i], 10u + uint32_t(i));
-    EXPECT_EQ(r.refs, 10u + uint32_t(kTracedWorkFieldCount) - 1);
+    EXPECT_EQ(r.sphere_tests, 10u + uint32_t(kTracedWorkFieldCount) - 1);
     const WorkCounts back = r.counts();
     EXPECT_EQ(back.refs, w.refs);
     EXPECT_EQ(back.mailbox_lookups, 0u);
@@ -131,6 +134,58 @@ TEST(TraceRecords, WorkRecordIsTheDeclaredFieldsInOrder) {
 template <class T>
 bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+TEST(TraceRoundTrip, OlderWorkRecordsAreWidenedWithZeroSphereTests) {
+    // A version-5 file: 32-byte WORK records (the fields before sphere_tests), over chunk ends.
+    ScratchDir dir;
+    const std::string path = dir.file("trace.rtt");
+    struct WorkV5 {
+        uint32_t field[kWorkRecordBytesV5 / 4];
+    };
+    std::vector<WorkV5> old(100);
+    for (size_t i = 0; i < old.size(); ++i)
+        for (uint32_t f = 0; f < kWorkRecordBytesV5 / 4; ++f) old[i].field[f] = uint32_t(100 * i + f + 1);
+    // This build writes only 36-byte WORK records: the old ones go in under a kind of no fixed
+    // size, relabelled WORK in the section table afterwards.
+    const auto unsized = SectionKind(0x31313131);
+    {
+        TraceWriter writer(path, 200);
+        writer.append(unsized, old);
+        writer.close();
+    }
+    std::vector<uint8_t> bytes = test::read_bytes(path);
+    tl::FileHeader h = tl::decode_header(bytes.data());
+    SectionInfo entry = tl::decode_entry(&bytes[h.table_offset]);
+    ASSERT_EQ(entry.kind, unsized);
+    entry.kind = SectionKind::work;
+    tl::encode_entry(entry, &bytes[h.table_offset]);
+    const size_t n = h.table_bytes - 4;
+    const uint32_t crc = tl::crc32_bytes(&bytes[h.table_offset], n);
+    std::memcpy(&bytes[h.table_offset + n], &crc, 4);
+    h.version = 5;
+    tl::encode_header(h, bytes.data());
+    test::write_bytes(path, bytes);
+    TraceReader reader(path);
+    EXPECT_EQ(reader.version(), 5u);
+    EXPECT_EQ(reader.section(SectionKind::work).record_bytes, kWorkRecordBytesV5);
+    std::vector<WorkRecord> got(60);
+    reader.read(SectionKind::work, 30, 60, got.data());
+    for (size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].steps, uint32_t(100 * (30 + i) + 1)) << i;
+        EXPECT_EQ(got[i].refs, uint32_t(100 * (30 + i) + 8)) << i;
+        EXPECT_EQ(got[i].sphere_tests, 0u) << i;
+    }
+    // The same 32-byte records under version 6 are refused, naming the size this build expects.
+    h.version = 6;
+    tl::encode_header(h, bytes.data());
+    test::write_bytes(path, bytes);
+    try {
+        TraceReader again(path);
+        FAIL() << "32-byte WORK records accepted as version 6";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("has 32-byte records, this build expects 36"), std::string::npos) << e.what();
+    }
 }
 
 TEST(TraceRoundTrip, InterleavedAppendsOfAllKindsAcrossManyChunks) {

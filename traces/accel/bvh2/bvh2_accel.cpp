@@ -19,6 +19,7 @@ Bvh2View bvh2_view(const HwBvh& bvh) {
     v.triangles = bvh.triangles.data();
     v.node_count = bvh.nodes.size();
     v.triangle_count = bvh.triangles.size();
+    v.spheres = detail::any_sphere(bvh.triangles.data(), bvh.triangles.size());
     return v;
 }
 
@@ -184,6 +185,7 @@ Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::m
     m_view.triangles = m_triangles.triangles();
     m_view.triangle_count = m_triangles.count();
     m_view.tri_at = m_triangles.addressing();
+    m_view.spheres = has_spheres();
     validate_bvh2(m_view, source);
 }
 
@@ -214,6 +216,7 @@ LocalityPartition Bvh2Accel::partition(uint64_t budget_bytes) const {
 std::vector<OpKind> Bvh2Accel::op_kinds() const {
     std::vector<OpKind> kinds{OpKind::box, OpKind::triangle};
     if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
+    if (has_spheres()) kinds.push_back(OpKind::sphere);
     return kinds;
 }
 

@@ -24,7 +24,8 @@ void detail::Bvh2LaneRules::plan(StepPlan& plan, uint32_t ref, uint32_t count) c
         plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
         const TriangleAddressing::Span span = view.tri_at.span(ref, count);
         plan.add_fetch(span.address, span.bytes, DataKind::triangle);
-        plan.add_op(OpKind::triangle, count);
+        const detail::LeafTests t = detail::leaf_tests(view.triangles + ref, count, view.spheres);
+        plan.add_leaf_ops(t.triangles, t.spheres);
     }
 }
 
@@ -71,7 +72,8 @@ void Bvh2PacketStepper::plan_next() {
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
         const TriangleAddressing::Span span = m_view.tri_at.span(m_ref, m_count);
         m_plan.add_fetch(span.address, span.bytes, DataKind::triangle);
-        m_plan.add_op(OpKind::triangle, m_count * rays);
+        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + m_ref, m_count, m_view.spheres);
+        m_plan.add_leaf_ops(t.triangles * rays, t.spheres * rays);
     }
 }
 

@@ -69,7 +69,8 @@ void Bvh2Stepper::plan_at(uint32_t ref, uint32_t count) {
         m_plan.set_host(m_view.triangles + ref, uint32_t(sizeof(HwTriangle) * count));
         const TriangleAddressing::Span s = m_view.tri_at.span(ref, count);
         m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-        m_plan.add_op(OpKind::triangle, count);
+        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + ref, count, m_view.spheres);
+        m_plan.add_leaf_ops(t.triangles, t.spheres);
     }
 }
 
@@ -140,7 +141,9 @@ void Bvh2Stepper::visit_node(const HwNode& node) {
 }
 
 uint32_t Bvh2Stepper::visit_leaf(const HwTriangle* triangles) {
-    m_work.tri_tests += m_count;
+    const detail::LeafTests t = detail::leaf_tests(triangles, m_count, m_view.spheres);
+    m_work.tri_tests += t.triangles;
+    m_work.sphere_tests += t.spheres;
     const uint32_t alpha_before = m_work.anyhit_calls;
     const bool done =
         m_mode == TraversalMode::any_hit

@@ -1,0 +1,153 @@
+"""Spheres (docs/accel.md, "Spheres"): the sphere scenes trace on the BVH kinds and replay with
+zero mismatches at every level and execution model, their sphere tests going to the sphere
+pipeline; glTF POINTS with _RADIUS is the way in, and bad input is refused naming the culprit;
+structures that cannot store spheres refuse them naming those that can; the study runs."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rtsim
+from conftest import checked, run_rtsim
+
+
+@pytest.fixture(scope="module", params=["bvh2", "cwbvh8"])
+def trace(tmp_path_factory: pytest.TempPathFactory, request: pytest.FixtureRequest) -> Path:
+    out = tmp_path_factory.mktemp("spheres") / f"particles-{request.param}"
+    made = run_rtsim("trace", "particles", "-o", str(out), "--resolution", "24x18",
+                     "--accel", request.param)  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    return out
+
+
+def test_manifest_counts_spheres_and_their_tests(trace: Path) -> None:
+    m = json.loads((trace / "manifest.json").read_text())
+    assert m["scene"]["spheres"] == 40001 and m["scene"]["triangles"] == 2
+    assert m["trace_version"] == 6
+    kinds = m["counts"]["by_kind"]
+    assert set(kinds) >= {"primary", "shadow", "diffuse"}
+    assert kinds["primary"]["sphere_tests_per_ray"] > 0
+    t = rtsim.open_trace(trace)
+    assert t.work["sphere_tests"].sum() > 0
+    # The image's sphere records: flag bit 1, centre and radius (docs/bvh_layout.md).
+    tris = t.triangles
+    spheres = tris[(tris["flags"] & 2) != 0]
+    assert len(spheres) == 40001
+    assert (spheres["v1"][:, 0] >= 0.006).all() and (spheres["v2"] == 0).all()
+
+
+@pytest.mark.parametrize(
+    "sets",
+    [
+        ["fidelity=functional"],
+        ["fidelity=approx"],
+        ["fidelity=detailed"],
+        ["fidelity=analytic"],
+        ["traversal.model=simt"],
+        ["traversal.model=packet"],
+        ["treelets.enabled=true"],
+    ],
+)
+def test_replays_with_zero_mismatches(
+    trace: Path, sim_exe: Path, tmp_path: Path, sets: list[str]
+) -> None:
+    stats = checked(sim_exe, trace, tmp_path / "run", *sets)
+    if "fidelity=functional" not in sets:
+        blocks = {b["block"]: b for b in stats["instantiated"]}
+        assert blocks["sphere"]["instantiated"], blocks["sphere"]
+        assert stats["area"]["mm2"]["sphere"] > 0
+        assert stats["energy"]["per_ray_nj"]["sphere"] > 0
+        tests = sum(p["tests"] for p in stats["model"]["sphere"].values())
+        t = rtsim.open_trace(trace)
+        if "traversal.model=packet" not in sets:
+            assert tests == int(np.asarray(t.work["sphere_tests"]).sum())
+
+
+def test_triangle_scenes_build_no_sphere_pipeline(sim_exe: Path, tmp_path: Path) -> None:
+    out = tmp_path / "cornell"
+    assert run_rtsim("trace", "cornell", "-o", str(out), "--resolution", "8x6").returncode == 0
+    stats = checked(sim_exe, out, tmp_path / "run")
+    blocks = {b["block"]: b for b in stats["instantiated"]}
+    assert not blocks["sphere"]["instantiated"]
+    assert "sphere" not in stats["area"]["mm2"]
+
+
+def test_structures_that_clip_refuse_spheres(tmp_path: Path) -> None:
+    made = run_rtsim("trace", "furball", "-o", str(tmp_path / "kd"), "--resolution", "8x6",
+                     "--accel", "kdtree")  # fmt: skip
+    assert made.returncode != 0
+    assert "the scene has spheres, which accel kdtree cannot store" in made.stderr, made.stderr
+    assert "bvh2, bvh4" in made.stderr
+    made = run_rtsim("trace", "furball", "-o", str(tmp_path / "sbvh"), "--resolution", "8x6",
+                     "--builder", "sbvh")  # fmt: skip
+    assert made.returncode != 0 and "sbvh builder clips" in made.stderr, made.stderr
+
+
+def _points_gltf(folder: Path, radius: list[float] | None) -> Path:
+    """A glTF of two points (spheres when `radius` is given as their _RADIUS)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    pos = np.array([[0, 0, 0], [3, 0, 0]], dtype=np.float32).tobytes()
+    attributes = {"POSITION": 0}
+    views = [{"buffer": 0, "byteOffset": 0, "byteLength": 24}]
+    accessors = [{"bufferView": 0, "componentType": 5126, "count": 2, "type": "VEC3",
+                  "min": [0, 0, 0], "max": [3, 0, 0]}]  # fmt: skip
+    data = pos
+    if radius is not None:
+        data += np.array(radius, dtype=np.float32).tobytes()
+        views.append({"buffer": 0, "byteOffset": 24, "byteLength": 8})
+        accessors.append({"bufferView": 1, "componentType": 5126, "count": 2, "type": "SCALAR"})
+        attributes["_RADIUS"] = 1
+    (folder / "points.bin").write_bytes(data)
+    gltf = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "scale": [2, 2, 2]}],
+        "meshes": [{"name": "beads", "primitives": [{"attributes": attributes, "mode": 0}]}],
+        "buffers": [{"uri": "points.bin", "byteLength": len(data)}],
+        "bufferViews": views,
+        "accessors": accessors,
+    }
+    path = folder / "points.gltf"
+    path.write_text(json.dumps(gltf))
+    return path
+
+
+def test_gltf_points_with_radius_are_spheres(tmp_path: Path) -> None:
+    scene = rtsim._core.load_scene(str(_points_gltf(tmp_path / "ok", [0.5, 1.0])))
+    tris = np.asarray(scene.triangles())
+    # Flattened as {lo, hi, centre}: the node's scale of 2 moves the centre and scales the radius.
+    assert np.allclose(tris[1, 2], [6, 0, 0]) and np.allclose(tris[1, 1], [8, 2, 2])
+    out = tmp_path / "trace"
+    gltf = str(tmp_path / "ok" / "points.gltf")
+    made = run_rtsim("trace", gltf, "-o", str(out), "--resolution", "8x6",
+                     "--camera", "3,0,-20,3,0,0,40")  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    assert rtsim.open_trace(out).hits["prim"].max() >= 0
+
+
+@pytest.mark.parametrize(
+    ("radius", "message"),
+    [
+        (None, "needs a _RADIUS attribute"),
+        ([0.5, 0.0], "has _RADIUS 0"),
+        ([0.5, float("nan")], "has _RADIUS nan"),
+    ],
+)
+def test_bad_points_are_refused_naming_the_culprit(
+    tmp_path: Path, radius: list[float] | None, message: str
+) -> None:
+    path = _points_gltf(tmp_path, radius)
+    with pytest.raises(rtsim.RtsimError) as err:
+        rtsim._core.load_scene(str(path))
+    assert "primitive 0" in str(err.value) and message in str(err.value), str(err.value)
+
+
+def test_spheres_study_quick(tmp_path: Path) -> None:
+    made = run_rtsim("study", "spheres", "--quick", "-o", str(tmp_path / "study"))
+    assert made.returncode == 0, made.stderr
+    assert "| particles | primary | bvh2 | 40,001 / 800,022 |" in made.stdout, made.stdout

@@ -1,0 +1,143 @@
+// Scenes of spheres (curved primitives, docs/scenes.md "Spheres"), written as glTF POINTS
+// primitives with a _RADIUS attribute:
+//  - particles: a cloud of small spheres (a particle system's sprites as geometry) around a
+//    mirror sphere, over a floor, lit by a point light: primary, shadow, reflection and
+//    diffuse rays, spheres and triangles in one structure;
+//  - furball: the hairball's counterpart in spheres, fur grown from a core sphere, each strand
+//    a chain of overlapping beads (how hair was traced before swept-sphere primitives; the
+//    strands are as thin and as crossed as the hairball's ribbons, but round).
+// Each has a twin of triangles, "particles_mesh" and "furball_mesh": the same spheres, each an
+// icosahedron with its vertices on the sphere (20 triangles), so a study can set native spheres
+// beside the coarsest tessellation a renderer would use.
+// O(N) and deterministic: every particle and strand draws from its own counter-based stream.
+#include <cmath>
+#include <vector>
+
+#include "traces/common/rng.h"
+#include "traces/scene/gltf_writer.h"
+#include "traces/scene/procedural_shapes.h"
+
+namespace rtsim {
+
+namespace {
+
+constexpr uint32_t kParticles = 40000;
+constexpr uint32_t kStrands = 2000;
+constexpr int kBeads = 48;            ///< spheres per strand
+constexpr float kCoreRadius = 0.6f;   ///< the furball's body
+constexpr float kBeadRadius = 0.004f;
+constexpr float kBeadStep = 0.006f;   ///< centre to centre: beads overlap by a third
+constexpr float kFurCurl = 0.25f;     ///< random turn per bead
+
+Vec3 random_unit(Rng& rng) {
+    const float z = 2.0f * rng.next() - 1.0f, phi = 6.28318530718f * rng.next();
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+struct Spheres {
+    std::vector<Vec3> centres;
+    std::vector<float> radii;
+};
+
+/// An icosahedron inscribed in each sphere (vertices on it), faces wound outward.
+TriangleSoup icosahedra(const Spheres& s) {
+    const float g = 1.6180339887f;
+    Vec3 unit[12] = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                     {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+    for (Vec3& v : unit) v = glm::normalize(v);
+    static const uint32_t kFaces[60] = {0, 11, 5, 0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
+                                        4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3,
+                                        6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+    TriangleSoup soup;
+    soup.vertices.reserve(12 * s.centres.size());
+    soup.indices.reserve(60 * s.centres.size());
+    for (size_t i = 0; i < s.centres.size(); ++i) {
+        const uint32_t base = uint32_t(soup.vertices.size());
+        for (const Vec3& v : unit) soup.add_vertex(s.centres[i] + s.radii[i] * v);
+        for (int f = 0; f < 60; f += 3) soup.add_triangle(base + kFaces[f], base + kFaces[f + 1], base + kFaces[f + 2]);
+    }
+    return soup;
+}
+
+/// Adds `s` as a mesh node: spheres, or their icosahedra.
+void add_spheres(GltfWriter& w, const std::string& name, const Spheres& s, int material, bool tessellated) {
+    if (!tessellated) {
+        w.add_mesh_node(name, w.add_sphere_mesh(name, s.centres, s.radii, material));
+        return;
+    }
+    const TriangleSoup soup = icosahedra(s);
+    w.add_mesh_node(name, w.add_mesh(name, {{&soup, material}}));
+}
+
+}  // namespace
+
+std::string write_particles(const std::string& dir, const ProceduralOptions& options, bool tessellated) {
+    Spheres cloud;
+    std::vector<Vec3>& centres = cloud.centres;
+    std::vector<float>& radii = cloud.radii;
+    centres.reserve(kParticles);
+    radii.reserve(kParticles);
+    for (uint32_t i = 0; i < kParticles; ++i) {
+        Rng rng(hash_combine(options.seed, 0x70617274ull /*"part"*/, i));
+        // A shell between the mirror sphere and radius 1.2, denser towards the inside.
+        const float r = 0.45f + 0.75f * rng.next() * rng.next();
+        centres.push_back(random_unit(rng) * r + Vec3(0.0f, 1.2f, 0.0f));
+        radii.push_back(0.006f + 0.014f * rng.next());
+    }
+    TriangleSoup floor;
+    floor.add_quad({-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}, {0, 1, 0});
+
+    GltfWriter w;
+    const int dust = w.add_material(make_material("particle", {0.85f, 0.55f, 0.25f}, 0.0f, 0.8f));
+    const int mirror = w.add_material(make_material("mirror", {0.95f, 0.95f, 0.95f}, 1.0f, 0.05f));
+    const int ground = w.add_material(make_material("floor", {0.6f, 0.6f, 0.62f}, 0.0f, 1.0f));
+    add_spheres(w, "particles", cloud, dust, tessellated);
+    add_spheres(w, "mirror_sphere", Spheres{{{0.0f, 1.2f, 0.0f}}, {0.35f}}, mirror, tessellated);
+    w.add_mesh_node("floor", w.add_mesh("floor", {{&floor, ground}}));
+    w.add_light("key_light", LightType::point, {2.5f, 4.0f, 2.5f}, {0, 0, 0}, {1, 1, 1}, 80.0f);
+    w.add_camera("camera", {0.0f, 1.5f, 3.6f}, {0.0f, 1.1f, 0.0f}, 0.75f, 1.0f);
+    return w.write(dir, tessellated ? "particles_mesh" : "particles");
+}
+
+std::string write_furball(const std::string& dir, const ProceduralOptions& options, bool tessellated) {
+    Spheres fur_spheres;
+    std::vector<Vec3>& centres = fur_spheres.centres;
+    std::vector<float>& radii = fur_spheres.radii;
+    centres.reserve(size_t(kStrands) * kBeads);
+    for (uint32_t s = 0; s < kStrands; ++s) {
+        Rng rng(hash_combine(options.seed, 0x66757262ull /*"furb"*/, s));
+        const Vec3 root = random_unit(rng);
+        Vec3 p = root * (kCoreRadius - kBeadRadius), dir = root;
+        for (int b = 0; b < kBeads; ++b) {
+            centres.push_back(p);
+            radii.push_back(kBeadRadius * (1.0f - 0.5f * float(b) / kBeads));  // strands taper
+            // Curl, but keep growing outward (never back into the body).
+            dir = glm::normalize(dir + kFurCurl * random_unit(rng));
+            if (glm::dot(dir, glm::normalize(p)) < 0.2f) dir = glm::normalize(dir + glm::normalize(p));
+            p += kBeadStep * dir;
+        }
+    }
+    GltfWriter w;
+    const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
+    add_spheres(w, "fur", fur_spheres, fur, tessellated);
+    add_spheres(w, "body", Spheres{{{0.0f, 0.0f, 0.0f}}, {kCoreRadius}}, fur, tessellated);
+    w.add_light("key_light", LightType::point, {2.5f, 3.0f, 2.5f}, {0, 0, 0}, {1, 1, 1}, 60.0f);
+    w.add_camera("camera", {0.0f, 0.3f, 3.2f}, {0, 0, 0}, 0.7f, 1.0f);
+    return w.write(dir, tessellated ? "furball_mesh" : "furball");
+}
+
+std::string write_particles(const std::string& dir, const ProceduralOptions& options) {
+    return write_particles(dir, options, false);
+}
+std::string write_particles_mesh(const std::string& dir, const ProceduralOptions& options) {
+    return write_particles(dir, options, true);
+}
+std::string write_furball(const std::string& dir, const ProceduralOptions& options) {
+    return write_furball(dir, options, false);
+}
+std::string write_furball_mesh(const std::string& dir, const ProceduralOptions& options) {
+    return write_furball(dir, options, true);
+}
+
+}  // namespace rtsim
