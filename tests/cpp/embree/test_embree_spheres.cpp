@@ -1,0 +1,168 @@
+// Spheres against Embree 3's own (RTC_GEOMETRY_TYPE_SPHERE_POINT, robust mode): the particles
+// and the furball (overlapping beads: many near-ties), traced by rtsim's BVHs and by Embree with
+// the same rays. Hits must name the same sphere with t within 1e-4 relative; every disagreement
+// must be a graze (the ray passes within 1e-4 of the hit sphere's radius of its centre, where
+// float and double arithmetic may decide differently) or a tie (two spheres crossed within 1e-4
+// relative t: rtsim takes the smaller id, Embree either). Any-hit rays must agree on occlusion
+// but for grazes.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <embree3/rtcore.h>
+#include <gtest/gtest.h>
+
+#include "traces/accel/accel.h"
+#include "traces/common/rng.h"
+#include "traces/scene/gltf_loader.h"
+#include "traces/scene/procedural.h"
+#include "tests/cpp/process_temp_dir.h"
+
+namespace rtsim {
+namespace {
+
+/// Embree's spheres of a flattened scene (its triangles are left out: the rays are aimed so the
+/// comparison is about spheres; rtsim traces only spheres too, see sphere_only_scene).
+class EmbreeSpheres {
+public:
+    explicit EmbreeSpheres(const Scene& scene) {
+        m_device = rtcNewDevice("threads=1");
+        m_scene = rtcNewScene(m_device);
+        rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
+        RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        const size_t n = scene.triangles.size();
+        auto* v = static_cast<float*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
+        for (size_t i = 0; i < n; ++i) {
+            const Vec3 c = sphere_centre(scene.triangles[i]);
+            v[4 * i] = c.x, v[4 * i + 1] = c.y, v[4 * i + 2] = c.z, v[4 * i + 3] = scene.sphere_radius[i];
+        }
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(m_scene, g);
+        rtcReleaseGeometry(g);
+        rtcCommitScene(m_scene);
+    }
+    ~EmbreeSpheres() {
+        rtcReleaseScene(m_scene);
+        rtcReleaseDevice(m_device);
+    }
+    Hit intersect(const Ray& r) const {
+        RTCRayHit rh{};
+        rh.ray.org_x = r.origin.x, rh.ray.org_y = r.origin.y, rh.ray.org_z = r.origin.z;
+        rh.ray.dir_x = r.direction.x, rh.ray.dir_y = r.direction.y, rh.ray.dir_z = r.direction.z;
+        rh.ray.tnear = r.tmin, rh.ray.tfar = r.tmax, rh.ray.mask = 0xFFFFFFFFu;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        rtcIntersect1(m_scene, &ctx, &rh);
+        Hit h;
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
+        h.prim = int32_t(rh.hit.primID);
+        h.t = rh.ray.tfar;
+        return h;
+    }
+    bool occluded(const Ray& r) const {
+        RTCRay ray{};
+        ray.org_x = r.origin.x, ray.org_y = r.origin.y, ray.org_z = r.origin.z;
+        ray.dir_x = r.direction.x, ray.dir_y = r.direction.y, ray.dir_z = r.direction.z;
+        ray.tnear = r.tmin, ray.tfar = r.tmax, ray.mask = 0xFFFFFFFFu;
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        rtcOccluded1(m_scene, &ctx, &ray);
+        return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion
+    }
+
+private:
+    RTCDevice m_device;
+    RTCScene m_scene;
+};
+
+/// The scene with its triangles dropped (spheres only, ids kept dense in scene order).
+Scene sphere_only_scene(const Scene& full) {
+    Scene s;
+    Mesh mesh;
+    mesh.name = "spheres";
+    for (uint32_t p = 0; p < full.triangles.size(); ++p) {
+        if (!full.is_sphere(p)) continue;
+        const Vec3 c = sphere_centre(full.triangles[p]);
+        mesh.positions.insert(mesh.positions.end(), {c, c, c});
+        mesh.radii.push_back(full.sphere_radius[p]);
+    }
+    mesh.materials.assign(mesh.radii.size(), 0u);
+    s.meshes.push_back(mesh);
+    s.instances.push_back(Instance{});
+    s.materials = {Material{}};
+    s.flatten();
+    return s;
+}
+
+/// The ray passes within a relative 1e-4 of the sphere's radius of its centre: a graze.
+bool grazes(const Scene& scene, const Ray& r, const Hit& h) {
+    if (!h.valid()) return false;
+    const glm::dvec3 c(sphere_centre(scene.triangles[uint32_t(h.prim)]));
+    const glm::dvec3 o(r.origin), d = glm::normalize(glm::dvec3(r.direction));
+    const glm::dvec3 f = c - o;
+    const double perp = glm::length(f - glm::dot(f, d) * d), rad = scene.sphere_radius[uint32_t(h.prim)];
+    return std::fabs(perp - rad) <= 1e-4 * rad;
+}
+
+void compare(const std::string& name, const Scene& full, const char* kind) {
+    const Scene scene = sphere_only_scene(full);
+    AccelOptions o;
+    o.kind = kind;
+    const std::unique_ptr<Accel> accel = load_accel(build_accel(scene, o), name);
+    const EmbreeSpheres embree(scene);
+    Rng rng(9);
+    const Vec3 lo = scene.bounds.lo, ext = scene.bounds.hi - scene.bounds.lo;
+    auto point = [&](float margin) {
+        return lo - margin * ext + (1.0f + 2.0f * margin) * Vec3(rng.next(), rng.next(), rng.next()) * ext;
+    };
+    int rays = 20000, hits = 0, graze = 0, tie = 0, other = 0, occlusion_graze = 0;
+    for (int i = 0; i < rays; ++i) {
+        Ray r;
+        r.origin = point(0.5f);
+        r.direction = point(0.0f) - r.origin;
+        const Hit a = accel->trace(r, TraversalMode::closest_hit), b = embree.intersect(r);
+        hits += a.valid();
+        if (a.valid() && b.valid() && a.prim == b.prim) {
+            EXPECT_NEAR(a.t, b.t, 1e-4f * std::max(1.0f, a.t)) << name << " ray " << i;
+        } else if (a.valid() || b.valid()) {
+            if (grazes(scene, r, a) || grazes(scene, r, b)) {
+                ++graze;
+            } else if (a.valid() && b.valid() && std::fabs(a.t - b.t) <= 1e-4f * a.t) {
+                ++tie;
+            } else {
+                ++other;
+                ADD_FAILURE() << name << " " << kind << " ray " << i << ": rtsim sphere " << a.prim << " t " << a.t
+                              << "; Embree sphere " << b.prim << " t " << b.t;
+            }
+        }
+        Ray shadow = r;
+        shadow.tmax = 0.5f;  // halfway to the target: some occluded, some not
+        const bool ours = accel->trace(shadow, TraversalMode::any_hit).valid(), theirs = embree.occluded(shadow);
+        if (ours != theirs) {
+            const Hit near = accel->trace(shadow, TraversalMode::closest_hit);
+            const Hit far = embree.intersect(shadow);
+            if (grazes(scene, shadow, near) || grazes(scene, shadow, far)) ++occlusion_graze;
+            else ADD_FAILURE() << name << " " << kind << " shadow ray " << i << ": rtsim " << ours << ", Embree " << theirs;
+        }
+    }
+    std::printf("[ embree    ] %s %s: %zu spheres, %d rays, %d hits; %d graze, %d tie and %d occlusion-graze "
+                "disagreements\n",
+                name.c_str(), kind, scene.triangles.size(), rays, hits, graze, tie, occlusion_graze);
+    EXPECT_GT(hits, rays / 10) << name;
+    EXPECT_EQ(other, 0) << name;
+    EXPECT_LE(graze + tie + occlusion_graze, rays / 1000) << name;
+}
+
+TEST(EmbreeSpheres, ParticlesAndFurball) {
+    const std::string tmp = rtsim::test::process_temp_dir("embree_spheres").string();
+    for (const char* name : {"particles", "furball"}) {
+        const Scene scene = load_gltf(write_procedural_scene(name, tmp), true);
+        for (const char* kind : {"bvh2", "cwbvh8"}) compare(name, scene, kind);
+    }
+}
+
+}  // namespace
+}  // namespace rtsim
