@@ -126,8 +126,15 @@ def write_heatmaps(
     width, height = size
     out = Path(out_dir) if out_dir is not None else trace.folder
     out.mkdir(parents=True, exist_ok=True)
-    steps, tris = pixel_work(trace, width, height, ("steps", "tri_tests"))
+    steps, tris, spheres = pixel_work(trace, width, height, ("steps", "tri_tests", "sphere_tests"))
     paths = [out / "heatmap_nodes.png", out / "heatmap_tris.png"]
     _draw(steps, "traversal steps (nodes or cells visited)", trace.scene_name, paths[0])
-    _draw(tris, "triangle tests", trace.scene_name, paths[1])
+    # Spheres are primitives too: the map counts every primitive test, titled by what there is.
+    has_spheres = spheres.all_rays.any()
+    title = "primitive tests (triangles and spheres)" if has_spheres else "triangle tests"
+    tests = PixelWork(
+        "primitive_tests", tris.primary + spheres.primary, tris.all_rays + spheres.all_rays,
+        tris.primary_rays, tris.other_rays,
+    )  # fmt: skip
+    _draw(tests, title, trace.scene_name, paths[1])
     return paths

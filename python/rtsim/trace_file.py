@@ -49,6 +49,8 @@ SECTION_DTYPES["accl"] = np.dtype("u1")
 RAY_DTYPE = SECTION_DTYPES["rays"]
 HIT_DTYPE = SECTION_DTYPES["hits"]
 WORK_DTYPE = SECTION_DTYPES["work"]
+#: Bytes of a WORK record before version 6 (no sphere_tests; read widened, sphere_tests 0).
+WORK_BYTES_V5 = 32
 FRAME_DTYPE = SECTION_DTYPES["frms"]
 
 
@@ -80,10 +82,10 @@ class Trace:
         # rtsim-sim checks them: a flipped byte raises RtsimError naming the section and chunk.
         verify_trace(self.path, name.upper())
         dtype = SECTION_DTYPES[name]
-        if section.record_bytes < dtype.itemsize:
-            dtype = _leading_fields(dtype, section.record_bytes)
         if section.record_count == 0:
             return np.zeros(0, dtype=dtype)
+        if section.record_bytes < dtype.itemsize:
+            return _widened(self.path, section, dtype)
         return np.memmap(
             self.path, dtype=dtype, mode="r", offset=section.offset, shape=(section.record_count,)
         )
@@ -187,18 +189,18 @@ class Trace:
         verify_trace(self.path)
 
 
-def _leading_fields(dtype: np.dtype, itemsize: int) -> np.dtype:
-    """An older version's shorter records (WORK before version 6 has no sphere_tests): the
-    fields that fit in `itemsize` bytes; the counters it predates are absent."""
-    names = [n for n in dtype.names if dtype.fields[n][1] + dtype.fields[n][0].itemsize <= itemsize]
-    return np.dtype(
-        {
-            "names": names,
-            "formats": [dtype.fields[n][0] for n in names],
-            "offsets": [dtype.fields[n][1] for n in names],
-            "itemsize": itemsize,
-        }
-    )
+def _widened(path: Path, section: Section, dtype: np.dtype) -> np.ndarray:
+    """An older version's shorter records (WORK before version 6 has no sphere_tests) in this
+    version's layout, the counters they predate zero (as the C++ reader widens them)."""
+    stored = np.memmap(
+        path, dtype=np.uint8, mode="r", offset=section.offset,
+        shape=(section.record_count, section.record_bytes),
+    )  # fmt: skip
+    out = np.zeros((section.record_count, dtype.itemsize), dtype=np.uint8)
+    out[:, : section.record_bytes] = stored
+    wide = out.view(dtype).reshape(section.record_count)
+    wide.flags.writeable = False
+    return wide
 
 
 def _section_name(info: dict[str, Any]) -> str:
@@ -237,7 +239,8 @@ def open_trace(path: str | Path) -> Trace:
             bytes=int(info["bytes"]),
         )
         dtype = SECTION_DTYPES.get(name)
-        if dtype is not None and dtype.itemsize != section.record_bytes:
+        older_work = name == "work" and section.record_bytes == WORK_BYTES_V5
+        if dtype is not None and dtype.itemsize != section.record_bytes and not older_work:
             raise RtsimError(
                 f"{file}: section '{name}' has {section.record_bytes}-byte records but this "
                 f"rtsim reads {dtype.itemsize}-byte records (trace written by another version?)"

@@ -151,3 +151,21 @@ def test_spheres_study_quick(tmp_path: Path) -> None:
     made = run_rtsim("study", "spheres", "--quick", "-o", str(tmp_path / "study"))
     assert made.returncode == 0, made.stderr
     assert "| particles | primary | bvh2 | 40,001 / 800,022 |" in made.stdout, made.stdout
+
+
+def test_version_5_traces_open_with_zero_sphere_tests(trace: Path, tmp_path: Path) -> None:
+    """A trace of version 5 (32-byte WORK records) opens in Python as in C++: this version's
+    fields, sphere_tests 0, the others as stored."""
+    from trace_forge import as_version_5_work, read_sections, write_trace
+
+    sections = read_sections(trace / "trace.rtt")
+    as_version_5_work(sections)
+    folder = tmp_path / "v5"
+    folder.mkdir()
+    (folder / "manifest.json").write_text((trace / "manifest.json").read_text())
+    write_trace(folder / "trace.rtt", sections, version=5)
+    old, new = rtsim.open_trace(folder), rtsim.open_trace(trace)
+    assert old.work.dtype == new.work.dtype and len(old.work) == len(new.work)
+    assert (old.work["sphere_tests"] == 0).all()
+    for field in ("steps", "box_tests", "tri_tests", "refs"):
+        assert (old.work[field] == new.work[field]).all(), field

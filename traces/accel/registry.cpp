@@ -342,7 +342,7 @@ void check_spheres_supported(const Scene& scene, const Entry& e, const AccelOpti
     require(e.info.capabilities.spheres, where + ", which accel " + o.kind +
                                              " cannot store (its builder clips primitives against planes, or its "
                                              "leaves hold triangles only); trace it with one of: " + kinds);
-    require(!o.two_level, where + ": two-level structures over spheres are not built; trace it single-level (drop --two-level)");
+    require(!o.two_level, where + ": two-level structures over spheres are not built; trace it flattened (--flatten)");
     require(o.builder != "sbvh", where + ": the sbvh builder clips triangles against split planes; use binned, sweep, median or lbvh");
     require(!s.leaves.compressed, where + ": compressed leaves index triangle vertices; set leaves.compressed=false");
 }

@@ -10,8 +10,6 @@
 
 namespace rtsim {
 
-using detail::closer;
-
 Hit trace_ray_brute_force(const HwTriangle* triangles, size_t count, const Ray& ray, TraversalMode mode) {
     Hit best;
     if (!ray_is_valid(ray)) return best;
@@ -22,17 +20,16 @@ Hit trace_ray_brute_force(const HwTriangle* triangles, size_t count, const Ray& 
     for (size_t i = 0; i < count; ++i) max_prim = std::max(max_prim, triangles[i].prim);
     std::vector<const HwTriangle*> order(count ? size_t(max_prim) + 1 : 0, nullptr);
     for (size_t i = 0; i < count; ++i) order[triangles[i].prim] = &triangles[i];
+    // Each record by the hit rules every structure shares (leaf_kernel.h).
+    float cull = detail::cull_distance(best.t);
+    uint32_t alpha_tests = 0;
     for (const HwTriangle* tri : order) {
         if (!tri) continue;
-        TriangleHit th;
-        if (!detail::primitive_kernel(pre, *tri, ray.tmin, ray.tmax, &th)) continue;
-        if (mode == TraversalMode::closest_hit && !closer(th.t, tri->prim, best.t, best.prim))
-            continue;
-        if ((tri->flags & kTriAnyHit) &&
-            !alpha_test_accepts(tri->prim, th.u, th.v, (tri->flags >> kTriCoverageShift) & 0xFFu))
-            continue;
-        best = Hit{int32_t(tri->prim), int32_t(tri->inst), th.t, th.u, th.v};
-        if (mode == TraversalMode::any_hit) break;
+        if (mode == TraversalMode::any_hit) {
+            if (detail::triangle_step<true>(pre, ray.tmin, ray.tmax, *tri, best, cull, alpha_tests)) break;
+        } else {
+            detail::triangle_step<false>(pre, ray.tmin, ray.tmax, *tri, best, cull, alpha_tests);
+        }
     }
     if (best.prim < 0) best = Hit{};
     return best;

@@ -75,9 +75,16 @@ inline bool triangle_step(const RayTrianglePre& pre, float tmin, float tmax, con
     if (!kAnyHit && !closer(th.t, tri.prim, best.t, best.prim)) return false;
     // Alpha-MASK triangles: the any-hit (alpha) test decides.
     if (tri.flags & kTriAnyHit) {
-        anyhit_calls += 1;
         const uint32_t coverage = (tri.flags >> kTriCoverageShift) & 0xFFu;
-        if (!alpha_test_accepts(tri.prim, th.u, th.v, coverage)) return false;
+        anyhit_calls += 1;
+        if (!alpha_test_accepts(tri.prim, th.u, th.v, coverage)) {
+            // A sphere's far side shows where its near side is cut out: its second crossing
+            // (beyond the first) gets an alpha test of its own.
+            if (!is_sphere(tri) || !sphere_kernel(pre, tri.v0, tri.v1[0], th.t, tmax, &th)) return false;
+            if (!kAnyHit && !closer(th.t, tri.prim, best.t, best.prim)) return false;
+            anyhit_calls += 1;
+            if (!alpha_test_accepts(tri.prim, th.u, th.v, coverage)) return false;
+        }
     }
     best.prim = int32_t(tri.prim);
     best.inst = int32_t(tri.inst);

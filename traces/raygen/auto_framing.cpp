@@ -1,5 +1,7 @@
 #include "traces/raygen/auto_framing.h"
 
+#include "traces/raygen/surface.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -7,6 +9,7 @@
 #include "traces/accel/accel.h"
 #include "traces/common/error.h"
 #include "traces/raygen/camera.h"
+#include "traces/raygen/surface.h"
 
 namespace rtsim {
 
@@ -30,16 +33,24 @@ std::vector<Vec3> sphere_directions(int n) {
     return dirs;
 }
 
+/// Negative when the ray meets the hit's front face (a triangle's by its winding, a sphere's
+/// outside), positive at a back face, 0 for a triangle seen edge-on.
+float facing(const Scene& scene, const Ray& r, const Hit& h) {
+    if (scene.is_sphere(uint32_t(h.prim))) return surface_point(scene, r, h).front ? -1.0f : 1.0f;
+    const Triangle t = scene.world_triangle(uint32_t(h.prim));
+    return glm::dot(glm::cross(t.v1 - t.v0, t.v2 - t.v0), r.direction);
+}
+
 /// Fraction of probe rays from p that hit the front face of some geometry. A room seen from
 /// inside shows its front faces; a closed object probed from its centre shows back faces.
 float enclosure(const Scene& scene, const Accel& accel, const Vec3& p) {
     std::vector<Vec3> dirs = sphere_directions(128);
     int front = 0;
     for (const Vec3& d : dirs) {
-        Hit h = accel.trace(Ray{p, 0.0f, d, INFINITY}, TraversalMode::closest_hit);
+        const Ray probe{p, 0.0f, d, INFINITY};
+        Hit h = accel.trace(probe, TraversalMode::closest_hit);
         if (!h.valid()) continue;
-        const Triangle t = scene.world_triangle(uint32_t(h.prim));
-        front += glm::dot(glm::cross(t.v1 - t.v0, t.v2 - t.v0), d) < 0.0f;
+        front += facing(scene, probe, h) < 0.0f;
     }
     return float(front) / float(dirs.size());
 }
@@ -58,8 +69,7 @@ float view_score(const Scene& scene, const Accel& accel, const Vec3& eye, const 
                 dist.push_back(1e30f);
                 continue;
             }
-            const Triangle t = scene.world_triangle(uint32_t(h.prim));
-            if (glm::dot(glm::cross(t.v1 - t.v0, t.v2 - t.v0), r.direction) > 0.0f) ++back_faces;
+            if (facing(scene, r, h) > 0.0f) ++back_faces;
             dist.push_back(h.t);
         }
     if (back_faces > int(dist.size()) / 2) return 0.0f;

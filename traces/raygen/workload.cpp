@@ -4,7 +4,10 @@
 #include <cmath>
 #include <sstream>
 
+#include <glm/gtc/constants.hpp>
+
 namespace rtsim {
+
 
 namespace {
 
@@ -50,7 +53,8 @@ void plan_emissive(const Scene& scene, const std::vector<bool>& used, WorkloadPl
     std::sort(emissive.begin(), emissive.end());
     for (uint32_t i : emissive) {
         const Triangle t = scene.world_triangle(i);
-        double area = 0.5 * glm::length(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
+        const double r = scene.is_sphere(i) ? double(scene.sphere_radius[i]) : 0.0;
+        double area = scene.is_sphere(i) ? 4.0 * glm::pi<double>() * r * r : 0.5 * glm::length(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
         if (!(area > 0.0)) continue;
         plan->emissive_prims.push_back(uint32_t(i));
         total += area;
@@ -142,12 +146,21 @@ std::vector<LightSample> light_samples(const Scene& scene, const WorkloadPlan& p
     if (!plan.emissive_cdf.empty()) {
         size_t i = std::lower_bound(plan.emissive_cdf.begin(), plan.emissive_cdf.end(), u0) - plan.emissive_cdf.begin();
         i = std::min(i, plan.emissive_cdf.size() - 1);
-        const Triangle t = scene.world_triangle(plan.emissive_prims[i]);
-        // Uniform point on the triangle (square-root parameterisation).
-        float su = std::sqrt(u1);
-        float b1 = 1.0f - su, b2 = u2 * su;
+        const uint32_t prim = plan.emissive_prims[i];
+        const Triangle t = scene.world_triangle(prim);
         LightSample s;
-        s.point = (1.0f - b1 - b2) * t.v0 + b1 * t.v1 + b2 * t.v2;
+        if (scene.is_sphere(prim)) {
+            // Uniform point on the sphere (area-uniform, as the triangles: the far half is
+            // shadowed by the light itself).
+            const float z = 1.0f - 2.0f * u1, phi = 2.0f * glm::pi<float>() * u2;
+            const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
+            s.point = sphere_centre(t) + scene.sphere_radius[prim] * Vec3(ring * std::cos(phi), ring * std::sin(phi), z);
+        } else {
+            // Uniform point on the triangle (square-root parameterisation).
+            float su = std::sqrt(u1);
+            float b1 = 1.0f - su, b2 = u2 * su;
+            s.point = (1.0f - b1 - b2) * t.v0 + b1 * t.v1 + b2 * t.v2;
+        }
         out.push_back(s);
     }
     return out;

@@ -105,10 +105,12 @@ void Scene::flatten() {
                 const glm::dvec4 w = inst.object_to_world * glm::dvec4(glm::dvec3(mesh.positions[3 * t]), 1.0);
                 radius = float(double(mesh.radii[t]) * scale);
                 tri = sphere_primitive(Vec3(float(w.x), float(w.y), float(w.z)), radius);
-                if (!(radius > 0.0f) || !std::isfinite(radius))
+                // A node scaled to 0 (how glTF hides nodes) leaves radius 0: never hit, as its
+                // triangles would be.
+                if (!(radius >= 0.0f) || !std::isfinite(radius))
                     throw Error(source + ": mesh " + std::to_string(inst.mesh) + " '" + mesh.name + "' sphere " +
                                 std::to_string(t) + (inst.node >= 0 ? " placed by node " + std::to_string(inst.node) : "") +
-                                " has radius " + std::to_string(radius) + " in world space (it must be positive and finite)");
+                                " has radius " + std::to_string(radius) + " in world space (beyond the float range)");
             }
             if (!finite(tri.v0) || !finite(tri.v1) || !finite(tri.v2))
                 throw Error(source + ": mesh " + std::to_string(inst.mesh) + " '" + mesh.name + "' triangle " +

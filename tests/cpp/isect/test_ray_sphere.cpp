@@ -14,6 +14,7 @@
 #include "traces/common/rng.h"
 #include "traces/isect/brute_force.h"
 #include "traces/isect/leaf_kernel.h"
+#include "traces/raygen/workload.h"
 
 namespace rtsim {
 namespace {
@@ -189,6 +190,56 @@ TEST(RaySphere, EachSphereKeepsItsOwnRadiusAndTheNodeScalesIt) {
                                         make_ray(Vec3(10, 0, -5), Vec3(0, 0, 1)), TraversalMode::closest_hit);
     EXPECT_EQ(h.prim, 1);
     EXPECT_FLOAT_EQ(h.t, 4.0f);
+}
+
+TEST(RaySphere, AnAlphaMaskedSphereShowsItsFarSideWhereItsNearSideIsCutOut) {
+    // One MASK sphere (coverage 0.5): a ray whose near crossing fails the alpha test goes on
+    // to the far crossing, which has an alpha test of its own.
+    HwTriangle rec{{0, 0, 0}, {1, 0, 0}, {0, 0, 0}, 0, 0, kPrimSphere | kTriAnyHit | (128u << kTriCoverageShift)};
+    Rng rng(5);
+    int near = 0, far = 0, none = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const float x = 0.9f * (2 * rng.next() - 1), y = 0.9f * (2 * rng.next() - 1);
+        if (x * x + y * y > 0.81f) continue;  // every ray crosses the sphere twice
+        const Ray r = make_ray(Vec3(x, y, -5), Vec3(0, 0, 1));
+        Hit best;
+        best.t = r.tmax;
+        float cull = detail::cull_distance(best.t);
+        uint32_t alpha = 0;
+        const bool hit = detail::triangle_step<false>(ray_triangle_precompute(r), r.tmin, r.tmax, rec, best, cull, alpha);
+        if (!hit) {
+            EXPECT_EQ(alpha, 2u);
+            ++none;
+        } else if (best.t < 5.0f) {
+            EXPECT_EQ(alpha, 1u);
+            ++near;
+        } else {
+            EXPECT_EQ(alpha, 2u);  // the near side was cut out here
+            ++far;
+        }
+    }
+    EXPECT_GT(near, 500);
+    EXPECT_GT(far, 200);
+    EXPECT_GT(none, 200);
+}
+
+TEST(RaySphere, AnEmissiveSphereIsAnAreaLightSampledOnItsSurface) {
+    Scene scene = mixed_scene();
+    Material glow;
+    glow.emissive = Vec3(4.0f);
+    scene.materials.push_back(glow);
+    const uint32_t lamp = uint32_t(scene.triangles.size() - 1);  // the last sphere
+    ASSERT_TRUE(scene.is_sphere(lamp));
+    scene.meshes[0].materials.back() = 1;
+    scene.flatten();
+    const WorkloadPlan plan = plan_workload(scene, {RayKind::primary, RayKind::shadow});
+    ASSERT_EQ(plan.emissive_prims, std::vector<uint32_t>{lamp});
+    const Vec3 c = sphere_centre(scene.triangles[lamp]);
+    for (float u : {0.1f, 0.5f, 0.9f}) {
+        const std::vector<LightSample> s = light_samples(scene, plan, 0.5f, u, 1.0f - u);
+        ASSERT_EQ(s.size(), 1u);
+        EXPECT_NEAR(glm::length(s[0].point - c), scene.sphere_radius[lamp], 1e-5f);
+    }
 }
 
 TEST(RaySphere, BvhOverSpheresAndTrianglesMatchesBruteForce) {
