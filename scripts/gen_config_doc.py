@@ -56,6 +56,9 @@ SECTION_NOTES = {
     "sphere": "The ray/sphere pipeline of curved primitives: one operation per sphere record a "
     "leaf tests (docs/intersection.md, Ray/sphere); built only for traces whose scenes have "
     "spheres.",
+    "capsule": "The ray/capsule pipeline of curved primitives: one operation per capsule record a "
+    "leaf tests (docs/intersection.md, Ray/capsule); built only for traces whose scenes have "
+    "capsules.",
     "mailbox": "Mailboxes in the traversal units: a table per ray context of the primitives the "
     "ray tested, so grids, kd-trees and octrees skip retests (docs/accel.md, Mailboxes).",
     "l1": "The private per-unit L1 caches (MSHRs modelled exactly).",

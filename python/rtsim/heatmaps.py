@@ -126,14 +126,16 @@ def write_heatmaps(
     width, height = size
     out = Path(out_dir) if out_dir is not None else trace.folder
     out.mkdir(parents=True, exist_ok=True)
-    steps, tris, spheres = pixel_work(trace, width, height, ("steps", "tri_tests", "sphere_tests"))
+    fields = ("steps", "tri_tests", "sphere_tests", "capsule_tests")
+    steps, tris, spheres, capsules = pixel_work(trace, width, height, fields)
     paths = [out / "heatmap_nodes.png", out / "heatmap_tris.png"]
     _draw(steps, "traversal steps (nodes or cells visited)", trace.scene_name, paths[0])
-    # Spheres are primitives too: the map counts every primitive test, titled by what there is.
-    has_spheres = spheres.all_rays.any()
-    title = "primitive tests (triangles and spheres)" if has_spheres else "triangle tests"
+    # Curved primitives are primitives too: the map counts every primitive test.
+    curved = spheres.all_rays.any() or capsules.all_rays.any()
+    title = "primitive tests (triangles, spheres, capsules)" if curved else "triangle tests"
     tests = PixelWork(
-        "primitive_tests", tris.primary + spheres.primary, tris.all_rays + spheres.all_rays,
+        "primitive_tests", tris.primary + spheres.primary + capsules.primary,
+        tris.all_rays + spheres.all_rays + capsules.all_rays,
         tris.primary_rays, tris.other_rays,
     )  # fmt: skip
     _draw(tests, title, trace.scene_name, paths[1])

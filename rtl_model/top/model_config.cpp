@@ -32,6 +32,7 @@ const PipelineConfig& ModelConfig::pipeline(OpKind kind) const {
         case OpKind::plane: return plane;
         case OpKind::obb: return obb;
         case OpKind::sphere: return sphere;
+        case OpKind::capsule: return capsule;
         default: break;
     }
     throw Error(std::string("config: no pipeline is configured for '") + op_kind_name(kind) + "' operations");

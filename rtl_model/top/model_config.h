@@ -68,6 +68,10 @@ struct ModelConfig {
     /// after the dot products, as long a pipeline as the triangle's. An assumption: NVIDIA's
     /// Blackwell RT cores test spheres natively, but no public figure gives their latency.
     PipelineConfig sphere = pipeline_of(/*latency=*/20, /*width=*/1);
+    /// Ray/capsule tests (curved primitives): a cylinder's and two spheres' crossings, three of
+    /// the sphere's quadrics side by side, then their selection; a longer pipeline. An
+    /// assumption, as the sphere's (Blackwell's linear swept spheres are unpriced in public).
+    PipelineConfig capsule = pipeline_of(/*latency=*/28, /*width=*/1);
     MailboxConfig mailbox;
     // MSHRs: one per ray context in each L1, and enough in the L2 for the L1s' misses in flight
     // (docs/presets.md, "How the defaults were chosen": at 8 and 32 the MSHRs starved Sponza).
@@ -115,6 +119,7 @@ struct ModelConfig {
         v.section("plane", plane);
         v.section("obb", obb);
         v.section("sphere", sphere);
+        v.section("capsule", capsule);
         v.section("mailbox", mailbox);
         v.section("l1", l1);
         v.section("l2", l2);

@@ -123,7 +123,8 @@ private:
     double plan_steps() const {
         const double x1 = AnalyticProfile::plan_step_work(m_p.work) * m_step_scale;
         const double x2 = m_p.work[size_t(WorkField::tri_tests)] * m_work_scale[size_t(WorkField::tri_tests)] +
-                          m_p.work[size_t(WorkField::sphere_tests)] * m_work_scale[size_t(WorkField::sphere_tests)];
+                          m_p.work[size_t(WorkField::sphere_tests)] * m_work_scale[size_t(WorkField::sphere_tests)] +
+                          m_p.work[size_t(WorkField::capsule_tests)] * m_work_scale[size_t(WorkField::capsule_tests)];
         const double fit = m_p.plan_steps_per[0] * x1 + m_p.plan_steps_per[1] * x2;
         if (fit > 0) return fit;
         return m_p.sample_rays > 0 ? m_step_scale * m_p.sample_plan_steps * double(m_p.rays) / m_p.sample_rays : 0.0;

@@ -192,7 +192,7 @@ void SampleProfiler::finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RayS
     for (int f = 0; f < kWorkFieldCount; ++f) m_p.sample_work[size_t(f)] += w[WorkField(f)];
     m_p.sample_rays += 1;
     m_p.sample_plan_steps += ctx.plan_steps;
-    const double x1 = plan_step_work(w), x2 = double(w.tri_tests) + double(w.sphere_tests), y = ctx.plan_steps;
+    const double x1 = plan_step_work(w), x2 = double(w.tri_tests) + double(w.sphere_tests) + double(w.capsule_tests), y = ctx.plan_steps;
     m_fit[0] += x1 * x1, m_fit[1] += x1 * x2, m_fit[2] += x2 * x2, m_fit[3] += x1 * y, m_fit[4] += x2 * y;
 }
 
@@ -331,7 +331,7 @@ void SampleProfiler::finish() {
     m_step_critical.drain([&](uint32_t key, uint64_t n) { m_p.step_critical.add(key, double(n)); });
     m_ray_critical.drain([&](uint32_t key, uint64_t n) { m_p.ray_critical.add(key, double(n)); });
     // Least squares without intercept: plan steps = a (plan-step work) + b primitive tests
-    // (triangles' and spheres').
+    // (triangles', spheres' and capsules').
     const double det = m_fit[0] * m_fit[2] - m_fit[1] * m_fit[1];
     if (det > 1e-9 * m_fit[0] * m_fit[2] && det > 0) {
         m_p.plan_steps_per[0] = (m_fit[3] * m_fit[2] - m_fit[4] * m_fit[1]) / det;

@@ -87,8 +87,15 @@ constexpr Flops kObbFlops{12, 18, 0, 3};
 // interval 5 cmp; the division b/a, the square root and c/q, q/a priced as 4 divides. The
 // reference computes in double; priced here as the fp32 unit hardware would build.
 constexpr Flops kSphereFlops{17, 17, 5, 4};
-constexpr std::array<Flops, kOpKindCount> kTestFlops{kBoxFlops, kTriangleFlops, kAnyhitFlops, kTransformFlops,
-                                                     kCellFlops, kPlaneFlops, kObbFlops, kSphereFlops};
+// Ray/capsule (traces/isect/ray_capsule_kernel.h): the axis and its length (3 sub, 3 mul + 2 add,
+// a root and a divide for the unit axis), the ray's parts across it (2 x (3 mul + 2 add, 3 mul +
+// 3 sub)), then three of the sphere's quadrics (the cylinder's and the two caps') with their
+// axial checks (2 x (2 mul + 1 add) and 2 compares each), and the nearest of six crossings (6
+// compares).
+constexpr Flops kCapsuleFlops{3 * 17 + 17, 3 * 17 + 24, 3 * 5 + 12, 3 * 4 + 2};
+constexpr std::array<Flops, kOpKindCount> kTestFlops{kBoxFlops,  kTriangleFlops, kAnyhitFlops,
+                                                     kTransformFlops, kCellFlops, kPlaneFlops,
+                                                     kObbFlops,  kSphereFlops,   kCapsuleFlops};
 // Per ray: inv_dir (3 div) for the box test; the triangle test's shear constants (RayTrianglePre:
 // the largest axis, 2 cmp; 1 / dir_kz, 1 div; sx, sy, 2 mul).
 constexpr Flops kRaySetupFlops{0, 2, 2, 4};
@@ -206,6 +213,8 @@ json area_json(const SimConfig& s, const json& stats) {
         mm2["obb"] = pipeline_mm2(c, s, s.obb, kObbFlops);
     if (instantiated(stats.value("instantiated", json::array()), "sphere"))
         mm2["sphere"] = pipeline_mm2(c, s, s.sphere, kSphereFlops);
+    if (instantiated(stats.value("instantiated", json::array()), "capsule"))
+        mm2["capsule"] = pipeline_mm2(c, s, s.capsule, kCapsuleFlops);
     for (const auto& [block, logic] : added.logic_mm2) mm2[block] = mm2.value(block, 0.0) + logic;
     double total = 0;
     for (auto it = mm2.begin(); it != mm2.end(); ++it) total += it->get<double>();
@@ -400,7 +409,7 @@ const StatBlock& energy_stats() {
             {"area_scale", "x", "Stillmaker & Baas area factor from 45 nm to the node"},
             {"dram_kind", "", "the DRAM kind (`energy.dram_kind`)"},
             {"dram_pj_per_bit", "pJ/bit", "its energy per bit (or the override)"},
-            {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`, `obb`, `sphere`) and one `ray_setup` at the node"},
+            {"op_pj", "pJ", "`{op: pJ}`: energy of one test of each operation kind (`box`, `triangle`, `anyhit`, `transform`, `cell`, `plane`, `obb`, `sphere`, `capsule`) and one `ray_setup` at the node"},
             {"rays", "rays", "rays the energy is divided by: the rays checked (a sampled run's simulated rays, warm-up included)"},
             {"per_ray_nj", "nJ/ray", "`{block: nJ}`: each operation kind (tests x op energy), `mailbox` (only with `mailbox.entries > 0`: lookups and recorded tests in the mailbox SRAM), the techniques' blocks as in `area.mm2` (decodes per test, scheduler picks per step or warp step, sorted rays, prefetched lines, helper steps' stack hand-overs, stack prefetches' filter compares, mailbox compares, the build unit's rebuilt triangles and refit nodes), `traversal` (ray setup, context-state reads, stack pushes and pops), `l1` (all L1s, or `ideal_memory`), `l2`, `ray_buffer`, `dram`, `leakage` (leakage power over rays/s) and `total` (their sum; `null` unless every block is known)"},
             {"dynamic_nj", "nJ", "dynamic energy of the blocks with counts, summed over the rays"},

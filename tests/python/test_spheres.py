@@ -80,15 +80,19 @@ def test_structures_that_clip_refuse_spheres(tmp_path: Path) -> None:
     made = run_rtsim("trace", "furball", "-o", str(tmp_path / "kd"), "--resolution", "8x6",
                      "--accel", "kdtree")  # fmt: skip
     assert made.returncode != 0
-    assert "the scene has spheres, which accel kdtree cannot store" in made.stderr, made.stderr
+    assert (
+        "the scene has curved primitives (spheres or capsules), which accel kdtree cannot store"
+        in made.stderr
+    ), made.stderr
     assert "bvh2, bvh4" in made.stderr
     made = run_rtsim("trace", "furball", "-o", str(tmp_path / "sbvh"), "--resolution", "8x6",
                      "--builder", "sbvh")  # fmt: skip
     assert made.returncode != 0 and "sbvh builder clips" in made.stderr, made.stderr
 
 
-def _points_gltf(folder: Path, radius: list[float] | None) -> Path:
-    """A glTF of two points (spheres when `radius` is given as their _RADIUS)."""
+def _points_gltf(folder: Path, radius: list[float] | None, mode: int = 0) -> Path:
+    """A glTF of two points (spheres when `radius` is given as their _RADIUS), or of the
+    segment between them (a capsule) for a LINES mode."""
     folder.mkdir(parents=True, exist_ok=True)
     pos = np.array([[0, 0, 0], [3, 0, 0]], dtype=np.float32).tobytes()
     attributes = {"POSITION": 0}
@@ -107,7 +111,7 @@ def _points_gltf(folder: Path, radius: list[float] | None) -> Path:
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"mesh": 0, "scale": [2, 2, 2]}],
-        "meshes": [{"name": "beads", "primitives": [{"attributes": attributes, "mode": 0}]}],
+        "meshes": [{"name": "beads", "primitives": [{"attributes": attributes, "mode": mode}]}],
         "buffers": [{"uri": "points.bin", "byteLength": len(data)}],
         "bufferViews": views,
         "accessors": accessors,
@@ -130,10 +134,36 @@ def test_gltf_points_with_radius_are_spheres(tmp_path: Path) -> None:
     assert rtsim.open_trace(out).hits["prim"].max() >= 0
 
 
+@pytest.mark.parametrize("mode", [1, 3])
+def test_gltf_lines_with_radius_are_capsules(tmp_path: Path, mode: int) -> None:
+    scene = rtsim._core.load_scene(str(_points_gltf(tmp_path, [0.5, 1.0], mode)))
+    tris = np.asarray(scene.triangles())
+    # One capsule (0,0,0)-(6,0,0) under the scale of 2, radius the larger end's: 2.
+    assert tris.shape == (1, 3, 3)
+    assert np.allclose(tris[0, 0], [-2, -2, -2]) and np.allclose(tris[0, 1], [8, 2, 2])
+    assert np.allclose(tris[0, 2], [3, 0, 0])
+
+
+def test_capsules_replay_with_zero_mismatches(sim_exe: Path, tmp_path: Path) -> None:
+    out = tmp_path / "fur"
+    made = run_rtsim("trace", "furball_capsules", "-o", str(out), "--resolution", "24x18",
+                     "--accel", "bvh8")  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["scene"]["capsules"] == 16000 and m["scene"]["spheres"] == 1
+    assert m["counts"]["by_kind"]["primary"]["capsule_tests_per_ray"] > 0
+    for sets in (["fidelity=detailed"], ["fidelity=analytic"], ["traversal.model=simt"],
+                 ["traversal.model=packet"]):  # fmt: skip
+        stats = checked(sim_exe, out, tmp_path / sets[0].replace("=", "-"), *sets)
+        assert stats["area"]["mm2"]["capsule"] > 0 and stats["energy"]["per_ray_nj"]["capsule"] > 0
+        tests = sum(p["tests"] for p in stats["model"]["capsule"].values())
+        assert tests > 0
+
+
 @pytest.mark.parametrize(
     ("radius", "message"),
     [
-        (None, "needs a _RADIUS attribute"),
+        (None, "need a _RADIUS attribute"),
         ([0.5, 0.0], "has _RADIUS 0"),
         ([0.5, float("nan")], "has _RADIUS nan"),
     ],

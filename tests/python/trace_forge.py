@@ -30,8 +30,8 @@ FOURCC = {
     "work": 0x4B524F57,
     "accel": 0x4C434341,
 }
-RECORD_BYTES = {"rays": 40, "hits": 20, "work": 36, "accel": 1}
-#: WORK records before version 6 (no sphere_tests).
+RECORD_BYTES = {"rays": 40, "hits": 20, "work": 40, "accel": 1}
+#: WORK records before version 6 (no sphere_tests, capsule_tests).
 WORK_BYTES_V5 = 32
 #: bvh2's region sections under the names older tests use.
 ALIASES = {"bvh_nodes": "RG00", "triangles": "RG01"}

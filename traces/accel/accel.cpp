@@ -26,6 +26,7 @@ void Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n
 
 bool Accel::has_anyhit_triangles() const { return has_flagged_records(kTriAnyHit); }
 bool Accel::has_spheres() const { return has_flagged_records(kPrimSphere); }
+bool Accel::has_capsules() const { return has_flagged_records(kPrimCapsule); }
 
 bool Accel::has_flagged_records(uint32_t flag) const {
     for (const Region& r : m_image.regions) {

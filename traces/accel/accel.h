@@ -87,6 +87,8 @@ public:
     bool has_anyhit_triangles() const;
     /// True when some record is a sphere (the sphere pipeline is then needed).
     bool has_spheres() const;
+    /// True when some record is a capsule (the capsule pipeline is then needed).
+    bool has_capsules() const;
     /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
     /// two-level image traced with --frames, one TLAS per frame over the same BLASes.
     virtual uint32_t frame_count() const { return 1; }

@@ -37,9 +37,9 @@ struct AccelCapabilities {
     /// stack-driven prefetching, traversal.stack_prefetch.
     bool stack_addresses = false;
     /// Its builders bound primitives by their boxes and its leaves test whatever records they
-    /// hold, so a scene's spheres (curved primitives) are stored and tested as spheres; kinds
-    /// that clip triangles against planes (kd-tree, grid, octree, GK-BVH) refuse them.
-    bool spheres = false;
+    /// hold, so a scene's curved primitives (spheres, capsules) are stored and tested as such;
+    /// kinds that clip triangles against planes (kd-tree, grid, octree, GK-BVH) refuse them.
+    bool curved = false;
     /// Bytes of one traversal stack entry (Accel::stack_entry_bytes; 0: no stack).
     uint32_t stack_entry_bytes = 8;
 
@@ -63,7 +63,7 @@ struct AccelCapabilities {
                 {"treelet_partition", treelet_partition},
                 {"refit", refit},
                 {"stack_addresses", stack_addresses},
-                {"spheres", spheres},
+                {"curved", curved},
                 {"stack_entry_bytes", stack_entry_bytes}};
     }
 };

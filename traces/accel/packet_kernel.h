@@ -27,8 +27,7 @@ inline uint32_t packet_leaf(PacketLanes& p, LaneMask active, const HwTriangle* t
     const LeafTests kinds = leaf_tests(triangles, count, true);
     for_each_lane(active, [&](uint32_t r) {
         WorkCounts& w = p.work[r];
-        w.tri_tests += kinds.triangles;
-        w.sphere_tests += kinds.spheres;
+        count_leaf_tests(w, kinds);
         const uint32_t before = w.anyhit_calls;
         const Ray& ray = p.ray[r];
         if (p.mode[r] == TraversalMode::any_hit) {

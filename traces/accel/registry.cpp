@@ -183,7 +183,7 @@ Entry wide_entry(const std::string& name, const std::string& description, int wi
                               .with(&AccelCapabilities::refit)
                               .with(&AccelCapabilities::anyhit_order)
                               .with(&AccelCapabilities::stack_addresses)
-                              .with(&AccelCapabilities::spheres);
+                              .with(&AccelCapabilities::curved);
     c.quantized_boxes = compressed;
     return {{name, description, tree_builder_names(), c}, tree_settings, build, load};
 }
@@ -203,7 +203,7 @@ const std::vector<Entry>& registry() {
               .with(&AccelCapabilities::anyhit_order)
               .with(&AccelCapabilities::refit)
               .with(&AccelCapabilities::stack_addresses)
-              .with(&AccelCapabilities::spheres)},
+              .with(&AccelCapabilities::curved)},
          tree_settings, build_bvh2, loader<Bvh2Accel>()},
         wide_entry("bvh4", "4-wide BVH, 128-byte fp32 nodes, SAH-optimal collapse of the binary tree (docs/accel.md)", 4,
                    false, ChildOrder::distance),
@@ -330,19 +330,19 @@ BuildSettings resolve_settings(const Entry& e, const std::string& builder, const
     return s;
 }
 
-/// Refuses (naming the scene, the structure and what would trace it) a scene with spheres on a
-/// structure, builder or leaf layout that cannot store them: splits that clip primitives against
-/// planes, compressed leaf blocks (vertex indices), and two levels (not built).
-void check_spheres_supported(const Scene& scene, const Entry& e, const AccelOptions& o, const BuildSettings& s) {
-    if (!scene.has_spheres()) return;
-    const std::string where = (scene.source.empty() ? std::string("scene") : scene.source) + ": the scene has spheres";
+/// Refuses (naming the scene, the structure and what would trace it) a scene with curved
+/// primitives on a structure, builder or leaf layout that cannot store them: splits that clip
+/// primitives against planes, compressed leaf blocks (vertex indices), and two levels (not built).
+void check_curved_supported(const Scene& scene, const Entry& e, const AccelOptions& o, const BuildSettings& s) {
+    if (!scene.has_curved()) return;
+    const std::string where = (scene.source.empty() ? std::string("scene") : scene.source) + ": the scene has curved primitives (spheres or capsules)";
     std::string kinds;
     for (const Entry& k : registry())
-        if (k.info.capabilities.spheres) kinds += (kinds.empty() ? "" : ", ") + k.info.name;
-    require(e.info.capabilities.spheres, where + ", which accel " + o.kind +
+        if (k.info.capabilities.curved) kinds += (kinds.empty() ? "" : ", ") + k.info.name;
+    require(e.info.capabilities.curved, where + ", which accel " + o.kind +
                                              " cannot store (its builder clips primitives against planes, or its "
                                              "leaves hold triangles only); trace it with one of: " + kinds);
-    require(!o.two_level, where + ": two-level structures over spheres are not built; trace it flattened (--flatten)");
+    require(!o.two_level, where + ": two-level structures over curved primitives are not built; trace it flattened (--flatten)");
     require(o.builder != "sbvh", where + ": the sbvh builder clips triangles against split planes; use binned, sweep, median or lbvh");
     require(!s.leaves.compressed, where + ": compressed leaves index triangle vertices; set leaves.compressed=false");
 }
@@ -423,7 +423,7 @@ AccelImage build_accel(const Scene& scene, const AccelOptions& options) {
         image.stats["build_set"] = o.settings;
         return image;
     };
-    check_spheres_supported(scene, e, o, s);
+    check_curved_supported(scene, e, o, s);
     if (o.two_level) return finish(build_two_level(scene, o));
     require(!scene.triangles.empty(), "scene has no triangles");
     require(scene.tri_material.size() == scene.triangles.size() && scene.tri_instance.size() == scene.triangles.size(),

@@ -66,11 +66,14 @@ struct StepPlan {
     }
     void add_fetch(uint64_t addr, uint32_t bytes, DataKind kind) { fetch[fetch_count++] = Fetch{addr, bytes, kind}; }
     void add_op(OpKind kind, uint32_t count) { op[op_count++] = Op{kind, count}; }
-    /// A leaf's tests: triangles to the triangle pipeline, spheres to the sphere pipeline (a
-    /// kind with no test adds no operation, but a leaf always issues one).
-    void add_leaf_ops(uint32_t triangles, uint32_t spheres) {
-        if (triangles || !spheres) add_op(OpKind::triangle, triangles);
-        if (spheres) add_op(OpKind::sphere, spheres);
+    /// A leaf's tests: triangles, spheres and capsules each to their pipeline (a kind with no
+    /// test adds no operation, but a leaf always issues one). `times`: rays testing each (a
+    /// packet's).
+    template <class Tests>
+    void add_leaf_ops(const Tests& t, uint32_t times = 1) {
+        if (t.triangles || (!t.spheres && !t.capsules)) add_op(OpKind::triangle, t.triangles * times);
+        if (t.spheres) add_op(OpKind::sphere, t.spheres * times);
+        if (t.capsules) add_op(OpKind::capsule, t.capsules * times);
     }
 };
 

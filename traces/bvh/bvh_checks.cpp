@@ -82,9 +82,9 @@ void Checker::check_leaf(uint32_t node, int slot, const Aabb& box, uint32_t dept
             if (common.empty()) fail(node, slot, triangle_name(j, t.prim) + " does not overlap the leaf box");
             covered[t.prim] += ClippedTriangle(s, box).area();
         } else {
-            // A triangle's own vertices; a sphere's box corners, from the scene (scene.h).
+            // A triangle's own vertices; a curved primitive's box corners, from the scene (scene.h).
             const float* p[3] = {t.v0, t.v1, t.v2};
-            if (is_sphere(t)) p[0] = &s.v0.x, p[1] = &s.v1.x, p[2] = &s.v2.x;
+            if (is_curved(t)) p[0] = &s.v0.x, p[1] = &s.v1.x, p[2] = &s.v2.x;
             if (!inside(box, p[0]) || !inside(box, p[1]) || !inside(box, p[2]))
                 fail(node, slot, triangle_name(j, t.prim) + " outside the leaf box");
             if (prim_seen[t.prim]) fail(node, slot, triangle_name(j, t.prim) + ": primitive stored twice");
@@ -92,7 +92,7 @@ void Checker::check_leaf(uint32_t node, int slot, const Aabb& box, uint32_t dept
         prim_seen[t.prim] = 1;
         const HwTriangle want = make_hw_triangle(scene, t.prim);
         if (!same_vertex(t.v0, want.v0) || !same_vertex(t.v1, want.v1) || !same_vertex(t.v2, want.v2) ||
-            t.inst != want.inst || is_sphere(t) != is_sphere(want))
+            t.inst != want.inst || is_sphere(t) != is_sphere(want) || is_capsule(t) != is_capsule(want))
             fail(node, slot, triangle_name(j, t.prim) + " differs from the scene's primitive");
     }
 }

@@ -52,9 +52,14 @@ uint32_t material_flags(const Scene& scene, uint32_t material, uint32_t prim) {
 HwTriangle triangle_record(const Scene& scene, uint32_t prim, uint32_t flags) {
     const Triangle& t = scene.triangles[prim];
     HwTriangle hw;
+    if (scene.is_capsule(prim)) {  // docs/bvh_layout.md, "Capsule records"
+        const Vec3 &a = scene.capsule_ends[prim][0], &b = scene.capsule_ends[prim][1];
+        return HwTriangle{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {scene.curved_radius[prim], 0.0f, 0.0f}, prim,
+                          scene.tri_instance[prim], flags | kPrimCapsule};
+    }
     if (scene.is_sphere(prim)) {  // docs/bvh_layout.md, "Sphere records"
         const Vec3 c = sphere_centre(t);
-        hw = HwTriangle{{c.x, c.y, c.z}, {scene.sphere_radius[prim], 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, prim,
+        hw = HwTriangle{{c.x, c.y, c.z}, {scene.curved_radius[prim], 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, prim,
                         scene.tri_instance[prim], flags | kPrimSphere};
         return hw;
     }

@@ -12,6 +12,9 @@ constexpr uint32_t kTriAnyHit = 1u << 0;         ///< alpha-MASK: call the any-h
 /// The record is a sphere (docs/bvh_layout.md, "Sphere records"): v0 its centre, v1[0] its
 /// radius, v1[1..2] and v2 zero.
 constexpr uint32_t kPrimSphere = 1u << 1;
+/// The record is a capsule (docs/bvh_layout.md, "Capsule records"): a sphere of radius v2[0]
+/// swept from v0 to v1; v2[1..2] zero.
+constexpr uint32_t kPrimCapsule = 1u << 2;
 constexpr uint32_t kTriCoverageShift = 8;        ///< bits 8..15: alpha coverage x 255
 constexpr uint32_t kTriMaterialShift = 16;       ///< bits 16..31: material index
 
@@ -21,10 +24,13 @@ struct HwTriangle {             // 48 bytes
     float v2[3];                // 24
     uint32_t prim;              // 36: stable primitive id (scene order, see scene.h)
     uint32_t inst;              // 40: instance id
-    uint32_t flags;             // 44: kTriAnyHit | kPrimSphere | coverage << 8 | material << 16
+    uint32_t flags;             // 44: kTriAnyHit | kPrimSphere | kPrimCapsule | coverage << 8 | material << 16
 };
 static_assert(sizeof(HwTriangle) == 48, "HwTriangle must be 48 bytes");
 inline bool is_sphere(const HwTriangle& t) { return (t.flags & kPrimSphere) != 0; }
+inline bool is_capsule(const HwTriangle& t) { return (t.flags & kPrimCapsule) != 0; }
+/// A curved primitive (sphere or capsule): tested by its own pipeline, not the triangle's.
+inline bool is_curved(const HwTriangle& t) { return (t.flags & (kPrimSphere | kPrimCapsule)) != 0; }
 inline RecordLayout layout_of(const HwTriangle*) {
     return {RTSIM_FIELD(HwTriangle, v0),   RTSIM_FIELD(HwTriangle, v1),   RTSIM_FIELD(HwTriangle, v2),
             RTSIM_FIELD(HwTriangle, prim), RTSIM_FIELD(HwTriangle, inst), RTSIM_FIELD(HwTriangle, flags)};

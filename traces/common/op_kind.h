@@ -19,13 +19,14 @@ enum class OpKind : uint8_t {
     plane = 5,      ///< ray/split-plane test
     obb = 6,        ///< ray rotation into an oriented node's frame (its child boxes are tested there)
     sphere = 7,     ///< ray/sphere test (curved primitives)
+    capsule = 8,    ///< ray/capsule test (curved primitives: a swept sphere)
 };
-constexpr int kOpKindCount = 8;
+constexpr int kOpKindCount = 9;
 /// "No operation kind" in tables keyed by kind (a work counter that counts no pipeline's tests).
 constexpr OpKind kNoOpKind = OpKind(0xFF);
 
 inline constexpr std::array<const char*, kOpKindCount> kOpKindNames{
-    {"box", "triangle", "anyhit", "transform", "cell", "plane", "obb", "sphere"}};
+    {"box", "triangle", "anyhit", "transform", "cell", "plane", "obb", "sphere", "capsule"}};
 /// "box", "triangle", ...; "unknown" outside the enum.
 inline const char* op_kind_name(OpKind kind) {
     return size_t(kind) < kOpKindNames.size() ? kOpKindNames[size_t(kind)] : "unknown";

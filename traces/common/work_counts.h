@@ -27,7 +27,8 @@
     X(cell_steps, OpKind::cell, true, "3D-DDA steps from cell to cell (grids)")                    \
     X(plane_tests, OpKind::plane, false, "ray/split-plane tests (kd-trees, BIH)")                  \
     X(refs, kNoOpKind, false, "primitive references fetched (structures with index lists)")       \
-    X(sphere_tests, OpKind::sphere, false, "ray/sphere tests (curved primitives)")
+    X(sphere_tests, OpKind::sphere, false, "ray/sphere tests (curved primitives)")              \
+    X(capsule_tests, OpKind::capsule, false, "ray/capsule tests (curved primitives)")
 
 // The mailbox's counts (docs/accel.md, "Mailboxes"): never in a trace (a trace's work is the
 // structure's without one). With a mailbox tri_tests counts the tests run, and

@@ -8,6 +8,7 @@
 
 #include "traces/common/hw_triangle.h"
 #include "traces/common/ray.h"
+#include "traces/isect/ray_capsule_kernel.h"
 #include "traces/isect/ray_sphere_kernel.h"
 #include "traces/isect/ray_triangle_kernel.h"
 
@@ -33,35 +34,41 @@ inline bool closer(float t, uint32_t prim, float best_t, int32_t best_prim) {
 /// for boxes entered within 0.1% behind the best hit.
 inline float cull_distance(float t) { return t + std::fabs(t) * 0x1p-10f; }
 
-/// The primitive test of one record: a sphere's (kPrimSphere) or a triangle's.
+/// The primitive test of one record: a sphere's (kPrimSphere), a capsule's (kPrimCapsule) or a
+/// triangle's.
 inline bool primitive_kernel(const RayTrianglePre& pre, const HwTriangle& rec, float tmin, float tmax,
                              TriangleHit* hit) {
-    if (__builtin_expect(is_sphere(rec), 0)) return sphere_kernel(pre, rec.v0, rec.v1[0], tmin, tmax, hit);
+    if (__builtin_expect(is_curved(rec), 0)) {
+        if (is_sphere(rec)) return sphere_kernel(pre, rec.v0, rec.v1[0], tmin, tmax, hit);
+        return capsule_kernel(pre, rec.v0, rec.v1, rec.v2[0], tmin, tmax, hit);
+    }
     return triangle_kernel(pre, rec.v0, rec.v1, rec.v2, tmin, tmax, hit);
 }
 
-/// Spheres among `count` records (the sphere pipeline's tests of a leaf; the rest go to the
-/// triangle pipeline).
-inline uint32_t sphere_count(const HwTriangle* records, uint32_t count) {
-    uint32_t n = 0;
-    for (uint32_t i = 0; i < count; ++i) n += is_sphere(records[i]) ? 1u : 0u;
-    return n;
-}
-
-/// True when some of `count` records is a sphere (a structure's view notes it once, at load).
-inline bool any_sphere(const HwTriangle* records, uint64_t count) {
+/// True when some of `count` records is curved (a structure's view notes it once, at load).
+inline bool any_curved(const HwTriangle* records, uint64_t count) {
     for (uint64_t i = 0; i < count; ++i)
-        if (is_sphere(records[i])) return true;
+        if (is_curved(records[i])) return true;
     return false;
 }
 
-/// A leaf's tests by pipeline: spheres (counted only when the structure has some) and triangles.
+/// A leaf's tests by pipeline: spheres and capsules (counted only when the structure has curved
+/// records) and triangles.
 struct LeafTests {
-    uint32_t triangles = 0, spheres = 0;
+    uint32_t triangles = 0, spheres = 0, capsules = 0;
 };
-inline LeafTests leaf_tests(const HwTriangle* records, uint32_t count, bool has_spheres) {
-    const uint32_t s = has_spheres ? sphere_count(records, count) : 0u;
-    return {count - s, s};
+inline LeafTests leaf_tests(const HwTriangle* records, uint32_t count, bool has_curved) {
+    LeafTests t;
+    if (has_curved)
+        for (uint32_t i = 0; i < count; ++i) t.spheres += is_sphere(records[i]), t.capsules += is_capsule(records[i]);
+    t.triangles = count - t.spheres - t.capsules;
+    return t;
+}
+/// Adds a leaf's tests to the ray's work.
+inline void count_leaf_tests(WorkCounts& w, const LeafTests& t) {
+    w.tri_tests += t.triangles;
+    w.sphere_tests += t.spheres;
+    w.capsule_tests += t.capsules;
 }
 
 /// Tests one triangle (or sphere) against the ray's own [tmin, tmax] (so acceptance never depends on visit
@@ -78,9 +85,9 @@ inline bool triangle_step(const RayTrianglePre& pre, float tmin, float tmax, con
         const uint32_t coverage = (tri.flags >> kTriCoverageShift) & 0xFFu;
         anyhit_calls += 1;
         if (!alpha_test_accepts(tri.prim, th.u, th.v, coverage)) {
-            // A sphere's far side shows where its near side is cut out: its second crossing
-            // (beyond the first) gets an alpha test of its own.
-            if (!is_sphere(tri) || !sphere_kernel(pre, tri.v0, tri.v1[0], th.t, tmax, &th)) return false;
+            // A curved primitive's far side shows where its near side is cut out: its next
+            // crossing (beyond the first) gets an alpha test of its own.
+            if (!is_curved(tri) || !primitive_kernel(pre, tri, th.t, tmax, &th)) return false;
             if (!kAnyHit && !closer(th.t, tri.prim, best.t, best.prim)) return false;
             anyhit_calls += 1;
             if (!alpha_test_accepts(tri.prim, th.u, th.v, coverage)) return false;

@@ -33,10 +33,10 @@ std::vector<Vec3> sphere_directions(int n) {
     return dirs;
 }
 
-/// Negative when the ray meets the hit's front face (a triangle's by its winding, a sphere's
+/// Negative when the ray meets the hit's front face (a triangle's by its winding, a curved primitive's
 /// outside), positive at a back face, 0 for a triangle seen edge-on.
 float facing(const Scene& scene, const Ray& r, const Hit& h) {
-    if (scene.is_sphere(uint32_t(h.prim))) return surface_point(scene, r, h).front ? -1.0f : 1.0f;
+    if (scene.is_curved(uint32_t(h.prim))) return surface_point(scene, r, h).front ? -1.0f : 1.0f;
     const Triangle t = scene.world_triangle(uint32_t(h.prim));
     return glm::dot(glm::cross(t.v1 - t.v0, t.v2 - t.v0), r.direction);
 }

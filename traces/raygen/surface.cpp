@@ -14,18 +14,26 @@ constexpr float gamma(int n) {
     return (n * eps) / (1.0f - n * eps);
 }
 
-/// A sphere's hit point (pbrt-v4 Sphere::Intersect): the point on the ray, reprojected onto
-/// the sphere (centre + radius x its unit normal), with pbrt's gamma(5) bound, taken here
-/// relative to the world origin (the centre's magnitude adds to it).
-SurfacePoint sphere_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
-    const Vec3 c = sphere_centre(scene.triangles[uint32_t(hit.prim)]);
-    const float r = scene.sphere_radius[uint32_t(hit.prim)];
+/// A curved primitive's hit point (pbrt-v4 Sphere::Intersect): the point on the ray,
+/// reprojected onto the surface (the nearest point of the sphere's centre or the capsule's axis,
+/// plus radius x the unit normal from it), with pbrt's gamma(5) bound, taken here relative to
+/// the world origin (the axis point's magnitude adds to it).
+SurfacePoint curved_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
+    const uint32_t prim = uint32_t(hit.prim);
+    const float r = scene.curved_radius[prim];
     const glm::dvec3 p = glm::dvec3(ray.origin) + double(hit.t) * glm::dvec3(ray.direction);
-    const glm::dvec3 rel = p - glm::dvec3(c);
+    glm::dvec3 axis_point(sphere_centre(scene.triangles[prim]));
+    if (scene.is_capsule(prim)) {
+        const glm::dvec3 a(scene.capsule_ends[prim][0]), b(scene.capsule_ends[prim][1]);
+        const double s = glm::clamp(glm::dot(p - a, b - a) / glm::dot(b - a, b - a), 0.0, 1.0);
+        axis_point = a + s * (b - a);
+    }
+    const Vec3 c(axis_point);
+    const glm::dvec3 rel = p - axis_point;
     const double len = glm::length(rel);
     Vec3 n = len > 0.0 ? Vec3(rel / len) : Vec3(0.0f, 0.0f, 1.0f);
     SurfacePoint sp;
-    sp.position = Vec3(glm::dvec3(c) + double(r) * glm::dvec3(n));
+    sp.position = Vec3(axis_point + double(r) * glm::dvec3(n));
     const Vec3 magnitude = glm::abs(c) + glm::abs(r * n);
     const float floor = std::max(magnitude.x, std::max(magnitude.y, magnitude.z));
     sp.error = gamma(5) * (magnitude + Vec3(floor));
@@ -40,7 +48,7 @@ SurfacePoint sphere_surface_point(const Scene& scene, const Ray& ray, const Hit&
 }  // namespace
 
 SurfacePoint surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
-    if (scene.is_sphere(uint32_t(hit.prim))) return sphere_surface_point(scene, ray, hit);
+    if (scene.is_curved(uint32_t(hit.prim))) return curved_surface_point(scene, ray, hit);
     const Triangle tri = scene.world_triangle(uint32_t(hit.prim));
     float b0 = 1.0f - hit.u - hit.v;
     SurfacePoint sp;

@@ -6,6 +6,8 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "traces/raygen/surface.h"
+
 namespace rtsim {
 
 
@@ -53,8 +55,7 @@ void plan_emissive(const Scene& scene, const std::vector<bool>& used, WorkloadPl
     std::sort(emissive.begin(), emissive.end());
     for (uint32_t i : emissive) {
         const Triangle t = scene.world_triangle(i);
-        const double r = scene.is_sphere(i) ? double(scene.sphere_radius[i]) : 0.0;
-        double area = scene.is_sphere(i) ? 4.0 * glm::pi<double>() * r * r : 0.5 * glm::length(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
+        double area = scene.is_curved(i) ? curved_area(scene, i) : 0.5 * glm::length(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
         if (!(area > 0.0)) continue;
         plan->emissive_prims.push_back(uint32_t(i));
         total += area;
@@ -131,6 +132,36 @@ WorkloadPlan plan_workload(const Scene& scene, const std::vector<RayKind>& reque
     return plan;
 }
 
+namespace {
+
+/// A point on an emissive sphere or capsule, area-uniform as the triangles' (the far half is
+/// shadowed by the light itself): a sphere's by (z, phi); a capsule's on its cylinder or, in
+/// proportion to their area, on its end caps (each the half of its end sphere beyond its end).
+Vec3 curved_light_point(const Scene& scene, uint32_t prim, float u1, float u2) {
+    const float r = scene.curved_radius[prim];
+    auto on_sphere = [](float a, float b) {
+        const float z = 1.0f - 2.0f * a, phi = 2.0f * glm::pi<float>() * b;
+        const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        return Vec3(ring * std::cos(phi), ring * std::sin(phi), z);
+    };
+    if (!scene.is_capsule(prim)) return sphere_centre(scene.triangles[prim]) + r * on_sphere(u1, u2);
+    const Vec3 a = scene.capsule_ends[prim][0], b = scene.capsule_ends[prim][1];
+    const float length = glm::length(b - a);
+    const Vec3 axis = (b - a) / length;
+    const float body = length / (length + 2.0f * r);  // 2 pi r L against the caps' 4 pi r^2
+    if (u1 < body) {
+        Vec3 e1, e2;
+        make_basis(axis, &e1, &e2);
+        const float phi = 2.0f * glm::pi<float>() * u2;
+        return a + (u1 / body) * (b - a) + r * (std::cos(phi) * e1 + std::sin(phi) * e2);
+    }
+    const Vec3 d = on_sphere((u1 - body) / (1.0f - body), u2);
+    const bool at_a = glm::dot(d, axis) <= 0.0f;  // each cap holds the directions beyond its end
+    return (at_a ? a : b) + r * d;
+}
+
+}  // namespace
+
 std::vector<LightSample> light_samples(const Scene& scene, const WorkloadPlan& plan, float u0, float u1, float u2) {
     std::vector<LightSample> out;
     for (const Light& light : scene.lights) {
@@ -149,12 +180,8 @@ std::vector<LightSample> light_samples(const Scene& scene, const WorkloadPlan& p
         const uint32_t prim = plan.emissive_prims[i];
         const Triangle t = scene.world_triangle(prim);
         LightSample s;
-        if (scene.is_sphere(prim)) {
-            // Uniform point on the sphere (area-uniform, as the triangles: the far half is
-            // shadowed by the light itself).
-            const float z = 1.0f - 2.0f * u1, phi = 2.0f * glm::pi<float>() * u2;
-            const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
-            s.point = sphere_centre(t) + scene.sphere_radius[prim] * Vec3(ring * std::cos(phi), ring * std::sin(phi), z);
+        if (scene.is_curved(prim)) {
+            s.point = curved_light_point(scene, prim, u1, u2);
         } else {
             // Uniform point on the triangle (square-root parameterisation).
             float su = std::sqrt(u1);

@@ -1,5 +1,6 @@
 // glTF meshes to rtsim::Mesh: every primitive's triangles, in primitive order, as a triangle list;
 // POINTS primitives with a _RADIUS attribute as spheres.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -23,6 +24,10 @@ const char* mode_name(int mode) {
     }
 }
 
+bool is_line_mode(int mode) {
+    return mode == TINYGLTF_MODE_LINE || mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP;
+}
+
 /// Vertex indices of a primitive as a triangle list. Strips and fans follow the glTF 2.0 spec
 /// (section 3.7.2.1) so that every triangle keeps the winding of the first one:
 /// strip triangle i = {i, i + 1 + i%2, i + 2 - i%2}; fan triangle i = {i + 1, i + 2, 0}.
@@ -44,6 +49,17 @@ std::vector<uint32_t> triangle_list(const std::vector<uint32_t>& idx, int mode) 
         // Spheres: a primitive's three corners are its centre (scene.h, Mesh::radii).
         out.reserve(3 * n);
         for (uint32_t i : idx) out.insert(out.end(), {i, i, i});
+    } else if (is_line_mode(mode) && n >= 2) {
+        // Capsules: a segment's corners are its two ends and the second again (glTF 2.0
+        // section 3.7.2.1's segments: pairs for LINES, consecutive for LINE_STRIP, closed for
+        // LINE_LOOP).
+        const size_t segments = mode == TINYGLTF_MODE_LINE ? n / 2 : (mode == TINYGLTF_MODE_LINE_STRIP ? n - 1 : n);
+        out.reserve(3 * segments);
+        for (size_t s = 0; s < segments; ++s) {
+            const uint32_t a = mode == TINYGLTF_MODE_LINE ? idx[2 * s] : idx[s];
+            const uint32_t b = mode == TINYGLTF_MODE_LINE ? idx[2 * s + 1] : idx[(s + 1) % n];
+            out.insert(out.end(), {a, b, b});
+        }
     }
     return out;
 }
@@ -92,24 +108,28 @@ void read_texcoords(const Source& src, const tinygltf::Primitive& prim, size_t v
     for (uint32_t i : list) out.uvs.emplace_back(uv.component(i, 0), uv.component(i, 1));
 }
 
-/// A POINTS primitive's sphere radii (docs/scenes.md, "Spheres"): its _RADIUS attribute, one
-/// positive finite float per vertex, appended to out.radii for the points `list` names (three
-/// corners each).
+/// A POINTS or LINES primitive's radii (docs/accel.md, "Spheres and capsules"): its _RADIUS
+/// attribute, one positive finite float per vertex, appended to out.radii for the spheres or
+/// capsules `list` names (three corners each); a capsule takes the larger of its ends' radii.
 void read_radii(const Source& src, const tinygltf::Primitive& prim, size_t vertex_count,
                 const std::vector<uint32_t>& list, const std::string& where, Mesh& out) {
     auto it = prim.attributes.find("_RADIUS");
     if (it == prim.attributes.end())
-        src.fail(where + ": a POINTS primitive is traced as spheres and needs a _RADIUS attribute (float SCALAR, "
-                         "one radius per point; docs/scenes.md)");
+        src.fail(where + ": POINTS and LINES primitives are traced as spheres and capsules and need a _RADIUS "
+                         "attribute (float SCALAR, one radius per vertex; docs/accel.md)");
     AccessorView radius = view_accessor(src, it->second, where + " _RADIUS");
     if (radius.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT || radius.components != 1 || radius.count < vertex_count)
-        src.fail(where + ": _RADIUS must be float SCALAR with one entry per point");
+        src.fail(where + ": _RADIUS must be float SCALAR with one entry per vertex");
     out.radii.resize(out.triangle_count() - list.size() / 3, 0.0f);  // the mesh's earlier triangles
     for (size_t k = 0; k < list.size(); k += 3) {
-        const float r = radius.component(list[k], 0);
-        if (!(r > 0.0f) || !std::isfinite(r))
-            src.fail(where + ": point " + std::to_string(list[k]) + " has _RADIUS " + std::to_string(r) +
-                     " (a sphere's radius must be positive and finite)");
+        float r = 0.0f;
+        for (uint32_t vertex : {list[k], list[k + 1]}) {
+            const float rv = radius.component(vertex, 0);
+            if (!(rv > 0.0f) || !std::isfinite(rv))
+                src.fail(where + ": vertex " + std::to_string(vertex) + " has _RADIUS " + std::to_string(rv) +
+                         " (a radius must be positive and finite)");
+            r = std::max(r, rv);
+        }
         out.radii.push_back(r);
     }
 }
@@ -119,9 +139,8 @@ void read_primitive(const Source& src, const tinygltf::Primitive& prim, const st
                     Scene& scene, Mesh& out) {
     int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-        mode != TINYGLTF_MODE_TRIANGLE_FAN && mode != TINYGLTF_MODE_POINTS)
-        src.fail(where + ": unsupported primitive mode " + std::to_string(mode) + " (" + mode_name(mode) +
-                 "); only TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN and POINTS (spheres, with _RADIUS) are traced");
+        mode != TINYGLTF_MODE_TRIANGLE_FAN && mode != TINYGLTF_MODE_POINTS && !is_line_mode(mode))
+        src.fail(where + ": unsupported primitive mode " + std::to_string(mode) + " (" + mode_name(mode) + ")");
     auto pos_it = prim.attributes.find("POSITION");
     if (pos_it == prim.attributes.end()) src.fail(where + ": no POSITION attribute");
     AccessorView pos = view_accessor(src, pos_it->second, where + " POSITION");
@@ -153,7 +172,7 @@ void read_primitive(const Source& src, const tinygltf::Primitive& prim, const st
         out.positions.emplace_back(xyz[0], xyz[1], xyz[2]);
     }
     out.materials.insert(out.materials.end(), list.size() / 3, material);
-    if (mode == TINYGLTF_MODE_POINTS) {
+    if (mode == TINYGLTF_MODE_POINTS || is_line_mode(mode)) {
         read_radii(src, prim, pos.count, list, where, out);
         if (!out.uvs.empty()) out.uvs.resize(out.positions.size(), glm::vec2(0.0f));  // spheres map their own
     } else {

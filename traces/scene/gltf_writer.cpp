@@ -246,6 +246,20 @@ int GltfWriter::add_sphere_mesh(const std::string& name, const std::vector<Vec3>
     return int(g.model.meshes.size() - 1);
 }
 
+int GltfWriter::add_capsule_mesh(const std::string& name, const std::vector<Vec3>& vertices,
+                                 const std::vector<float>& radii, const std::vector<uint32_t>& segments, int material) {
+    if (vertices.size() != radii.size() || segments.empty() || segments.size() % 2)
+        throw Error("capsule mesh '" + name + "': one radius per vertex, and index pairs");
+    int mesh = add_sphere_mesh(name, vertices, radii, material);  // POSITION and _RADIUS alike
+    Impl& g = *m_impl;
+    tinygltf::Primitive& prim = g.model.meshes[size_t(mesh)].primitives[0];
+    prim.indices = g.add_accessor(g.add_view(segments.data(), segments.size() * sizeof(uint32_t),
+                                             TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, segments.size());
+    prim.mode = TINYGLTF_MODE_LINE;
+    return mesh;
+}
+
 void GltfWriter::add_mesh_node(const std::string& name, int mesh, const glm::dmat4& transform) {
     tinygltf::Node node;
     node.name = name;

@@ -67,6 +67,10 @@ public:
     /// are the centres and whose _RADIUS the radii; returns the glTF mesh index.
     int add_sphere_mesh(const std::string& name, const std::vector<Vec3>& centres, const std::vector<float>& radii,
                         int material);
+    /// Adds a mesh of capsules: one LINES primitive of `segments` (index pairs into `vertices`),
+    /// each vertex's radius its _RADIUS; returns the glTF mesh index.
+    int add_capsule_mesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<float>& radii,
+                         const std::vector<uint32_t>& segments, int material);
     /// Marks glTF mesh `mesh` as deforming with `motion` (written as its extras.rtsimMotion).
     void set_mesh_motion(int mesh, const ProceduralMotion& motion);
     /// Adds a root node placing `mesh` with `transform` (identity: no matrix written).

@@ -39,6 +39,7 @@ const Entry kInstancedScenes[] = {
 const Entry kSphereScenes[] = {
     {"particles", write_particles},
     {"furball", write_furball},
+    {"furball_capsules", write_furball_capsules},
     {"particles_mesh", write_particles_mesh},
     {"furball_mesh", write_furball_mesh},
 };

@@ -5,7 +5,9 @@
 //    diffuse rays, spheres and triangles in one structure;
 //  - furball: the hairball's counterpart in spheres, fur grown from a core sphere, each strand
 //    a chain of overlapping beads (how hair was traced before swept-sphere primitives; the
-//    strands are as thin and as crossed as the hairball's ribbons, but round).
+//    strands are as thin and as crossed as the hairball's ribbons, but round);
+//  - furball_capsules: the same strands as chains of capsules through every sixth bead (glTF
+//    LINES with _RADIUS), 8 primitives a strand instead of 48.
 // Each has a twin of triangles, "particles_mesh" and "furball_mesh": the same spheres, each an
 // icosahedron with its vertices on the sphere (20 triangles), so a study can set native spheres
 // beside the coarsest tessellation a renderer would use.
@@ -28,6 +30,7 @@ constexpr float kCoreRadius = 0.6f;   ///< the furball's body
 constexpr float kBeadRadius = 0.004f;
 constexpr float kBeadStep = 0.006f;   ///< centre to centre: beads overlap by a third
 constexpr float kFurCurl = 0.25f;     ///< random turn per bead
+constexpr int kCapsuleBeads = 6;      ///< beads a capsule of furball_capsules spans
 
 Vec3 random_unit(Rng& rng) {
     const float z = 2.0f * rng.next() - 1.0f, phi = 6.28318530718f * rng.next();
@@ -100,7 +103,10 @@ std::string write_particles(const std::string& dir, const ProceduralOptions& opt
     return w.write(dir, tessellated ? "particles_mesh" : "particles");
 }
 
-std::string write_furball(const std::string& dir, const ProceduralOptions& options, bool tessellated) {
+/// How the furball's strands are written: beads (spheres), their icosahedra, or capsules.
+enum class Fur { beads, icosahedra, capsules };
+
+std::string write_furball(const std::string& dir, const ProceduralOptions& options, Fur as) {
     Spheres fur_spheres;
     std::vector<Vec3>& centres = fur_spheres.centres;
     std::vector<float>& radii = fur_spheres.radii;
@@ -120,11 +126,31 @@ std::string write_furball(const std::string& dir, const ProceduralOptions& optio
     }
     GltfWriter w;
     const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
-    add_spheres(w, "fur", fur_spheres, fur, tessellated);
+    const bool tessellated = as == Fur::icosahedra;
+    if (as == Fur::capsules) {
+        // Each strand a chain of capsules through every kCapsuleBeads-th bead and its last one,
+        // a vertex's radius its bead's (a capsule takes the larger of its ends').
+        std::vector<Vec3> vertices;
+        std::vector<float> vertex_radii;
+        std::vector<uint32_t> segments;
+        for (uint32_t s = 0; s < kStrands; ++s) {
+            const size_t first = size_t(s) * kBeads;
+            for (int b = 0; b < kBeads; b += kCapsuleBeads) {
+                const int next = std::min(b + kCapsuleBeads, kBeads - 1);
+                if (b == 0) vertices.push_back(centres[first]), vertex_radii.push_back(radii[first]);
+                vertices.push_back(centres[first + size_t(next)]), vertex_radii.push_back(radii[first + size_t(next)]);
+                segments.insert(segments.end(), {uint32_t(vertices.size() - 2), uint32_t(vertices.size() - 1)});
+                if (next == kBeads - 1) break;
+            }
+        }
+        w.add_mesh_node("fur", w.add_capsule_mesh("fur", vertices, vertex_radii, segments, fur));
+    } else {
+        add_spheres(w, "fur", fur_spheres, fur, tessellated);
+    }
     add_spheres(w, "body", Spheres{{{0.0f, 0.0f, 0.0f}}, {kCoreRadius}}, fur, tessellated);
     w.add_light("key_light", LightType::point, {2.5f, 3.0f, 2.5f}, {0, 0, 0}, {1, 1, 1}, 60.0f);
     w.add_camera("camera", {0.0f, 0.3f, 3.2f}, {0, 0, 0}, 0.7f, 1.0f);
-    return w.write(dir, tessellated ? "furball_mesh" : "furball");
+    return w.write(dir, as == Fur::beads ? "furball" : (tessellated ? "furball_mesh" : "furball_capsules"));
 }
 
 std::string write_particles(const std::string& dir, const ProceduralOptions& options) {
@@ -134,10 +160,13 @@ std::string write_particles_mesh(const std::string& dir, const ProceduralOptions
     return write_particles(dir, options, true);
 }
 std::string write_furball(const std::string& dir, const ProceduralOptions& options) {
-    return write_furball(dir, options, false);
+    return write_furball(dir, options, Fur::beads);
+}
+std::string write_furball_capsules(const std::string& dir, const ProceduralOptions& options) {
+    return write_furball(dir, options, Fur::capsules);
 }
 std::string write_furball_mesh(const std::string& dir, const ProceduralOptions& options) {
-    return write_furball(dir, options, true);
+    return write_furball(dir, options, Fur::icosahedra);
 }
 
 }  // namespace rtsim

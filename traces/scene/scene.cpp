@@ -51,15 +51,16 @@ float round_up(double x) {
     return double(f) < x ? std::nextafter(f, INFINITY) : f;
 }
 
-/// A sphere as a flattened primitive: {lo, hi, centre}, its box rounded outward so it holds the
-/// whole sphere the records store (centre and radius as floats).
-Triangle sphere_primitive(const Vec3& c, float r) {
+/// A sphere (p0 == p1) or capsule (p0 to p1) as a flattened primitive: {lo, hi, centre}, its
+/// box rounded outward so it holds the whole shape the records store (floats), the centre a
+/// sphere's or the capsule's midpoint.
+Triangle curved_primitive(const Vec3& p0, const Vec3& p1, float r) {
     Triangle t;
     for (int a = 0; a < 3; ++a) {
-        t.v0[a] = round_down(double(c[a]) - double(r));
-        t.v1[a] = round_up(double(c[a]) + double(r));
+        t.v0[a] = round_down(double(std::min(p0[a], p1[a])) - double(r));
+        t.v1[a] = round_up(double(std::max(p0[a], p1[a])) + double(r));
     }
-    t.v2 = c;
+    t.v2 = p0 == p1 ? p0 : Vec3(0.5 * (glm::dvec3(p0) + glm::dvec3(p1)));
     return t;
 }
 
@@ -78,9 +79,11 @@ void Scene::flatten() {
     triangles.clear();
     tri_material.clear();
     tri_instance.clear();
-    sphere_radius.clear();
-    const bool spheres = has_spheres();  // then a radius per primitive, 0 for a triangle
-    if (spheres) sphere_radius.reserve(total);
+    curved_radius.clear();
+    capsule_ends.clear();
+    const bool curved = has_curved(), capsules = has_capsules();  // then a radius (ends) per primitive
+    if (curved) curved_radius.reserve(total);
+    if (capsules) capsule_ends.reserve(total);
     triangles.reserve(total);
     tri_material.reserve(total);
     tri_instance.reserve(total);
@@ -101,14 +104,14 @@ void Scene::flatten() {
             Triangle tri{to_world(mesh.positions[3 * t]), to_world(mesh.positions[3 * t + 1]),
                          to_world(mesh.positions[3 * t + 2])};
             float radius = 0.0f;
-            if (mesh.is_sphere(t)) {
-                const glm::dvec4 w = inst.object_to_world * glm::dvec4(glm::dvec3(mesh.positions[3 * t]), 1.0);
+            const std::array<Vec3, 2> ends{tri.v0, tri.v1};
+            if (mesh.is_curved(t)) {
                 radius = float(double(mesh.radii[t]) * scale);
-                tri = sphere_primitive(Vec3(float(w.x), float(w.y), float(w.z)), radius);
+                tri = curved_primitive(ends[0], ends[1], radius);
                 // A node scaled to 0 (how glTF hides nodes) leaves radius 0: never hit, as its
                 // triangles would be.
                 if (!(radius >= 0.0f) || !std::isfinite(radius))
-                    throw Error(source + ": mesh " + std::to_string(inst.mesh) + " '" + mesh.name + "' sphere " +
+                    throw Error(source + ": mesh " + std::to_string(inst.mesh) + " '" + mesh.name + "' curved primitive " +
                                 std::to_string(t) + (inst.node >= 0 ? " placed by node " + std::to_string(inst.node) : "") +
                                 " has radius " + std::to_string(radius) + " in world space (beyond the float range)");
             }
@@ -122,21 +125,44 @@ void Scene::flatten() {
             triangles.push_back(tri);
             tri_material.push_back(mesh.materials[t]);
             tri_instance.push_back(uint32_t(i));
-            if (spheres) sphere_radius.push_back(radius);
+            if (curved) curved_radius.push_back(radius);
+            if (capsules) capsule_ends.push_back(mesh.is_capsule(t) ? ends : std::array<Vec3, 2>{tri.v2, tri.v2});
         }
     }
 }
 
+double curved_area(const Scene& scene, uint32_t prim) {
+    constexpr double kPi = 3.14159265358979323846;
+    const double r = scene.curved_radius[prim];
+    const double length = scene.is_capsule(prim)
+                              ? glm::length(glm::dvec3(scene.capsule_ends[prim][1]) - glm::dvec3(scene.capsule_ends[prim][0]))
+                              : 0.0;
+    return 2.0 * kPi * r * length + 4.0 * kPi * r * r;
+}
+
 size_t Scene::sphere_count() const {
     size_t n = 0;
-    for (float r : sphere_radius) n += r > 0.0f ? 1 : 0;
+    for (uint32_t p = 0; p < curved_radius.size(); ++p) n += is_sphere(p) ? 1 : 0;
     return n;
 }
 
-bool Scene::has_spheres() const {
+size_t Scene::capsule_count() const {
+    size_t n = 0;
+    for (uint32_t p = 0; p < capsule_ends.size(); ++p) n += is_capsule(p) ? 1 : 0;
+    return n;
+}
+
+bool Scene::has_curved() const {
     for (const Mesh& m : meshes)
         for (float r : m.radii)
             if (r > 0.0f) return true;
+    return false;
+}
+
+bool Scene::has_capsules() const {
+    for (const Mesh& m : meshes)
+        for (size_t p = 0; p < m.radii.size(); ++p)
+            if (m.is_capsule(p)) return true;
     return false;
 }
 

@@ -9,6 +9,7 @@
 // primitives in order and each primitive's indices in order (strips and fans converted to
 // triangle lists first). The primitive id of a triangle is instance.prim_base + its index in
 // the mesh, so ids run 0..N-1 over the whole scene and `triangles()` is indexed by them.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -93,11 +94,13 @@ struct Mesh {
     /// TEXCOORD_0, 3 per triangle like positions; empty when no primitive has it (a mesh with
     /// some primitives lacking it gets (0, 0) there).
     std::vector<glm::vec2> uvs;
-    /// Spheres (curved primitives, docs/scenes.md "Spheres"): one radius per primitive, 0 for a
-    /// triangle; empty when the mesh has none. A sphere's three positions are its centre.
+    /// Curved primitives (docs/accel.md, "Spheres and capsules"): one radius per primitive, 0 for
+    /// a triangle; empty when the mesh has none. A sphere's three positions are its centre, a
+    /// capsule's its two ends and the second end again.
     std::vector<float> radii;
     size_t triangle_count() const { return materials.size(); }
-    bool is_sphere(size_t prim) const { return !radii.empty() && radii[prim] > 0.0f; }
+    bool is_curved(size_t prim) const { return !radii.empty() && radii[prim] > 0.0f; }
+    bool is_capsule(size_t prim) const { return is_curved(prim) && positions[3 * prim] != positions[3 * prim + 1]; }
 };
 
 /// One placement of a mesh in the world.
@@ -108,13 +111,17 @@ struct Instance {
     int32_t node = -1;       ///< glTF node index it came from (-1 for procedural)
 };
 
-/// A flattened primitive. A sphere is stored as its box and centre, {lo, hi, centre} (its radius
-/// in Scene::sphere_radius), so every builder that bounds primitives by their vertices bounds
-/// it right; builders that clip triangles against planes refuse scenes with spheres.
+/// A flattened primitive. A sphere or capsule is stored as its box and centre, {lo, hi, centre}
+/// (its radius in Scene::curved_radius, a capsule's ends in Scene::capsule_ends), so every
+/// builder that bounds primitives by their vertices bounds it right; builders that clip
+/// triangles against planes refuse scenes with curved primitives.
 struct Triangle {
     Vec3 v0, v1, v2;
 };
 inline Vec3 sphere_centre(const Triangle& t) { return t.v2; }
+struct Scene;
+/// Surface area of curved primitive `prim`: a sphere's 4 pi r^2, a capsule's 2 pi r L + 4 pi r^2.
+double curved_area(const Scene& scene, uint32_t prim);
 
 /// Peak memory of tracing, per flattened triangle (scene, BVH build, hardware image, writer),
 /// measured with /usr/bin/time on 2M-triangle hairballs (docs/validation.md).
@@ -148,9 +155,12 @@ struct Scene {
     std::vector<Triangle> triangles;
     std::vector<uint32_t> tri_material;
     std::vector<uint32_t> tri_instance;
-    /// Per primitive: a sphere's world-space radius, 0 for a triangle; empty when the scene has
-    /// no spheres (filled by flatten()).
-    std::vector<float> sphere_radius;
+    /// Per primitive: a sphere's or capsule's world-space radius, 0 for a triangle; empty when
+    /// the scene has no curved primitives (filled by flatten()).
+    std::vector<float> curved_radius;
+    /// Per primitive: a capsule's two ends in world space (a sphere's or triangle's are its
+    /// centre, twice); empty when the scene has no capsules (filled by flatten()).
+    std::vector<std::array<Vec3, 2>> capsule_ends;
     uint64_t placed_triangles = 0;  ///< set by index_instances() (flatten() fills triangles instead)
     Aabb bounds;
 
@@ -164,11 +174,17 @@ struct Scene {
     /// triangles. Throws rtsim::Error naming `source` if primitive ids would not fit int32.
     void index_instances();
     bool flattened() const { return !triangles.empty(); }
-    bool is_sphere(uint32_t prim) const { return !sphere_radius.empty() && sphere_radius[prim] > 0.0f; }
-    /// Spheres among the flattened primitives.
+    bool is_curved(uint32_t prim) const { return !curved_radius.empty() && curved_radius[prim] > 0.0f; }
+    bool is_capsule(uint32_t prim) const {
+        return is_curved(prim) && !capsule_ends.empty() && capsule_ends[prim][0] != capsule_ends[prim][1];
+    }
+    bool is_sphere(uint32_t prim) const { return is_curved(prim) && !is_capsule(prim); }
+    /// Spheres and capsules among the flattened primitives.
     size_t sphere_count() const;
-    /// True if some mesh has spheres (flattened or not).
-    bool has_spheres() const;
+    size_t capsule_count() const;
+    /// True if some mesh has curved primitives, and capsules (flattened or not).
+    bool has_curved() const;
+    bool has_capsules() const;
     /// Triangles the instances place: the flattened list's size, or placed_triangles.
     size_t triangle_count() const { return flattened() ? triangles.size() : size_t(placed_triangles); }
     /// Instance that places primitive `prim` (binary search over prim_base).

@@ -21,7 +21,7 @@ Vec3 to_world(const glm::dmat4& m, const Vec3& p) {
 }  // namespace
 
 void Scene::index_instances() {
-    sphere_radius.clear();  // no flattened primitives (two levels store no spheres)
+    curved_radius.clear();  // no flattened primitives (two levels store no spheres)
     uint64_t total = 0;
     std::vector<Aabb> mesh_box(meshes.size());
     for (size_t m = 0; m < meshes.size(); ++m)

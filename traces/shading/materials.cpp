@@ -176,24 +176,24 @@ json ShadingScene::to_json(const Scene& scene) const {
 
 namespace {
 
-/// A sphere's record: its texture coordinates are its hit's sphere coordinates (u, v), which
-/// the barycentric interpolation every shader runs reproduces from these corners; the normal is
-/// zero (each hit has its own; the level-of-detail rule then takes the mean cosine, texels.cpp),
-/// and the level of detail spreads the unit uv square over the sphere's area.
-TriShadeRecord sphere_shade_record(const Scene& scene, uint32_t prim) {
+/// A curved primitive's record: its texture coordinates are its hit's own (u, v: a sphere's
+/// longitude and colatitude, a capsule's axial and angular coordinates), which the barycentric
+/// interpolation every shader runs reproduces from these corners; the normal is zero (each hit
+/// has its own; the level-of-detail rule then takes a sphere's mean cosine, texels.cpp), and the
+/// level of detail spreads the unit uv square over the surface's area.
+TriShadeRecord curved_shade_record(const Scene& scene, uint32_t prim) {
     TriShadeRecord r{};
     const float uv[6] = {0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 1.0f};
     for (int i = 0; i < 6; ++i) r.uv[i] = uv[i];
     r.material = scene.material_of(prim);
-    const double radius = scene.sphere_radius[prim];
-    r.lod_base = float(0.5 * std::log2(1.0 / (4.0 * 3.14159265358979323846 * radius * radius)));
+    r.lod_base = float(0.5 * std::log2(1.0 / curved_area(scene, prim)));
     return r;
 }
 
 }  // namespace
 
 TriShadeRecord tri_shade_record(const Scene& scene, uint32_t prim) {
-    if (scene.is_sphere(prim)) return sphere_shade_record(scene, prim);
+    if (scene.is_curved(prim)) return curved_shade_record(scene, prim);
     TriShadeRecord r{};
     const Triangle t = scene.world_triangle(prim);
     const Vec3 n = glm::cross(t.v1 - t.v0, t.v2 - t.v0);

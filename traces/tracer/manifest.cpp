@@ -22,8 +22,9 @@ json scene_json(const Scene& scene, const std::string& name, bool procedural) {
     return {{"name", name},
             {"source", scene.source},
             {"procedural", procedural},
-            {"triangles", scene.triangle_count() - scene.sphere_count()},
+            {"triangles", scene.triangle_count() - scene.sphere_count() - scene.capsule_count()},
             {"spheres", scene.sphere_count()},
+            {"capsules", scene.capsule_count()},
             {"meshes", scene.meshes.size()},
             {"instances", scene.instances.size()},
             {"uses_instancing", scene.uses_instancing()},
@@ -74,6 +75,7 @@ void RayCounts::add(RayKind kind, uint16_t depth, const Hit& hit, const WorkCoun
     k.box_tests += w.box_tests;
     k.tri_tests += w.tri_tests;
     k.sphere_tests += w.sphere_tests;
+    k.capsule_tests += w.capsule_tests;
     k.anyhit_calls += w.anyhit_calls;
     k.max_depth = std::max(k.max_depth, depth);
     m_written += written;
@@ -94,6 +96,7 @@ json RayCounts::to_json() const {
                                             {"box_tests_per_ray", k.box_tests / n},
                                             {"tri_tests_per_ray", k.tri_tests / n},
                                             {"sphere_tests_per_ray", k.sphere_tests / n},
+                                            {"capsule_tests_per_ray", k.capsule_tests / n},
                                             {"anyhit_calls_per_ray", k.anyhit_calls / n}};
     }
     return {{"rays", m_written}, {"rejected", m_rejected}, {"by_kind", kinds}};

@@ -24,7 +24,8 @@ public:
 
 private:
     struct KindStats {
-        uint64_t rays = 0, hits = 0, written = 0, steps = 0, box_tests = 0, tri_tests = 0, sphere_tests = 0, anyhit_calls = 0;
+        uint64_t rays = 0, hits = 0, written = 0, steps = 0, box_tests = 0, tri_tests = 0, sphere_tests = 0, capsule_tests = 0,
+                 anyhit_calls = 0;
         uint16_t max_depth = 0;
     };
     KindStats m_kinds[kRayKindCount];

@@ -20,7 +20,7 @@ Vec3 sky(const Vec3& d) {
 }
 
 float headlight(const Scene& scene, const Ray& ray, const Hit& hit) {
-    if (scene.is_sphere(uint32_t(hit.prim))) {
+    if (scene.is_curved(uint32_t(hit.prim))) {
         const float len = glm::length(ray.direction);
         return len > 0.0f ? std::abs(glm::dot(surface_point(scene, ray, hit).normal, ray.direction)) / len : 0.0f;
     }

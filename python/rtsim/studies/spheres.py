@@ -1,13 +1,14 @@
-"""Spheres against their tessellation (docs/accel.md, "Spheres").
+"""Spheres and capsules against their tessellation (docs/accel.md, "Spheres and capsules").
 
-The two sphere scenes (`particles`: 40,000 particles round a mirror sphere over a floor;
-`furball`: 2,000 strands of 48 overlapping beads on a core sphere) beside their twins in
-triangles (`particles_mesh`, `furball_mesh`: each sphere an icosahedron with its vertices on it,
-20 triangles, the coarsest tessellation a renderer would use). Per structure and ray kind, both
-are traced and simulated at the detailed level at the default config. Per row: the image's
-footprint and the build time (from the traces' manifests), steps and primitive tests per ray,
-the hit rates, and speed and DRAM bytes per ray of the spheres against the twin; the sphere
-pipeline's area beside the design's. Every run must have zero hit and work mismatches.
+The sphere scenes (`particles`: 40,000 particles round a mirror sphere over a floor; `furball`:
+2,000 strands of 48 overlapping beads on a core sphere) and the furball's strands as capsules
+(`furball_capsules`: 8 capsules a strand) beside the twins in triangles (`particles_mesh`,
+`furball_mesh`: each sphere an icosahedron with its vertices on it, 20 triangles, the coarsest
+tessellation a renderer would use). Per structure and ray kind, each is traced and simulated at
+the detailed level at the default config. Per row: the image's footprint and the build time
+(from the traces' manifests), steps and primitive tests per ray, the hit rates, and speed and
+DRAM bytes per ray of the curved scene against the twin; the curved pipelines' area beside the
+design's. Every run must have zero hit and work mismatches.
 
 Table between the `spheres-study` markers of docs/accel.md."""
 
@@ -21,15 +22,25 @@ from rtsim.study import Study, StudyRun, Table
 from rtsim.study.tables import markdown, mismatches
 from rtsim.study.traces import manifest
 
-WORK = ("steps", "tri_tests", "sphere_tests")
+WORK = ("steps", "tri_tests", "sphere_tests", "capsule_tests")
 TWIN = "_mesh"
+#: Variants of a scene in curved primitives, traced beside it.
+VARIANTS = {"furball": ["furball_capsules"]}
+
+
+def twin_of(scene: str) -> str:
+    """The scene in triangles a curved scene is set against (a variant's, its base scene's)."""
+    for base, variants in VARIANTS.items():
+        if scene in variants:
+            return base + TWIN
+    return scene + TWIN
 
 
 def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
     return [
         {
             "name": f"spheres-{s}",
-            "scenes": [{"name": s}, {"name": s + TWIN}],
+            "scenes": [{"name": n} for n in [s, *VARIANTS.get(s, []), s + TWIN]],
             "workloads": [
                 {"name": w, "rays": [w], "resolution": o["resolution"]} for w in o["workloads"]
             ],
@@ -41,9 +52,11 @@ def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def sphere_area(run: StudyRun, row: dict[str, Any]) -> tuple[float, float]:
-    """The sphere pipelines' area and the design's, mm^2."""
+    """The sphere and capsule pipelines' area and the design's, mm^2."""
     area = run.stats(row).get("area", {})
-    return float(area.get("mm2", {}).get("sphere", 0.0)), float(area.get("total_mm2", 0.0))
+    mm2 = area.get("mm2", {})
+    curved = float(mm2.get("sphere", 0.0) + mm2.get("capsule", 0.0))
+    return curved, float(area.get("total_mm2", 0.0))
 
 
 def rows(run: StudyRun) -> list[dict[str, Any]]:
@@ -52,7 +65,7 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
         if r["scene"].endswith(TWIN):
             continue
         twin = run.row(
-            part=r["part"], workload=r["workload"], accel=r["accel"], scene=r["scene"] + TWIN
+            part=r["part"], workload=r["workload"], accel=r["accel"], scene=twin_of(r["scene"])
         )
         sph, tri = ray_work(run, r, WORK), ray_work(run, twin, WORK)
         ms, mt = manifest(Path(r["trace_dir"])), manifest(Path(twin["trace_dir"]))
@@ -63,13 +76,15 @@ def rows(run: StudyRun) -> list[dict[str, Any]]:
                 "workload": r["workload"],
                 "accel": r["accel"],
                 "rays": sph["rays"],
-                "spheres": ms["scene"]["spheres"],
+                "curved": ms["scene"]["spheres"] + ms["scene"]["capsules"],
                 "twin_triangles": mt["scene"]["triangles"],
                 "footprint": (ms["accel"]["footprint_bytes"], mt["accel"]["footprint_bytes"]),
                 "build_ms": (ms["accel"]["build_ms"], mt["accel"]["build_ms"]),
                 "steps": (sph["steps"]["mean"], tri["steps"]["mean"]),
                 "tests": (
-                    sph["sphere_tests"]["mean"] + sph["tri_tests"]["mean"],
+                    sph["sphere_tests"]["mean"]
+                    + sph["capsule_tests"]["mean"]
+                    + sph["tri_tests"]["mean"],
                     tri["tri_tests"]["mean"],
                 ),
                 "hit_rate": (sph["hit_rate"], tri["hit_rate"]),
@@ -88,23 +103,26 @@ def pair(x: tuple[float, float], spec: str) -> str:
 
 def table(run: StudyRun) -> str:
     rs, o, m = rows(run), run.options, run.measured()
-    area = rs[0]["area"] if rs else (0.0, 0.0)
+    areas = {r["scene"]: r["area"] for r in rs}
     head = (
         f"Generated by `{run.command}` on {m['host']} ({m['date']}): {o['resolution']} rays of "
         f"each kind, fidelity detailed at the default config, one run each; {run.runs} runs "
         f"taking {run.sim_seconds:.1f} s of rtsim-sim time, "
-        f"{sum(r['mismatches'] for r in rs)} hit and work mismatches. Each pair is the spheres' "
-        f"figure / the icosahedra's: the image's footprint (MiB) and build time (ms, one build "
-        f"while tracing), steps and primitive tests (sphere and triangle) per ray, the hit rate; "
-        f"speed and DRAM bytes per ray are the spheres' against the icosahedra's. The sphere "
-        f"pipelines add {area[0]:.3f} mm^2 to the {area[1]:.3f} mm^2 design."
+        f"{sum(r['mismatches'] for r in rs)} hit and work mismatches. Each pair is the curved "
+        f"primitives' figure / the icosahedra's (one per sphere; the capsules' against the beads' "
+        f"icosahedra): the image's footprint (MiB) and build time (ms, one build while "
+        f"tracing), steps and primitive tests (sphere, capsule and triangle) per ray, the hit "
+        f"rate; speed and DRAM bytes per ray are the curved primitives' against the "
+        f"icosahedra's. The curved pipelines' mm^2, of the design's: "
+        + ", ".join(f"{s} {a[0]:.3f} of {a[1]:.3f}" for s, a in areas.items())
+        + "."
     )
     body = [
         [
             r["scene"],
             r["workload"],
             r["accel"],
-            f"{r['spheres']:,} / {r['twin_triangles']:,}",
+            f"{r['curved']:,} / {r['twin_triangles']:,}",
             pair((r["footprint"][0] / 2**20, r["footprint"][1] / 2**20), ".1f"),
             pair(r["build_ms"], ".0f"),
             pair(r["steps"], ".1f"),
@@ -115,14 +133,14 @@ def table(run: StudyRun) -> str:
         ]
         for r in rs
     ]
-    header = ["scene", "rays", "accel", "spheres / triangles", "MiB", "build ms", "steps"]
+    header = ["scene", "rays", "accel", "curved / triangles", "MiB", "build ms", "steps"]
     header += ["tests", "hit rate", "speed", "DRAM/ray"]
     return head + "\n\n" + markdown(header, "lllrrrrrrrr", body)
 
 
 STUDY = Study(
     name="spheres",
-    about="native spheres against the same spheres as icosahedra: footprint, walk, speed, DRAM",
+    about="spheres and capsules against icosahedra: footprint, walk, speed, DRAM",
     specs=specs,
     tables=[Table("accel.md", "spheres-study", table)],
     options={

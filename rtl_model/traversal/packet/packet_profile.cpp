@@ -37,7 +37,7 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
         p.active_lanes += double(counts.active_rays);
         p.requests += steps;  // one fetch serves the packet's active rays
         p.kind_steps[size_t(OpKind::box)] += double(counts.node_steps);
-        double tri_tests = 0, sphere_tests = 0;
+        double tri_tests = 0, sphere_tests = 0, capsule_tests = 0;
         for (size_t i = 0; i < n; ++i) {
             WorkCounts alone;
             accel.trace(group[i], modes[i], &alone, step);
@@ -47,12 +47,17 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
             }
             p.lane_requests += plan_step_work(alone);
             tri_tests += work[i].tri_tests, sphere_tests += work[i].sphere_tests;
+            capsule_tests += work[i].capsule_tests;
         }
-        // Leaf steps by the kind of their tests: shared out by the packet's sphere and triangle
-        // tests (a leaf of both kinds runs both; counted here as one of either, in proportion).
-        const double tests = tri_tests + sphere_tests, sphere_share = tests > 0 ? sphere_tests / tests : 0.0;
-        p.kind_steps[size_t(OpKind::triangle)] += double(counts.leaf_steps) * (1.0 - sphere_share);
-        p.kind_steps[size_t(OpKind::sphere)] += double(counts.leaf_steps) * sphere_share;
+        // Leaf steps by the kind of their tests: shared out by the packet's triangle, sphere and
+        // capsule tests (a leaf of several kinds runs each; counted here as one, in proportion).
+        const double tests = tri_tests + sphere_tests + capsule_tests;
+        const double leaves = double(counts.leaf_steps);
+        p.kind_steps[size_t(OpKind::triangle)] += tests > 0 ? leaves * tri_tests / tests : leaves;
+        if (tests > 0) {
+            p.kind_steps[size_t(OpKind::sphere)] += leaves * sphere_tests / tests;
+            p.kind_steps[size_t(OpKind::capsule)] += leaves * capsule_tests / tests;
+        }
     }
     return p;
 }

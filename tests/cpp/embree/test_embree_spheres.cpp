@@ -1,6 +1,7 @@
-// Spheres against Embree 3's own (RTC_GEOMETRY_TYPE_SPHERE_POINT, robust mode): the particles
-// and the furball (overlapping beads: many near-ties), traced by rtsim's BVHs and by Embree with
-// the same rays. Hits must name the same sphere with t within 1e-4 relative; every disagreement
+// Spheres and capsules against Embree 3's own (RTC_GEOMETRY_TYPE_SPHERE_POINT, and
+// RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE with equal radii at both ends of a segment: a capsule;
+// robust mode): the particles, the furball (overlapping beads: many near-ties) and its capsules,
+// traced by rtsim's BVHs and by Embree with the same rays. Hits must name the same sphere with t within 1e-4 relative; every disagreement
 // must be a graze (the ray passes within 1e-4 of the hit sphere's radius of its centre, where
 // float and double arithmetic may decide differently) or a tie (two spheres crossed within 1e-4
 // relative t: rtsim takes the smaller id, Embree either). Any-hit rays must agree on occlusion
@@ -30,13 +31,29 @@ public:
         m_device = rtcNewDevice("threads=1");
         m_scene = rtcNewScene(m_device);
         rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
-        RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
         const size_t n = scene.triangles.size();
+        const bool capsules = scene.capsule_count() > 0;  // all capsules, or all spheres
+        RTCGeometry g = rtcNewGeometry(m_device, capsules ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
+                                                          : RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        const size_t vertices = capsules ? 2 * n : n;
         auto* v = static_cast<float*>(
-            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), vertices));
+        uint32_t* segment = capsules ? static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+                                           g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(uint32_t), n))
+                                     : nullptr;
         for (size_t i = 0; i < n; ++i) {
-            const Vec3 c = sphere_centre(scene.triangles[i]);
-            v[4 * i] = c.x, v[4 * i + 1] = c.y, v[4 * i + 2] = c.z, v[4 * i + 3] = scene.sphere_radius[i];
+            const float r = scene.curved_radius[i];
+            if (!capsules) {
+                const Vec3 c = sphere_centre(scene.triangles[i]);
+                v[4 * i] = c.x, v[4 * i + 1] = c.y, v[4 * i + 2] = c.z, v[4 * i + 3] = r;
+                continue;
+            }
+            for (int e = 0; e < 2; ++e) {
+                const Vec3 p = scene.capsule_ends[i][size_t(e)];
+                float* out = v + 4 * (2 * i + size_t(e));
+                out[0] = p.x, out[1] = p.y, out[2] = p.z, out[3] = r;
+            }
+            segment[i] = uint32_t(2 * i);
         }
         rtcCommitGeometry(g);
         rtcAttachGeometry(m_scene, g);
@@ -78,16 +95,19 @@ private:
     RTCScene m_scene;
 };
 
-/// The scene with its triangles dropped (spheres only, ids kept dense in scene order).
+/// The scene's spheres, or its capsules when it has any (ids dense in scene order; triangles and
+/// the other kind dropped).
 Scene sphere_only_scene(const Scene& full) {
     Scene s;
     Mesh mesh;
-    mesh.name = "spheres";
+    mesh.name = "curved";
+    const bool capsules = full.capsule_count() > 0;
     for (uint32_t p = 0; p < full.triangles.size(); ++p) {
-        if (!full.is_sphere(p)) continue;
-        const Vec3 c = sphere_centre(full.triangles[p]);
-        mesh.positions.insert(mesh.positions.end(), {c, c, c});
-        mesh.radii.push_back(full.sphere_radius[p]);
+        if (capsules ? !full.is_capsule(p) : !full.is_sphere(p)) continue;
+        const Vec3 a = capsules ? full.capsule_ends[p][0] : sphere_centre(full.triangles[p]);
+        const Vec3 b = capsules ? full.capsule_ends[p][1] : a;
+        mesh.positions.insert(mesh.positions.end(), {a, b, b});
+        mesh.radii.push_back(full.curved_radius[p]);
     }
     mesh.materials.assign(mesh.radii.size(), 0u);
     s.meshes.push_back(mesh);
@@ -97,14 +117,28 @@ Scene sphere_only_scene(const Scene& full) {
     return s;
 }
 
-/// The ray passes within a relative 1e-4 of the sphere's radius of its centre: a graze.
+/// The ray passes within a relative 1e-4 of the radius of the hit sphere's centre (the hit
+/// capsule's axis: the closest approach by ternary search, the distance being convex): a graze.
 bool grazes(const Scene& scene, const Ray& r, const Hit& h) {
     if (!h.valid()) return false;
-    const glm::dvec3 c(sphere_centre(scene.triangles[uint32_t(h.prim)]));
+    const uint32_t p = uint32_t(h.prim);
+    const glm::dvec3 a(scene.is_capsule(p) ? scene.capsule_ends[p][0] : sphere_centre(scene.triangles[p]));
+    const glm::dvec3 b(scene.is_capsule(p) ? scene.capsule_ends[p][1] : sphere_centre(scene.triangles[p]));
     const glm::dvec3 o(r.origin), d = glm::normalize(glm::dvec3(r.direction));
-    const glm::dvec3 f = c - o;
-    const double perp = glm::length(f - glm::dot(f, d) * d), rad = scene.sphere_radius[uint32_t(h.prim)];
-    return std::fabs(perp - rad) <= 1e-4 * rad;
+    auto distance = [&](double t) {
+        const glm::dvec3 q = o + t * d, ab = b - a;
+        const double len2 = glm::dot(ab, ab);
+        const double s = len2 > 0.0 ? glm::clamp(glm::dot(q - a, ab) / len2, 0.0, 1.0) : 0.0;
+        return glm::length(q - (a + s * ab));
+    };
+    double lo = 0.0, hi = 1e4;
+    for (int k = 0; k < 200; ++k) {
+        const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+        if (distance(m1) < distance(m2)) hi = m2;
+        else lo = m1;
+    }
+    const double rad = scene.curved_radius[p];
+    return std::fabs(distance(lo) - rad) <= 1e-4 * rad;
 }
 
 void compare(const std::string& name, const Scene& full, const char* kind) {
@@ -148,7 +182,7 @@ void compare(const std::string& name, const Scene& full, const char* kind) {
             else ADD_FAILURE() << name << " " << kind << " shadow ray " << i << ": rtsim " << ours << ", Embree " << theirs;
         }
     }
-    std::printf("[ embree    ] %s %s: %zu spheres, %d rays, %d hits; %d graze, %d tie and %d occlusion-graze "
+    std::printf("[ embree    ] %s %s: %zu primitives, %d rays, %d hits; %d graze, %d tie and %d occlusion-graze "
                 "disagreements\n",
                 name.c_str(), kind, scene.triangles.size(), rays, hits, graze, tie, occlusion_graze);
     EXPECT_GT(hits, rays / 10) << name;
@@ -156,9 +190,9 @@ void compare(const std::string& name, const Scene& full, const char* kind) {
     EXPECT_LE(graze + tie + occlusion_graze, rays / 1000) << name;
 }
 
-TEST(EmbreeSpheres, ParticlesAndFurball) {
+TEST(EmbreeSpheres, ParticlesFurballAndCapsules) {
     const std::string tmp = rtsim::test::process_temp_dir("embree_spheres").string();
-    for (const char* name : {"particles", "furball"}) {
+    for (const char* name : {"particles", "furball", "furball_capsules"}) {
         const Scene scene = load_gltf(write_procedural_scene(name, tmp), true);
         for (const char* kind : {"bvh2", "cwbvh8"}) compare(name, scene, kind);
     }

@@ -165,7 +165,7 @@ TEST_F(CorruptionTest, WrongVersionAndForeignFilesAreRefused) {
     // size (older versions are read with theirs: TraceRoundTrip.OlderWorkRecordsAreWidened...).
     h.version = 3;
     tl::encode_header(h, b.data());
-    EXPECT_TRUE(contains(open_error(b), "section WORK has 36-byte records, this build expects 32")) << open_error(b);
+    EXPECT_TRUE(contains(open_error(b), "section WORK has 40-byte records, this build expects 32")) << open_error(b);
 
     const std::string text = "This is a text file, long enough to fill a whole trace header, honestly.\n";
     EXPECT_EQ(open_error(std::vector<uint8_t>(text.begin(), text.end())),

@@ -64,7 +64,7 @@ TEST(TraceRecords, SectionNamesAndSizes) {
     EXPECT_EQ(index, 13u);
     EXPECT_FALSE(is_region_section(SectionKind::rays));
     EXPECT_EQ(section_record_bytes(SectionKind::rays), 40u);
-    EXPECT_EQ(section_record_bytes(SectionKind::work), 36u);
+    EXPECT_EQ(section_record_bytes(SectionKind::work), 40u);
     EXPECT_EQ(section_record_bytes(region_section(0)), 0u);  // regions: size from the descriptor
     EXPECT_EQ(section_record_bytes(SectionKind(0x12345678)), 0u);
 }
@@ -117,7 +117,7 @@ TEST(TraceRecords, WorkRecordIsTheDeclaredFieldsInOrder) {
     for (int i = 0; i < kTracedWorkFieldCount; ++i) EXPECT_TRUE(kWorkFields[size_t(i)].traced);
     for (int i = kTracedWorkFieldCount; i < kWorkFieldCount; ++i) EXPECT_FALSE(kWorkFields[size_t(i)].traced);
     for (int i = 0; i < kTracedWorkFieldCount; ++i) EXPECT_EQ(record_words[i], 10u + uint32_t(i));
-    EXPECT_EQ(r.sphere_tests, 10u + uint32_t(kTracedWorkFieldCount) - 1);
+    EXPECT_EQ(r.capsule_tests, 10u + uint32_t(kTracedWorkFieldCount) - 1);
     const WorkCounts back = r.counts();
     EXPECT_EQ(back.refs, w.refs);
     EXPECT_EQ(back.mailbox_lookups, 0u);
@@ -146,7 +146,7 @@ TEST(TraceRoundTrip, OlderWorkRecordsAreWidenedWithZeroSphereTests) {
     std::vector<WorkV5> old(100);
     for (size_t i = 0; i < old.size(); ++i)
         for (uint32_t f = 0; f < kWorkRecordBytesV5 / 4; ++f) old[i].field[f] = uint32_t(100 * i + f + 1);
-    // This build writes only 36-byte WORK records: the old ones go in under a kind of no fixed
+    // This build writes only 40-byte WORK records: the old ones go in under a kind of no fixed
     // size, relabelled WORK in the section table afterwards.
     const auto unsized = SectionKind(0x31313131);
     {
@@ -175,6 +175,7 @@ TEST(TraceRoundTrip, OlderWorkRecordsAreWidenedWithZeroSphereTests) {
         EXPECT_EQ(got[i].steps, uint32_t(100 * (30 + i) + 1)) << i;
         EXPECT_EQ(got[i].refs, uint32_t(100 * (30 + i) + 8)) << i;
         EXPECT_EQ(got[i].sphere_tests, 0u) << i;
+        EXPECT_EQ(got[i].capsule_tests, 0u) << i;
     }
     // The same 32-byte records under version 6 are refused, naming the size this build expects.
     h.version = 6;
@@ -184,7 +185,7 @@ TEST(TraceRoundTrip, OlderWorkRecordsAreWidenedWithZeroSphereTests) {
         TraceReader again(path);
         FAIL() << "32-byte WORK records accepted as version 6";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("has 32-byte records, this build expects 36"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("has 32-byte records, this build expects 40"), std::string::npos) << e.what();
     }
 }
 

@@ -141,6 +141,12 @@ Scene mixed_scene() {
         mesh.positions.insert(mesh.positions.end(), {c, c, c});
         mesh.radii.push_back(0.02f + 0.2f * rng.next());
     }
+    for (int i = 0; i < 100; ++i) {  // capsules: two ends and the second again
+        const Vec3 a(4 * rng.next() - 2, 2 * rng.next() - 1, 4 * rng.next() - 2);
+        const Vec3 b = a + 0.5f * Vec3(rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f);
+        mesh.positions.insert(mesh.positions.end(), {a, b, b});
+        mesh.radii.push_back(0.01f + 0.05f * rng.next());
+    }
     mesh.materials.assign(mesh.positions.size() / 3, 0u);
     scene.meshes.push_back(mesh);
     scene.instances.push_back(Instance{});
@@ -152,13 +158,20 @@ Scene mixed_scene() {
 TEST(RaySphere, SpheresFlattenToTheirBoxAndCentre) {
     const Scene scene = mixed_scene();
     ASSERT_EQ(scene.sphere_count(), 300u);
+    ASSERT_EQ(scene.capsule_count(), 100u);
     for (uint32_t p = 0; p < scene.triangles.size(); ++p) {
-        if (!scene.is_sphere(p)) continue;
+        if (!scene.is_curved(p)) continue;
         const Triangle& t = scene.triangles[p];
-        const float r = scene.sphere_radius[p];
-        for (int a = 0; a < 3; ++a) {
-            EXPECT_LE(double(t.v0[a]), double(t.v2[a]) - double(r)) << p;
-            EXPECT_GE(double(t.v1[a]), double(t.v2[a]) + double(r)) << p;
+        const float r = scene.curved_radius[p];
+        const Vec3 a = scene.is_capsule(p) ? scene.capsule_ends[p][0] : t.v2;
+        const Vec3 b = scene.is_capsule(p) ? scene.capsule_ends[p][1] : t.v2;
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_LE(double(t.v0[k]), double(std::min(a[k], b[k])) - double(r)) << p;
+            EXPECT_GE(double(t.v1[k]), double(std::max(a[k], b[k])) + double(r)) << p;
+        }
+        if (scene.is_capsule(p)) {
+            const HwTriangle rec = make_hw_triangle(scene, p);
+            EXPECT_TRUE(is_capsule(rec) && rec.v2[0] == r && rec.v0[0] == a.x && rec.v1[2] == b.z) << p;
         }
     }
 }
@@ -179,9 +192,9 @@ TEST(RaySphere, EachSphereKeepsItsOwnRadiusAndTheNodeScalesIt) {
     scene.instances.push_back(inst);
     scene.materials = {Material{}};
     scene.flatten();
-    ASSERT_EQ(scene.sphere_radius.size(), 3u);
-    EXPECT_EQ(scene.sphere_radius[0], 2.0f);
-    EXPECT_EQ(scene.sphere_radius[1], 1.0f);
+    ASSERT_EQ(scene.curved_radius.size(), 3u);
+    EXPECT_EQ(scene.curved_radius[0], 2.0f);
+    EXPECT_EQ(scene.curved_radius[1], 1.0f);
     EXPECT_FALSE(scene.is_sphere(2));
     EXPECT_EQ(make_hw_triangle(scene, 1).v1[0], 1.0f);
     EXPECT_EQ(make_hw_triangle(scene, 1).v0[0], 10.0f);
@@ -223,22 +236,28 @@ TEST(RaySphere, AnAlphaMaskedSphereShowsItsFarSideWhereItsNearSideIsCutOut) {
     EXPECT_GT(none, 200);
 }
 
-TEST(RaySphere, AnEmissiveSphereIsAnAreaLightSampledOnItsSurface) {
-    Scene scene = mixed_scene();
-    Material glow;
-    glow.emissive = Vec3(4.0f);
-    scene.materials.push_back(glow);
-    const uint32_t lamp = uint32_t(scene.triangles.size() - 1);  // the last sphere
-    ASSERT_TRUE(scene.is_sphere(lamp));
-    scene.meshes[0].materials.back() = 1;
-    scene.flatten();
-    const WorkloadPlan plan = plan_workload(scene, {RayKind::primary, RayKind::shadow});
-    ASSERT_EQ(plan.emissive_prims, std::vector<uint32_t>{lamp});
-    const Vec3 c = sphere_centre(scene.triangles[lamp]);
-    for (float u : {0.1f, 0.5f, 0.9f}) {
-        const std::vector<LightSample> s = light_samples(scene, plan, 0.5f, u, 1.0f - u);
-        ASSERT_EQ(s.size(), 1u);
-        EXPECT_NEAR(glm::length(s[0].point - c), scene.sphere_radius[lamp], 1e-5f);
+TEST(RaySphere, EmissiveSpheresAndCapsulesAreAreaLightsSampledOnTheirSurface) {
+    for (bool capsule : {false, true}) {
+        Scene scene = mixed_scene();
+        Material glow;
+        glow.emissive = Vec3(4.0f);
+        scene.materials.push_back(glow);
+        uint32_t lamp = 0;
+        for (uint32_t p = 0; p < scene.triangles.size(); ++p)
+            if (capsule ? scene.is_capsule(p) : scene.is_sphere(p)) lamp = p;
+        scene.meshes[0].materials[lamp] = 1;
+        scene.flatten();
+        const WorkloadPlan plan = plan_workload(scene, {RayKind::primary, RayKind::shadow});
+        ASSERT_EQ(plan.emissive_prims, std::vector<uint32_t>{lamp});
+        const glm::dvec3 a(capsule ? scene.capsule_ends[lamp][0] : sphere_centre(scene.triangles[lamp]));
+        const glm::dvec3 b(capsule ? scene.capsule_ends[lamp][1] : sphere_centre(scene.triangles[lamp]));
+        for (float u : {0.05f, 0.3f, 0.5f, 0.7f, 0.95f}) {
+            const std::vector<LightSample> s = light_samples(scene, plan, 0.5f, u, 1.0f - u);
+            ASSERT_EQ(s.size(), 1u);
+            const glm::dvec3 p(s[0].point);
+            const double t = capsule ? glm::clamp(glm::dot(p - a, b - a) / glm::dot(b - a, b - a), 0.0, 1.0) : 0.0;
+            EXPECT_NEAR(glm::length(p - (a + t * (b - a))), scene.curved_radius[lamp], 1e-5) << capsule << " " << u;
+        }
     }
 }
 
@@ -252,7 +271,7 @@ TEST(RaySphere, BvhOverSpheresAndTrianglesMatchesBruteForce) {
         const HwBvh flat = build_bvh(scene);
         check_bvh_invariants(flat, scene);
         Rng rng(11);
-        uint64_t sphere_hits = 0, sphere_tests = 0;
+        uint64_t sphere_hits = 0, sphere_tests = 0, capsule_hits = 0, capsule_tests = 0;
         for (int i = 0; i < 4000; ++i) {
             const Vec3 o(0, 0.5f, 6), target(4 * rng.next() - 2, 2.5f * rng.next() - 1.2f, 4 * rng.next() - 2);
             const Ray r = make_ray(o, target - o);
@@ -265,6 +284,7 @@ TEST(RaySphere, BvhOverSpheresAndTrianglesMatchesBruteForce) {
                     EXPECT_EQ(got.prim, want.prim) << kind << " ray " << i;
                     EXPECT_EQ(got.t, want.t) << kind << " ray " << i;
                     sphere_hits += scene.is_sphere(uint32_t(got.prim));
+                    capsule_hits += scene.is_capsule(uint32_t(got.prim));
                 }
                 // The stepper (what the model drives) counts what the fused loop counts.
                 WorkCounts stepped;
@@ -275,10 +295,13 @@ TEST(RaySphere, BvhOverSpheresAndTrianglesMatchesBruteForce) {
                 EXPECT_EQ(again.prim, got.prim) << kind;
                 EXPECT_EQ(stepped, w) << kind << " ray " << i;
                 sphere_tests += w.sphere_tests;
+                capsule_tests += w.capsule_tests;
             }
         }
         EXPECT_GT(sphere_hits, 400u) << kind;
         EXPECT_GT(sphere_tests, 0u) << kind;
+        EXPECT_GT(capsule_hits, 20u) << kind;
+        EXPECT_GT(capsule_tests, 0u) << kind;
     }
 }
 
@@ -291,7 +314,7 @@ TEST(RaySphere, StructuresThatClipRefuseSpheres) {
             build_accel(scene, o);
             FAIL() << kind << " accepted spheres";
         } catch (const Error& e) {
-            EXPECT_NE(std::string(e.what()).find("the scene has spheres"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("the scene has curved primitives"), std::string::npos) << e.what();
             EXPECT_NE(std::string(e.what()).find("bvh2"), std::string::npos) << e.what();
         }
     }

@@ -76,10 +76,13 @@ TEST(GltfErrors, IndexOutOfRange) {
                  {"mesh 0 'tri' primitive 0: index 7 out of range (vertex count 3)"});
 }
 
-TEST(GltfErrors, UnsupportedMode) {
-    GltfBuilder b = test::one_triangle();
-    b.doc["meshes"][0]["primitives"][0]["mode"] = 1;
-    expect_error(b.write(test::test_dir(), "lines"), {"mesh 0 'tri' primitive 0", "mode 1 (LINES)"});
+TEST(GltfErrors, LinesAndPointsNeedRadii) {
+    // LINES and POINTS are capsules and spheres, which need a radius per vertex.
+    for (int mode : {0, 1, 2, 3}) {
+        GltfBuilder b = test::one_triangle();
+        b.doc["meshes"][0]["primitives"][0]["mode"] = mode;
+        expect_error(b.write(test::test_dir(), "lines"), {"mesh 0 'tri' primitive 0", "need a _RADIUS attribute"});
+    }
 }
 
 TEST(GltfErrors, PositionNotFloatVec3) {

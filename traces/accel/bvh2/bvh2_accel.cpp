@@ -19,7 +19,7 @@ Bvh2View bvh2_view(const HwBvh& bvh) {
     v.triangles = bvh.triangles.data();
     v.node_count = bvh.nodes.size();
     v.triangle_count = bvh.triangles.size();
-    v.spheres = detail::any_sphere(bvh.triangles.data(), bvh.triangles.size());
+    v.curved = detail::any_curved(bvh.triangles.data(), bvh.triangles.size());
     return v;
 }
 
@@ -185,7 +185,7 @@ Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::m
     m_view.triangles = m_triangles.triangles();
     m_view.triangle_count = m_triangles.count();
     m_view.tri_at = m_triangles.addressing();
-    m_view.spheres = has_spheres();
+    m_view.curved = has_spheres() || has_capsules();
     validate_bvh2(m_view, source);
 }
 
@@ -217,6 +217,7 @@ std::vector<OpKind> Bvh2Accel::op_kinds() const {
     std::vector<OpKind> kinds{OpKind::box, OpKind::triangle};
     if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
     if (has_spheres()) kinds.push_back(OpKind::sphere);
+    if (has_capsules()) kinds.push_back(OpKind::capsule);
     return kinds;
 }
 

@@ -24,8 +24,8 @@ void detail::Bvh2LaneRules::plan(StepPlan& plan, uint32_t ref, uint32_t count) c
         plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
         const TriangleAddressing::Span span = view.tri_at.span(ref, count);
         plan.add_fetch(span.address, span.bytes, DataKind::triangle);
-        const detail::LeafTests t = detail::leaf_tests(view.triangles + ref, count, view.spheres);
-        plan.add_leaf_ops(t.triangles, t.spheres);
+        const detail::LeafTests t = detail::leaf_tests(view.triangles + ref, count, view.curved);
+        plan.add_leaf_ops(t);
     }
 }
 
@@ -72,8 +72,8 @@ void Bvh2PacketStepper::plan_next() {
         m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
         const TriangleAddressing::Span span = m_view.tri_at.span(m_ref, m_count);
         m_plan.add_fetch(span.address, span.bytes, DataKind::triangle);
-        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + m_ref, m_count, m_view.spheres);
-        m_plan.add_leaf_ops(t.triangles * rays, t.spheres * rays);
+        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + m_ref, m_count, m_view.curved);
+        m_plan.add_leaf_ops(t, rays);
     }
 }
 

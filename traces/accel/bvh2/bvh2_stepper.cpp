@@ -69,8 +69,8 @@ void Bvh2Stepper::plan_at(uint32_t ref, uint32_t count) {
         m_plan.set_host(m_view.triangles + ref, uint32_t(sizeof(HwTriangle) * count));
         const TriangleAddressing::Span s = m_view.tri_at.span(ref, count);
         m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + ref, count, m_view.spheres);
-        m_plan.add_leaf_ops(t.triangles, t.spheres);
+        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + ref, count, m_view.curved);
+        m_plan.add_leaf_ops(t);
     }
 }
 
@@ -141,9 +141,8 @@ void Bvh2Stepper::visit_node(const HwNode& node) {
 }
 
 uint32_t Bvh2Stepper::visit_leaf(const HwTriangle* triangles) {
-    const detail::LeafTests t = detail::leaf_tests(triangles, m_count, m_view.spheres);
-    m_work.tri_tests += t.triangles;
-    m_work.sphere_tests += t.spheres;
+    const detail::LeafTests t = detail::leaf_tests(triangles, m_count, m_view.curved);
+    detail::count_leaf_tests(m_work, t);
     const uint32_t alpha_before = m_work.anyhit_calls;
     const bool done =
         m_mode == TraversalMode::any_hit

@@ -38,7 +38,7 @@ struct Bvh2View {
     uint64_t triangle_count = 0;
     uint64_t node_base = 0;      ///< address of node 0
     TriangleAddressing tri_at;   ///< where triangles' bytes are (plain or compressed leaves)
-    bool spheres = false;        ///< some records are spheres: leaves split their tests by kind
+    bool curved = false;         ///< some records are curved: leaves split their tests by kind
     /// Oriented nodes only (obvh2, traces/accel/obvh/obvh.h): node i's child boxes lie in the
     /// frame of row-major 3x3 rotation_table[9 * rotations[i]] (kNoRotation: the world's axes).
     const uint8_t* rotations = nullptr;

@@ -34,7 +34,7 @@ Hit trace_fused(const Bvh2View& bvh, const Ray& ray, WorkCounts* work) {
     const __m128 tmin4 = _mm_set1_ps(tmin);
     __m128 cull4 = _mm_set1_ps(cull);
 #endif
-    uint32_t node_visits = 0, tri_tests = 0, sphere_tests = 0, anyhit_calls = 0;
+    uint32_t node_visits = 0, tri_tests = 0, sphere_tests = 0, capsule_tests = 0, anyhit_calls = 0;
 
     struct Entry {
         uint32_t ref, count;
@@ -81,9 +81,10 @@ Hit trace_fused(const Bvh2View& bvh, const Ray& ray, WorkCounts* work) {
                 continue;
             }
         } else {
-            const detail::LeafTests kinds = detail::leaf_tests(tris + ref, count, bvh.spheres);
+            const detail::LeafTests kinds = detail::leaf_tests(tris + ref, count, bvh.curved);
             tri_tests += kinds.triangles;
             sphere_tests += kinds.spheres;
+            capsule_tests += kinds.capsules;
             if (detail::leaf_step<kAnyHit>(tri, tmin, tmax, tris + ref, count, best, cull,
                                            anyhit_calls))
                 break;
@@ -108,6 +109,7 @@ done:
         work->box_tests = 2 * node_visits;
         work->tri_tests = tri_tests;
         work->sphere_tests = sphere_tests;
+        work->capsule_tests = capsule_tests;
         work->anyhit_calls = anyhit_calls;
     }
     if (best.prim < 0) best = Hit{};

@@ -62,8 +62,8 @@ struct WideLaneRules {
             plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
             const TriangleAddressing::Span span = view.tri_at.span(ref, count);
             plan.add_fetch(span.address, span.bytes, DataKind::triangle);
-            const LeafTests t = leaf_tests(view.triangles + ref, count, view.spheres);
-            plan.add_leaf_ops(t.triangles, t.spheres);
+            const LeafTests t = leaf_tests(view.triangles + ref, count, view.curved);
+            plan.add_leaf_ops(t);
         }
     }
     const HwTriangle* leaf(uint32_t ref) const { return view.triangles + ref; }
@@ -152,8 +152,8 @@ private:
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
             const TriangleAddressing::Span span = m_view.tri_at.span(m_ref, m_count);
             m_plan.add_fetch(span.address, span.bytes, DataKind::triangle);
-            const detail::LeafTests t = detail::leaf_tests(m_view.triangles + m_ref, m_count, m_view.spheres);
-            m_plan.add_leaf_ops(t.triangles * rays, t.spheres * rays);
+            const detail::LeafTests t = detail::leaf_tests(m_view.triangles + m_ref, m_count, m_view.curved);
+            m_plan.add_leaf_ops(t, rays);
         }
     }
 

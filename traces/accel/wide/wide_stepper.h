@@ -40,7 +40,7 @@ struct WideView {
     uint64_t triangle_count = 0;
     uint64_t node_base = 0;      ///< address of node 0
     TriangleAddressing tri_at;   ///< where triangles' bytes are (plain or compressed leaves)
-    bool spheres = false;        ///< some records are spheres: leaves split their tests by kind
+    bool curved = false;         ///< some records are curved: leaves split their tests by kind
     ChildOrder order = ChildOrder::distance;
     uint32_t max_stack = 1;  ///< deepest stack a ray can need (from validation)
     /// Host-side copy of each node's slot mask, derived from the image when it is loaded (not
@@ -119,8 +119,8 @@ private:
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
             const TriangleAddressing::Span s = m_view.tri_at.span(ref, count);
             m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-            const detail::LeafTests t = detail::leaf_tests(m_view.triangles + ref, count, m_view.spheres);
-            m_plan.add_leaf_ops(t.triangles, t.spheres);
+            const detail::LeafTests t = detail::leaf_tests(m_view.triangles + ref, count, m_view.curved);
+            m_plan.add_leaf_ops(t);
         }
     }
 
@@ -156,9 +156,8 @@ private:
     }
 
     uint32_t visit_leaf() {
-        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + m_ref, m_count, m_view.spheres);
-        m_work.tri_tests += t.triangles;
-        m_work.sphere_tests += t.spheres;
+        const detail::LeafTests t = detail::leaf_tests(m_view.triangles + m_ref, m_count, m_view.curved);
+        detail::count_leaf_tests(m_work, t);
         const uint32_t alpha_before = m_work.anyhit_calls;
         const HwTriangle* tris = m_view.triangles + m_ref;
         const bool done = m_mode == TraversalMode::any_hit
