@@ -268,7 +268,7 @@ private:
             m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
             const TriangleAddressing::Span span = m_rules.tri_at().span(first, count);
             m_plan.add_fetch(span.address, span.bytes, DataKind::triangle);
-            m_plan.add_op(OpKind::triangle, count * lane_count(m_active));
+            m_plan.add_leaf_ops(detail::leaf_tests(m_rules.triangles() + first, count, true), lane_count(m_active));
             m_phase = Phase::leaf;
         }
         count_step(false);

@@ -236,7 +236,8 @@ const std::vector<Entry>& registry() {
           single_level(kBihStackEntryBytes)
               .with(&AccelCapabilities::packet_kernel)
               .with(&AccelCapabilities::restart_trail)
-              .with(&AccelCapabilities::refit)},
+              .with(&AccelCapabilities::refit)
+              .with(&AccelCapabilities::curved)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              if (builder == "wachter_keller") s.bih.visit(v);
              else tree_settings(builder, s, v);
@@ -278,7 +279,10 @@ const std::vector<Entry>& registry() {
          loader<ObvhAccel>()},
         {{"bkd", "B-Kd tree: two intervals per 20-byte node on one axis, no duplicates (Woop et al. 2006)",
           tree_builder_names(),
-          single_level(kBkdStackEntryBytes).with(&AccelCapabilities::packet_kernel).with(&AccelCapabilities::refit)},
+          single_level(kBkdStackEntryBytes)
+              .with(&AccelCapabilities::packet_kernel)
+              .with(&AccelCapabilities::refit)
+              .with(&AccelCapabilities::curved)},
          tree_settings,
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
              nlohmann::json unused;

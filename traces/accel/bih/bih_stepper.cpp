@@ -31,7 +31,7 @@ StepOutcome BihStepper::execute() {
                 m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
                 const TriangleAddressing::Span s = m_view.tri_at.span(n.first(), n.count());
                 m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-                m_plan.add_op(OpKind::triangle, n.count());
+                m_plan.add_leaf_ops(detail::leaf_tests(m_view.triangles + n.first(), n.count(), m_view.curved));
             }
             break;
         }
@@ -69,7 +69,7 @@ void BihStepper::interior(const BihNode& n) {
 
 uint32_t BihStepper::leaf() {
     const BihNode& n = m_view.nodes[m_node];
-    m_work.tri_tests += n.count();
+    detail::count_leaf_tests(m_work, detail::leaf_tests(m_view.triangles + n.first(), n.count(), m_view.curved));
     const uint32_t alpha_before = m_work.anyhit_calls;
     const HwTriangle* tris = m_view.triangles + n.first();
     const bool done = m_mode == TraversalMode::any_hit

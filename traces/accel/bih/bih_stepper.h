@@ -29,6 +29,7 @@ struct BihView {
     uint64_t node_count = 0, triangle_count = 0;
     uint64_t node_base = 0;                     ///< address of node 0
     TriangleAddressing tri_at;                  ///< where triangles' bytes are (plain or compressed leaves)
+    bool curved = false;                        ///< some records are curved: leaves split their tests by kind
     Aabb bounds;                                ///< the root cell
 };
 

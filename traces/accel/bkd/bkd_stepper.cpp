@@ -29,7 +29,7 @@ StepOutcome BkdStepper::execute() {
                 m_plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
                 const TriangleAddressing::Span s = m_view.tri_at.span(n.first(), n.count());
                 m_plan.add_fetch(s.address, s.bytes, DataKind::triangle);
-                m_plan.add_op(OpKind::triangle, n.count());
+                m_plan.add_leaf_ops(detail::leaf_tests(m_view.triangles + n.first(), n.count(), m_view.curved));
             }
             break;
         }
@@ -68,7 +68,7 @@ void BkdStepper::interior(const BkdNode& n) {
 
 uint32_t BkdStepper::leaf() {
     const BkdNode& n = m_view.nodes[m_node];
-    m_work.tri_tests += n.count();
+    detail::count_leaf_tests(m_work, detail::leaf_tests(m_view.triangles + n.first(), n.count(), m_view.curved));
     const uint32_t alpha_before = m_work.anyhit_calls;
     const HwTriangle* tris = m_view.triangles + n.first();
     const bool done = m_mode == TraversalMode::any_hit
