@@ -10,7 +10,7 @@ from rich.table import Table
 
 from rtsim.sim_summary import _get, _is_num, _two_column, fmt_float, fmt_int, fmt_pct
 
-BREAKDOWN = ("raygen", "traversal", "reorder", "shading")
+BREAKDOWN = ("raygen", "build", "traversal", "reorder", "shading")
 
 
 def frame_energy_mj(stats: dict[str, Any]) -> float | None:
@@ -34,6 +34,8 @@ def frame_table(stats: dict[str, Any]) -> Table:
     breakdown = sh.get("breakdown") or {}
     for part in BREAKDOWN:
         value = breakdown.get(part)
+        if part == "build" and not value:
+            continue  # only a moving scene's frame loop waits for builds
         share = value / frame if _is_num(value) and _is_num(frame) and frame else None
         table.add_row(f"  {part}", f"{fmt_int(value)} ({fmt_pct(share)})")
     stalls = sh.get("stalls") or {}

@@ -81,6 +81,15 @@ Cycle ShadingBlock::begin_frame(uint32_t f, Cycle at) {
     return end;
 }
 
+Cycle ShadingBlock::await_build(Cycle built) {
+    if (built > m_release) {
+        m_build += built - m_release;
+        m_release = built;
+        m_last_end = std::max(m_last_end, built);
+    }
+    return m_release;
+}
+
 ShadingBlock::Lane ShadingBlock::lane_of(const RayResult& r) {
     const RayRecord& ray = m_in.rays[r.id];
     const ShadeRecord& ref = m_in.shade[r.id];

@@ -43,6 +43,10 @@ public:
     /// wavefront, an animated trace: frame `f`'s primary rays are generated from `at` (its
     /// camera program, after the previous frame's last bounce); returns when its rays may start.
     Cycle begin_frame(uint32_t f, Cycle at);
+    /// wavefront, an animated trace: the frame's structures are built until `built` (the build
+    /// unit, beside the camera rays' generation); its rays start at neither's end before. Returns
+    /// when they may start; the wait beyond the ray generation is the breakdown's `build`.
+    Cycle await_build(Cycle built);
     /// inflight: when ray `id`'s parent is shaded, true and *not_before = that cycle.
     bool parent_shaded(uint64_t id, Cycle* not_before) const;
     /// inflight: the ray whose shading ray `id` waits for (its parent).
@@ -96,7 +100,7 @@ private:
     Cycle m_reorder_exposed = 0;  ///< sorting before the first warp of the current batch
     // Frame accounting (wavefront: serial parts that sum to the frame time).
     Cycle m_release = 0;  ///< current wavefront's start
-    uint64_t m_traversal = 0, m_reorder = 0, m_shading = 0, m_texture_bound = 0;
+    uint64_t m_traversal = 0, m_reorder = 0, m_shading = 0, m_texture_bound = 0, m_build = 0;
     Cycle m_last_end = 0;
     nlohmann::json m_wavefronts = nlohmann::json::array();
     // Counters.

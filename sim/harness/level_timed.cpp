@@ -92,7 +92,7 @@ LevelResult run_timed_level(RunInputs& in) {
             checker, built.features, shading.get());
     // The build unit, where the trace's frames record their builds (frame_builds.h).
     const std::vector<std::vector<BuildJob>> build_jobs =
-        c.build_unit.enabled && !wavefront ? frame_build_jobs(accel) : std::vector<std::vector<BuildJob>>{};
+        c.build_unit.enabled ? frame_build_jobs(accel) : std::vector<std::vector<BuildJob>>{};
     std::unique_ptr<BuildUnit> build_unit;
     if (!build_jobs.empty())
         build_unit = std::make_unique<BuildUnit>(c.build_unit, top.shared_memory(), c.l2.line_bytes);
@@ -116,11 +116,29 @@ LevelResult run_timed_level(RunInputs& in) {
             if (f != bound && built.frames.size() > 1) accel.bind_frame(uint32_t(f));
             bound = f;
         });
-        // Leading empty frames end at cycle 0, before the first frame with rays.
-        for (uint32_t f = 0; !shading->wavefront_frame.empty() && f < shading->wavefront_frame[0]; ++f)
-            frame_figures.frame_end(f, 0, top.memory_totals());
-        wire_frame_loop(top, c.shading, *shading,
-                        [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); });
+        // Frames first..last build their structures one after another from `at` (frame_builds.h).
+        FrameBuilds builds;
+        if (build_unit)
+            builds = [&](uint32_t first, uint32_t last, Cycle at) {
+                for (uint32_t f = first; f <= last && f < build_jobs.size(); ++f) {
+                    if (build_jobs[f].empty()) continue;
+                    const FrameBuild b = build_unit->run(build_jobs[f], at);
+                    frame_figures.set_build(f, b);
+                    at = b.end;
+                }
+                return at;
+            };
+        // Leading empty frames end at cycle 0, before the first frame with rays, whose structures
+        // are built from cycle 0 beside its ray generation.
+        const uint32_t first_frame = shading->wavefront_frame.empty() ? 0 : shading->wavefront_frame[0];
+        for (uint32_t f = 0; f < first_frame; ++f) frame_figures.frame_end(f, 0, top.memory_totals());
+        wire_frame_loop(
+            top, c.shading, *shading,
+            [&](uint32_t f, Cycle end) { frame_figures.frame_end(f, end, top.memory_totals()); }, builds);
+        if (builds && first_frame > 0) {
+            const Cycle built = builds(1, first_frame, 0);
+            top.dispatch().hold_until(top.shading()->await_build(built));
+        }
     } else if (!sampled || built.frames.size() > 1) {
         // A sampled animated trace: each frame's clusters behind its barrier, its structure bound for them.
         if (build_unit) top.dispatch().set_barrier(build_at_barrier);  // before: leading empty frames build too

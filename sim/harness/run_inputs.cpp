@@ -73,7 +73,10 @@ StructureTraits structure_traits(const RunInputs& in) {
     t.kind = f.kind;
     t.blas_kind = f.blas_kind;
     t.compressed_leaves = f.compressed_leaves;
-    t.can_compress_leaves = f.caps.compressed_leaves;
+    // Compressed leaves index triangle vertices: a scene with spheres or capsules refuses them.
+    const json scene = in.manifest.value("scene", json::object());
+    const bool curved = scene.is_object() && (scene.value("spheres", 0) > 0 || scene.value("capsules", 0) > 0);
+    t.can_compress_leaves = f.caps.compressed_leaves && !curved;
     t.treelet_partition = f.caps.treelet_partition;
     t.stack_addresses = f.caps.stack_addresses;
     t.quantized_boxes = f.caps.quantized_boxes;

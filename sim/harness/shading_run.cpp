@@ -79,12 +79,12 @@ std::vector<FrameRecord> wavefront_segments(const ShadingInputs& inputs) {
 }
 
 void wire_frame_loop(Top& top, const ShadingConfig& config, const ShadingInputs& inputs,
-                     std::function<void(uint32_t, Cycle)> on_frame) {
+                     std::function<void(uint32_t, Cycle)> on_frame, FrameBuilds build) {
     ShadingBlock& shading = *top.shading();
     Dispatch& dispatch = top.dispatch();
     dispatch.hold_until(shading.raygen_end());
     if (config.frame_loop == FrameLoop::wavefront) {
-        dispatch.set_barrier([&shading, &inputs, on_frame](uint32_t w, Cycle end) {
+        dispatch.set_barrier([&shading, &inputs, on_frame, build](uint32_t w, Cycle end) {
             Cycle released = shading.wavefront_end(w, end);
             const size_t n = inputs.wavefronts.size();
             const uint32_t frame = w < inputs.wavefront_frame.size() ? inputs.wavefront_frame[w] : 0;
@@ -96,8 +96,13 @@ void wire_frame_loop(Top& top, const ShadingConfig& config, const ShadingInputs&
                 on_frame(frame, released);
                 for (uint32_t e = frame + 1; e < next; ++e) on_frame(e, released);
             }
-            // The next frame's camera rays, after this frame's last bounce is shaded.
-            if (last_of_frame && w + 1 < n) released = shading.begin_frame(inputs.wavefront_frame[w + 1], released);
+            // The next frame's camera rays, after this frame's last bounce is shaded, while the
+            // build unit builds its structures (and those of the empty frames before it).
+            if (last_of_frame && w + 1 < n) {
+                const uint32_t next = inputs.wavefront_frame[w + 1];
+                const Cycle built = build ? build(frame + 1, next, released) : released;
+                released = shading.await_build(std::max(built, shading.begin_frame(next, released)));
+            }
             return released;
         });
         return;

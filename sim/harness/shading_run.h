@@ -22,7 +22,11 @@ std::vector<FrameRecord> wavefront_segments(const ShadingInputs& inputs);
 /// per bounce released when the shading block has shaded it (`on_frame(f, cycle)`: frame f's last
 /// bounce shaded; an animated trace's next frame then generates its camera rays); inflight: rays
 /// wait for their parent's warp.
+/// `build(first, last, at)`: an animated trace's frames first..last build their structures from
+/// `at` on the build unit and return when the last is built (wavefront, between frames; none
+/// without a build unit).
+using FrameBuilds = std::function<Cycle(uint32_t first, uint32_t last, Cycle at)>;
 void wire_frame_loop(Top& top, const ShadingConfig& config, const ShadingInputs& inputs,
-                     std::function<void(uint32_t, Cycle)> on_frame);
+                     std::function<void(uint32_t, Cycle)> on_frame, FrameBuilds build = nullptr);
 
 }  // namespace rtsim

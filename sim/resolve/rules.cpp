@@ -229,10 +229,6 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
         out.push_back({"traversal.stack_prefetch", f.structure.name() + "'s steppers report no stack addresses to prefetch"});
     else if (f.config.traversal.stack_prefetch && !f.level.timed)
         out.push_back({"traversal.stack_prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
-    if (f.config.build_unit.enabled && animated(f) && f.config.shading.enabled && f.structure.shading_sections &&
-        f.level.shades)
-        out.push_back({"build_unit.enabled", "with shading, an animated trace's frames are the wavefront loop's "
-                                             "barriers, where the build unit's work is not simulated yet"});
     if (f.config.shading.enabled && !f.structure.shading_sections)
         out.push_back({"shading.enabled", "this trace has no shading sections (written before trace version 5): "
                                           "the RT unit alone is timed"});

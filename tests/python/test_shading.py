@@ -16,7 +16,7 @@ import pytest
 import rtsim
 from conftest import checked, run_rtsim
 
-BREAKDOWN = ("raygen", "traversal", "reorder", "shading")
+BREAKDOWN = ("raygen", "build", "traversal", "reorder", "shading")
 
 
 @pytest.fixture(scope="module")

@@ -199,3 +199,13 @@ def test_version_5_traces_open_with_zero_sphere_tests(trace: Path, tmp_path: Pat
     assert (old.work["sphere_tests"] == 0).all()
     for field in ("steps", "box_tests", "tri_tests", "refs"):
         assert (old.work[field] == new.work[field]).all(), field
+
+
+def test_verdict_offers_no_compressed_leaves_for_curved_scenes(
+    trace: Path, sim_exe: Path, tmp_path: Path
+) -> None:
+    """Compressed leaves index triangle vertices (a sphere scene refuses them), so the verdict's
+    structural alternatives leave them out; the other structures that store spheres stay."""
+    stats = checked(sim_exe, trace, tmp_path / "run")
+    keys = {k["key"] for k in stats["verdict"]["structural"]}
+    assert "compressed_leaves" not in keys and "treelets.enabled" in keys

@@ -52,7 +52,7 @@
     X(rp_box_hits, kNoOpKind, false, "reduced-precision boxes: entered, though fp32 rejects or culls them") \
     X(rp_steps, kNoOpKind, true, "reduced-precision boxes: node steps inside those boxes")           \
     X(rp_box_tests, kNoOpKind, false, "reduced-precision boxes: box tests of those steps")          \
-    X(rp_tri_tests, kNoOpKind, false, "reduced-precision boxes: triangle tests in their leaves (no hit)") \
+    X(rp_tri_tests, kNoOpKind, false, "reduced-precision boxes: primitive tests in their leaves (no hit; curved ones priced as triangles)") \
     X(obb_rotations, OpKind::obb, false, "oriented boxes: ray rotations into oriented nodes' frames (obvh2)")
 
 #define RTSIM_ALL_WORK_FIELDS(X) RTSIM_WORK_FIELDS(X) RTSIM_MODEL_WORK_FIELDS(X)
