@@ -264,7 +264,8 @@ const std::vector<Entry>& registry() {
           tree_builder_names(),
           single_level(kBvhStackEntryBytes)
               .with(&AccelCapabilities::anyhit_order)
-              .with(&AccelCapabilities::stack_addresses)},
+              .with(&AccelCapabilities::stack_addresses)
+              .with(&AccelCapabilities::curved)},
          [](const std::string& builder, BuildSettings& s, SettingsVisitor& v) {
              tree_settings(builder, s, v);
              s.obb.visit(v);

@@ -53,6 +53,22 @@ struct ObbNodeFit {
     Aabb box[2];
 };
 
+/// Grows `box` by record `rec` in the frame of rotation `m`: a triangle's rotated vertices; a
+/// sphere's rotated centre, or a capsule's rotated ends, widened by the radius (a sphere is the
+/// same in every frame).
+void grow_rotated(Aabb& box, const float* m, const HwTriangle& rec) {
+    auto point = [&](const float* p) { return obb_rotate(m, Vec3(p[0], p[1], p[2])); };
+    if (!is_curved(rec)) {
+        box.grow(point(rec.v0)), box.grow(point(rec.v1)), box.grow(point(rec.v2));
+        return;
+    }
+    const float r = is_sphere(rec) ? rec.v1[0] : rec.v2[0];
+    for (const Vec3& c : {point(rec.v0), is_sphere(rec) ? point(rec.v0) : point(rec.v1)}) {
+        box.grow(c - Vec3(r));
+        box.grow(c + Vec3(r));
+    }
+}
+
 /// Tries rotations [first, last) on every node, keeping in `fits` each node's best below its
 /// current cost (a lower index wins ties: the result does not depend on how rotations are split
 /// among threads).
@@ -72,11 +88,7 @@ void fit_rotations(const HwNode* nodes, uint64_t count, const HwTriangle* tris, 
                     box[c] = subtree[n.child_ref[c]];
                     continue;
                 }
-                for (uint32_t t = n.child_ref[c]; t < n.child_ref[c] + k; ++t) {
-                    box[c].grow(obb_rotate(m, Vec3(tris[t].v0[0], tris[t].v0[1], tris[t].v0[2])));
-                    box[c].grow(obb_rotate(m, Vec3(tris[t].v1[0], tris[t].v1[1], tris[t].v1[2])));
-                    box[c].grow(obb_rotate(m, Vec3(tris[t].v2[0], tris[t].v2[1], tris[t].v2[2])));
-                }
+                for (uint32_t t = n.child_ref[c]; t < n.child_ref[c] + k; ++t) grow_rotated(box[c], m, tris[t]);
             }
             subtree[i] = box[0];
             subtree[i].grow(box[1]);
