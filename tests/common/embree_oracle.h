@@ -29,6 +29,23 @@
 
 namespace rtsim::oracle {
 
+/// rtsim's ray as Embree's, with rtsim's interval: tmin excluded (tnear just above it), tmax
+/// included.
+inline void embree_ray(const Ray& r, RTCRay* ray) {
+    ray->org_x = r.origin.x;
+    ray->org_y = r.origin.y;
+    ray->org_z = r.origin.z;
+    ray->dir_x = r.direction.x;
+    ray->dir_y = r.direction.y;
+    ray->dir_z = r.direction.z;
+    ray->tnear = std::nextafter(r.tmin, std::numeric_limits<float>::infinity());
+    ray->tfar = r.tmax;
+    ray->time = 0.0f;
+    ray->mask = 0xFFFFFFFFu;
+    ray->id = 0;
+    ray->flags = 0;
+}
+
 /// Alpha coverage x 255 of a material, as the BVH flattener stores it (255 for non-MASK).
 inline uint32_t material_coverage_x255(const Material& m) {
     if (m.alpha_mode != AlphaMode::mask) return 255u;
@@ -79,7 +96,7 @@ public:
     /// Closest hit in rtsim's terms (prim -1 and t = +inf on a miss).
     Hit intersect(const Ray& r) const {
         RTCRayHit rh;
-        fill(r, &rh.ray);
+        embree_ray(r, &rh.ray);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
         RTCIntersectContext ctx;
@@ -98,7 +115,7 @@ public:
     /// Any hit (occlusion) in the ray's interval.
     bool occluded(const Ray& r) const {
         RTCRay ray;
-        fill(r, &ray);
+        embree_ray(r, &ray);
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         rtcOccluded1(m_scene, &ctx, &ray);
@@ -172,20 +189,6 @@ private:
         }
     }
 
-    static void fill(const Ray& r, RTCRay* ray) {
-        ray->org_x = r.origin.x;
-        ray->org_y = r.origin.y;
-        ray->org_z = r.origin.z;
-        ray->dir_x = r.direction.x;
-        ray->dir_y = r.direction.y;
-        ray->dir_z = r.direction.z;
-        ray->tnear = std::nextafter(r.tmin, std::numeric_limits<float>::infinity());
-        ray->tfar = r.tmax;
-        ray->time = 0.0f;
-        ray->mask = 0xFFFFFFFFu;
-        ray->id = 0;
-        ray->flags = 0;
-    }
 
     void check(const char* what) const {
         const RTCError e = rtcGetDeviceError(m_device);

@@ -27,6 +27,14 @@ void Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n
 bool Accel::has_anyhit_triangles() const { return has_flagged_records(kTriAnyHit); }
 bool Accel::has_spheres() const { return has_flagged_records(kPrimSphere); }
 bool Accel::has_capsules() const { return has_flagged_records(kPrimCapsule); }
+bool Accel::has_curved() const { return has_flagged_records(kPrimSphere | kPrimCapsule); }
+
+std::vector<OpKind> Accel::with_record_kinds(std::vector<OpKind> kinds) const {
+    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
+    if (has_spheres()) kinds.push_back(OpKind::sphere);
+    if (has_capsules()) kinds.push_back(OpKind::capsule);
+    return kinds;
+}
 
 bool Accel::has_flagged_records(uint32_t flag) const {
     for (const Region& r : m_image.regions) {

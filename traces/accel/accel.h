@@ -89,6 +89,8 @@ public:
     bool has_spheres() const;
     /// True when some record is a capsule (the capsule pipeline is then needed).
     bool has_capsules() const;
+    /// True when some record is a sphere or a capsule (leaves then split their tests by kind).
+    bool has_curved() const;
     /// Frames of an animated scene the image holds (docs/accel.md, "Frames"): 1, or for a
     /// two-level image traced with --frames, one TLAS per frame over the same BLASes.
     virtual uint32_t frame_count() const { return 1; }
@@ -98,6 +100,10 @@ public:
     virtual void bind_frame(uint32_t f);
 
 protected:
+    /// `kinds` (the structure's own operations) and those its records call for: the any-hit
+    /// stage for alpha-MASK triangles, the sphere and capsule pipelines for curved ones.
+    std::vector<OpKind> with_record_kinds(std::vector<OpKind> kinds) const;
+
     AccelImage m_image;
     /// The triangles the steppers read, plain or decoded from compressed leaves (leaf_blocks.h);
     /// opened by structures that have a triangle region.

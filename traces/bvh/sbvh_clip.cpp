@@ -5,20 +5,12 @@
 #include <cmath>
 #include <limits>
 
+#include "traces/common/float_rounding.h"
+
 namespace rtsim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-/// Largest float <= x and smallest float >= x.
-float round_down(double x) {
-    float f = float(x);
-    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-}
-float round_up(double x) {
-    float f = float(x);
-    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-}
 
 }  // namespace
 

@@ -15,32 +15,6 @@
 namespace rtsim {
 namespace detail {
 
-struct Dvec {
-    double x, y, z;
-};
-inline double dot(const Dvec& a, const Dvec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Dvec sub(const Dvec& a, const Dvec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Dvec mad(const Dvec& a, double s, const Dvec& b) { return {a.x + s * b.x, a.y + s * b.y, a.z + s * b.z}; }
-
-/// The two crossings (nearer first) of the ray f + t d (f: origin relative to a point of the
-/// shape) with the quadric |f + t d|^2 = rr, where f and d are already projected as the shape
-/// needs (the whole vectors for a sphere, their parts across the axis for a cylinder). False
-/// when the ray misses (or d is 0).
-inline bool quadric_roots(const Dvec& f, const Dvec& d, double rr, double* t0, double* t1) {
-    const double a = dot(d, d);
-    if (!(a > 0.0)) return false;
-    const double b = -dot(f, d);
-    const Dvec l = mad(f, b / a, d);
-    const double disc = rr - dot(l, l);
-    if (!(disc >= 0.0)) return false;
-    const double q = b + std::copysign(std::sqrt(a * disc), b);
-    const double c = dot(f, f) - rr;
-    *t0 = q != 0.0 ? c / q : 0.0;
-    *t1 = q != 0.0 ? q / a : 0.0;
-    if (*t0 > *t1) std::swap(*t0, *t1);
-    return true;
-}
-
 /// Texture coordinates of a capsule hit: u along the axis (0 at p0, 1 at p1; the caps at the
 /// ends), v the angle about the axis over 2 pi, from a frame fixed by the axis alone.
 inline void capsule_uv(const Dvec& axis, double length, const Dvec& rel, float* u, float* v) {

@@ -25,6 +25,32 @@ inline void sphere_uv(double nx, double ny, double nz, float* u, float* v) {
     if (!(*u < 1.0f)) *u = 0.0f;  // phi rounded up to 2 pi
 }
 
+struct Dvec {
+    double x, y, z;
+};
+inline double dot(const Dvec& a, const Dvec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Dvec sub(const Dvec& a, const Dvec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Dvec mad(const Dvec& a, double s, const Dvec& b) { return {a.x + s * b.x, a.y + s * b.y, a.z + s * b.z}; }
+
+/// The two crossings (nearer first) of the ray f + t d (f: origin relative to a point of the
+/// shape) with the quadric |f + t d|^2 = rr, where f and d are already projected as the shape
+/// needs (the whole vectors for a sphere, their parts across the axis for a cylinder). False
+/// when the ray misses (or d is 0).
+inline bool quadric_roots(const Dvec& f, const Dvec& d, double rr, double* t0, double* t1) {
+    const double a = dot(d, d);
+    if (!(a > 0.0)) return false;
+    const double b = -dot(f, d);
+    const Dvec l = mad(f, b / a, d);
+    const double disc = rr - dot(l, l);
+    if (!(disc >= 0.0)) return false;
+    const double q = b + std::copysign(std::sqrt(a * disc), b);
+    const double c = dot(f, f) - rr;
+    *t0 = q != 0.0 ? c / q : 0.0;
+    *t1 = q != 0.0 ? q / a : 0.0;
+    if (*t0 > *t1) std::swap(*t0, *t1);
+    return true;
+}
+
 /// True if the ray hits the sphere (centre c, radius r) at tmin < t <= tmax: the nearer of the
 /// two crossings inside the interval (the far one for a ray starting inside). A tangent ray hits
 /// at its one point of contact; a sphere of radius 0 (or not finite) is never hit. hit->u, v are
@@ -32,30 +58,18 @@ inline void sphere_uv(double nx, double ny, double nz, float* u, float* v) {
 inline bool sphere_kernel(const RayTrianglePre& pre, const float c[3], float r, float tmin, float tmax,
                           TriangleHit* hit) {
     if (!(r > 0.0f) || !std::isfinite(r)) return false;
-    const double fx = double(pre.origin.x) - c[0], fy = double(pre.origin.y) - c[1], fz = double(pre.origin.z) - c[2];
-    const double dx = pre.direction.x, dy = pre.direction.y, dz = pre.direction.z;
-    const double a = dx * dx + dy * dy + dz * dz;
-    const double b = -(fx * dx + fy * dy + fz * dz);  // half of the textbook's -b
-    // The closest point of the ray's line to the centre, relative to it: f + (b / a) d.
-    const double s = b / a;
-    const double lx = fx + s * dx, ly = fy + s * dy, lz = fz + s * dz;
-    const double rr = double(r) * double(r);
-    const double disc = rr - (lx * lx + ly * ly + lz * lz);  // (discriminant / 4) / a
-    if (!(disc >= 0.0)) return false;
-    const double q = b + std::copysign(std::sqrt(a * disc), b);
-    const double cc = fx * fx + fy * fy + fz * fz - rr;
-    // The two crossings, nearer first. q is 0 only when both b and the root are: a tangent ray
-    // at its closest approach, whose one crossing is t = s = 0.
-    double t0 = q != 0.0 ? cc / q : 0.0, t1 = q != 0.0 ? q / a : 0.0;
-    if (t0 > t1) std::swap(t0, t1);
+    const Dvec f{double(pre.origin.x) - c[0], double(pre.origin.y) - c[1], double(pre.origin.z) - c[2]};
+    const Dvec d{pre.direction.x, pre.direction.y, pre.direction.z};
+    double t0, t1;
+    if (!quadric_roots(f, d, double(r) * double(r), &t0, &t1)) return false;
     float t = float(t0);
     if (!(t > tmin && t <= tmax)) {
         t = float(t1);
         if (!(t > tmin && t <= tmax)) return false;
     }
-    const double nx = (fx + double(t) * dx) / r, ny = (fy + double(t) * dy) / r, nz = (fz + double(t) * dz) / r;
+    const Dvec n = mad(f, double(t), d);
     hit->t = t;
-    sphere_uv(nx, ny, nz, &hit->u, &hit->v);
+    sphere_uv(n.x / r, n.y / r, n.z / r, &hit->u, &hit->v);
     return true;
 }
 

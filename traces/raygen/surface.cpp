@@ -14,6 +14,25 @@ constexpr float gamma(int n) {
     return (n * eps) / (1.0f - n * eps);
 }
 
+/// The error bound `gamma(n)` of a point whose terms sum to `magnitude` per axis, with a floor of
+/// its largest axis (pbrt's bound is zero in an axis where every term is 0, e.g. a wall in the
+/// plane x = 0, and then the offset vanishes while the intersection's arithmetic can still turn
+/// the exact t = 0 of a self-hit into ~1e-9; the floor keeps it non-zero and scale-invariant).
+Vec3 point_error(const Vec3& magnitude, int n) {
+    const float floor = std::max(magnitude.x, std::max(magnitude.y, magnitude.z));
+    return gamma(n) * (magnitude + Vec3(floor));
+}
+
+/// The rest of a surface point from its geometric normal `n` (unit): which side the ray meets,
+/// the normal turned towards the ray, the primitive and its material.
+void face_the_ray(SurfacePoint& sp, Vec3 n, const Scene& scene, const Ray& ray, const Hit& hit) {
+    sp.front = glm::dot(n, ray.direction) <= 0.0f;
+    if (!sp.front) n = -n;
+    sp.normal = n;
+    sp.prim = uint32_t(hit.prim);
+    sp.material = scene.material_of(uint32_t(hit.prim));
+}
+
 /// A curved primitive's hit point (pbrt-v4 Sphere::Intersect): the point on the ray,
 /// reprojected onto the surface (the nearest point of the sphere's centre or the capsule's axis,
 /// plus radius x the unit normal from it), with pbrt's gamma(5) bound, taken here relative to
@@ -34,14 +53,8 @@ SurfacePoint curved_surface_point(const Scene& scene, const Ray& ray, const Hit&
     Vec3 n = len > 0.0 ? Vec3(rel / len) : Vec3(0.0f, 0.0f, 1.0f);
     SurfacePoint sp;
     sp.position = Vec3(axis_point + double(r) * glm::dvec3(n));
-    const Vec3 magnitude = glm::abs(c) + glm::abs(r * n);
-    const float floor = std::max(magnitude.x, std::max(magnitude.y, magnitude.z));
-    sp.error = gamma(5) * (magnitude + Vec3(floor));
-    sp.front = glm::dot(n, ray.direction) <= 0.0f;
-    if (!sp.front) n = -n;
-    sp.normal = n;
-    sp.prim = uint32_t(hit.prim);
-    sp.material = scene.material_of(uint32_t(hit.prim));
+    sp.error = point_error(glm::abs(c) + glm::abs(r * n), 5);
+    face_the_ray(sp, n, scene, ray, hit);
     return sp;
 }
 
@@ -54,21 +67,11 @@ SurfacePoint surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
     SurfacePoint sp;
     // Barycentric interpolation and its error bound (pbrt-v4 Triangle::InteractionFromIntersection).
     sp.position = b0 * tri.v0 + hit.u * tri.v1 + hit.v * tri.v2;
-    Vec3 abs_sum = glm::abs(b0 * tri.v0) + glm::abs(hit.u * tri.v1) + glm::abs(hit.v * tri.v2);
-    // pbrt's bound is zero in an axis where all three vertices are 0 (a wall in the plane x = 0),
-    // and then the offset vanishes while the shear in the triangle test can still turn the exact
-    // t = 0 of a self-hit into ~1e-9. A floor relative to the point's magnitude keeps the offset
-    // non-zero and scale-invariant.
-    float floor = std::max(abs_sum.x, std::max(abs_sum.y, abs_sum.z));
-    sp.error = gamma(7) * (abs_sum + Vec3(floor));
+    sp.error = point_error(glm::abs(b0 * tri.v0) + glm::abs(hit.u * tri.v1) + glm::abs(hit.v * tri.v2), 7);
     Vec3 n = glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
     float len = glm::length(n);
     n = len > 0.0f ? n / len : Vec3(0.0f, 0.0f, 1.0f);
-    sp.front = glm::dot(n, ray.direction) <= 0.0f;
-    if (!sp.front) n = -n;
-    sp.normal = n;
-    sp.prim = uint32_t(hit.prim);
-    sp.material = scene.material_of(uint32_t(hit.prim));
+    face_the_ray(sp, n, scene, ray, hit);
     return sp;
 }
 

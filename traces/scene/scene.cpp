@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "traces/common/error.h"
+#include "traces/common/float_rounding.h"
 
 namespace rtsim {
 
@@ -39,16 +40,6 @@ double largest_axis_scale(const glm::dmat4& m) {
     double s = 0.0;
     for (int c = 0; c < 3; ++c) s = std::max(s, glm::length(glm::dvec3(m[c])));
     return s;
-}
-
-/// x rounded to float towards -inf (down) or +inf (up).
-float round_down(double x) {
-    float f = float(x);
-    return double(f) > x ? std::nextafter(f, -INFINITY) : f;
-}
-float round_up(double x) {
-    float f = float(x);
-    return double(f) < x ? std::nextafter(f, INFINITY) : f;
 }
 
 /// A sphere (p0 == p1) or capsule (p0 to p1) as a flattened primitive: {lo, hi, centre}, its

@@ -14,6 +14,7 @@
 #include <embree3/rtcore.h>
 #include <gtest/gtest.h>
 
+#include "embree_oracle.h"
 #include "traces/accel/accel.h"
 #include "traces/common/rng.h"
 #include "traces/scene/gltf_loader.h"
@@ -66,9 +67,7 @@ public:
     }
     Hit intersect(const Ray& r) const {
         RTCRayHit rh{};
-        rh.ray.org_x = r.origin.x, rh.ray.org_y = r.origin.y, rh.ray.org_z = r.origin.z;
-        rh.ray.dir_x = r.direction.x, rh.ray.dir_y = r.direction.y, rh.ray.dir_z = r.direction.z;
-        rh.ray.tnear = r.tmin, rh.ray.tfar = r.tmax, rh.ray.mask = 0xFFFFFFFFu;
+        oracle::embree_ray(r, &rh.ray);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
@@ -81,9 +80,7 @@ public:
     }
     bool occluded(const Ray& r) const {
         RTCRay ray{};
-        ray.org_x = r.origin.x, ray.org_y = r.origin.y, ray.org_z = r.origin.z;
-        ray.dir_x = r.direction.x, ray.dir_y = r.direction.y, ray.dir_z = r.direction.z;
-        ray.tnear = r.tmin, ray.tfar = r.tmax, ray.mask = 0xFFFFFFFFu;
+        oracle::embree_ray(r, &ray);
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         rtcOccluded1(m_scene, &ctx, &ray);

@@ -205,6 +205,28 @@ TEST(RaySphere, EachSphereKeepsItsOwnRadiusAndTheNodeScalesIt) {
     EXPECT_FLOAT_EQ(h.t, 4.0f);
 }
 
+TEST(RaySphere, ANodeScaledToZeroHidesItsSpheres) {
+    // glTF hides nodes by scaling them to 0: the sphere is flattened with radius 0, never hit.
+    Scene scene;
+    Mesh mesh;
+    mesh.name = "hidden";
+    mesh.positions = {Vec3(0), Vec3(0), Vec3(0)};
+    mesh.radii = {1.0f};
+    mesh.materials = {0};
+    scene.meshes.push_back(mesh);
+    Instance inst;
+    inst.object_to_world = glm::dmat4(0.0);
+    inst.object_to_world[3][3] = 1.0;
+    scene.instances.push_back(inst);
+    scene.materials = {Material{}};
+    scene.flatten();
+    EXPECT_FALSE(scene.is_sphere(0));
+    const HwBvh bvh = build_bvh(scene);
+    EXPECT_FALSE(trace_ray_brute_force(bvh.triangles.data(), bvh.triangles.size(),
+                                       make_ray(Vec3(0, 0, -5), Vec3(0, 0, 1)), TraversalMode::closest_hit)
+                     .valid());
+}
+
 TEST(RaySphere, AnAlphaMaskedSphereShowsItsFarSideWhereItsNearSideIsCutOut) {
     // One MASK sphere (coverage 0.5): a ray whose near crossing fails the alpha test goes on
     // to the far crossing, which has an alpha test of its own.

@@ -75,7 +75,7 @@ BihAccel::BihAccel(AccelImage image, const std::string& source) : Accel(std::mov
     m_view.triangles = m_triangles.triangles();
     m_view.triangle_count = m_triangles.count();
     m_view.tri_at = m_triangles.addressing();
-    m_view.curved = has_spheres() || has_capsules();
+    m_view.curved = has_curved();
     m_view.bounds = root_cell_from_json(m_image.params, source + ": bih params");
     m_depth = validate_bih(m_view, source);
 }
@@ -115,11 +115,7 @@ LocalityPartition BihAccel::partition(uint64_t budget_bytes) const {
 }
 
 std::vector<OpKind> BihAccel::op_kinds() const {
-    std::vector<OpKind> kinds{OpKind::box, OpKind::plane, OpKind::triangle};
-    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
-    if (has_spheres()) kinds.push_back(OpKind::sphere);
-    if (has_capsules()) kinds.push_back(OpKind::capsule);
-    return kinds;
+    return with_record_kinds({OpKind::box, OpKind::plane, OpKind::triangle});
 }
 
 }  // namespace rtsim

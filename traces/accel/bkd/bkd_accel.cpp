@@ -86,7 +86,7 @@ BkdAccel::BkdAccel(AccelImage image, const std::string& source) : Accel(std::mov
     m_view.triangles = m_triangles.triangles();
     m_view.triangle_count = m_triangles.count();
     m_view.tri_at = m_triangles.addressing();
-    m_view.curved = has_spheres() || has_capsules();
+    m_view.curved = has_curved();
     m_view.bounds = root_cell_from_json(m_image.params, source + ": bkd params");
     m_depth = validate_bkd(m_view, source);
 }
@@ -122,11 +122,7 @@ LocalityPartition BkdAccel::partition(uint64_t budget_bytes) const {
 }
 
 std::vector<OpKind> BkdAccel::op_kinds() const {
-    std::vector<OpKind> kinds{OpKind::box, OpKind::plane, OpKind::triangle};
-    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
-    if (has_spheres()) kinds.push_back(OpKind::sphere);
-    if (has_capsules()) kinds.push_back(OpKind::capsule);
-    return kinds;
+    return with_record_kinds({OpKind::box, OpKind::plane, OpKind::triangle});
 }
 
 }  // namespace rtsim

@@ -185,7 +185,7 @@ Bvh2Accel::Bvh2Accel(AccelImage image, const std::string& source) : Accel(std::m
     m_view.triangles = m_triangles.triangles();
     m_view.triangle_count = m_triangles.count();
     m_view.tri_at = m_triangles.addressing();
-    m_view.curved = has_spheres() || has_capsules();
+    m_view.curved = has_curved();
     validate_bvh2(m_view, source);
 }
 
@@ -214,11 +214,7 @@ LocalityPartition Bvh2Accel::partition(uint64_t budget_bytes) const {
 }
 
 std::vector<OpKind> Bvh2Accel::op_kinds() const {
-    std::vector<OpKind> kinds{OpKind::box, OpKind::triangle};
-    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
-    if (has_spheres()) kinds.push_back(OpKind::sphere);
-    if (has_capsules()) kinds.push_back(OpKind::capsule);
-    return kinds;
+    return with_record_kinds({OpKind::box, OpKind::triangle});
 }
 
 }  // namespace rtsim

@@ -65,9 +65,7 @@ Hit GridAccel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const
 LocalityPartition GridAccel::partition(uint64_t budget_bytes) const { return grid_partition(m_view, budget_bytes); }
 
 std::vector<OpKind> GridAccel::op_kinds() const {
-    std::vector<OpKind> kinds{OpKind::box, OpKind::cell, OpKind::triangle};
-    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
-    return kinds;
+    return with_record_kinds({OpKind::box, OpKind::cell, OpKind::triangle});
 }
 
 }  // namespace rtsim

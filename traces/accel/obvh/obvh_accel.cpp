@@ -50,7 +50,7 @@ ObvhAccel::ObvhAccel(AccelImage image, const std::string& source) : Accel(std::m
     m_view.triangles = m_triangles.triangles();
     m_view.triangle_count = m_triangles.count();
     m_view.tri_at = m_triangles.addressing();
-    m_view.curved = has_spheres() || has_capsules();
+    m_view.curved = has_curved();
     m_view.rotations = m_rotations.data();
     m_view.rotation_table = m_table.data();
     // Every vertex lies in the scene's bounds, so within their farthest corner's distance.
@@ -79,11 +79,7 @@ LocalityPartition ObvhAccel::partition(uint64_t budget_bytes) const {
 }
 
 std::vector<OpKind> ObvhAccel::op_kinds() const {
-    std::vector<OpKind> kinds{OpKind::box, OpKind::obb, OpKind::triangle};
-    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
-    if (has_spheres()) kinds.push_back(OpKind::sphere);
-    if (has_capsules()) kinds.push_back(OpKind::capsule);
-    return kinds;
+    return with_record_kinds({OpKind::box, OpKind::obb, OpKind::triangle});
 }
 
 }  // namespace rtsim

@@ -137,9 +137,7 @@ LocalityPartition OctreeAccel::partition(uint64_t budget_bytes) const {
 }
 
 std::vector<OpKind> OctreeAccel::op_kinds() const {
-    std::vector<OpKind> kinds{OpKind::box, OpKind::plane, OpKind::triangle};
-    if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
-    return kinds;
+    return with_record_kinds({OpKind::box, OpKind::plane, OpKind::triangle});
 }
 
 }  // namespace rtsim

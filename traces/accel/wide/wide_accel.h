@@ -130,7 +130,7 @@ public:
         m_view.triangles = m_triangles.triangles();
         m_view.triangle_count = m_triangles.count();
         m_view.tri_at = m_triangles.addressing();
-        m_view.curved = has_spheres() || has_capsules();
+        m_view.curved = has_curved();
         m_view.order = child_order_param(m_image, source);
         m_view.max_stack = validate_wide<Codec>(m_view, source, m_image.kind);
         m_valid.resize(m_view.node_count);
@@ -165,11 +165,7 @@ public:
         return partition_tree(wide_locality_tree<Codec>(m_view), budget_bytes);
     }
     std::vector<OpKind> op_kinds() const override {
-        std::vector<OpKind> kinds{OpKind::box, OpKind::triangle};
-        if (has_anyhit_triangles()) kinds.push_back(OpKind::anyhit);
-        if (has_spheres()) kinds.push_back(OpKind::sphere);
-        if (has_capsules()) kinds.push_back(OpKind::capsule);
-        return kinds;
+        return with_record_kinds({OpKind::box, OpKind::triangle});
     }
     uint32_t max_stack_entries() const override { return m_view.max_stack; }
     const WideView& view() const { return m_view; }
