@@ -63,7 +63,7 @@ public:
     int add_material(const Material& m);
     /// Adds a mesh with one primitive per (soup, material) pair; returns the glTF mesh index.
     int add_mesh(const std::string& name, const std::vector<std::pair<const TriangleSoup*, int>>& parts);
-    /// Adds a mesh of spheres (docs/scenes.md, "Spheres"): one POINTS primitive whose POSITION
+    /// Adds a mesh of spheres (docs/accel.md, "Spheres and capsules"): one POINTS primitive whose POSITION
     /// are the centres and whose _RADIUS the radii; returns the glTF mesh index.
     int add_sphere_mesh(const std::string& name, const std::vector<Vec3>& centres, const std::vector<float>& radii,
                         int material);

@@ -1,5 +1,5 @@
-// Scenes of spheres (curved primitives, docs/scenes.md "Spheres"), written as glTF POINTS
-// primitives with a _RADIUS attribute:
+// Scenes of spheres and capsules (docs/accel.md, "Spheres and capsules"), written as glTF POINTS
+// and LINES primitives with a _RADIUS attribute:
 //  - particles: a cloud of small spheres (a particle system's sprites as geometry) around a
 //    mirror sphere, over a floor, lit by a point light: primary, shadow, reflection and
 //    diffuse rays, spheres and triangles in one structure;
