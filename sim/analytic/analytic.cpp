@@ -113,8 +113,14 @@ std::string stream_fingerprint(const std::vector<RayJob>& jobs, const Accel& acc
         const auto* p = static_cast<const unsigned char*>(data);
         for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
     };
+    // The structure by address and by what it is: an address alone is reused once a structure
+    // is freed (the verdict opens and closes alternative structures one after another).
     const void* a = &accel;
     add(&a, sizeof a);
+    const AccelImage& image = accel.image();
+    add(image.kind.data(), image.kind.size());
+    const uint64_t sizes[] = {image.footprint_bytes(), image.end_address()};
+    add(sizes, sizeof sizes);
     add(&step.mailbox_entries, sizeof step.mailbox_entries);
     add(&step.short_stack_entries, sizeof step.short_stack_entries);
     add(&step.box_precision_bits, sizeof step.box_precision_bits);
