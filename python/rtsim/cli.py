@@ -87,6 +87,7 @@ class TraceJob:
     lights: str | None = None  # lights added to a scene without any (none, sun)
     reflections: str | None = None  # reflection rays: mirror or glossy (a GGX lobe)
     roulette_after: int | None = None  # Russian roulette past this many bounces (0: off)
+    alternatives: bool = False  # also trace the structures one step away, beside it
 
 
 def parse_workload(text: str) -> list[str]:
@@ -177,32 +178,9 @@ def run_trace(job: TraceJob, console: Console) -> dict:
     from rtsim.progress import TraceProgress
     from rtsim.summary import print_summary
     from rtsim.trace_file import open_trace
-    from rtsim.tracing import trace_scene
 
     with TraceProgress(console=Console(stderr=True)) as progress:
-        manifest = trace_scene(
-            job.scene,
-            job.out_dir,
-            workload=job.workload,
-            width=job.width,
-            height=job.height,
-            bounces=job.bounces,
-            seed=job.seed,
-            camera=job.camera,
-            threads=job.threads,
-            hairball_triangles=job.hairball_triangles,
-            progress=progress,
-            accel=job.accel,
-            builder=job.builder,
-            build_settings=job.build_settings,
-            flatten=job.flatten,
-            frames=job.frames,
-            frame_policy=job.frame_policy,
-            rebuild_threshold=job.rebuild_threshold,
-            lights=job.lights,
-            reflections=job.reflections,
-            roulette_after=job.roulette_after,
-        )
+        manifest = _trace_job(job, progress)
     trace = open_trace(job.out_dir)
     width, height = manifest["workload"]["resolution"]
     heatmaps = write_heatmaps(trace, size=(width, height))
@@ -213,7 +191,74 @@ def run_trace(job: TraceJob, console: Console) -> dict:
         console.print(f"render:   {render}")
     for path in heatmaps:
         console.print(f"heatmap:  {path}")
+    if job.alternatives:
+        trace_alternatives(job, manifest, console)
     return manifest
+
+
+def _trace_job(job: TraceJob, progress: Any = None) -> dict:
+    from rtsim.tracing import trace_scene
+
+    return trace_scene(
+        job.scene,
+        job.out_dir,
+        workload=job.workload,
+        width=job.width,
+        height=job.height,
+        bounces=job.bounces,
+        seed=job.seed,
+        camera=job.camera,
+        threads=job.threads,
+        hairball_triangles=job.hairball_triangles,
+        progress=progress,
+        accel=job.accel,
+        builder=job.builder,
+        build_settings=job.build_settings,
+        flatten=job.flatten,
+        frames=job.frames,
+        frame_policy=job.frame_policy,
+        rebuild_threshold=job.rebuild_threshold,
+        lights=job.lights,
+        reflections=job.reflections,
+        roulette_after=job.roulette_after,
+    )
+
+
+def trace_alternatives(job: TraceJob, manifest: dict, console: Console) -> list[Path]:
+    """Traces the structures one step from the trace's (rtsim._core.structure_alternatives: a
+    wide BVH, compressed nodes, compressed leaves) beside it, at OUT/alternatives/KEY=VALUE:
+    the same scene, workload and rays, so the verdict of every run of the trace estimates them
+    with the analytic level (docs/verdict.md, "Structural estimates"). Each keeps the trace's
+    leaves (compressed or not) where the other structure can store them."""
+    from dataclasses import replace
+
+    from rtsim import _core
+
+    accel = manifest["accel"]
+    if (manifest.get("frames") or {}).get("count", 1) > 1 or accel["kind"] == "two_level":
+        console.print(
+            "alternatives: none for an animated or two-level trace (the verdict measures them)"
+        )
+        return []
+    compressed = bool(accel.get("build_settings", {}).get("compressed_leaves", False))
+    scene = manifest["scene"]
+    curved = scene.get("spheres", 0) + scene.get("capsules", 0) > 0
+    out = []
+    for key, value, folder in _core.structure_alternatives(accel["kind"], compressed, curved):
+        if key == "accel":
+            alt = replace(
+                job,
+                accel=value,
+                builder=None,
+                build_settings={"compressed_leaves": True} if compressed else None,
+            )
+        else:
+            alt = replace(job, build_settings={**(job.build_settings or {}), key: True})
+        alt = replace(alt, out_dir=job.out_dir / folder, alternatives=False)
+        _trace_job(alt)
+        console.print(f"alternative: {alt.out_dir / 'trace.rtt'}")
+        out.append(alt.out_dir)
+    return out
 
 
 def cmd_trace(args: argparse.Namespace, console: Console) -> int:
@@ -239,6 +284,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         lights=args.lights,
         reflections=args.reflections,
         roulette_after=args.roulette_after,
+        alternatives=args.alternatives,
     )
     run_trace(job, console)
     return 0
@@ -448,6 +494,13 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         metavar="N",
         help="Russian roulette: each path ray past the first N bounces continues with the "
         "surface's albedo as probability (0, the default: off; --bounces still caps the depth)",
+    )
+    p.add_argument(
+        "--alternatives",
+        action="store_true",
+        help="also trace the structures one step from this one (a wide BVH, compressed nodes, "
+        "compressed leaves) beside it, in OUT/alternatives/KEY=VALUE, over the same rays: every "
+        "run's verdict then estimates them with the analytic level (docs/verdict.md)",
     )
     p.add_argument(
         "--flatten",

@@ -392,6 +392,18 @@ void bind_trace(py::module_& m) {
         },
         "The acceleration structures this build knows: name, description, builders, and per builder\n"
         "its settings {name: {type, default, unit, min, max, doc}} (docs/accel.md, Builder settings).");
+    m.def(
+        "structure_alternatives",
+        [](const std::string& kind, bool compressed_leaves, bool curved) {
+            py::list out;
+            for (const StructureAlternative& a : structure_alternatives(kind, compressed_leaves, curved))
+                out.append(py::make_tuple(a.key, a.value, structure_alternative_dir(a)));
+            return out;
+        },
+        py::arg("kind"), py::arg("compressed_leaves") = false, py::arg("curved") = false,
+        "The structures one step from a trace's, as (key, value, folder): ('accel', KIND) or\n"
+        "('compressed_leaves', 'true'), and where rtsim trace --alternatives writes it beside the\n"
+        "trace ('alternatives/KEY=VALUE'); what the verdict weighs.");
     m.attr("trace_version") = kTraceVersion;  // the trace format this build writes and reads
     m.def("trace_sections", &trace_sections, py::arg("path"),
           "Validates a trace file's header, section table and BVH image; returns its sections.");

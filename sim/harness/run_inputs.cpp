@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "sim/analytic/analysis_cache.h"
+#include "sim/harness/alternative_trace.h"
 #include "sim/harness/frames.h"
 #include "sim/harness/memory_estimate.h"
 #include "sim/harness/run_files.h"
@@ -76,7 +77,7 @@ StructureTraits structure_traits(const RunInputs& in) {
     // Compressed leaves index triangle vertices: a scene with spheres or capsules refuses them.
     const json scene = in.manifest.value("scene", json::object());
     const bool curved = scene.is_object() && (scene.value("spheres", 0) > 0 || scene.value("capsules", 0) > 0);
-    t.can_compress_leaves = f.caps.compressed_leaves && !curved;
+    t.curved = curved;
     t.treelet_partition = f.caps.treelet_partition;
     t.stack_addresses = f.caps.stack_addresses;
     t.quantized_boxes = f.caps.quantized_boxes;
@@ -116,6 +117,7 @@ VerdictContext verdict_context(RunInputs& in, const BuiltRun& built, const json&
     v.instantiated = with_structure_blocks(instantiated, in.setup.structure);
     v.structure = structure_traits(in);
     v.frames = built.frames.size();
+    if (built.frames.size() == 1) v.alternative = alternative_traces(in.rtt, in.options.config, built.rays);
     if (built.frames.size() > 1) {
         // The estimates trace a sample of rays against one bound structure: an animated trace's
         // first frame, its rays against its structure.

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "sim/harness/run_files.h"
+#include "traces/accel/accel.h"
 #include "traces/common/error.h"
 
 extern char** environ;
@@ -20,36 +22,53 @@ using nlohmann::json;
 
 namespace {
 
-/// The candidates to measure: the top three knobs (one `key=value` each) and the best
-/// co-limit (both at once), without repeats.
-std::vector<std::pair<std::vector<std::string>, json>> to_measure(const json& verdict) {
-    std::vector<std::pair<std::vector<std::string>, json>> out;
-    auto add = [&](std::vector<std::string> sets, const json& estimated) {
-        for (const auto& o : out)
-            if (o.first == sets) return;
-        out.push_back({std::move(sets), estimated});
+/// One re-run: the `--set`s, the estimate, and for another structure its trace beside the run's.
+struct Candidate {
+    std::vector<std::string> sets;
+    json estimated;
+    std::string trace;  ///< "" for the run's own trace
+};
+
+std::string value_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+
+/// The candidates to measure: the top three knobs (one `key=value` each), the best co-limit
+/// (both at once) and the structural alternatives: the best estimated one (on its trace beside
+/// the run's when it is another structure) and the best that needs no new trace, without repeats.
+std::vector<Candidate> to_measure(const json& verdict, const std::string& rtt) {
+    std::vector<Candidate> out;
+    auto add = [&](Candidate c) {
+        for (const Candidate& o : out)
+            if (o.sets == c.sets) return;
+        out.push_back(std::move(c));
     };
-    for (const json& k : verdict.value("top", json::array())) {
-        const std::string to = k["to"].is_string() ? k["to"].get<std::string>() : k["to"].dump();
-        add({k["key"].get<std::string>() + "=" + to}, k["speedup"]);
-    }
+    for (const json& k : verdict.value("top", json::array()))
+        add({{k["key"].get<std::string>() + "=" + value_text(k["to"])}, k["speedup"]});
     for (const json& co : verdict.value("co_limits", json::array())) {
-        add(co["sets"].get<std::vector<std::string>>(), co["joint"]);
+        add({co["sets"].get<std::vector<std::string>>(), co["joint"]});
         break;
     }
-    // The best structural alternative a re-run can measure (one that needs no new trace): the
-    // one the run's cycle accounting points at most, first listed on a tie.
     const json structural = verdict.value("structural", json::array());
+    // The best estimated alternative (the list is best first): the one the verdict may name.
+    for (const json& k : structural) {
+        if (!k["speedup"].is_number() || k.contains("refused")) continue;
+        const std::string set = k["key"].get<std::string>() + "=" + value_text(k["to"]);
+        if (!k.value("trace", false)) {
+            add({{set}, k["speedup"]});
+        } else {
+            const fs::path alt = fs::path(rtt).parent_path() /
+                                 structure_alternative_dir({k["key"].get<std::string>(), value_text(k["to"])});
+            add({{set}, k["speedup"], alt.string()});
+        }
+        break;
+    }
+    // The best structural alternative a re-run can measure with no new trace: the one the run's
+    // cycle accounting points at most, first listed on a tie.
     const json* best = nullptr;
     for (const json& k : structural)
         if (!k.value("trace", false) && !k.contains("refused") &&
             (!best || k.value("evidence", 0.0) > best->value("evidence", 0.0)))
             best = &k;
-    if (best) {
-        const json& k = *best;
-        const std::string to = k["to"].is_string() ? k["to"].get<std::string>() : k["to"].dump();
-        add({k["key"].get<std::string>() + "=" + to}, nullptr);
-    }
+    if (best) add({{(*best)["key"].get<std::string>() + "=" + value_text((*best)["to"])}, (*best)["speedup"]});
     return out;
 }
 
@@ -88,14 +107,24 @@ json check_verdict(const SimOptions& o, const json& verdict, double base_rays_pe
     const fs::path config = fs::path(o.out_dir) / "config.resolved.json";
     json out = json::array();
     int n = 0;
-    for (const auto& [sets, estimated] : to_measure(verdict)) {
+    for (const Candidate& m : to_measure(verdict, trace_file(o.trace))) {
         const fs::path run = fs::path(o.out_dir) / "check" / std::to_string(++n);
         fs::create_directories(run);
-        std::vector<std::string> argv = {exe, o.trace, "--config", config.string(), "--no-verdict", "-o", run.string()};
-        for (const std::string& s : sets) argv.insert(argv.end(), {"--set", s});
+        std::vector<std::string> argv = {exe, m.trace.empty() ? o.trace : m.trace, "--no-verdict", "-o", run.string()};
+        if (m.trace.empty()) {
+            argv.insert(argv.end(), {"--config", config.string()});
+            for (const std::string& s : m.sets) argv.insert(argv.end(), {"--set", s});
+        } else {
+            // Another structure resolves the run's config afresh (its stack entries, say): the
+            // config as given, not as resolved against this trace's structure.
+            const fs::path given = run / "config.given.json";
+            std::ofstream(given) << config_to_json(o.config).dump(2);
+            argv.insert(argv.end(), {"--config", given.string()});
+        }
         const int code = run_process(argv, (run / "log.txt").string());
         const double rps = code == 0 ? rays_per_second_of(run) : 0;
-        json c = {{"sets", sets}, {"estimated", estimated}, {"run", run.string()}};
+        json c = {{"sets", m.sets}, {"estimated", m.estimated}, {"run", run.string()}};
+        if (!m.trace.empty()) c["trace"] = m.trace;
         c["measured"] = rps > 0 && base_rays_per_second > 0 ? json(rps / base_rays_per_second) : json(nullptr);
         if (code != 0)
             c["error"] = "rtsim-sim exited with " + std::to_string(code) + " (see " + (run / "log.txt").string() + ")";

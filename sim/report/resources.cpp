@@ -96,6 +96,13 @@ std::vector<std::string> knob_relaxes(const SimConfig& c, const std::string& key
         out = {"stack"};
     } else if (key.rfind("build_unit.", 0) == 0 || key == "frame_policy") {
         out = {"build"};
+    } else if (key == "accel" || key == "compressed_leaves") {
+        // Another structure changes every demand a ray makes: its steps, its tests and the
+        // bytes (and lines) each step reads.
+        out = {"latency", "l1_capacity", "l1_mshrs", "l1_banks", "l2_capacity", "l2_mshrs", "l2_banks", "dram"};
+        for (int k = 0; k < kOpKindCount; ++k) out.push_back(op_kind_name(OpKind(k)));
+    } else if (key == "traversal.model") {
+        out = {"divergence", "latency", "scheduler"};
     } else if (key.rfind("treelets.", 0) == 0) {
         out = {"admission", "ray_buffer", "treelet_scheduling"};
     } else {

@@ -23,6 +23,10 @@ namespace {
 constexpr double kSaturated = 0.7;
 /// A run whose traversal waited for the build unit this share of its cycles is bound by it.
 constexpr double kBuildBound = 0.5;
+/// A structural alternative is named ahead of the best resource knob when its estimate beats
+/// that knob's by this much: the analytic level's error between two designs' analyses is larger
+/// than between two configs of one.
+constexpr double kDesignMargin = 0.05;
 
 std::string label_of(const std::string& resource) { return resource_label(resource); }
 
@@ -116,8 +120,8 @@ Evidence timed_evidence(const SimConfig& c, const json& model) {
         // scheduler, unshared pipelines, the L1's MSHRs and banks.
         if (per_unit(c, r)) e.add("units", use, fraction);
         if (use == "ray_buffer") e.add("treelet_scheduling", use, fraction / 2);
-        // What the structural alternatives would change (they are measured, never estimated:
-        // this only orders which one --check-verdict re-runs): treelets cut DRAM waits when
+        // What the structural alternatives would change (this orders the ones left to measure
+        // and which of them --check-verdict re-runs): treelets cut DRAM waits when
         // off and cost ray-buffer and admission time when on; prefetching and sorting shorten
         // memory waits; another execution model removes masked-off lanes.
         const bool memory = use == "dram" || use == "l2" || use == "l2_mshr_full" || use == "l1_mshr_full";
@@ -217,6 +221,11 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
     const json& relax = v["relax"];
     if (relax.is_null()) {
         text += "; no hardware knob relaxes it";
+    } else if (relax.value("structural", false)) {
+        text += "; another design pays more than any resource knob: " + knob_text(relax) + " estimated by " +
+                relax.value("estimated_by", std::string()) +
+                (relax.value("trace", false) ? " (a new trace; measure: " + relax["measure"].get<std::string>() + ")"
+                                             : "");
     } else if (relax["speedup"].is_number()) {
         text += "; " + knob_text(relax) + " estimated by the analytic level";
     } else if (not_covered.empty()) {
@@ -240,18 +249,22 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
                 " together " + gain(co["joint"].get<double>()) + " (alone " + gain(co["alone"][0].get<double>()) +
                 ", " + gain(co["alone"][1].get<double>()) + ")";
     if (!not_covered.empty()) text += "; " + not_covered;
-    // Another design is not a step of a resource: name the alternatives to measure, priced.
-    std::string alternatives;
+    // Another design is not a step of a resource: name the alternatives, priced, with the
+    // estimate of those the analytic level could cost on their own analysis.
+    std::string estimated, measured;
     for (const json& k : weighed["structural"]) {
-        if (k.contains("refused")) continue;
+        if (k.contains("refused") || (!relax.is_null() && k["key"] == relax["key"] && k["to"] == relax["to"])) continue;
         char mm2[48] = "";
         if (k["added_mm2"].is_number()) std::snprintf(mm2, sizeof mm2, " %+.3f mm^2", k["added_mm2"].get<double>());
         const std::string to = k["to"].is_string() ? k["to"].get<std::string>() : k["to"].dump();
-        alternatives += (alternatives.empty() ? "" : ", ") + k["key"].get<std::string>() + "=" + to + mm2;
+        const std::string item = k["key"].get<std::string>() + "=" + to +
+                                 (k["speedup"].is_number() ? " " + gain(k["speedup"].get<double>()) : "") + mm2;
+        std::string& list = k["speedup"].is_number() ? estimated : measured;
+        list += (list.empty() ? "" : ", ") + item;
     }
-    if (!alternatives.empty())
-        text += "; structural alternatives, not estimated, measure them (verdict.structural has each command): " +
-                alternatives;
+    if (!estimated.empty()) text += "; other designs, estimated: " + estimated;
+    if (!measured.empty())
+        text += "; other designs, not estimated, measure them (verdict.structural has each command): " + measured;
     // An estimate that names a resource no context cycle points at disagrees with the run's own
     // accounting: say so rather than let the two read as one story.
     if (!relax.is_null() && relax["speedup"].is_number() && v["evidence"].value("share", 1.0) < 0.02 &&
@@ -294,6 +307,7 @@ json judge(const VerdictContext& c) {
     WeighInputs in{c.config, c.instantiated, [&](const SimConfig& x) { return estimator(x).first; }, base_cycles,
                    not_covered, evidence.share, c.unit.knobs, c.structure,
                    [&](const SimConfig& x) { return estimator.dram_bytes(x); }};
+    in.structural = [&](const Knob& k) { return estimator.structural(k, c.config); };
     const json weighed = weigh_knobs(in);
     // The binding resource: the best knob's when it buys 2% (or, unestimated, when the
     // evidence points at it); else the largest cycle use's.
@@ -305,6 +319,14 @@ json judge(const VerdictContext& c) {
     if (!best_pays)
         for (const json& k : weighed["knobs"])
             if (relax.is_null() && k["resource"] == binding) relax = k;
+    // Another design the estimates put clearly ahead of every resource knob is the one to try
+    // first (it needs a new trace or config: its `measure`); the binding stays the resource
+    // that binds this design.
+    const json& design = weighed["structural"].empty() ? json(nullptr) : weighed["structural"][0];
+    const double resource_best = !best.is_null() && best["speedup"].is_number() ? best["speedup"].get<double>() : 1.0;
+    if (!design.is_null() && design["speedup"].is_number() && design["speedup"].get<double>() >= 1.02 &&
+        design["speedup"].get<double>() > resource_best + kDesignMargin)
+        relax = design;
     json v = {{"binding", binding},
               {"label", label_of(binding)},
               {"evidence", evidence_for(binding, evidence, c.model, timed)},
@@ -445,9 +467,9 @@ const StatBlock& verdict_stats() {
             {"top_per_mm2", "list", "the three best `gain_per_mm2`"},
             {"co_limits", "list", "pairs of estimated knobs whose joint relaxation gains much more than either alone (joint gain >= 1.5 x the better single gain + 5 points): `keys`, `sets` (`key=value` each), `resources`, `joint` (estimated speed-up of both), `alone` (each's)"},
             {"coverage", "", "`estimated` (false where the analytic level does not model the machine: treelets), `why_not`, `frames` (an animated trace's estimates are the first frame's)"},
-            {"structural", "list", "the structural alternatives to the run's design, one step each: another structure (`accel`: a wide BVH, or compressed nodes) and `compressed_leaves` (both a new trace), `treelets.enabled` flipped, another `traversal.model`, `dispatch.sort` on or off, `treelets.prefetch` flipped, and for an animated trace the other `frame_policy` values (a new trace: `rtsim trace --frame-policy`); each with the candidates' fields (`speedup` null: never estimated), `structural` (true), `trace` (needs a new trace), `measure` (the command that measures it; `--check-verdict` re-runs the best config one) and `added_mm2` (its added area: the decoders of compressed nodes or leaves, a ray buffer, SIMT control, a sort stage, a prefetcher); `refused` when the config refuses it"},
-            {"check", "list", "with `--check-verdict`: each top candidate and co-limit re-run at the run's level: `sets`, `estimated`, `measured` (rays/s relaxed over the run's), `run` (its folder); best measured first", false, true},
-            {"relax", "", "the best candidate, with the same fields; `null` when no knob relaxes the binding resource"},
+            {"structural", "list", "the structural alternatives to the run's design, one step each: another structure (`accel`: a wide BVH, or compressed nodes) and `compressed_leaves` (both a new trace), `treelets.enabled` flipped, another `traversal.model`, `dispatch.sort` on or off, `treelets.prefetch` flipped, and for an animated trace the other `frame_policy` values (a new trace: `rtsim trace --frame-policy`); each with the candidates' fields (`speedup` and `estimated_by` for another structure or compressed leaves estimated on the alternative trace beside the run's, `rtsim trace --alternatives`, and for treelets flipped or the other execution model estimated on the run's trace; else `speedup` null and `why_not`), `structural` (true), `trace` (needs a new trace), `measure` (the command that measures it; `--check-verdict` re-runs the best estimated one and the best that needs no new trace) and `added_mm2` (its added area: the decoders of compressed nodes or leaves, a ray buffer, SIMT control, a sort stage, a prefetcher); `refused` when the config refuses it"},
+            {"check", "list", "with `--check-verdict`: each top candidate, the best co-limit and the structural alternatives re-run (the best estimated one, on its own trace for another structure; the best needing no new trace) at the run's level: `sets`, `estimated`, `measured` (rays/s relaxed over the run's), `run` (its folder), `trace` (a re-run on the alternative trace); best measured first", false, true},
+            {"relax", "", "the best candidate, with the same fields, or the best estimated `structural` alternative when it pays five points more than any candidate; `null` when no knob relaxes the binding resource"},
             {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `reused` (the analysis was loaded from beside the trace, stored there by an earlier run, instead of stepped by this one), `base_cycles` (its cycles for the run's own config), `dram_latency` (timed runs with the bank model: `added_cycles`, what each DRAM access is charged beyond `dram.latency`, the run's own row outcome `row_cycles` rounded; `bank_wait_cycles`, its bank wait, reported but not charged; `null` otherwise), `wall_seconds` (the host time the estimates took)"},
             {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
             {"frame", "list", "only with `shading.enabled`: the shading side's knobs beside the RT unit's, weighed by what they buy the frame (Amdahl over `model.shading.breakdown`): `key`, `from`, `to`, `part` (traversal or shading), `part_speedup` (the RT knob's estimate; 2 for doubled shader cores; the divergence for sorting by shader, an upper bound), `frame_speedup`; best first", false, true},

@@ -41,6 +41,26 @@ Relaxation relaxation_for(const std::string& resource, const SimConfig& config);
 /// rays the verdict's own analysis steps (the run loop reads them: sim/harness/trace_stream.h).
 using SampleStreamFactory = std::function<std::unique_ptr<RayStream>(uint64_t first, uint64_t rays, uint64_t sample)>;
 
+/// A structural alternative's trace, opened: another structure over the same rays, traced
+/// beside the run's by `rtsim trace --alternatives` (sim/harness/alternative_trace.h). The
+/// verdict's estimate of the alternative is the analytic level on the same sample of its rays.
+struct AlternativeTrace {
+    virtual ~AlternativeTrace() = default;
+    std::string path;       ///< its .rtt (its analysis is stored beside it)
+    std::string identity;   ///< its identity (analysis_cache.h)
+    const Accel* accel = nullptr;
+    const MemoryMap* map = nullptr;
+    SimConfig config;       ///< the run's config resolved against its structure
+    StepOptions step = {};  ///< what its steppers walk with (the same resolution's)
+    uint64_t rays = 0;
+    SampleStreamFactory sample_stream;
+};
+
+/// The alternative trace for `key=value` (StructureAlternative), or null with `why` (none was
+/// traced, its rays are not the run's, the config refuses its structure).
+using AlternativeFactory =
+    std::function<std::unique_ptr<AlternativeTrace>(const std::string& key, const std::string& value, std::string* why)>;
+
 struct VerdictContext {
     const SimConfig& config;
     const nlohmann::json& model;  ///< the run's model stats (cycle accounting, utilisation, ...)
@@ -64,6 +84,7 @@ struct VerdictContext {
     uint64_t first_ray = 0, frame_rays = 0;  ///< that frame's rays (0: the whole trace)
     nlohmann::json instantiated = nlohmann::json::array();  ///< the run's blocks (the area model's input)
     StructureTraits structure = {};  ///< the run's structure, for the structural knobs
+    AlternativeFactory alternative = {};  ///< unset: no structural alternative is estimated
 };
 
 /// {binding, label, evidence, relax, candidates, top, top_per_mm2, co_limits, coverage, estimate,

@@ -7,6 +7,7 @@
 #include "sim/analytic/analytic.h"
 #include "sim/analytic/estimate.h"
 #include "sim/report/verdict.h"
+#include "traces/common/error.h"
 
 namespace rtsim {
 
@@ -44,6 +45,53 @@ nlohmann::json verdict_sample_key(const SimConfig& base, const std::string& iden
 
 }  // namespace
 
+namespace {
+
+/// The verdict's own analysis of `sample_rays` rays of [first, first + rays) of a trace for the
+/// config `base`: loaded from beside the trace when a run stored it for this key, else stepped
+/// and stored there (under a lock, as a sweep's processes share it). `reused` says which.
+std::unique_ptr<AnalyticProfile> sample_analysis(const SimConfig& base, const Accel& accel, const MemoryMap& map,
+                                                 const StepOptions& step, const SampleStreamFactory& streams,
+                                                 const std::string& identity, const std::string& trace_path,
+                                                 uint64_t first, uint64_t rays, uint64_t sample_rays, bool* reused) {
+    const nlohmann::json key =
+        identity.empty() ? nlohmann::json() : verdict_sample_key(base, identity, first, rays, sample_rays);
+    const std::string path = identity.empty() ? std::string() : analysis_path(trace_path, key);
+    std::optional<AnalyticProfile> stored = load_analysis(path, key);
+    if (!stored) {
+        AnalysisLock lock(path);
+        stored = load_analysis(path, key);
+        if (!stored) {
+            DiscardSink sink;
+            const std::unique_ptr<RayStream> stream = streams(first, rays, sample_rays);
+            // A copy: analyze_stream keeps only a handful of analyses, and a verdict may make more.
+            auto profile = std::make_unique<AnalyticProfile>(analyze_stream(base, accel, map, step, *stream, sink));
+            if (!path.empty()) {
+                AnalyticProfile keyed = *profile;
+                keyed.key = key;
+                store_analysis(path, keyed);
+            }
+            *reused = false;
+            return profile;
+        }
+    }
+    *reused = true;
+    return std::make_unique<AnalyticProfile>(std::move(*stored));
+}
+
+/// The kind whose analytic estimate stands in for `config`'s unit kind ("" when the level costs
+/// the kind itself: unit_traits in sim/harness/run_inputs.h).
+std::string stand_in_of(const SimConfig& config) {
+    const UnitKind& u = config.traversal.kind();
+    return u.needs.lock_step && !u.group_profile ? u.estimate_as : std::string();
+}
+
+std::string config_text(const Relaxation& r) {
+    return r.key + "=" + (r.to.is_string() ? r.to.get<std::string>() : r.to.dump());
+}
+
+}  // namespace
+
 VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
     // A timed run's own DRAM figures: the row outcomes and bank waits the closed form leaves out.
     if (c.config.fidelity == Fidelity::approx || c.config.fidelity == Fidelity::detailed)
@@ -68,37 +116,86 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
         }
     }
     const uint64_t rays = c.frame_rays ? c.frame_rays : c.trace_rays;
-    const std::unique_ptr<RayStream> sample = c.sample_stream(c.first_ray, rays, c.sample_rays);
-    RayStream& stream = *sample;
-    m_method = "analytic level on " + std::to_string(stream.total_rays()) + " sampled rays" +
-               (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " in treelet order" : "");
-    // Else the verdict's own sample analysis: stored beside the trace by the first run that
-    // needs it (under a lock, as a sweep's processes share it), loaded by every later one.
-    const nlohmann::json key =
-        identity.empty() ? nlohmann::json() : verdict_sample_key(base, identity, c.first_ray, rays, c.sample_rays);
-    const std::string path = identity.empty() ? std::string() : analysis_path(c.trace_path, key);
-    std::optional<AnalyticProfile> stored = load_analysis(path, key);
-    if (!stored) {
-        AnalysisLock lock(path);
-        stored = load_analysis(path, key);
-        if (!stored) {
-            DiscardSink sink;
-            m_profile = &analyze_stream(base, *c.accel, *c.map, c.step, stream, sink);
-            if (!path.empty()) {
-                AnalyticProfile keyed = *m_profile;
-                keyed.key = key;
-                store_analysis(path, keyed);
-            }
-            m_form = std::make_unique<FormEstimator>(*m_profile);
-            return;
-        }
-    }
-    m_loaded = std::make_unique<AnalyticProfile>(std::move(*stored));
+    m_loaded = sample_analysis(base, *c.accel, *c.map, c.step, c.sample_stream, identity, c.trace_path, c.first_ray,
+                               rays, c.sample_rays, &m_reused);
     m_profile = m_loaded.get();
     m_form = std::make_unique<FormEstimator>(*m_profile);
-    m_reused = true;
+    m_form_is_sample = true;
+    m_method = "analytic level on " + std::to_string(uint64_t(m_profile->stepped_rays)) + " sampled rays" +
+               (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " in treelet order" : "");
 }
 
+const FormEstimator& VerdictEstimator::sample_form() const {
+    if (m_form_is_sample) return *m_form;
+    if (!m_sample_form) {
+        const VerdictContext& c = m_context;
+        bool reused = false;
+        m_sample = sample_analysis(analytic_config(c.config, c.unit.estimate_as), *c.accel, *c.map, c.step,
+                                   c.sample_stream, c.trace_path.empty() ? std::string() : c.identity, c.trace_path,
+                                   c.first_ray, c.frame_rays ? c.frame_rays : c.trace_rays, c.sample_rays, &reused);
+        m_sample_form = std::make_unique<FormEstimator>(*m_sample);
+    }
+    return *m_sample_form;
+}
+
+StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& config) const {
+    const VerdictContext& c = m_context;
+    StructuralEstimate out;
+    // The stand-in kinds' estimates are the stand-in's: no execution model is estimated there.
+    const bool model = k.relax.key == "traversal.model";
+    if (!k.trace && !model && k.relax.key != "treelets.enabled") {
+        out.why_not = "the analytic level does not model it";
+        return out;
+    }
+    if (c.frames > 1 || !c.sample_stream) {
+        out.why_not = "the trace is animated";
+        return out;
+    }
+    try {
+        const double base = sample_form()(m_dram.apply(analytic_config(config, c.unit.estimate_as))).cycles;
+        bool reused = false;
+        double cycles = 0;
+        if (k.trace) {
+            std::string why;
+            const std::unique_ptr<AlternativeTrace> alt =
+                c.alternative ? c.alternative(k.relax.key, k.relax.to.is_string() ? k.relax.to.get<std::string>()
+                                                                                  : k.relax.to.dump(), &why)
+                              : nullptr;
+            if (!alt) {
+                out.why_not = why.empty() ? "no alternative trace" : why;
+                return out;
+            }
+            const SimConfig a = analytic_config(alt->config, stand_in_of(alt->config));
+            const auto profile = sample_analysis(a, *alt->accel, *alt->map, alt->step, alt->sample_stream,
+                                                 alt->identity, alt->path, 0, alt->rays, c.sample_rays, &reused);
+            cycles = FormEstimator(*profile)(m_dram.apply(a)).cycles;
+            out.method = "the analytic level on the same " + std::to_string(uint64_t(profile->stepped_rays)) +
+                         " sampled rays of the alternative trace beside this one";
+        } else {
+            const SimConfig relaxed = relaxed_config(config, {k.relax});
+            const std::string as = stand_in_of(relaxed);
+            if (model && (!as.empty() || !c.unit.estimate_as.empty())) {
+                out.why_not = "the analytic level has no lock-step groups for one of the two kinds";
+                return out;
+            }
+            const SimConfig a = analytic_config(relaxed, as);
+            const auto profile = sample_analysis(a, *c.accel, *c.map, c.step, c.sample_stream,
+                                                 c.trace_path.empty() ? std::string() : c.identity, c.trace_path,
+                                                 c.first_ray, c.trace_rays, c.sample_rays, &reused);
+            cycles = FormEstimator(*profile)(m_dram.apply(a)).cycles;
+            out.method = "the analytic level on the same " + std::to_string(uint64_t(profile->stepped_rays)) +
+                         " sampled rays with " + config_text(k.relax);
+        }
+        if (!(cycles > 0) || !(base > 0)) {
+            out.why_not = "the analytic level gave no cycles";
+            return out;
+        }
+        out.speedup = base / cycles;
+    } catch (const Error& e) {
+        out.why_not = e.what();
+    }
+    return out;
+}
 
 SimConfig VerdictEstimator::estimated_config(const SimConfig& config) const {
     return m_dram.apply(analytic_config(config, m_context.unit.estimate_as));

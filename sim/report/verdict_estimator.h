@@ -15,6 +15,7 @@
 #include "sim/analytic/profile.h"
 #include "sim/config/config.h"
 #include "sim/report/dram_latency_calibration.h"
+#include "sim/report/verdict_knobs.h"
 
 namespace rtsim {
 
@@ -32,6 +33,12 @@ public:
     std::pair<double, std::string> operator()(const SimConfig& config) const;
     /// The DRAM bytes the estimate moves for `config` (0 when the estimator does not say).
     double dram_bytes(const SimConfig& config) const;
+    /// A structural alternative of `config` (the run's): the analytic level on its own analysis of
+    /// the same sample of rays, against the run's design on that sample. Another structure reads
+    /// the alternative trace beside the run's (VerdictContext::alternative); another execution
+    /// model or treelets flipped analyse the run's trace under the relaxed config. Both designs'
+    /// analyses are stored beside their traces, so later runs load them.
+    StructuralEstimate structural(const Knob& knob, const SimConfig& config) const;
     /// How the estimates are made, for the verdict's text.
     const std::string& method() const { return m_method; }
     /// True when the analysis was loaded from beside the trace (not stepped by this run).
@@ -45,6 +52,12 @@ private:
     std::unique_ptr<AnalyticProfile> m_loaded;  ///< a stored per-trace analysis, when one was found
     const AnalyticProfile* m_profile = nullptr;
     std::unique_ptr<FormEstimator> m_form;  ///< the closed form of each config against m_profile
+    bool m_form_is_sample = false;          ///< m_profile is the verdict's own sample analysis
+    /// The run's design on the verdict's sample, when m_profile is another analysis (the
+    /// analytic level's, a stored per-trace one): what structural estimates compare against.
+    mutable std::unique_ptr<AnalyticProfile> m_sample;
+    mutable std::unique_ptr<FormEstimator> m_sample_form;
+    const FormEstimator& sample_form() const;
     std::string m_method;
     bool m_reused = false;
     DramLatencyCalibration m_dram;

@@ -6,6 +6,7 @@
 #include "rtl_model/traversal/simt/simt_config.h"
 #include "sim/report/energy_area.h"
 #include "sim/report/technique_cost.h"
+#include "traces/accel/accel.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -160,22 +161,14 @@ void structural(std::vector<Knob>* out, Relaxation r, const std::string& resourc
     out->push_back(std::move(k));
 }
 
-/// Another structure one step away: a wide BVH for a binary or other kind, compressed nodes for
-/// a wide fp32 one (Ylitie, Karras & Laine 2017); none for compressed nodes or two levels.
-std::vector<std::string> structure_alternatives(const std::string& kind) {
-    if (kind.rfind("cwbvh", 0) == 0 || kind == "two_level") return {};
-    if (kind == "bvh6") return {"cwbvh6"};
-    if (kind == "bvh8") return {"cwbvh8"};
-    return {"bvh8", "cwbvh8"};
-}
-
 }  // namespace
 
 std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st) {
     std::vector<Knob> out;
-    for (const std::string& alt : structure_alternatives(st.kind)) structural(&out, {"accel", st.kind, alt}, "structure", true);
-    if (st.can_compress_leaves && !st.compressed_leaves)
-        structural(&out, {"compressed_leaves", false, true}, "structure", true);
+    for (const StructureAlternative& alt : structure_alternatives(st.kind, st.compressed_leaves, st.curved)) {
+        if (alt.key == "accel") structural(&out, {"accel", st.kind, alt.value}, "structure", true);
+        else structural(&out, {alt.key, false, true}, "structure", true);
+    }
     if (c.treelets.enabled) structural(&out, {"treelets.enabled", true, false}, "treelets");
     else if (st.treelet_partition)
         structural(&out, {"treelets.enabled", false, true}, "treelets");
@@ -270,10 +263,10 @@ json weigh_knobs(const WeighInputs& in) {
         knobs[0]["tie_break"] = "within the estimate's error of " + knobs[1]["key"].get<std::string>() +
                                 "'s gain, and it also removes DRAM traffic";
     }
-    // The structural alternatives: another design, not a step of a resource. The analytic level
-    // does not estimate them (a structure is the trace's; treelets, another execution model,
-    // sorting and prefetching change the order rays meet the memory); each is priced and comes
-    // with the command that measures it.
+    // The structural alternatives: another design, not a step of a resource. Each is priced and
+    // comes with the command that measures it; the estimator estimates those the analytic level
+    // can cost on an analysis of their own (another structure traced beside this one, another
+    // execution model, treelets flipped), never on this design's analysis.
     json structural = json::array();
     for (const Knob& k : structural_knobs(in.config, in.structure)) {
         json j = {{"key", k.relax.key}, {"resource", k.resource}, {"from", k.relax.from}, {"to", k.relax.to},
@@ -298,9 +291,21 @@ json weigh_knobs(const WeighInputs& in) {
         } catch (const Error& e) {
             j["refused"] = e.what();
         }
-        j["why_not"] = "a structural change, not estimated: measure it (" + j["measure"].get<std::string>() + ")";
+        const StructuralEstimate est = in.structural && in.not_covered.empty() && !j.contains("refused")
+                                         ? in.structural(k)
+                                         : StructuralEstimate{0, "", in.not_covered.empty() ? "" : in.not_covered};
+        if (est.speedup > 0) {
+            j["speedup"] = est.speedup;
+            j["estimated_by"] = est.method;
+            if (j["added_mm2"].is_number() && j["added_mm2"].get<double>() > 1e-9)
+                j["gain_per_mm2"] = (est.speedup - 1.0) / j["added_mm2"].get<double>();
+        } else {
+            j["why_not"] = "a structural change, not estimated" + (est.why_not.empty() ? std::string() : " (" + est.why_not + ")") +
+                           ": measure it (" + j["measure"].get<std::string>() + ")";
+        }
         structural.push_back(j);
     }
+    rank(structural);
     return {{"knobs", knobs},
             {"structural", structural},
             {"top", first(knobs, 3)},

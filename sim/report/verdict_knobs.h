@@ -37,8 +37,9 @@ struct Knob {
     std::string resource;
     bool estimable = true;  ///< the analytic level models what the knob changes
     /// A structural knob (the structure, its leaves, treelets on or off, the execution model,
-    /// sorting, prefetching): not a step of a resource but another design, measured, never
-    /// estimated; `trace` when it needs another trace (the structure is the trace's).
+    /// sorting, prefetching): not a step of a resource but another design, estimated only on an
+    /// analysis of its own (StructuralEstimator), else measured; `trace` when it needs another
+    /// trace (the structure is the trace's).
     bool structural = false;
     bool trace = false;
 };
@@ -49,7 +50,7 @@ struct StructureTraits {
     std::string kind = "bvh2";        ///< the trace's structure ("two_level": its BLASes' kind below)
     std::string blas_kind;
     bool compressed_leaves = false;   ///< its leaves are compressed
-    bool can_compress_leaves = false; ///< the kind may store compressed leaves
+    bool curved = false;              ///< the scene has spheres or capsules (no compressed leaves)
     bool treelet_partition = true;    ///< the kind partitions itself into treelets
     bool stack_addresses = false;     ///< its stacks hold addresses (traversal.stack_prefetch)
     bool quantized_boxes = false;     ///< its nodes hold 8-bit boxes (traversal.quantized_boxes)
@@ -92,6 +93,16 @@ std::string measure_command(const Knob& knob, const StructureTraits& structure);
 /// The cycles the estimator gives for a config; throws rtsim::Error for a config it refuses.
 using CycleEstimate = std::function<double(const SimConfig&)>;
 
+/// A structural knob's estimate: `speedup` 0 with `why_not` where none is made.
+struct StructuralEstimate {
+    double speedup = 0;
+    std::string method;   ///< how it was made, for the verdict's text
+    std::string why_not;  ///< why it was not
+};
+
+/// A structural knob's estimate for the run's config (VerdictEstimator::structural).
+using StructuralEstimator = std::function<StructuralEstimate(const Knob&)>;
+
 struct WeighInputs {
     const SimConfig& config;
     nlohmann::json instantiated;          ///< stats.json "instantiated" (the area model's input)
@@ -104,6 +115,7 @@ struct WeighInputs {
     /// The DRAM bytes the estimator moves for a config (unset: not known): each knob's share of
     /// DRAM energy saved, and the tie-break between knobs whose estimates are within its error.
     CycleEstimate dram_bytes = {};
+    StructuralEstimator structural = {};  ///< unset: every structural knob is measured, not estimated
 };
 
 /// {knobs (best first), top (three), top_per_mm2 (three), co_limits, structural}; each knob {key,

@@ -212,6 +212,17 @@ def test_frame_policy_is_a_trace_of_its_own() -> None:
     assert "workloads[0].rebuild_threshold" in spec_error(low)
 
 
+def test_alternatives_are_a_trace_of_their_own() -> None:
+    text = "scenes: [cornell]\nworkloads:\n  - {name: a, rays: [diffuse]}\n"
+    text += "  - {name: b, rays: [diffuse], alternatives: true}\n"
+    plain, weighed = parse_spec(text, "s.yaml").traces()
+    assert "alternatives" not in plain.workload.key() and plain.trace_id != weighed.trace_id
+    assert "--alternatives" in trace_task(weighed, Path("out")).command("t")
+    assert "--alternatives" not in trace_task(plain, Path("out")).command("t")
+    bad = "scenes: [cornell]\nworkloads: [{rays: [diffuse], alternatives: 2}]\n"
+    assert "s.yaml:2: workloads[0].alternatives: expected true or false" in spec_error(bad)
+
+
 def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
     # A study counting refusals (rtsim study composition) needs the refused runs as failed runs.
     text = "scenes: [cornell]\nworkloads: [{rays: [primary], resolution: 8x8}]\naccel: [grid]\n"

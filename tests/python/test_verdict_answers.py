@@ -133,8 +133,13 @@ def test_structural_alternatives_with_commands(
     assert alts["accel"]["trace"] and "rtsim trace" in alts["accel"]["measure"]
     assert "--set treelets.enabled=true" in alts["treelets.enabled"]["measure"]
     assert alts["compressed_leaves"]["added_mm2"] > 0  # the leaf decoders
-    assert all(k["speedup"] is None and k["structural"] for k in alts.values())
-    assert "structural alternatives" in stats["verdict"]["text"]
+    assert all(k["structural"] for k in alts.values())
+    # Without alternatives traced beside it, another structure is left to measure; flipping
+    # treelets or the execution model the analytic level estimates on the run's own trace.
+    assert alts["accel"]["speedup"] is None and "--alternatives" in alts["accel"]["why_not"]
+    assert alts["treelets.enabled"]["speedup"] > 0 and alts["traversal.model"]["speedup"] > 0
+    assert alts["dispatch.sort"]["speedup"] is None
+    assert "other designs, estimated:" in stats["verdict"]["text"]
 
 
 def test_the_newest_techniques_are_structural_alternatives_where_they_apply(

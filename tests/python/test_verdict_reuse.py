@@ -1,5 +1,5 @@
 """The verdict's analysis is stepped once per trace and key, then reused (docs/verdict.md, "What
-the verdict costs"): the first default run stores its sample analysis beside the trace, later
+the verdict costs"): the first default run stores its sample analyses beside the trace, later
 runs load it and weigh the same knobs to the same figures; with the cache off nothing is stored.
 
 Each simulation is one `rtsim-sim` process on a private copy of the small cornell trace
@@ -41,10 +41,15 @@ def test_second_run_loads_the_stored_analysis(
     env = {k: v for k, v in os.environ.items() if k != "RTSIM_ANALYTIC_CACHE"}
     first = run(sim_exe, trace, tmp_path / "one", env)
     assert first["estimate"]["reused"] is False
-    stored = list((trace / "analytic").glob("*.json"))
-    assert len(stored) == 1 and "verdict_sample" in json.loads(stored[0].read_text())["key"]
+    stored = sorted((trace / "analytic").glob("*.json"))
+    # The run's design and each design the verdict estimates on this trace (treelets flipped,
+    # the other execution model), every one the verdict's sample.
+    on_this_trace = [k for k in first["structural"] if k.get("speedup") and not k["trace"]]
+    assert len(stored) == 1 + len(on_this_trace) >= 3
+    assert all("verdict_sample" in json.loads(p.read_text())["key"] for p in stored)
     second = run(sim_exe, trace, tmp_path / "two", env)
     assert second["estimate"]["reused"] is True
+    assert sorted((trace / "analytic").glob("*.json")) == stored  # nothing stepped again
     assert without_host(second) == without_host(first)
 
 

@@ -150,6 +150,20 @@ const std::vector<AccelKindInfo>& accel_kinds();
 /// The capabilities a kind's registry entry declares (capabilities.h); "two_level" with the
 /// BLAS kind `blas_kind`. Throws rtsim::Error listing the known kinds if `kind` is none.
 AccelCapabilities accel_capabilities(const std::string& kind, const std::string& blas_kind = "bvh2");
+/// A structure one step from a trace's (what the verdict weighs as a structural alternative and
+/// `rtsim trace --alternatives` traces beside it): `key` is `accel` (another kind: a wide BVH for
+/// a binary or other kind, compressed nodes for a wide fp32 one, after Ylitie, Karras & Laine
+/// 2017) or `compressed_leaves` (`value` "true"), the build setting.
+struct StructureAlternative {
+    std::string key, value;
+};
+/// None for compressed nodes or two levels; compressed leaves where the kind may store them and
+/// the scene has no curved primitives (leaf blocks index triangle vertices).
+std::vector<StructureAlternative> structure_alternatives(const std::string& kind, bool compressed_leaves,
+                                                         bool curved);
+/// Where `rtsim trace --alternatives` writes an alternative, relative to the trace's folder:
+/// "alternatives/<key>=<value>".
+std::string structure_alternative_dir(const StructureAlternative& alternative);
 /// Throws rtsim::Error listing the known kinds and builders if the options name none.
 void validate_accel_options(const AccelOptions& options);
 /// Builds the image of a structure over a flattened scene (two-level: over its meshes and

@@ -389,6 +389,22 @@ AccelCapabilities accel_capabilities(const std::string& kind, const std::string&
     return c;
 }
 
+std::vector<StructureAlternative> structure_alternatives(const std::string& kind, bool compressed_leaves,
+                                                         bool curved) {
+    std::vector<StructureAlternative> out;
+    if (kind.rfind("cwbvh", 0) == 0 || kind == "two_level") return out;
+    if (kind == "bvh6") out.push_back({"accel", "cwbvh6"});
+    else if (kind == "bvh8") out.push_back({"accel", "cwbvh8"});
+    else out.insert(out.end(), {{"accel", "bvh8"}, {"accel", "cwbvh8"}});
+    if (!compressed_leaves && !curved && accel_capabilities(kind).compressed_leaves)
+        out.push_back({"compressed_leaves", "true"});
+    return out;
+}
+
+std::string structure_alternative_dir(const StructureAlternative& a) {
+    return "alternatives/" + a.key + "=" + a.value;
+}
+
 nlohmann::json accel_settings_schema(const std::string& kind, const std::string& builder) {
     AccelOptions o;
     o.kind = kind;

@@ -11,8 +11,10 @@ verdict's knob, its estimated and measured gain, and the best single knob's meas
 The `unseen` designs are the check on designs the verdict was not tuned on: the hairball (a scene
 no tuned design uses), under three structures, SIMT, treelets and DRAM-bound points, with every
 structural alternative measured too (another structure and compressed leaves on their own
-traces, treelets flipped, the other execution model, sorting, prefetching); between the
-`verdict-unseen` markers. Table code: rtsim/studies/_verdict_table.py."""
+traces, treelets flipped, the other execution model, sorting, prefetching); their traces are
+made with the alternatives beside them, so the verdict estimates the structural knobs as well;
+between the `verdict-unseen` markers, and each structural estimate against its measurement between
+the `structural-estimates` markers. Table code: rtsim/studies/_verdict_table.py."""
 
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from rtsim.studies._verdict_table import Outcome, knob_str, note, table
+from rtsim.studies._verdict_table import Outcome, knob_str, note, structural_table, table
 from rtsim.study import Study, StudyRun, Table
 from rtsim.study.core import StudyError
 from rtsim.sweep.spec import SpecError, spec_from_dict
@@ -124,6 +126,9 @@ def spec(
     scene, accel, *leaves = trace.split("-")
     entry: Any = {"kind": accel, "build": {"compressed_leaves": True}} if leaves else accel
     res = o["resolution"] if kind == "tuned" else o["unseen_resolution"]
+    workload: dict[str, Any] = {"name": "diffuse", "rays": ["diffuse"], "resolution": res}
+    if kind == "unseen":  # the other structures beside each trace: the verdict estimates them
+        workload["alternatives"] = True
     sc: dict[str, Any] = {"name": scene}
     if scene == "hairball":
         sc["hairball_triangles"] = o["hairball_triangles"]
@@ -132,7 +137,7 @@ def spec(
     return {
         "name": name,
         "scenes": [sc],
-        "workloads": [{"name": "diffuse", "rays": ["diffuse"], "resolution": res}],
+        "workloads": [workload],
         "accel": [entry],
         "points": points,
     }
@@ -158,6 +163,9 @@ def knobs_to_measure(verdict: dict[str, Any], structural: bool = False) -> list[
     chosen += [c for c in cands if any(c["key"].startswith(k) for k in CORE) and c not in chosen]
     out = [knob_str(c) for c in chosen]
     out += [" ".join(co["sets"]) for co in (verdict.get("co_limits") or [])[:1]]
+    relax = verdict.get("relax") or {}
+    if relax.get("structural") and knob_str(relax) not in out:  # a named structural knob
+        out.append(knob_str(relax))
     if structural:
         out += [
             knob_str(k)
@@ -267,6 +275,11 @@ STUDY = Study(
     tables=[
         Table("verdict.md", "verdict-study", render("tuned")),
         Table("verdict.md", "verdict-unseen", render("unseen")),
+        Table(
+            "verdict.md",
+            "structural-estimates",
+            lambda run: structural_table(outcomes(run, "unseen")),
+        ),
     ],
     options={
         "resolution": "128x96",

@@ -85,6 +85,7 @@ def trace_task(plan: TracePlan, out: Path) -> TraceTask:
         rebuild_threshold=w.rebuild_threshold,
         reflections=w.reflections,
         roulette_after=w.roulette_after,
+        alternatives=w.alternatives,
         flatten=plan.scene.flatten,
         lights=plan.scene.lights,
     )

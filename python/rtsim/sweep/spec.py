@@ -118,6 +118,9 @@ class WorkloadSpec:
     rebuild_threshold: float = 1.25
     reflections: str = "mirror"  # rtsim trace --reflections (mirror or glossy)
     roulette_after: int = 0  # rtsim trace --roulette-after (0: off)
+    # rtsim trace --alternatives: the structures one step away traced beside the trace, so each
+    # run's verdict estimates them (docs/verdict.md, "Structural estimates").
+    alternatives: bool = False
 
     def key(self) -> dict[str, Any]:
         key: dict[str, Any] = {
@@ -137,6 +140,8 @@ class WorkloadSpec:
             key["reflections"] = self.reflections
         if self.roulette_after:
             key["roulette_after"] = self.roulette_after
+        if self.alternatives:
+            key["alternatives"] = True
         return key
 
 
@@ -387,7 +392,8 @@ class _Reader:
 
     def workload(self, items: LineList, i: int) -> WorkloadSpec:
         allowed = ("name", "rays", "resolution", "bounces", "seed", "frames", "frame_policy",
-                   "rebuild_threshold", "reflections", "roulette_after")  # fmt: skip
+                   "rebuild_threshold", "reflections", "roulette_after",
+                   "alternatives")  # fmt: skip
         d = self.mapping(items, i, f"workloads[{i}]", allowed)
         path = f"workloads[{i}]"
         rays = d.get("rays", [])  # absent: what the scene calls for
@@ -429,10 +435,16 @@ class _Reader:
             if "roulette_after" in d
             else 0
         )
+        alternatives = d.get("alternatives", False)
+        if not isinstance(alternatives, bool):
+            raise self.fail(
+                d, "alternatives", f"{path}.alternatives",
+                f"expected true or false, got {alternatives!r}",
+            )  # fmt: skip
         label = str(d.get("name") or "-".join(rays) or "scene")
         return WorkloadSpec(
             label, tuple(rays), int(w), int(h), bounces, seed, frames, policy, float(threshold),
-            reflections, int(roulette),
+            reflections, int(roulette), alternatives,
         )  # fmt: skip
 
     def accels(self, doc: LineDict) -> list[AccelSpec]:

@@ -53,6 +53,7 @@ class TraceTask:
     lights: str = ""  # rtsim trace --lights (a scene without lights given some); "": none
     reflections: str = "mirror"  # rtsim trace --reflections
     roulette_after: int = 0  # rtsim trace --roulette-after (0: off)
+    alternatives: bool = False  # rtsim trace --alternatives (other structures beside it)
 
     def command(self, out: str) -> list[str]:
         workload = ["--workload", ",".join(self.rays)] if self.rays else []
@@ -92,6 +93,7 @@ class TraceTask:
             *(["--lights", self.lights] if self.lights else []),
             *(["--reflections", self.reflections] if self.reflections != "mirror" else []),
             *(["--roulette-after", str(self.roulette_after)] if self.roulette_after else []),
+            *(["--alternatives"] if self.alternatives else []),
         ]
 
 

@@ -116,7 +116,6 @@ TEST(Verdict, StructuralAlternativesAreMeasuredAndPriced) {
     c.traversal.ray_contexts = 16;
     StructureTraits st;
     st.kind = "bvh2";
-    st.can_compress_leaves = true;
     st.trace = "t/trace.rtt";
     std::map<std::string, Knob> by_key;
     for (const Knob& k : structural_knobs(c, st)) by_key[k.relax.key + "=" + k.relax.to.dump()] = k;
