@@ -82,6 +82,7 @@ StructureTraits structure_traits(const RunInputs& in) {
     t.stack_addresses = f.caps.stack_addresses;
     t.quantized_boxes = f.caps.quantized_boxes;
     t.trace = in.rtt;
+    t.run = in.options.out_dir;
     const json frames = in.manifest.value("frames", json(nullptr));
     if (frames.is_object() && frames.contains("policy") && frames["policy"].is_string())
         t.frame_policy = frames["policy"].get<std::string>();

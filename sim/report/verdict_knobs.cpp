@@ -203,14 +203,15 @@ std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st
 
 std::string measure_command(const Knob& k, const StructureTraits& st) {
     const std::string trace = st.trace.empty() ? "TRACE" : st.trace;
+    const std::string config = (st.run.empty() ? std::string("RUN") : st.run) + "/config.resolved.json";
     const std::string to = k.relax.to.is_string() ? k.relax.to.get<std::string>() : k.relax.to.dump();
-    if (!k.trace) return "rtsim simulate " + trace + " -o RUN --config RUN0/config.resolved.json --set " + k.relax.key + "=" + to;
+    if (!k.trace) return "rtsim simulate " + trace + " -o NEW_RUN --config " + config + " --set " + k.relax.key + "=" + to;
     const std::string option = k.relax.key == "accel"          ? "--accel " + to
                                : k.relax.key == "frame_policy" ? "--frame-policy " + to
                                                                : "--build-set compressed_leaves=true";
     return "rtsim trace SCENE -o NEW_TRACE " + option +
-           " (the scene, workload and resolution of " + trace + "; its manifest.json lists them), then rtsim simulate "
-           "NEW_TRACE -o RUN --config RUN0/config.resolved.json";
+           " (the scene, workload and resolution of " + trace + "; its manifest.json lists them; or trace it with "
+           "--alternatives), then rtsim simulate NEW_TRACE -o NEW_RUN --config " + config;
 }
 
 SimConfig relaxed_config(const SimConfig& config, const std::vector<Relaxation>& knobs) {

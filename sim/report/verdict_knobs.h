@@ -55,6 +55,7 @@ struct StructureTraits {
     bool stack_addresses = false;     ///< its stacks hold addresses (traversal.stack_prefetch)
     bool quantized_boxes = false;     ///< its nodes hold 8-bit boxes (traversal.quantized_boxes)
     std::string trace;                ///< the run's trace, for the commands that measure
+    std::string run;                  ///< the run's folder (its config.resolved.json), likewise
     std::string frame_policy;         ///< an animated trace's --frame-policy ("" for a still trace)
 };
 

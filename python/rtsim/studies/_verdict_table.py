@@ -135,7 +135,7 @@ def structural_table(outcomes: list[Outcome]) -> str:
     """Every estimated structural knob of the designs against its measured speed-up."""
     rows = [
         "| design | structural knob | estimated on | estimated | measured | error |",
-        "|---|---|---:|---:|---:|---|",
+        "|---|---|---|---:|---:|---:|",
     ]
     errors, signs = [], 0
     for o in outcomes:
