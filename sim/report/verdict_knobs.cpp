@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "rtl_model/traversal/simt/simt_config.h"
 #include "sim/report/energy_area.h"
@@ -206,6 +207,11 @@ std::string measure_command(const Knob& k, const StructureTraits& st) {
     const std::string config = (st.run.empty() ? std::string("RUN") : st.run) + "/config.resolved.json";
     const std::string to = k.relax.to.is_string() ? k.relax.to.get<std::string>() : k.relax.to.dump();
     if (!k.trace) return "rtsim simulate " + trace + " -o NEW_RUN --config " + config + " --set " + k.relax.key + "=" + to;
+    // Traced beside the run's already (rtsim trace --alternatives): simulate it.
+    const std::filesystem::path beside =
+        std::filesystem::path(trace).parent_path() / structure_alternative_dir({k.relax.key, to}) / "trace.rtt";
+    if (k.relax.key != "frame_policy" && !st.trace.empty() && std::filesystem::exists(beside))
+        return "rtsim simulate " + beside.string() + " -o NEW_RUN --config " + config;
     const std::string option = k.relax.key == "accel"          ? "--accel " + to
                                : k.relax.key == "frame_policy" ? "--frame-policy " + to
                                                                : "--build-set compressed_leaves=true";

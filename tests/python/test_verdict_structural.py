@@ -81,6 +81,11 @@ def test_structural_knobs_are_estimated_from_the_alternatives(
     assert knobs["accel=cwbvh8"]["speedup"] > 1.2
     assert "alternative trace" in knobs["accel=cwbvh8"]["estimated_by"]
     assert knobs["accel=cwbvh8"]["gain_per_mm2"] is not None
+    # Its command simulates the alternative beside the trace with the run's config.
+    measure = knobs["accel=cwbvh8"]["measure"]
+    assert measure.startswith("rtsim simulate ")
+    assert "alternatives/accel=cwbvh8/trace.rtt" in measure
+    assert str(tmp_path / "run" / "config.resolved.json") in measure
     # Best first among the estimated; the unestimated say why once and give the command.
     gains = [k["speedup"] for k in v["structural"] if k.get("speedup")]
     assert gains == sorted(gains, reverse=True)
