@@ -13,35 +13,6 @@ WindowRing::WindowRing(uint32_t horizon) {
     m_entries.resize(size);
 }
 
-OccupancyCalendar::OccupancyCalendar(uint32_t slots, uint32_t window_cycles, uint32_t horizon)
-    : m_capacity(uint64_t(slots) * window_cycles), m_window(window_cycles), m_window_of(window_cycles), m_ring(horizon) {
-    require(slots > 0 && window_cycles > 0, "OccupancyCalendar: slots and window must be positive");
-}
-
-Cycle OccupancyCalendar::earliest(Cycle time, Cycle expected) {
-    expected = std::max<Cycle>(expected, 1);
-    for (Cycle start = time;;) {
-        Cycle blocked = 0;  // first window that lacks room, if any
-        for (uint64_t w = m_window_of.div(start); w * m_window < start + expected; ++w) {
-            const uint64_t* used = m_ring.used(w);
-            if (!used) continue;  // beyond the horizon: treat as free
-            Cycle lo = std::max<Cycle>(start, w * m_window), hi = std::min<Cycle>(start + expected, (w + 1) * m_window);
-            if (*used + (hi - lo) > m_capacity) {
-                blocked = (w + 1) * m_window;
-                break;
-            }
-        }
-        if (!blocked) return start;
-        start = blocked;
-    }
-}
-
-void OccupancyCalendar::occupy(Cycle start, Cycle end) {
-    for (uint64_t w = m_window_of.div(start); w * m_window < end; ++w)
-        if (uint64_t* used = m_ring.used(w))
-            *used += std::min<Cycle>(end, (w + 1) * m_window) - std::max<Cycle>(start, w * m_window);
-}
-
 BandwidthCalendar::BandwidthCalendar(uint64_t capacity, uint32_t window_cycles, uint32_t horizon)
     : m_capacity(capacity), m_window(window_cycles), m_window_of(window_cycles), m_per_unit(capacity), m_ring(horizon) {
     require(capacity > 0 && window_cycles > 0, "BandwidthCalendar: capacity and window must be positive");

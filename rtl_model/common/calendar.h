@@ -56,25 +56,6 @@ private:
     std::vector<Entry> m_entries;
 };
 
-/// Bounded concurrency (MSHRs) for requests in any time order: each window of cycles can hold
-/// `slots` x window occupancy-cycles. A request asks for the earliest start at or after its time
-/// where adding [start, start + expected) keeps every window within that budget, then records
-/// the interval it really occupied. This caps the average number of outstanding requests per
-/// window at `slots` (fluid, like BandwidthCalendar), which is what limits a shared cache that
-/// units reach out of time order within a quantum.
-class OccupancyCalendar {
-public:
-    OccupancyCalendar(uint32_t slots, uint32_t window_cycles = 16, uint32_t horizon_windows = 1u << 14);
-    Cycle earliest(Cycle time, Cycle expected);
-    void occupy(Cycle start, Cycle end);
-
-private:
-    uint64_t m_capacity;  ///< occupancy-cycles per window
-    uint32_t m_window;
-    Divider m_window_of;  ///< cycle -> window
-    WindowRing m_ring;
-};
-
 class BandwidthCalendar {
 public:
     /// capacity: units (bytes, accesses, issues) per window; window: cycles; horizon: windows

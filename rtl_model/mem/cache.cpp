@@ -133,11 +133,12 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
             issue = m_mshr_free.top_time();
         }
     }
-    if (m_mshr_occupancy) {
-        // Out-of-order requests: wait until the MSHRs have room for a miss of the usual length.
-        Cycle start = m_mshr_occupancy->earliest(issue, Cycle(m_expected_miss));
-        m_mshr_stall_cycles += start - issue;
-        issue = start;
+    if (m_mshr_backfill) {
+        // Requests out of time order: the MSHR that can take a miss of the usual length soonest.
+        const BackfillSlots::Pick pick = m_mshr_backfill->earliest(issue, Cycle(m_expected_miss));
+        m_mshr_stall_cycles += pick.start - issue;
+        issue = pick.start;
+        mshr = pick.slot;
     }
     if (info) info->mshr_wait[size_t(m_level)] += issue - tag_done;
     AccessInfo below;
@@ -151,8 +152,8 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     m_mshr_busy_cycles += fill - issue;
     m_mshr_use.add_interval(issue, fill);
     if (m_mshrs_enabled) m_mshr_free.set(mshr, fill);
-    if (m_mshr_occupancy) {
-        m_mshr_occupancy->occupy(issue, fill);
+    if (m_mshr_backfill) {
+        m_mshr_backfill->book(mshr, issue, fill);
         m_expected_miss += (double(fill - issue) - m_expected_miss) / 64.0;  // running mean
     }
 
@@ -193,10 +194,11 @@ bool Cache::warm(uint64_t addr, uint32_t bytes) {
     return hit;
 }
 
-void Cache::limit_out_of_order_misses() {
-    m_mshr_occupancy = std::make_unique<OccupancyCalendar>(m_config.mshrs);
+void Cache::backfill_misses() {
+    m_mshr_backfill = std::make_unique<BackfillSlots>(m_config.mshrs);
     m_expected_miss = double(2 * m_next_latency + m_config.latency + 100);  // first guess, then learnt
 }
+
 
 nlohmann::json Cache::stats_json(Cycle total_cycles, bool series) const {
     nlohmann::json j;
@@ -215,7 +217,7 @@ nlohmann::json Cache::stats_json(Cycle total_cycles, bool series) const {
         w.set("bank_utilization_over_time", m_bank_use.to_json(bank_capacity()));
         w.set("mshr_utilization_over_time", m_mshr_use.to_json(double(m_config.mshrs)));
     }
-    const uint32_t mshrs = (m_mshrs_enabled || m_mshr_occupancy) ? m_config.mshrs : 0u;
+    const uint32_t mshrs = (m_mshrs_enabled || m_mshr_backfill) ? m_config.mshrs : 0u;
     w.set("config", cache_config_json(m_config, mshrs));
     if (m_prefetch_seen) w.set("prefetch", prefetch_json());
     w.done();

@@ -7,10 +7,9 @@
 // after the tag latency, allocates the line at once (LRU victim) and holds the MSHR until the fill.
 // Writes are write-through and no-write-allocate (ray hits and stack spills are written once and
 // not read back soon); they are posted: the issuer does not wait beyond the tag access.
-// MSHRs are exact when one issuer accesses the cache in time order (a private L1); for a shared
-// cache accessed out of order within a quantum they are not modelled (mshrs_enabled = false).
-// At the detailed level (exact = true) units synchronise every cycle, so the shared L2 sees
-// requests in time order and models its MSHRs too; banks are then per-cycle slot calendars
+// MSHRs are a free list when one issuer accesses the cache in time order (a private L1); a
+// shared cache reached out of time order (the L2) keeps each MSHR's booked intervals instead
+// (backfill_misses). At the detailed level (exact = true) banks are per-cycle slot calendars
 // (one access per bank_cycles, arrival order at equal cycles) instead of 16-access windows.
 // Prefetches (treelet prefetching, cache_prefetch.cpp) allocate a line without a waiter, only
 // into a free MSHR, and are counted until a read uses the line or it is evicted unused.
@@ -21,6 +20,7 @@
 
 #include <systemc>
 
+#include "rtl_model/common/backfill_slots.h"
 #include "rtl_model/common/calendar.h"
 #include "rtl_model/common/min_tree.h"
 #include "rtl_model/common/usage_series.h"
@@ -49,9 +49,11 @@ public:
     /// Returns true when every line was already present (a hit: the level below would not see it).
     bool warm(uint64_t addr, uint32_t bytes);
     uint32_t line_bytes() const { return m_config.line_bytes; }
-    /// For a shared cache reached out of time order (the approx L2): bound outstanding misses by
-    /// `mshrs` with an occupancy calendar instead of leaving them unlimited.
-    void limit_out_of_order_misses();
+    /// For a shared cache reached out of time order (the L2: within a quantum at approx, and at
+    /// both timed levels for an L1 miss that waited for its MSHR, stamped with the cycle it
+    /// frees): MSHRs that an earlier-stamped request takes while idle before later bookings
+    /// (backfill_slots.h).
+    void backfill_misses();
 
     const MemStats& stats() const { return m_stats; }
     /// MSHR-cycles held by misses (sum over misses of issue to fill): Little's law demand.
@@ -102,7 +104,7 @@ private:
     CacheSets m_sets;
     std::vector<LineFill> m_fills;
     MinTree m_mshr_free;  ///< cycle each MSHR is free again; the earliest is the next one used
-    std::unique_ptr<OccupancyCalendar> m_mshr_occupancy;  ///< out-of-order MSHR bound (approx L2)
+    std::unique_ptr<BackfillSlots> m_mshr_backfill;  ///< MSHRs reached out of time order (the L2)
     double m_expected_miss = 0;                           ///< running mean of miss durations
     Divider m_bank_of;  ///< line -> bank (line-interleaved)
     std::vector<BandwidthCalendar> m_banks;

@@ -38,8 +38,8 @@ Cycle Cache::prefetch(const MemRequest& req) {
         ++m_prefetch.blocked;
         return free;
     }
-    if (m_mshr_occupancy) {
-        const Cycle start = m_mshr_occupancy->earliest(req.time, Cycle(m_expected_miss));
+    if (m_mshr_backfill) {
+        const Cycle start = m_mshr_backfill->earliest(req.time, Cycle(m_expected_miss)).start;
         if (start > req.time) {
             ++m_prefetch.blocked;
             return start;

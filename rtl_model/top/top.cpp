@@ -122,15 +122,15 @@ void Top::build_memory() {
                                   {"why", kIdealMemoryWhy}});
         return;
     }
-    // The detailed level adds exact per-cycle cache banks and the L2's MSHRs (its units
-    // synchronise every cycle, so the shared L2 sees requests in time order). DRAM banks and row
-    // buffers are modelled at both timed levels (dram.model).
+    // The detailed level adds exact per-cycle cache banks (its units synchronise every cycle).
+    // DRAM banks and row buffers are modelled at both timed levels (dram.model).
     const bool detailed = c.fidelity == Fidelity::detailed;
     m_dram = std::make_unique<Dram>("dram", c.dram);
-    // At approx the L2 is reached out of time order within a quantum: its MSHRs bound outstanding
-    // misses through an occupancy calendar (docs/model.md); the private L1s model theirs exactly.
-    m_l2 = std::make_unique<Cache>("l2", c.l2, detailed, 0, detailed, ServedBy::l2);
-    if (!detailed) m_l2->limit_out_of_order_misses();
+    // The L2 is reached out of time order (within a quantum at approx; at both levels by L1
+    // misses stamped with the cycle their MSHR frees): its MSHRs keep their booked intervals and
+    // an earlier request back-fills them (docs/model.md); the private L1s' are a free list.
+    m_l2 = std::make_unique<Cache>("l2", c.l2, false, 0, detailed, ServedBy::l2);
+    m_l2->backfill_misses();
     m_l2->next(*m_dram);
     for (uint32_t u = 0; u < c.traversal.units; ++u) {
         m_l1.push_back(std::make_unique<Cache>(("l1_" + std::to_string(u)).c_str(), c.l1, true, c.interconnect_latency,

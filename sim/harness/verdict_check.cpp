@@ -42,9 +42,9 @@ std::vector<Candidate> to_measure(const json& verdict, const std::string& rtt) {
         out.push_back(std::move(c));
     };
     for (const json& k : verdict.value("top", json::array()))
-        add({{k["key"].get<std::string>() + "=" + value_text(k["to"])}, k["speedup"]});
+        add({{k["key"].get<std::string>() + "=" + value_text(k["to"])}, k["speedup"], ""});
     for (const json& co : verdict.value("co_limits", json::array())) {
-        add({co["sets"].get<std::vector<std::string>>(), co["joint"]});
+        add({co["sets"].get<std::vector<std::string>>(), co["joint"], ""});
         break;
     }
     const json structural = verdict.value("structural", json::array());
@@ -53,7 +53,7 @@ std::vector<Candidate> to_measure(const json& verdict, const std::string& rtt) {
         if (!k["speedup"].is_number() || k.contains("refused")) continue;
         const std::string set = k["key"].get<std::string>() + "=" + value_text(k["to"]);
         if (!k.value("trace", false)) {
-            add({{set}, k["speedup"]});
+            add({{set}, k["speedup"], ""});
         } else {
             const fs::path alt = fs::path(rtt).parent_path() /
                                  structure_alternative_dir({k["key"].get<std::string>(), value_text(k["to"])});
@@ -68,7 +68,7 @@ std::vector<Candidate> to_measure(const json& verdict, const std::string& rtt) {
         if (!k.value("trace", false) && !k.contains("refused") &&
             (!best || k.value("evidence", 0.0) > best->value("evidence", 0.0)))
             best = &k;
-    if (best) add({{(*best)["key"].get<std::string>() + "=" + value_text((*best)["to"])}, (*best)["speedup"]});
+    if (best) add({{(*best)["key"].get<std::string>() + "=" + value_text((*best)["to"])}, (*best)["speedup"], ""});
     return out;
 }
 

@@ -53,7 +53,7 @@ struct AlternativeTrace {
     SimConfig config;       ///< the run's config resolved against its structure
     StepOptions step = {};  ///< what its steppers walk with (the same resolution's)
     uint64_t rays = 0;
-    SampleStreamFactory sample_stream;
+    SampleStreamFactory sample_stream = {};
 };
 
 /// The alternative trace for `key=value` (StructureAlternative), or null with `why` (none was
@@ -66,7 +66,7 @@ struct VerdictContext {
     const nlohmann::json& model;  ///< the run's model stats (cycle accounting, utilisation, ...)
     const Accel* accel;           ///< the structure, its memory map and the trace's rays: the
     const MemoryMap* map;         ///< sample the analytic estimates run on (unless `estimate` is set)
-    SampleStreamFactory sample_stream;
+    SampleStreamFactory sample_stream = {};
     StepOptions step = {};        ///< what the sample's steppers walk with (the run's)
     std::string identity = {};    ///< the trace's identity (analysis_cache.h), "" when none
     uint64_t trace_rays = 0;      ///< rays in the trace

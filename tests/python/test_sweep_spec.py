@@ -234,3 +234,14 @@ def test_check_runs_false_leaves_refusals_to_the_runs() -> None:
     assert overflow == ["spill", "restart_trail"]
     with pytest.raises(SpecError, match=r"s\.yaml:6: check_runs: expected true or false"):
         parse_spec(text + "check_runs: 1\n", source="s.yaml")
+
+
+@pytest.mark.parametrize(
+    "path",
+    sorted((Path(__file__).parents[2] / "python" / "rtsim" / "specs").glob("*.yaml")),
+    ids=lambda p: p.stem,
+)
+def test_the_shipped_specs_parse(path: Path) -> None:
+    """The specs the docs run (accuracy grids, studies, the demo) stay valid as the config grows."""
+    spec = parse_spec(path.read_text(), source=str(path))
+    assert spec.runs()

@@ -4,6 +4,7 @@
 
 #include <map>
 
+#include "rtl_model/common/backfill_slots.h"
 #include "rtl_model/common/calendar.h"
 #include "rtl_model/common/min_tree.h"
 #include "traces/common/error.h"
@@ -81,31 +82,41 @@ TEST(BandwidthCalendar, RejectsZeroCapacityOrWindow) {
     EXPECT_THROW(BandwidthCalendar(4, 0), Error);
 }
 
-TEST(OccupancyCalendar, CapsOutstandingRequestsAtItsSlots) {
-    // 4 slots, 16-cycle windows: 4 requests of 100 cycles fit at cycle 0; a fifth waits until
-    // the first windows free up (after the others end), whatever order they are asked in.
-    OccupancyCalendar mshrs(4, 16);
-    for (int i = 0; i < 4; ++i) {
-        EXPECT_EQ(mshrs.earliest(0, 100), 0u) << i;
-        mshrs.occupy(0, 100);
+TEST(BackfillSlots, InTimeOrderTheSlotFreeEarliest) {
+    // 4 MSHRs: 4 misses of 100 cycles at cycle 0 each take one; a fifth waits for the first to
+    // free, on the lowest slot among equals, as a free list would have it.
+    BackfillSlots mshrs(4);
+    for (uint32_t i = 0; i < 4; ++i) {
+        const BackfillSlots::Pick p = mshrs.earliest(0, 100);
+        EXPECT_EQ(p.start, 0u) << i;
+        EXPECT_EQ(p.slot, i);
+        mshrs.book(p.slot, 0, 100 + i);
     }
-    Cycle fifth = mshrs.earliest(0, 100);
-    EXPECT_GE(fifth, 96u);  // the window holding cycle 96..111 is the first with room
-    EXPECT_LE(fifth, 112u);
-    // An earlier-stamped request arriving later is not blocked by requests in its future.
-    OccupancyCalendar late(1, 16);
-    late.occupy(1000, 1100);
-    EXPECT_EQ(late.earliest(0, 100), 0u);
-    // Average concurrency: 1,000 back-to-back requests of 64 cycles on 8 slots take about
-    // 1000 * 64 / 8 cycles.
-    OccupancyCalendar pool(8, 16);
-    Cycle last = 0;
-    for (int i = 0; i < 1000; ++i) {
-        Cycle s = pool.earliest(0, 64);
-        pool.occupy(s, s + 64);
-        last = std::max(last, s + 64);
-    }
-    EXPECT_NEAR(double(last), 1000.0 * 64 / 8, 1000.0 * 64 / 8 * 0.05);
+    const BackfillSlots::Pick fifth = mshrs.earliest(10, 100);
+    EXPECT_EQ(fifth.slot, 0u);
+    EXPECT_EQ(fifth.start, 100u);
+}
+
+TEST(BackfillSlots, AnEarlierStampedRequestTakesTheIdleGapBeforeLaterBookings) {
+    // One MSHR booked over [1000, 1100) by a request stamped ahead (an L1 miss that waited for
+    // its MSHR): a request stamped 0 takes the slot at once when its miss fits before 1000, and
+    // after 1100 when it does not. A free list made it wait until 1100 either way.
+    BackfillSlots one(1);
+    one.book(0, 1000, 1100);
+    EXPECT_EQ(one.earliest(0, 100).start, 0u);
+    EXPECT_EQ(one.earliest(950, 100).start, 1100u);
+    one.book(0, 0, 100);
+    EXPECT_EQ(one.earliest(50, 100).start, 100u);   // the gap [100, 1000) after its booking
+    EXPECT_EQ(one.earliest(50, 900).start, 100u);   // exactly long enough
+    EXPECT_EQ(one.earliest(50, 901).start, 1100u);  // a cycle too short
+    // Of two slots, the one idle soonest; back to the in-order rule once past every start.
+    BackfillSlots two(2);
+    two.book(0, 500, 600);
+    two.book(1, 200, 300);
+    EXPECT_EQ(two.earliest(250, 50).slot, 0u);
+    EXPECT_EQ(two.earliest(250, 50).start, 250u);
+    EXPECT_EQ(two.earliest(700, 50).slot, 1u);  // free since 300, slot 0 since 600: the lower end
+    EXPECT_EQ(two.earliest(700, 50).start, 700u);
 }
 
 TEST(MinTree, RunnerUpIsTheEarliestSlotBesideTheTop) {
