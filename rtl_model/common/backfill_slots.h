@@ -12,6 +12,7 @@
 // slot free earliest, lowest index on a tie. Out of order a slot is taken where it has an idle
 // gap of `expected` cycles (a miss's duration is known only once it has been served); a miss
 // longer than its gap overlaps the next booking of its slot, as a calendar would let it.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -30,20 +31,31 @@ public:
     };
     /// The slot that can take a request at `time` soonest for `expected` cycles.
     Pick earliest(Cycle time, Cycle expected) const;
-    /// `slot` is held over [start, end).
-    void book(uint32_t slot, Cycle start, Cycle end);
+    /// `slot` is held over [start, end) by a request stamped `time` (<= start).
+    void book(uint32_t slot, Cycle time, Cycle start, Cycle end);
 
 private:
     struct Interval {
         Cycle start, end;
     };
-    /// Intervals kept per slot (the latest by start): a request stamped before all of them is
-    /// rarer than one in 10^5 on the traces measured, and then takes the slot's oldest gap.
-    static constexpr size_t kKeep = 16;
-    std::vector<std::vector<Interval>> m_booked;  ///< per slot, sorted by start
+    /// How far behind the latest request's stamp a request may still be stamped: intervals that
+    /// ended longer before it are dropped. Every booking inside it is kept (a cap by count let a
+    /// request stamped behind a deep queue of bookings take a slot already held: 16 units on 8
+    /// L2 MSHRs held 40 at once); requests are stamped apart by an L1 MSHR wait, thousands of
+    /// cycles at most.
+    static constexpr Cycle kHorizon = Cycle(1) << 18;
+    /// A slot's bookings, sorted by start, from `head` on (those before it were dropped; the
+    /// vector is compacted when they are half of it: a flat array searches faster than a deque).
+    struct Booked {
+        std::vector<Interval> v;
+        size_t head = 0;
+    };
+    std::vector<Booked> m_booked;
     std::vector<Cycle> m_last_end;                ///< per slot, the latest end booked
     MinTree m_free;                               ///< m_last_end, for the in-order pick
     Cycle m_latest_start = 0;                     ///< latest start booked on any slot
+    Cycle m_latest_request = 0;                   ///< latest request stamp booked
+    Cycle m_longest = 0;                          ///< longest interval booked (where a search starts)
 };
 
 }  // namespace rtsim

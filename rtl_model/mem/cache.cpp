@@ -133,6 +133,7 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
             issue = m_mshr_free.top_time();
         }
     }
+    const Cycle stamped = issue;
     if (m_mshr_backfill) {
         // Requests out of time order: the MSHR that can take a miss of the usual length soonest.
         const BackfillSlots::Pick pick = m_mshr_backfill->earliest(issue, Cycle(m_expected_miss));
@@ -153,7 +154,7 @@ Cycle Cache::miss(uint64_t line, const MemRequest& req, Cycle tag_done, AccessIn
     m_mshr_use.add_interval(issue, fill);
     if (m_mshrs_enabled) m_mshr_free.set(mshr, fill);
     if (m_mshr_backfill) {
-        m_mshr_backfill->book(mshr, issue, fill);
+        m_mshr_backfill->book(mshr, stamped, issue, fill);
         m_expected_miss += (double(fill - issue) - m_expected_miss) / 64.0;  // running mean
     }
 

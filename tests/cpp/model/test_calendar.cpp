@@ -90,11 +90,43 @@ TEST(BackfillSlots, InTimeOrderTheSlotFreeEarliest) {
         const BackfillSlots::Pick p = mshrs.earliest(0, 100);
         EXPECT_EQ(p.start, 0u) << i;
         EXPECT_EQ(p.slot, i);
-        mshrs.book(p.slot, 0, 100 + i);
+        mshrs.book(p.slot, 0, 0, 100 + i);
     }
     const BackfillSlots::Pick fifth = mshrs.earliest(10, 100);
     EXPECT_EQ(fifth.slot, 0u);
     EXPECT_EQ(fifth.start, 100u);
+}
+
+TEST(BackfillSlots, NeverHoldsMoreThanItsSlotsOutOfOrder) {
+    // 20,000 misses of 150 cycles on 8 MSHRs, stamped up to 5,000 cycles behind the latest (a
+    // deep queue: far more bookings a slot than any cap by count would keep), offered 9x faster
+    // than the MSHRs serve them and again just below their rate. Whatever the order, no cycle
+    // sees more than 8 held; saturated, the misses take 20,000 x 150 / 8 cycles.
+    for (const Cycle step : {Cycle(2), Cycle(18)}) {
+        BackfillSlots mshrs(8);
+        std::map<Cycle, int> delta;  // +1 at a start, -1 at an end
+        uint64_t state = 12345;
+        Cycle front = 0, last = 0;
+        for (int n = 0; n < 20000; ++n) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            front += step;
+            const Cycle back = (state >> 33) % 5000;
+            const Cycle time = front > back ? front - back : 0;
+            const BackfillSlots::Pick p = mshrs.earliest(time, 150);
+            ASSERT_GE(p.start, time);
+            mshrs.book(p.slot, time, p.start, p.start + 150);
+            ++delta[p.start];
+            --delta[p.start + 150];
+            last = std::max(last, p.start + 150);
+        }
+        int held = 0, most = 0;
+        for (const auto& [cycle, d] : delta) most = std::max(most, held += d);
+        EXPECT_LE(most, 8) << step;
+        EXPECT_GE(double(last), 20000.0 * 150 / 8) << step;
+        if (step == 2) {
+            EXPECT_NEAR(double(last), 20000.0 * 150 / 8, 20000.0 * 150 / 8 * 0.02);
+        }
+    }
 }
 
 TEST(BackfillSlots, AnEarlierStampedRequestTakesTheIdleGapBeforeLaterBookings) {
@@ -102,17 +134,17 @@ TEST(BackfillSlots, AnEarlierStampedRequestTakesTheIdleGapBeforeLaterBookings) {
     // its MSHR): a request stamped 0 takes the slot at once when its miss fits before 1000, and
     // after 1100 when it does not. A free list made it wait until 1100 either way.
     BackfillSlots one(1);
-    one.book(0, 1000, 1100);
+    one.book(0, 1000, 1000, 1100);
     EXPECT_EQ(one.earliest(0, 100).start, 0u);
     EXPECT_EQ(one.earliest(950, 100).start, 1100u);
-    one.book(0, 0, 100);
+    one.book(0, 0, 0, 100);
     EXPECT_EQ(one.earliest(50, 100).start, 100u);   // the gap [100, 1000) after its booking
     EXPECT_EQ(one.earliest(50, 900).start, 100u);   // exactly long enough
     EXPECT_EQ(one.earliest(50, 901).start, 1100u);  // a cycle too short
     // Of two slots, the one idle soonest; back to the in-order rule once past every start.
     BackfillSlots two(2);
-    two.book(0, 500, 600);
-    two.book(1, 200, 300);
+    two.book(0, 500, 500, 600);
+    two.book(1, 200, 200, 300);
     EXPECT_EQ(two.earliest(250, 50).slot, 0u);
     EXPECT_EQ(two.earliest(250, 50).start, 250u);
     EXPECT_EQ(two.earliest(700, 50).slot, 1u);  // free since 300, slot 0 since 600: the lower end
