@@ -243,6 +243,10 @@ def trace_alternatives(job: TraceJob, manifest: dict, console: Console) -> list[
     compressed = bool(accel.get("build_settings", {}).get("compressed_leaves", False))
     scene = manifest["scene"]
     curved = scene.get("spheres", 0) + scene.get("capsules", 0) > 0
+    import shutil
+
+    # Alternatives of an earlier trace in this folder would be of other rays: start afresh.
+    shutil.rmtree(job.out_dir / "alternatives", ignore_errors=True)
     out = []
     for key, value, folder in _core.structure_alternatives(accel["kind"], compressed, curved):
         if key == "accel":
@@ -255,7 +259,11 @@ def trace_alternatives(job: TraceJob, manifest: dict, console: Console) -> list[
         else:
             alt = replace(job, build_settings={**(job.build_settings or {}), key: True})
         alt = replace(alt, out_dir=job.out_dir / folder, alternatives=False)
-        _trace_job(alt)
+        try:
+            _trace_job(alt)
+        except Exception as err:  # the main trace stands; this alternative is left out
+            console.print(f"alternative {folder}: not traced ({err}); the verdict measures it")
+            continue
         console.print(f"alternative: {alt.out_dir / 'trace.rtt'}")
         out.append(alt.out_dir)
     return out

@@ -19,7 +19,7 @@ BackfillSlots::Pick BackfillSlots::earliest(Cycle time, Cycle expected) const {
         const Cycle from = time > m_longest ? time - m_longest : 0;
         auto i = std::lower_bound(v.begin() + std::ptrdiff_t(m_booked[s].head), v.end(), from,
                                   [](const Interval& a, Cycle t) { return a.start < t; });
-        Cycle at = time;
+        Cycle at = std::max(time, m_booked[s].floor);
         for (; i != v.end(); ++i) {
             if (i->end <= at) continue;
             if (i->start >= at + expected) break;  // the gap before it is long enough
@@ -46,7 +46,8 @@ void BackfillSlots::book(uint32_t slot, Cycle time, Cycle start, Cycle end) {
     m_latest_start = std::max(m_latest_start, start);
     m_latest_request = std::max(m_latest_request, time);
     // Drop what no request can reach any more (ended a horizon before the latest stamp).
-    while (b.head < v.size() && v[b.head].end + kHorizon < m_latest_request) ++b.head;
+    for (; b.head < v.size() && v[b.head].end + kHorizon < m_latest_request; ++b.head)
+        b.floor = std::max(b.floor, v[b.head].end);
     if (b.head > 64 && 2 * b.head > v.size()) {
         v.erase(v.begin(), v.begin() + std::ptrdiff_t(b.head));
         b.head = 0;

@@ -39,7 +39,8 @@ private:
         Cycle start, end;
     };
     /// How far behind the latest request's stamp a request may still be stamped: intervals that
-    /// ended longer before it are dropped. Every booking inside it is kept (a cap by count let a
+    /// ended longer before it are dropped (a request stamped before a dropped one then starts
+    /// after it: it waits rather than taking a slot that may be held). Every booking inside it is kept (a cap by count let a
     /// request stamped behind a deep queue of bookings take a slot already held: 16 units on 8
     /// L2 MSHRs held 40 at once); requests are stamped apart by an L1 MSHR wait, thousands of
     /// cycles at most.
@@ -49,6 +50,7 @@ private:
     struct Booked {
         std::vector<Interval> v;
         size_t head = 0;
+        Cycle floor = 0;  ///< latest end of a dropped booking: a request stamped before it waits
     };
     std::vector<Booked> m_booked;
     std::vector<Cycle> m_last_end;                ///< per slot, the latest end booked

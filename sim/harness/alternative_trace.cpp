@@ -46,7 +46,8 @@ AlternativeFactory alternative_traces(const std::string& rtt, const SimConfig& c
     return [dir, rtt, config, rays](const std::string& key, const std::string& value,
                                     std::string* why) -> std::unique_ptr<AlternativeTrace> {
         const fs::path path = dir / structure_alternative_dir({key, value}) / "trace.rtt";
-        if (!fs::exists(path)) {
+        std::error_code missing;
+        if (!fs::exists(path, missing)) {
             *why = "no alternative traced beside the trace (rtsim trace --alternatives writes " +
                    (fs::path(structure_alternative_dir({key, value})) / "trace.rtt").string() + ")";
             return nullptr;
@@ -81,7 +82,7 @@ AlternativeFactory alternative_traces(const std::string& rtt, const SimConfig& c
                 return std::make_unique<SampleStream>(*reader, first, n, sample);
             };
             return a;
-        } catch (const Error& e) {
+        } catch (const std::exception& e) {  // a bad file, or the filesystem's own errors
             *why = e.what();
             return nullptr;
         }

@@ -29,6 +29,9 @@ RunInputs::RunInputs(const SimOptions& o)
       setup(resolve_run(o.config, structure_facts(reader))) {
     fs::create_directories(o.out_dir);
     write_json(fs::path(o.out_dir) / "config.resolved.json", config_to_json(setup.config));
+    // The config as given, before it was resolved against this trace's structure: what another
+    // structure's trace is simulated with (the verdict's measure commands, --check-verdict).
+    write_json(fs::path(o.out_dir) / "config.given.json", config_to_json(o.config));
 }
 
 double RunInputs::wall_seconds() const {

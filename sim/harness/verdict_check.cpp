@@ -116,10 +116,8 @@ json check_verdict(const SimOptions& o, const json& verdict, double base_rays_pe
             for (const std::string& s : m.sets) argv.insert(argv.end(), {"--set", s});
         } else {
             // Another structure resolves the run's config afresh (its stack entries, say): the
-            // config as given, not as resolved against this trace's structure.
-            const fs::path given = run / "config.given.json";
-            std::ofstream(given) << config_to_json(o.config).dump(2);
-            argv.insert(argv.end(), {"--config", given.string()});
+            // config as given (run_inputs.cpp), not as resolved against this trace's structure.
+            argv.insert(argv.end(), {"--config", (fs::path(o.out_dir) / "config.given.json").string()});
         }
         const int code = run_process(argv, (run / "log.txt").string());
         const double rps = code == 0 ? rays_per_second_of(run) : 0;

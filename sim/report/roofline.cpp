@@ -94,6 +94,13 @@ json roofline_json(const SimConfig& c, const json& summary, const json& model) {
             lowest = it.value().get<double>();
             bound = it.key();
         }
+    // A miss holds its MSHR while it queues for a DRAM channel, so saturated channels fill the
+    // MSHRs too and their Little's-law ceiling meets the DRAM's: within 2% of it, the DRAM binds.
+    if ((bound == "l1_mshrs" || bound == "l2_mshrs") && ceilings.contains("dram") &&
+        ceilings["dram"].get<double>() <= lowest * 1.02) {
+        bound = "dram";
+        lowest = ceilings["dram"].get<double>();
+    }
     return {{"dram_bytes_per_ray", bytes},
             {"rays_per_second", summary.value("rays_per_second", json(nullptr))},
             {"peak_dram_bytes_per_second", double(c.dram.bytes_per_cycle) * c.dram.channels * hz},
@@ -110,9 +117,9 @@ const StatBlock& roofline_stats() {
         {
             {"rays_per_second", "rays/s", "achieved (`summary.rays_per_second`)"},
             {"ceilings", "rays/s", "`{resource: rays/s}` what each resource alone allows: `dram` = peak DRAM bytes/s over `dram_bytes_per_ray`, `box`, `triangle`, ... = pipeline issue slots/s over issues per ray, `scheduler` = units x clock / (steps per ray x `issue_cycles`), `l1_mshrs` and `l2_mshrs` = Little's law, MSHRs x line bytes / the misses' mean MSHR hold time, over miss bytes per ray (`mshr_little`), `l2_banks` = L2 banks / `bank_cycles` x clock over L2 line accesses per ray; at the analytic level the memory ceilings are its closed form's bounds"},
-            {"bound", "", "the lowest ceiling's name, in the verdict's vocabulary (`verdict.binding`, `model.analytic.bounds`)"},
+            {"bound", "", "the lowest ceiling's name, in the verdict's vocabulary (`verdict.binding`, `model.analytic.bounds`); `dram` when an MSHR ceiling is lowest but the DRAM's is within 2% of it (the MSHRs are held by the DRAM's queue)"},
             {"bound_label", "", "the same in words, as the verdict labels it"},
-            {"bound_rays_per_second", "rays/s", "the lowest ceiling; the run can never be faster (tested)"},
+            {"bound_rays_per_second", "rays/s", "the bound's ceiling (the lowest, or the DRAM's within 2% of it); the run can never be faster than the lowest (tested)"},
             {"dram_bytes_per_ray", "bytes/ray", "as `summary.dram_bytes_per_ray`"},
             {"peak_dram_bytes_per_second", "B/s", "`channels x bytes_per_cycle x clock`"},
             {"mshr_little", "", "timed levels: `l1` and `l2`, each with `rays_per_second` (the ceiling), `mshrs` (all units' at the L1), `line_bytes`, `mean_hold_cycles` (loaded: a miss's MSHR time), `bytes_per_second` (`mshrs x line_bytes / mean_hold_cycles x clock`) and `miss_bytes_per_ray`; empty when no level kept MSHR time"},

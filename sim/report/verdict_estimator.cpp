@@ -191,7 +191,7 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
             return out;
         }
         out.speedup = base / cycles;
-    } catch (const Error& e) {
+    } catch (const std::exception& e) {  // a refused config, a bad alternative, the filesystem
         out.why_not = e.what();
     }
     return out;

@@ -204,13 +204,17 @@ std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st
 
 std::string measure_command(const Knob& k, const StructureTraits& st) {
     const std::string trace = st.trace.empty() ? "TRACE" : st.trace;
-    const std::string config = (st.run.empty() ? std::string("RUN") : st.run) + "/config.resolved.json";
+    const std::string run = st.run.empty() ? std::string("RUN") : st.run;
     const std::string to = k.relax.to.is_string() ? k.relax.to.get<std::string>() : k.relax.to.dump();
-    if (!k.trace) return "rtsim simulate " + trace + " -o NEW_RUN --config " + config + " --set " + k.relax.key + "=" + to;
-    // Traced beside the run's already (rtsim trace --alternatives): simulate it.
+    if (!k.trace)
+        return "rtsim simulate " + trace + " -o NEW_RUN --config " + run + "/config.resolved.json --set " + k.relax.key + "=" + to;
+    // Another structure's trace takes the config as given (resolved afresh against it: its stack
+    // entries differ). Traced beside the run's already (rtsim trace --alternatives): simulate it.
+    const std::string config = run + "/config.given.json";
     const std::filesystem::path beside =
         std::filesystem::path(trace).parent_path() / structure_alternative_dir({k.relax.key, to}) / "trace.rtt";
-    if (k.relax.key != "frame_policy" && !st.trace.empty() && std::filesystem::exists(beside))
+    std::error_code missing;
+    if (k.relax.key != "frame_policy" && !st.trace.empty() && std::filesystem::exists(beside, missing))
         return "rtsim simulate " + beside.string() + " -o NEW_RUN --config " + config;
     const std::string option = k.relax.key == "accel"          ? "--accel " + to
                                : k.relax.key == "frame_policy" ? "--frame-policy " + to

@@ -221,6 +221,8 @@ def test_alternatives_are_a_trace_of_their_own() -> None:
     assert "--alternatives" not in trace_task(plain, Path("out")).command("t")
     bad = "scenes: [cornell]\nworkloads: [{rays: [diffuse], alternatives: 2}]\n"
     assert "s.yaml:2: workloads[0].alternatives: expected true or false" in spec_error(bad)
+    moving = "scenes: [cloth]\nworkloads: [{frames: 3, alternatives: true}]\n"
+    assert "an animated trace has no structural alternatives" in spec_error(moving)
 
 
 def test_check_runs_false_leaves_refusals_to_the_runs() -> None:

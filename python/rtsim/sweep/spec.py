@@ -441,6 +441,11 @@ class _Reader:
                 d, "alternatives", f"{path}.alternatives",
                 f"expected true or false, got {alternatives!r}",
             )  # fmt: skip
+        if alternatives and int(frames) > 1:
+            raise self.fail(
+                d, "alternatives", f"{path}.alternatives",
+                "an animated trace has no structural alternatives (the verdict measures them)",
+            )  # fmt: skip
         label = str(d.get("name") or "-".join(rays) or "scene")
         return WorkloadSpec(
             label, tuple(rays), int(w), int(h), bounces, seed, frames, policy, float(threshold),

@@ -129,6 +129,17 @@ TEST(BackfillSlots, NeverHoldsMoreThanItsSlotsOutOfOrder) {
     }
 }
 
+TEST(BackfillSlots, ARequestStampedBeforeDroppedBookingsWaits) {
+    // A booking that ended a horizon before the latest stamp is dropped; a request stamped before
+    // its end starts after it (it may be held then) instead of taking the slot at its stamp.
+    BackfillSlots one(1);
+    one.book(0, 0, 0, 100);
+    const Cycle late = Cycle(1) << 19;
+    one.book(0, late, late, late + 100);  // drops [0, 100)
+    EXPECT_EQ(one.earliest(50, 10).start, 100u);
+    EXPECT_EQ(one.earliest(200, 10).start, 200u);  // idle after it, before the later booking
+}
+
 TEST(BackfillSlots, AnEarlierStampedRequestTakesTheIdleGapBeforeLaterBookings) {
     // One MSHR booked over [1000, 1100) by a request stamped ahead (an L1 miss that waited for
     // its MSHR): a request stamped 0 takes the slot at once when its miss fits before 1000, and
