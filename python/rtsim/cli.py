@@ -248,14 +248,18 @@ def trace_alternatives(job: TraceJob, manifest: dict, console: Console) -> list[
     # Alternatives of an earlier trace in this folder would be of other rays: start afresh.
     shutil.rmtree(job.out_dir / "alternatives", ignore_errors=True)
     out = []
+    kinds = {k["name"]: k for k in _core.accel_kinds()}
     for key, value, folder in _core.structure_alternatives(accel["kind"], compressed, curved):
         if key == "accel":
-            alt = replace(
-                job,
-                accel=value,
-                builder=None,
-                build_settings={"compressed_leaves": True} if compressed else None,
-            )
+            # The same builder and settings where the other structure takes them: one step away
+            # is the structure alone (an lbvh-built bvh2 against an lbvh-built bvh8).
+            other = kinds[value]
+            builder = job.builder if job.builder in other["builders"] else None
+            schema = other["settings"].get(builder or other["builders"][0], {})
+            settings = {k: v for k, v in (job.build_settings or {}).items() if k in schema}
+            if compressed:
+                settings["compressed_leaves"] = True
+            alt = replace(job, accel=value, builder=builder, build_settings=settings or None)
         else:
             alt = replace(job, build_settings={**(job.build_settings or {}), key: True})
         alt = replace(alt, out_dir=job.out_dir / folder, alternatives=False)

@@ -143,3 +143,13 @@ def test_check_verdict_reruns_the_best_structure_on_its_trace(
     assert Path(c["trace"]).name == "accel=cwbvh8"
     summary = json.loads((Path(c["run"]) / "stats.json").read_text())["summary"]
     assert summary["hit_mismatches"] == 0 and summary["work_mismatches"] == 0
+
+
+def test_alternatives_keep_the_builder(tmp_path: Path) -> None:
+    """One step away is the structure alone: an lbvh-built bvh2's alternatives are lbvh-built."""
+    out = tmp_path / "lbvh"
+    rtsim_trace("cornell", "-o", str(out), "--workload", "primary", "--resolution", "16x12",
+                "--builder", "lbvh", "--alternatives")  # fmt: skip
+    for _, _, folder in _core.structure_alternatives("bvh2"):
+        accel = json.loads((out / folder / "manifest.json").read_text())["accel"]
+        assert accel["builder"] == "lbvh", folder
