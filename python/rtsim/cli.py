@@ -197,31 +197,16 @@ def run_trace(job: TraceJob, console: Console) -> dict:
 
 
 def _trace_job(job: TraceJob, progress: Any = None) -> dict:
+    """trace_scene with the job's options: TraceJob's fields are its keyword arguments (declared
+    once), less the folder's and --alternatives, which trace_scene does not take."""
+    from dataclasses import fields
+
     from rtsim.tracing import trace_scene
 
-    return trace_scene(
-        job.scene,
-        job.out_dir,
-        workload=job.workload,
-        width=job.width,
-        height=job.height,
-        bounces=job.bounces,
-        seed=job.seed,
-        camera=job.camera,
-        threads=job.threads,
-        hairball_triangles=job.hairball_triangles,
-        progress=progress,
-        accel=job.accel,
-        builder=job.builder,
-        build_settings=job.build_settings,
-        flatten=job.flatten,
-        frames=job.frames,
-        frame_policy=job.frame_policy,
-        rebuild_threshold=job.rebuild_threshold,
-        lights=job.lights,
-        reflections=job.reflections,
-        roulette_after=job.roulette_after,
-    )
+    options = {f.name: getattr(job, f.name) for f in fields(job)}
+    scene, out_dir = options.pop("scene"), options.pop("out_dir")
+    del options["alternatives"]
+    return trace_scene(scene, out_dir, progress=progress, **options)
 
 
 def trace_alternatives(job: TraceJob, manifest: dict, console: Console) -> list[Path]:
@@ -230,6 +215,7 @@ def trace_alternatives(job: TraceJob, manifest: dict, console: Console) -> list[
     the same scene, workload and rays, so the verdict of every run of the trace estimates them
     with the analytic level (docs/verdict.md, "Structural estimates"). Each keeps the trace's
     leaves (compressed or not) where the other structure can store them."""
+    import shutil
     from dataclasses import replace
 
     from rtsim import _core
@@ -243,8 +229,6 @@ def trace_alternatives(job: TraceJob, manifest: dict, console: Console) -> list[
     compressed = bool(accel.get("build_settings", {}).get("compressed_leaves", False))
     scene = manifest["scene"]
     curved = scene.get("spheres", 0) + scene.get("capsules", 0) > 0
-    import shutil
-
     # Alternatives of an earlier trace in this folder would be of other rays: start afresh.
     shutil.rmtree(job.out_dir / "alternatives", ignore_errors=True)
     out = []

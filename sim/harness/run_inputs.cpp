@@ -121,8 +121,9 @@ VerdictContext verdict_context(RunInputs& in, const BuiltRun& built, const json&
     v.instantiated = with_structure_blocks(instantiated, in.setup.structure);
     v.structure = structure_traits(in);
     v.frames = built.frames.size();
-    if (built.frames.size() == 1) v.alternative = alternative_traces(in.rtt, in.options.config, built.rays);
-    if (built.frames.size() > 1) {
+    if (built.frames.size() == 1) {
+        v.alternative = alternative_traces(in.rtt, in.options.config, built.rays);
+    } else {
         // The estimates trace a sample of rays against one bound structure: an animated trace's
         // first frame, its rays against its structure.
         built.accel->bind_frame(0);

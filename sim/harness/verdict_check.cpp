@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "sim/harness/run_files.h"
+#include "sim/report/verdict_knobs.h"
 #include "traces/accel/accel.h"
 #include "traces/common/error.h"
 
@@ -28,8 +29,6 @@ struct Candidate {
     json estimated;
     std::string trace;  ///< "" for the run's own trace
 };
-
-std::string value_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
 /// The candidates to measure: the top three knobs (one `key=value` each), the best co-limit
 /// (both at once) and the structural alternatives: the best estimated one (on its trace beside

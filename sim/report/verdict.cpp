@@ -256,8 +256,7 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
         if (k.contains("refused") || (!relax.is_null() && k["key"] == relax["key"] && k["to"] == relax["to"])) continue;
         char mm2[48] = "";
         if (k["added_mm2"].is_number()) std::snprintf(mm2, sizeof mm2, " %+.3f mm^2", k["added_mm2"].get<double>());
-        const std::string to = k["to"].is_string() ? k["to"].get<std::string>() : k["to"].dump();
-        const std::string item = k["key"].get<std::string>() + "=" + to +
+        const std::string item = k["key"].get<std::string>() + "=" + value_text(k["to"]) +
                                  (k["speedup"].is_number() ? " " + gain(k["speedup"].get<double>()) : "") + mm2;
         std::string& list = k["speedup"].is_number() ? estimated : measured;
         list += (list.empty() ? "" : ", ") + item;

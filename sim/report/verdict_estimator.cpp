@@ -86,10 +86,6 @@ std::string stand_in_of(const SimConfig& config) {
     return u.needs.lock_step && !u.group_profile ? u.estimate_as : std::string();
 }
 
-std::string config_text(const Relaxation& r) {
-    return r.key + "=" + (r.to.is_string() ? r.to.get<std::string>() : r.to.dump());
-}
-
 }  // namespace
 
 VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
@@ -115,9 +111,7 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
             return;
         }
     }
-    const uint64_t rays = c.frame_rays ? c.frame_rays : c.trace_rays;
-    m_loaded = sample_analysis(base, *c.accel, *c.map, c.step, c.sample_stream, identity, c.trace_path, c.first_ray,
-                               rays, c.sample_rays, &m_reused);
+    m_loaded = own_sample(base, &m_reused);
     m_profile = m_loaded.get();
     m_form = std::make_unique<FormEstimator>(*m_profile);
     m_form_is_sample = true;
@@ -125,14 +119,18 @@ VerdictEstimator::VerdictEstimator(const VerdictContext& c) : m_context(c) {
                (c.frames > 1 ? " of the first frame" : "") + (c.config.treelets.enabled ? " in treelet order" : "");
 }
 
+std::unique_ptr<AnalyticProfile> VerdictEstimator::own_sample(const SimConfig& config, bool* reused) const {
+    const VerdictContext& c = m_context;
+    return sample_analysis(config, *c.accel, *c.map, c.step, c.sample_stream,
+                           c.trace_path.empty() ? std::string() : c.identity, c.trace_path, c.first_ray,
+                           c.frame_rays ? c.frame_rays : c.trace_rays, c.sample_rays, reused);
+}
+
 const FormEstimator& VerdictEstimator::sample_form() const {
     if (m_form_is_sample) return *m_form;
     if (!m_sample_form) {
-        const VerdictContext& c = m_context;
         bool reused = false;
-        m_sample = sample_analysis(analytic_config(c.config, c.unit.estimate_as), *c.accel, *c.map, c.step,
-                                   c.sample_stream, c.trace_path.empty() ? std::string() : c.identity, c.trace_path,
-                                   c.first_ray, c.frame_rays ? c.frame_rays : c.trace_rays, c.sample_rays, &reused);
+        m_sample = own_sample(analytic_config(m_context.config, m_context.unit.estimate_as), &reused);
         m_sample_form = std::make_unique<FormEstimator>(*m_sample);
     }
     return *m_sample_form;
@@ -158,9 +156,7 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
         if (k.trace) {
             std::string why;
             const std::unique_ptr<AlternativeTrace> alt =
-                c.alternative ? c.alternative(k.relax.key, k.relax.to.is_string() ? k.relax.to.get<std::string>()
-                                                                                  : k.relax.to.dump(), &why)
-                              : nullptr;
+                c.alternative ? c.alternative(k.relax.key, value_text(k.relax.to), &why) : nullptr;
             if (!alt) {
                 out.why_not = why.empty() ? "no alternative trace" : why;
                 return out;
@@ -179,12 +175,10 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
                 return out;
             }
             const SimConfig a = analytic_config(relaxed, as);
-            const auto profile = sample_analysis(a, *c.accel, *c.map, c.step, c.sample_stream,
-                                                 c.trace_path.empty() ? std::string() : c.identity, c.trace_path,
-                                                 c.first_ray, c.trace_rays, c.sample_rays, &reused);
+            const auto profile = own_sample(a, &reused);
             cycles = FormEstimator(*profile)(m_dram.apply(a)).cycles;
             out.method = "the analytic level on the same " + std::to_string(uint64_t(profile->stepped_rays)) +
-                         " sampled rays with " + config_text(k.relax);
+                         " sampled rays with " + setting_text(k.relax);
         }
         if (!(cycles > 0) || !(base > 0)) {
             out.why_not = "the analytic level gave no cycles";

@@ -58,6 +58,9 @@ private:
     mutable std::unique_ptr<AnalyticProfile> m_sample;
     mutable std::unique_ptr<FormEstimator> m_sample_form;
     const FormEstimator& sample_form() const;
+    /// The verdict's analysis of its sample of the run's own trace for `config` (stored beside
+    /// the trace, or loaded from there: `reused`).
+    std::unique_ptr<AnalyticProfile> own_sample(const SimConfig& config, bool* reused) const;
     std::string m_method;
     bool m_reused = false;
     DramLatencyCalibration m_dram;

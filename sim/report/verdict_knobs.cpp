@@ -116,6 +116,8 @@ json co_limits(const WeighInputs& in, const json& knobs) {
 
 }  // namespace
 
+std::string value_text(const json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
+
 Relaxation doubled(const SimConfig& c, const std::string& key) {
     const ConfigField f = config_field(c, key);
     const double value = f.value.get<double>();
@@ -205,9 +207,9 @@ std::vector<Knob> structural_knobs(const SimConfig& c, const StructureTraits& st
 std::string measure_command(const Knob& k, const StructureTraits& st) {
     const std::string trace = st.trace.empty() ? "TRACE" : st.trace;
     const std::string run = st.run.empty() ? std::string("RUN") : st.run;
-    const std::string to = k.relax.to.is_string() ? k.relax.to.get<std::string>() : k.relax.to.dump();
+    const std::string to = value_text(k.relax.to);
     if (!k.trace)
-        return "rtsim simulate " + trace + " -o NEW_RUN --config " + run + "/config.resolved.json --set " + k.relax.key + "=" + to;
+        return "rtsim simulate " + trace + " -o NEW_RUN --config " + run + "/config.resolved.json --set " + setting_text(k.relax);
     // Another structure's trace takes the config as given (resolved afresh against it: its stack
     // entries differ). Traced beside the run's already (rtsim trace --alternatives): simulate it.
     const std::string config = run + "/config.given.json";
@@ -227,7 +229,7 @@ std::string measure_command(const Knob& k, const StructureTraits& st) {
 SimConfig relaxed_config(const SimConfig& config, const std::vector<Relaxation>& knobs) {
     SimConfig c = config;
     for (const Relaxation& r : knobs)
-        config_set(c, r.key + "=" + (r.to.is_string() ? r.to.get<std::string>() : r.to.dump()));
+        config_set(c, setting_text(r));
     validate(c);
     return c;
 }

@@ -55,7 +55,7 @@ struct StructureTraits {
     bool stack_addresses = false;     ///< its stacks hold addresses (traversal.stack_prefetch)
     bool quantized_boxes = false;     ///< its nodes hold 8-bit boxes (traversal.quantized_boxes)
     std::string trace;                ///< the run's trace, for the commands that measure
-    std::string run;                  ///< the run's folder (its config.resolved.json), likewise
+    std::string run;                  ///< the run's folder (its config.resolved.json and config.given.json), likewise
     std::string frame_policy;         ///< an animated trace's --frame-policy ("" for a still trace)
 };
 
@@ -90,6 +90,11 @@ std::vector<Knob> structural_knobs(const SimConfig& config, const StructureTrait
 /// The command that measures a structural knob: a re-run with `--set` (what --check-verdict
 /// runs), or for a new structure the trace to make first.
 std::string measure_command(const Knob& knob, const StructureTraits& structure);
+
+/// A knob value as `--set` reads it (a string as is, numbers and switches as JSON writes them).
+std::string value_text(const nlohmann::json& value);
+/// `key=value`, as `--set` reads it.
+inline std::string setting_text(const Relaxation& r) { return r.key + "=" + value_text(r.to); }
 
 /// The cycles the estimator gives for a config; throws rtsim::Error for a config it refuses.
 using CycleEstimate = std::function<double(const SimConfig&)>;

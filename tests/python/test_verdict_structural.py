@@ -153,3 +153,29 @@ def test_alternatives_keep_the_builder(tmp_path: Path) -> None:
     for _, _, folder in _core.structure_alternatives("bvh2"):
         accel = json.loads((out / folder / "manifest.json").read_text())["accel"]
         assert accel["builder"] == "lbvh", folder
+
+
+def test_a_failed_alternative_is_left_out_and_old_ones_cleared(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:  # fmt: skip
+    """The main trace stands when an alternative cannot be traced; alternatives an earlier trace
+    left in the folder (of other rays) are removed first."""
+    import io
+
+    from rich.console import Console
+
+    from rtsim import cli
+
+    stale = tmp_path / "alternatives" / "accel=bvh4"
+    stale.mkdir(parents=True)
+
+    def refuse(job: cli.TraceJob, progress: Any = None) -> dict:
+        raise ValueError("no room")
+
+    monkeypatch.setattr(cli, "_trace_job", refuse)
+    text = io.StringIO()
+    manifest = {"accel": {"kind": "bvh2"}, "scene": {}}
+    job = cli.TraceJob(scene="cornell", out_dir=tmp_path, alternatives=True)
+    assert cli.trace_alternatives(job, manifest, Console(file=text, width=200)) == []
+    assert not stale.exists()
+    assert "alternative alternatives/accel=cwbvh8: not traced (no room)" in text.getvalue()

@@ -340,6 +340,22 @@ TEST(AnalyticClosedForm, L2MshrBoundAddsDramQueueingNearThePeak) {
     EXPECT_NEAR(closed_form(c, {}, light).bounds["l2_mshrs"].get<double>(), light.l2_hold / 4, 0.01 * light.l2_hold / 4);
 }
 
+TEST(AnalyticClosedForm, L1MshrsAreHeldWhileTheirMissesWaitBelow) {
+    // The same L1 misses, their L2 misses waiting for 4 L2 MSHRs or for none: the L1's bound
+    // holds the wait below it when the L2 starves, its unloaded occupancy when it does not.
+    SimConfig c;
+    AnalyticDemands d = l2_misses(c, 1e5);
+    d.l1_hold = 2e5 * 200.0;  // 2e5 L1 misses of 200 cycles unloaded
+    d.latency_sum = d.rays * 20000.0;
+    const double unloaded = d.l1_hold / (double(c.l1.mshrs) * c.traversal.units);
+    c.l2.mshrs = 4096;
+    EXPECT_NEAR(closed_form(c, {}, d).bounds["l1_mshrs"].get<double>(), unloaded, 0.05 * unloaded);
+    c.l2.mshrs = 4;
+    const ClosedForm starved = closed_form(c, {}, d);
+    EXPECT_GT(starved.bounds["l1_mshrs"].get<double>(), 1.2 * unloaded);
+    EXPECT_GE(starved.cycles, starved.bounds["l2_mshrs"].get<double>());
+}
+
 TEST(AnalyticClosedForm, OneRayInFlightTakesItsUnloadedLatencyPlusIssueCycles) {
     // One unit with one ray context: no queueing, so the MVA's residence is the delay plus each
     // queue's service. The pipelines', banks' and DRAM's service is in the unloaded latency
