@@ -1,6 +1,7 @@
 // Brute force and the alpha test: the definitions the structures' traversals are checked against.
 #include "traces/isect/brute_force.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -38,8 +39,12 @@ Hit trace_ray_brute_force(const HwTriangle* triangles, size_t count, const Ray& 
 bool alpha_test_accepts(uint32_t prim, float u, float v, uint32_t coverage_x255) {
     if (coverage_x255 >= 255) return true;
     if (coverage_x255 == 0) return false;
-    // u, v quantised to 1/1024 so tiny arithmetic differences cannot flip the decision.
-    const auto quantise = [](float x) { return uint64_t(int64_t(std::floor(x * 1024.0f)) & 0x7FF); };
+    // u, v quantised to 1/1024 so tiny arithmetic differences cannot flip the decision. A NaN or
+    // far-out u, v (from a corrupt trace's triangle) is clamped first: converting it is undefined.
+    const auto quantise = [](float x) {
+        const float inside = std::isfinite(x) ? std::clamp(x, -4.0f, 4.0f) : 0.0f;
+        return uint64_t(int64_t(std::floor(inside * 1024.0f)) & 0x7FF);
+    };
     const uint64_t h = hash_combine(0xA1FAu, prim, quantise(u), quantise(v));
     return hash_to_unit(h) * 255.0f < float(coverage_x255);
 }

@@ -205,5 +205,12 @@ TEST(Traversal, AlphaTest) {
     EXPECT_EQ(alpha_test_accepts(5, 0.50001f, 0.25f, 100), alpha_test_accepts(5, 0.50002f, 0.25f, 100));
 }
 
+TEST(Traversal, AlphaTestOfANanOrFarOutBarycentricIsDefined) {
+    // A corrupt trace's triangle can give NaN or huge u, v; the decision stays deterministic.
+    const float nan = std::numeric_limits<float>::quiet_NaN(), huge = 1e30f;
+    EXPECT_EQ(alpha_test_accepts(3, nan, 0.5f, 100), alpha_test_accepts(3, 0.0f, 0.5f, 100));
+    EXPECT_EQ(alpha_test_accepts(3, huge, -huge, 100), alpha_test_accepts(3, 4.0f, -4.0f, 100));
+}
+
 }  // namespace
 }  // namespace rtsim
