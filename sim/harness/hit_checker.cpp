@@ -45,7 +45,9 @@ void HitChecker::packet_done(const RayResult* results, const Ray* rays, const Tr
     m_packet_reference(rays, modes, n, hits.data(), work.data());
     for (uint32_t i = 0; i < n; ++i) {
         HitRecord want = m_reference.hit(results[i].id);
-        // An any-hit ray that agrees with the trace on occlusion must have the packet loop's hit.
+        if (m_reordered_anyhit && modes[i] == TraversalMode::any_hit) count_reordered(results[i]);
+        // An any-hit ray that agrees with the trace on occlusion must have the packet loop's hit
+        // (the packet loop walks in the run's any-hit order too).
         if (modes[i] == TraversalMode::any_hit && (want.prim >= 0) == hits[i].valid()) {
             want.prim = hits[i].prim;
             want.t = hits[i].t;
@@ -56,16 +58,20 @@ void HitChecker::packet_done(const RayResult* results, const Ray* rays, const Tr
 
 void HitChecker::occlusion_done(const RayResult& r) {
     HitRecord want = m_reference.hit(r.id);
-    // The same ray's work in the trace's order (nearest first) against its own: what the
-    // order changes (validation.reordered_anyhit).
-    m_reordered_reference.add(m_reference.work(r.id).counts());
-    m_reordered_own.add(r.work);
-    ++m_reordered;
+    count_reordered(r);
     if ((want.prim >= 0) == r.hit.valid()) {
         want.prim = r.hit.prim;
         want.t = r.hit.t;
     }
     check(r, want, WorkRecord::of(r.work.traced()));
+}
+
+void HitChecker::count_reordered(const RayResult& r) {
+    // The same ray's work in the trace's order (nearest first) against its own: what the
+    // order changes (validation.reordered_anyhit).
+    m_reordered_reference.add(m_reference.work(r.id).counts());
+    m_reordered_own.add(r.work);
+    ++m_reordered;
 }
 
 void HitChecker::check(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work) {

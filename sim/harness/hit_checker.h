@@ -55,6 +55,8 @@ public:
 
 private:
     void check(const RayResult& r, const HitRecord& ref_hit, const WorkRecord& ref_work);
+    /// An any-hit ray walked in the run's order: its work beside the trace's (validation.reordered_anyhit).
+    void count_reordered(const RayResult& r);
 
     PacketReference m_packet_reference;
     bool m_reordered_anyhit = false;

@@ -20,8 +20,8 @@ using nlohmann::json;
 /// Rays traced as one packet by the reference packet loop.
 class FunctionalPackets {
 public:
-    FunctionalPackets(const Accel& accel, HitChecker& checker, const PacketReference& packets)
-        : m_accel(accel), m_checker(checker), m_lanes(packets.lanes), m_split_below(packets.split_below) {}
+    FunctionalPackets(const Accel& accel, HitChecker& checker, const PacketReference& packets, const StepOptions& step)
+        : m_accel(accel), m_checker(checker), m_lanes(packets.lanes), m_split_below(packets.split_below), m_step(step) {}
     void add(const RayJob& job) {
         m_results.push_back(RayResult{});
         m_results.back().id = job.id;
@@ -34,7 +34,7 @@ public:
         if (n == 0) return;
         std::vector<Hit> hits(n);
         std::vector<WorkCounts> work(n);
-        m_accel.trace_packet(m_rays.data(), m_modes.data(), n, hits.data(), work.data(), nullptr, m_split_below);
+        m_accel.trace_packet(m_rays.data(), m_modes.data(), n, hits.data(), work.data(), nullptr, m_split_below, m_step);
         for (uint32_t i = 0; i < n; ++i) m_results[i].hit = hits[i], m_results[i].work = work[i];
         m_checker.packet_done(m_results.data(), m_rays.data(), m_modes.data(), n);
         m_results.clear(), m_rays.clear(), m_modes.clear();
@@ -45,6 +45,7 @@ private:
     HitChecker& m_checker;
     uint32_t m_lanes;
     float m_split_below;
+    StepOptions m_step;
     std::vector<RayResult> m_results;
     std::vector<Ray> m_rays;
     std::vector<TraversalMode> m_modes;
@@ -96,10 +97,13 @@ LevelResult run_functional_level(RunInputs& in) {
     if (s.packet_reference) {
         // Packets change each ray's work: it is checked against the reference packet loop.
         const PacketReference p = *s.packet_reference;
+        const StepOptions step = s.step.reference_walk();
         Accel& accel = *built.accel;
-        checker.set_packet_reference([&accel, p](const Ray* r, const TraversalMode* m, uint32_t n, Hit* h,
-                                                 WorkCounts* w) { accel.trace_packet(r, m, n, h, w, nullptr, p.split_below); });
-        packets = std::make_unique<FunctionalPackets>(accel, checker, p);
+        checker.set_packet_reference(
+            [&accel, p, step](const Ray* r, const TraversalMode* m, uint32_t n, Hit* h, WorkCounts* w) {
+                accel.trace_packet(r, m, n, h, w, nullptr, p.split_below, step);
+            });
+        packets = std::make_unique<FunctionalPackets>(accel, checker, p, step);
     }
     trace_all(*built.accel, s.step, in.reader, checker, built.frames, packets.get());
     require(checker.checked() == built.rays, "simulation ended with " + std::to_string(checker.checked()) + " of " +

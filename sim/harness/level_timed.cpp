@@ -77,8 +77,11 @@ LevelResult run_timed_level(RunInputs& in) {
     if (s.packet_reference) {
         // Packets change each ray's work: it is checked against the reference packet loop.
         const float split = s.packet_reference->split_below;
-        checker.set_packet_reference([&accel, split](const Ray* r, const TraversalMode* m, uint32_t n, Hit* h,
-                                                     WorkCounts* w) { accel.trace_packet(r, m, n, h, w, nullptr, split); });
+        const StepOptions step = s.step.reference_walk();
+        checker.set_packet_reference(
+            [&accel, split, step](const Ray* r, const TraversalMode* m, uint32_t n, Hit* h, WorkCounts* w) {
+                accel.trace_packet(r, m, n, h, w, nullptr, split, step);
+            });
     }
     FrameRecorder frame_figures(c, built.frames, in.manifest.value("frames", json(nullptr)));
     Timeline timeline(c.clock_ghz);

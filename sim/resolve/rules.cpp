@@ -128,11 +128,6 @@ std::vector<Rule> make_rules() {
          "BIH, B-Kd tree, octree and grid visit near cells before far ones by their own rules",
          "traversal.anyhit_order=nearest, or trace a structure with the setting (rtsim capabilities)", "grid",
          {"traversal.anyhit_order=fixed"}});
-    add({"anyhit_order/unit", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::unit,
-         "a unit kind whose rays walk their own stacks", [](const RunFacts& f) { return f.unit.needs.per_ray_stack; },
-         "a packet's shared walk orders children for all its rays by entry distance",
-         "traversal.model=mimd or simt, or traversal.anyhit_order=nearest", "bvh2",
-         {"traversal.model=packet", "traversal.anyhit_order=largest_box"}});
     add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::level,
          "a level that steps every ray (functional, approx, detailed, or analytic with analytic.caches=functional)",
          [](const RunFacts& f) {

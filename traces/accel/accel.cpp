@@ -11,8 +11,8 @@ Hit Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const Ste
 }
 
 void Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
-                         PacketCounts* counts, float split_below) const {
-    const std::unique_ptr<PacketStepper> s = make_packet_stepper();
+                         PacketCounts* counts, float split_below, const StepOptions& options) const {
+    const std::unique_ptr<PacketStepper> s = make_packet_stepper(options);
     require(s != nullptr, "structure '" + kind() + "' has no packet traversal");
     s->set_split_below(split_below);
     s->begin_packet(rays, modes, n);

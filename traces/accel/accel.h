@@ -66,10 +66,11 @@ public:
         return nullptr;
     }
     /// The reference packet loop: rays[0, n) traced as one packet, each ray's hit and work and the
-    /// packet's counts (any output may be null); `split_below` as PacketStepper::set_split_below.
+    /// packet's counts (any output may be null); `split_below` as PacketStepper::set_split_below,
+    /// `options` as make_packet_stepper's (the any-hit order is the one that changes the walk).
     /// The default drives make_packet_stepper(); throws rtsim::Error where the kind has none.
     virtual void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
-                              PacketCounts* counts, float split_below = 0.0f) const;
+                              PacketCounts* counts, float split_below = 0.0f, const StepOptions& options = {}) const;
     /// Treelets (or cell blocks) of at most `budget_bytes`, keyed by StepPlan::locality.
     virtual LocalityPartition partition(uint64_t budget_bytes) const = 0;
     /// Operation kinds the steppers issue (the model instantiates a pipeline for each).

@@ -15,6 +15,7 @@
 // so a packet of one ray, or of copies of one ray, does each ray's single-ray work exactly.
 #include <cstdint>
 
+#include "traces/accel/step_options.h"
 #include "traces/accel/stepper.h"
 #include "traces/isect/ray_box.h"
 #include "traces/isect/ray_triangle.h"
@@ -65,6 +66,22 @@ struct PacketLanes {
     float cull[kMaxPacketLanes];  ///< boxes entered beyond this are culled: best t widened
     Hit hit[kMaxPacketLanes];     ///< best hit so far (t: the shrinking tmax)
     WorkCounts work[kMaxPacketLanes];
+    /// Child order of the packet's any-hit rays (StepOptions::anyhit_order), kept across begin().
+    AnyHitOrder anyhit_order = AnyHitOrder::nearest;
+
+    /// The order of a node step over `active` rays: the any-hit order when every one of them is
+    /// an any-hit ray (a shadow packet: the order is the boxes', the same for every ray), else
+    /// nearest first (a closest-hit ray among them must not trade its order for another's).
+    AnyHitOrder order_for(LaneMask active) const {
+        if (anyhit_order == AnyHitOrder::nearest) return anyhit_order;
+        for (LaneMask m = active; m; m &= m - 1)
+            if (mode[__builtin_ctzll(m)] != TraversalMode::any_hit) return AnyHitOrder::nearest;
+        return anyhit_order;
+    }
+    /// Ray r's own order when it walks alone after a split (its single-ray stepper's).
+    AnyHitOrder order_of(uint32_t r) const {
+        return mode[r] == TraversalMode::any_hit ? anyhit_order : AnyHitOrder::nearest;
+    }
 
     /// Starts the packet (n <= kMaxPacketLanes; throws rtsim::Error otherwise). Invalid rays are
     /// never live: a miss, no work.
@@ -91,6 +108,9 @@ public:
     /// Every ray's hit and work are the serial walk's (each walk is the ray's alone); the
     /// packet's lane_hit(i) / lane_work(i) and counts() are final once every walker is done.
     void set_split_walks(SplitWalks walks) { m_split_walks = walks; }
+    /// Child order of any-hit rays (StepOptions::anyhit_order) from the next packet on, on the
+    /// structures whose packet kernels offer it (AccelCapabilities::anyhit_order).
+    void set_anyhit_order(AnyHitOrder order) { m_lanes.anyhit_order = order; }
     /// The rays walking alone after a split with SplitWalks::lanes (0 before, and otherwise).
     LaneMask split_lanes() const { return m_split_lanes; }
     /// Ray i's walker (i in split_lanes()).

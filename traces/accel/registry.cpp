@@ -251,6 +251,7 @@ const std::vector<Entry>& registry() {
         {{"gkbvh", "GK-BVH: a binary BVH by space subdivision alone, straddlers referenced on both sides (Popov et al. 2009)",
           {"clipped", "boxes"}, single_level(kBvhStackEntryBytes)
                                     .with(&AccelCapabilities::packet_kernel)
+                                    .with(&AccelCapabilities::anyhit_order)
                                     .with(&AccelCapabilities::restart_trail)
                                     .with(&AccelCapabilities::reduced_precision_boxes)
                                     .with(&AccelCapabilities::stack_addresses)},

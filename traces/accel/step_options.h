@@ -40,6 +40,14 @@ struct StepOptions {
     /// checker checks their occlusion alone (HitChecker::set_reordered_anyhit).
     bool reorders_anyhit() const { return anyhit_order != AnyHitOrder::nearest; }
 
+    /// The options a reference packet loop walks with (Accel::trace_packet): the any-hit order,
+    /// which changes the walk; the others only add model-only work, which the reference leaves out.
+    StepOptions reference_walk() const {
+        StepOptions o;
+        o.anyhit_order = anyhit_order;
+        return o;
+    }
+
     /// True when a structure's fused reference loop walks as its steppers do: no short stack or
     /// reduced-precision walk whose extra work only a stepper counts, and any-hit rays nearest first.
     bool fused_loop_walks_alike() const {

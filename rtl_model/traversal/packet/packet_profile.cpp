@@ -29,7 +29,7 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
         }
         PacketCounts counts;
         accel.trace_packet(group.data(), modes.data(), uint32_t(n), hits.data(), work.data(), &counts,
-                           float(pc.split_below));
+                           float(pc.split_below), step.reference_walk());
         const double steps = double(counts.node_steps + counts.leaf_steps);
         p.group_steps += steps;
         p.scheduler_steps += 1 + 2 * steps;  // the packet's ray fetch, then each step and its operations

@@ -16,8 +16,8 @@ namespace {
 /// Packets of `lanes` consecutive rays: hits against single rays, stepper against fused loop,
 /// plans against work. Returns the packets' counts.
 PacketCounts check_packets(const Accel& accel, const std::vector<Ray>& rays, uint32_t lanes, TraversalMode mode,
-                           const std::string& what, float split_below = 0.0f) {
-    std::unique_ptr<PacketStepper> s = accel.make_packet_stepper();
+                           const std::string& what, float split_below = 0.0f, const StepOptions& options = {}) {
+    std::unique_ptr<PacketStepper> s = accel.make_packet_stepper(options);
     s->set_split_below(split_below);
     PacketCounts total;
     int diffs = 0;
@@ -27,7 +27,7 @@ PacketCounts check_packets(const Accel& accel, const std::vector<Ray>& rays, uin
         std::vector<Hit> hits(n);
         std::vector<WorkCounts> work(n);
         PacketCounts fused;
-        accel.trace_packet(&rays[first], modes.data(), n, hits.data(), work.data(), &fused, split_below);
+        accel.trace_packet(&rays[first], modes.data(), n, hits.data(), work.data(), &fused, split_below, options);
         // The stepper, driven step by step: its plans' tests are the active rays' tests.
         s->begin_packet(&rays[first], modes.data(), n);
         uint64_t box = 0, tri = 0, alpha = 0, fetches = 0;
@@ -246,8 +246,8 @@ TEST(Packets, WideBvhsCopiesOfOneRayDoItsSingleRayWorkFullyActive) {
 /// the walkers stepped round robin as a unit's lanes would: each ray's hit and work, and the
 /// packet's counts, are the serial walk's (the fused loop's).
 void check_lane_walks(const Accel& accel, const std::vector<Ray>& rays, TraversalMode mode, float split,
-                      const std::string& what, bool expect_split) {
-    std::unique_ptr<PacketStepper> s = accel.make_packet_stepper();
+                      const std::string& what, bool expect_split, const StepOptions& options = {}) {
+    std::unique_ptr<PacketStepper> s = accel.make_packet_stepper(options);
     s->set_split_below(split);
     s->set_split_walks(SplitWalks::lanes);
     uint64_t launched = 0;
@@ -256,7 +256,7 @@ void check_lane_walks(const Accel& accel, const std::vector<Ray>& rays, Traversa
         std::vector<Hit> hits(16);
         std::vector<WorkCounts> work(16);
         PacketCounts fused;
-        accel.trace_packet(&rays[first], modes.data(), 16, hits.data(), work.data(), &fused, split);
+        accel.trace_packet(&rays[first], modes.data(), 16, hits.data(), work.data(), &fused, split, options);
         s->begin_packet(&rays[first], modes.data(), 16);
         while (!s->done()) s->execute();
         for (LaneMask walking = s->split_lanes(); walking;) {
@@ -293,6 +293,53 @@ TEST(Packets, SplitRaysOnTheirOwnLanesWalkAsTheSerialHybrid) {
                     check_lane_walks(*accel, camera, mode, split, what + " camera", false);
                 }
         }
+    }
+}
+
+TEST(Packets, AnyHitPacketsWalkInTheRunsChildOrder) {
+    // traversal.anyhit_order on packets: an all-any-hit step takes the order's child first (the
+    // boxes', the same for every ray), so a packet of one ray, or of copies of one, does the
+    // single-ray stepper's work in that order; stepper and fused loop agree; occlusion never changes.
+    const Scene& scene = test::procedural("hairball");
+    const std::vector<HwTriangle> tris = test::hw_triangles(scene);
+    const std::vector<Ray> random = test::random_rays(scene, tris, 41, 384), camera = camera_rays(tris, 576, 11);
+    for (const std::string kind : {"bvh2", "gkbvh", "bvh4", "bvh8", "cwbvh8", "cwbvh8_octant"}) {
+        const std::unique_ptr<Accel> accel = accel_of(scene, kind);
+        ASSERT_TRUE(accel->capabilities().anyhit_order) << kind;
+        uint64_t nearest_steps = 0, reordered_steps = 0;
+        for (AnyHitOrder order : {AnyHitOrder::largest_box, AnyHitOrder::fixed}) {
+            StepOptions options;
+            options.anyhit_order = order;
+            const std::string what = kind + " order " + std::to_string(int(order));
+            for (uint32_t lanes : {1u, 16u, 64u}) {
+                check_packets(*accel, random, lanes, TraversalMode::any_hit, what + " random", 0.0f, options);
+                check_packets(*accel, camera, lanes, TraversalMode::any_hit, what + " camera", 0.0f, options);
+            }
+            check_packets(*accel, random, 16, TraversalMode::any_hit, what + " split", 0.5f, options);
+            check_lane_walks(*accel, random, TraversalMode::any_hit, 0.5f, what + " lane walks", true, options);
+            for (size_t i = 0; i < 96; ++i) {
+                const Ray& r = random[i];
+                WorkCounts single, near;
+                accel->trace(r, TraversalMode::any_hit, &single, options);
+                accel->trace(r, TraversalMode::any_hit, &near);
+                const std::vector<Ray> same(16, r);
+                const std::vector<TraversalMode> modes(16, TraversalMode::any_hit);
+                std::vector<WorkCounts> work(16);
+                accel->trace_packet(same.data(), modes.data(), 16, nullptr, work.data(), nullptr, 0.0f, options);
+                for (const WorkCounts& w : work) EXPECT_EQ(w, single) << what << " ray " << i;
+                if (order == AnyHitOrder::largest_box) nearest_steps += near.steps, reordered_steps += single.steps;
+            }
+            // A closest-hit ray among any-hit rays keeps its nearest-first walk and its closest hit.
+            std::vector<TraversalMode> mixed(16, TraversalMode::any_hit);
+            mixed[0] = mixed[7] = TraversalMode::closest_hit;
+            std::vector<Hit> hits(16);
+            accel->trace_packet(camera.data(), mixed.data(), 16, hits.data(), nullptr, nullptr, 0.0f, options);
+            for (uint32_t i : {0u, 7u})
+                EXPECT_TRUE(test::same_hit(hits[i], accel->trace(camera[i], TraversalMode::closest_hit),
+                                           TraversalMode::closest_hit))
+                    << what;
+        }
+        EXPECT_NE(nearest_steps, reordered_steps) << kind << ": the order changed no walk (a vacuous test)";
     }
 }
 

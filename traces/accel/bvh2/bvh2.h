@@ -51,7 +51,7 @@ public:
               const StepOptions& options = {}) const override;
     std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override;
     void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
-                      PacketCounts* counts, float split_below = 0.0f) const override;
+                      PacketCounts* counts, float split_below = 0.0f, const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return kTraversalStackSize; }

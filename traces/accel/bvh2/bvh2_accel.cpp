@@ -199,13 +199,15 @@ Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const
     return trace_bvh2(m_view, ray, mode, work);
 }
 
-std::unique_ptr<PacketStepper> Bvh2Accel::make_packet_stepper(const StepOptions&) const {
-    return std::make_unique<Bvh2PacketStepper>(m_view);
+std::unique_ptr<PacketStepper> Bvh2Accel::make_packet_stepper(const StepOptions& options) const {
+    auto s = std::make_unique<Bvh2PacketStepper>(m_view);
+    s->set_anyhit_order(options.anyhit_order);
+    return s;
 }
 
 void Bvh2Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
-                             PacketCounts* counts, float split_below) const {
-    trace_packet_bvh2(m_view, rays, modes, n, hits, work, counts, split_below);
+                             PacketCounts* counts, float split_below, const StepOptions& options) const {
+    trace_packet_bvh2(m_view, rays, modes, n, hits, work, counts, split_below, options.anyhit_order);
 }
 
 LocalityPartition Bvh2Accel::partition(uint64_t budget_bytes) const {

@@ -112,10 +112,11 @@ void Bvh2PacketStepper::pop_next() {
 void Bvh2PacketStepper::finish() { end_packet(); }
 
 void trace_packet_bvh2(const Bvh2View& bvh, const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits,
-                       WorkCounts* work, PacketCounts* counts, float split_below) {
+                       WorkCounts* work, PacketCounts* counts, float split_below, AnyHitOrder anyhit_order) {
     static thread_local PacketLanes p;
     static thread_local detail::PacketStackEntry stack[kTraversalStackSize];
     static thread_local detail::SplitWalk walk;
+    p.anyhit_order = anyhit_order;
     p.begin(rays, modes, n);
     PacketCounts c;
     LaneMask active = p.live;

@@ -23,7 +23,7 @@ struct Bvh2LaneRules {
     bool descend(PacketLanes& p, uint32_t r, uint32_t* ref, uint32_t* count, std::vector<Entry>& stack,
                  int& size) const {
         return detail::descend(p.box[r], view.nodes[*ref], p.ray[r].tmin, p.cull[r], p.work[r], stack.data(), size,
-                               ref, count);
+                               ref, count, p.order_of(r));
     }
     void plan(StepPlan& plan, uint32_t ref, uint32_t count) const;
     const HwTriangle* leaf(uint32_t ref) const { return view.triangles + ref; }
@@ -57,8 +57,9 @@ private:
 
 /// The fused packet loop: rays[0, n) traced as one packet; each ray's hit and work, and the
 /// packet's counts (any of hits, work, counts may be null). `split_below`: the hybrid's threshold
-/// (PacketStepper::set_split_below; 0: never split).
+/// (PacketStepper::set_split_below; 0: never split); `anyhit_order` as PacketStepper::set_anyhit_order.
 void trace_packet_bvh2(const Bvh2View& bvh, const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits,
-                       WorkCounts* work, PacketCounts* counts, float split_below = 0.0f);
+                       WorkCounts* work, PacketCounts* counts, float split_below = 0.0f,
+                       AnyHitOrder anyhit_order = AnyHitOrder::nearest);
 
 }  // namespace rtsim

@@ -9,6 +9,9 @@
 //          When both are entered, the packet goes first to the child most of the rays hitting
 //          both enter first (child 0 on a tie); the other is pushed with its mask and each
 //          ray's entry distance. A packet of one ray thus visits in the single ray's order.
+//          With an any-hit order (traversal.anyhit_order) and only any-hit rays active, the
+//          packet goes first to the child that order picks (larger box, or child 0): the
+//          order is the node's, the same for every ray, so a shadow packet keeps it whole.
 //   leaf:  every active ray tests the leaf's triangles; an any-hit ray that found its hit
 //          leaves the packet.
 //   pop:   an entry's rays whose entry distance lies beyond their own (widened) best hit are
@@ -46,7 +49,11 @@ inline bool packet_descend(PacketLanes& p, LaneMask active, const HwNode& node, 
         if (m == 3u) ++both, far_first += next_slot(m, t);
     });
     if ((hit[0] | hit[1]) == 0) return false;
-    const unsigned next = !hit[0] ? 1u : !hit[1] ? 0u : (2 * far_first > both ? 1u : 0u);
+    const AnyHitOrder order = p.order_for(active);
+    const unsigned next = !hit[0]                          ? 1u
+                          : !hit[1]                        ? 0u
+                          : order != AnyHitOrder::nearest ? next_slot(3u, nullptr, node, order)
+                                                           : (2 * far_first > both ? 1u : 0u);
     if (hit[0] && hit[1]) {
         const unsigned far = next ^ 1u;
         if (size >= kTraversalStackSize) throw_stack_overflow();
@@ -121,7 +128,8 @@ inline uint32_t split_step(PacketLanes& p, const HwNode* nodes, const HwTriangle
     const uint32_t r = s.ray;
     uint32_t alpha = 0;
     if (*count == 0) {
-        if (descend(p.box[r], nodes[*ref], p.ray[r].tmin, p.cull[r], p.work[r], s.stack, s.size, ref, count)) {
+        if (descend(p.box[r], nodes[*ref], p.ray[r].tmin, p.cull[r], p.work[r], s.stack, s.size, ref, count,
+                    p.order_of(r))) {
             *more = true;
             return 0;
         }

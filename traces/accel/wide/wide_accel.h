@@ -152,12 +152,14 @@ public:
         }
         return Accel::trace(ray, mode, work, options);
     }
-    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& = {}) const override {
-        return std::make_unique<WidePacketStepper<Codec>>(m_view);
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override {
+        auto s = std::make_unique<WidePacketStepper<Codec>>(m_view);
+        s->set_anyhit_order(options.anyhit_order);
+        return s;
     }
     void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
-                      PacketCounts* counts, float split_below = 0.0f) const override {
-        trace_packet_wide<Codec>(m_view, rays, modes, n, hits, work, counts, split_below);
+                      PacketCounts* counts, float split_below = 0.0f, const StepOptions& options = {}) const override {
+        trace_packet_wide<Codec>(m_view, rays, modes, n, hits, work, counts, split_below, options.anyhit_order);
     }
     LocalityPartition partition(uint64_t budget_bytes) const override {
         require(budget_bytes >= Codec::kBytes, "treelet budget must be at least one node (" +

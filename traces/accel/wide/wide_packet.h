@@ -44,7 +44,7 @@ struct WideLaneRules {
         float tnear[kMaxWideWidth];
         const uint32_t mask = wide_box_tests(p.box[r], d, p.ray[r].tmin, p.cull[r], tnear);
         uint8_t slots[kMaxWideWidth];
-        const int n = order_children(mask, tnear, view.order, ray_octant(p.box[r]), slots);
+        const int n = order_entered(mask, tnear, view.order, ray_octant(p.box[r]), d, p.order_of(r), slots);
         if (n == 0) return false;
         for (int i = n - 1; i >= 1; --i) {
             if (size_t(size) >= stack.size()) throw_wide_packet_overflow(stack.size());
@@ -188,15 +188,17 @@ private:
 
 /// The fused packet loop: rays[0, n) traced as one packet; each ray's hit and work, and the
 /// packet's counts (any of hits, work, counts may be null); `split_below` as
-/// PacketStepper::set_split_below.
+/// PacketStepper::set_split_below, `anyhit_order` as PacketStepper::set_anyhit_order.
 template <class Codec>
 void trace_packet_wide(const WideView& view, const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits,
-                       WorkCounts* work, PacketCounts* counts, float split_below) {
+                       WorkCounts* work, PacketCounts* counts, float split_below,
+                       AnyHitOrder anyhit_order = AnyHitOrder::nearest) {
     static thread_local PacketLanes p;
     static thread_local std::vector<detail::PacketStackEntry> stack;
     static thread_local detail::WideSplitWalk walk;
     const size_t depth = std::max<uint32_t>(1, view.max_stack);
     if (stack.size() != depth) stack.resize(depth), walk.stack.resize(depth);
+    p.anyhit_order = anyhit_order;
     p.begin(rays, modes, n);
     PacketCounts c;
     LaneMask active = p.live;

@@ -13,7 +13,8 @@
 //          among the rays entering each (ties to the lower slot), in octant order by the first
 //          active ray's octant. The first is visited next, the others pushed farthest first with
 //          their masks and each ray's entry distance. A packet of one ray, or of copies of one
-//          ray, thus visits in the single ray's order.
+//          ray, thus visits in the single ray's order. With an any-hit order and only any-hit
+//          rays active, the children go in that order (the boxes', the same for every ray).
 //   split: the hybrid (Benthin et al. 2012): below the threshold the packet stops and its rays
 //          finish alone, one after the other in lane order, each from its own part of the shared
 //          stack with the single-ray rules of wide_stepper.h (plain stack, fp32 box tests).
@@ -28,6 +29,15 @@ namespace rtsim::detail {
 
 [[noreturn]] inline void throw_wide_packet_overflow(size_t capacity) {
     throw Error("wide BVH: packet traversal stack overflow (" + std::to_string(capacity) + " entries)");
+}
+
+/// The children `mask` entered in visit order: by the any-hit order when one applies (the
+/// node's boxes, the same for every ray: wide_stepper.h's any-hit order), else by `order` on the
+/// entry distances `key` and the octant.
+inline int order_entered(uint32_t mask, const float* key, ChildOrder order, uint8_t octant, const DecodedNode& d,
+                         AnyHitOrder anyhit, uint8_t slots[kMaxWideWidth]) {
+    if (anyhit != AnyHitOrder::nearest) return order_children_anyhit(mask, d, anyhit, slots);
+    return order_children(mask, key, order, octant, slots);
 }
 
 /// The packet's node step over `active` rays on the decoded node `d`: pushes the children
@@ -58,7 +68,7 @@ inline bool wide_packet_descend(PacketLanes& p, LaneMask active, const DecodedNo
     if (entered == 0) return false;
     const uint32_t first = uint32_t(__builtin_ctzll(active));
     uint8_t slots[kMaxWideWidth];
-    const int n = order_children(entered, key, order, ray_octant(p.box[first]), slots);
+    const int n = order_entered(entered, key, order, ray_octant(p.box[first]), d, p.order_for(active), slots);
     for (int i = n - 1; i >= 1; --i) {
         if (size_t(size) >= stack.size()) throw_wide_packet_overflow(stack.size());
         PacketStackEntry& e = stack[size_t(size++)];
@@ -141,7 +151,7 @@ struct WideSplitWalk {
             float tnear[kMaxWideWidth];
             const uint32_t mask = wide_box_tests(p.box[r], *d, p.ray[r].tmin, p.cull[r], tnear);
             uint8_t slots[kMaxWideWidth];
-            const int n = order_children(mask, tnear, order, ray_octant(p.box[r]), slots);
+            const int n = order_entered(mask, tnear, order, ray_octant(p.box[r]), *d, p.order_of(r), slots);
             if (n > 0) {
                 for (int i = n - 1; i >= 1; --i) {
                     if (size_t(size) >= stack.size()) throw_wide_packet_overflow(stack.size());
