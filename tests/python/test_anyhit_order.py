@@ -52,3 +52,23 @@ def test_reordered_rays_report_their_work(trace: Path, sim_exe: Path, tmp_path: 
 def test_nearest_reorders_nothing(trace: Path, sim_exe: Path, tmp_path: Path) -> None:
     stats = checked(sim_exe, trace, tmp_path / "run", "fidelity=functional")
     assert "reordered_anyhit" not in stats["validation"]
+
+
+def test_packet_units_walk_shadow_packets_in_the_order(trace: Path, sim_exe: Path,
+                                                       tmp_path: Path) -> None:  # fmt: skip
+    """Packet units take the order at node steps of shadow packets (the boxes' order is every
+    ray's), so a shadow ray does about its single-ray reordered work (exactly, in a packet of
+    shadow rays alone), checked in full against the reference packet loop at every level."""
+    alone = checked(sim_exe, trace, tmp_path / "mimd", "fidelity=functional",
+                    "traversal.anyhit_order=largest_box")  # fmt: skip
+    own = {}
+    for fidelity in ("functional", "approx", "detailed"):
+        stats = checked(sim_exe, trace, tmp_path / fidelity, f"fidelity={fidelity}",
+                        "traversal.model=packet", "traversal.anyhit_order=largest_box")  # fmt: skip
+        v = stats["validation"]
+        assert v["hit_mismatches"] == v["work_mismatches"] == 0, fidelity
+        assert v["reordered_anyhit"]["rays"] == alone["validation"]["reordered_anyhit"]["rays"]
+        own[fidelity] = v["reordered_anyhit"]["own"]
+    assert own["approx"] == own["detailed"] == own["functional"]
+    for key, value in alone["validation"]["reordered_anyhit"]["own"].items():
+        assert own["functional"][key] == pytest.approx(value, rel=0.02), key
