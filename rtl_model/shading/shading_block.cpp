@@ -255,6 +255,17 @@ Cycle ShadingBlock::wavefront_end(uint32_t w, Cycle end) {
     return shaded;
 }
 
+Cycle ShadingBlock::end_frame_inflight(Cycle end) {
+    // The frame's hits still forming a warp are shaded now: nothing of this frame is left to join them.
+    flush_inflight(end);
+    const Cycle shaded = std::max(end, m_last_end);
+    m_inflight_rt += end > m_release ? end - m_release : 0;
+    m_inflight_tail += shaded - std::max(end, m_release);
+    ++m_frames_ended;
+    m_release = shaded;
+    return shaded;
+}
+
 bool ShadingBlock::parent_shaded(uint64_t id, Cycle* not_before) const {
     const int64_t parent = id < m_in.shade.size() ? m_in.shade[id].parent : -1;
     if (parent < 0) {

@@ -47,6 +47,10 @@ public:
     /// unit, beside the camera rays' generation); its rays start at neither's end before. Returns
     /// when they may start; the wait beyond the ray generation is the breakdown's `build`.
     Cycle await_build(Cycle built);
+    /// inflight, an animated trace: frame f's last ray finished at `end`; shades the hits still
+    /// waiting for a warp and returns the cycle the frame's last ray is shaded (the frame's end,
+    /// after which the next frame's camera rays are generated: begin_frame, await_build).
+    Cycle end_frame_inflight(Cycle end);
     /// inflight: when ray `id`'s parent is shaded, true and *not_before = that cycle.
     bool parent_shaded(uint64_t id, Cycle* not_before) const;
     /// inflight: the ray whose shading ray `id` waits for (its parent).
@@ -101,6 +105,8 @@ private:
     // Frame accounting (wavefront: serial parts that sum to the frame time).
     Cycle m_release = 0;  ///< current wavefront's start
     uint64_t m_traversal = 0, m_reorder = 0, m_shading = 0, m_texture_bound = 0, m_build = 0;
+    // inflight over frames: each frame's RT span (release to its last ray) and shading tail.
+    uint64_t m_frames_ended = 0, m_inflight_rt = 0, m_inflight_tail = 0;
     Cycle m_last_end = 0;
     nlohmann::json m_wavefronts = nlohmann::json::array();
     // Counters.

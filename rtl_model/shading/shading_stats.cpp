@@ -13,7 +13,7 @@ const StatBlock& shading_stats() {
             {"reorder", "", "The sorting stage's key before warps form (`none`: completion order)"},
             {"frame_cycles", "cycles", "Frame time: ray generation to the last ray shaded", true},
             {"frame_ms", "ms", "Frame time at the clock", true},
-            {"breakdown", "cycles", "`{raygen, build, traversal, reorder, shading}`, summing to `frame_cycles` (build: an animated trace's waits for the build unit beyond the next frame's ray generation, wavefront loop; inflight: traversal spans the RT unit's busy period, shading the tail after it)", true},
+            {"breakdown", "cycles", "`{raygen, build, traversal, reorder, shading}`, summing to `frame_cycles` (build: an animated trace's waits for the build unit beyond the next frame's ray generation, wavefront loop; inflight: traversal spans the RT unit's busy period, shading the tail after it, each summed over an animated trace's frames with their ray generation and build waits)", true},
             {"stalls", "cycles", "wavefront loop: `{rt_waits_for_shading, cores_wait_for_traversal, shading_texture_bound}`: the RT unit idle while a bounce is generated, sorted and shaded; the shader cores idle while it is traced; the part of shading the cores' issue does not explain (waiting for texels). Absent in flight (the two overlap)", true, true},
             {"shading_share", "", "Fraction of the frame not in traversal (raygen + reorder + shading) / frame", true},
             {"amdahl", "", "`{traversal_share, speedup_2x_rt, speedup_infinite_rt}`: what a 2x (or infinitely) faster RT unit buys the frame with shading unchanged", true},
@@ -52,6 +52,11 @@ json ShadingBlock::stats_json(Cycle rt_end, double clock_ghz) const {
     if (m_config.frame_loop == FrameLoop::wavefront) {
         breakdown = {{"raygen", m_raygen_cycles}, {"build", m_build}, {"traversal", m_traversal}, {"reorder", m_reorder},
                      {"shading", m_shading}};
+    } else if (m_frames_ended > 0) {
+        // An animated trace: per frame its camera rays' generation, the wait for its builds, its
+        // RT span (shading overlapped) and the shading tail after its last ray, summed.
+        breakdown = {{"raygen", m_raygen_cycles}, {"build", m_build}, {"traversal", m_inflight_rt}, {"reorder", 0},
+                     {"shading", m_inflight_tail}};
     } else {
         const Cycle rt = std::max(rt_end, m_raygen_end);
         breakdown = {{"raygen", m_raygen_end}, {"build", 0}, {"traversal", rt - m_raygen_end}, {"reorder", 0},

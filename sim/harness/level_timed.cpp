@@ -6,6 +6,7 @@
 #include <fstream>
 #include <memory>
 
+#include "rtl_model/shading/shading_block.h"
 #include "rtl_model/top/top.h"
 #include "sim/config/config.h"
 #include "sim/harness/frame_builds.h"
@@ -144,7 +145,27 @@ LevelResult run_timed_level(RunInputs& in) {
         }
     } else if (!sampled || built.frames.size() > 1) {
         // A sampled animated trace: each frame's clusters behind its barrier, its structure bound for them.
-        if (build_unit) top.dispatch().set_barrier(build_at_barrier);  // before: leading empty frames build too
+        // The in-flight frame loop over an animated trace: a frame ends when its last hit is
+        // shaded; the next frame's camera rays are generated then, beside its builds.
+        const uint32_t first_frame = shading && !shading->wavefront_frame.empty() ? shading->wavefront_frame[0] : 0;
+        auto inflight_barrier = [&, first_frame](uint32_t f, Cycle end) {
+            ShadingBlock& block = *top.shading();
+            const Cycle shaded = f < first_frame ? end : block.end_frame_inflight(end);  // leading empty frames: no rays
+            frame_figures.frame_end(f, shaded, top.memory_totals());
+            if (f + 1 >= built.frames.size()) return shaded;
+            Cycle built_at = shaded;
+            if (f + 1 < build_jobs.size() && !build_jobs[f + 1].empty()) {
+                const FrameBuild b = build_unit->run(build_jobs[f + 1], shaded);
+                frame_figures.set_build(f + 1, b);
+                built_at = b.end;
+            }
+            if (f + 1 < first_frame) return built_at;
+            // The first frame with rays had its camera rays generated from cycle 0.
+            if (f + 1 == first_frame) return block.await_build(built_at);
+            return block.await_build(std::max(built_at, block.begin_frame(f + 1, shaded)));
+        };
+        if (shading && built.frames.size() > 1) top.dispatch().set_barrier(inflight_barrier);
+        else if (build_unit) top.dispatch().set_barrier(build_at_barrier);  // before: leading empty frames build too
         top.dispatch().set_frames(
             sampled ? sampled->plan.rays_per_frame(built.frames.size()) : frame_rays,
             [&](uint32_t f, Cycle end) {

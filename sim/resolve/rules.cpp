@@ -167,13 +167,6 @@ std::vector<Rule> make_rules() {
          [](const RunFacts& f) { return !sampling(f); },
          "a frame's rays depend on their parents' shading, which a sample of rays leaves out",
          "sampling.fraction=0", "bvh2", {"shading.enabled=true", "sampling.fraction=0.2"}});
-    add({"shading/frames", "shading.enabled (the frame: shading and the frame loop)", shading,
-         RuleSide::technique, "the wavefront frame loop, or a trace of one frame",
-         [](const RunFacts& f) { return !animated(f) || f.config.shading.frame_loop == FrameLoop::wavefront; },
-         "an animated trace's frames are barriers, which the wavefront loop's bounce barriers hold (each frame's "
-         "camera rays after the last bounce of the one before); the in-flight loop's per-ray gate does not yet",
-         "shading.frame_loop=wavefront, or trace one frame", "frames",
-         {"shading.enabled=true", "shading.frame_loop=inflight"}});
     add({"shading/treelets", "shading.enabled (the frame: shading and the frame loop)", shading,
          RuleSide::technique, "treelets.enabled=false", [](const RunFacts& f) { return !treelets(f); },
          "the treelet ray buffer takes rays ahead of the frame loop's barriers and parent order",

@@ -178,7 +178,7 @@ def test_sampling_cuts_every_frame_into_clusters_behind_its_barrier(
     assert sampled["summary"]["cycles"] == pytest.approx(exact["summary"]["cycles"], rel=0.25)
 
 
-def test_shading_runs_frame_after_frame_in_the_wavefront_loop(
+def test_shading_runs_frame_after_frame_in_both_frame_loops(
     traces: tuple[Path, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
     animated, _ = traces
@@ -196,8 +196,18 @@ def test_shading_runs_frame_after_frame_in_the_wavefront_loop(
     assert sum(shading["breakdown"].values()) == shading["frame_cycles"]
     # A wavefront never spans two frames: at least one per frame and depth.
     assert len(shading["wavefronts"]) >= FRAMES * 2
-    # The in-flight loop does not hold frame barriers yet: refused, naming the setting.
-    refused = simulate(sim_exe, animated, tmp_path / "inflight", "shading.enabled=true",
-                       "shading.frame_loop=inflight")  # fmt: skip
-    assert refused.returncode == 2
-    assert "shading.frame_loop=wavefront" in refused.stderr, refused.stderr
+    # The in-flight loop holds the frames as barriers too: a frame ends when its last hit is
+    # shaded, the next frame's camera rays are generated then; within a frame, rays go as their
+    # parents' warps are shaded.
+    result = simulate(sim_exe, animated, tmp_path / "inflight", "shading.enabled=true",
+                      "shading.frame_loop=inflight")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    inflight = json.loads((tmp_path / "inflight" / "stats.json").read_text())
+    v = inflight["validation"]
+    assert v["hit_mismatches"] == v["work_mismatches"] == v["texel_mismatches"] == 0
+    assert v["order_violations"] == 0 and v["shaded_rays"] == v["rays_checked"]
+    loop = inflight["model"]["shading"]
+    assert [f["frame"] for f in inflight["frames"]] == list(range(FRAMES))
+    assert sum(f["cycles"] for f in inflight["frames"]) == loop["frame_cycles"]
+    assert sum(loop["breakdown"].values()) == loop["frame_cycles"]
+    assert loop["breakdown"]["raygen"] == shading["breakdown"]["raygen"]  # every frame's, once

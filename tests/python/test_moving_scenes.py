@@ -137,21 +137,25 @@ def test_analytic_level_prices_frames_and_builds(sim_exe: Path, tmp_path: Path) 
 
 def test_shaded_frame_loop_builds_between_frames(runs: dict[str, dict], sim_exe: Path,
                                                  tmp_path: Path) -> None:  # fmt: skip
-    """With shading, the wavefront loop's frames are barriers where the build unit builds the
+    """With shading, either frame loop's frames are barriers where the build unit builds the
     next frame's structures beside its camera rays' generation: each later frame carries its
     build, the frame's breakdown (with its `build` part) sums to the frame time, and the build
     unit runs the unshaded run's jobs (its busy cycles differ only by the memory it shares with a
     different traffic around it)."""
     trace = Path(runs["rebuild"]["stats"]["provenance"]["trace"])
     trace = trace.parent if trace.suffix == ".rtt" else trace
-    stats = sim_stats(sim_exe, trace, tmp_path / "shaded", "shading.enabled=true")
-    assert stats["summary"]["hit_mismatches"] == 0 and stats["summary"]["work_mismatches"] == 0
-    unused = {u["key"] for u in stats["summary"]["resolved"]["unused"]}
-    assert "build_unit.enabled" not in unused
-    assert [f["build_cycles"] > 0 for f in stats["frames"]] == [False] + [True] * (FRAMES - 1)
-    shading = stats["model"]["shading"]
-    assert sum(shading["breakdown"].values()) == shading["frame_cycles"]
-    assert sum(f["cycles"] for f in stats["frames"]) == shading["frame_cycles"]
-    plain, unit = runs["rebuild"]["stats"]["model"]["build_unit"], stats["model"]["build_unit"]
-    assert (unit["rebuilds"], unit["refits"]) == (plain["rebuilds"], plain["refits"])
-    assert unit["busy_cycles"] == pytest.approx(plain["busy_cycles"], rel=0.05)
+    for loop in ("wavefront", "inflight"):
+        stats = sim_stats(sim_exe, trace, tmp_path / loop, "shading.enabled=true",
+                          f"shading.frame_loop={loop}")  # fmt: skip
+        assert stats["summary"]["hit_mismatches"] == 0 and stats["summary"]["work_mismatches"] == 0
+        assert stats["validation"]["order_violations"] == 0, loop
+        unused = {u["key"] for u in stats["summary"]["resolved"]["unused"]}
+        assert "build_unit.enabled" not in unused
+        assert [f["build_cycles"] > 0 for f in stats["frames"]] == [False] + [True] * (FRAMES - 1)
+        shading = stats["model"]["shading"]
+        assert sum(shading["breakdown"].values()) == shading["frame_cycles"], loop
+        assert shading["breakdown"]["build"] > 0, loop
+        assert sum(f["cycles"] for f in stats["frames"]) == shading["frame_cycles"], loop
+        plain, unit = runs["rebuild"]["stats"]["model"]["build_unit"], stats["model"]["build_unit"]
+        assert (unit["rebuilds"], unit["refits"]) == (plain["rebuilds"], plain["refits"])
+        assert unit["busy_cycles"] == pytest.approx(plain["busy_cycles"], rel=0.05), loop
