@@ -64,14 +64,21 @@ class Run:
     sets: tuple[str, ...] = ()
 
 
-#: The `ddr4` modifier's second-order limits (tRAS, tRRD, tFAW, refresh) as --set assignments.
+#: The `ddr4` modifier's limits as --set assignments: all of them, and the bank limits alone
+#: (tRAS, tRRD, tFAW, refresh; without bank groups, turnarounds or the controller queue).
 DDR4 = tuple(f"dram.{k}={v}" for k, v in MODIFIERS["ddr4"]["dram"].items())
+BANK_LIMITS = ("t_ras", "t_rrd", "t_rrd_l", "t_faw", "t_refi", "t_rfc")
+DDR4_BANKS = tuple(
+    f"dram.{k}={v}" for k, v in MODIFIERS["ddr4"]["dram"].items() if k in BANK_LIMITS
+)
 
 RUNS = [
     Run("default (2 channels)"),
-    Run("ddr4 limits, 2 channels", DDR4),
+    Run("ddr4 bank limits, 2 channels", DDR4_BANKS),
+    Run("ddr4, 2 channels", DDR4),
     Run("1 channel", ("dram.channels=1",)),
-    Run("ddr4 limits, 1 channel", ("dram.channels=1", *DDR4)),
+    Run("ddr4 bank limits, 1 channel", ("dram.channels=1", *DDR4_BANKS)),
+    Run("ddr4, 1 channel", ("dram.channels=1", *DDR4)),
     Run("32 units, 1 channel", ("traversal.units=32", "dram.channels=1")),
 ]
 

@@ -36,7 +36,7 @@ Cycle Dram::access(const MemRequest& req) {
     Cycle start, ready, data;  // data: the first cycle the bytes are on the bus
     if (m_banks) {
         // Bank, row buffer and data bus timing; the rest of `latency` is a fixed front end.
-        const DramBanks::Timing t = m_banks->access(req.addr, req.bytes, req.time);
+        const DramBanks::Timing t = m_banks->access(req.addr, req.bytes, req.time, req.write);
         start = t.start;
         data = t.done - std::min<Cycle>(t.done, (req.bytes + m_config.bytes_per_cycle - 1) / m_config.bytes_per_cycle);
         const Cycle bank_part = Cycle(m_config.t_rcd) + m_config.t_cas;

@@ -5,9 +5,15 @@
 namespace rtsim {
 
 DramBanks::DramBanks(const DramConfig& config)
-    : m_config(config), m_close_page(config.page_policy == PagePolicy::close), m_banks(size_t(config.channels) * config.banks) {
+    : m_config(config),
+      m_close_page(config.page_policy == PagePolicy::close),
+      m_column_limits(config.t_ccd_l || config.t_wtr || config.t_rtw),
+      m_banks(size_t(config.channels) * config.banks) {
     for (uint32_t c = 0; c < config.channels; ++c) m_buses.emplace_back(config.bytes_per_cycle, 1);
     m_activates.resize(config.channels);
+    m_columns.resize(config.channels);
+    if (config.queue_entries)
+        for (uint32_t c = 0; c < config.channels; ++c) m_queues.emplace_back(config.queue_entries);
 }
 
 DramAddress DramBanks::map(uint64_t addr) const {
@@ -17,6 +23,7 @@ DramAddress DramBanks::map(uint64_t addr) const {
     const uint64_t local = (granule / m_config.channels) * m_config.interleave_bytes + addr % m_config.interleave_bytes;
     a.column = uint32_t(local % m_config.row_bytes);
     a.bank = uint32_t((local / m_config.row_bytes) % m_config.banks);
+    a.group = a.bank % m_config.bank_groups;
     a.row = local / m_config.row_bytes / m_config.banks;
     return a;
 }
@@ -48,45 +55,82 @@ void DramBanks::Bank::insert(uint32_t i, const Booking& b) {
 
 namespace {
 constexpr size_t kActivatesKept = 32;  ///< per channel, for tRRD and tFAW
+constexpr size_t kColumnsKept = 32;    ///< per channel, for tCCD_L, tWTR and tRTW
 }
 
-Cycle DramBanks::first_activate(uint32_t c, Cycle at) const {
-    const Cycle rrd = m_config.t_rrd, faw = m_config.t_faw;
-    if (rrd == 0 && faw == 0) return at;
-    const std::vector<Cycle>& acts = m_activates[c];
+Cycle DramBanks::first_activate(uint32_t c, uint32_t group, Cycle at) const {
+    const Cycle rrd = m_config.t_rrd, rrd_l = std::max(m_config.t_rrd, m_config.t_rrd_l), faw = m_config.t_faw;
+    if (rrd_l == 0 && faw == 0) return at;
+    const std::vector<Activate>& acts = m_activates[c];
     for (;;) {
         bool moved = false;
-        for (const Cycle x : acts)
-            if (x + rrd > at && at + rrd > x) {  // within tRRD of another activate
-                at = x + rrd, moved = true;
+        for (const Activate& x : acts) {
+            const Cycle sep = x.group == group ? rrd_l : rrd;
+            if (x.at + sep > at && at + sep > x.at) {  // within tRRD (tRRD_L in one group) of another activate
+                at = x.at + sep, moved = true;
                 break;
             }
+        }
         if (moved) continue;
         if (faw) {
             // Every window of tFAW cycles that would hold this activate: starting at it, or at an
             // earlier activate less than tFAW before it. Four others in one: move past it.
             auto others_in = [&](Cycle w) {
                 int n = 0;
-                for (const Cycle x : acts) n += x >= w && x < w + faw;
+                for (const Activate& x : acts) n += x.at >= w && x.at < w + faw;
                 return n;
             };
             if (others_in(at) >= 4) at += 1, moved = true;
             for (size_t i = 0; !moved && i < acts.size(); ++i)
-                if (acts[i] <= at && acts[i] + faw > at && others_in(acts[i]) >= 4) at = acts[i] + faw, moved = true;
+                if (acts[i].at <= at && acts[i].at + faw > at && others_in(acts[i].at) >= 4)
+                    at = acts[i].at + faw, moved = true;
         }
         if (!moved) return at;
     }
 }
 
-void DramBanks::record_activate(uint32_t c, Cycle at) {
-    if (m_config.t_rrd == 0 && m_config.t_faw == 0) return;
-    std::vector<Cycle>& acts = m_activates[c];
-    acts.insert(std::upper_bound(acts.begin(), acts.end(), at), at);
+void DramBanks::record_activate(uint32_t c, uint32_t group, Cycle at) {
+    if (m_config.t_rrd == 0 && m_config.t_rrd_l == 0 && m_config.t_faw == 0) return;
+    std::vector<Activate>& acts = m_activates[c];
+    const auto later = std::upper_bound(acts.begin(), acts.end(), at, [](Cycle t, const Activate& x) { return t < x.at; });
+    acts.insert(later, Activate{at, group});
     if (acts.size() > kActivatesKept) acts.erase(acts.begin());
 }
 
-DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, Cycle burst, Cycle* end,
-                                  Cycle* activate) const {
+Cycle DramBanks::first_column(uint32_t c, uint32_t group, bool write, Cycle burst, Cycle at) const {
+    if (!m_column_limits) return at;
+    const Cycle ccd = m_config.t_ccd_l, wtr = m_config.t_wtr, rtw = m_config.t_rtw, cas = m_config.t_cas;
+    for (;;) {
+        bool moved = false;
+        for (const Column& x : m_columns[c]) {
+            // The least distance from x to this command when it follows x (`after`) and from it
+            // to x when it precedes x (`before`); a command strictly between is moved past x.
+            Cycle after = x.group == group ? ccd : 0, before = after;
+            if (x.write && !write && wtr) after = std::max(after, cas + x.burst + wtr);   // read after a write's data
+            if (x.write && !write && rtw) before = std::max(before, rtw);                // read, then the write
+            if (!x.write && write && rtw) after = std::max(after, rtw);                  // write after a read
+            if (!x.write && write && wtr) before = std::max(before, cas + burst + wtr);  // write's data, then the read
+            // Issued at x's cycle or later it follows x (x was booked first).
+            const bool conflict = at >= x.at ? at < x.at + after : at + before > x.at;
+            if (conflict) {
+                at = x.at + after, moved = true;
+                break;
+            }
+        }
+        if (!moved) return at;
+    }
+}
+
+void DramBanks::record_column(uint32_t c, uint32_t group, bool write, Cycle burst, Cycle at) {
+    if (!m_column_limits) return;
+    std::vector<Column>& cols = m_columns[c];
+    const auto later = std::upper_bound(cols.begin(), cols.end(), at, [](Cycle t, const Column& x) { return t < x.at; });
+    cols.insert(later, Column{at, group, write, burst});
+    if (cols.size() > kColumnsKept) cols.erase(cols.begin());
+}
+
+DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, Cycle burst, bool write,
+                                  Cycle* end, Cycle* activate) const {
     const Cycle refi = m_config.t_refi, rfc = m_config.t_rfc;
     Timing t;
     bool deferred = false;  // past one refresh already: a gap too short for it does not defer it again
@@ -102,7 +146,7 @@ DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, C
                    : open.row == a.row && !m_close_page ? RowResult::hit
                                                         : RowResult::conflict;
         Cycle act = kNoActivate;
-        t.ras_wait = t.activate_wait = 0;
+        t.ras_wait = t.activate_wait = t.column_wait = 0;
         if (t.result == RowResult::hit) {
             t.column = s;
         } else {
@@ -115,10 +159,13 @@ DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, C
                 t.ras_wait = precharge - s;
                 want = precharge + m_config.t_rp;
             }
-            act = first_activate(a.channel, want);
+            act = first_activate(a.channel, a.group, want);
             t.activate_wait = act - want;
             t.column = act + m_config.t_rcd;
         }
+        const Cycle column = first_column(a.channel, a.group, write, burst, t.column);
+        t.column_wait = column - t.column;
+        t.column = column;
         Cycle finish = t.column + burst;
         if (m_close_page) {  // auto-precharge, no sooner than tRAS after the activate
             const Cycle precharge = std::max<Cycle>(finish, act == kNoActivate ? 0 : act + m_config.t_ras);
@@ -141,11 +188,18 @@ DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, C
     }
 }
 
-DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time) {
+DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time, bool write) {
     const DramAddress a = map(addr);
     Bank& bank = m_banks[size_t(a.channel) * m_config.banks + a.bank];
     const uint32_t bpc = m_config.bytes_per_cycle;
     const Cycle burst = (std::max<uint32_t>(bytes, 1) + bpc - 1) / bpc;
+    // A full controller queue: the request enters when an entry frees (held to its last data).
+    const Cycle arrival = time;
+    BackfillSlots::Pick entry;
+    if (!m_queues.empty()) {
+        entry = m_queues[a.channel].earliest(time, Cycle(m_config.t_rcd) + m_config.t_cas + burst);
+        time = entry.start;
+    }
     // The first idle gap at or after `time` long enough for this access, given the row the
     // access before it leaves open.
     uint32_t next = bank.upper_bound(time);
@@ -157,19 +211,21 @@ DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time) {
         s = std::max(s, prev.end);
     }
     Cycle end = 0, act = kNoActivate;
-    Timing t = plan(a, s, open, burst, &end, &act);
+    Timing t = plan(a, s, open, burst, write, &end, &act);
     for (; next < bank.size && end > bank.at(next).start; ++next) {
         const Booking& b = bank.at(next);
         s = std::max(t.start, b.end);
         open = {b.row, b.activated, b.end};
-        t = plan(a, s, open, burst, &end, &act);
+        t = plan(a, s, open, burst, write, &end, &act);
     }
     const Cycle activated = act != kNoActivate ? act : open.activated;
     bank.insert(next, Booking{t.start, end, m_close_page ? kClosed : a.row, activated});
-    if (act != kNoActivate) record_activate(a.channel, act);
+    if (act != kNoActivate) record_activate(a.channel, a.group, act);
+    record_column(a.channel, a.group, write, burst, t.column);
     m_ras_wait += t.ras_wait;
     m_activate_wait += t.activate_wait;
     m_refresh_wait += t.refresh_wait;
+    m_column_wait += t.column_wait;
     // The burst takes the first free cycles of the channel's data bus from column + tCAS.
     SlotCalendar& bus = m_buses[a.channel];
     Cycle cycle = t.column + m_config.t_cas;
@@ -180,6 +236,12 @@ DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time) {
         left -= chunk;
     }
     t.done = cycle;
+    if (!m_queues.empty()) {
+        m_queues[a.channel].book(entry.slot, arrival, time, t.done);
+        t.queue_wait = time - arrival;
+        m_queue_wait += t.queue_wait;
+        m_queue_full += t.queue_wait > 0;
+    }
     ++bank.counts[size_t(t.result)];
     ++m_totals[size_t(t.result)];
     return t;
@@ -205,6 +267,10 @@ nlohmann::json DramBanks::stats_json() const {
             {"ras_wait_cycles", m_ras_wait},
             {"activate_wait_cycles", m_activate_wait},
             {"refresh_wait_cycles", m_refresh_wait},
+            {"column_wait_cycles", m_column_wait},
+            {"queue_wait_cycles", m_queue_wait},
+            {"queue_full_requests", m_queue_full},
+            {"bank_groups", m_config.bank_groups},
             {"by_bank", by_bank}};
 }
 

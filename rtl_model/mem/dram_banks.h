@@ -25,6 +25,18 @@
 // refreshes, outside any DDR part's timing, runs past the next) and closes every row. The gap a
 // request takes must fit its whole delayed service. Not modelled: a row left open across a
 // refresh owes no tRAS or tRP before it.
+// Bank groups and turnaround, each off at 0 as well: bank b of a channel is in group
+// b mod bank_groups; tRRD_L spaces two activates in one group (tRRD the others), tCCD_L two
+// column commands in one group (other groups are spaced by their bursts on the data bus, tCCD_S);
+// tWTR spaces a read's column command after the end of a write's data on the channel, tRTW a
+// write's column command after a read's. A column command is delayed until each of these holds
+// against the channel's last 32 column commands, before and after it in time, as activates are
+// for tRRD and tFAW. A controller queue of queue_entries requests per channel: a request holds
+// an entry from its arrival to its last data cycle, and one arriving at a full queue starts when
+// an entry frees (BackfillSlots: a request stamped before bookings already made takes an entry
+// idle long enough before them). Not modelled: FR-FCFS reordering (a request's timing is fixed
+// when it arrives, so a later row hit cannot pass a queued conflict), write queues drained in
+// batches, per-group tWTR_S/tWTR_L (one t_wtr), the command bus.
 // At detailed requests normally arrive in time order (units synchronise every cycle), and then
 // this is first come, first served; at approx units run up to a quantum apart, so requests
 // arrive out of order within a quantum and back-fill as below. Only the last 64 bookings per
@@ -39,6 +51,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtl_model/common/backfill_slots.h"
 #include "rtl_model/common/calendar.h"
 #include "rtl_model/mem/dram_config.h"
 
@@ -47,6 +60,7 @@ namespace rtsim {
 struct DramAddress {
     uint32_t channel = 0;
     uint32_t bank = 0;
+    uint32_t group = 0;  ///< bank group: bank mod bank_groups
     uint64_t row = 0;
     uint32_t column = 0;  ///< byte offset in the row
 };
@@ -70,9 +84,11 @@ public:
         Cycle ras_wait = 0;      ///< cycles the precharge waited for tRAS
         Cycle activate_wait = 0; ///< cycles the activate waited for tRRD and tFAW
         Cycle refresh_wait = 0;  ///< cycles the start waited for a refresh
+        Cycle column_wait = 0;   ///< cycles the column command waited for tCCD_L, tWTR, tRTW
+        Cycle queue_wait = 0;    ///< cycles the request waited for an entry of a full queue
     };
-    /// Serves one request of `bytes` bytes arriving at `time`.
-    Timing access(uint64_t addr, uint32_t bytes, Cycle time);
+    /// Serves one request of `bytes` bytes arriving at `time` (a write when `write`).
+    Timing access(uint64_t addr, uint32_t bytes, Cycle time, bool write = false);
 
     uint64_t row_hits() const { return m_totals[0]; }
     uint64_t row_misses() const { return m_totals[1]; }
@@ -114,17 +130,36 @@ private:
     };
     /// The service of an access to `a` starting no earlier than `s` with the bank as `open`
     /// left it: its start (later past a refresh), row outcome, column command and end.
-    Timing plan(const DramAddress& a, Cycle s, OpenRow open, Cycle burst, Cycle* end, Cycle* activate) const;
-    /// The first cycle at or after `at` at which channel `c` may activate (tRRD, tFAW).
-    Cycle first_activate(uint32_t c, Cycle at) const;
-    void record_activate(uint32_t c, Cycle at);
+    Timing plan(const DramAddress& a, Cycle s, OpenRow open, Cycle burst, bool write, Cycle* end,
+                Cycle* activate) const;
+    /// The first cycle at or after `at` at which channel `c` may activate in `group` (tRRD, tRRD_L, tFAW).
+    Cycle first_activate(uint32_t c, uint32_t group, Cycle at) const;
+    void record_activate(uint32_t c, uint32_t group, Cycle at);
+    /// The first cycle at or after `at` at which channel `c` may issue the column command of an
+    /// access of `burst` bus cycles in `group` (tCCD_L, tWTR, tRTW).
+    Cycle first_column(uint32_t c, uint32_t group, bool write, Cycle burst, Cycle at) const;
+    void record_column(uint32_t c, uint32_t group, bool write, Cycle burst, Cycle at);
+    struct Activate {
+        Cycle at;
+        uint32_t group;
+    };
+    struct Column {
+        Cycle at;
+        uint32_t group;
+        bool write;
+        Cycle burst;
+    };
     DramConfig m_config;
     bool m_close_page;
+    bool m_column_limits;  ///< any of tCCD_L, tWTR, tRTW set
     std::vector<Bank> m_banks;          ///< channel-major: channel * banks + bank
     std::vector<SlotCalendar> m_buses;  ///< one data bus per channel: bytes_per_cycle per cycle
-    std::vector<std::vector<Cycle>> m_activates;  ///< per channel: its last activates, sorted
+    std::vector<std::vector<Activate>> m_activates;  ///< per channel: its last activates, sorted
+    std::vector<std::vector<Column>> m_columns;      ///< per channel: its last column commands, sorted
+    std::vector<BackfillSlots> m_queues;  ///< per channel: its controller queue (queue_entries > 0)
     uint64_t m_totals[3] = {};
-    Cycle m_ras_wait = 0, m_activate_wait = 0, m_refresh_wait = 0;
+    Cycle m_ras_wait = 0, m_activate_wait = 0, m_refresh_wait = 0, m_column_wait = 0, m_queue_wait = 0;
+    uint64_t m_queue_full = 0;  ///< requests that found their channel's queue full
 };
 
 }  // namespace rtsim

@@ -73,8 +73,12 @@ const StatBlock& dram_stats() {
                  {"banks_per_channel", "banks", "bank model: banks per channel", false, true},
                  {"row_bytes", "bytes", "bank model: bytes per row", false, true},
                  {"ras_wait_cycles", "cycles", "bank model: cycles precharges waited for `t_ras` after their row's activate, summed (0 with `t_ras` 0)", false, true},
-                 {"activate_wait_cycles", "cycles", "bank model: cycles activates waited for `t_rrd` and `t_faw`, summed (0 with both 0)", false, true},
+                 {"activate_wait_cycles", "cycles", "bank model: cycles activates waited for `t_rrd`, `t_rrd_l` and `t_faw`, summed (0 with all 0)", false, true},
                  {"refresh_wait_cycles", "cycles", "bank model: cycles accesses waited for a refresh (`t_refi`, `t_rfc`), summed", false, true},
+                 {"column_wait_cycles", "cycles", "bank model: cycles column commands waited for `t_ccd_l` (one bank group) and the turnarounds `t_wtr`, `t_rtw`, summed (0 with all 0)", false, true},
+                 {"queue_wait_cycles", "cycles", "bank model: cycles requests waited for an entry of their channel's full controller queue (`queue_entries`), summed (0 with no limit)", false, true},
+                 {"queue_full_requests", "requests", "bank model: requests that found their channel's controller queue full", false, true},
+                 {"bank_groups", "groups", "bank model: bank groups per channel (`dram.bank_groups`)", false, true},
                  {"by_bank", "list", "bank model: `[{channel, bank, accesses, row_hits, row_misses, row_conflicts}]` for every bank accessed", false, true},
              })};
     return block;

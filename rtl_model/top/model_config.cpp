@@ -53,6 +53,9 @@ void validate_model(const ModelConfig& config) {
             "config: 'dram.latency' must be at least dram.t_rcd + dram.t_cas with dram.model banks (it is the "
             "latency of an access to a closed bank); raise dram.latency, lower dram.t_rcd/dram.t_cas, or set "
             "dram.model=bandwidth");
+    require(config.dram.banks % config.dram.bank_groups == 0,
+            "config: 'dram.bank_groups' (" + std::to_string(config.dram.bank_groups) + ") must divide 'dram.banks' (" +
+                std::to_string(config.dram.banks) + "): every group holds as many banks");
     require(config.dram.t_refi == 0 || config.dram.t_rfc < config.dram.t_refi,
             "config: 'dram.t_rfc' (" + std::to_string(config.dram.t_rfc) + ") must be below 'dram.t_refi' (" +
                 std::to_string(config.dram.t_refi) + "): a channel must be free between refreshes");

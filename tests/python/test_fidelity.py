@@ -170,13 +170,23 @@ def test_ddr4_limits_slow_the_banks_and_count_their_waits(
         runs[name] = stats_of(tmp_path / name)
     first, ddr4_run = runs["first"]["model"]["dram"], runs["ddr4"]["model"]["dram"]
     assert first["ras_wait_cycles"] == first["activate_wait_cycles"] == 0
-    assert first["refresh_wait_cycles"] == 0
+    assert (
+        first["refresh_wait_cycles"]
+        == first["column_wait_cycles"]
+        == first["queue_wait_cycles"]
+        == 0
+    )
     assert ddr4_run["ras_wait_cycles"] > 0 and ddr4_run["activate_wait_cycles"] > 0
+    assert ddr4_run["column_wait_cycles"] > 0 and ddr4_run["bank_groups"] == 4
     assert runs["ddr4"]["summary"]["cycles"] > runs["first"]["summary"]["cycles"]
     assert runs["ddr4"]["validation"]["hit_mismatches"] == 0
     # A refresh longer than its interval is refused, naming both fields.
     bad = sim(hairball, tmp_path / "bad", "dram.t_refi=100", "dram.t_rfc=200")
     assert bad.returncode == 2
+    # Bank groups that do not divide the banks are refused, naming both fields.
+    uneven = sim(hairball, tmp_path / "uneven", "dram.bank_groups=3")
+    assert uneven.returncode == 2 and "dram.bank_groups" in uneven.stderr
+    assert "dram.banks" in uneven.stderr
     assert "dram.t_rfc" in bad.stderr and "dram.t_refi" in bad.stderr, bad.stderr
 
 

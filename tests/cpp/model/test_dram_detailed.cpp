@@ -175,6 +175,82 @@ TEST(DramDetailed, RrdAndFawSpaceActivatesOfAChannel) {
     EXPECT_EQ(faw.access(5 * 1024, 64, 0).column, 50u + 0u);
 }
 
+DramConfig grouped() {
+    // 4 banks in 2 groups: bank k (at k x 1024) in group k mod 2.
+    DramConfig c = small();
+    c.banks = 4;
+    c.bank_groups = 2;
+    return c;
+}
+
+TEST(DramDetailed, CcdLSpacesColumnsOfOneBankGroup) {
+    DramConfig c = grouped();
+    c.t_ccd_l = 12;
+    DramBanks banks(c);
+    EXPECT_EQ(banks.access(0, 64, 0).column, 10u);  // bank 0, group 0
+    // Bank 2 is in group 0 too: its column no sooner than 10 + 12.
+    const DramBanks::Timing same = banks.access(2 * 1024, 64, 0);
+    EXPECT_EQ(same.column, 22u);
+    EXPECT_EQ(same.column_wait, 12u);
+    // Bank 1 is in group 1: only the data bus spaces it (data 20..23 after bank 0's 16..19).
+    const DramBanks::Timing other = banks.access(1024, 64, 0);
+    EXPECT_EQ(other.column, 10u);
+    EXPECT_EQ(other.column_wait, 0u);
+    EXPECT_EQ(other.done, 24u);
+    EXPECT_EQ(banks.stats_json()["column_wait_cycles"], 12);
+}
+
+TEST(DramDetailed, RrdLSpacesActivatesOfOneBankGroup) {
+    DramConfig c = grouped();
+    c.t_rrd = 4;
+    c.t_rrd_l = 9;
+    DramBanks banks(c);
+    EXPECT_EQ(banks.access(0, 64, 0).column, 10u);         // bank 0 activates at 0
+    EXPECT_EQ(banks.access(1024, 64, 0).column, 14u);      // group 1: tRRD, activate at 4
+    EXPECT_EQ(banks.access(2 * 1024, 64, 0).column, 19u);  // group 0: tRRD_L after 0, activate at 9
+}
+
+TEST(DramDetailed, TurnaroundsSpaceReadsAndWrites) {
+    DramConfig c = grouped();
+    c.t_wtr = 5;
+    DramBanks wtr(c);
+    // A write's data on the bus 16..19; a read's column no sooner than 20 + tWTR.
+    EXPECT_EQ(wtr.access(0, 64, 0, true).column, 10u);
+    const DramBanks::Timing read = wtr.access(1024, 64, 0);
+    EXPECT_EQ(read.column, 25u);
+    EXPECT_EQ(read.column_wait, 15u);
+    // Reads after reads are not turned around.
+    EXPECT_EQ(wtr.access(2 * 1024, 64, 0).column, 25u);
+    c = grouped();
+    c.t_rtw = 7;
+    DramBanks rtw(c);
+    EXPECT_EQ(rtw.access(0, 64, 0).column, 10u);
+    EXPECT_EQ(rtw.access(1024, 64, 0, true).column, 17u);  // a write's column tRTW after the read's
+    // A read stamped before a booked write, but too close to it, goes after the write's data.
+    c = grouped();
+    c.t_wtr = 5;
+    c.t_rtw = 7;
+    DramBanks both(c);
+    EXPECT_EQ(both.access(0, 64, 20, true).column, 30u);  // write: column 30, data 36..39
+    EXPECT_EQ(both.access(1024, 64, 17).column, 45u);     // read at 27 would precede it by 3 < 7: after 40 + 5
+}
+
+TEST(DramDetailed, AFullControllerQueueHoldsRequestsBack) {
+    DramConfig c = grouped();
+    c.queue_entries = 2;
+    DramBanks banks(c);
+    EXPECT_EQ(banks.access(0, 64, 0).done, 20u);     // data 16..19
+    EXPECT_EQ(banks.access(1024, 64, 0).done, 24u);  // data 20..23
+    // The third waits for the first to leave the queue (at 20): activate 20, column 30.
+    const DramBanks::Timing third = banks.access(2 * 1024, 64, 0);
+    EXPECT_EQ(third.start, 20u);
+    EXPECT_EQ(third.queue_wait, 20u);
+    EXPECT_EQ(third.column, 30u);
+    const nlohmann::json j = banks.stats_json();
+    EXPECT_EQ(j["queue_wait_cycles"], 20);
+    EXPECT_EQ(j["queue_full_requests"], 1);
+}
+
 TEST(DramDetailed, RefreshBlocksTheChannelAndClosesRows) {
     DramConfig c = small();
     c.t_refi = 100;
