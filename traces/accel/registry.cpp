@@ -379,6 +379,8 @@ AccelCapabilities accel_capabilities(const std::string& kind, const std::string&
     // Per-level restart trails, the BLASes' reduced-precision walks and compressed leaves (each
     // BLAS's leaf blocks a slice of "blas_leaf_blocks", decoded by its own load; two_level.h).
     c.restart_trail = blas.restart_trail;
+    // The TLAS is a binary BVH: any-hit rays take the order at its nodes and at the BLAS's.
+    c.anyhit_order = blas.anyhit_order;
     c.reduced_precision_boxes = blas.reduced_precision_boxes;
     // The BLASes' quantised box tests (the TLAS's boxes stay fp32), and stack addresses: the
     // TLAS's entries are node and instance-record addresses, the BLAS kind's its own.

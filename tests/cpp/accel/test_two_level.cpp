@@ -256,6 +256,51 @@ TEST(TwoLevel, PerLevelTrailsReducedPrecisionBlasesAndCompressedLeavesKeepHitsAn
     }
 }
 
+TEST(TwoLevel, AnyHitOrdersAtBothLevelsKeepOcclusionAndChangeTheWalk) {
+    // traversal.anyhit_order at the TLAS's nodes and the BLASes': occlusion never changes,
+    // closest-hit rays keep hit and work, plans ask for the work counted; a shadow packet of
+    // copies of one ray does that ray's reordered work (the boxes' order is every ray's).
+    const Scene scene = instanced_scene(4);
+    const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 43, 800);
+    for (const std::string blas : {"bvh2", "bvh8", "cwbvh8"}) {
+        const std::unique_ptr<Accel> accel = two_level(scene, blas);
+        ASSERT_TRUE(accel->capabilities().anyhit_order) << blas;
+        for (AnyHitOrder order : {AnyHitOrder::largest_box, AnyHitOrder::fixed}) {
+            StepOptions options;
+            options.anyhit_order = order;
+            std::unique_ptr<Stepper> ordered = accel->make_stepper(options);
+            int diffs = 0, walked_otherwise = 0;
+            for (const Ray& r : rays)
+                for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+                    WorkCounts want;
+                    const Hit h = accel->trace(r, mode, &want);
+                    const WorkCounts planned = test::tally_plans(*ordered, r, mode);
+                    const WorkCounts got = ordered->work();
+                    // The plans' tests (a plan counts no TLAS share or transform fields).
+                    bool ok = test::same_hit(ordered->hit(), h, mode) && planned.box_tests == got.box_tests &&
+                              planned.tri_tests == got.tri_tests;
+                    if (mode == TraversalMode::closest_hit) ok = ok && got == want;
+                    else walked_otherwise += got.steps != want.steps;
+                    if (!ok && ++diffs <= 3)
+                        ADD_FAILURE() << blas << " order " << int(order) << ": ray differs: hit " << ordered->hit().prim
+                                      << "/" << h.prim << " steps " << got.steps << "/" << want.steps;
+                }
+            EXPECT_EQ(diffs, 0) << blas;
+            EXPECT_GT(walked_otherwise, 0) << blas << ": the order changed no walk";
+            for (size_t i = 0; i < 64; ++i) {
+                if (!ray_is_valid(rays[i])) continue;
+                WorkCounts single;
+                accel->trace(rays[i], TraversalMode::any_hit, &single, options);
+                const std::vector<Ray> same(16, rays[i]);
+                const std::vector<TraversalMode> modes(16, TraversalMode::any_hit);
+                std::vector<WorkCounts> work(16);
+                accel->trace_packet(same.data(), modes.data(), 16, nullptr, work.data(), nullptr, 0.0f, options);
+                for (const WorkCounts& w : work) EXPECT_EQ(w, single) << blas << " ray " << i;
+            }
+        }
+    }
+}
+
 TEST(TwoLevel, ValidationRefusesBadInstanceRecords) {
     const Scene scene = instanced_scene(2);
     AccelOptions o;

@@ -16,6 +16,7 @@ LaneMask low_lanes(uint32_t n) { return n >= kMaxPacketLanes ? ~LaneMask(0) : (L
 
 TwoLevelPacketStepper::TwoLevelPacketStepper(const TwoLevelAccel& accel, const StepOptions& options)
     : m_accel(accel) {
+    set_anyhit_order(options.anyhit_order);  // the TLAS's packet steps; each BLAS packet its own
     for (const auto& blas : accel.blases()) {
         m_blas_packets.push_back(blas->make_packet_stepper(options));
         require(m_blas_packets.back() != nullptr, "two-level packets need a BLAS kind with a packet kernel");

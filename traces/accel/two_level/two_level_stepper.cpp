@@ -8,7 +8,8 @@ namespace rtsim {
 
 using detail::cull_distance;
 
-TwoLevelStepper::TwoLevelStepper(const TwoLevelAccel& accel, const StepOptions& options) : m_accel(accel) {
+TwoLevelStepper::TwoLevelStepper(const TwoLevelAccel& accel, const StepOptions& options)
+    : m_accel(accel), m_anyhit_order(options.anyhit_order) {
     for (const auto& blas : accel.blases()) m_blas_steppers.push_back(blas->make_stepper(options));
     m_short.configure(options.short_stack_entries);
 }
@@ -77,12 +78,14 @@ StepOutcome TwoLevelStepper::execute() {
 }
 
 void TwoLevelStepper::visit_node(const HwNode& node) {
-    // The binary BVH's node step (bvh2_kernel.h): nearer child next, the farther pushed.
+    // The binary BVH's node step (bvh2_kernel.h): nearer child next (any-hit rays by their
+    // order), the other pushed.
     m_work.tlas_steps += 1;  // the TLAS's share of steps and box tests (descend counts both)
     m_work.tlas_box_tests += 2;
     const int before = m_tlas_size;
     if (m_short.enabled()) m_short.visit(m_ref, m_depth);
-    if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_tlas_size, &m_ref, &m_count))
+    const AnyHitOrder order = m_mode == TraversalMode::any_hit ? m_anyhit_order : AnyHitOrder::nearest;
+    if (!detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_tlas_size, &m_ref, &m_count, order))
         return pop_next();
     if (m_short.enabled()) {
         if (m_tlas_size > before) {

@@ -56,6 +56,7 @@ private:
     void finish();
 
     const TwoLevelAccel& m_accel;
+    AnyHitOrder m_anyhit_order = AnyHitOrder::nearest;  ///< any-hit rays' TLAS child order (the BLASes' their own)
     std::vector<std::unique_ptr<Stepper>> m_blas_steppers;  ///< one per BLAS, reused
     RayBoxPre m_box;
     float m_cull_t = 0.0f;
