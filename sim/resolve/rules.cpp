@@ -209,8 +209,9 @@ std::vector<Unused> unused_settings(const RunFacts& f) {
     else if (f.config.treelets.prefetch && !f.level.timed)
         out.push_back({"treelets.prefetch", "the untimed levels model no prefetches (the analytic level's caches see demand reads only)"});
     if (f.unit.needs.packet_kernel && f.structure.kind == "two_level" &&
-        f.config.traversal.kinds.of<PacketConfig>("packet").split_below > 0)
-        out.push_back({"traversal.packet.split_below", "a two-level packet stays whole to its end (no hybrid split)"});
+        f.config.traversal.kinds.of<PacketConfig>("packet").split_walks == SplitWalks::lanes)
+        out.push_back({"traversal.packet.split_walks", "a two-level packet splits inside instances, its rays finishing "
+                                                       "the instance one after another on the packet's context (serial)"});
     if (f.config.traversal.stack_prefetch && f.config.ideal_memory)
         out.push_back({"traversal.stack_prefetch", "with ideal_memory every access hits: there is nothing to prefetch"});
     else if (f.config.traversal.stack_prefetch && !f.structure.caps.stack_addresses)

@@ -1,8 +1,9 @@
 """Packets through two levels (traces/accel/two_level/two_level_packet.h): the grove's instances
 traced two-level over binary, wide and compressed BLASes replay on packet units at every level
 with 0 hit and 0 work mismatches (each ray's hit is the single-ray reference's); a primary-ray
-packet shares its TLAS steps; the hybrid's split is listed as unused; an animated two-level
-scene (the skinned tube, refitted per frame) replays on packets too."""
+packet shares its TLAS steps; the hybrid splits inside instances (its lanes mode listed as
+unused: split rays walk serially); an animated two-level scene (the skinned tube, refitted per
+frame) replays on packets too."""
 
 from __future__ import annotations
 
@@ -43,16 +44,23 @@ def test_two_level_packets_match_the_reference(
             assert 0 < stats["summary"]["simd_efficiency"] <= 1
 
 
-def test_two_level_packets_keep_whole_and_take_stack_prefetch(
-    sim_exe: Path, grove: dict[str, Path], tmp_path: Path
+@pytest.mark.parametrize("kind", ["bvh2", "cwbvh8"])
+def test_two_level_packets_split_inside_instances_and_take_stack_prefetch(
+    sim_exe: Path, grove: dict[str, Path], tmp_path: Path, kind: str
 ) -> None:
+    whole = checked(sim_exe, grove[kind], tmp_path / "whole", *PACKETS, "fidelity=detailed")
     stats = checked(
-        sim_exe, grove["bvh2"], tmp_path / "split", *PACKETS, "traversal.packet.split_below=0.5",
-        "traversal.stack_prefetch=2",
+        sim_exe, grove[kind], tmp_path / "split", *PACKETS, "traversal.packet.split_below=0.5",
+        "traversal.packet.split_walks=lanes", "traversal.stack_prefetch=2", "fidelity=detailed",
     )  # fmt: skip
     unused = {u["key"]: u["why"] for u in stats["summary"]["resolved"]["unused"]}
-    assert "no hybrid split" in unused["traversal.packet.split_below"]
+    assert "traversal.packet.split_below" not in unused
+    assert "serial" in unused["traversal.packet.split_walks"]
     assert "traversal.stack_prefetch" not in unused
+    units = stats["model"]["units"].values()
+    assert sum(u["packet_splits"] for u in units) > 0
+    assert sum(u["packet_split_steps"] for u in units) > 0
+    assert sum(u["packet_splits"] for u in whole["model"]["units"].values()) == 0
 
 
 def test_packets_on_a_moving_two_level_scene(sim_exe: Path, tmp_path: Path) -> None:

@@ -301,6 +301,40 @@ TEST(TwoLevel, AnyHitOrdersAtBothLevelsKeepOcclusionAndChangeTheWalk) {
     }
 }
 
+TEST(TwoLevel, PacketsSplitInsideInstancesKeepHitsAndAgreeWithTheReferenceLoop) {
+    // The hybrid on two levels: BLAS packets split below the fraction, their rays finish the
+    // instance alone; hits stay the single-ray walk's, the stepper's work and counts are the
+    // reference packet loop's, and random rays split.
+    const Scene scene = instanced_scene(4);
+    const std::vector<Ray> rays = test::random_rays(scene, test::hw_triangles(scene), 47, 640);
+    for (const std::string blas : {"bvh2", "cwbvh8"}) {
+        const std::unique_ptr<Accel> accel = two_level(scene, blas);
+        std::unique_ptr<PacketStepper> s = accel->make_packet_stepper();
+        s->set_split_below(0.5f);
+        uint64_t splits = 0;
+        int diffs = 0;
+        for (size_t first = 0; first + 16 <= rays.size(); first += 16)
+            for (TraversalMode mode : {TraversalMode::closest_hit, TraversalMode::any_hit}) {
+                const std::vector<TraversalMode> modes(16, mode);
+                std::vector<Hit> hits(16);
+                std::vector<WorkCounts> work(16);
+                PacketCounts fused;
+                accel->trace_packet(&rays[first], modes.data(), 16, hits.data(), work.data(), &fused, 0.5f);
+                s->begin_packet(&rays[first], modes.data(), 16);
+                while (!s->done()) s->execute();
+                EXPECT_EQ(s->counts(), fused) << blas;
+                splits += fused.splits;
+                for (uint32_t i = 0; i < 16; ++i) {
+                    EXPECT_EQ(s->lane_work(i), work[i]) << blas;
+                    if (!test::same_hit(hits[i], accel->trace(rays[first + i], mode), mode) && ++diffs <= 3)
+                        ADD_FAILURE() << blas << ": ray " << first + i << " differs from its single-ray walk";
+                }
+            }
+        EXPECT_EQ(diffs, 0) << blas;
+        EXPECT_GT(splits, 0u) << blas;
+    }
+}
+
 TEST(TwoLevel, ValidationRefusesBadInstanceRecords) {
     const Scene scene = instanced_scene(2);
     AccelOptions o;

@@ -24,7 +24,7 @@ TwoLevelPacketStepper::TwoLevelPacketStepper(const TwoLevelAccel& accel, const S
 }
 
 Stepper& TwoLevelPacketStepper::lane_walker(uint32_t) {
-    throw Error("two-level packets do not split: no lane walkers");
+    throw Error("two-level packets split serially inside instances: no lane walkers");
 }
 
 void TwoLevelPacketStepper::begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) {
@@ -105,6 +105,10 @@ void TwoLevelPacketStepper::enter_instance(const InstanceRecord& record) {
     m_instance = &record;
     m_inner_offset = m_accel.locality_offset(record.blas);
     m_inner = m_blas_packets[record.blas].get();
+    // The hybrid inside the instance: the BLAS packet splits below the fraction of its own rays,
+    // its rays finishing the instance one after another on this packet's context.
+    m_inner->set_split_below(m_split_below);
+    m_inner->set_split_walks(SplitWalks::serial);
     m_inner->begin_packet(object, modes, n);
     if (m_inner->done()) leave_instance();
     else plan_blas();

@@ -11,8 +11,12 @@
 // Work per ray: the TLAS steps and box tests it took part in (counted in steps, box_tests and
 // the TLAS's share, tlas_steps and tlas_box_tests), one transform per instance entered, and its
 // BLAS packets' work. Counts: TLAS node steps as node steps, transform steps as leaf steps, the
-// BLAS packets' counts added. The hybrid's split (set_split_below) is not offered: a two-level
-// packet stays whole to its end (the packet unit lists the setting as unused).
+// BLAS packets' counts added. The hybrid's split (set_split_below; Benthin et al. 2012) acts
+// inside instances: a BLAS packet whose active rays at a node are fewer than the fraction of the
+// rays that entered the instance splits, and they finish the instance alone, one after another
+// on the packet's context (SplitWalks::serial whatever set_split_walks says), each from its own
+// part of the BLAS packet's stack with the BLAS kind's single-ray rules; the TLAS walk resumes as
+// a packet after it. The TLAS walk itself never splits.
 #include <memory>
 #include <vector>
 
@@ -31,7 +35,7 @@ public:
 
     void begin_packet(const Ray* rays, const TraversalMode* modes, uint32_t n) override;
     StepOutcome execute() override;
-    /// Never called: a two-level packet does not split (split_lanes() stays 0).
+    /// Never called: a two-level packet's split rays walk serially (split_lanes() stays 0).
     Stepper& lane_walker(uint32_t i) override;
 
 private:
