@@ -105,12 +105,16 @@ LevelResult run_timed_level(RunInputs& in) {
     for (const FrameRecord& f : segments) frame_rays.push_back(f.rays);
     // Moving scenes: the next frame's structures are built at the barrier, before its rays
     // (rtl_model/build_unit/build_unit.h); the frame's figures are taken before the build.
+    // Frame f's structures built from `at`; returns when they are (`at` when it builds none).
+    auto build_frame = [&](uint32_t f, Cycle at) {
+        if (f >= build_jobs.size() || build_jobs[f].empty()) return at;
+        const FrameBuild b = build_unit->run(build_jobs[f], at);
+        frame_figures.set_build(f, b);
+        return b.end;
+    };
     auto build_at_barrier = [&](uint32_t f, Cycle end) {
         frame_figures.frame_end(f, end, top.memory_totals());
-        if (f + 1 >= build_jobs.size() || build_jobs[f + 1].empty()) return end;
-        const FrameBuild b = build_unit->run(build_jobs[f + 1], end);
-        frame_figures.set_build(f + 1, b);
-        return b.end;
+        return build_frame(f + 1, end);
     };
     if (wavefront) {
         // Each bounce's barrier is its shading; a frame's figures at its last bounce, and an
@@ -124,12 +128,7 @@ LevelResult run_timed_level(RunInputs& in) {
         FrameBuilds builds;
         if (build_unit)
             builds = [&](uint32_t first, uint32_t last, Cycle at) {
-                for (uint32_t f = first; f <= last && f < build_jobs.size(); ++f) {
-                    if (build_jobs[f].empty()) continue;
-                    const FrameBuild b = build_unit->run(build_jobs[f], at);
-                    frame_figures.set_build(f, b);
-                    at = b.end;
-                }
+                for (uint32_t f = first; f <= last && f < build_jobs.size(); ++f) at = build_frame(f, at);
                 return at;
             };
         // Leading empty frames end at cycle 0, before the first frame with rays, whose structures
@@ -153,12 +152,7 @@ LevelResult run_timed_level(RunInputs& in) {
             const Cycle shaded = f < first_frame ? end : block.end_frame_inflight(end);  // leading empty frames: no rays
             frame_figures.frame_end(f, shaded, top.memory_totals());
             if (f + 1 >= built.frames.size()) return shaded;
-            Cycle built_at = shaded;
-            if (f + 1 < build_jobs.size() && !build_jobs[f + 1].empty()) {
-                const FrameBuild b = build_unit->run(build_jobs[f + 1], shaded);
-                frame_figures.set_build(f + 1, b);
-                built_at = b.end;
-            }
+            const Cycle built_at = build_frame(f + 1, shaded);
             if (f + 1 < first_frame) return built_at;
             // The first frame with rays had its camera rays generated from cycle 0.
             if (f + 1 == first_frame) return block.await_build(built_at);

@@ -182,32 +182,28 @@ def test_shading_runs_frame_after_frame_in_both_frame_loops(
     traces: tuple[Path, Path], sim_exe: Path, tmp_path: Path
 ) -> None:
     animated, _ = traces
-    result = simulate(sim_exe, animated, tmp_path / "run", "shading.enabled=true")
-    assert result.returncode == 0, result.stderr
-    stats = json.loads((tmp_path / "run" / "stats.json").read_text())
-    v = stats["validation"]
-    assert v["hit_mismatches"] == v["work_mismatches"] == v["texel_mismatches"] == 0
-    assert v["order_violations"] == 0 and v["shaded_rays"] == v["rays_checked"]
-    shading = stats["model"]["shading"]
-    # Each frame's camera rays are generated after the frame before is shaded, and the frames'
-    # times add up to the frame loop's, whose parts add up to it.
-    assert [f["frame"] for f in stats["frames"]] == list(range(FRAMES))
-    assert sum(f["cycles"] for f in stats["frames"]) == shading["frame_cycles"]
-    assert sum(shading["breakdown"].values()) == shading["frame_cycles"]
+
+    def shaded_frames(name: str, *sets: str) -> dict:
+        """A shaded run's stats: every check passed, frames in order summing to the frame loop's
+        time, whose parts add up to it."""
+        result = simulate(sim_exe, animated, tmp_path / name, "shading.enabled=true", *sets)
+        assert result.returncode == 0, result.stderr
+        stats = json.loads((tmp_path / name / "stats.json").read_text())
+        v = stats["validation"]
+        assert v["hit_mismatches"] == v["work_mismatches"] == v["texel_mismatches"] == 0
+        assert v["order_violations"] == 0 and v["shaded_rays"] == v["rays_checked"]
+        loop = stats["model"]["shading"]
+        assert [f["frame"] for f in stats["frames"]] == list(range(FRAMES))
+        assert sum(f["cycles"] for f in stats["frames"]) == loop["frame_cycles"]
+        assert sum(loop["breakdown"].values()) == loop["frame_cycles"]
+        return loop
+
+    # Each frame's camera rays are generated after the frame before is shaded.
+    shading = shaded_frames("run")
     # A wavefront never spans two frames: at least one per frame and depth.
     assert len(shading["wavefronts"]) >= FRAMES * 2
     # The in-flight loop holds the frames as barriers too: a frame ends when its last hit is
     # shaded, the next frame's camera rays are generated then; within a frame, rays go as their
     # parents' warps are shaded.
-    result = simulate(sim_exe, animated, tmp_path / "inflight", "shading.enabled=true",
-                      "shading.frame_loop=inflight")  # fmt: skip
-    assert result.returncode == 0, result.stderr
-    inflight = json.loads((tmp_path / "inflight" / "stats.json").read_text())
-    v = inflight["validation"]
-    assert v["hit_mismatches"] == v["work_mismatches"] == v["texel_mismatches"] == 0
-    assert v["order_violations"] == 0 and v["shaded_rays"] == v["rays_checked"]
-    loop = inflight["model"]["shading"]
-    assert [f["frame"] for f in inflight["frames"]] == list(range(FRAMES))
-    assert sum(f["cycles"] for f in inflight["frames"]) == loop["frame_cycles"]
-    assert sum(loop["breakdown"].values()) == loop["frame_cycles"]
+    loop = shaded_frames("inflight", "shading.frame_loop=inflight")
     assert loop["breakdown"]["raygen"] == shading["breakdown"]["raygen"]  # every frame's, once
