@@ -44,18 +44,36 @@ struct AnalyticDemands {
     double merge_wait = 0;
 };
 
+/// One window of a run's phases (profile.h's PhaseWindow) as shares of the whole run's demands:
+/// what drives each resource in the window over its whole-run total, the window's unloaded
+/// latency summed over its steps, and the contexts active in it per unit (its steps over its
+/// rounds and the units).
+struct PhaseShare {
+    double steps = 0;     ///< pipelines, scheduler, rays
+    double l1_misses = 0; ///< L1 MSHRs, L2 banks
+    double l2_misses = 0; ///< DRAM, L2 MSHRs
+    double reads = 0;     ///< L1 banks
+    double latency_sum = 0;
+    double population = 0;
+};
+
 struct ClosedForm {
     nlohmann::json bounds;  ///< {name: cycles}
     std::string binding;    ///< the largest bound
     double roofline = 0;    ///< its cycles
     double queueing = 0;    ///< the MVA estimate
-    double cycles = 0;      ///< max(roofline, queueing), rounded up
+    double cycles = 0;      ///< max(roofline, queueing), rounded up (times phase_factor)
+    /// A whole-trace analysis's phases: the windows' cycles summed over max(roofline, queueing)
+    /// (1: no phases known, or the sum is below); `cycles` carries it.
+    double phase_factor = 1;
     double dram_bytes = 0;  ///< the DRAM bytes behind it (the demands'): what a knob's traffic costs in energy
 };
 
 /// The roofline and the MVA estimate of a run with these demands (ideal_memory: no cache or
-/// DRAM bounds).
-ClosedForm closed_form(const SimConfig& config, const std::vector<OpKind>& ops, const AnalyticDemands& d);
+/// DRAM bounds); with `phases`, each window is also priced as a run of its own (its share of the
+/// demands at its population) and the run is at least their sum.
+ClosedForm closed_form(const SimConfig& config, const std::vector<OpKind>& ops, const AnalyticDemands& d,
+                       const std::vector<PhaseShare>& phases = {});
 
 /// The stats of model.analytic, declared once.
 const StatBlock& analytic_stats();

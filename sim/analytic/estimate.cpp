@@ -224,12 +224,19 @@ private:
     }
     void count_kinds();
     void ops(double* op_latency);
+    /// The windows of a whole-trace analysis's rounds as shares of the run (profile.h's
+    /// PhaseWindow), once per estimate; none for lock-step kinds and sampled analyses. Then
+    /// their latencies at the current latency per step.
+    void phase_windows();
+    const std::vector<PhaseShare>& phase_shares(double steps);
     json memory_json(double cycles) const;
 
     const SimConfig& m_c;
     const AnalyticProfile& m_p;
     MissTables m_miss;
     double m_lat_l1, m_lat_l2, m_lat_dram, m_dram;
+    std::vector<PhaseShare> m_phases;   ///< phase_windows()
+    std::vector<double> m_phase_fetch;  ///< each window's latency per step over the run's mean
     double m_active = 1.0;    ///< SIMD efficiency of a lock-step kind's groups (group_factors)
     double m_coalesce = 1.0;  ///< structure reads after coalescing per read asked for
     double m_step_scale = 1.0;  ///< the groups' plan steps per the rays' own
@@ -353,7 +360,8 @@ ClosedForm Estimator::form() {
     const double per_step = steps > 0 ? (steps * fetch + op_latency) / steps : 0.0;
     const double longest = m_p.plan_steps_per[0] * m_p.longest_ray_steps + m_p.plan_steps_per[1] * m_p.longest_ray_tests;
     m_d.latency_max = ray_start + longest * per_step / m_active;
-    ClosedForm f = closed_form(m_c, m_p.op_kinds, m_d);
+    phase_windows();
+    ClosedForm f = closed_form(m_c, m_p.op_kinds, m_d, phase_shares(steps));
     if (!m_p.has_group && (!m_p.merge_l1.empty() || !m_p.merge_l2.empty())) {
         // The merged reads' wait depends on the rate of reads, hence on the cycles it adds to:
         // a fixed point, which a few rounds reach (more wait, fewer reads per cycle, less wait).
@@ -361,10 +369,57 @@ ClosedForm Estimator::form() {
         for (int round = 0; round < 4; ++round) {
             m_d.merge_wait = merge_wait(f.cycles);
             m_d.latency_sum = base + steps * m_d.merge_wait;
-            f = closed_form(m_c, m_p.op_kinds, m_d);
+            f = closed_form(m_c, m_p.op_kinds, m_d, phase_shares(steps));
         }
     }
     return f;
+}
+
+// Each window of rounds as a run of its own (closed_form's phases): its share of every demand
+// (a resource's spread by what drives it in the window: L2 misses for the DRAM and the L2's MSHRs,
+// L1 misses for the L1's MSHRs and the L2's banks, line reads for the L1's banks, steps for the
+// pipelines and the scheduler), its steps' unloaded latency (their slowest lines') and the
+// contexts active in it. At the start every ray is at the top of the tree, its lines in the
+// caches, and the DRAM waits; at the end fewer rays than contexts remain and the longest runs
+// alone: a closed form over the whole run's totals averages both away. In a steady state every
+// window is alike and their sum is the whole run's (docs/fidelity.md, "Where designs starve or
+// fill slowly").
+void Estimator::phase_windows() {
+    m_phases.clear();
+    m_phase_fetch.clear();
+    if (m_p.has_group || m_p.phases.empty()) return;
+    PhaseShare all;
+    double fetch_sum = 0;
+    for (const PhaseWindow& pw : m_p.phases) {
+        PhaseShare& s = m_phases.emplace_back();
+        for (const auto& [key, count] : pw.reads.cells) {
+            const auto [m1, m12] = m_miss.cell(key);
+            s.l1_misses += count * m1, s.l2_misses += count * m12, s.reads += count;
+        }
+        s.steps = pw.steps;
+        s.population = pw.rounds > 0 ? pw.steps / pw.rounds / m_c.traversal.units : 0.0;
+        const double fetch = mean_latency(pw.critical);
+        m_phase_fetch.push_back(fetch);
+        fetch_sum += fetch * pw.steps;
+        all.steps += s.steps, all.l1_misses += s.l1_misses, all.l2_misses += s.l2_misses, all.reads += s.reads;
+    }
+    auto share = [](double part, double whole) { return whole > 0 ? part / whole : 0.0; };
+    for (PhaseShare& s : m_phases) {
+        s.steps = share(s.steps, all.steps), s.reads = share(s.reads, all.reads);
+        s.l1_misses = share(s.l1_misses, all.l1_misses), s.l2_misses = share(s.l2_misses, all.l2_misses);
+    }
+    // The windows' latencies relative to the run's mean (their octave keys' bias cancels).
+    const double mean = all.steps > 0 ? fetch_sum / all.steps : 0.0;
+    for (double& f : m_phase_fetch) f = mean > 0 ? f / mean : 1.0;
+}
+
+const std::vector<PhaseShare>& Estimator::phase_shares(double steps) {
+    if (m_phases.empty() || steps <= 0) return m_phases;
+    const double fetch = mean_latency(m_p.step_critical);
+    const double other = std::max(0.0, (m_d.latency_sum - steps * fetch) / steps);  // per step: operations, ray starts
+    for (size_t w = 0; w < m_phases.size(); ++w)
+        m_phases[w].latency_sum = m_phases[w].steps * steps * (fetch * m_phase_fetch[w] + other);
+    return m_phases;
 }
 
 AnalyticEstimate Estimator::run() {

@@ -12,9 +12,9 @@ namespace rtsim {
 class KeyCounts {
 public:
     /// One more of `key` (any key but ~0u, the empty slot's mark; histogram keys use 18 bits).
-    void add(uint32_t key) {
+    void add(uint32_t key, uint64_t n = 1) {
         bool found;
-        m_table.find_or_add(key, found) += 1;
+        m_table.find_or_add(key, found) += n;
     }
     /// Calls f(key, count) for every key counted, then forgets them.
     template <class F>

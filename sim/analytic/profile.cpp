@@ -46,6 +46,21 @@ void array_from(const json& j, Array* a) {
     std::copy(v.begin(), v.end(), a->begin());
 }
 
+json phases_json(const std::vector<PhaseWindow>& phases) {
+    json a = json::array();
+    for (const PhaseWindow& w : phases)
+        a.push_back({{"rounds", w.rounds}, {"steps", w.steps}, {"reads", hist_json(w.reads)}, {"critical", hist_json(w.critical)}});
+    return a;
+}
+
+std::vector<PhaseWindow> phases_from(const json& a) {
+    std::vector<PhaseWindow> phases;
+    for (const json& e : a)
+        phases.push_back({e.at("rounds").get<double>(), e.at("steps").get<double>(), hist_from(e.at("reads")),
+                          hist_from(e.at("critical"))});
+    return phases;
+}
+
 }  // namespace
 
 double JointHistogram::total() const {
@@ -111,6 +126,7 @@ json AnalyticProfile::to_json() const {
             {"workload", workload},
             {"stepped_rays", stepped_rays},
             {"analysis_seconds", analysis_seconds},
+            {"phases", phases_json(phases)},
             {"group", has_group ? group.to_json() : json(nullptr)},
             {"treelets", {{"takes", treelet_takes}, {"parks", treelet_parks}, {"overflows", treelet_overflows}}}};
 }
@@ -154,6 +170,7 @@ AnalyticProfile AnalyticProfile::from_json(const json& j) {
     p.workload = j.at("workload");
     p.stepped_rays = j.at("stepped_rays");
     p.analysis_seconds = j.at("analysis_seconds");
+    p.phases = phases_from(j.at("phases"));
     if (j.contains("treelets")) {
         const json& t = j.at("treelets");
         p.treelet_takes = t.at("takes"), p.treelet_parks = t.at("parks"), p.treelet_overflows = t.at("overflows");

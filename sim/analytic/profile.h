@@ -63,6 +63,20 @@ struct MergeKey {
     }
 };
 
+/// A window of consecutive rounds of a whole-trace analysis (sample.h: every active context
+/// takes one step per round): what its steps asked for. The windows in order are the run's
+/// phases: the fill (every ray at the top of the tree at once), the steady state and the drain
+/// (fewer rays than contexts, the longest ray alone at the end), which a closed form over the
+/// whole run's totals averages away (estimate.cpp, "phases").
+struct PhaseWindow {
+    double rounds = 0;        ///< rounds in the window
+    double steps = 0;         ///< planned steps taken in them
+    // Keys to octaves (MergeKey::octaves): a window's shares of the run, not its absolute
+    // figures, are what the estimate takes from them, and the analysis file stays small.
+    JointHistogram reads;     ///< their line reads (every data kind)
+    JointHistogram critical;  ///< each step's slowest line
+};
+
 struct AnalyticProfile {
     nlohmann::json key;  ///< what the analysis depends on (analysis_cache.h)
     std::string accel_kind;        ///< the structure's kind (for the stats' why texts)
@@ -100,6 +114,11 @@ struct AnalyticProfile {
     // Treelet scheduling (the sample stepped in treelet order, sample.h): the measured rays'
     // takes from the ray buffer, parks in other treelets' queues, and overflows of its SRAM.
     double treelet_takes = 0, treelet_parks = 0, treelet_overflows = 0;
+
+    // Whole-trace analyses of contexts that run alone (one cluster from the first ray, no
+    // treelet scheduling): the rounds in windows of equal length, at most kMaxPhaseWindows.
+    static constexpr size_t kMaxPhaseWindows = 32;
+    std::vector<PhaseWindow> phases;
 
     // Lock-step unit kinds (SIMT warps, packets): the sample's rays stepped in the kind's groups,
     // functionally (UnitKind::group_profile): SIMD efficiency, coalescing, the groups' work.

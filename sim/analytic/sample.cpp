@@ -46,6 +46,12 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
     m_global_pos = 0;
     std::fill(m_unit_pos.begin(), m_unit_pos.end(), 0);
     RayDealer dealer(m_c.dispatch, m_units, stream);
+    // The phases are the run's only when one cluster holds the whole trace from its first ray.
+    m_record_phases = ++m_clusters_run == 1 && !m_partition && measure_first == 0 &&
+                      measure_end >= stream.total_rays();
+    m_phases.clear();
+    m_window_rounds = 1;
+    if (m_record_phases) m_phases.emplace_back();
     if (m_partition) return run_treelets(dealer, sink);
     for (uint32_t c = 0; c < m_slots; ++c)
         for (uint32_t u = 0; u < m_units; ++u) start_ray(dealer, u, c, sink);
@@ -63,7 +69,29 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
             step(dealer, uint32_t(i / m_slots), uint32_t(i % m_slots), sink);
             any = true;
         }
+        if (any && m_record_phases) end_round();
     }
+}
+
+void SampleProfiler::end_round() {
+    PhaseCounts& w = m_phases.back();
+    if (++w.rounds < m_window_rounds) return;
+    if (m_phases.size() < AnalyticProfile::kMaxPhaseWindows) {
+        m_phases.emplace_back();
+        return;
+    }
+    // Full: neighbours merged, windows twice as long; the next round opens a new one.
+    for (size_t i = 0; i < m_phases.size() / 2; ++i) {
+        PhaseCounts& into = m_phases[i];
+        if (i > 0) into = std::move(m_phases[2 * i]);
+        PhaseCounts& other = m_phases[2 * i + 1];
+        into.rounds += other.rounds, into.steps += other.steps;
+        other.reads.drain([&](uint32_t key, uint64_t n) { into.reads.add(key, n); });
+        other.critical.drain([&](uint32_t key, uint64_t n) { into.critical.add(key, n); });
+    }
+    m_phases.resize(m_phases.size() / 2);
+    m_window_rounds *= 2;
+    m_phases.emplace_back();
 }
 
 void SampleProfiler::run_treelets(RayDealer& dealer, RaySinkIf& sink) {
@@ -230,6 +258,11 @@ void SampleProfiler::step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySi
         const Access a = read(unit, d.reads[i].addr, d.reads[i].bytes, d.reads[i].kind, ctx.measured);
         if (i == 0 || a.rank > critical.rank) critical = a;
     }
+    if (m_record_phases) {
+        PhaseCounts& w = m_phases.back();
+        w.steps += 1;
+        if (d.read_count) w.critical.add(MergeKey::octaves(critical.key));
+    }
     if (ctx.measured && d.read_count) {
         m_step_critical.add(critical.key);
         if (m_merges && critical.merge_l1) m_p.merge_l1[critical.merge_l1_key] += 1;
@@ -293,6 +326,7 @@ SampleProfiler::Access SampleProfiler::read_line(uint32_t unit, uint64_t line, D
     (uc ? m_p.unit_censored : m_p.unit_events)[ub] += 1;
     (gc ? m_p.global_censored : m_p.global_events)[gb] += 1;
     m_reads[size_t(kind)].add(key);
+    if (m_record_phases) m_phases.back().reads.add(MergeKey::octaves(key));
     a.key = key;
     a.rank = (uint64_t(gc) << 63) | (uint64_t(uc) << 62) | (uint64_t(gb) << 8) | uint64_t(ub);
     // The L1's merge asks of the read only whether it hits the L1 (its unit-stream bin).
@@ -330,6 +364,15 @@ void SampleProfiler::finish() {
         m_op_sizes[k].drain([&](uint32_t key, uint64_t n) { m_p.op_sizes[k][key] += double(n); });
     m_step_critical.drain([&](uint32_t key, uint64_t n) { m_p.step_critical.add(key, double(n)); });
     m_ray_critical.drain([&](uint32_t key, uint64_t n) { m_p.ray_critical.add(key, double(n)); });
+    m_p.phases.clear();
+    if (m_clusters_run == 1)
+        for (PhaseCounts& w : m_phases) {
+            if (w.rounds == 0) continue;
+            PhaseWindow& out = m_p.phases.emplace_back();
+            out.rounds = w.rounds, out.steps = w.steps;
+            w.reads.drain([&](uint32_t key, uint64_t n) { out.reads.add(key, double(n)); });
+            w.critical.drain([&](uint32_t key, uint64_t n) { out.critical.add(key, double(n)); });
+        }
     // Least squares without intercept: plan steps = a (plan-step work) + b primitive tests
     // (triangles', spheres' and capsules').
     const double det = m_fit[0] * m_fit[2] - m_fit[1] * m_fit[1];

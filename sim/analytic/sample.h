@@ -76,6 +76,9 @@ private:
     void write(uint64_t addr, uint32_t bytes, DataKind kind, bool measured);
     void stack_traffic(uint32_t unit, uint32_t slot, const StepDemand& d, bool measured);
     void finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink);
+    /// Whole-trace analyses: the round just run into the current phase window (profile.h),
+    /// halving the windows' count by merging neighbours when it reaches the maximum.
+    void end_round();
     /// Speed only: the host data of context `index`'s next step and its first line's reuse slots.
     void prefetch_ahead(size_t index) const;
 
@@ -96,6 +99,15 @@ private:
     // The profile's histograms as counted (finish() moves them into the profile).
     std::vector<KeyCounts> m_reads, m_op_sizes;  ///< per DataKind, per OpKind
     KeyCounts m_step_critical, m_ray_critical;
+    // Phase windows as counted (whole-trace analyses only; finish() moves them into the profile).
+    struct PhaseCounts {
+        double rounds = 0, steps = 0;
+        KeyCounts reads, critical;
+    };
+    std::vector<PhaseCounts> m_phases;
+    double m_window_rounds = 1;  ///< rounds per window
+    bool m_record_phases = false;
+    uint32_t m_clusters_run = 0;
     // Treelet scheduling only (treelets.enabled).
     std::unique_ptr<LocalityPartition> m_partition;
     std::vector<std::deque<Ray>> m_queues;

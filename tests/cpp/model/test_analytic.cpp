@@ -257,6 +257,36 @@ TEST(AnalyticLevel, SecondConfigurationOnTheSameRaysReusesTheAnalysis) {
     EXPECT_GT(slow.cycles, base.cycles);
 }
 
+TEST(AnalyticLevel, WholeTraceAnalysisRecordsItsRoundsInPhaseWindows) {
+    // Every step of the whole trace lies in one window; the windows' rounds are at least the
+    // longest ray's steps (a context takes one step per round) and their populations never
+    // exceed the contexts; the drain (fewer rays than contexts) is the last windows'. A profile
+    // with phases round-trips through the analysis file.
+    const Workload& w = workload();
+    const SimConfig c = small_machine();
+    RayList rays(w.jobs);
+    Discard sink;
+    const AnalyticProfile& p = analyze_stream(c, *w.accel, w.map(c), StepOptions{}, rays, sink);
+    ASSERT_FALSE(p.phases.empty());
+    EXPECT_LE(p.phases.size(), AnalyticProfile::kMaxPhaseWindows);
+    double steps = 0, rounds = 0;
+    for (const PhaseWindow& pw : p.phases) {
+        steps += pw.steps, rounds += pw.rounds;
+        EXPECT_LE(pw.steps, pw.rounds * c.traversal.units * c.traversal.contexts());
+        EXPECT_GT(pw.reads.total(), 0.0);
+    }
+    EXPECT_EQ(steps, p.sample_plan_steps);
+    EXPECT_GE(rounds, p.longest_ray_steps * p.plan_steps_per[0] * 0.5);
+    const PhaseWindow& last = p.phases.back();
+    EXPECT_LT(last.steps / last.rounds, 0.5 * c.traversal.units * c.traversal.contexts());
+    const AnalyticProfile back = AnalyticProfile::from_json(p.to_json());
+    EXPECT_EQ(back.to_json(), p.to_json());
+    // Its estimate carries the phases: a drain makes the run longer than the whole run's form.
+    const AnalyticEstimate e = estimate_analytic(c, p);
+    EXPECT_GE(e.form.phase_factor, 1.0);
+    EXPECT_EQ(e.model["analytic"]["phase_factor"].get<double>(), e.form.phase_factor);
+}
+
 TEST(AnalyticLevel, MergedMissesWaitForTheFillAndNotUnderIdealMemory) {
     // Coherent camera rays read the top of the tree again while its first misses are in flight:
     // the profile records those reads, and the estimate charges their wait on the fill.
@@ -375,6 +405,36 @@ TEST(AnalyticClosedForm, OneRayInFlightTakesItsUnloadedLatencyPlusIssueCycles) {
     const ClosedForm f = closed_form(c, {OpKind(0)}, d);
     // (Within 0.01%: the L2's loop bound holds the DRAM queueing of busy MSHRs, a few cycles here.)
     EXPECT_NEAR(f.queueing, d.latency_sum + d.scheduler_steps * c.traversal.issue_cycles, 1e-4 * d.latency_sum);
+}
+
+TEST(AnalyticClosedForm, PhasesAllAlikeGiveTheWholeRunAndADrainAddsItsLatency) {
+    SimConfig c;
+    c.traversal.units = 2;
+    c.traversal.ray_contexts = 8;
+    AnalyticDemands d = l2_misses(c, 2000);
+    d.issues[0] = 40000;
+    d.scheduler_steps = 60000;
+    d.l1_accesses = 30000;
+    d.l2_accesses = 4000;
+    d.l1_hold = 4000 * 250.0;
+    d.latency_sum = d.rays * 3000.0;
+    const ClosedForm whole = closed_form(c, {OpKind(0)}, d);
+    // Ten alike windows, each a tenth of everything at the full population: the whole run.
+    std::vector<PhaseShare> alike(10);
+    for (PhaseShare& s : alike)
+        s = {0.1, 0.1, 0.1, 0.1, 0.1 * d.latency_sum, double(c.traversal.contexts())};
+    const ClosedForm same = closed_form(c, {OpKind(0)}, d, alike);
+    EXPECT_NEAR(same.cycles, whole.cycles, 1e-3 * whole.cycles);
+    // The same with a last window of one ray alone, 1% of the steps at the same latency per
+    // step: it lasts that ray's latency (no one to overlap with), on top.
+    std::vector<PhaseShare> drain = alike;
+    for (PhaseShare& s : drain) s.steps = s.l1_misses = s.l2_misses = s.reads = 0.099, s.latency_sum *= 0.99;
+    const double alone = 0.01 * d.latency_sum;  // one ray's worth of steps, summed
+    drain.push_back({0.01, 0.01, 0.01, 0.01, alone, 1.0 / c.traversal.units});
+    const ClosedForm drained = closed_form(c, {OpKind(0)}, d, drain);
+    EXPECT_GT(drained.phase_factor, 1.0);
+    // One context in the machine for 1% of the rays (10 rays, 30,000 cycles of latency).
+    EXPECT_NEAR(drained.cycles - 0.99 * whole.cycles, alone, 0.05 * alone);
 }
 
 TEST(AnalyticCache, KeyHoldsWhatShapesTheAccessStreamsOnly) {
