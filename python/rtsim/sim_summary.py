@@ -402,6 +402,12 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         for w in warnings:
             table.add_row("[bold yellow]warning[/]", str(w))
         console.print(table)
+    outside = _get(stats, "summary.fidelity_warnings") or []
+    if outside:
+        table = _two_column("outside the level's measured band (docs/fidelity.md)")
+        for w in outside:
+            table.add_row("[bold yellow]warning[/]", str(w))
+        console.print(table)
     if _get(stats, "summary.cycles") is not None:
         console.print(utilisation_table(stats))
         if stats.get("verdict") or stats.get("roofline"):

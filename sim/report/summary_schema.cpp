@@ -138,6 +138,9 @@ const StatBlock& summary_stats() {
         {"study_warnings", "list",
          "`study_size.findings[].text`: why the run is too small to answer its question (a ray buffer that never filled, a drain that dominates, a sample too short), each with the trace size that would do; empty when none applies. `rtsim simulate` prints them and the sweep report lists them",
          false, false},
+        {"fidelity_warnings", "list",
+         "`fidelity_band.findings[].text`: the design is of a kind the level was measured outside its band on (analytic with treelets, or with few rays per context), with the section of docs/fidelity.md that measured it; empty when none applies. `rtsim simulate` prints them and the sweep report lists them",
+         false, false},
     }};
     return block;
 }
@@ -162,6 +165,7 @@ const StatBlock& run_stats() {
             {"verdict", "", "why the run is slow: the binding resource, its evidence and the knob that relaxes it (below); `null` at functional or with `--no-verdict`"},
             {"roofline", "", "the run against its throughput ceilings (below); `null` at functional"},
             {"study_size", "", "whether the run is big enough to answer its question, and the trace size that would be (below)"},
+            {"fidelity_band", "", "whether the design is of a kind the run's level was measured outside its band on (below)"},
             {"mailbox", "", "only when `mailbox.entries > 0`: the mailboxes' lookups, hits and the triangle tests and fetches they saved (below)", false, true},
             {"short_stack", "", "only when `traversal.stack_overflow = restart_trail`: entries dropped, restarts and the re-traversal they cost (below)", false, true},
             {"box_precision", "", "only when `traversal.box_precision_bits > 0`: the reduced-precision box pipeline's extra walk, its energy and area beside fp32's (below)", false, true},

@@ -179,3 +179,27 @@ def test_a_treelet_run_says_when_it_is_too_small(
     assert "too small: the ray buffer never filled" in stats["verdict"]["text"]
     big = sim_stats(sim_exe, trace_of(), tmp_path / "plain")
     assert not any(x["kind"] == "ray_buffer_not_filled" for x in big["study_size"]["findings"])
+
+
+def test_an_analytic_run_says_when_its_design_is_outside_the_levels_band(
+    trace_of: Callable[..., Path], sim_exe: Path, tmp_path: Path
+) -> None:
+    # This trace's ~700 rays on 8 x 16 contexts: few rays per context, a kind of design the
+    # analytic level was measured outside its band on (docs/fidelity.md).
+    small = sim_stats(sim_exe, trace_of(), tmp_path / "small", "fidelity=analytic")
+    kinds = [f["kind"] for f in small["fidelity_band"]["findings"]]
+    assert kinds == ["few_rays_per_context"]
+    assert small["fidelity_band"]["outside"]
+    assert small["summary"]["fidelity_warnings"] == [
+        f["text"] for f in small["fidelity_band"]["findings"]
+    ]
+    assert "docs/fidelity.md" in small["summary"]["fidelity_warnings"][0]
+    # One unit of 8 contexts: many rays per context, inside the band; treelets on MIMD are not.
+    few = ("fidelity=analytic", "traversal.units=1", "traversal.ray_contexts=8")
+    inside = sim_stats(sim_exe, trace_of(), tmp_path / "inside", *few)
+    assert not inside["fidelity_band"]["outside"] and inside["summary"]["fidelity_warnings"] == []
+    treelets = sim_stats(sim_exe, trace_of(), tmp_path / "treelets", *few, "treelets.enabled=true")
+    assert [f["kind"] for f in treelets["fidelity_band"]["findings"]] == ["treelets_on_contexts"]
+    # approx was within its band on every kind measured: no finding.
+    timed = sim_stats(sim_exe, trace_of(), tmp_path / "approx", "fidelity=approx")
+    assert timed["fidelity_band"] == {"level": "approx", "outside": False, "findings": []}

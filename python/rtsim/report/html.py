@@ -120,6 +120,22 @@ def _overview(data: SweepData) -> str:
                 f"<ul>{items}{more}</ul>",
             ]
         )
+    outside = [r for r in data.runs if r.summary.get("fidelity_warnings")]
+    if outside:
+        # A run whose design the level was measured outside its band on (stats `fidelity_band`).
+        items = "".join(
+            f"<li>{escape(data.label(r))} ({escape(r.scene)} / {escape(r.workload)}): "
+            f"{escape('; '.join(r.summary['fidelity_warnings']))}</li>"
+            for r in outside[:12]
+        )
+        more = f"<li>and {len(outside) - 12} more</li>" if len(outside) > 12 else ""
+        rows.append(
+            [
+                "<span class='bad'>outside its band</span>",
+                f"{len(outside)} of {len(data.runs)} runs are of designs their level was measured "
+                f"outside its band on (docs/fidelity.md):<ul>{items}{more}</ul>",
+            ]
+        )
     spec = data.meta.get("spec", "")
     return _table(["", ""], rows) + (
         f"<details><summary>sweep spec</summary><pre>{escape(spec)}</pre></details>" if spec else ""

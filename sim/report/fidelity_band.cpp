@@ -1,0 +1,99 @@
+// Is this run's level inside the band it was measured in, for this kind of design? (docs/fidelity.md,
+// "Designs a level was measured outside its band on"). The analytic level is within 10% of
+// `detailed` on the design grids it was measured on, but on some kinds of design it was measured
+// well outside that band; a run of such a design says so in its summary, names the mechanism the
+// level leaves out and the level that was within its band there, so an architect reads the figure
+// as what it is. The kinds are the accuracy grids' (python/rtsim/specs/unit_models_grid.yaml and
+// starved_grid.yaml); their measured errors are in docs/fidelity.md, generated from those runs.
+#include <cstdio>
+#include <string>
+
+#include "rtl_model/common/stats.h"
+#include "rtl_model/traversal/unit_kind.h"
+#include "sim/report/report_block.h"
+
+namespace rtsim {
+
+using nlohmann::json;
+
+namespace {
+
+/// Rays per ray context below which the fill and the drain are a large part of the run: the
+/// starved grid's fill-limited points hold 0.3-6 rays per context, its other points 48.
+constexpr double kFewRaysPerContext = 8;
+
+json finding(const char* kind, const std::string& why, const char* section) {
+    return {{"kind", kind},
+            {"text", "analytic: " + why + "; the level was measured outside its 10% band on such designs "
+                     "(docs/fidelity.md, \"" + section + "\"), approx within it: use approx or detailed for figures"},
+            {"section", section}};
+}
+
+json fidelity_band(const SimConfig& c, const json& stats) {
+    json findings = json::array();
+    if (c.fidelity == Fidelity::analytic) {
+        const bool lock_step = bool(c.traversal.kind().group_profile);
+        const json& summary = stats.value("summary", json::object());
+        const json& r = summary.value("rays", json(nullptr));
+        const double rays = r.is_number() ? r.get<double>() : 0.0;
+        const double contexts = double(c.traversal.units) * c.traversal.contexts();
+        const double per_context = contexts > 0 ? rays / contexts : 0.0;
+        if (c.treelets.enabled && !lock_step)
+            findings.push_back(finding("treelets_on_contexts",
+                                       "MIMD units with treelet scheduling: a treelet's contexts become ready together "
+                                       "and convoy at the scheduler, which the closed form does not model (it is fast)",
+                                       "What is left with treelets"));
+        if (c.treelets.enabled && lock_step)
+            findings.push_back(finding("treelets_on_groups",
+                                       "lock-step units with treelet queues: a warp step waits for the slowest of its "
+                                       "lines drawn independently, while a treelet warp's lanes read one small treelet's "
+                                       "(it can be slow where the DRAM is fast)",
+                                       "What is left with treelets"));
+        if (rays > 0 && per_context < kFewRaysPerContext) {
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%.1f", per_context);
+            const std::string why =
+                std::string(buf) + " rays per ray context (" + std::to_string(uint64_t(rays)) + " rays, " +
+                std::to_string(uint64_t(contexts)) + " contexts): the fill and the drain are much of the run; " +
+                (lock_step ? "a lock-step unit's analysis keeps no phases, and a warp lasts as long as its longest ray"
+                           : "the phases are priced, the spread of the last rays' latencies is not (it is fast)");
+            findings.push_back(finding("few_rays_per_context", why, "Where designs starve or fill slowly"));
+        }
+    }
+    json texts = json::array();
+    for (const json& f : findings) texts.push_back(f["text"]);
+    return {{"level", kFidelityChoices.name(c.fidelity)}, {"outside", !findings.empty()}, {"findings", findings}, {"texts", texts}};
+}
+
+const StatBlock& fidelity_band_stats() {
+    static const StatBlock block{
+        "fidelity_band",
+        {
+            {"level", "", "the run's fidelity level"},
+            {"outside", "bool", "the design is of a kind the level was measured outside its band on (docs/fidelity.md)"},
+            {"findings", "list", "each with `kind` (`treelets_on_contexts`: analytic with treelet scheduling on MIMD units; `treelets_on_groups`: analytic with treelet queues on lock-step units; `few_rays_per_context`: analytic with fewer than 8 rays per ray context), `text` and `section` (the docs/fidelity.md section with the measured errors)"},
+        }};
+    return block;
+}
+
+RTSIM_REGISTER_STAT_BLOCK(fidelity_band_stats)
+
+ReportBlock fidelity_band_report() {
+    ReportBlock b;
+    b.name = "fidelity band";
+    b.order = 66;  // after the study size, before the verdict
+    b.add = [](json& stats, const ReportInputs& in) {
+        json band = fidelity_band(in.config, stats);
+        stats["summary"]["fidelity_warnings"] = band["texts"];
+        band.erase("texts");
+        stats["fidelity_band"] = std::move(band);
+    };
+    b.keys = {{"fidelity_band", fidelity_band_stats}};
+    return b;
+}
+
+}  // namespace
+
+RTSIM_REGISTER_REPORT_BLOCK(fidelity_band_report())
+
+}  // namespace rtsim
