@@ -176,6 +176,7 @@ ClosedForm closed_form(const SimConfig& c, const std::vector<OpKind>& ops, const
         }
     f.queueing = mva_cycles(c, ops, held, f.bounds);
     f.cycles = std::max(f.roofline, f.queueing);
+    f.steady_cycles = std::ceil(f.cycles);
     double phased = 0;
     for (const PhaseShare& s : phases) {
         const AnalyticDemands w = scaled(held, s);

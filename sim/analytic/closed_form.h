@@ -66,6 +66,9 @@ struct ClosedForm {
     /// A whole-trace analysis's phases: the windows' cycles summed over max(roofline, queueing)
     /// (1: no phases known, or the sum is below); `cycles` carries it.
     double phase_factor = 1;
+    /// max(roofline, queueing), rounded up, without the phases: what estimates are compared on
+    /// when one of them has no phases (another structure, treelets, a lock-step kind).
+    double steady_cycles = 0;
     double dram_bytes = 0;  ///< the DRAM bytes behind it (the demands'): what a knob's traffic costs in energy
 };
 

@@ -150,7 +150,9 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
         return out;
     }
     try {
-        const double base = sample_form()(m_dram.apply(analytic_config(config, c.unit.estimate_as))).cycles;
+        // Steady-state cycles on both sides: an alternative's analysis may keep no phases
+        // (treelets, lock-step kinds), and a phased base against it would favour the alternative.
+        const double base = sample_form()(m_dram.apply(analytic_config(config, c.unit.estimate_as))).steady_cycles;
         bool reused = false;
         double cycles = 0;
         if (k.trace) {
@@ -164,7 +166,7 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
             const SimConfig a = analytic_config(alt->config, stand_in_of(alt->config));
             const auto profile = sample_analysis(a, *alt->accel, *alt->map, alt->step, alt->sample_stream,
                                                  alt->identity, alt->path, 0, alt->rays, c.sample_rays, &reused);
-            cycles = FormEstimator(*profile)(m_dram.apply(a)).cycles;
+            cycles = FormEstimator(*profile)(m_dram.apply(a)).steady_cycles;
             out.method = "the analytic level on the same " + std::to_string(uint64_t(profile->stepped_rays)) +
                          " sampled rays of the alternative trace beside this one";
         } else {
@@ -176,7 +178,7 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
             }
             const SimConfig a = analytic_config(relaxed, as);
             const auto profile = own_sample(a, &reused);
-            cycles = FormEstimator(*profile)(m_dram.apply(a)).cycles;
+            cycles = FormEstimator(*profile)(m_dram.apply(a)).steady_cycles;
             out.method = "the analytic level on the same " + std::to_string(uint64_t(profile->stepped_rays)) +
                          " sampled rays with " + setting_text(k.relax);
         }
