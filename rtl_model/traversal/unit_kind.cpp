@@ -44,9 +44,24 @@ const UnitKind& unit_kind(const std::string& name) {
     return it->second;
 }
 
+void GroupWindow::end_round(std::vector<GroupWindow>& windows, double* window_rounds) {
+    if (++windows.back().rounds < *window_rounds) return;
+    if (windows.size() >= kMaxWindows) {
+        for (size_t i = 0; i < windows.size() / 2; ++i) {
+            const GroupWindow a = windows[2 * i], b = windows[2 * i + 1];
+            windows[i] = {a.rounds + b.rounds, a.group_steps + b.group_steps, a.active_lanes + b.active_lanes};
+        }
+        windows.resize(windows.size() / 2);
+        *window_rounds *= 2;
+    }
+    windows.emplace_back();
+}
+
 GroupProfile& GroupProfile::operator+=(const GroupProfile& o) {
+    if (rays == 0) phases = o.phases;
+    else phases.clear();  // windows of two steppings do not add up to one run's
     rays += o.rays, scheduler_steps += o.scheduler_steps, group_steps += o.group_steps, buffer_steps += o.buffer_steps;
-    lane_slots += o.lane_slots, active_lanes += o.active_lanes;
+    lane_slots += o.lane_slots, active_lanes += o.active_lanes, occupied_lanes += o.occupied_lanes;
     lane_requests += o.lane_requests, requests += o.requests;
     for (size_t i = 0; i < work.size(); ++i) work[i] += o.work[i], single_work[i] += o.single_work[i];
     for (size_t i = 0; i < kind_steps.size(); ++i) kind_steps[i] += o.kind_steps[i];
@@ -60,22 +75,30 @@ nlohmann::json GroupProfile::to_json() const {
             {"buffer_steps", buffer_steps},
             {"lane_slots", lane_slots},
             {"active_lanes", active_lanes},
+            {"occupied_lanes", occupied_lanes},
             {"lane_requests", lane_requests},
             {"requests", requests},
             {"work", work},
             {"single_work", single_work},
-            {"kind_steps", kind_steps}};
+            {"kind_steps", kind_steps},
+            {"phases", [&] {
+                 nlohmann::json a = nlohmann::json::array();
+                 for (const GroupWindow& w : phases) a.push_back({w.rounds, w.group_steps, w.active_lanes});
+                 return a;
+             }()}};
 }
 
 GroupProfile GroupProfile::from_json(const nlohmann::json& j) {
     GroupProfile g;
     g.rays = j.at("rays"), g.scheduler_steps = j.at("scheduler_steps"), g.group_steps = j.at("group_steps");
     g.buffer_steps = j.at("buffer_steps");
-    g.lane_slots = j.at("lane_slots"), g.active_lanes = j.at("active_lanes");
+    g.lane_slots = j.at("lane_slots"), g.active_lanes = j.at("active_lanes"), g.occupied_lanes = j.at("occupied_lanes");
     g.lane_requests = j.at("lane_requests"), g.requests = j.at("requests");
     g.work = j.at("work").get<std::array<double, kWorkFieldCount>>();
     g.single_work = j.at("single_work").get<std::array<double, kWorkFieldCount>>();
     g.kind_steps = j.at("kind_steps").get<std::array<double, kOpKindCount>>();
+    for (const nlohmann::json& w : j.at("phases"))
+        g.phases.push_back({w.at(0).get<double>(), w.at(1).get<double>(), w.at(2).get<double>()});
     return g;
 }
 

@@ -32,6 +32,18 @@ class TraversalUnit;
 
 /// What a lock-step kind's groups do on a sample of rays, stepped functionally (no time, no
 /// memory model): what the analytic level needs to cost them (sim/analytic/estimate.cpp).
+/// A window of consecutive rounds of a kind's functional group stepping (every group with rays
+/// takes one step per round): the run's phases, as the analytic level prices them
+/// (sim/analytic/estimate.cpp; MIMD contexts' windows are sim/analytic/profile.h's PhaseWindow).
+struct GroupWindow {
+    double rounds = 0, group_steps = 0, active_lanes = 0;
+    /// Adds `step` (a group step's active lanes) to the last of `windows`, rounds at a time: when
+    /// the last holds `*window_rounds` rounds a new one opens, and at kMaxWindows neighbours
+    /// merge and the windows double in length.
+    static constexpr size_t kMaxWindows = 32;
+    static void end_round(std::vector<GroupWindow>& windows, double* window_rounds);
+};
+
 struct GroupProfile {
     double rays = 0;             ///< rays of the sample
     double scheduler_steps = 0;  ///< scheduler phases the unit would take (its tally's steps)
@@ -41,6 +53,9 @@ struct GroupProfile {
     double buffer_steps = 0;
     double lane_slots = 0;       ///< group steps x rays per group
     double active_lanes = 0;     ///< rays that took part, summed over group steps
+    /// Lanes holding a ray (stepping or waiting for their class), summed over group steps; 0: as
+    /// lane_slots (a kind whose groups are always full)
+    double occupied_lanes = 0;
     double lane_requests = 0;    ///< structure reads the stepping rays asked for
     double requests = 0;         ///< structure reads after coalescing (a packet's: one per step)
     /// Group steps by the operation kind they run (a warp step's kind, a packet's node or leaf
@@ -48,6 +63,9 @@ struct GroupProfile {
     std::array<double, kOpKindCount> kind_steps{};
     /// The rays' work as the groups walk it (packets change it) and walked alone.
     std::array<double, kWorkFieldCount> work{}, single_work{};
+    /// The rounds in windows (GroupWindow), when the kind keeps them and one stepping covered
+    /// every ray (a sum of several keeps none).
+    std::vector<GroupWindow> phases;
 
     GroupProfile& operator+=(const GroupProfile& o);
     nlohmann::json to_json() const;

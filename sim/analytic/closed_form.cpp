@@ -89,8 +89,12 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
     std::vector<Station> stations;
     // Unloaded latency per visit: the rays' residence over the visits, shared by each customer's
     // rays (a group's rays wait together).
-    double think = population > 0 ? d.latency_sum / rays
-                                  : d.latency_sum / rays * double(customers) / double(c.traversal.contexts());
+    // (A customer of a lock-step kind is a group: its visit's delay is one group step's, its
+    // rays' residence over the rays per group; contexts: one ray's.)
+    const double per_customer = d.group_rays > 0   ? 1.0 / d.group_rays
+                                : d.customers > 0 ? d.customers / double(c.traversal.contexts())
+                                                  : 1.0;
+    double think = d.latency_sum / rays * per_customer;
     for (const auto& [name, shared] : kinds) {
         if (!bounds.contains(name)) continue;
         const double bound = bounds[name].get<double>();
@@ -130,9 +134,9 @@ double mva_cycles(const SimConfig& c, const std::vector<OpKind>& ops, const Anal
 /// A share of the demands (a window of the run's phases).
 AnalyticDemands scaled(const AnalyticDemands& d, const PhaseShare& s) {
     AnalyticDemands w = d;
-    w.rays = d.rays * s.steps;
-    w.visits = 0, w.customers = 0;
-    for (double& i : w.issues) i *= s.steps;
+    w.rays = d.rays * s.work;
+    w.visits = d.visits * s.steps;  // a lock-step kind's group steps (0 for contexts)
+    for (double& i : w.issues) i *= s.work;
     w.scheduler_steps *= s.steps;
     w.l1_accesses *= s.reads;
     w.l2_accesses *= s.l1_misses;

@@ -38,6 +38,9 @@ struct AnalyticDemands {
     /// each visiting once per ray (0, 0: the config's contexts and d.rays); a lock-step kind's
     /// groups, each visiting once per group step (its rays step, wait and issue together).
     double customers = 0, visits = 0;
+    /// A lock-step kind's rays held per group (its occupied lanes): the rays' residence over
+    /// them is a group visit's delay (0: contexts / customers).
+    double group_rays = 0;
     /// Treelet scheduling: bytes through the ray buffer's SRAM port, and the takes' latency.
     double ray_buffer_bytes = 0, latency_sum_extra = 0;
     /// Mean wait per planned step for fills already in flight (merged misses), in latency_sum.
@@ -46,10 +49,11 @@ struct AnalyticDemands {
 
 /// One window of a run's phases (profile.h's PhaseWindow) as shares of the whole run's demands:
 /// what drives each resource in the window over its whole-run total, the window's unloaded
-/// latency summed over its steps, and the contexts active in it per unit (its steps over its
-/// rounds and the units).
+/// latency summed over its steps, and the customers active in it per unit (its steps over its
+/// rounds and the units: contexts, or a lock-step kind's groups).
 struct PhaseShare {
-    double steps = 0;     ///< pipelines, scheduler, rays
+    double steps = 0;     ///< scheduler, rays (a lock-step kind's visits: its group steps)
+    double work = 0;      ///< pipelines' issues: the steps, or a lock-step kind's active lanes
     double l1_misses = 0; ///< L1 MSHRs, L2 banks
     double l2_misses = 0; ///< DRAM, L2 MSHRs
     double reads = 0;     ///< L1 banks

@@ -228,6 +228,7 @@ private:
     /// PhaseWindow), once per estimate; none for lock-step kinds and sampled analyses. Then
     /// their latencies at the current latency per step.
     void phase_windows();
+    void group_phase_windows();
     const std::vector<PhaseShare>& phase_shares(double steps);
     json memory_json(double cycles) const;
 
@@ -237,6 +238,10 @@ private:
     double m_lat_l1, m_lat_l2, m_lat_dram, m_dram;
     std::vector<PhaseShare> m_phases;   ///< phase_windows()
     std::vector<double> m_phase_fetch;  ///< each window's latency per step over the run's mean
+    /// A lock-step kind's ray takes part in this share of its group's steps (active over occupied
+    /// lanes): the longest ray's steps over it are its group's.
+    double m_longest_share = 1.0;
+    double m_group_fetch = 0, m_group_ops = 0;  ///< a lock-step kind's group step: its slowest line, its operations
     double m_active = 1.0;    ///< SIMD efficiency of a lock-step kind's groups (group_factors)
     double m_coalesce = 1.0;  ///< structure reads after coalescing per read asked for
     double m_step_scale = 1.0;  ///< the groups' plan steps per the rays' own
@@ -351,7 +356,13 @@ ClosedForm Estimator::form() {
         // (its SRAM's latency, for the warp's slowest) instead of the memory: the takes' time.
         const double buffer_steps = m_c.treelets.enabled ? g.buffer_steps * rays / g.rays : 0.0;
         const double fetches = (groups - buffer_steps) * group_fetch + buffer_steps * buffer_latency;
-        m_d.latency_sum = rays * ray_start + slots * (fetches + groups * group_ops);
+        m_group_fetch = group_fetch, m_group_ops = group_ops;
+        // The rays' residence is the lanes holding a ray: fewer than the slots where rays run out
+        // (a short trace's drain, a warp waiting for its longest ray).
+        const double held = g.occupied_lanes > 0 ? g.occupied_lanes / g.group_steps : slots;
+        m_d.latency_sum = rays * ray_start + held * (fetches + groups * group_ops);
+        m_d.group_rays = held;
+        m_longest_share = held > 0 ? std::min(1.0, active / held) : 1.0;
         // The groups circulate, one visit per group step, each with what its rays' steps ask.
         m_d.customers = double(m_c.traversal.contexts()) / slots;
         m_d.visits = groups;
@@ -359,7 +370,7 @@ ClosedForm Estimator::form() {
     // The longest ray: its planned steps at the mean cost of a step.
     const double per_step = steps > 0 ? (steps * fetch + op_latency) / steps : 0.0;
     const double longest = m_p.plan_steps_per[0] * m_p.longest_ray_steps + m_p.plan_steps_per[1] * m_p.longest_ray_tests;
-    m_d.latency_max = ray_start + longest * per_step / m_active;
+    m_d.latency_max = ray_start + longest * per_step / m_longest_share;
     phase_windows();
     ClosedForm f = closed_form(m_c, m_p.op_kinds, m_d, phase_shares(steps));
     if (!m_p.has_group && (!m_p.merge_l1.empty() || !m_p.merge_l2.empty())) {
@@ -387,7 +398,8 @@ ClosedForm Estimator::form() {
 void Estimator::phase_windows() {
     m_phases.clear();
     m_phase_fetch.clear();
-    if (m_p.has_group || m_p.phases.empty()) return;
+    if (m_p.has_group) return group_phase_windows();
+    if (m_p.phases.empty()) return;
     PhaseShare all;
     double fetch_sum = 0;
     for (const PhaseWindow& pw : m_p.phases) {
@@ -396,7 +408,7 @@ void Estimator::phase_windows() {
             const auto [m1, m12] = m_miss.cell(key);
             s.l1_misses += count * m1, s.l2_misses += count * m12, s.reads += count;
         }
-        s.steps = pw.steps;
+        s.steps = s.work = pw.steps;
         s.population = pw.rounds > 0 ? pw.steps / pw.rounds / m_c.traversal.units : 0.0;
         const double fetch = mean_latency(pw.critical);
         m_phase_fetch.push_back(fetch);
@@ -405,7 +417,7 @@ void Estimator::phase_windows() {
     }
     auto share = [](double part, double whole) { return whole > 0 ? part / whole : 0.0; };
     for (PhaseShare& s : m_phases) {
-        s.steps = share(s.steps, all.steps), s.reads = share(s.reads, all.reads);
+        s.steps = s.work = share(s.steps, all.steps), s.reads = share(s.reads, all.reads);
         s.l1_misses = share(s.l1_misses, all.l1_misses), s.l2_misses = share(s.l2_misses, all.l2_misses);
     }
     // The windows' latencies relative to the run's mean (their octave keys' bias cancels).
@@ -413,8 +425,40 @@ void Estimator::phase_windows() {
     for (double& f : m_phase_fetch) f = mean > 0 ? f / mean : 1.0;
 }
 
+// A lock-step kind's windows come from its functional group stepping (GroupWindow), which has no
+// reuse distances: its memory demands are spread by the window's active lanes (each lane's reads),
+// its visits by its group steps, its latency by its group steps at the window's own group-step
+// time (the slowest of its active lanes' lines), its population is the groups stepping per round
+// and unit. The fill's cache-warm
+// top of the tree is not in them; the drain (groups running out of rays, a warp held by its
+// longest ray) is. Whole-trace analyses only, without treelet queues.
+void Estimator::group_phase_windows() {
+    const std::vector<GroupWindow>& windows = m_p.group.phases;
+    if (!m_p.whole_trace || m_c.treelets.enabled || windows.empty()) return;
+    double steps = 0, lanes = 0;
+    for (const GroupWindow& w : windows) steps += w.group_steps, lanes += w.active_lanes;
+    if (steps <= 0 || lanes <= 0) return;
+    for (const GroupWindow& w : windows) {
+        PhaseShare& s = m_phases.emplace_back();
+        s.steps = w.group_steps / steps;
+        s.work = s.l1_misses = s.l2_misses = s.reads = w.active_lanes / lanes;
+        s.population = w.rounds > 0 ? w.group_steps / w.rounds / m_c.traversal.units : 0.0;
+        // A group step waits for the slowest of its active lanes' lines: fewer lanes, a
+        // shorter wait (the drain's warps step with a lane or two).
+        const double active = w.group_steps > 0 ? w.active_lanes / w.group_steps : 1.0;
+        const double fetch = max_latency(m_p.step_critical, std::max(1.0, active * m_coalesce), m_coalesce);
+        const double base = m_group_fetch + m_group_ops;
+        m_phase_fetch.push_back(base > 0 ? (fetch + m_group_ops) / base : 1.0);
+    }
+}
+
 const std::vector<PhaseShare>& Estimator::phase_shares(double steps) {
     if (m_phases.empty() || steps <= 0) return m_phases;
+    if (m_p.has_group) {
+        for (size_t w = 0; w < m_phases.size(); ++w)
+            m_phases[w].latency_sum = m_phases[w].steps * m_d.latency_sum * m_phase_fetch[w];
+        return m_phases;
+    }
     const double fetch = mean_latency(m_p.step_critical);
     const double other = std::max(0.0, (m_d.latency_sum - steps * fetch) / steps);  // per step: operations, ray starts
     for (size_t w = 0; w < m_phases.size(); ++w)

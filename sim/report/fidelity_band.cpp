@@ -55,8 +55,7 @@ json fidelity_band(const SimConfig& c, const json& stats) {
             const std::string why =
                 std::string(buf) + " rays per ray context (" + std::to_string(uint64_t(rays)) + " rays, " +
                 std::to_string(uint64_t(contexts)) + " contexts): the fill and the drain are much of the run; " +
-                (lock_step ? "a lock-step unit's analysis keeps no phases, and a warp lasts as long as its longest ray"
-                           : "the phases are priced, the spread of the last rays' latencies is not (it is fast)");
+                "the phases are priced, the spread of the last rays' latencies is not (it can be fast)";
             findings.push_back(finding("few_rays_per_context", why, "Where designs starve or fill slowly"));
         }
     }

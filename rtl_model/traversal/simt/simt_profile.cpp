@@ -60,10 +60,20 @@ public:
 
     GroupProfile run() {
         const size_t warps = m_last_class.size();
+        // The rounds' windows (GroupWindow): without treelet queues, whose warps re-form.
+        const bool phases = !m_setup.treelets;
+        double window_rounds = 1;
+        if (phases) m_p.phases.emplace_back();
         for (bool any = true; any;) {
             any = false;
+            const double steps = m_p.group_steps, lanes = m_p.active_lanes;
             for (size_t w = 0; w < warps; ++w) any = step(w) || any;
+            if (!any || !phases) continue;
+            m_p.phases.back().group_steps += m_p.group_steps - steps;
+            m_p.phases.back().active_lanes += m_p.active_lanes - lanes;
+            GroupWindow::end_round(m_p.phases, &window_rounds);
         }
+        if (!m_p.phases.empty() && m_p.phases.back().rounds == 0) m_p.phases.pop_back();
         m_p.lane_requests = double(m_coalescer.lane_requests());
         return m_p;
     }
@@ -88,7 +98,7 @@ private:
         if (taken) {  // a warp step of its own fetches the new rays' records (coalesced) or states
             m_p.group_steps += 1, m_p.scheduler_steps += 1;
             if (m_setup.treelets) m_p.buffer_steps += 1;
-            m_p.lane_slots += m_simt.lanes, m_p.active_lanes += taken;
+            m_p.lane_slots += m_simt.lanes, m_p.active_lanes += taken, m_p.occupied_lanes += occupied(w);
         }
         return taken > 0;
     }
@@ -132,8 +142,14 @@ private:
         m_p.requests += m_coalescer.issue([](uint64_t, uint32_t, DataKind) {});
         m_p.group_steps += 1, m_p.scheduler_steps += 2;  // the step and its operations
         if (cls < kOpKindCount) m_p.kind_steps[cls] += 1;
-        m_p.lane_slots += m_simt.lanes, m_p.active_lanes += active;
+        m_p.lane_slots += m_simt.lanes, m_p.active_lanes += active, m_p.occupied_lanes += occupied(w);
         return true;
+    }
+
+    uint32_t occupied(size_t w) {
+        uint32_t n = 0;
+        for (uint32_t i = 0; i < m_simt.lanes; ++i) n += lane(w, i).has_ray;
+        return n;
     }
 
     /// Idle lanes take the rays dispatch dealt the warp's unit, in order.

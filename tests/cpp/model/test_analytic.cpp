@@ -337,6 +337,21 @@ TEST(AnalyticLevel, SimtWarpsFormedFromTreeletQueuesWalkEveryRayOnce) {
     EXPECT_LE(tl.active_lanes, tl.lane_slots);
     // A profile round-trips through the analysis file.
     EXPECT_EQ(GroupProfile::from_json(tl.to_json()).to_json(), tl.to_json());
+    // Lanes holding a ray lie between the stepping ones and the slots. Without treelet queues
+    // the rounds are kept in windows holding every group step and active lane (with queues,
+    // whose warps re-form, none), the last window the drain: fewer groups step than at the start.
+    EXPECT_LE(alone.active_lanes, alone.occupied_lanes);
+    EXPECT_LE(alone.occupied_lanes, alone.lane_slots);
+    EXPECT_TRUE(tl.phases.empty());
+    ASSERT_FALSE(alone.phases.empty());
+    EXPECT_LE(alone.phases.size(), GroupWindow::kMaxWindows);
+    double steps = 0, lanes = 0;
+    for (const GroupWindow& gw : alone.phases) steps += gw.group_steps, lanes += gw.active_lanes;
+    EXPECT_EQ(steps, alone.group_steps);
+    EXPECT_EQ(lanes, alone.active_lanes);
+    const GroupWindow &first = alone.phases.front(), &last = alone.phases.back();
+    EXPECT_LT(last.group_steps / last.rounds, first.group_steps / first.rounds);
+    EXPECT_EQ(GroupProfile::from_json(alone.to_json()).to_json(), alone.to_json());
 }
 
 /// Demands of `misses` L2 misses of 64-byte lines (no writes) under the default DRAM config.
@@ -419,18 +434,23 @@ TEST(AnalyticClosedForm, PhasesAllAlikeGiveTheWholeRunAndADrainAddsItsLatency) {
     d.l1_hold = 4000 * 250.0;
     d.latency_sum = d.rays * 3000.0;
     const ClosedForm whole = closed_form(c, {OpKind(0)}, d);
+    auto window = [](double share, double latency_sum, double population) {
+        PhaseShare s;
+        s.steps = s.work = s.l1_misses = s.l2_misses = s.reads = share;
+        s.latency_sum = latency_sum, s.population = population;
+        return s;
+    };
     // Ten alike windows, each a tenth of everything at the full population: the whole run.
     std::vector<PhaseShare> alike(10);
-    for (PhaseShare& s : alike)
-        s = {0.1, 0.1, 0.1, 0.1, 0.1 * d.latency_sum, double(c.traversal.contexts())};
+    for (PhaseShare& s : alike) s = window(0.1, 0.1 * d.latency_sum, double(c.traversal.contexts()));
     const ClosedForm same = closed_form(c, {OpKind(0)}, d, alike);
     EXPECT_NEAR(same.cycles, whole.cycles, 1e-3 * whole.cycles);
     // The same with a last window of one ray alone, 1% of the steps at the same latency per
     // step: it lasts that ray's latency (no one to overlap with), on top.
     std::vector<PhaseShare> drain = alike;
-    for (PhaseShare& s : drain) s.steps = s.l1_misses = s.l2_misses = s.reads = 0.099, s.latency_sum *= 0.99;
+    for (PhaseShare& s : drain) s = window(0.099, 0.099 * d.latency_sum, double(c.traversal.contexts()));
     const double alone = 0.01 * d.latency_sum;  // one ray's worth of steps, summed
-    drain.push_back({0.01, 0.01, 0.01, 0.01, alone, 1.0 / c.traversal.units});
+    drain.push_back(window(0.01, alone, 1.0 / c.traversal.units));
     const ClosedForm drained = closed_form(c, {OpKind(0)}, d, drain);
     EXPECT_GT(drained.phase_factor, 1.0);
     // One context in the machine for 1% of the rays (10 rays, 30,000 cycles of latency).
