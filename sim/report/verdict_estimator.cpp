@@ -66,6 +66,11 @@ std::unique_ptr<AnalyticProfile> sample_analysis(const SimConfig& base, const Ac
             const std::unique_ptr<RayStream> stream = streams(first, rays, sample_rays);
             // A copy: analyze_stream keeps only a handful of analyses, and a verdict may make more.
             auto profile = std::make_unique<AnalyticProfile>(analyze_stream(base, accel, map, step, *stream, sink));
+            if (sample_rays < rays) {
+                // A sample of the trace: its fill and drain are the sample's, not the run's.
+                profile->phases.clear();
+                profile->group.phases.clear();
+            }
             if (!path.empty()) {
                 AnalyticProfile keyed = *profile;
                 keyed.key = key;
