@@ -107,6 +107,9 @@ const std::vector<TreeBuilder>& tree_builders() {
         // Full sweeping-plane SAH and equal-count (median) splits (sweep_builder.h): no bins.
         {"sweep", [](const Scene& sc, const BuildSettings& s, unsigned, nlohmann::json*) { return build_sweep_sah(sc.triangles, s.bvh); },
          [](BuildSettings&, SettingsVisitor&) {}, false},
+        // The full sweep with local ray termination in its split cost (sweep_builder.h).
+        {"lrt", [](const Scene& sc, const BuildSettings& s, unsigned, nlohmann::json*) { return build_sweep_termination(sc.triangles, s.bvh); },
+         [](BuildSettings&, SettingsVisitor&) {}, false},
         {"median", [](const Scene& sc, const BuildSettings& s, unsigned, nlohmann::json*) { return build_median(sc.triangles, s.bvh); },
          [](BuildSettings&, SettingsVisitor&) {}, false},
     };
@@ -232,7 +235,7 @@ const std::vector<Entry>& registry() {
          [](const Scene& scene, const AccelOptions&, const BuildSettings& s) { return kdtree_image(scene, s.kd); },
          loader<KdAccel>()},
         {{"bih", "bounding interval hierarchy, two clip planes per 12-byte node, no duplicates (Wachter & Keller 2006)",
-          {"binned", "wachter_keller", "lbvh", "sweep", "median"},
+          {"binned", "wachter_keller", "lbvh", "sweep", "lrt", "median"},
           single_level(kBihStackEntryBytes)
               .with(&AccelCapabilities::packet_kernel)
               .with(&AccelCapabilities::restart_trail)

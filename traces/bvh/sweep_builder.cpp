@@ -1,10 +1,12 @@
-// The full-sweep SAH and equal-count builders (sweep_builder.h).
+// The full-sweep SAH, local-ray-termination and equal-count builders (sweep_builder.h).
 #include "traces/bvh/sweep_builder.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
+
+#include <glm/glm.hpp>
 
 #include "traces/common/error.h"
 
@@ -18,12 +20,16 @@ struct Item {
     uint32_t node, begin, end, depth;
 };
 
+enum class Cost { median, sah, termination };
+
 class ObjectBuilder {
 public:
-    ObjectBuilder(const std::vector<Triangle>& tris, const BuildConfig& c, bool sah) : m_c(c), m_sah(sah) {
+    ObjectBuilder(const std::vector<Triangle>& tris, const BuildConfig& c, Cost cost)
+        : m_c(c), m_sah(cost != Cost::median), m_termination(cost == Cost::termination) {
         const size_t n = tris.size();
         m_box.resize(n);
         m_c2.resize(n);
+        m_area.resize(n);
         for (size_t i = 0; i < n; ++i) {
             for (const Vec3& v : {tris[i].v0, tris[i].v1, tris[i].v2}) {
                 require(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z),
@@ -31,6 +37,7 @@ public:
                 m_box[i].grow(v);
             }
             m_c2[i] = m_box[i].lo + m_box[i].hi;
+            m_area[i] = 0.5f * glm::length(glm::cross(tris[i].v1 - tris[i].v0, tris[i].v2 - tris[i].v0));
         }
     }
 
@@ -69,27 +76,60 @@ private:
     /// The best object partition by the SAH over every boundary of every axis: the references
     /// sorted by centroid, right boxes accumulated from the end, left boxes from the front.
     /// Returns the cost (sum of half area x references) and leaves the winning order in place.
-    float sweep(const Item& item, int* best_axis, uint32_t* best_left) {
+    /// With local ray termination the cost of a split is lowered by what the rays that enter
+    /// both children save when they stop in the one they visit first (termination_saving).
+    float sweep(const Item& item, float parent_area, int* best_axis, uint32_t* best_left) {
         const uint32_t n = item.end - item.begin;
         float best = std::numeric_limits<float>::infinity();
         m_right.resize(n);
+        m_right_tris.resize(n);
+        m_right_lo.resize(n);
         for (int a = 0; a < 3; ++a) {
             std::vector<uint32_t>& ids = m_sorted[a];
             ids.assign(m_tree.prim_ids.begin() + item.begin, m_tree.prim_ids.begin() + item.end);
             std::sort(ids.begin(), ids.end(), by_centroid(a));
             Aabb acc;
+            float tris = 0;
             for (uint32_t k = n; k-- > 1;) {
                 acc.grow(m_box[ids[k]]);
+                tris += m_area[ids[k]];
                 m_right[k] = acc.half_area();
+                m_right_tris[k] = tris;
+                m_right_lo[k] = acc.lo[a];
             }
             acc = Aabb{};
+            tris = 0;
             for (uint32_t k = 1; k < n; ++k) {
                 acc.grow(m_box[ids[k - 1]]);
-                const float cost = acc.half_area() * float(k) + m_right[k] * float(n - k);
+                tris += m_area[ids[k - 1]];
+                const float left = acc.half_area();
+                float cost = left * float(k) + m_right[k] * float(n - k);
+                // Only children apart along the axis: a ray through both then leaves the first
+                    // before it enters the second, so a hit in the first culls the second (with
+                    // overlapping boxes the second's entry may come before the hit).
+                if (m_termination && acc.hi[a] <= m_right_lo[k])
+                    cost -= termination_saving(parent_area, left, tris, float(k), m_right[k], m_right_tris[k], float(n - k));
                 if (cost < best) best = cost, *best_axis = a, *best_left = k;
             }
         }
         return best;
+    }
+
+    /// Local ray termination (after Moulin & Dutre's use of it in SAH-style builds): a ray that
+    /// enters both children visits one first and, if it hits a triangle there, need not visit
+    /// the other. Of the rays through the parent (half area A), at least (A_l + A_r - A) / A enter
+    /// both (exact for adjacent boxes: they cross the shared face); each child is first half of
+    /// the time; a ray through a box of half area h hits a flat triangle of area t inside it with
+    /// probability t / h (Cauchy: a convex body's surface over the box's; a triangle has two
+    /// sides), so a child stops it with probability alpha = min(1, sum of t / h). The saving is
+    /// those rays' share of the other child's tests, in the sweep's units (half area x references).
+    static float termination_saving(float parent, float left, float left_tris, float nl, float right,
+                                    float right_tris, float nr) {
+        const float both = std::max(0.0f, left + right - parent);
+        if (both <= 0.0f) return 0.0f;
+        const float alpha_l = left > 0.0f ? std::min(1.0f, left_tris / left) : 0.0f;
+        const float alpha_r = right > 0.0f ? std::min(1.0f, right_tris / right) : 0.0f;
+        return 0.5f * both * (alpha_l * nr + alpha_r * nl);
     }
 
     /// The centroid median on the widest centroid axis.
@@ -112,8 +152,8 @@ private:
         if (m_sah && item.depth + 8 < m_c.max_depth) {
             int axis = -1;
             uint32_t left = 0;
-            const float cost = sweep(item, &axis, &left);
             const float area = node.box.half_area();
+            const float cost = sweep(item, area, &axis, &left);
             const float split_cost = area > 0.0f ? m_c.traversal_cost + m_c.intersection_cost * cost / area
                                                  : std::numeric_limits<float>::infinity();
             if (n <= m_c.max_leaf_size && !(split_cost < m_c.intersection_cost * float(n))) return make_leaf();
@@ -138,12 +178,13 @@ private:
     }
 
     BuildConfig m_c;
-    bool m_sah;
+    bool m_sah, m_termination;
     std::vector<Aabb> m_box;
     std::vector<Vec3> m_c2;  ///< twice the box centres
+    std::vector<float> m_area;  ///< each triangle's area
     BuildTree m_tree;
     std::vector<uint32_t> m_sorted[3];
-    std::vector<float> m_right;
+    std::vector<float> m_right, m_right_tris, m_right_lo;  ///< per boundary: the right side's box half area, triangle area, low bound on the axis
 };
 
 void validate(const std::vector<Triangle>& triangles, const BuildConfig& c) {
@@ -163,12 +204,17 @@ void validate(const std::vector<Triangle>& triangles, const BuildConfig& c) {
 
 BuildTree build_sweep_sah(const std::vector<Triangle>& triangles, const BuildConfig& config) {
     sweep_detail::validate(triangles, config);
-    return sweep_detail::ObjectBuilder(triangles, config, true).build();
+    return sweep_detail::ObjectBuilder(triangles, config, sweep_detail::Cost::sah).build();
+}
+
+BuildTree build_sweep_termination(const std::vector<Triangle>& triangles, const BuildConfig& config) {
+    sweep_detail::validate(triangles, config);
+    return sweep_detail::ObjectBuilder(triangles, config, sweep_detail::Cost::termination).build();
 }
 
 BuildTree build_median(const std::vector<Triangle>& triangles, const BuildConfig& config) {
     sweep_detail::validate(triangles, config);
-    return sweep_detail::ObjectBuilder(triangles, config, false).build();
+    return sweep_detail::ObjectBuilder(triangles, config, sweep_detail::Cost::median).build();
 }
 
 }  // namespace rtsim

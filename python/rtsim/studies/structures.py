@@ -1,7 +1,8 @@
 """More structures against the BVH's builders (docs/accel.md, the `structures-study` section):
-the binary BVH from its sweep, median and SBVH builders, the GK-BVH (Popov et al. 2009) with
-its boxes-only variant, BIH and the B-Kd tree, on primary and shadow rays (a sun added to the
-scenes without lights), by the method of the `partition` study (its tables, no mailbox runs)."""
+the binary BVH from its sweep, local-ray-termination (lrt), median and SBVH builders, the GK-BVH
+(Popov et al. 2009) with its boxes-only variant, BIH and the B-Kd tree, on primary and shadow
+rays (a sun added to the scenes without lights), by the method of the `partition` study (its
+tables, no mailbox runs)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from rtsim.studies import partition
 from rtsim.study import Study, Table
 
 #: The documented run's structures.
-ACCELS = ["bvh2", "bvh2:sweep", "bvh2:median", "bvh2:sbvh", "gkbvh", "gkbvh:boxes", "bih", "bkd"]
+ACCELS = ["bvh2", "bvh2:sweep", "bvh2:lrt", "bvh2:median", "bvh2:sbvh", "gkbvh", "gkbvh:boxes", "bih", "bkd"]
 
 STUDY = Study(
     name="structures",

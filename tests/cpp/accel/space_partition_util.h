@@ -18,7 +18,8 @@ inline const std::vector<std::string>& partition_kinds() {
     static const std::vector<std::string> kinds = {"kdtree",      "bih",          "bih:wachter_keller", "bih:lbvh",
                                                    "octree",      "bvh2:lbvh",    "bvh2:sweep",         "bvh2:median",
                                                    "bkd",         "bkd:sweep",    "bkd:median",         "gkbvh",
-                                                   "gkbvh:boxes", "bih:sweep",    "obvh2",              "obvh2:sbvh"};
+                                                   "gkbvh:boxes", "bih:sweep",    "obvh2",              "obvh2:sbvh",
+                                                   "bvh2:lrt"};
     return kinds;
 }
 

@@ -25,7 +25,33 @@ TEST(ObjectBuilders, TreesKeepTheBvhInvariants) {
         const Scene scene = test::random_soup(seed, 1500);
         EXPECT_NO_THROW(check_bvh_invariants(flatten_bvh(build_sweep_sah(scene.triangles, c), scene, c), scene));
         EXPECT_NO_THROW(check_bvh_invariants(flatten_bvh(build_median(scene.triangles, c), scene, c), scene));
+        EXPECT_NO_THROW(check_bvh_invariants(flatten_bvh(build_sweep_termination(scene.triangles, c), scene, c), scene));
     }
+}
+
+TEST(ObjectBuilders, LocalRayTerminationPricesOccludersIntoItsSplits) {
+    // A wall of large triangles beside a cloud of small ones: rays entering both stop at the
+    // wall, which the termination-aware cost prices, so its tree differs from the sweep's (the
+    // hits are the same: test_space_partition.cpp's kinds include bvh2:lrt).
+    std::vector<Vec3> soup;
+    for (int i = 0; i < 8; ++i) {  // the wall at x = 0: 8 big quads' halves
+        const float y = float(i) - 4.0f;
+        soup.insert(soup.end(), {Vec3(0, y, -4), Vec3(0, y + 1, -4), Vec3(0, y, 4)});
+    }
+    Rng rng(3);
+    for (int i = 0; i < 600; ++i) {  // the cloud behind it
+        const Vec3 c = test::random_point(rng, Vec3(0.5f, -4.0f, -4.0f), Vec3(8.0f, 4.0f, 4.0f));
+        soup.insert(soup.end(), {c, c + Vec3(0.05f, 0, 0), c + Vec3(0, 0.05f, 0)});
+    }
+    const Scene scene = test::make_scene(soup);
+    const auto sweep = build_named(scene, "bvh2:sweep"), lrt = build_named(scene, "bvh2:lrt");
+    EXPECT_NE(sah_of(*lrt), sah_of(*sweep));
+    EXPECT_NO_THROW(check_bvh_invariants(flatten_bvh(build_sweep_termination(scene.triangles, BuildConfig{}), scene,
+                                                     BuildConfig{}),
+                                         scene));
+    const BuildTree a = build_sweep_sah(scene.triangles, BuildConfig{});
+    const BuildTree b = build_sweep_termination(scene.triangles, BuildConfig{});
+    EXPECT_NE(a.prim_ids, b.prim_ids);
 }
 
 TEST(ObjectBuilders, SweepPricesAtLeastAsWellAsBinsAndMedianIsBalanced) {
