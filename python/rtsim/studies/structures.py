@@ -10,7 +10,9 @@ from rtsim.studies import partition
 from rtsim.study import Study, Table
 
 #: The documented run's structures.
-ACCELS = ["bvh2", "bvh2:sweep", "bvh2:lrt", "bvh2:median", "bvh2:sbvh", "gkbvh", "gkbvh:boxes", "bih", "bkd"]
+ACCELS = [
+    "bvh2", "bvh2:sweep", "bvh2:lrt", "bvh2:median", "bvh2:sbvh", "gkbvh", "gkbvh:boxes", "bih", "bkd",
+]  # fmt: skip
 
 STUDY = Study(
     name="structures",
