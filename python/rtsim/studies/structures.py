@@ -11,7 +11,8 @@ from rtsim.study import Study, Table
 
 #: The documented run's structures.
 ACCELS = [
-    "bvh2", "bvh2:sweep", "bvh2:lrt", "bvh2:median", "bvh2:sbvh", "gkbvh", "gkbvh:boxes", "bih", "bkd",
+    "bvh2", "bvh2:sweep", "bvh2:lrt", "bvh2:median", "bvh2:sbvh",
+    "gkbvh", "gkbvh:boxes", "bih", "bkd",
 ]  # fmt: skip
 
 STUDY = Study(
