@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rtl_model/isect/pipeline.h"
+#include "traces/common/error.h"
 #include "rtl_model/top/model_stats.h"
 
 namespace rtsim {
@@ -172,6 +173,10 @@ ClosedForm closed_form(const SimConfig& c, const std::vector<OpKind>& ops, const
     ClosedForm f;
     const AnalyticDemands held = with_waits_below_l1(c, ops, d);
     f.bounds = bounds_of(c, ops, held);
+    // A bound that is not a number would drop out of the roofline unseen (and write null).
+    for (auto& [name, value] : f.bounds.items())
+        require(value.is_number() && std::isfinite(value.get<double>()),
+                "analytic: the closed form's '" + name + "' bound is not a finite number (a bug in its demands)");
     f.binding = "latency";
     for (auto& [name, value] : f.bounds.items())
         if (value.get<double>() > f.roofline) {

@@ -166,12 +166,14 @@ private:
         if (total <= 0) return m_lat_l1;
         at[2] = std::min(total, at[2] / coalesce);
         at[1] = std::min(total - at[2], at[1] / coalesce);
-        at[0] = total - at[1] - at[2];
+        // (Rounding can leave the L1's share a hair below 0, and a negative base to a fractional
+        // power is NaN: a packet of 16 over a BIH had NaN cycles from it.)
+        at[0] = std::max(0.0, total - at[1] - at[2]);
         const double lat[3] = {m_lat_l1, m_lat_l2, m_lat_dram};
         double below = 0, e = 0;
         for (int i = 0; i < 3; ++i) {
-            const double upto = below + at[i] / total;
-            e += lat[i] * (std::pow(std::min(upto, 1.0), n) - std::pow(below, n));
+            const double upto = std::min(1.0, below + at[i] / total);
+            e += lat[i] * (std::pow(upto, n) - std::pow(below, n));
             below = upto;
         }
         return e;

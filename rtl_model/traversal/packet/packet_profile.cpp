@@ -36,8 +36,8 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
         p.lane_slots += steps * pc.lanes;
         p.active_lanes += double(counts.active_rays);
         p.requests += steps;  // one fetch serves the packet's active rays
-        p.kind_steps[size_t(OpKind::box)] += double(counts.node_steps);
         double tri_tests = 0, sphere_tests = 0, capsule_tests = 0;
+        double node_tests[3] = {0, 0, 0};  // box tests, plane tests, cell steps: what a node step runs
         for (size_t i = 0; i < n; ++i) {
             WorkCounts alone;
             accel.trace(group[i], modes[i], &alone, step);
@@ -48,7 +48,17 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
             p.lane_requests += plan_step_work(alone);
             tri_tests += work[i].tri_tests, sphere_tests += work[i].sphere_tests;
             capsule_tests += work[i].capsule_tests;
+            node_tests[0] += work[i].box_tests, node_tests[1] += work[i].plane_tests, node_tests[2] += work[i].cell_steps;
         }
+        // Node steps by the operation kind they run: a BVH's box tests, a kd-tree's or BIH's plane
+        // tests, a grid's cell steps (a structure's few others, such as a kd-tree's one clip
+        // against the scene box, shared in proportion). Counted all as box steps, a kd-tree
+        // packet's steps were priced at the box pipeline's latency (analytic 10-28% slow).
+        const double node_all = node_tests[0] + node_tests[1] + node_tests[2];
+        const OpKind node_kinds[3] = {OpKind::box, OpKind::plane, OpKind::cell};
+        for (int k = 0; k < 3; ++k)
+            p.kind_steps[size_t(node_kinds[k])] +=
+                node_all > 0 ? double(counts.node_steps) * node_tests[k] / node_all : (k == 0 ? double(counts.node_steps) : 0.0);
         // Leaf steps by the kind of their tests: shared out by the packet's triangle, sphere and
         // capsule tests (a leaf of several kinds runs each; counted here as one, in proportion).
         const double tests = tri_tests + sphere_tests + capsule_tests;
