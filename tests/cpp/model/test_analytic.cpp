@@ -11,6 +11,7 @@
 
 #include "../bvh/bvh_test_scenes.h"
 #include "rtl_model/mem/functional_cache.h"
+#include "rtl_model/traversal/packet/packet_profile.h"
 #include "rtl_model/traversal/simt/simt_profile.h"
 #include "sim/analytic/analytic.h"
 #include "sim/analytic/analysis_cache.h"
@@ -352,6 +353,28 @@ TEST(AnalyticLevel, SimtWarpsFormedFromTreeletQueuesWalkEveryRayOnce) {
     const GroupWindow &first = alone.phases.front(), &last = alone.phases.back();
     EXPECT_LT(last.group_steps / last.rounds, first.group_steps / first.rounds);
     EXPECT_EQ(GroupProfile::from_json(alone.to_json()).to_json(), alone.to_json());
+}
+
+TEST(AnalyticLevel, PacketStepsAreCountedByTheOperationKindTheyRun) {
+    // A kd-tree packet's node steps test split planes, a grid's step cells, a BVH's test boxes:
+    // the group profile counts them so, and the estimate prices each at its pipeline.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    config_set(c, "traversal.model=packet");
+    const Scene scene = test::make_scene(test::random_triangles(3000, 5, 1.0f, 0.05f));
+    std::vector<std::vector<RayJob>> by_unit(c.traversal.units);
+    for (size_t i = 0; i < 2000; ++i) by_unit[i % c.traversal.units].push_back(w.jobs[i]);
+    for (const auto& [kind, node] : std::vector<std::pair<std::string, OpKind>>{
+             {"bvh2", OpKind::box}, {"kdtree", OpKind::plane}, {"grid", OpKind::cell}}) {
+        AccelOptions o;
+        o.kind = kind;
+        const auto accel = load_accel(build_accel(scene, o));
+        const GroupProfile g = packet_group_profile(*accel, StepOptions{}, c.traversal, by_unit, GroupSetup{});
+        double nodes = 0;
+        for (OpKind k : {OpKind::box, OpKind::plane, OpKind::cell}) nodes += g.kind_steps[size_t(k)];
+        EXPECT_GT(g.kind_steps[size_t(node)], 0.9 * nodes) << kind;
+        EXPECT_NEAR(nodes + g.kind_steps[size_t(OpKind::triangle)], g.group_steps, 1e-6 * g.group_steps) << kind;
+    }
 }
 
 /// Demands of `misses` L2 misses of 64-byte lines (no writes) under the default DRAM config.
