@@ -200,6 +200,9 @@ def test_an_analytic_run_says_when_its_design_is_outside_the_levels_band(
     assert not inside["fidelity_band"]["outside"] and inside["summary"]["fidelity_warnings"] == []
     treelets = sim_stats(sim_exe, trace_of(), tmp_path / "treelets", *few, "treelets.enabled=true")
     assert [f["kind"] for f in treelets["fidelity_band"]["findings"]] == ["treelets_on_contexts"]
+    # The grid's walks and packets on it are a kind of their own.
+    grid = sim_stats(sim_exe, trace_of("grid"), tmp_path / "grid", *few)
+    assert [f["kind"] for f in grid["fidelity_band"]["findings"]] == ["cell_structure"]
     # approx was within its band on every kind measured: no finding.
     timed = sim_stats(sim_exe, trace_of(), tmp_path / "approx", "fidelity=approx")
     assert timed["fidelity_band"] == {"level": "approx", "outside": False, "findings": []}
