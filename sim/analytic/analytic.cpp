@@ -286,6 +286,7 @@ AnalyticProfile analyze_trace(const SimConfig& config, const Accel& accel, const
             const auto f = std::upper_bound(frames.begin(), frames.end(), c.first,
                                             [](uint64_t id, const FrameRecord& r) { return id < r.first_ray; });
             bind_frame(uint32_t(f - frames.begin() - 1));
+            profiler.begin_frame_sample(uint32_t(f - frames.begin() - 1));
         }
         std::vector<RayJob> jobs;
         read_ray_jobs(reader, c.first, size_t(c.warmup + c.measured), &buffer, &jobs);

@@ -588,6 +588,48 @@ PredictedRates predicted_rates(const SimConfig& config, const AnalyticProfile& p
     return Estimator(config, profile, misses).rates();
 }
 
+std::vector<PredictedRates> frame_hit_rates(const SimConfig& config, const AnalyticProfile& profile, size_t frames) {
+    std::vector<PredictedRates> out;
+    const std::vector<FrameSample>& samples = profile.frame_samples;
+    if (samples.empty() || frames == 0) return out;
+    MissModel misses(profile);
+    const MissTables tables(config, misses);
+    const PredictedRates run = Estimator(config, profile, misses).rates();
+    // Each sample's miss ratios (L1 over reads, L2 over L1 misses), and their means.
+    std::vector<std::pair<double, double>> miss;
+    double mean1 = 0, mean2 = 0;
+    for (const FrameSample& f : samples) {
+        double reads = 0, m1 = 0, m12 = 0;
+        for (const auto& [key, count] : f.reads.cells) {
+            const auto [p1, p12] = tables.cell(key);
+            reads += count, m1 += count * p1, m12 += count * p12;
+        }
+        miss.push_back({reads > 0 ? m1 / reads : 0.0, m1 > 0 ? m12 / m1 : 0.0});
+        mean1 += miss.back().first / double(samples.size()), mean2 += miss.back().second / double(samples.size());
+    }
+    auto rates = [&](double r1, double r2) {
+        PredictedRates r;
+        const double l1 = mean1 > 0 ? (1.0 - run.l1_read_hit_rate) * r1 / mean1 : 1.0 - run.l1_read_hit_rate;
+        const double l2 = mean2 > 0 ? (1.0 - run.l2_read_hit_rate) * r2 / mean2 : 1.0 - run.l2_read_hit_rate;
+        r.l1_read_hit_rate = std::clamp(1.0 - l1, 0.0, 1.0);
+        r.l2_read_hit_rate = std::clamp(1.0 - l2, 0.0, 1.0);
+        return r;
+    };
+    for (size_t f = 0; f < frames; ++f) {
+        size_t k = 0;
+        while (k + 1 < samples.size() && samples[k + 1].frame <= f) ++k;
+        if (f <= samples.front().frame || k + 1 == samples.size()) {
+            const size_t near = f <= samples.front().frame ? 0 : k;
+            out.push_back(rates(miss[near].first, miss[near].second));
+            continue;
+        }
+        const double a = double(f - samples[k].frame) / double(samples[k + 1].frame - samples[k].frame);
+        out.push_back(rates(miss[k].first + a * (miss[k + 1].first - miss[k].first),
+                            miss[k].second + a * (miss[k + 1].second - miss[k].second)));
+    }
+    return out;
+}
+
 FormEstimator::FormEstimator(const AnalyticProfile& profile)
     : m_profile(profile), m_misses(std::make_unique<MissModel>(profile)) {}
 

@@ -52,4 +52,10 @@ struct PredictedRates {
 };
 PredictedRates predicted_rates(const SimConfig& config, const AnalyticProfile& profile);
 
+/// An animated trace's hit rates frame by frame: each analysed frame's from its own reads (its
+/// miss ratios scaled so that their mean over the analysed frames is the run's: the frames' keys
+/// are octaves), the frames between two analysed ones interpolated, those before the first and
+/// after the last the nearest's. Empty without frame samples.
+std::vector<PredictedRates> frame_hit_rates(const SimConfig& config, const AnalyticProfile& profile, size_t frames);
+
 }  // namespace rtsim

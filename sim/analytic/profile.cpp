@@ -127,6 +127,11 @@ json AnalyticProfile::to_json() const {
             {"stepped_rays", stepped_rays},
             {"analysis_seconds", analysis_seconds},
             {"phases", phases_json(phases)},
+            {"frame_samples", [&] {
+                 json a = json::array();
+                 for (const FrameSample& f : frame_samples) a.push_back({{"frame", f.frame}, {"reads", hist_json(f.reads)}});
+                 return a;
+             }()},
             {"group", has_group ? group.to_json() : json(nullptr)},
             {"treelets", {{"takes", treelet_takes}, {"parks", treelet_parks}, {"overflows", treelet_overflows}}}};
 }
@@ -171,6 +176,8 @@ AnalyticProfile AnalyticProfile::from_json(const json& j) {
     p.stepped_rays = j.at("stepped_rays");
     p.analysis_seconds = j.at("analysis_seconds");
     p.phases = phases_from(j.at("phases"));
+    for (const json& f : j.at("frame_samples"))
+        p.frame_samples.push_back({f.at("frame").get<uint32_t>(), hist_from(f.at("reads"))});
     if (j.contains("treelets")) {
         const json& t = j.at("treelets");
         p.treelet_takes = t.at("takes"), p.treelet_parks = t.at("parks"), p.treelet_overflows = t.at("overflows");

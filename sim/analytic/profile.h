@@ -77,6 +77,13 @@ struct PhaseWindow {
     JointHistogram critical;  ///< each step's slowest line
 };
 
+/// One analysed frame of an animated trace (the cluster placed in it): the frame and its line
+/// reads (every data kind, keys to octaves as PhaseWindow's), whose hit rates are the frame's.
+struct FrameSample {
+    uint32_t frame = 0;
+    JointHistogram reads;
+};
+
 struct AnalyticProfile {
     nlohmann::json key;  ///< what the analysis depends on (analysis_cache.h)
     std::string accel_kind;        ///< the structure's kind (for the stats' why texts)
@@ -119,6 +126,8 @@ struct AnalyticProfile {
     // treelet scheduling): the rounds in windows of equal length, at most kMaxPhaseWindows.
     static constexpr size_t kMaxPhaseWindows = 32;
     std::vector<PhaseWindow> phases;
+    /// Animated traces: each analysed frame's reads, in frame order (none for one frame).
+    std::vector<FrameSample> frame_samples;
 
     // Lock-step unit kinds (SIMT warps, packets): the sample's rays stepped in the kind's groups,
     // functionally (UnitKind::group_profile): SIMD efficiency, coalescing, the groups' work.

@@ -327,6 +327,7 @@ SampleProfiler::Access SampleProfiler::read_line(uint32_t unit, uint64_t line, D
     (gc ? m_p.global_censored : m_p.global_events)[gb] += 1;
     m_reads[size_t(kind)].add(key);
     if (m_record_phases) m_phases.back().reads.add(MergeKey::octaves(key));
+    if (!m_frame_reads.empty()) m_frame_reads.back().second.add(MergeKey::octaves(key));
     a.key = key;
     a.rank = (uint64_t(gc) << 63) | (uint64_t(uc) << 62) | (uint64_t(gb) << 8) | uint64_t(ub);
     // The L1's merge asks of the read only whether it hits the L1 (its unit-stream bin).
@@ -357,7 +358,15 @@ void SampleProfiler::stack_traffic(uint32_t unit, uint32_t slot, const StepDeman
     });
 }
 
+void SampleProfiler::begin_frame_sample(uint32_t frame) { m_frame_reads.emplace_back(frame, KeyCounts{}); }
+
 void SampleProfiler::finish() {
+    m_p.frame_samples.clear();
+    for (auto& [frame, counts] : m_frame_reads) {
+        FrameSample& f = m_p.frame_samples.emplace_back();
+        f.frame = frame;
+        counts.drain([&](uint32_t key, uint64_t n) { f.reads.add(key, double(n)); });
+    }
     for (size_t k = 0; k < m_reads.size(); ++k)
         m_reads[k].drain([&](uint32_t key, uint64_t n) { m_p.reads[k].add(key, double(n)); });
     for (size_t k = 0; k < m_op_sizes.size(); ++k)

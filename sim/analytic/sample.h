@@ -41,6 +41,9 @@ public:
     /// Steps every ray of `stream` (one cluster, fresh history); rays with trace index in
     /// [measure_first, measure_end) are measured. Every stepped ray goes to `sink` (the checker).
     void run_cluster(RayStream& stream, uint64_t measure_first, uint64_t measure_end, RaySinkIf& sink);
+    /// Animated traces: the measured reads of the clusters run from now on are frame `frame`'s
+    /// (profile.h, FrameSample).
+    void begin_frame_sample(uint32_t frame);
     /// Fits steps per unit of work; call once after the clusters.
     void finish();
 
@@ -107,6 +110,7 @@ private:
     std::vector<PhaseCounts> m_phases;
     double m_window_rounds = 1;  ///< rounds per window
     bool m_record_phases = false;
+    std::vector<std::pair<uint32_t, KeyCounts>> m_frame_reads;  ///< begin_frame_sample's, in order
     uint32_t m_clusters_run = 0;
     // Treelet scheduling only (treelets.enabled).
     std::unique_ptr<LocalityPartition> m_partition;

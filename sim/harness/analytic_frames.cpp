@@ -54,11 +54,11 @@ private:
     std::deque<uint64_t> m_order;
 };
 
-/// Counters whose hit rate is `rate` over `reads` reads (null rate: none).
-MemCounters counters(double reads, const json& rate) {
+/// Counters of `reads` reads with `hits` hits (no rate known: none).
+MemCounters counters(double reads, double hits, bool known) {
     MemCounters m;
     m.reads = uint64_t(std::llround(reads));
-    if (rate.is_number()) m.read_hits = uint64_t(std::llround(reads * rate.get<double>()));
+    if (known) m.read_hits = uint64_t(std::llround(hits));
     return m;
 }
 
@@ -82,7 +82,7 @@ std::vector<double> frame_step_work(TraceReader& reader, const std::vector<Frame
 AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameRecord>& frames,
                                const std::vector<double>& step_work, const json& manifest_frames,
                                const std::vector<std::vector<BuildJob>>& jobs, double traversal_cycles,
-                               double mean_latency, const json& summary) {
+                               double mean_latency, const json& summary, const std::vector<PredictedRates>& rates) {
     AnalyticFrames out;
     FrameRecorder recorder(config, frames, manifest_frames);
     ClosedFormMemory memory(config);
@@ -96,6 +96,12 @@ AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameR
     // of lost overlap (the closed form's steady state has the first frame's fill in it already).
     const double refill = std::min(mean_latency, traversal_cycles);
     double t = 0, done_work = 0, build_bytes = 0;
+    // Running read counters (any scale: only the rates are read back), each frame's reads at its
+    // own hit rates where the analysis has them, else the run's. The L2's reads are the L1's
+    // misses.
+    const json run1 = summary.value("l1_hit_rate", json(nullptr)), run2 = summary.value("l2_hit_rate", json(nullptr));
+    const bool known1 = run1.is_number(), known2 = run2.is_number();
+    double l1_reads = 0, l1_hits = 0, l2_reads = 0, l2_hits = 0;
     for (uint32_t f = 0; f < frames.size(); ++f) {
         if (f > 0 && unit && f < jobs.size() && !jobs[f].empty()) {
             const FrameBuild b = unit->run(jobs[f], Cycle(std::ceil(t)));
@@ -105,11 +111,16 @@ AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameR
         }
         t += per_work * step_work[f] + (f > 0 ? refill : 0.0);
         done_work += step_work[f];
-        // The frame's memory figures: the closed form's shared out by work (hit rates the run's).
+        // The frame's memory figures: the closed form's shared out by work.
+        const bool own = rates.size() == frames.size();
+        const double h1 = own ? rates[f].l1_read_hit_rate : known1 ? run1.get<double>() : 0.0;
+        const double h2 = own ? rates[f].l2_read_hit_rate : known2 ? run2.get<double>() : 0.0;
+        const double reads = step_work[f] * 1024;
+        l1_reads += reads, l1_hits += reads * h1;
+        l2_reads += reads * (1.0 - h1), l2_hits += reads * (1.0 - h1) * h2;
         MemoryTotals totals;
-        const double reads = done_work * 16;  // any scale: only the rates are read back
-        totals.l1 = counters(reads, summary.value("l1_hit_rate", json(nullptr)));
-        totals.l2 = counters(reads, summary.value("l2_hit_rate", json(nullptr)));
+        totals.l1 = counters(l1_reads, l1_hits, known1);
+        totals.l2 = counters(l2_reads, l2_hits, known2);
         totals.dram.read_bytes = uint64_t(std::llround(dram_per_work * done_work + build_bytes));
         recorder.frame_end(f, Cycle(std::ceil(t)), totals);
     }

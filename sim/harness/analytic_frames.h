@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rtl_model/build_unit/build_unit.h"
+#include "sim/analytic/estimate.h"
 #include "sim/config/config.h"
 #include "traces/format/trace_format.h"
 #include "traces/format/trace_reader.h"
@@ -29,11 +30,12 @@ std::vector<double> frame_step_work(TraceReader& reader, const std::vector<Frame
 
 /// `traversal_cycles`: the closed form's time for all the rays without barriers, shared out by
 /// `step_work`; `mean_latency`: a ray's latency in it (the refill a barrier costs); `summary`:
-/// its dram_bytes, l1_hit_rate and l2_hit_rate (shared out likewise); `jobs`: each frame's builds
-/// (frame_builds.h).
+/// its dram_bytes (shared out likewise), l1_hit_rate and l2_hit_rate (each frame's where `rates`
+/// has one per frame: estimate.h's frame_hit_rates); `jobs`: each frame's builds (frame_builds.h).
 AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameRecord>& frames,
                                const std::vector<double>& step_work, const nlohmann::json& manifest_frames,
                                const std::vector<std::vector<BuildJob>>& jobs, double traversal_cycles,
-                               double mean_latency, const nlohmann::json& summary);
+                               double mean_latency, const nlohmann::json& summary,
+                               const std::vector<PredictedRates>& rates = {});
 
 }  // namespace rtsim

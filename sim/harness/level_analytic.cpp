@@ -149,7 +149,7 @@ LevelResult run_statistical(RunInputs& in) {
         const AnalyticFrames af = estimate_frames(c, frames, frame_step_work(in.reader, frames),
                                                   in.manifest.value("frames", json(nullptr)),
                                                   frame_build_jobs(*animated), e.form.cycles, e.mean_latency,
-                                                  r.summary);
+                                                  r.summary, frame_hit_rates(c, *p, frames.size()));
         r.cycles = af.cycles;
         r.frames = af.frames;
         r.frame_count = frames.size();

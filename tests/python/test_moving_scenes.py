@@ -130,6 +130,12 @@ def test_analytic_level_prices_frames_and_builds(sim_exe: Path, tmp_path: Path) 
         assert frames[0]["build_cycles"] == 0 and all(f["build_cycles"] > 0 for f in frames[1:])
         for a, d in zip(frames[1:], detailed["frames"][1:], strict=True):
             assert a["build_cycles"] == pytest.approx(d["build_cycles"], rel=0.02), policy
+        # Each frame's own L1 hit rate (its analysed rays' reads): the scattering triangles lose
+        # locality frame by frame, as the detailed level's do.
+        rates = [f["l1_hit_rate"] for f in frames]
+        assert rates[-1] < rates[0], policy
+        for a, d in zip(frames, detailed["frames"], strict=True):
+            assert a["l1_hit_rate"] == pytest.approx(d["l1_hit_rate"], abs=0.06), policy
         unit = analytic["model"]["build_unit"]
         assert unit["refits" if policy == "refit" else "rebuilds"] == 4
         assert s["cycles"] == pytest.approx(detailed["summary"]["cycles"], rel=0.10), policy
