@@ -214,6 +214,7 @@ const StatBlock& analytic_stats() {
             {"unloaded_latency_mean_cycles", "cycles", "mean unloaded ray latency"},
             {"unloaded_latency_max_cycles", "cycles", "longest unloaded ray latency"},
             {"merge_wait_cycles", "cycles", "mean wait per planned step for a line whose earlier miss is still in flight (merged misses, which the reuse distances count as hits); in the unloaded latency"},
+            {"convoy_contexts", "contexts", "contexts that run alone: how many one fill releases at once (its first read's and the merged reads' that wait for it), which then step on together: the mean value analysis's customers are the contexts over it (1: no merges)"},
             {"caches", "", "`statistical` (reuse distances of a sample, the default) or `functional` (every ray through functional caches)"},
             {"assignment", "", "functional caches only: how rays are assigned to contexts and how contexts interleave (text)", false, true},
             {"analysis", "", "statistical only: `file` (the per-trace analysis beside the trace), `reused` (loaded, or built by this run), `seconds`, `stepped_rays`, `sample_rays` (what building it cost) and `key` (what it depends on)", false, true},
@@ -235,7 +236,8 @@ json closed_form_json(const ClosedForm& f, const AnalyticDemands& d) {
             {"phase_factor", f.phase_factor},
             {"unloaded_latency_mean_cycles", d.rays > 0 ? d.latency_sum / d.rays : 0.0},
             {"unloaded_latency_max_cycles", d.latency_max},
-            {"merge_wait_cycles", d.merge_wait}};
+            {"merge_wait_cycles", d.merge_wait},
+            {"convoy_contexts", d.convoy}};
 }
 
 json pipelines_json(const SimConfig& c, const std::vector<OpKind>& ops, const std::vector<std::vector<double>>& unit_issues,

@@ -45,6 +45,9 @@ struct AnalyticDemands {
     double ray_buffer_bytes = 0, latency_sum_extra = 0;
     /// Mean wait per planned step for fills already in flight (merged misses), in latency_sum.
     double merge_wait = 0;
+    /// Contexts that run alone: how many one fill releases at once (its read's and the merged
+    /// ones'), the rays a customer carries (customers, visits and group_rays say so); 1: none.
+    double convoy = 1;
 };
 
 /// One window of a run's phases (profile.h's PhaseWindow) as shares of the whole run's demands:

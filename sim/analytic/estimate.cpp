@@ -193,9 +193,13 @@ private:
     /// first read missed with its key's probabilities; the fill is due that miss's unloaded
     /// latency after it, and the read came `gap` accesses later, at the stream's rate of reads
     /// over `cycles` (the unit's for the L1, all units' for the L2).
-    double merge_wait(double cycles) const {
+    /// ... and `*convoy`, the contexts a fill releases at once: its first read's and the merged
+    /// ones that wait for it (1 + waiting merged reads over step-critical L1 misses).
+    double merge_wait(double cycles, double* convoy) const {
+        *convoy = 1.0;
         const double steps = m_p.step_critical.total();
         if (m_c.ideal_memory || steps <= 0 || cycles <= 0) return 0;
+        double waiting = 0;  // step-critical reads that wait for a fill in flight (L1 merges)
         double reads = 0;
         for (const KindCounts& kc : m_kinds) reads += kc.reads;
         const double l1_rate = reads / m_c.traversal.units / cycles, l2_rate = reads / cycles;
@@ -209,7 +213,11 @@ private:
             const double t = gap_cycles(gap_bin, l1_rate);
             wait += n * (1.0 - r1) *
                     ((h1 - h12) * std::max(0.0, m_lat_l2 - m_lat_l1 - t) + h12 * std::max(0.0, m_lat_dram - m_lat_l1 - t));
+            waiting += n * (1.0 - r1) * ((h1 - h12) * (t < m_lat_l2 - m_lat_l1) + h12 * (t < m_lat_dram - m_lat_l1));
         }
+        double misses = 0;
+        for (const auto& [key, n] : m_p.step_critical.cells) misses += n * m_miss.cell(key).first;
+        if (misses > 0) *convoy = 1.0 + waiting / misses;
         for (const auto& [k, n] : m_p.merge_l2) {  // an L2 hit on a line whose DRAM fill is due
             uint32_t read_key, head_key;
             int gap_bin;
@@ -243,7 +251,9 @@ private:
     /// A lock-step kind's ray takes part in this share of its group's steps (active over occupied
     /// lanes): the longest ray's steps over it are its group's.
     double m_longest_share = 1.0;
-    double m_group_fetch = 0, m_group_ops = 0;  ///< a lock-step kind's group step: its slowest line, its operations
+    double m_group_fetch = 0, m_group_ops = 0;
+    std::vector<double> m_phase_contexts;  ///< contexts' windows: the contexts active per unit
+    double m_convoy = 1.0;                 ///< contexts a fill releases at once (merge_wait)  ///< a lock-step kind's group step: its slowest line, its operations
     double m_active = 1.0;    ///< SIMD efficiency of a lock-step kind's groups (group_factors)
     double m_coalesce = 1.0;  ///< structure reads after coalescing per read asked for
     double m_step_scale = 1.0;  ///< the groups' plan steps per the rays' own
@@ -380,8 +390,19 @@ ClosedForm Estimator::form() {
         // a fixed point, which a few rounds reach (more wait, fewer reads per cycle, less wait).
         const double base = m_d.latency_sum;
         for (int round = 0; round < 4; ++round) {
-            m_d.merge_wait = merge_wait(f.cycles);
+            m_d.merge_wait = merge_wait(f.cycles, &m_convoy);
             m_d.latency_sum = base + steps * m_d.merge_wait;
+            // Convoys: the contexts one fill releases step on together, so the machine holds
+            // fewer independent customers (contexts over the convoy's size), each carrying that
+            // many rays through the queues at once. With treelets a unit's contexts walk one
+            // treelet and merge on its lines; this is the scheduler's burst that `detailed` waits
+            // out and a closed network of independent contexts does not (docs/fidelity.md).
+            m_d.convoy = m_convoy;
+            if (m_convoy > 1.0) {
+                m_d.customers = double(m_c.traversal.contexts()) / m_convoy;
+                m_d.visits = rays / m_convoy;
+                m_d.group_rays = m_convoy;
+            }
             f = closed_form(m_c, m_p.op_kinds, m_d, phase_shares(steps));
         }
     }
@@ -400,6 +421,7 @@ ClosedForm Estimator::form() {
 void Estimator::phase_windows() {
     m_phases.clear();
     m_phase_fetch.clear();
+    m_phase_contexts.clear();
     if (m_p.has_group) return group_phase_windows();
     if (m_p.phases.empty()) return;
     PhaseShare all;
@@ -412,6 +434,7 @@ void Estimator::phase_windows() {
         }
         s.steps = s.work = pw.steps;
         s.population = pw.rounds > 0 ? pw.steps / pw.rounds / m_c.traversal.units : 0.0;
+        m_phase_contexts.push_back(s.population);
         const double fetch = mean_latency(pw.critical);
         m_phase_fetch.push_back(fetch);
         fetch_sum += fetch * pw.steps;
@@ -463,8 +486,10 @@ const std::vector<PhaseShare>& Estimator::phase_shares(double steps) {
     }
     const double fetch = mean_latency(m_p.step_critical);
     const double other = std::max(0.0, (m_d.latency_sum - steps * fetch) / steps);  // per step: operations, ray starts
-    for (size_t w = 0; w < m_phases.size(); ++w)
+    for (size_t w = 0; w < m_phases.size(); ++w) {
         m_phases[w].latency_sum = m_phases[w].steps * steps * (fetch * m_phase_fetch[w] + other);
+        m_phases[w].population = m_phase_contexts[w] / m_convoy;  // convoys, as the whole run's
+    }
     return m_phases;
 }
 

@@ -288,6 +288,20 @@ TEST(AnalyticLevel, WholeTraceAnalysisRecordsItsRoundsInPhaseWindows) {
     EXPECT_EQ(e.model["analytic"]["phase_factor"].get<double>(), e.form.phase_factor);
 }
 
+TEST(AnalyticLevel, TreeletContextsConvoyOnTheFillsTheyMergeOn) {
+    // With treelets a unit's contexts walk one treelet and merge on its lines: a fill releases
+    // more than one context, the closed form's customers are convoys of them.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    config_set(c, "treelets.enabled=true");
+    config_set(c, "treelets.treelet_kib=8");
+    RayList rays(w.jobs);
+    Discard sink;
+    const AnalyticOutcome out = run_analytic(c, *w.accel, w.map(c), StepOptions{}, rays, sink);
+    EXPECT_GT(out.model["analytic"]["convoy_contexts"].get<double>(), 1.0);
+    EXPECT_LE(out.model["analytic"]["convoy_contexts"].get<double>(), double(c.traversal.contexts()));
+}
+
 TEST(AnalyticLevel, MergedMissesWaitForTheFillAndNotUnderIdealMemory) {
     // Coherent camera rays read the top of the tree again while its first misses are in flight:
     // the profile records those reads, and the estimate charges their wait on the fill.
