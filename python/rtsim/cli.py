@@ -31,7 +31,7 @@ from rtsim import __version__
 from rtsim.accuracy import add_parser as add_accuracy_parser
 from rtsim.cli_help import HelpFormatter, LazyHelpStore
 from rtsim.errors import RtsimError
-from rtsim.kinds import RAY_KINDS
+from rtsim.kinds import ANYHIT_ORDERS, RAY_KINDS
 from rtsim.sim_cli import add_parsers as add_simulate_parsers
 from rtsim.study.cli import add_parser as add_study_parser
 from rtsim.sweep.cli import add_parsers as add_sweep_parsers
@@ -87,6 +87,7 @@ class TraceJob:
     lights: str | None = None  # lights added to a scene without any (none, sun)
     reflections: str | None = None  # reflection rays: mirror or glossy (a GGX lobe)
     roulette_after: int | None = None  # Russian roulette past this many bounces (0: off)
+    anyhit_order: str | None = None  # any-hit rays' child order (traversal.anyhit_order's names)
     alternatives: bool = False  # also trace the structures one step away, beside it
 
 
@@ -280,6 +281,7 @@ def cmd_trace(args: argparse.Namespace, console: Console) -> int:
         lights=args.lights,
         reflections=args.reflections,
         roulette_after=args.roulette_after,
+        anyhit_order=args.anyhit_order,
         alternatives=args.alternatives,
     )
     run_trace(job, console)
@@ -490,6 +492,15 @@ def add_trace_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[t
         metavar="N",
         help="Russian roulette: each path ray past the first N bounces continues with the "
         "surface's albedo as probability (0, the default: off; --bounces still caps the depth)",
+    )
+    p.add_argument(
+        "--anyhit-order",
+        choices=ANYHIT_ORDERS,
+        default=None,
+        help="the child order any-hit (shadow) rays are traced in: nearest (default), "
+        "largest_box or fixed, as traversal.anyhit_order names them; a run in the trace's order "
+        "checks those rays' work exactly, and the analytic level's statistical caches take it "
+        '(docs/accel.md, "Any-hit child order")',
     )
     p.add_argument(
         "--alternatives",

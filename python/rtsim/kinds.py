@@ -29,3 +29,6 @@ OP_KINDS: tuple[str, ...] = tuple(_NAMES["op_kinds"])
 UNIT_KINDS: tuple[str, ...] = tuple(_NAMES["unit_kinds"])
 #: Acceleration structures registered in this build (`rtsim trace --accel`).
 ACCEL_KINDS: tuple[str, ...] = tuple(_NAMES["accel_kinds"])
+#: Any-hit rays' child orders (traces/accel/step_options.h: traversal.anyhit_order, rtsim trace
+#: --anyhit-order).
+ANYHIT_ORDERS: tuple[str, ...] = tuple(_NAMES["anyhit_orders"])

@@ -28,7 +28,7 @@ from rtsim.args import (
     path_arg,
 )
 from rtsim.errors import RtsimError
-from rtsim.kinds import RAY_KINDS
+from rtsim.kinds import ANYHIT_ORDERS, RAY_KINDS
 from rtsim.scenes import resolve_scene
 
 if TYPE_CHECKING:
@@ -180,6 +180,7 @@ def trace_scene(
     rebuild_threshold: float | None = None,
     reflections: str | None = None,
     roulette_after: int | None = None,
+    anyhit_order: str | None = None,
 ) -> dict[str, Any]:
     """Runs the reference tracer like `rtsim trace`: writes OUT/trace.rtt, manifest.json and
     render.png, and returns the manifest. Every option left None takes the tracer's default
@@ -202,7 +203,9 @@ def trace_scene(
     workload.lights_added says what was added). reflections="glossy" samples reflection rays
     from the GGX lobe of each material's roughness instead of the mirror direction;
     roulette_after=N plays Russian roulette on path rays past N bounces (survival: the surface's
-    albedo; docs/ray_generation.md)."""
+    albedo; docs/ray_generation.md). anyhit_order traces any-hit rays in that child order
+    ("nearest", "largest_box", "fixed"; the structure must offer it): a run in the same
+    traversal.anyhit_order then checks their work exactly."""
     from rtsim import _core
 
     checks: dict[str, Callable[[Any], Any]] = {
@@ -224,6 +227,7 @@ def trace_scene(
         "rebuild_threshold": _rebuild_threshold_arg,
         "reflections": _reflections_arg,
         "roulette_after": lambda v: int_arg(v, "roulette_after", 0, MAX_BOUNCES),
+        "anyhit_order": _anyhit_order_arg,
     }
     values = {
         "workload": workload, "width": width, "height": height, "bounces": bounces, "seed": seed,
@@ -231,7 +235,7 @@ def trace_scene(
         "accel": accel, "builder": builder, "flatten": flatten, "frames": frames,
         "build_settings": build_settings, "lights": lights, "frame_policy": frame_policy,
         "rebuild_threshold": rebuild_threshold, "reflections": reflections,
-        "roulette_after": roulette_after,
+        "roulette_after": roulette_after, "anyhit_order": anyhit_order,
     }  # fmt: skip
     # Only the options given are passed: the others take the tracer's defaults (trace_defaults).
     given = {k: checks[k](v) for k, v in values.items() if v is not None}
@@ -247,6 +251,14 @@ def trace_scene(
     return _core.trace_scene(
         _scene_arg(scene), path_arg(out_dir, "out_dir"), progress=progress, **given
     )
+
+
+def _anyhit_order_arg(order: str) -> str:
+    if order not in ANYHIT_ORDERS:
+        raise ArgumentValueError(
+            f"anyhit_order: {order!r} is not one of {', '.join(ANYHIT_ORDERS)}"
+        )
+    return order
 
 
 #: The choices of reflections= (traces/tracer/tracer.h, TraceOptions::reflections).

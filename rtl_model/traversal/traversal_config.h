@@ -23,7 +23,7 @@ inline constexpr Choices<StackOverflow, 2> kStackOverflowChoices{{"spill", "rest
 /// Which hit child an any-hit (shadow) ray visits first at a node (traces/accel/step_options.h):
 /// nearest (entry distance, the closest-hit order), largest_box (larger surface area first: more
 /// likely to hold an occluder) or fixed (child 0 first, no sort). Hit/miss never changes.
-inline constexpr Choices<AnyHitOrder, 3> kAnyHitOrderChoices{{"nearest", "largest_box", "fixed"}};
+inline constexpr Choices<AnyHitOrder, 3> kAnyHitOrderChoices{kAnyHitOrderNames};
 
 /// Ray contexts per unit when traversal.ray_contexts is 0 and each context runs alone.
 inline constexpr uint32_t kDefaultRayContexts = 16;

@@ -77,13 +77,15 @@ std::string cell(const std::string& unit, const std::vector<std::string>& sets, 
 
 json declared_names() {
     json rays = json::array(), data = json::array(), ops = json::array(), units = json::array(),
-         accels = json::array();
+         accels = json::array(), anyhit = json::array();
     for (int k = 0; k < kRayKindCount; ++k) rays.push_back(ray_kind_name(RayKind(k)));
     for (const DataKindInfo& d : kDataKinds) data.push_back(d.name);
     for (const char* op : kOpKindNames) ops.push_back(op);
     for (const UnitKind* k : unit_kinds()) units.push_back(k->name);
     for (const AccelKindInfo& a : accel_kinds()) accels.push_back(a.name);
-    return {{"ray_kinds", rays}, {"data_kinds", data}, {"op_kinds", ops}, {"unit_kinds", units}, {"accel_kinds", accels}};
+    for (const char* order : kAnyHitOrderNames) anyhit.push_back(order);
+    return {{"ray_kinds", rays},       {"data_kinds", data},     {"op_kinds", ops},
+            {"unit_kinds", units},     {"accel_kinds", accels}, {"anyhit_orders", anyhit}};
 }
 
 json capability_table() {

@@ -56,6 +56,7 @@ RunSetup resolve_run(const SimConfig& config, const StructureFacts& structure) {
     s.step.box_precision_bits = t.box_precision_bits;
     s.step.quantized_box_tests = t.quantized_boxes;
     s.step.anyhit_order = t.anyhit_order;
+    s.step.traced_anyhit_order = s.structure.traced_anyhit_order;
     if (s.unit->needs.packet_kernel) s.packet_reference = s.unit->packet_reference(t);
     return s;
 }

@@ -10,6 +10,8 @@ bool restart_trail(const RunFacts& f) { return f.config.traversal.stack_overflow
 bool reduced_boxes(const RunFacts& f) { return f.config.traversal.box_precision_bits != 0; }
 bool quantized_boxes(const RunFacts& f) { return f.config.traversal.quantized_boxes; }
 bool anyhit_reordered(const RunFacts& f) { return f.config.traversal.anyhit_order != AnyHitOrder::nearest; }
+/// The run's any-hit order differs from the one its trace was traced in.
+bool anyhit_off_trace(const RunFacts& f) { return f.config.traversal.anyhit_order != f.structure.traced_anyhit_order; }
 bool treelets(const RunFacts& f) { return f.config.treelets.enabled; }
 bool sampling(const RunFacts& f) { return f.config.sampling.enabled(); }
 bool animated(const RunFacts& f) { return f.structure.frames > 1; }
@@ -128,16 +130,18 @@ std::vector<Rule> make_rules() {
          "BIH, B-Kd tree, octree and grid visit near cells before far ones by their own rules",
          "traversal.anyhit_order=nearest, or trace a structure with the setting (rtsim capabilities)", "grid",
          {"traversal.anyhit_order=fixed"}});
-    add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_reordered, RuleSide::level,
+    add({"anyhit_order/level", "traversal.anyhit_order (any-hit child order)", anyhit_off_trace, RuleSide::level,
          "a level that steps every ray (functional, approx, detailed, or analytic with analytic.caches=functional)",
          [](const RunFacts& f) {
              return f.config.fidelity == Fidelity::functional || f.level.timed ||
                     (f.config.fidelity == Fidelity::analytic && f.config.analytic.caches == AnalyticCaches::functional);
          },
          "the analytic level's statistical caches take the work of the rays they do not step from the trace, "
-         "traced nearest first, and another order finds other occluders with other work; the levels that step "
-         "every ray check a reordered any-hit ray's occlusion against the trace and count and time its own walk",
-         "fidelity=functional, approx or detailed, analytic.caches=functional, or traversal.anyhit_order=nearest",
+         "traced in another order (nearest first unless rtsim trace --anyhit-order), and another order finds "
+         "other occluders with other work; the levels that step every ray check a reordered any-hit ray's "
+         "occlusion against the trace and count and time its own walk",
+         "fidelity=functional, approx or detailed, analytic.caches=functional, traversal.anyhit_order set to "
+         "the trace's, or a trace traced in the run's order (rtsim trace --anyhit-order)",
          "bvh2", {"traversal.anyhit_order=fixed", "fidelity=analytic"}});
 
     // Sampling.

@@ -63,6 +63,9 @@ StructureFacts structure_facts(TraceReader& reader) {
     require(bytes.is_number_unsigned() && bytes.get<uint64_t>() >= 1 && bytes.get<uint64_t>() <= 64,
             where + ": stats 'stack_entry_bytes' must be an integer in 1..64, got " + bytes.dump());
     f.stack_entry_bytes = bytes.get<uint32_t>();
+    const json order = stats.is_object() ? stats.value("anyhit_order", json("nearest")) : json("nearest");
+    require(order.is_string() && parse_anyhit_order(order.get<std::string>(), &f.traced_anyhit_order),
+            where + ": stats 'anyhit_order' must be one of nearest, largest_box, fixed, got " + order.dump());
     if (reader.has(SectionKind::frames)) f.frames = reader.section(SectionKind::frames).record_count;
     f.shading_sections = reader.has(SectionKind::shading) && reader.has(SectionKind::tri_shading) &&
                          reader.has(SectionKind::materials);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "traces/accel/capabilities.h"
+#include "traces/accel/step_options.h"
 
 namespace rtsim {
 
@@ -21,6 +22,9 @@ struct StructureFacts {
     bool compressed_leaves = false;  ///< its triangles are compressed leaf blocks
     uint64_t frames = 1;             ///< frames of an animated trace
     bool shading_sections = true;    ///< the trace carries shading sections (version 5; facts from a name: yes)
+    /// The child order its any-hit rays were traced in (the structure's stats' anyhit_order,
+    /// `rtsim trace --anyhit-order`; nearest first when absent).
+    AnyHitOrder traced_anyhit_order = AnyHitOrder::nearest;
     std::string source;              ///< the trace (messages), or "" for facts from a name
 
     /// How messages name it: "this trace's structure 'kdtree'" or "structure 'kdtree'".

@@ -12,6 +12,7 @@ import pytest
 
 import rtsim
 from conftest import checked, run_rtsim
+from rtsim.errors import ArgumentValueError
 from rtsim.kinds import RAY_KINDS
 
 
@@ -72,3 +73,45 @@ def test_packet_units_walk_shadow_packets_in_the_order(trace: Path, sim_exe: Pat
     assert own["approx"] == own["detailed"] == own["functional"]
     for key, value in alone["validation"]["reordered_anyhit"]["own"].items():
         assert own["functional"][key] == pytest.approx(value, rel=0.02), key
+
+
+def test_a_trace_in_the_runs_order_checks_its_work_exactly(
+    trace: Path, sim_exe: Path, tmp_path: Path
+) -> None:
+    """`rtsim trace --anyhit-order` writes the any-hit rays' reference work in that order: a run
+    in the same order checks every ray's work (no reordered rays), its reordered work is the
+    nearest-first trace's `own` work, and the analytic level's statistical caches take it; a run
+    in another order than the trace's is reordered against it (and refused there)."""
+    kind = trace.name.split("-")[1]
+    ordered = tmp_path / "ordered"
+    made = run_rtsim("trace", "cornell", "-o", str(ordered), "--resolution", "24x18",
+                     "--workload", "primary,shadow", "--accel", kind,
+                     "--anyhit-order", "largest_box")  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    assert rtsim.open_trace(ordered).manifest["workload"]["anyhit_order"] == "largest_box"
+    near = checked(sim_exe, trace, tmp_path / "near", "fidelity=functional",
+                   "traversal.anyhit_order=largest_box")  # fmt: skip
+    same = checked(sim_exe, ordered, tmp_path / "same", "fidelity=functional",
+                   "traversal.anyhit_order=largest_box")  # fmt: skip
+    assert "reordered_anyhit" not in same["validation"]
+    t = rtsim.open_trace(ordered)
+    shadow = t.rays["kind"] == RAY_KINDS.index("shadow")
+    for key in ("steps", "box_tests", "tri_tests"):
+        own = near["validation"]["reordered_anyhit"]["own"][key]
+        assert float(np.mean(t.work[key][shadow])) == pytest.approx(own), key
+    analytic = checked(sim_exe, ordered, tmp_path / "analytic", "fidelity=analytic",
+                       "traversal.anyhit_order=largest_box")  # fmt: skip
+    assert analytic["summary"]["cycles"] > 0
+    other = checked(sim_exe, ordered, tmp_path / "other", "fidelity=functional")
+    assert other["validation"]["reordered_anyhit"]["rays"] == int(shadow.sum())
+    refused = run_rtsim("simulate", str(ordered), "-o", str(tmp_path / "refused"),
+                        "--set", "fidelity=analytic")  # fmt: skip
+    assert refused.returncode != 0 and "anyhit_order" in refused.stderr
+
+
+def test_an_order_the_structure_lacks_is_refused_by_name(tmp_path: Path) -> None:
+    bad = run_rtsim("trace", "cornell", "-o", str(tmp_path / "grid"), "--resolution", "8x6",
+                    "--accel", "grid", "--anyhit-order", "fixed")  # fmt: skip
+    assert bad.returncode != 0 and "grid" in bad.stderr and "any-hit child order" in bad.stderr
+    with pytest.raises(ArgumentValueError, match="anyhit_order"):
+        rtsim.trace_scene("cornell", tmp_path / "x", anyhit_order="sideways")

@@ -5,7 +5,9 @@
 // run's resolution step (sim/resolve/resolve.h) fills it from the config, once, after matching
 // each technique against the structure's capabilities (capabilities.h); a structure ignores an
 // option its capabilities do not offer.
+#include <array>
 #include <cstdint>
+#include <string>
 
 namespace rtsim {
 
@@ -17,6 +19,17 @@ enum class AnyHitOrder : uint8_t {
     largest_box = 1,  ///< larger child box surface area first: more likely to hold an occluder
     fixed = 2,        ///< child 0 first, no sort
 };
+/// Their names, in value order (the config's traversal.anyhit_order, rtsim trace --anyhit-order).
+inline constexpr std::array<const char*, 3> kAnyHitOrderNames{{"nearest", "largest_box", "fixed"}};
+/// True and *order set when `name` is one of kAnyHitOrderNames.
+inline bool parse_anyhit_order(const std::string& name, AnyHitOrder* order) {
+    for (size_t i = 0; i < kAnyHitOrderNames.size(); ++i)
+        if (name == kAnyHitOrderNames[i]) {
+            *order = AnyHitOrder(i);
+            return true;
+        }
+    return false;
+}
 
 struct StepOptions {
     /// Primitive ids remembered per ray (mailbox.h; structures whose references repeat along a
@@ -36,9 +49,13 @@ struct StepOptions {
     /// found and the work may. The fused loops walk nearest first, so other orders use a stepper.
     AnyHitOrder anyhit_order = AnyHitOrder::nearest;
 
-    /// Any-hit rays walk in another child order than the trace's (nearest first): the hit
-    /// checker checks their occlusion alone (HitChecker::set_reordered_anyhit).
-    bool reorders_anyhit() const { return anyhit_order != AnyHitOrder::nearest; }
+    /// The order the trace's any-hit rays were traced in (its reference work): nearest first
+    /// unless traced with `rtsim trace --anyhit-order` (the structure's stats say so).
+    AnyHitOrder traced_anyhit_order = AnyHitOrder::nearest;
+
+    /// Any-hit rays walk in another child order than the trace's: the hit checker checks their
+    /// occlusion alone (HitChecker::set_reordered_anyhit).
+    bool reorders_anyhit() const { return anyhit_order != traced_anyhit_order; }
 
     /// The options a reference packet loop walks with (Accel::trace_packet): the any-hit order,
     /// which changes the walk; the others only add model-only work, which the reference leaves out.
@@ -51,7 +68,8 @@ struct StepOptions {
     /// True when a structure's fused reference loop walks as its steppers do: no short stack or
     /// reduced-precision walk whose extra work only a stepper counts, and any-hit rays nearest first.
     bool fused_loop_walks_alike() const {
-        return short_stack_entries == 0 && box_precision_bits == 0 && !quantized_box_tests && !reorders_anyhit();
+        return short_stack_entries == 0 && box_precision_bits == 0 && !quantized_box_tests &&
+               anyhit_order == AnyHitOrder::nearest;
     }
 };
 

@@ -117,6 +117,9 @@ void validate(const TraceOptions& o) {
     require(o.reflections == "mirror" || o.reflections == "glossy",
             "reflections: unknown choice '" + o.reflections + "' (choose mirror or glossy)");
     require(o.roulette_after <= 64, "roulette_after " + std::to_string(o.roulette_after) + " is out of range (0..64)");
+    AnyHitOrder order;
+    require(parse_anyhit_order(o.anyhit_order, &order),
+            "anyhit_order: unknown choice '" + o.anyhit_order + "' (choose nearest, largest_box or fixed)");
     require(o.frames >= 1 && o.frames <= kMaxFrames,
             "frames " + std::to_string(o.frames) + " is out of range (1.." + std::to_string(kMaxFrames) + ")");
     parse_frame_policy(o.frame_policy);  // refuses an unknown one, listing the choices
@@ -176,6 +179,16 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     const FramePolicyOptions policy{parse_frame_policy(o.frame_policy), o.rebuild_threshold};
     if (o.frames > 1) animated = build_animated(scene, accel_options, o.frames, policy);
     else animated.image = build_accel(scene, accel_options);
+    // Any-hit rays traced in another child order than nearest first: the structure says so (its
+    // stats, read back with the trace by the simulator: StructureFacts::traced_anyhit_order).
+    StepOptions walk;
+    parse_anyhit_order(o.anyhit_order, &walk.anyhit_order);
+    if (walk.anyhit_order != AnyHitOrder::nearest) {
+        require(accel_capabilities(animated.image.kind, animated.image.params.value("blas_kind", "")).anyhit_order,
+                path + ": --anyhit-order " + o.anyhit_order + ": structure '" + animated.image.kind +
+                    "' has no any-hit child order (rtsim capabilities)");
+        animated.image.stats["anyhit_order"] = o.anyhit_order;
+    }
     const std::unique_ptr<Accel> accel = load_accel(std::move(animated.image), path + ": built " + o.accel.kind);
     WorkloadPlan plan = plan_workload(scene, o.workload);
     if (!lights_added["added"].empty())
@@ -217,7 +230,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
         for (uint32_t depth = 0; !wave.empty(); ++depth) {
             std::string stage = prefix + (depth == 0 ? "primary" : "depth " + std::to_string(depth));
             WavefrontResult res =
-                trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); });
+                trace_wavefront(*accel, wave, o.threads, [&](uint64_t done) { report(done, wave.size(), stage); }, walk);
             folder.add_wavefront(plan, wave, res);
             if (f == 0) render.add(scene, wave, res.hits);  // the preview shows frame 0
             wave = next_wavefront(ctx, wave, res.hits);
@@ -239,6 +252,7 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
           {"bounces", o.bounces},
           {"reflections", o.reflections},
           {"roulette_after", o.roulette_after},
+          {"anyhit_order", o.anyhit_order},
           {"seed", o.seed},
           {"effects", effects_json(plan)},
           {"lights_added", lights_added}}},

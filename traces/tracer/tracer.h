@@ -63,6 +63,10 @@ struct TraceOptions {
     /// Russian roulette on path rays: 0 off; N, each bounce past the first N continues with the
     /// surface's albedo as probability (bounces still caps the depth).
     uint32_t roulette_after = 0;
+    /// The child order any-hit (shadow) rays are traced in, as traversal.anyhit_order names it:
+    /// nearest (the default), largest_box or fixed. A trace in a run's order carries that walk's
+    /// reference work, so the run checks it exactly (docs/accel.md, "Any-hit child order").
+    std::string anyhit_order = "nearest";
 
     /// The options a caller chooses, each with its name and meaning (scene and out_dir aside):
     /// the Python bindings read the defaults and apply keyword arguments through this, so every
@@ -87,6 +91,7 @@ struct TraceOptions {
         v("lights", lights, "lights added to a scene without any: none or sun (the manifest lists them)");
         v("reflections", reflections, "reflection rays: mirror, or glossy (a GGX lobe of the material's roughness)");
         v("roulette_after", roulette_after, "Russian roulette on path rays past this many bounces (0: off)");
+        v("anyhit_order", anyhit_order, "any-hit rays' child order: nearest, largest_box or fixed (traversal.anyhit_order)");
     }
 };
 

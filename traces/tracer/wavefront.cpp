@@ -12,7 +12,7 @@ constexpr uint64_t kBlock = 2048;  // rays per work item: big enough to amortise
 }
 
 WavefrontResult trace_wavefront(const Accel& accel, const std::vector<PendingRay>& rays, unsigned threads,
-                                const std::function<void(uint64_t)>& progress) {
+                                const std::function<void(uint64_t)>& progress, const StepOptions& step) {
     WavefrontResult result;
     result.hits.resize(rays.size());
     result.work.resize(rays.size());
@@ -27,7 +27,7 @@ WavefrontResult trace_wavefront(const Accel& accel, const std::vector<PendingRay
                 const PendingRay& r = rays[i];
                 if (!ray_is_valid(r.ray)) ++local_rejected;
                 TraversalMode mode = r.any_hit ? TraversalMode::any_hit : TraversalMode::closest_hit;
-                result.hits[i] = accel.trace(r.ray, mode, &result.work[i]);
+                result.hits[i] = accel.trace(r.ray, mode, &result.work[i], step);
             }
             uint64_t now = done.fetch_add(end - b * kBlock) + (end - b * kBlock);
             if (report && progress) progress(now);

@@ -17,7 +17,9 @@ struct WavefrontResult {
 };
 
 /// progress(done) is called from the calling thread only.
+/// `step`: what the rays walk with (the any-hit order of the trace; nothing else changes a
+/// reference walk).
 WavefrontResult trace_wavefront(const Accel& accel, const std::vector<PendingRay>& rays, unsigned threads,
-                                const std::function<void(uint64_t)>& progress);
+                                const std::function<void(uint64_t)>& progress, const StepOptions& step = {});
 
 }  // namespace rtsim
