@@ -248,6 +248,12 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
         text += "; co-limit: " + co["keys"][0].get<std::string>() + " and " + co["keys"][1].get<std::string>() +
                 " together " + gain(co["joint"].get<double>()) + " (alone " + gain(co["alone"][0].get<double>()) +
                 ", " + gain(co["alone"][1].get<double>()) + ")";
+    for (const json& k : weighed["area_savers"]) {
+        char mm2[48];
+        std::snprintf(mm2, sizeof mm2, " %+.3f mm^2", k["added_mm2"].get<double>());
+        text += std::string(&k == &weighed["area_savers"][0] ? "; same speed, less area: " : ", ") +
+                k["key"].get<std::string>() + "=" + value_text(k["to"]) + " " + gain(k["speedup"].get<double>()) + mm2;
+    }
     if (!not_covered.empty()) text += "; " + not_covered;
     // Another design is not a step of a resource: name the alternatives, priced, with the
     // estimate of those the analytic level could cost on their own analysis.
@@ -333,6 +339,7 @@ json judge(const VerdictContext& c) {
               {"candidates", weighed["knobs"]},
               {"top", weighed["top"]},
               {"top_per_mm2", weighed["top_per_mm2"]},
+              {"area_savers", weighed["area_savers"]},
               {"co_limits", weighed["co_limits"]},
               {"structural", weighed["structural"]},
               {"coverage", {{"estimated", not_covered.empty()},
@@ -464,6 +471,7 @@ const StatBlock& verdict_stats() {
             {"candidates", "list", "every knob, best first (by estimated gain; unestimated ones by `evidence`), each with `resource` (as `binding`), `key` (the `--set` knob that relaxes it), `from` and `to` (its values), `speedup` (the analytic estimate of cycles(from) / cycles(to); `null` without one, with `why_not`), `added_mm2` (the area model's added area), `gain_per_mm2` (`(speedup - 1) / added_mm2`; `null` for knobs the area model does not price: MSHRs, banks, channels, costs), `evidence` (the share of context cycles that points at the resource), `dram_saved_fraction` (estimated: the share of DRAM traffic the knob removes) and `dram_nj_saved_per_ray` (that share of the run's DRAM energy per ray: what it saves per ray in joules), `tie_break` (present when it was named ahead of an estimate within 3 points because it also removes DRAM traffic)"},
             {"top", "list", "the first three `candidates`: what to try, printed by `rtsim simulate`"},
             {"top_per_mm2", "list", "the three best `gain_per_mm2`"},
+            {"area_savers", "list", "up to three candidates that keep the run's speed (an estimate of at least 0.98x) and save area (`added_mm2` below 0), most saved first: a kind's private pipelines shared by the units (`KIND.sharing=shared`) where few of its tests run"},
             {"co_limits", "list", "pairs of estimated knobs whose joint relaxation gains much more than either alone (joint gain >= 1.5 x the better single gain + 5 points): `keys`, `sets` (`key=value` each), `resources`, `joint` (estimated speed-up of both), `alone` (each's)"},
             {"coverage", "", "`estimated` (false where the analytic level does not model the machine: treelets), `why_not`, `frames` (an animated trace's estimates are the first frame's)"},
             {"structural", "list", "the structural alternatives to the run's design, one step each: another structure (`accel`: a wide BVH, or compressed nodes) and `compressed_leaves` (both a new trace), `treelets.enabled` flipped, another `traversal.model`, `dispatch.sort` on or off, `treelets.prefetch` flipped, and for an animated trace the other `frame_policy` values (a new trace: `rtsim trace --frame-policy`); each with the candidates' fields (`speedup` and `estimated_by` for another structure or compressed leaves estimated on the alternative trace beside the run's, `rtsim trace --alternatives`, and for treelets flipped or the other execution model estimated on the run's trace; else `speedup` null and `why_not`), `structural` (true), `trace` (needs a new trace), `measure` (the command that measures it; `--check-verdict` re-runs the best estimated one and the best that needs no new trace) and `added_mm2` (its added area: the decoders of compressed nodes or leaves, a ray buffer, SIMT control, a sort stage, a prefetcher); `refused` when the config refuses it"},
@@ -563,7 +571,7 @@ ReportBlock verdict_report() {
                     k["dram_nj_saved_per_ray"] = k["dram_saved_fraction"].get<double>() * nj["dram"].get<double>();
             };
             if (nj.contains("dram") && nj["dram"].is_number()) {
-                for (const char* list : {"candidates", "top", "top_per_mm2"})
+                for (const char* list : {"candidates", "top", "top_per_mm2", "area_savers"})
                     for (json& k : verdict[list]) saved(k);
                 saved(verdict["relax"]);
             }

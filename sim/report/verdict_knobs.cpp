@@ -65,6 +65,34 @@ void rank(json& knobs) {
     });
 }
 
+/// Knobs that keep the speed and save area: pipelines a kind's private copies leave idle, shared
+/// by the units instead (a pool of `shared_count`). Curved primitives' and alpha tests' pipelines
+/// are the usual ones: few rays test them, and a pipeline per unit is mostly idle.
+void sharing_knobs(const SimConfig& c, const std::vector<OpKind>& ops, std::vector<Knob>* out) {
+    for (OpKind kind : ops) {
+        const PipelineConfig& p = c.pipeline(kind);
+        if (p.shared() || p.shared_count >= c.traversal.units) continue;
+        add(out, {std::string(op_kind_name(kind)) + ".sharing", "private", "shared"}, op_kind_name(kind));
+    }
+}
+
+/// Within the estimate's error of the run's speed and smaller: the three that save most area.
+constexpr double kSameSpeed = 0.98;
+
+json area_savers(const json& knobs) {
+    json out = json::array();
+    for (const json& k : knobs)
+        if (k["added_mm2"].is_number() && k["added_mm2"].get<double>() < -1e-9 && k["speedup"].is_number() &&
+            k["speedup"].get<double>() >= kSameSpeed)
+            out.push_back(k);
+    std::stable_sort(out.begin(), out.end(), [](const json& a, const json& b) {
+        return a["added_mm2"].get<double>() < b["added_mm2"].get<double>();
+    });
+    json top = json::array();
+    for (size_t i = 0; i < out.size() && i < 3; ++i) top.push_back(out[i]);
+    return top;
+}
+
 json first(const json& list, size_t n) {
     json out = json::array();
     for (size_t i = 0; i < list.size() && i < n; ++i) out.push_back(list[i]);
@@ -150,6 +178,7 @@ std::vector<Knob> every_knob(const SimConfig& c, const std::vector<OpKind>& ops,
     add(&out, doubled(c, "traversal.stack_entries"), "stack");
     for (const KindKnob& k : kind_knobs)
         add(&out, k.halve ? halved(c, k.key) : doubled(c, k.key), k.resource, k.estimated);
+    sharing_knobs(c, ops, &out);
     if (c.treelets.enabled) treelet_knobs(c, &out);
     return out;
 }
@@ -323,6 +352,7 @@ json weigh_knobs(const WeighInputs& in) {
             {"structural", structural},
             {"top", first(knobs, 3)},
             {"top_per_mm2", per_area(knobs)},
+            {"area_savers", area_savers(knobs)},
             {"co_limits", in.cycles && in.not_covered.empty() ? co_limits(in, knobs) : json::array()}};
 }
 

@@ -206,3 +206,19 @@ def test_an_analytic_run_says_when_its_design_is_outside_the_levels_band(
     # approx was within its band on every kind measured: no finding.
     timed = sim_stats(sim_exe, trace_of(), tmp_path / "approx", "fidelity=approx")
     assert timed["fidelity_band"] == {"level": "approx", "outside": False, "findings": []}
+
+
+def test_the_verdict_names_pipelines_to_share_where_they_idle(
+    sim_exe: Path, tmp_path: Path
+) -> None:
+    """Spheres on a pipeline per unit are mostly idle: sharing them keeps the speed and saves
+    area, which the verdict names apart from the knobs that pay (docs/verdict.md)."""
+    trace = tmp_path / "particles"
+    rtsim_trace("particles", "-o", str(trace), "--resolution", "32x24")
+    stats = sim_stats(sim_exe, trace, tmp_path / "run")
+    savers = stats["verdict"]["area_savers"]
+    keys = [k["key"] for k in savers]
+    assert "sphere.sharing" in keys
+    for k in savers:
+        assert k["to"] == "shared" and k["added_mm2"] < 0 and k["speedup"] >= 0.98
+    assert "same speed, less area: " in stats["verdict"]["text"]
