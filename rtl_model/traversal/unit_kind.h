@@ -37,9 +37,9 @@ class TraversalUnit;
 /// (sim/analytic/estimate.cpp; MIMD contexts' windows are sim/analytic/profile.h's PhaseWindow).
 struct GroupWindow {
     double rounds = 0, group_steps = 0, active_lanes = 0;
-    /// Adds `step` (a group step's active lanes) to the last of `windows`, rounds at a time: when
-    /// the last holds `*window_rounds` rounds a new one opens, and at kMaxWindows neighbours
-    /// merge and the windows double in length.
+    /// Ends a round in the last of `windows` (its steps and lanes added by the caller): when the
+    /// last holds `*window_rounds` rounds a new one opens, and at kMaxWindows neighbours merge and
+    /// the windows double in length.
     static constexpr size_t kMaxWindows = 32;
     static void end_round(std::vector<GroupWindow>& windows, double* window_rounds);
 };

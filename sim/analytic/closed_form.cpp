@@ -191,8 +191,12 @@ ClosedForm closed_form(const SimConfig& c, const std::vector<OpKind>& ops, const
         const AnalyticDemands w = scaled(held, s);
         const json wb = bounds_of(c, ops, w);
         double window = mva_cycles(c, ops, w, wb, nullptr, std::max(s.population, 1e-3));
-        for (auto& [name, value] : wb.items())
+        for (auto& [name, value] : wb.items()) {
+            require(value.is_number() && std::isfinite(value.get<double>()),
+                    "analytic: a phase window's '" + name + "' bound is not a finite number (a bug in its shares)");
             if (name != "latency") window = std::max(window, value.get<double>());
+        }
+        require(std::isfinite(window), "analytic: a phase window's mean value analysis is not a finite number");
         phased += window;
     }
     if (f.cycles > 0 && phased > f.cycles) f.phase_factor = phased / f.cycles, f.cycles = phased;
@@ -210,7 +214,7 @@ const StatBlock& analytic_stats() {
             {"roofline_cycles", "cycles", "the largest bound"},
             {"queueing_cycles", "cycles", "the mean-value-analysis estimate (never below the roofline's throughput bounds)"},
             {"cycles", "cycles", "`max(roofline_cycles, queueing_cycles)` times `phase_factor`, rounded up: `summary.cycles`"},
-            {"phase_factor", "", "whole-trace analyses of contexts that run alone: the run's phases (fill, steady state, drain), each window's largest bound summed over the windows, over the largest bound of the whole run's sums (1: no phases, or all alike)"},
+            {"phase_factor", "", "whole-trace analyses on the analysed machine: the run's phases (fill, steady state, drain), each window priced as a run of its own (the larger of its mean value analysis at its population and its bounds), their sum over max(roofline_cycles, queueing_cycles) when it is larger (1: no phases, or a sum below)"},
             {"unloaded_latency_mean_cycles", "cycles", "mean unloaded ray latency"},
             {"unloaded_latency_max_cycles", "cycles", "longest unloaded ray latency"},
             {"merge_wait_cycles", "cycles", "mean wait per planned step for a line whose earlier miss is still in flight (merged misses, which the reuse distances count as hits); in the unloaded latency"},

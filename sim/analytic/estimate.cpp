@@ -235,7 +235,8 @@ private:
     void count_kinds();
     void ops(double* op_latency);
     /// The windows of a whole-trace analysis's rounds as shares of the run (profile.h's
-    /// PhaseWindow), once per estimate; none for lock-step kinds and sampled analyses. Then
+    /// PhaseWindow, or a lock-step kind's GroupWindow), once per estimate; none for sampled
+    /// analyses or a machine other than the analysed one. Then
     /// their latencies at the current latency per step.
     void phase_windows();
     void group_phase_windows();
@@ -251,9 +252,9 @@ private:
     /// A lock-step kind's ray takes part in this share of its group's steps (active over occupied
     /// lanes): the longest ray's steps over it are its group's.
     double m_longest_share = 1.0;
-    double m_group_fetch = 0, m_group_ops = 0;
+    double m_group_fetch = 0, m_group_ops = 0;  ///< a lock-step kind's group step: its slowest line, its operations
     std::vector<double> m_phase_contexts;  ///< contexts' windows: the contexts active per unit
-    double m_convoy = 1.0;                 ///< contexts a fill releases at once (merge_wait)  ///< a lock-step kind's group step: its slowest line, its operations
+    double m_convoy = 1.0;                 ///< contexts a fill releases at once (merge_wait)
     double m_active = 1.0;    ///< SIMD efficiency of a lock-step kind's groups (group_factors)
     double m_coalesce = 1.0;  ///< structure reads after coalescing per read asked for
     double m_step_scale = 1.0;  ///< the groups' plan steps per the rays' own
@@ -390,7 +391,12 @@ ClosedForm Estimator::form() {
         // a fixed point, which a few rounds reach (more wait, fewer reads per cycle, less wait).
         const double base = m_d.latency_sum;
         for (int round = 0; round < 4; ++round) {
-            m_d.merge_wait = merge_wait(f.cycles, &m_convoy);
+            // The reads' rate in the steady state (the phases' fill and drain are not where merges
+            // crowd), so steady_cycles does not depend on the phases.
+            double convoy = 1.0;
+            m_d.merge_wait = merge_wait(f.steady_cycles, &convoy);
+            convoy = std::clamp(convoy, 1.0, double(m_c.traversal.contexts()));
+            m_convoy = round == 0 ? convoy : 0.5 * (m_convoy + convoy);  // damped: convoys and cycles pull apart
             m_d.latency_sum = base + steps * m_d.merge_wait;
             // Convoys: the contexts one fill releases step on together, so the machine holds
             // fewer independent customers (contexts over the convoy's size), each carrying that
@@ -398,11 +404,10 @@ ClosedForm Estimator::form() {
             // treelet and merge on its lines; this is the scheduler's burst that `detailed` waits
             // out and a closed network of independent contexts does not (docs/fidelity.md).
             m_d.convoy = m_convoy;
-            if (m_convoy > 1.0) {
-                m_d.customers = double(m_c.traversal.contexts()) / m_convoy;
-                m_d.visits = rays / m_convoy;
-                m_d.group_rays = m_convoy;
-            }
+            const bool convoys = m_convoy > 1.0;
+            m_d.customers = convoys ? double(m_c.traversal.contexts()) / m_convoy : 0.0;
+            m_d.visits = convoys ? rays / m_convoy : 0.0;
+            m_d.group_rays = convoys ? m_convoy : 0.0;
             f = closed_form(m_c, m_p.op_kinds, m_d, phase_shares(steps));
         }
     }
@@ -422,6 +427,9 @@ void Estimator::phase_windows() {
     m_phases.clear();
     m_phase_fetch.clear();
     m_phase_contexts.clear();
+    // The windows' rounds and populations are the analysed machine's: another count of units or
+    // contexts (a verdict's knob evaluated on this analysis) would run other rounds.
+    if (m_p.phase_units != m_c.traversal.units || m_p.phase_contexts != m_c.traversal.contexts()) return;
     if (m_p.has_group) return group_phase_windows();
     if (m_p.phases.empty()) return;
     PhaseShare all;

@@ -127,6 +127,7 @@ json AnalyticProfile::to_json() const {
             {"stepped_rays", stepped_rays},
             {"analysis_seconds", analysis_seconds},
             {"phases", phases_json(phases)},
+            {"phase_machine", {phase_units, phase_contexts}},
             {"frame_samples", [&] {
                  json a = json::array();
                  for (const FrameSample& f : frame_samples) a.push_back({{"frame", f.frame}, {"reads", hist_json(f.reads)}});
@@ -176,6 +177,8 @@ AnalyticProfile AnalyticProfile::from_json(const json& j) {
     p.stepped_rays = j.at("stepped_rays");
     p.analysis_seconds = j.at("analysis_seconds");
     p.phases = phases_from(j.at("phases"));
+    p.phase_units = j.at("phase_machine").at(0).get<uint32_t>();
+    p.phase_contexts = j.at("phase_machine").at(1).get<uint32_t>();
     for (const json& f : j.at("frame_samples"))
         p.frame_samples.push_back({f.at("frame").get<uint32_t>(), hist_from(f.at("reads"))});
     if (j.contains("treelets")) {

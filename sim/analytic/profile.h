@@ -126,6 +126,8 @@ struct AnalyticProfile {
     // treelet scheduling): the rounds in windows of equal length, at most kMaxPhaseWindows.
     static constexpr size_t kMaxPhaseWindows = 32;
     std::vector<PhaseWindow> phases;
+    /// The machine the rounds ran on (the phases are its: a config of other counts has none).
+    uint32_t phase_units = 0, phase_contexts = 0;
     /// Animated traces: each analysed frame's reads, in frame order (none for one frame).
     std::vector<FrameSample> frame_samples;
 

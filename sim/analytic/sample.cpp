@@ -374,6 +374,7 @@ void SampleProfiler::finish() {
     m_step_critical.drain([&](uint32_t key, uint64_t n) { m_p.step_critical.add(key, double(n)); });
     m_ray_critical.drain([&](uint32_t key, uint64_t n) { m_p.ray_critical.add(key, double(n)); });
     m_p.phases.clear();
+    m_p.phase_units = m_units, m_p.phase_contexts = m_slots;
     if (m_clusters_run == 1)
         for (PhaseCounts& w : m_phases) {
             if (w.rounds == 0) continue;

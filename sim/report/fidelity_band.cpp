@@ -32,7 +32,7 @@ json finding(const char* kind, const std::string& why, const char* section) {
 json fidelity_band(const SimConfig& c, const json& stats, const std::string& structure) {
     json findings = json::array();
     if (c.fidelity == Fidelity::analytic) {
-        const bool lock_step = bool(c.traversal.kind().group_profile);
+        const bool lock_step = c.traversal.kind().needs.lock_step;
         const json& summary = stats.value("summary", json::object());
         const json& r = summary.value("rays", json(nullptr));
         const double rays = r.is_number() ? r.get<double>() : 0.0;

@@ -211,8 +211,11 @@ double VerdictEstimator::dram_bytes(const SimConfig& config) const {
 std::pair<double, std::string> VerdictEstimator::operator()(const SimConfig& config) const {
     const SimConfig a = estimated_config(config);
     if (m_context.estimate) return m_context.estimate(a);
+    // Steady-state cycles, as the structural alternatives': a knob of more units or contexts has
+    // no phases on this analysis (its rounds are the analysed machine's), so a phased base
+    // against it would misstate the knob's gain.
     const ClosedForm form = (*m_form)(a);
-    return {form.cycles, form.binding};
+    return {form.steady_cycles, form.binding};
 }
 
 }  // namespace rtsim
