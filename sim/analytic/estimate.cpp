@@ -441,7 +441,7 @@ void Estimator::phase_windows() {
             s.l1_misses += count * m1, s.l2_misses += count * m12, s.reads += count;
         }
         s.steps = s.work = pw.steps;
-        s.population = pw.rounds > 0 ? pw.steps / pw.rounds / m_c.traversal.units : 0.0;
+        s.population = pw.rounds > 0 ? pw.contexts / pw.rounds / m_c.traversal.units : 0.0;
         m_phase_contexts.push_back(s.population);
         const double fetch = mean_latency(pw.critical);
         m_phase_fetch.push_back(fetch);

@@ -49,15 +49,16 @@ void array_from(const json& j, Array* a) {
 json phases_json(const std::vector<PhaseWindow>& phases) {
     json a = json::array();
     for (const PhaseWindow& w : phases)
-        a.push_back({{"rounds", w.rounds}, {"steps", w.steps}, {"reads", hist_json(w.reads)}, {"critical", hist_json(w.critical)}});
+        a.push_back({{"rounds", w.rounds}, {"steps", w.steps}, {"contexts", w.contexts}, {"reads", hist_json(w.reads)},
+                     {"critical", hist_json(w.critical)}});
     return a;
 }
 
 std::vector<PhaseWindow> phases_from(const json& a) {
     std::vector<PhaseWindow> phases;
     for (const json& e : a)
-        phases.push_back({e.at("rounds").get<double>(), e.at("steps").get<double>(), hist_from(e.at("reads")),
-                          hist_from(e.at("critical"))});
+        phases.push_back({e.at("rounds").get<double>(), e.at("steps").get<double>(), e.at("contexts").get<double>(),
+                          hist_from(e.at("reads")), hist_from(e.at("critical"))});
     return phases;
 }
 

@@ -71,6 +71,7 @@ struct MergeKey {
 struct PhaseWindow {
     double rounds = 0;        ///< rounds in the window
     double steps = 0;         ///< planned steps taken in them
+    double contexts = 0;      ///< contexts busy in them, summed over the rounds (a step, or a ray's end and the next's start)
     // Keys to octaves (MergeKey::octaves): a window's shares of the run, not its absolute
     // figures, are what the estimate takes from them, and the analysis file stays small.
     JointHistogram reads;     ///< their line reads (every data kind)

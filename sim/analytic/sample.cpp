@@ -68,6 +68,7 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
             if (!m_contexts[i].active) continue;
             step(dealer, uint32_t(i / m_slots), uint32_t(i % m_slots), sink);
             any = true;
+            if (m_record_phases) m_phases.back().contexts += 1;  // busy this round, stepping or not
         }
         if (any && m_record_phases) end_round();
     }
@@ -85,7 +86,7 @@ void SampleProfiler::end_round() {
         PhaseCounts& into = m_phases[i];
         if (i > 0) into = std::move(m_phases[2 * i]);
         PhaseCounts& other = m_phases[2 * i + 1];
-        into.rounds += other.rounds, into.steps += other.steps;
+        into.rounds += other.rounds, into.steps += other.steps, into.contexts += other.contexts;
         other.reads.drain([&](uint32_t key, uint64_t n) { into.reads.add(key, n); });
         other.critical.drain([&](uint32_t key, uint64_t n) { into.critical.add(key, n); });
     }
@@ -379,7 +380,7 @@ void SampleProfiler::finish() {
         for (PhaseCounts& w : m_phases) {
             if (w.rounds == 0) continue;
             PhaseWindow& out = m_p.phases.emplace_back();
-            out.rounds = w.rounds, out.steps = w.steps;
+            out.rounds = w.rounds, out.steps = w.steps, out.contexts = w.contexts;
             w.reads.drain([&](uint32_t key, uint64_t n) { out.reads.add(key, double(n)); });
             w.critical.drain([&](uint32_t key, uint64_t n) { out.critical.add(key, double(n)); });
         }

@@ -104,7 +104,7 @@ private:
     KeyCounts m_step_critical, m_ray_critical;
     // Phase windows as counted (whole-trace analyses only; finish() moves them into the profile).
     struct PhaseCounts {
-        double rounds = 0, steps = 0;
+        double rounds = 0, steps = 0, contexts = 0;
         KeyCounts reads, critical;
     };
     std::vector<PhaseCounts> m_phases;
