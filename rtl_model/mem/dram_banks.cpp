@@ -21,10 +21,24 @@ DramAddress DramBanks::map(uint64_t addr) const {
     DramAddress a;
     a.channel = uint32_t(granule % m_config.channels);
     const uint64_t local = (granule / m_config.channels) * m_config.interleave_bytes + addr % m_config.interleave_bytes;
-    a.column = uint32_t(local % m_config.row_bytes);
-    a.bank = uint32_t((local / m_config.row_bytes) % m_config.banks);
-    a.group = a.bank % m_config.bank_groups;
-    a.row = local / m_config.row_bytes / m_config.banks;
+    const uint32_t gi = m_config.group_interleave_bytes, groups = m_config.bank_groups;
+    if (gi == 0 || groups == 1) {
+        a.column = uint32_t(local % m_config.row_bytes);
+        a.bank = uint32_t((local / m_config.row_bytes) % m_config.banks);
+        a.group = a.bank % groups;
+        a.row = local / m_config.row_bytes / m_config.banks;
+        return a;
+    }
+    // Granule k of the channel goes to group k mod G; within a group its bytes fill rows of the
+    // group's banks in turn, as a channel's bytes fill its banks without interleaving (a
+    // bijection: group, bank in group, row and column give the address back).
+    const uint64_t k = local / gi;
+    a.group = uint32_t(k % groups);
+    const uint64_t in_group = (k / groups) * gi + local % gi;
+    const uint32_t per_group = m_config.banks / groups;
+    a.column = uint32_t(in_group % m_config.row_bytes);
+    a.bank = uint32_t((in_group / m_config.row_bytes) % per_group) * groups + a.group;
+    a.row = in_group / m_config.row_bytes / per_group;
     return a;
 }
 
@@ -271,6 +285,7 @@ nlohmann::json DramBanks::stats_json() const {
             {"queue_wait_cycles", m_queue_wait},
             {"queue_full_requests", m_queue_full},
             {"bank_groups", m_config.bank_groups},
+            {"group_interleave_bytes", m_config.group_interleave_bytes},
             {"by_bank", by_bank}};
 }
 

@@ -34,6 +34,9 @@ struct DramConfig {
     uint32_t t_refi = 0;            ///< all-bank refresh interval of a channel (0: no refresh)
     uint32_t t_rfc = 0;             ///< refresh time: every bank busy and precharged
     uint32_t bank_groups = 1;       ///< bank groups per channel (bank b in group b mod groups)
+    /// Bank-group interleaving: consecutive granules of this many bytes of a channel go to
+    /// consecutive bank groups (0: off, a row's bytes stay in one bank and so in one group).
+    uint32_t group_interleave_bytes = 0;
     uint32_t t_rrd_l = 0;           ///< activate to activate of two banks of one group (0: t_rrd)
     uint32_t t_ccd_l = 0;           ///< column to column of two accesses in one bank group
     uint32_t t_wtr = 0;             ///< end of a write's data to a read's column, on a channel
@@ -59,6 +62,7 @@ struct DramConfig {
         v.field("t_refi", t_refi, "cycles", "All-bank refresh interval of a channel, core cycles (model banks; 0: no refresh)", 0, 10000000);
         v.field("t_rfc", t_rfc, "cycles", "Refresh time: every bank of the channel busy and precharged, core cycles (model banks, with t_refi)", 0, 100000);
         v.field("bank_groups", bank_groups, "groups", "Bank groups per channel, bank b in group b mod bank_groups (model banks; 1: no groups; must divide dram.banks)", 1, 256);
+        v.field("group_interleave_bytes", group_interleave_bytes, "bytes", "Bank-group interleaving granule: consecutive granules of a channel go to consecutive bank groups, so streaming lines alternate groups and their column commands are spaced by tCCD_S (the bus) rather than t_ccd_l (model banks; power of two, at least the line size, at most dram.row_bytes; 0: off, a row's bytes in one bank)", 0, 1u << 20);
         v.field("t_rrd_l", t_rrd_l, "cycles", "Activate to activate of two banks in one bank group, at least, core cycles (model banks; t_rrd is then the other groups' figure; 0: t_rrd for all)", 0, 10000);
         v.field("t_ccd_l", t_ccd_l, "cycles", "Column to column of two accesses in one bank group, at least, core cycles (model banks; other groups are spaced by their bursts on the bus; 0: no limit)", 0, 10000);
         v.field("t_wtr", t_wtr, "cycles", "Write-to-read turnaround: end of a write's data to a read's column command on the channel, core cycles (model banks; 0: none)", 0, 10000);

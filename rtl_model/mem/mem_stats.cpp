@@ -79,6 +79,7 @@ const StatBlock& dram_stats() {
                  {"queue_wait_cycles", "cycles", "bank model: cycles requests waited for an entry of their channel's full controller queue (`queue_entries`), summed (0 with no limit)", false, true},
                  {"queue_full_requests", "requests", "bank model: requests that found their channel's controller queue full", false, true},
                  {"bank_groups", "groups", "bank model: bank groups per channel (`dram.bank_groups`)", false, true},
+                 {"group_interleave_bytes", "bytes", "bank model: the bank-group interleaving granule (`dram.group_interleave_bytes`; 0: off)", false, true},
                  {"by_bank", "list", "bank model: `[{channel, bank, accesses, row_hits, row_misses, row_conflicts}]` for every bank accessed", false, true},
              })};
     return block;

@@ -56,7 +56,11 @@ void validate_model(const ModelConfig& config) {
     require(config.dram.banks % config.dram.bank_groups == 0,
             "config: 'dram.bank_groups' (" + std::to_string(config.dram.bank_groups) + ") must divide 'dram.banks' (" +
                 std::to_string(config.dram.banks) + "): every group holds as many banks");
-    require(config.dram.t_refi == 0 || config.dram.t_rfc < config.dram.t_refi,
+    const uint32_t gi = config.dram.group_interleave_bytes;
+    require(gi == 0 || (power_of_two(gi) && gi >= config.l2.line_bytes && gi <= config.dram.row_bytes),
+            "config: 'dram.group_interleave_bytes' (" + std::to_string(gi) +
+                ") must be 0 or a power of two from the line size to 'dram.row_bytes'");
+        require(config.dram.t_refi == 0 || config.dram.t_rfc < config.dram.t_refi,
             "config: 'dram.t_rfc' (" + std::to_string(config.dram.t_rfc) + ") must be below 'dram.t_refi' (" +
                 std::to_string(config.dram.t_refi) + "): a channel must be free between refreshes");
     require(config.dram.t_refi != 0 || config.dram.t_rfc == 0,

@@ -5,6 +5,7 @@
 
 #include <map>
 #include <random>
+#include <tuple>
 
 #include "model_test_util.h"
 #include "rtl_model/mem/dram.h"
@@ -198,6 +199,42 @@ TEST(DramDetailed, CcdLSpacesColumnsOfOneBankGroup) {
     EXPECT_EQ(other.column_wait, 0u);
     EXPECT_EQ(other.done, 24u);
     EXPECT_EQ(banks.stats_json()["column_wait_cycles"], 12);
+}
+
+TEST(DramDetailed, GroupInterleavingAlternatesGroupsLineByLineAndKeepsTheMapABijection) {
+    // 4 banks in 2 groups, 64-byte granules: line k of the channel in group k mod 2; within a
+    // group the lines fill a 1 KiB row of its first bank, then its second bank's, then row 1.
+    DramConfig c = grouped();
+    c.group_interleave_bytes = 64;
+    DramBanks banks(c);
+    for (uint64_t line = 0; line < 8; ++line) EXPECT_EQ(banks.map(line * 64).group, line % 2) << line;
+    const DramAddress a = banks.map(3 * 64 + 5);  // line 3: group 1, its line 1 in the group
+    EXPECT_EQ(a.bank, 1u);
+    EXPECT_EQ(a.column, 64u + 5u);
+    EXPECT_EQ(a.row, 0u);
+    const DramAddress b = banks.map(2 * 1024 + 64);  // line 33: group 1, its line 16: bank 3, column 0
+    EXPECT_EQ(b.bank, 3u);
+    EXPECT_EQ(b.column, 0u);
+    EXPECT_EQ(b.row, 0u);
+    std::map<std::tuple<uint32_t, uint64_t, uint32_t>, uint64_t> seen;  // every byte's own place
+    for (uint64_t addr = 0; addr < 4 * 4 * 1024; addr += 16) {
+        const DramAddress m = banks.map(addr);
+        EXPECT_EQ(m.group, m.bank % 2);
+        EXPECT_TRUE(seen.emplace(std::make_tuple(m.bank, m.row, m.column), addr).second) << addr;
+    }
+    // Streaming lines: with tCCD_L, lines in one group (no interleaving: a row's lines share a
+    // bank) wait for it; alternating groups only for the bus.
+    c.t_ccd_l = 12;
+    DramConfig plain = c;
+    plain.group_interleave_bytes = 0;
+    DramBanks inter(c), flat(plain);
+    Cycle end_inter = 0, end_flat = 0;
+    for (uint64_t line = 0; line < 8; ++line) {
+        end_inter = std::max(end_inter, inter.access(line * 64, 64, 0).done);
+        end_flat = std::max(end_flat, flat.access(line * 64, 64, 0).done);
+    }
+    EXPECT_LT(end_inter, end_flat);
+    EXPECT_GT(flat.stats_json()["column_wait_cycles"].get<uint64_t>(), inter.stats_json()["column_wait_cycles"].get<uint64_t>());
 }
 
 TEST(DramDetailed, RrdLSpacesActivatesOfOneBankGroup) {
