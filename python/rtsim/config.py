@@ -465,7 +465,7 @@ MODIFIERS: dict[str, dict[str, Any]] = {
     "dram-2x": {"dram": {"bytes_per_cycle": 32}},
     "dram-4x": {"dram": {"bytes_per_cycle": 64}},
     # DDR4-2133's second-order limits (DRAMsim3's DDR4_8Gb_x8_2133.ini: tRAS 36, tRRD_S/L 4/6,
-    # tFAW 23, tREFI 8328, tRFC 374, 4 bank groups, tCCD_L 6, tWTR_S/L 3/8, tRTW = CL + BL/2 -
+    # tFAW 23, tREFI 8328, tRFC 374, 4 bank groups, tCCD_L 6, tWTR_S/L 3/8 (2.8 and 7.5 ns), tRTW = CL + BL/2 -
     # CWL + 2 = 11 at tCK 0.94 ns; a 32-entry transaction queue per channel) in 1 GHz core
     # cycles (docs/model.md).
     "ddr4": {
@@ -478,7 +478,8 @@ MODIFIERS: dict[str, dict[str, Any]] = {
             "t_rfc": 350,
             "bank_groups": 4,
             "t_ccd_l": 6,
-            "t_wtr": 5,
+            "t_wtr": 3,
+            "t_wtr_l": 8,
             "t_rtw": 10,
             "queue_entries": 32,
         }

@@ -7,7 +7,7 @@ namespace rtsim {
 DramBanks::DramBanks(const DramConfig& config)
     : m_config(config),
       m_close_page(config.page_policy == PagePolicy::close),
-      m_column_limits(config.t_ccd_l || config.t_wtr || config.t_rtw),
+      m_column_limits(config.t_ccd_l || config.t_wtr || config.t_wtr_l || config.t_rtw),
       m_banks(size_t(config.channels) * config.banks) {
     for (uint32_t c = 0; c < config.channels; ++c) m_buses.emplace_back(config.bytes_per_cycle, 1);
     m_activates.resize(config.channels);
@@ -113,12 +113,15 @@ void DramBanks::record_activate(uint32_t c, uint32_t group, Cycle at) {
 
 Cycle DramBanks::first_column(uint32_t c, uint32_t group, bool write, Cycle burst, Cycle at) const {
     if (!m_column_limits) return at;
-    const Cycle ccd = m_config.t_ccd_l, wtr = m_config.t_wtr, rtw = m_config.t_rtw, cas = m_config.t_cas;
+    const Cycle ccd = m_config.t_ccd_l, rtw = m_config.t_rtw, cas = m_config.t_cas;
+    const Cycle wtr_s = m_config.t_wtr, wtr_l = m_config.t_wtr_l ? m_config.t_wtr_l : m_config.t_wtr;
     for (;;) {
         bool moved = false;
         for (const Column& x : m_columns[c]) {
             // The least distance from x to this command when it follows x (`after`) and from it
             // to x when it precedes x (`before`); a command strictly between is moved past x.
+            // Write to read within one bank group: tWTR_L; across groups: tWTR_S.
+            const Cycle wtr = x.group == group ? wtr_l : wtr_s;
             Cycle after = x.group == group ? ccd : 0, before = after;
             if (x.write && !write && wtr) after = std::max(after, cas + x.burst + wtr);   // read after a write's data
             if (x.write && !write && rtw) before = std::max(before, rtw);                // read, then the write

@@ -28,15 +28,16 @@
 // Bank groups and turnaround, each off at 0 as well: bank b of a channel is in group
 // b mod bank_groups; tRRD_L spaces two activates in one group (tRRD the others), tCCD_L two
 // column commands in one group (other groups are spaced by their bursts on the data bus, tCCD_S);
-// tWTR spaces a read's column command after the end of a write's data on the channel, tRTW a
-// write's column command after a read's. A column command is delayed until each of these holds
+// tWTR spaces a read's column command after the end of a write's data on the channel (tWTR_L,
+// t_wtr_l, when both are in one bank group; tWTR_S, t_wtr, otherwise), tRTW a write's column
+// command after a read's. A column command is delayed until each of these holds
 // against the channel's last 32 column commands, before and after it in time, as activates are
 // for tRRD and tFAW. A controller queue of queue_entries requests per channel: a request holds
 // an entry from its arrival to its last data cycle, and one arriving at a full queue starts when
 // an entry frees (BackfillSlots: a request stamped before bookings already made takes an entry
 // idle long enough before them). Not modelled: FR-FCFS reordering (a request's timing is fixed
 // when it arrives, so a later row hit cannot pass a queued conflict), write queues drained in
-// batches, per-group tWTR_S/tWTR_L (one t_wtr), the command bus.
+// batches, the command bus.
 // At detailed requests normally arrive in time order (units synchronise every cycle), and then
 // this is first come, first served; at approx units run up to a quantum apart, so requests
 // arrive out of order within a quantum and back-fill as below. Only the last 64 bookings per

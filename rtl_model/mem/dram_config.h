@@ -39,7 +39,8 @@ struct DramConfig {
     uint32_t group_interleave_bytes = 0;
     uint32_t t_rrd_l = 0;           ///< activate to activate of two banks of one group (0: t_rrd)
     uint32_t t_ccd_l = 0;           ///< column to column of two accesses in one bank group
-    uint32_t t_wtr = 0;             ///< end of a write's data to a read's column, on a channel
+    uint32_t t_wtr = 0;             ///< end of a write's data to a read's column, on a channel (tWTR_S)
+    uint32_t t_wtr_l = 0;           ///< the same within one bank group (tWTR_L; 0: t_wtr for all)
     uint32_t t_rtw = 0;             ///< a read's column to a write's column, on a channel
     uint32_t queue_entries = 0;     ///< requests a channel's controller holds at once (0: any)
 
@@ -65,7 +66,8 @@ struct DramConfig {
         v.field("group_interleave_bytes", group_interleave_bytes, "bytes", "Bank-group interleaving granule: consecutive granules of a channel go to consecutive bank groups, so streaming lines alternate groups and their column commands are spaced by tCCD_S (the bus) rather than t_ccd_l (model banks; power of two, at least the line size, at most dram.row_bytes; 0: off, a row's bytes in one bank)", 0, 1u << 20);
         v.field("t_rrd_l", t_rrd_l, "cycles", "Activate to activate of two banks in one bank group, at least, core cycles (model banks; t_rrd is then the other groups' figure; 0: t_rrd for all)", 0, 10000);
         v.field("t_ccd_l", t_ccd_l, "cycles", "Column to column of two accesses in one bank group, at least, core cycles (model banks; other groups are spaced by their bursts on the bus; 0: no limit)", 0, 10000);
-        v.field("t_wtr", t_wtr, "cycles", "Write-to-read turnaround: end of a write's data to a read's column command on the channel, core cycles (model banks; 0: none)", 0, 10000);
+        v.field("t_wtr", t_wtr, "cycles", "Write-to-read turnaround: end of a write's data to a read's column command on the channel, core cycles (tWTR_S with t_wtr_l set; model banks; 0: none)", 0, 10000);
+        v.field("t_wtr_l", t_wtr_l, "cycles", "Write-to-read turnaround within one bank group: end of a write's data to a read's column command in the same group, core cycles (tWTR_L; t_wtr is then the other groups' figure, tWTR_S; model banks; 0: t_wtr for all)", 0, 10000);
         v.field("t_rtw", t_rtw, "cycles", "Read-to-write turnaround: a read's column command to a write's on the channel, core cycles (model banks; 0: none)", 0, 10000);
         v.field("queue_entries", queue_entries, "requests", "Requests a channel's controller holds at once, arrival to data; one arriving at a full queue waits for the first to leave (model banks; 0: no limit)", 0, 4096);
     }

@@ -258,6 +258,15 @@ TEST(DramDetailed, TurnaroundsSpaceReadsAndWrites) {
     EXPECT_EQ(read.column_wait, 15u);
     // Reads after reads are not turned around.
     EXPECT_EQ(wtr.access(2 * 1024, 64, 0).column, 25u);
+    // tWTR_L within the write's bank group, tWTR_S (t_wtr) across: bank 1 is in group 1, bank 2
+    // in the write's group 0.
+    c = grouped();
+    c.t_wtr = 3;
+    c.t_wtr_l = 9;
+    DramBanks split(c);
+    EXPECT_EQ(split.access(0, 64, 0, true).column, 10u);  // bank 0, group 0: data 16..19
+    EXPECT_EQ(split.access(1024, 64, 0).column, 23u);     // group 1: 20 + 3
+    EXPECT_EQ(split.access(2 * 1024, 64, 0).column, 29u); // group 0: 20 + 9
     c = grouped();
     c.t_rtw = 7;
     DramBanks rtw(c);
