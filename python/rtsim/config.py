@@ -465,9 +465,9 @@ MODIFIERS: dict[str, dict[str, Any]] = {
     "dram-2x": {"dram": {"bytes_per_cycle": 32}},
     "dram-4x": {"dram": {"bytes_per_cycle": 64}},
     # DDR4-2133's second-order limits (DRAMsim3's DDR4_8Gb_x8_2133.ini: tRAS 36, tRRD_S/L 4/6,
-    # tFAW 23, tREFI 8328, tRFC 374, 4 bank groups, tCCD_L 6, tWTR_S/L 3/8 (2.8 and 7.5 ns), tRTW = CL + BL/2 -
-    # CWL + 2 = 11 at tCK 0.94 ns; a 32-entry transaction queue per channel) in 1 GHz core
-    # cycles (docs/model.md).
+    # tFAW 23, tREFI 8328, tRFC 374, 4 bank groups, tCCD_L 6, tWTR_S/L 3/8 (2.8 and 7.5 ns),
+    # tRTW = CL + BL/2 - CWL + 2 = 11 at tCK 0.94 ns; a 32-entry transaction queue per channel)
+    # in 1 GHz core cycles (docs/model.md).
     "ddr4": {
         "dram": {
             "t_ras": 34,
