@@ -396,18 +396,16 @@ def print_sim_summary(stats: dict[str, Any], console: Console | None = None) -> 
         from rtsim.frame_summary import frame_table
 
         console.print(frame_table(stats))
-    warnings = _get(stats, "summary.study_warnings") or []
-    if warnings:
-        table = _two_column("too small to answer its question (docs/treelets.md)")
-        for w in warnings:
-            table.add_row("[bold yellow]warning[/]", str(w))
-        console.print(table)
-    outside = _get(stats, "summary.fidelity_warnings") or []
-    if outside:
-        table = _two_column("outside the level's measured band (docs/fidelity.md)")
-        for w in outside:
-            table.add_row("[bold yellow]warning[/]", str(w))
-        console.print(table)
+    for key, title in (
+        ("summary.study_warnings", "too small to answer its question (docs/treelets.md)"),
+        ("summary.fidelity_warnings", "outside the level's measured band (docs/fidelity.md)"),
+    ):
+        warnings = _get(stats, key) or []
+        if warnings:
+            table = _two_column(title)
+            for w in warnings:
+                table.add_row("[bold yellow]warning[/]", str(w))
+            console.print(table)
     if _get(stats, "summary.cycles") is not None:
         console.print(utilisation_table(stats))
         if stats.get("verdict") or stats.get("roofline"):

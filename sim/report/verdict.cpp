@@ -248,12 +248,14 @@ std::string verdict_text(const json& v, const json& weighed, const std::string& 
         text += "; co-limit: " + co["keys"][0].get<std::string>() + " and " + co["keys"][1].get<std::string>() +
                 " together " + gain(co["joint"].get<double>()) + " (alone " + gain(co["alone"][0].get<double>()) +
                 ", " + gain(co["alone"][1].get<double>()) + ")";
+    std::string savers;
     for (const json& k : weighed["area_savers"]) {
         char mm2[48];
         std::snprintf(mm2, sizeof mm2, " %+.3f mm^2", k["added_mm2"].get<double>());
-        text += std::string(&k == &weighed["area_savers"][0] ? "; same speed, less area: " : ", ") +
-                k["key"].get<std::string>() + "=" + value_text(k["to"]) + " " + gain(k["speedup"].get<double>()) + mm2;
+        savers += (savers.empty() ? "" : ", ") + k["key"].get<std::string>() + "=" + value_text(k["to"]) + " " +
+                  gain(k["speedup"].get<double>()) + mm2;
     }
+    if (!savers.empty()) text += "; same speed, less area: " + savers;
     if (!not_covered.empty()) text += "; " + not_covered;
     // Another design is not a step of a resource: name the alternatives, priced, with the
     // estimate of those the analytic level could cost on their own analysis.

@@ -65,6 +65,12 @@ void rank(json& knobs) {
     });
 }
 
+json first(const json& list, size_t n) {
+    json out = json::array();
+    for (size_t i = 0; i < list.size() && i < n; ++i) out.push_back(list[i]);
+    return out;
+}
+
 /// Knobs that keep the speed and save area: pipelines a kind's private copies leave idle, shared
 /// by the units instead (a pool of `shared_count`). Curved primitives' and alpha tests' pipelines
 /// are the usual ones: few rays test them, and a pipeline per unit is mostly idle.
@@ -88,15 +94,7 @@ json area_savers(const json& knobs) {
     std::stable_sort(out.begin(), out.end(), [](const json& a, const json& b) {
         return a["added_mm2"].get<double>() < b["added_mm2"].get<double>();
     });
-    json top = json::array();
-    for (size_t i = 0; i < out.size() && i < 3; ++i) top.push_back(out[i]);
-    return top;
-}
-
-json first(const json& list, size_t n) {
-    json out = json::array();
-    for (size_t i = 0; i < list.size() && i < n; ++i) out.push_back(list[i]);
-    return out;
+    return first(out, 3);
 }
 
 /// The three best gains per added mm^2 (knobs the area model prices, that gain at all).

@@ -104,42 +104,40 @@ def _overview(data: SweepData) -> str:
         ],
         ["store", escape(str((data.path / "results.sqlite").resolve()))],
     ]
-    small = [r for r in data.runs if r.summary.get("study_warnings")]
-    if small:
-        # A run too small to answer its question says so (stats `study_size`, docs/treelets.md).
-        items = "".join(
-            f"<li>{escape(data.label(r))} ({escape(r.scene)} / {escape(r.workload)}): "
-            f"{escape('; '.join(r.summary['study_warnings']))}</li>"
-            for r in small[:12]
-        )
-        more = f"<li>and {len(small) - 12} more</li>" if len(small) > 12 else ""
-        rows.append(
-            [
-                "<span class='bad'>too small</span>",
-                f"{len(small)} of {len(data.runs)} runs are too small to answer their question:"
-                f"<ul>{items}{more}</ul>",
-            ]
-        )
-    outside = [r for r in data.runs if r.summary.get("fidelity_warnings")]
-    if outside:
-        # A run whose design the level was measured outside its band on (stats `fidelity_band`).
-        items = "".join(
-            f"<li>{escape(data.label(r))} ({escape(r.scene)} / {escape(r.workload)}): "
-            f"{escape('; '.join(r.summary['fidelity_warnings']))}</li>"
-            for r in outside[:12]
-        )
-        more = f"<li>and {len(outside) - 12} more</li>" if len(outside) > 12 else ""
-        rows.append(
-            [
-                "<span class='bad'>outside its band</span>",
-                f"{len(outside)} of {len(data.runs)} runs are of designs their level was measured "
-                f"outside its band on (docs/fidelity.md):<ul>{items}{more}</ul>",
-            ]
-        )
+    # A run too small to answer its question (stats `study_size`, docs/treelets.md), and one whose
+    # design its level was measured outside its band on (stats `fidelity_band`, docs/fidelity.md).
+    for key, label, what in (
+        ("study_warnings", "too small", "runs are too small to answer their question"),
+        (
+            "fidelity_warnings",
+            "outside its band",
+            "runs are of designs their level was measured outside its band on (docs/fidelity.md)",
+        ),
+    ):
+        row = _warned_runs(data, key, label, what)
+        if row:
+            rows.append(row)
     spec = data.meta.get("spec", "")
     return _table(["", ""], rows) + (
         f"<details><summary>sweep spec</summary><pre>{escape(spec)}</pre></details>" if spec else ""
     )
+
+
+def _warned_runs(data: SweepData, key: str, label: str, what: str) -> list[str] | None:
+    """An overview row listing the runs whose summary `key` holds warnings (the first 12)."""
+    warned = [r for r in data.runs if r.summary.get(key)]
+    if not warned:
+        return None
+    items = "".join(
+        f"<li>{escape(data.label(r))} ({escape(r.scene)} / {escape(r.workload)}): "
+        f"{escape('; '.join(r.summary[key]))}</li>"
+        for r in warned[:12]
+    )
+    more = f"<li>and {len(warned) - 12} more</li>" if len(warned) > 12 else ""
+    return [
+        f"<span class='bad'>{label}</span>",
+        f"{len(warned)} of {len(data.runs)} {what}:<ul>{items}{more}</ul>",
+    ]
 
 
 def _scenes(data: SweepData) -> str:
