@@ -91,8 +91,11 @@ constexpr Flops kSphereFlops{17, 17, 5, 4};
 // a root and a divide for the unit axis), the ray's parts across it (2 x (3 mul + 2 add, 3 mul +
 // 3 sub)), then three of the sphere's quadrics (the cylinder's and the two caps') with their
 // axial checks (2 x (2 mul + 1 add) and 2 compares each), and the nearest of six crossings (6
-// compares).
-constexpr Flops kCapsuleFlops{3 * 17 + 17, 3 * 17 + 24, 3 * 5 + 12, 3 * 4 + 2};
+// compares). The pipeline tests capsules of two radii too (a round cone), which adds the slope
+// k = (r1 - r0) / L and 1 - k^2 (1 sub, 1 mul + 1 sub, a divide), the cone's terms in the body's
+// quadric (8 mul + 3 add), its circles of contact (2 mul + 1 sub), and the ray's origin moved to
+// the segment's midpoint (6 mul + 5 add, a divide).
+constexpr Flops kCapsuleFlops{3 * 17 + 17 + 11, 3 * 17 + 24 + 17, 3 * 5 + 12, 3 * 4 + 2 + 2};
 constexpr std::array<Flops, kOpKindCount> kTestFlops{kBoxFlops,  kTriangleFlops, kAnyhitFlops,
                                                      kTransformFlops, kCellFlops, kPlaneFlops,
                                                      kObbFlops,  kSphereFlops,   kCapsuleFlops};

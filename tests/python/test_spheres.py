@@ -138,9 +138,10 @@ def test_gltf_points_with_radius_are_spheres(tmp_path: Path) -> None:
 def test_gltf_lines_with_radius_are_capsules(tmp_path: Path, mode: int) -> None:
     scene = rtsim._core.load_scene(str(_points_gltf(tmp_path, [0.5, 1.0], mode)))
     tris = np.asarray(scene.triangles())
-    # One capsule (0,0,0)-(6,0,0) under the scale of 2, radius the larger end's: 2.
+    # One capsule (0,0,0)-(6,0,0) under the scale of 2, its radius from 1 to 2: its box is
+    # its end spheres'.
     assert tris.shape == (1, 3, 3)
-    assert np.allclose(tris[0, 0], [-2, -2, -2]) and np.allclose(tris[0, 1], [8, 2, 2])
+    assert np.allclose(tris[0, 0], [-1, -2, -2]) and np.allclose(tris[0, 1], [8, 2, 2])
     assert np.allclose(tris[0, 2], [3, 0, 0])
 
 

@@ -54,7 +54,7 @@ HwTriangle triangle_record(const Scene& scene, uint32_t prim, uint32_t flags) {
     HwTriangle hw;
     if (scene.is_capsule(prim)) {  // docs/bvh_layout.md, "Capsule records"
         const Vec3 &a = scene.capsule_ends[prim][0], &b = scene.capsule_ends[prim][1];
-        return HwTriangle{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {scene.curved_radius[prim], 0.0f, 0.0f}, prim,
+        return HwTriangle{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {scene.curved_radius[prim], scene.end_radius(prim), 0.0f}, prim,
                           scene.tri_instance[prim], flags | kPrimCapsule};
     }
     if (scene.is_sphere(prim)) {  // docs/bvh_layout.md, "Sphere records"

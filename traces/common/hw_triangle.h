@@ -12,8 +12,8 @@ constexpr uint32_t kTriAnyHit = 1u << 0;         ///< alpha-MASK: call the any-h
 /// The record is a sphere (docs/bvh_layout.md, "Sphere records"): v0 its centre, v1[0] its
 /// radius, v1[1..2] and v2 zero.
 constexpr uint32_t kPrimSphere = 1u << 1;
-/// The record is a capsule (docs/bvh_layout.md, "Capsule records"): a sphere of radius v2[0]
-/// swept from v0 to v1; v2[1..2] zero.
+/// The record is a capsule (docs/bvh_layout.md, "Capsule records"): a sphere swept from v0 to
+/// v1, its radius going from v2[0] at v0 to v2[1] at v1; v2[2] zero.
 constexpr uint32_t kPrimCapsule = 1u << 2;
 constexpr uint32_t kTriCoverageShift = 8;        ///< bits 8..15: alpha coverage x 255
 constexpr uint32_t kTriMaterialShift = 16;       ///< bits 16..31: material index

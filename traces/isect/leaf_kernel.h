@@ -40,7 +40,7 @@ inline bool primitive_kernel(const RayTrianglePre& pre, const HwTriangle& rec, f
                              TriangleHit* hit) {
     if (__builtin_expect(is_curved(rec), 0)) {
         if (is_sphere(rec)) return sphere_kernel(pre, rec.v0, rec.v1[0], tmin, tmax, hit);
-        return capsule_kernel(pre, rec.v0, rec.v1, rec.v2[0], tmin, tmax, hit);
+        return capsule_kernel(pre, rec.v0, rec.v1, rec.v2[0], rec.v2[1], tmin, tmax, hit);
     }
     return triangle_kernel(pre, rec.v0, rec.v1, rec.v2, tmin, tmax, hit);
 }

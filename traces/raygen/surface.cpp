@@ -34,18 +34,31 @@ void face_the_ray(SurfacePoint& sp, Vec3 n, const Scene& scene, const Ray& ray, 
 }
 
 /// A curved primitive's hit point (pbrt-v4 Sphere::Intersect): the point on the ray,
-/// reprojected onto the surface (the nearest point of the sphere's centre or the capsule's axis,
-/// plus radius x the unit normal from it), with pbrt's gamma(5) bound, taken here relative to
-/// the world origin (the axis point's magnitude adds to it).
+/// reprojected onto the surface (from the centre of the swept sphere that touches the surface
+/// there: the sphere's centre, or the point of the capsule's axis, plus that sphere's radius x
+/// the unit normal from it), with pbrt's gamma(5) bound, taken here relative to the world origin
+/// (the axis point's magnitude adds to it).
 SurfacePoint curved_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
     const uint32_t prim = uint32_t(hit.prim);
-    const float r = scene.curved_radius[prim];
+    float r = scene.curved_radius[prim];
     const glm::dvec3 p = glm::dvec3(ray.origin) + double(hit.t) * glm::dvec3(ray.direction);
     glm::dvec3 axis_point(sphere_centre(scene.triangles[prim]));
     if (scene.is_capsule(prim)) {
         const glm::dvec3 a(scene.capsule_ends[prim][0]), b(scene.capsule_ends[prim][1]);
-        const double s = glm::clamp(glm::dot(p - a, b - a) / glm::dot(b - a, b - a), 0.0, 1.0);
-        axis_point = a + s * (b - a);
+        const double r0 = r, r1 = scene.end_radius(prim), length = glm::length(b - a);
+        if (length <= std::fabs(r1 - r0)) {  // the larger end sphere holds the other
+            axis_point = r1 > r0 ? b : a;
+            r = float(std::max(r0, r1));
+        } else {
+            // The sphere of centre a + s axis and radius r0 + k s touching p: its normal n has
+            // n.axis = -k, so s = y + q k / sqrt(1 - k^2) (y along the axis, q across it).
+            const glm::dvec3 axis = (b - a) / length;
+            const double k = (r1 - r0) / length, y = glm::dot(p - a, axis);
+            const double q = glm::length(p - a - y * axis);
+            const double s = glm::clamp(y + q * k / std::sqrt(1.0 - k * k), 0.0, length);
+            axis_point = a + s * axis;
+            r = float(r0 + k * s);
+        }
     }
     const Vec3 c(axis_point);
     const glm::dvec3 rel = p - axis_point;

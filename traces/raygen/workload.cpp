@@ -135,8 +135,11 @@ WorkloadPlan plan_workload(const Scene& scene, const std::vector<RayKind>& reque
 namespace {
 
 /// A point on an emissive sphere or capsule, area-uniform as the triangles' (the far half is
-/// shadowed by the light itself): a sphere's by (z, phi); a capsule's on its cylinder or, in
-/// proportion to their area, on its end caps (each the half of its end sphere beyond its end).
+/// shadowed by the light itself): a sphere's by (z, phi); a capsule's on its body or, in
+/// proportion to their area, on its end caps (each the part of its end sphere beyond the body's
+/// circle of contact). With k = (r1 - r0) / L the body's point for the swept sphere of centre
+/// parameter s is that sphere's at n = -k axis + sqrt(1 - k^2) (cos phi, sin phi), and its area
+/// grows with the radius r0 + k s: s is drawn with that density.
 Vec3 curved_light_point(const Scene& scene, uint32_t prim, float u1, float u2) {
     const float r = scene.curved_radius[prim];
     auto on_sphere = [](float a, float b) {
@@ -146,18 +149,28 @@ Vec3 curved_light_point(const Scene& scene, uint32_t prim, float u1, float u2) {
     };
     if (!scene.is_capsule(prim)) return sphere_centre(scene.triangles[prim]) + r * on_sphere(u1, u2);
     const Vec3 a = scene.capsule_ends[prim][0], b = scene.capsule_ends[prim][1];
-    const float length = glm::length(b - a);
+    const float r0 = r, r1 = scene.end_radius(prim), length = glm::length(b - a);
+    if (length <= std::fabs(r1 - r0)) return (r1 > r0 ? b : a) + std::max(r0, r1) * on_sphere(u1, u2);
     const Vec3 axis = (b - a) / length;
-    const float body = length / (length + 2.0f * r);  // 2 pi r L against the caps' 4 pi r^2
-    if (u1 < body) {
-        Vec3 e1, e2;
-        make_basis(axis, &e1, &e2);
-        const float phi = 2.0f * glm::pi<float>() * u2;
-        return a + (u1 / body) * (b - a) + r * (std::cos(phi) * e1 + std::sin(phi) * e2);
+    Vec3 e1, e2;
+    make_basis(axis, &e1, &e2);
+    const float k = (r1 - r0) / length, c = std::sqrt(1.0f - k * k), phi = 2.0f * glm::pi<float>() * u2;
+    const Vec3 ring = std::cos(phi) * e1 + std::sin(phi) * e2;
+    const float band = (r0 + r1) * length * c * c / 2.0f, cap0 = r0 * r0 * (1.0f - k), cap1 = r1 * r1 * (1.0f + k);
+    float u = u1 * (band + cap0 + cap1);  // in units of 2 pi
+    if (u < band) {
+        // s with density r0 + k s: the root of k s^2 / 2 + r0 s = u (L (r0 + r1) / 2) / band.
+        const float area = u / band * length * (r0 + r1) / 2.0f;
+        const float s = 2.0f * area / (r0 + std::sqrt(std::max(0.0f, r0 * r0 + 2.0f * k * area)));
+        return a + s * axis + (r0 + k * s) * (-k * axis + c * ring);
     }
-    const Vec3 d = on_sphere((u1 - body) / (1.0f - body), u2);
-    const bool at_a = glm::dot(d, axis) <= 0.0f;  // each cap holds the directions beyond its end
-    return (at_a ? a : b) + r * d;
+    u -= band;
+    const bool at_a = u < cap0;
+    // z = n.axis uniform over the cap: [-1, -k] at a, [-k, 1] at b.
+    const float f = at_a ? u / cap0 : (u - cap0) / cap1;
+    const float z = at_a ? -1.0f + f * (1.0f - k) : -k + f * (1.0f + k);
+    const Vec3 n = z * axis + std::sqrt(std::max(0.0f, 1.0f - z * z)) * ring;
+    return at_a ? a + r0 * n : b + r1 * n;
 }
 
 }  // namespace

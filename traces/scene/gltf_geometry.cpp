@@ -110,7 +110,7 @@ void read_texcoords(const Source& src, const tinygltf::Primitive& prim, size_t v
 
 /// A POINTS or LINES primitive's radii (docs/accel.md, "Spheres and capsules"): its _RADIUS
 /// attribute, one positive finite float per vertex, appended to out.radii for the spheres or
-/// capsules `list` names (three corners each); a capsule takes the larger of its ends' radii.
+/// capsules `list` names (three corners each); a capsule of two radii fills out.end_radii.
 void read_radii(const Source& src, const tinygltf::Primitive& prim, size_t vertex_count,
                 const std::vector<uint32_t>& list, const std::string& where, Mesh& out) {
     auto it = prim.attributes.find("_RADIUS");
@@ -120,17 +120,21 @@ void read_radii(const Source& src, const tinygltf::Primitive& prim, size_t verte
     AccessorView radius = view_accessor(src, it->second, where + " _RADIUS");
     if (radius.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT || radius.components != 1 || radius.count < vertex_count)
         src.fail(where + ": _RADIUS must be float SCALAR with one entry per vertex");
-    out.radii.resize(out.triangle_count() - list.size() / 3, 0.0f);  // the mesh's earlier triangles
+    const size_t before = out.triangle_count() - list.size() / 3;  // the mesh's earlier triangles
+    out.radii.resize(before, 0.0f);
+    if (!out.end_radii.empty()) out.end_radii.resize(before, 0.0f);
     for (size_t k = 0; k < list.size(); k += 3) {
-        float r = 0.0f;
-        for (uint32_t vertex : {list[k], list[k + 1]}) {
-            const float rv = radius.component(vertex, 0);
-            if (!(rv > 0.0f) || !std::isfinite(rv))
-                src.fail(where + ": vertex " + std::to_string(vertex) + " has _RADIUS " + std::to_string(rv) +
+        float r[2];
+        for (int end = 0; end < 2; ++end) {
+            const uint32_t vertex = list[k + size_t(end)];
+            r[end] = radius.component(vertex, 0);
+            if (!(r[end] > 0.0f) || !std::isfinite(r[end]))
+                src.fail(where + ": vertex " + std::to_string(vertex) + " has _RADIUS " + std::to_string(r[end]) +
                          " (a radius must be positive and finite)");
-            r = std::max(r, rv);
         }
-        out.radii.push_back(r);
+        if (r[0] != r[1] && out.end_radii.empty()) out.end_radii = out.radii;  // the first capsule of two radii
+        out.radii.push_back(r[0]);
+        if (!out.end_radii.empty()) out.end_radii.push_back(r[1]);
     }
 }
 
@@ -179,6 +183,7 @@ void read_primitive(const Source& src, const tinygltf::Primitive& prim, const st
         read_texcoords(src, prim, pos.count, list, where, out);
     }
     if (!out.radii.empty()) out.radii.resize(out.triangle_count(), 0.0f);  // triangles after spheres
+    if (!out.end_radii.empty()) out.end_radii.resize(out.triangle_count(), 0.0f);
 }
 
 }  // namespace

@@ -129,7 +129,7 @@ std::string write_furball(const std::string& dir, const ProceduralOptions& optio
     const bool tessellated = as == Fur::icosahedra;
     if (as == Fur::capsules) {
         // Each strand a chain of capsules through every kCapsuleBeads-th bead and its last one,
-        // a vertex's radius its bead's (a capsule takes the larger of its ends').
+        // a vertex's radius its bead's (a capsule tapers from one end's radius to the other's).
         std::vector<Vec3> vertices;
         std::vector<float> vertex_radii;
         std::vector<uint32_t> segments;

@@ -42,14 +42,14 @@ double largest_axis_scale(const glm::dmat4& m) {
     return s;
 }
 
-/// A sphere (p0 == p1) or capsule (p0 to p1) as a flattened primitive: {lo, hi, centre}, its
+/// A sphere (p0 == p1) or capsule (p0 to p1, radii r0 and r1) as a flattened primitive: {lo, hi, centre}, its
 /// box rounded outward so it holds the whole shape the records store (floats), the centre a
 /// sphere's or the capsule's midpoint.
-Triangle curved_primitive(const Vec3& p0, const Vec3& p1, float r) {
+Triangle curved_primitive(const Vec3& p0, const Vec3& p1, float r0, float r1) {
     Triangle t;
-    for (int a = 0; a < 3; ++a) {
-        t.v0[a] = round_down(double(std::min(p0[a], p1[a])) - double(r));
-        t.v1[a] = round_up(double(std::max(p0[a], p1[a])) + double(r));
+    for (int a = 0; a < 3; ++a) {  // the swept sphere's box is its end spheres' boxes' union
+        t.v0[a] = round_down(std::min(double(p0[a]) - double(r0), double(p1[a]) - double(r1)));
+        t.v1[a] = round_up(std::max(double(p0[a]) + double(r0), double(p1[a]) + double(r1)));
     }
     t.v2 = p0 == p1 ? p0 : Vec3(0.5 * (glm::dvec3(p0) + glm::dvec3(p1)));
     return t;
@@ -71,9 +71,13 @@ void Scene::flatten() {
     tri_material.clear();
     tri_instance.clear();
     curved_radius.clear();
+    curved_end_radius.clear();
     capsule_ends.clear();
     const bool curved = has_curved(), capsules = has_capsules();  // then a radius (ends) per primitive
+    bool two_radii = false;
+    for (const Mesh& m : meshes) two_radii = two_radii || !m.end_radii.empty();
     if (curved) curved_radius.reserve(total);
+    if (two_radii) curved_end_radius.reserve(total);
     if (capsules) capsule_ends.reserve(total);
     triangles.reserve(total);
     tri_material.reserve(total);
@@ -94,14 +98,17 @@ void Scene::flatten() {
         for (size_t t = 0; t < mesh.triangle_count(); ++t) {
             Triangle tri{to_world(mesh.positions[3 * t]), to_world(mesh.positions[3 * t + 1]),
                          to_world(mesh.positions[3 * t + 2])};
-            float radius = 0.0f;
+            float radius = 0.0f, end_radius = 0.0f;
             const std::array<Vec3, 2> ends{tri.v0, tri.v1};
             if (mesh.is_curved(t)) {
                 radius = float(double(mesh.radii[t]) * scale);
-                tri = curved_primitive(ends[0], ends[1], radius);
+                end_radius = float(double(mesh.end_radius(t)) * scale);
+                // A capsule of zero length is the larger of its end spheres.
+                if (ends[0] == ends[1]) radius = end_radius = std::max(radius, end_radius);
+                tri = curved_primitive(ends[0], ends[1], radius, end_radius);
                 // A node scaled to 0 (how glTF hides nodes) leaves radius 0: never hit, as its
                 // triangles would be.
-                if (!(radius >= 0.0f) || !std::isfinite(radius))
+                if (!(radius >= 0.0f) || !std::isfinite(radius) || !(end_radius >= 0.0f) || !std::isfinite(end_radius))
                     throw Error(source + ": mesh " + std::to_string(inst.mesh) + " '" + mesh.name + "' curved primitive " +
                                 std::to_string(t) + (inst.node >= 0 ? " placed by node " + std::to_string(inst.node) : "") +
                                 " has radius " + std::to_string(radius) + " in world space (beyond the float range)");
@@ -117,6 +124,7 @@ void Scene::flatten() {
             tri_material.push_back(mesh.materials[t]);
             tri_instance.push_back(uint32_t(i));
             if (curved) curved_radius.push_back(radius);
+            if (two_radii) curved_end_radius.push_back(end_radius);
             if (capsules) capsule_ends.push_back(mesh.is_capsule(t) ? ends : std::array<Vec3, 2>{tri.v2, tri.v2});
         }
     }
@@ -124,11 +132,15 @@ void Scene::flatten() {
 
 double curved_area(const Scene& scene, uint32_t prim) {
     constexpr double kPi = 3.14159265358979323846;
-    const double r = scene.curved_radius[prim];
+    const double r0 = scene.curved_radius[prim], r1 = scene.end_radius(prim);
     const double length = scene.is_capsule(prim)
                               ? glm::length(glm::dvec3(scene.capsule_ends[prim][1]) - glm::dvec3(scene.capsule_ends[prim][0]))
                               : 0.0;
-    return 2.0 * kPi * r * length + 4.0 * kPi * r * r;
+    if (length <= std::fabs(r1 - r0)) return 4.0 * kPi * std::max(r0, r1) * std::max(r0, r1);  // one sphere holds the other
+    // With k = (r1 - r0) / L: the cone's band pi (r0 + r1) L (1 - k^2), and the caps beyond its
+    // circles of contact, 2 pi r0^2 (1 - k) and 2 pi r1^2 (1 + k); 2 pi r L + 4 pi r^2 at k = 0.
+    const double k = (r1 - r0) / length;
+    return kPi * (r0 + r1) * length * (1.0 - k * k) + 2.0 * kPi * (r0 * r0 * (1.0 - k) + r1 * r1 * (1.0 + k));
 }
 
 size_t Scene::sphere_count() const {

@@ -94,10 +94,14 @@ struct Mesh {
     /// TEXCOORD_0, 3 per triangle like positions; empty when no primitive has it (a mesh with
     /// some primitives lacking it gets (0, 0) there).
     std::vector<glm::vec2> uvs;
-    /// Curved primitives (docs/accel.md, "Spheres and capsules"): one radius per primitive, 0 for
-    /// a triangle; empty when the mesh has none. A sphere's three positions are its centre, a
-    /// capsule's its two ends and the second end again.
+    /// Curved primitives (docs/accel.md, "Spheres and capsules"): one radius per primitive (a
+    /// capsule's at its first end), 0 for a triangle; empty when the mesh has none. A sphere's
+    /// three positions are its centre, a capsule's its two ends and the second end again.
     std::vector<float> radii;
+    /// A capsule's radius at its second end, per primitive; empty when every capsule of the mesh
+    /// has one radius (then it is radii's).
+    std::vector<float> end_radii;
+    float end_radius(size_t prim) const { return end_radii.empty() ? radii[prim] : end_radii[prim]; }
     size_t triangle_count() const { return materials.size(); }
     bool is_curved(size_t prim) const { return !radii.empty() && radii[prim] > 0.0f; }
     bool is_capsule(size_t prim) const { return is_curved(prim) && positions[3 * prim] != positions[3 * prim + 1]; }
@@ -120,7 +124,8 @@ struct Triangle {
 };
 inline Vec3 sphere_centre(const Triangle& t) { return t.v2; }
 struct Scene;
-/// Surface area of curved primitive `prim`: a sphere's 4 pi r^2, a capsule's 2 pi r L + 4 pi r^2.
+/// Surface area of curved primitive `prim`: a sphere's 4 pi r^2, a capsule's 2 pi r L + 4 pi r^2
+/// (with two radii, its cone's band and the two end spheres' caps beyond it).
 double curved_area(const Scene& scene, uint32_t prim);
 
 /// Peak memory of tracing, per flattened triangle (scene, BVH build, hardware image, writer),
@@ -158,6 +163,10 @@ struct Scene {
     /// Per primitive: a sphere's or capsule's world-space radius, 0 for a triangle; empty when
     /// the scene has no curved primitives (filled by flatten()).
     std::vector<float> curved_radius;
+    /// Per primitive: a capsule's world-space radius at its second end (curved_radius is its
+    /// first end's); empty when no capsule has two radii (filled by flatten()).
+    std::vector<float> curved_end_radius;
+    float end_radius(uint32_t prim) const { return curved_end_radius.empty() ? curved_radius[prim] : curved_end_radius[prim]; }
     /// Per primitive: a capsule's two ends in world space (a sphere's or triangle's are its
     /// centre, twice); empty when the scene has no capsules (filled by flatten()).
     std::vector<std::array<Vec3, 2>> capsule_ends;

@@ -22,6 +22,7 @@ Vec3 to_world(const glm::dmat4& m, const Vec3& p) {
 
 void Scene::index_instances() {
     curved_radius.clear();  // no flattened primitives (two levels store no spheres)
+    curved_end_radius.clear();
     uint64_t total = 0;
     std::vector<Aabb> mesh_box(meshes.size());
     for (size_t m = 0; m < meshes.size(); ++m)

@@ -1,6 +1,6 @@
 // Spheres and capsules against Embree 3's own (RTC_GEOMETRY_TYPE_SPHERE_POINT, and
-// RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE with equal radii at both ends of a segment: a capsule;
-// robust mode): the particles, the furball (overlapping beads: many near-ties) and its capsules,
+// RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE with each segment's two radii: the cone touching both end
+// spheres, and the spheres; robust mode): the particles, the furball (overlapping beads: many near-ties) and its capsules,
 // traced by rtsim's BVHs and by Embree with the same rays. Hits must name the same sphere with t within 1e-4 relative; every disagreement
 // must be a graze (the ray passes within 1e-4 of the hit sphere's radius of its centre, where
 // float and double arithmetic may decide differently) or a tie (two spheres crossed within 1e-4
@@ -43,7 +43,7 @@ public:
                                            g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(uint32_t), n))
                                      : nullptr;
         for (size_t i = 0; i < n; ++i) {
-            const float r = scene.curved_radius[i];
+            const float r = scene.curved_radius[i], r_end = scene.end_radius(uint32_t(i));
             if (!capsules) {
                 const Vec3 c = sphere_centre(scene.triangles[i]);
                 v[4 * i] = c.x, v[4 * i + 1] = c.y, v[4 * i + 2] = c.z, v[4 * i + 3] = r;
@@ -52,7 +52,7 @@ public:
             for (int e = 0; e < 2; ++e) {
                 const Vec3 p = scene.capsule_ends[i][size_t(e)];
                 float* out = v + 4 * (2 * i + size_t(e));
-                out[0] = p.x, out[1] = p.y, out[2] = p.z, out[3] = r;
+                out[0] = p.x, out[1] = p.y, out[2] = p.z, out[3] = e == 0 ? r : r_end;
             }
             segment[i] = uint32_t(2 * i);
         }
@@ -105,6 +105,7 @@ Scene sphere_only_scene(const Scene& full) {
         const Vec3 b = capsules ? full.capsule_ends[p][1] : a;
         mesh.positions.insert(mesh.positions.end(), {a, b, b});
         mesh.radii.push_back(full.curved_radius[p]);
+        mesh.end_radii.push_back(full.end_radius(p));
     }
     mesh.materials.assign(mesh.radii.size(), 0u);
     s.meshes.push_back(mesh);
@@ -114,19 +115,25 @@ Scene sphere_only_scene(const Scene& full) {
     return s;
 }
 
-/// The ray passes within a relative 1e-4 of the radius of the hit sphere's centre (the hit
-/// capsule's axis: the closest approach by ternary search, the distance being convex): a graze.
+/// The ray passes within a relative 1e-4 of the hit primitive's radius of its surface (the
+/// swept sphere's signed distance, |q - c(s)| - r(s) at its minimiser s = y + q k / sqrt(1 - k^2);
+/// the closest approach by ternary search, the distance being convex): a graze.
 bool grazes(const Scene& scene, const Ray& r, const Hit& h) {
     if (!h.valid()) return false;
     const uint32_t p = uint32_t(h.prim);
     const glm::dvec3 a(scene.is_capsule(p) ? scene.capsule_ends[p][0] : sphere_centre(scene.triangles[p]));
     const glm::dvec3 b(scene.is_capsule(p) ? scene.capsule_ends[p][1] : sphere_centre(scene.triangles[p]));
+    const double r0 = scene.curved_radius[p], r1 = scene.end_radius(p);
     const glm::dvec3 o(r.origin), d = glm::normalize(glm::dvec3(r.direction));
+    const double length = glm::length(b - a);
+    const bool one_sphere = length <= std::fabs(r1 - r0);
     auto distance = [&](double t) {
-        const glm::dvec3 q = o + t * d, ab = b - a;
-        const double len2 = glm::dot(ab, ab);
-        const double s = len2 > 0.0 ? glm::clamp(glm::dot(q - a, ab) / len2, 0.0, 1.0) : 0.0;
-        return glm::length(q - (a + s * ab));
+        const glm::dvec3 q = o + t * d;
+        if (one_sphere) return r1 > r0 ? glm::length(q - b) - r1 : glm::length(q - a) - r0;
+        const glm::dvec3 axis = (b - a) / length;
+        const double k = (r1 - r0) / length, y = glm::dot(q - a, axis), across = glm::length(q - a - y * axis);
+        const double s = glm::clamp(y + across * k / std::sqrt(1.0 - k * k), 0.0, length);
+        return glm::length(q - (a + s * axis)) - (r0 + k * s);
     };
     double lo = 0.0, hi = 1e4;
     for (int k = 0; k < 200; ++k) {
@@ -134,8 +141,7 @@ bool grazes(const Scene& scene, const Ray& r, const Hit& h) {
         if (distance(m1) < distance(m2)) hi = m2;
         else lo = m1;
     }
-    const double rad = scene.curved_radius[p];
-    return std::fabs(distance(lo) - rad) <= 1e-4 * rad;
+    return std::fabs(distance(lo)) <= 1e-4 * std::max(r0, r1);
 }
 
 void compare(const std::string& name, const Scene& full, const char* kind) {
@@ -184,7 +190,10 @@ void compare(const std::string& name, const Scene& full, const char* kind) {
                 name.c_str(), kind, scene.triangles.size(), rays, hits, graze, tie, occlusion_graze);
     EXPECT_GT(hits, rays / 10) << name;
     EXPECT_EQ(other, 0) << name;
-    EXPECT_LE(graze + tie + occlusion_graze, rays / 1000) << name;
+    EXPECT_LE(graze + occlusion_graze, rays / 1000) << name;
+    // Consecutive capsules of a strand share their joint's sphere (same centre, same radius):
+    // a ray meeting a strand there crosses both at one t.
+    EXPECT_LE(tie, rays / 200) << name;
 }
 
 TEST(EmbreeSpheres, ParticlesFurballAndCapsules) {

@@ -54,7 +54,7 @@ struct ObbNodeFit {
 };
 
 /// Grows `box` by record `rec` in the frame of rotation `m`: a triangle's rotated vertices; a
-/// sphere's rotated centre, or a capsule's rotated ends, widened by the radius (a sphere is the
+/// sphere's rotated centre, or a capsule's rotated ends, widened by their radii (a sphere is the
 /// same in every frame).
 void grow_rotated(Aabb& box, const float* m, const HwTriangle& rec) {
     auto point = [&](const float* p) { return obb_rotate(m, Vec3(p[0], p[1], p[2])); };
@@ -62,11 +62,11 @@ void grow_rotated(Aabb& box, const float* m, const HwTriangle& rec) {
         box.grow(point(rec.v0)), box.grow(point(rec.v1)), box.grow(point(rec.v2));
         return;
     }
-    const float r = is_sphere(rec) ? rec.v1[0] : rec.v2[0];
-    for (const Vec3& c : {point(rec.v0), is_sphere(rec) ? point(rec.v0) : point(rec.v1)}) {
-        box.grow(c - Vec3(r));
-        box.grow(c + Vec3(r));
-    }
+    // A capsule's ends each by their own radius: the swept sphere's box is its end spheres'.
+    const float r0 = is_sphere(rec) ? rec.v1[0] : rec.v2[0], r1 = is_sphere(rec) ? rec.v1[0] : rec.v2[1];
+    const Vec3 c0 = point(rec.v0), c1 = is_sphere(rec) ? c0 : point(rec.v1);
+    box.grow(c0 - Vec3(r0)), box.grow(c0 + Vec3(r0));
+    box.grow(c1 - Vec3(r1)), box.grow(c1 + Vec3(r1));
 }
 
 /// Tries rotations [first, last) on every node, keeping in `fits` each node's best below its
