@@ -341,7 +341,8 @@ BuildSettings resolve_settings(const Entry& e, const std::string& builder, const
 
 /// Refuses (naming the scene, the structure and what would trace it) a scene with curved
 /// primitives on a structure, builder or leaf layout that cannot store them: splits that clip
-/// primitives against planes, compressed leaf blocks (vertex indices), and two levels (not built).
+/// primitives against planes and compressed leaf blocks (vertex indices). Two levels store them in
+/// their BLASes (each BLAS kind's own capability).
 void check_curved_supported(const Scene& scene, const Entry& e, const AccelOptions& o, const BuildSettings& s) {
     if (!scene.has_curved()) return;
     const std::string where = (scene.source.empty() ? std::string("scene") : scene.source) + ": the scene has curved primitives (spheres or capsules)";
@@ -351,7 +352,6 @@ void check_curved_supported(const Scene& scene, const Entry& e, const AccelOptio
     require(e.info.capabilities.curved, where + ", which accel " + o.kind +
                                              " cannot store (its builder clips primitives against planes, or its "
                                              "leaves hold triangles only); trace it with one of: " + kinds);
-    require(!o.two_level, where + ": two-level structures over curved primitives are not built; trace it flattened (--flatten)");
     require(o.builder != "sbvh", where + ": the sbvh builder clips triangles against split planes; use binned, sweep, median or lbvh");
     require(!s.leaves.compressed, where + ": compressed leaves index triangle vertices; set leaves.compressed=false");
 }

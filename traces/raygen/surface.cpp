@@ -39,13 +39,13 @@ void face_the_ray(SurfacePoint& sp, Vec3 n, const Scene& scene, const Ray& ray, 
 /// the unit normal from it), with pbrt's gamma(5) bound, taken here relative to the world origin
 /// (the axis point's magnitude adds to it).
 SurfacePoint curved_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
-    const uint32_t prim = uint32_t(hit.prim);
-    float r = scene.curved_radius[prim];
+    const CurvedShape shape = scene.curved_shape(uint32_t(hit.prim));
+    float r = shape.r0;
     const glm::dvec3 p = glm::dvec3(ray.origin) + double(hit.t) * glm::dvec3(ray.direction);
-    glm::dvec3 axis_point(sphere_centre(scene.triangles[prim]));
-    if (scene.is_capsule(prim)) {
-        const glm::dvec3 a(scene.capsule_ends[prim][0]), b(scene.capsule_ends[prim][1]);
-        const double r0 = r, r1 = scene.end_radius(prim), length = glm::length(b - a);
+    glm::dvec3 axis_point(shape.a);
+    if (shape.capsule()) {
+        const glm::dvec3 a(shape.a), b(shape.b);
+        const double r0 = shape.r0, r1 = shape.r1, length = glm::length(b - a);
         if (length <= std::fabs(r1 - r0)) {  // the larger end sphere holds the other
             axis_point = r1 > r0 ? b : a;
             r = float(std::max(r0, r1));

@@ -141,15 +141,16 @@ namespace {
 /// parameter s is that sphere's at n = -k axis + sqrt(1 - k^2) (cos phi, sin phi), and its area
 /// grows with the radius r0 + k s: s is drawn with that density.
 Vec3 curved_light_point(const Scene& scene, uint32_t prim, float u1, float u2) {
-    const float r = scene.curved_radius[prim];
+    const CurvedShape shape = scene.curved_shape(prim);
+    const float r = shape.r0;
     auto on_sphere = [](float a, float b) {
         const float z = 1.0f - 2.0f * a, phi = 2.0f * glm::pi<float>() * b;
         const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
         return Vec3(ring * std::cos(phi), ring * std::sin(phi), z);
     };
-    if (!scene.is_capsule(prim)) return sphere_centre(scene.triangles[prim]) + r * on_sphere(u1, u2);
-    const Vec3 a = scene.capsule_ends[prim][0], b = scene.capsule_ends[prim][1];
-    const float r0 = r, r1 = scene.end_radius(prim), length = glm::length(b - a);
+    if (!shape.capsule()) return shape.a + r * on_sphere(u1, u2);
+    const Vec3 a = shape.a, b = shape.b;
+    const float r0 = shape.r0, r1 = shape.r1, length = glm::length(b - a);
     if (length <= std::fabs(r1 - r0)) return (r1 > r0 ? b : a) + std::max(r0, r1) * on_sphere(u1, u2);
     const Vec3 axis = (b - a) / length;
     Vec3 e1, e2;

@@ -132,9 +132,10 @@ void read_radii(const Source& src, const tinygltf::Primitive& prim, size_t verte
                 src.fail(where + ": vertex " + std::to_string(vertex) + " has _RADIUS " + std::to_string(r[end]) +
                          " (a radius must be positive and finite)");
         }
-        if (r[0] != r[1] && out.end_radii.empty()) out.end_radii = out.radii;  // the first capsule of two radii
+        const bool two_radii = !out.end_radii.empty() || r[0] != r[1];
+        if (two_radii && out.end_radii.empty()) out.end_radii = out.radii;  // the earlier ones' ends: their radius
         out.radii.push_back(r[0]);
-        if (!out.end_radii.empty()) out.end_radii.push_back(r[1]);
+        if (two_radii) out.end_radii.push_back(r[1]);
     }
 }
 

@@ -40,6 +40,7 @@ const Entry kSphereScenes[] = {
     {"particles", write_particles},
     {"furball", write_furball},
     {"furball_capsules", write_furball_capsules},
+    {"furball_herd", write_furball_herd},
     {"particles_mesh", write_particles_mesh},
     {"furball_mesh", write_furball_mesh},
 };

@@ -7,13 +7,16 @@
 //    a chain of overlapping beads (how hair was traced before swept-sphere primitives; the
 //    strands are as thin and as crossed as the hairball's ribbons, but round);
 //  - furball_capsules: the same strands as chains of capsules through every sixth bead (glTF
-//    LINES with _RADIUS), 8 primitives a strand instead of 48.
+//    LINES with _RADIUS), 8 primitives a strand instead of 48;
+//  - furball_herd: nine furballs of capsules, one mesh placed nine times (two levels).
 // Each has a twin of triangles, "particles_mesh" and "furball_mesh": the same spheres, each an
 // icosahedron with its vertices on the sphere (20 triangles), so a study can set native spheres
 // beside the coarsest tessellation a renderer would use.
 // O(N) and deterministic: every particle and strand draws from its own counter-based stream.
 #include <cmath>
 #include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "traces/common/rng.h"
 #include "traces/scene/gltf_writer.h"
@@ -106,7 +109,9 @@ std::string write_particles(const std::string& dir, const ProceduralOptions& opt
 /// How the furball's strands are written: beads (spheres), their icosahedra, or capsules.
 enum class Fur { beads, icosahedra, capsules };
 
-std::string write_furball(const std::string& dir, const ProceduralOptions& options, Fur as) {
+/// The furball's strands as beads: kStrands chains of kBeads overlapping spheres grown from the
+/// core, curling but always outward, tapering to half the bead radius.
+Spheres fur_beads(const ProceduralOptions& options) {
     Spheres fur_spheres;
     std::vector<Vec3>& centres = fur_spheres.centres;
     std::vector<float>& radii = fur_spheres.radii;
@@ -124,33 +129,71 @@ std::string write_furball(const std::string& dir, const ProceduralOptions& optio
             p += kBeadStep * dir;
         }
     }
+    return fur_spheres;
+}
+
+/// The strands as a capsule mesh: each a chain of capsules through every kCapsuleBeads-th bead
+/// and its last one, a vertex's radius its bead's (a capsule tapers from one end's to the other's).
+int add_fur_capsules(GltfWriter& w, const Spheres& beads, int material) {
+    std::vector<Vec3> vertices;
+    std::vector<float> vertex_radii;
+    std::vector<uint32_t> segments;
+    for (uint32_t s = 0; s < kStrands; ++s) {
+        const size_t first = size_t(s) * kBeads;
+        for (int b = 0; b < kBeads; b += kCapsuleBeads) {
+            const int next = std::min(b + kCapsuleBeads, kBeads - 1);
+            if (b == 0) vertices.push_back(beads.centres[first]), vertex_radii.push_back(beads.radii[first]);
+            vertices.push_back(beads.centres[first + size_t(next)]);
+            vertex_radii.push_back(beads.radii[first + size_t(next)]);
+            segments.insert(segments.end(), {uint32_t(vertices.size() - 2), uint32_t(vertices.size() - 1)});
+            if (next == kBeads - 1) break;
+        }
+    }
+    return w.add_capsule_mesh("fur", vertices, vertex_radii, segments, material);
+}
+
+std::string write_furball(const std::string& dir, const ProceduralOptions& options, Fur as) {
+    const Spheres fur_spheres = fur_beads(options);
     GltfWriter w;
     const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
     const bool tessellated = as == Fur::icosahedra;
-    if (as == Fur::capsules) {
-        // Each strand a chain of capsules through every kCapsuleBeads-th bead and its last one,
-        // a vertex's radius its bead's (a capsule tapers from one end's radius to the other's).
-        std::vector<Vec3> vertices;
-        std::vector<float> vertex_radii;
-        std::vector<uint32_t> segments;
-        for (uint32_t s = 0; s < kStrands; ++s) {
-            const size_t first = size_t(s) * kBeads;
-            for (int b = 0; b < kBeads; b += kCapsuleBeads) {
-                const int next = std::min(b + kCapsuleBeads, kBeads - 1);
-                if (b == 0) vertices.push_back(centres[first]), vertex_radii.push_back(radii[first]);
-                vertices.push_back(centres[first + size_t(next)]), vertex_radii.push_back(radii[first + size_t(next)]);
-                segments.insert(segments.end(), {uint32_t(vertices.size() - 2), uint32_t(vertices.size() - 1)});
-                if (next == kBeads - 1) break;
-            }
-        }
-        w.add_mesh_node("fur", w.add_capsule_mesh("fur", vertices, vertex_radii, segments, fur));
-    } else {
-        add_spheres(w, "fur", fur_spheres, fur, tessellated);
-    }
+    if (as == Fur::capsules) w.add_mesh_node("fur", add_fur_capsules(w, fur_spheres, fur));
+    else add_spheres(w, "fur", fur_spheres, fur, tessellated);
     add_spheres(w, "body", Spheres{{{0.0f, 0.0f, 0.0f}}, {kCoreRadius}}, fur, tessellated);
     w.add_light("key_light", LightType::point, {2.5f, 3.0f, 2.5f}, {0, 0, 0}, {1, 1, 1}, 60.0f);
     w.add_camera("camera", {0.0f, 0.3f, 3.2f}, {0, 0, 0}, 0.7f, 1.0f);
     return w.write(dir, as == Fur::beads ? "furball" : (tessellated ? "furball_mesh" : "furball_capsules"));
+}
+
+constexpr int kHerdSide = 3;  ///< furball_herd: kHerdSide^2 furballs
+
+/// furball_herd: furball_capsules' fur and body placed kHerdSide^2 times on a floor, each turned
+/// about the vertical and scaled uniformly (0.6-1.1): instances of curved primitives, traced in
+/// two levels (each mesh's BLAS once, a TLAS over the placements), as hair and grass are.
+std::string write_furball_herd(const std::string& dir, const ProceduralOptions& options) {
+    const Spheres beads = fur_beads(options);
+    GltfWriter w;
+    const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
+    const int ground = w.add_material(make_material("floor", {0.55f, 0.6f, 0.5f}, 0.0f, 1.0f));
+    const int fur_mesh = add_fur_capsules(w, beads, fur);
+    const int body_mesh = w.add_sphere_mesh("body", {{0.0f, 0.0f, 0.0f}}, {kCoreRadius}, fur);
+    for (int i = 0; i < kHerdSide * kHerdSide; ++i) {
+        Rng rng(hash_combine(options.seed, 0x68657264ull /*"herd"*/, uint64_t(i)));
+        const float scale = 0.6f + 0.5f * rng.next(), turn = 6.28318530718f * rng.next();
+        const Vec3 at(2.2f * float(i % kHerdSide - 1), (kCoreRadius + 0.25f) * scale, -2.2f * float(i / kHerdSide));
+        glm::dmat4 m = glm::translate(glm::dmat4(1.0), glm::dvec3(at));
+        m = glm::rotate(m, double(turn), glm::dvec3(0, 1, 0));
+        m = glm::scale(m, glm::dvec3(scale));
+        const std::string name = "furball_" + std::to_string(i);
+        w.add_mesh_node(name + "_fur", fur_mesh, m);
+        w.add_mesh_node(name + "_body", body_mesh, m);
+    }
+    TriangleSoup floor;
+    floor.add_quad({-4, 0, 2}, {4, 0, 2}, {4, 0, -7}, {-4, 0, -7}, {0, 1, 0});
+    w.add_mesh_node("floor", w.add_mesh("floor", {{&floor, ground}}));
+    w.add_light("key_light", LightType::point, {3.0f, 5.0f, 2.0f}, {0, 0, -2}, {1, 1, 1}, 200.0f);
+    w.add_camera("camera", {0.0f, 3.6f, 5.2f}, {0.0f, 0.2f, -2.4f}, 0.75f, 1.0f);
+    return w.write(dir, "furball_herd");
 }
 
 std::string write_particles(const std::string& dir, const ProceduralOptions& options) {

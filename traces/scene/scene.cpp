@@ -31,16 +31,15 @@ void check_flat_size(const std::string& source, uint64_t triangles, const std::s
     throw Error(source + ": " + what + text);
 }
 
-namespace {
-
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-/// Length of the longest column of the transform's linear part.
 double largest_axis_scale(const glm::dmat4& m) {
     double s = 0.0;
     for (int c = 0; c < 3; ++c) s = std::max(s, glm::length(glm::dvec3(m[c])));
     return s;
 }
+
+namespace {
+
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 /// A sphere (p0 == p1) or capsule (p0 to p1, radii r0 and r1) as a flattened primitive: {lo, hi, centre}, its
 /// box rounded outward so it holds the whole shape the records store (floats), the centre a
@@ -132,10 +131,8 @@ void Scene::flatten() {
 
 double curved_area(const Scene& scene, uint32_t prim) {
     constexpr double kPi = 3.14159265358979323846;
-    const double r0 = scene.curved_radius[prim], r1 = scene.end_radius(prim);
-    const double length = scene.is_capsule(prim)
-                              ? glm::length(glm::dvec3(scene.capsule_ends[prim][1]) - glm::dvec3(scene.capsule_ends[prim][0]))
-                              : 0.0;
+    const CurvedShape s = scene.curved_shape(prim);
+    const double r0 = s.r0, r1 = s.r1, length = glm::length(glm::dvec3(s.b) - glm::dvec3(s.a));
     if (length <= std::fabs(r1 - r0)) return 4.0 * kPi * std::max(r0, r1) * std::max(r0, r1);  // one sphere holds the other
     // With k = (r1 - r0) / L: the cone's band pi (r0 + r1) L (1 - k^2), and the caps beyond its
     // circles of contact, 2 pi r0^2 (1 - k) and 2 pi r1^2 (1 + k); 2 pi r L + 4 pi r^2 at k = 0.
@@ -143,13 +140,30 @@ double curved_area(const Scene& scene, uint32_t prim) {
     return kPi * (r0 + r1) * length * (1.0 - k * k) + 2.0 * kPi * (r0 * r0 * (1.0 - k) + r1 * r1 * (1.0 + k));
 }
 
+namespace {
+
+/// Spheres (capsules when `capsules`) the instances place, for a scene kept as instances.
+size_t placed_curved(const Scene& scene, bool capsules) {
+    std::vector<size_t> in_mesh(scene.meshes.size(), 0);
+    for (size_t m = 0; m < scene.meshes.size(); ++m)
+        for (size_t p = 0; p < scene.meshes[m].radii.size(); ++p)
+            in_mesh[m] += scene.meshes[m].is_curved(p) && scene.meshes[m].is_capsule(p) == capsules ? 1 : 0;
+    size_t n = 0;
+    for (const Instance& inst : scene.instances) n += in_mesh[inst.mesh];
+    return n;
+}
+
+}  // namespace
+
 size_t Scene::sphere_count() const {
+    if (!flattened()) return placed_curved(*this, false);
     size_t n = 0;
     for (uint32_t p = 0; p < curved_radius.size(); ++p) n += is_sphere(p) ? 1 : 0;
     return n;
 }
 
 size_t Scene::capsule_count() const {
+    if (!flattened()) return placed_curved(*this, true);
     size_t n = 0;
     for (uint32_t p = 0; p < capsule_ends.size(); ++p) n += is_capsule(p) ? 1 : 0;
     return n;

@@ -123,6 +123,16 @@ struct Triangle {
     Vec3 v0, v1, v2;
 };
 inline Vec3 sphere_centre(const Triangle& t) { return t.v2; }
+/// Length of the longest column of the transform's linear part: the factor a curved primitive's
+/// radius scales by (a sphere under a non-uniform scale becomes the sphere bounding the ellipsoid).
+double largest_axis_scale(const glm::dmat4& m);
+/// A curved primitive in world space: a sphere (a == b, r0 == r1) or a capsule from a (radius r0)
+/// to b (radius r1).
+struct CurvedShape {
+    Vec3 a, b;
+    float r0 = 0.0f, r1 = 0.0f;
+    bool capsule() const { return a != b; }
+};
 struct Scene;
 /// Surface area of curved primitive `prim`: a sphere's 4 pi r^2, a capsule's 2 pi r L + 4 pi r^2
 /// (with two radii, its cone's band and the two end spheres' caps beyond it).
@@ -143,7 +153,12 @@ struct Scene;
 /// finite, and a scene whose every triangle collapses to zero area in world space (a node scaled
 /// by 0 or 1e-30, a matrix of zeros: no ray could hit anything). `invertible`: every transform
 /// must also invert in single precision (two-level structures trace rays in object space).
+/// Refuses too, when `invertible`, an instance of spheres or capsules whose transform is not a
+/// similarity (is_similarity).
 void check_instance_transforms(const Scene& scene, bool invertible);
+/// True if the transform's linear part is a rotation (or reflection) times a uniform scale, to a
+/// relative 1e-5: a sphere stays a sphere under it.
+bool is_similarity(const glm::dmat4& m);
 
 struct Scene {
     std::string source;  ///< file the scene was read from
@@ -183,9 +198,13 @@ struct Scene {
     /// triangles. Throws rtsim::Error naming `source` if primitive ids would not fit int32.
     void index_instances();
     bool flattened() const { return !triangles.empty(); }
-    bool is_curved(uint32_t prim) const { return !curved_radius.empty() && curved_radius[prim] > 0.0f; }
+    /// Flattened or kept as instances (then looked up in the placing mesh, as world_triangle()).
+    bool is_curved(uint32_t prim) const {
+        return flattened() ? !curved_radius.empty() && curved_radius[prim] > 0.0f : placed_is_curved(prim, false);
+    }
     bool is_capsule(uint32_t prim) const {
-        return is_curved(prim) && !capsule_ends.empty() && capsule_ends[prim][0] != capsule_ends[prim][1];
+        return flattened() ? is_curved(prim) && !capsule_ends.empty() && capsule_ends[prim][0] != capsule_ends[prim][1]
+                           : placed_is_curved(prim, true);
     }
     bool is_sphere(uint32_t prim) const { return is_curved(prim) && !is_capsule(prim); }
     /// Spheres and capsules among the flattened primitives.
@@ -194,6 +213,9 @@ struct Scene {
     /// True if some mesh has curved primitives, and capsules (flattened or not).
     bool has_curved() const;
     bool has_capsules() const;
+    /// World-space curved primitive `prim` (is_curved): the flattened one, or computed as
+    /// flatten() computes it (ends transformed, radii scaled by the transform's largest axis).
+    CurvedShape curved_shape(uint32_t prim) const;
     /// Triangles the instances place: the flattened list's size, or placed_triangles.
     size_t triangle_count() const { return flattened() ? triangles.size() : size_t(placed_triangles); }
     /// Instance that places primitive `prim` (binary search over prim_base).
@@ -206,6 +228,10 @@ struct Scene {
     bool uses_instancing() const;
     /// Index of the default material (white, rough dielectric) appended on demand.
     uint32_t default_material();
+
+private:
+    /// is_curved() (capsule: is_capsule()) of a primitive of a scene kept as instances.
+    bool placed_is_curved(uint32_t prim, bool capsule) const;
 };
 
 }  // namespace rtsim

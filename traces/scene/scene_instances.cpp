@@ -21,12 +21,20 @@ Vec3 to_world(const glm::dmat4& m, const Vec3& p) {
 }  // namespace
 
 void Scene::index_instances() {
-    curved_radius.clear();  // no flattened primitives (two levels store no spheres)
+    curved_radius.clear();  // no flattened primitives (curved_shape() computes them)
     curved_end_radius.clear();
+    capsule_ends.clear();
     uint64_t total = 0;
     std::vector<Aabb> mesh_box(meshes.size());
-    for (size_t m = 0; m < meshes.size(); ++m)
-        for (const Vec3& p : meshes[m].positions) mesh_box[m].grow(p);
+    for (size_t m = 0; m < meshes.size(); ++m) {
+        const Mesh& mesh = meshes[m];
+        for (size_t k = 0; k < mesh.positions.size(); ++k) {
+            const size_t prim = k / 3;
+            const float r = mesh.is_curved(prim) ? std::max(mesh.radii[prim], mesh.end_radius(prim)) : 0.0f;
+            mesh_box[m].grow(mesh.positions[k] - Vec3(r));  // a curved primitive's end spheres
+            mesh_box[m].grow(mesh.positions[k] + Vec3(r));
+        }
+    }
     bounds = Aabb{};
     for (size_t i = 0; i < instances.size(); ++i) {
         Instance& inst = instances[i];
@@ -68,6 +76,36 @@ Triangle Scene::world_triangle(uint32_t prim) const {
     const Vec3* p = &meshes[inst.mesh].positions[3 * size_t(prim - inst.prim_base)];
     return Triangle{to_world(inst.object_to_world, p[0]), to_world(inst.object_to_world, p[1]),
                     to_world(inst.object_to_world, p[2])};
+}
+
+bool Scene::placed_is_curved(uint32_t prim, bool capsule) const {
+    const Instance& inst = instances[instance_of(prim)];
+    const Mesh& mesh = meshes[inst.mesh];
+    const size_t local = prim - inst.prim_base;
+    return capsule ? mesh.is_capsule(local) : mesh.is_curved(local);
+}
+
+CurvedShape Scene::curved_shape(uint32_t prim) const {
+    if (flattened()) {
+        CurvedShape s;
+        s.r0 = curved_radius[prim];
+        s.r1 = end_radius(prim);
+        s.a = s.b = sphere_centre(triangles[prim]);
+        if (is_capsule(prim)) s.a = capsule_ends[prim][0], s.b = capsule_ends[prim][1];
+        return s;
+    }
+    const Instance& inst = instances[instance_of(prim)];
+    const Mesh& mesh = meshes[inst.mesh];
+    const size_t local = prim - inst.prim_base;
+    const glm::dmat4& m = inst.object_to_world;
+    const double scale = largest_axis_scale(m);
+    CurvedShape s;
+    s.a = to_world(m, mesh.positions[3 * local]);
+    s.b = to_world(m, mesh.positions[3 * local + 1]);
+    s.r0 = float(double(mesh.radii[local]) * scale);
+    s.r1 = float(double(mesh.end_radius(local)) * scale);
+    if (s.a == s.b) s.r0 = s.r1 = std::max(s.r0, s.r1);
+    return s;
 }
 
 uint32_t Scene::material_of(uint32_t prim) const {
@@ -119,6 +157,15 @@ bool keeps_area(const Scene& scene, const Instance& inst, bool* mesh_has_area) {
 
 }  // namespace
 
+bool is_similarity(const glm::dmat4& m) {
+    const glm::dvec3 c[3] = {glm::dvec3(m[0]), glm::dvec3(m[1]), glm::dvec3(m[2])};
+    const double s = glm::length(c[0]), tol = 1e-5 * s * s;
+    for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+            if (std::fabs(glm::dot(c[i], c[j]) - (i == j ? s * s : 0.0)) > tol) return false;
+    return true;
+}
+
 void check_instance_transforms(const Scene& scene, bool invertible) {
     int first_collapsed = -1;
     bool area_anywhere = false;
@@ -140,6 +187,13 @@ void check_instance_transforms(const Scene& scene, bool invertible) {
                             "two-level structure cannot invert; fix the node's scale or matrix, or trace "
                             "with --flatten");
         }
+        if (invertible && !scene.meshes[scene.instances[i].mesh].radii.empty())
+            require(is_similarity(m), scene.source + ": " + instance_name(scene, i) + " places mesh '" +
+                                          scene.meshes[scene.instances[i].mesh].name +
+                                          "' of spheres or capsules under a non-uniform scale or a shear; a two-level "
+                                          "structure traces them in object space, where that makes ellipsoids (a "
+                                          "flattened scene takes the bounding sphere): scale the node uniformly, or "
+                                          "trace with --flatten");
         if (area_anywhere && !invertible) continue;
         bool mesh_area = false;
         if (keeps_area(scene, scene.instances[i], &mesh_area)) area_anywhere = true;

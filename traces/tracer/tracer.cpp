@@ -164,10 +164,6 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     // The build may use the tracing threads too: its image does not depend on their number.
     accel_options.build_threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
     check_frames(o.frames, o.flatten, accel_options.two_level, path);
-    // Two levels (shared meshes, deforming or moving frames) store triangles only.
-    require(!accel_options.two_level || !scene.has_curved(),
-            path + ": the scene has curved primitives (spheres or capsules), and shares meshes between nodes or moves over --frames, so it would be "
-                   "traced in two levels, which store triangles only; trace it flattened (--flatten, one frame)");
     if (accel_options.two_level) check_instance_transforms(scene, true);
     if (!accel_options.two_level) scene.flatten();
     double load_ms = ms_since(t_start);

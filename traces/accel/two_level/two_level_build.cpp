@@ -29,10 +29,16 @@ int64_t alpha_key(const Scene& scene, uint32_t material) {
     return m.alpha_mode == AlphaMode::mask ? int64_t(std::lround(m.alpha_coverage * 255.0f)) : -1;
 }
 
+bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
 bool same_geometry(const Scene& scene, const Mesh& a, const Mesh& b) {
     if (a.positions.size() != b.positions.size() ||
         std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3)) != 0)
         return false;
+    // Spheres and capsules: the same centres or ends and the same radii.
+    if (!same_floats(a.radii, b.radii) || !same_floats(a.end_radii, b.end_radii)) return false;
     for (size_t t = 0; t < a.materials.size(); ++t)
         if (alpha_key(scene, a.materials[t]) != alpha_key(scene, b.materials[t])) return false;
     return true;
@@ -327,6 +333,12 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
         require(pose.size() == scene.instances.size(), scene.source + ": a frame poses " +
                                                            std::to_string(pose.size()) + " of " +
                                                            std::to_string(scene.instances.size()) + " instances");
+        // Spheres stay spheres only under similarities (check_instance_transforms, per frame).
+        for (size_t i = 0; i < pose.size(); ++i)
+            require(scene.meshes[scene.instances[i].mesh].radii.empty() || is_similarity(pose[i]),
+                    scene.source + ": frame " + std::to_string(f) + " poses instance " + std::to_string(i) +
+                        " of spheres or capsules with a non-uniform scale or a shear, which a two-level "
+                        "structure would trace as ellipsoids; animate a uniform scale");
         t0 = std::chrono::steady_clock::now();
         frames.push_back(build_tlas(scene, blases, blas_of_mesh[f], pose, options, tlas_tree.reuse_for(f)));
         frame_build[f]["tlas"] = tlas_tree.done(options.build);
