@@ -254,4 +254,3 @@ def test_instanced_spheres_under_a_non_uniform_scale_are_refused(tmp_path: Path)
     made = run_rtsim("trace", str(gltf), "-o", str(tmp_path / "t"), "--resolution", "8x6")
     assert made.returncode != 0 and "non-uniform scale" in made.stderr, made.stderr
     assert "node 1" in made.stderr
-
