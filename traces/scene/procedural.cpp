@@ -41,6 +41,7 @@ const Entry kSphereScenes[] = {
     {"furball", write_furball},
     {"furball_capsules", write_furball_capsules},
     {"furball_herd", write_furball_herd},
+    {"exploding_furball", write_exploding_furball},
     {"particles_mesh", write_particles_mesh},
     {"furball_mesh", write_furball_mesh},
 };

@@ -20,7 +20,8 @@ std::vector<std::string> procedural_scene_names();
 std::vector<std::string> instanced_procedural_scene_names();
 /// Names of the built-in scenes of spheres (procedural_spheres.cpp; BVH kinds only), "particles"
 /// and "furball", the furball's strands as capsules, "furball_capsules", nine of those placed
-/// as instances, "furball_herd" (two levels), and twins of icosahedra, "particles_mesh" and
+/// as instances, "furball_herd" (two levels), those flying apart over frames,
+/// "exploding_furball" (deforming), and twins of icosahedra, "particles_mesh" and
 /// "furball_mesh".
 std::vector<std::string> sphere_procedural_scene_names();
 bool is_procedural_scene(const std::string& name);

@@ -49,6 +49,7 @@ std::string write_particles_mesh(const std::string& dir, const ProceduralOptions
 std::string write_furball_mesh(const std::string& dir, const ProceduralOptions& options);
 std::string write_furball_capsules(const std::string& dir, const ProceduralOptions& options);
 std::string write_furball_herd(const std::string& dir, const ProceduralOptions& options);
+std::string write_exploding_furball(const std::string& dir, const ProceduralOptions& options);
 std::string write_forest(const std::string& dir, const ProceduralOptions& options);
 std::string write_grove(const std::string& dir, const ProceduralOptions& options);
 // Deforming scenes (procedural_moving.cpp): their meshes move over frames (Scene::animation).

@@ -8,7 +8,8 @@
 //    strands are as thin and as crossed as the hairball's ribbons, but round);
 //  - furball_capsules: the same strands as chains of capsules through every sixth bead (glTF
 //    LINES with _RADIUS), 8 primitives a strand instead of 48;
-//  - furball_herd: nine furballs of capsules, one mesh placed nine times (two levels).
+//  - furball_herd: nine furballs of capsules, one mesh placed nine times (two levels);
+//  - exploding_furball: the capsules flying apart over frames (a deforming mesh).
 // Each has a twin of triangles, "particles_mesh" and "furball_mesh": the same spheres, each an
 // icosahedron with its vertices on the sphere (20 triangles), so a study can set native spheres
 // beside the coarsest tessellation a renderer would use.
@@ -163,6 +164,33 @@ std::string write_furball(const std::string& dir, const ProceduralOptions& optio
     w.add_light("key_light", LightType::point, {2.5f, 3.0f, 2.5f}, {0, 0, 0}, {1, 1, 1}, 60.0f);
     w.add_camera("camera", {0.0f, 0.3f, 3.2f}, {0, 0, 0}, 0.7f, 1.0f);
     return w.write(dir, as == Fur::beads ? "furball" : (tessellated ? "furball_mesh" : "furball_capsules"));
+}
+
+/// exploding_furball: furball_capsules' strands flying apart over frames (each capsule moves
+/// away from the centre at its own speed, glTF extras' scatter motion, as exploding_hairball's
+/// triangles do), the body sphere still: curved primitives in a deforming mesh, whose BLAS is
+/// rebuilt or refitted per frame (--frame-policy).
+std::string write_exploding_furball(const std::string& dir, const ProceduralOptions& options) {
+    const Spheres beads = fur_beads(options);
+    GltfWriter w;
+    const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
+    const int ground = w.add_material(make_material("floor", {0.6f, 0.6f, 0.6f}, 0.0f, 1.0f));
+    const int fur_mesh = add_fur_capsules(w, beads, fur);
+    ProceduralMotion scatter;
+    scatter.kind = ProceduralMotion::Kind::scatter;
+    scatter.center = Vec3(0.0f);
+    scatter.speed_min = 0.1f;  // over 60 frames (1 s) the fur spreads to about 2-3x the ball
+    scatter.speed_max = 1.2f;
+    scatter.seed = options.seed;
+    w.set_mesh_motion(fur_mesh, scatter);
+    w.add_mesh_node("fur", fur_mesh);
+    add_spheres(w, "body", Spheres{{{0.0f, 0.0f, 0.0f}}, {kCoreRadius}}, fur, false);
+    TriangleSoup floor;
+    floor.add_quad({-5, -1.0f, -5}, {5, -1.0f, -5}, {5, -1.0f, 5}, {-5, -1.0f, 5}, {0, 1, 0});
+    w.add_mesh_node("floor", w.add_mesh("floor", {{&floor, ground}}));
+    w.add_light("key_light", LightType::point, {2.5f, 3.0f, 2.5f}, {0, 0, 0}, {1, 1, 1}, 60.0f);
+    w.add_camera("camera", {0.0f, 0.5f, 4.4f}, {0, 0, 0}, 0.8f, 1.0f);
+    return w.write(dir, "exploding_furball");
 }
 
 constexpr int kHerdSide = 3;  ///< furball_herd: kHerdSide^2 furballs

@@ -133,8 +133,8 @@ STUDY = Study(
     tables=[Table("accel.md", "moving-scenes", table)],
     figures=[Figure("moving_scenes.png", plot)],
     options={
-        "scenes": ["exploding_hairball", "cloth", "skinned_tube"],
-        "frames": [24, 12, 60],
+        "scenes": ["exploding_hairball", "cloth", "skinned_tube", "exploding_furball"],
+        "frames": [24, 12, 60, 24],
         "resolution": "96x72",
         "policies": list(POLICIES),
     },
