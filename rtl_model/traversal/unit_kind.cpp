@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "rtl_model/common/round_windows.h"
 #include "traces/common/error.h"
 
 namespace rtsim {
@@ -45,16 +46,9 @@ const UnitKind& unit_kind(const std::string& name) {
 }
 
 void GroupWindow::end_round(std::vector<GroupWindow>& windows, double* window_rounds) {
-    if (++windows.back().rounds < *window_rounds) return;
-    if (windows.size() >= kMaxWindows) {
-        for (size_t i = 0; i < windows.size() / 2; ++i) {
-            const GroupWindow a = windows[2 * i], b = windows[2 * i + 1];
-            windows[i] = {a.rounds + b.rounds, a.group_steps + b.group_steps, a.active_lanes + b.active_lanes};
-        }
-        windows.resize(windows.size() / 2);
-        *window_rounds *= 2;
-    }
-    windows.emplace_back();
+    end_window_round(windows, window_rounds, kMaxWindows, [](GroupWindow& into, const GroupWindow& other) {
+        into.rounds += other.rounds, into.group_steps += other.group_steps, into.active_lanes += other.active_lanes;
+    });
 }
 
 GroupProfile& GroupProfile::operator+=(const GroupProfile& o) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "rtl_model/common/ray_state.h"
+#include "rtl_model/common/round_windows.h"
 
 
 namespace rtsim {
@@ -75,24 +76,12 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
 }
 
 void SampleProfiler::end_round() {
-    PhaseCounts& w = m_phases.back();
-    if (++w.rounds < m_window_rounds) return;
-    if (m_phases.size() < AnalyticProfile::kMaxPhaseWindows) {
-        m_phases.emplace_back();
-        return;
-    }
-    // Full: neighbours merged, windows twice as long; the next round opens a new one.
-    for (size_t i = 0; i < m_phases.size() / 2; ++i) {
-        PhaseCounts& into = m_phases[i];
-        if (i > 0) into = std::move(m_phases[2 * i]);
-        PhaseCounts& other = m_phases[2 * i + 1];
-        into.rounds += other.rounds, into.steps += other.steps, into.contexts += other.contexts;
-        other.reads.drain([&](uint32_t key, uint64_t n) { into.reads.add(key, n); });
-        other.critical.drain([&](uint32_t key, uint64_t n) { into.critical.add(key, n); });
-    }
-    m_phases.resize(m_phases.size() / 2);
-    m_window_rounds *= 2;
-    m_phases.emplace_back();
+    end_window_round(m_phases, &m_window_rounds, AnalyticProfile::kMaxPhaseWindows,
+                     [](PhaseCounts& into, PhaseCounts& other) {
+                         into.rounds += other.rounds, into.steps += other.steps, into.contexts += other.contexts;
+                         other.reads.drain([&](uint32_t key, uint64_t n) { into.reads.add(key, n); });
+                         other.critical.drain([&](uint32_t key, uint64_t n) { into.critical.add(key, n); });
+                     });
 }
 
 void SampleProfiler::run_treelets(RayDealer& dealer, RaySinkIf& sink) {
