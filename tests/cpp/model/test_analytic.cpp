@@ -14,6 +14,7 @@
 #include "rtl_model/traversal/packet/packet_profile.h"
 #include "rtl_model/traversal/simt/simt_profile.h"
 #include "sim/analytic/analytic.h"
+#include "traces/common/error.h"
 #include "sim/analytic/analysis_cache.h"
 #include "sim/analytic/closed_form.h"
 #include "sim/analytic/estimate.h"
@@ -421,6 +422,30 @@ TEST(AnalyticClosedForm, L2MshrBoundAddsDramQueueingNearThePeak) {
     c.dram.bytes_per_cycle = 1024;
     const AnalyticDemands light = l2_misses(c, 1e6);
     EXPECT_NEAR(closed_form(c, {}, light).bounds["l2_mshrs"].get<double>(), light.l2_hold / 4, 0.01 * light.l2_hold / 4);
+}
+
+TEST(AnalyticClosedForm, ABoundThatIsNotANumberIsAnErrorNotADroppedCeiling) {
+    // A NaN demand (how a negative base to a fractional power once made a packet run's cycles
+    // NaN) must stop the estimate naming the bound, in the whole run and in a phase window.
+    SimConfig c;
+    AnalyticDemands d = l2_misses(c, 1e5);
+    d.dram_bytes = std::nan("");
+    try {
+        closed_form(c, {}, d);
+        FAIL() << "a NaN DRAM demand was priced";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("bound is not a finite number"), std::string::npos) << e.what();
+    }
+    const AnalyticDemands ok = l2_misses(c, 1e5);
+    PhaseShare window;
+    window.steps = window.work = window.l1_misses = window.l2_misses = window.reads = std::nan("");
+    window.population = 4;
+    try {
+        closed_form(c, {}, ok, {window});
+        FAIL() << "a NaN phase window was priced";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("phase window"), std::string::npos) << e.what();
+    }
 }
 
 TEST(AnalyticClosedForm, L1MshrsAreHeldWhileTheirMissesWaitBelow) {
