@@ -76,9 +76,11 @@ RUNS = [
     Run("default (2 channels)"),
     Run("ddr4 bank limits, 2 channels", DDR4_BANKS),
     Run("ddr4, 2 channels", DDR4),
+    Run("ddr4 + FR-FCFS, 2 channels", (*DDR4, "dram.scheduler=frfcfs")),
     Run("1 channel", ("dram.channels=1",)),
     Run("ddr4 bank limits, 1 channel", ("dram.channels=1", *DDR4_BANKS)),
     Run("ddr4, 1 channel", ("dram.channels=1", *DDR4)),
+    Run("ddr4 + FR-FCFS, 1 channel", ("dram.channels=1", *DDR4, "dram.scheduler=frfcfs")),
     Run("32 units, 1 channel", ("traversal.units=32", "dram.channels=1")),
 ]
 

@@ -8,6 +8,7 @@ DramBanks::DramBanks(const DramConfig& config)
     : m_config(config),
       m_close_page(config.page_policy == PagePolicy::close),
       m_column_limits(config.t_ccd_l || config.t_wtr || config.t_wtr_l || config.t_rtw),
+      m_frfcfs(config.scheduler == DramScheduler::frfcfs && config.page_policy == PagePolicy::open),
       m_banks(size_t(config.channels) * config.banks) {
     for (uint32_t c = 0; c < config.channels; ++c) m_buses.emplace_back(config.bytes_per_cycle, 1);
     m_activates.resize(config.channels);
@@ -205,6 +206,37 @@ DramBanks::Timing DramBanks::plan(const DramAddress& a, Cycle s, OpenRow open, C
     }
 }
 
+bool DramBanks::row_hit_first(Bank& bank, const DramAddress& a, Cycle time, Cycle burst, bool write, Timing* t) {
+    // Before booking p (p >= the first booked after `time`) the row is a.row, and booking p
+    // leaves another open (a conflict, or a refresh's miss): the scheduler, holding this
+    // request since `time`, would pick it first there. At the end of the bookings FCFS does.
+    const uint32_t first = bank.upper_bound(time);
+    uint32_t p = first;
+    auto row_before = [&](uint32_t i) { return i > 0 ? bank.at(i - 1).row : bank.base_row; };
+    while (p < bank.size && !(row_before(p) == a.row && bank.at(p).row != a.row)) ++p;
+    if (p >= bank.size) return false;
+    const Cycle idle = p > 0 ? bank.at(p - 1).end : bank.base_end;
+    const Cycle activated = p > 0 ? bank.at(p - 1).activated : bank.base_activated;
+    Cycle end = 0, act = kNoActivate;
+    const Timing planned = plan(a, std::max(time, idle), OpenRow{a.row, activated, idle}, burst, write, &end, &act);
+    if (planned.result != RowResult::hit) return false;  // a refresh closed the row first
+    *t = planned;
+    const bool forgets = bank.size == Bank::kKept;  // insert() then forgets the oldest booking
+    bank.insert(p, Booking{planned.start, end, a.row, activated});
+    ++m_hits_first;
+    // The bookings it passes move back as far as it overlaps them (their gaps absorb it).
+    uint32_t i = p + 1 - (forgets ? 1 : 0);
+    for (Cycle prev_end = end; i < bank.size && bank.at(i).start < prev_end; ++i) {
+        Booking& b = bank.at(i);
+        const Cycle shift = prev_end - b.start;
+        if (b.activated >= b.start) b.activated += shift;  // its own activate moves with it
+        b.start += shift, b.end += shift;
+        m_moved_back += shift;
+        prev_end = b.end;
+    }
+    return true;
+}
+
 DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time, bool write) {
     const DramAddress a = map(addr);
     Bank& bank = m_banks[size_t(a.channel) * m_config.banks + a.bank];
@@ -217,27 +249,30 @@ DramBanks::Timing DramBanks::access(uint64_t addr, uint32_t bytes, Cycle time, b
         entry = m_queues[a.channel].earliest(time, Cycle(m_config.t_rcd) + m_config.t_cas + burst);
         time = entry.start;
     }
-    // The first idle gap at or after `time` long enough for this access, given the row the
-    // access before it leaves open.
-    uint32_t next = bank.upper_bound(time);
-    OpenRow open{bank.base_row, bank.base_activated, bank.base_end};
-    Cycle s = time;
-    if (next > 0) {
-        const Booking& prev = bank.at(next - 1);
-        open = {prev.row, prev.activated, prev.end};
-        s = std::max(s, prev.end);
-    }
-    Cycle end = 0, act = kNoActivate;
-    Timing t = plan(a, s, open, burst, write, &end, &act);
-    for (; next < bank.size && end > bank.at(next).start; ++next) {
-        const Booking& b = bank.at(next);
-        s = std::max(t.start, b.end);
-        open = {b.row, b.activated, b.end};
+    Timing t;
+    if (!m_frfcfs || !row_hit_first(bank, a, time, burst, write, &t)) {
+        // The first idle gap at or after `time` long enough for this access, given the row the
+        // access before it leaves open.
+        uint32_t next = bank.upper_bound(time);
+        OpenRow open{bank.base_row, bank.base_activated, bank.base_end};
+        Cycle s = time;
+        if (next > 0) {
+            const Booking& prev = bank.at(next - 1);
+            open = {prev.row, prev.activated, prev.end};
+            s = std::max(s, prev.end);
+        }
+        Cycle end = 0, act = kNoActivate;
         t = plan(a, s, open, burst, write, &end, &act);
+        for (; next < bank.size && end > bank.at(next).start; ++next) {
+            const Booking& b = bank.at(next);
+            s = std::max(t.start, b.end);
+            open = {b.row, b.activated, b.end};
+            t = plan(a, s, open, burst, write, &end, &act);
+        }
+        const Cycle activated = act != kNoActivate ? act : open.activated;
+        bank.insert(next, Booking{t.start, end, m_close_page ? kClosed : a.row, activated});
+        if (act != kNoActivate) record_activate(a.channel, a.group, act);
     }
-    const Cycle activated = act != kNoActivate ? act : open.activated;
-    bank.insert(next, Booking{t.start, end, m_close_page ? kClosed : a.row, activated});
-    if (act != kNoActivate) record_activate(a.channel, a.group, act);
     record_column(a.channel, a.group, write, burst, t.column);
     m_ras_wait += t.ras_wait;
     m_activate_wait += t.activate_wait;
@@ -287,6 +322,9 @@ nlohmann::json DramBanks::stats_json() const {
             {"column_wait_cycles", m_column_wait},
             {"queue_wait_cycles", m_queue_wait},
             {"queue_full_requests", m_queue_full},
+            {"scheduler", kDramSchedulerChoices.name(m_config.scheduler)},
+            {"row_hits_first", m_hits_first},
+            {"moved_back_cycles", m_moved_back},
             {"bank_groups", m_config.bank_groups},
             {"group_interleave_bytes", m_config.group_interleave_bytes},
             {"by_bank", by_bank}};

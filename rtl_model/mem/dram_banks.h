@@ -6,7 +6,7 @@
 // "Memory Systems", 2008, ch. 11-13), the way Ramulator's and DRAMSim's simple bank state
 // machines do; docs/model.md has the address map and the hand-worked sequences the tests check.
 //
-// Per request at channel c, bank b, row r, arriving at cycle t (no FR-FCFS reordering):
+// Per request at channel c, bank b, row r, arriving at cycle t (scheduler fcfs):
 //   s   = the first cycle >= t at which the bank is idle long enough for the request; the row
 //         state is that left by the bank's previous access in time
 //   row hit      (open page, row r open):   column at s
@@ -35,9 +35,12 @@
 // for tRRD and tFAW. A controller queue of queue_entries requests per channel: a request holds
 // an entry from its arrival to its last data cycle, and one arriving at a full queue starts when
 // an entry frees (BackfillSlots: a request stamped before bookings already made takes an entry
-// idle long enough before them). Not modelled: FR-FCFS reordering (a request's timing is fixed
-// when it arrives, so a later row hit cannot pass a queued conflict), write queues drained in
-// batches, the command bus.
+// idle long enough before them). Not modelled: write queues drained in batches, the command bus. FR-FCFS (scheduler frfcfs, open page): a request to a row that a
+// booked access leaves open, and that the next booked access closes, is served right after the
+// first (a row hit) instead of after the bank's last booking; the bookings it passes move back
+// by as much as it overlaps them. Their times were already returned: they keep them (optimistic
+// by moved_back_cycles in all; their bus cycles and commands stay where they were booked), but
+// later requests see the bank as the reordered schedule leaves it.
 // At detailed requests normally arrive in time order (units synchronise every cycle), and then
 // this is first come, first served; at approx units run up to a quantum apart, so requests
 // arrive out of order within a quantum and back-fill as below. Only the last 64 bookings per
@@ -129,6 +132,10 @@ private:
         /// Inserts at index i (shifting later ones), then forgets the oldest beyond kKept.
         void insert(uint32_t i, const Booking& b);
     };
+    /// FR-FCFS: the first place after `time` where the bank's bookings leave row a.row open and
+    /// the next booking changes it; there `t` is a row hit booked (the bookings after it moved
+    /// back as far as it overlaps them) and true. False if there is none (FCFS gives the same).
+    bool row_hit_first(Bank& bank, const DramAddress& a, Cycle time, Cycle burst, bool write, Timing* t);
     /// The service of an access to `a` starting no earlier than `s` with the bank as `open`
     /// left it: its start (later past a refresh), row outcome, column command and end.
     Timing plan(const DramAddress& a, Cycle s, OpenRow open, Cycle burst, bool write, Cycle* end,
@@ -153,6 +160,7 @@ private:
     DramConfig m_config;
     bool m_close_page;
     bool m_column_limits;  ///< any of tCCD_L, tWTR, tRTW set
+    bool m_frfcfs;         ///< scheduler frfcfs with open pages
     std::vector<Bank> m_banks;          ///< channel-major: channel * banks + bank
     std::vector<SlotCalendar> m_buses;  ///< one data bus per channel: bytes_per_cycle per cycle
     std::vector<std::vector<Activate>> m_activates;  ///< per channel: its last activates, sorted
@@ -161,6 +169,8 @@ private:
     uint64_t m_totals[3] = {};
     Cycle m_ras_wait = 0, m_activate_wait = 0, m_refresh_wait = 0, m_column_wait = 0, m_queue_wait = 0;
     uint64_t m_queue_full = 0;  ///< requests that found their channel's queue full
+    uint64_t m_hits_first = 0;  ///< FR-FCFS: row hits served ahead of a booked row change
+    Cycle m_moved_back = 0;     ///< FR-FCFS: cycles the bookings they passed moved back, summed
 };
 
 }  // namespace rtsim

@@ -11,6 +11,9 @@ enum class PagePolicy : uint8_t { open = 0, close = 1 };
 inline constexpr Choices<PagePolicy, 2> kPagePolicyChoices{{"open", "close"}};
 
 enum class DramModel : uint8_t { banks = 0, bandwidth = 1 };
+
+enum class DramScheduler : uint8_t { fcfs = 0, frfcfs = 1 };
+inline constexpr Choices<DramScheduler, 2> kDramSchedulerChoices{{"fcfs", "frfcfs"}};
 inline constexpr Choices<DramModel, 2> kDramModelChoices{{"banks", "bandwidth"}};
 
 struct DramConfig {
@@ -43,6 +46,8 @@ struct DramConfig {
     uint32_t t_wtr_l = 0;           ///< the same within one bank group (tWTR_L; 0: t_wtr for all)
     uint32_t t_rtw = 0;             ///< a read's column to a write's column, on a channel
     uint32_t queue_entries = 0;     ///< requests a channel's controller holds at once (0: any)
+    /// The controller's order: first come first served, or row hits first (FR-FCFS; open page)
+    DramScheduler scheduler = DramScheduler::fcfs;
 
     template <class V>
     void visit(V& v) {
@@ -70,6 +75,7 @@ struct DramConfig {
         v.field("t_wtr_l", t_wtr_l, "cycles", "Write-to-read turnaround within one bank group: end of a write's data to a read's column command in the same group, core cycles (tWTR_L; t_wtr is then the other groups' figure, tWTR_S; model banks; 0: t_wtr for all)", 0, 10000);
         v.field("t_rtw", t_rtw, "cycles", "Read-to-write turnaround: a read's column command to a write's on the channel, core cycles (model banks; 0: none)", 0, 10000);
         v.field("queue_entries", queue_entries, "requests", "Requests a channel's controller holds at once, arrival to data; one arriving at a full queue waits for the first to leave (model banks; 0: no limit)", 0, 4096);
+        v.choice("scheduler", scheduler, kDramSchedulerChoices, "Controller order (model banks, open page): fcfs serves a bank's requests as they arrive; frfcfs serves a request to a row a booked access leaves open right after that access, ahead of the booked accesses that change the row, which move back (Rixner et al. 2000's first-ready FCFS; docs/model.md)");
     }
 };
 

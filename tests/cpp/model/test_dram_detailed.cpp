@@ -91,6 +91,34 @@ TEST(DramDetailed, OpenPageRowHitMissConflictSequence) {
     });
 }
 
+TEST(DramDetailed, FrFcfsServesARowHitAheadOfABookedConflict) {
+    // Worked by hand (docs/model.md): request 3 finds row 0 open until cycle 14 and request 2's
+    // conflict booked after it; FR-FCFS serves it there as a hit and moves request 2 back by its
+    // burst (request 2 keeps the times it was given: moved_back_cycles counts them).
+    DramConfig c = small();
+    ASSERT_TRUE(kDramSchedulerChoices.parse("frfcfs", &c.scheduler));
+    run_table(c, {
+        // addr  arrive  result          column  done  ready
+        {0,      0,      Row::miss,      10,     20,   104},  // bank 0: activate 0, column 10
+        {2048,   1,      Row::conflict,  32,     42,   126},  // row 1 after it: precharge 14, activate 22
+        {64,     2,      Row::hit,       14,     24,   108},  // row 0 still open at 14: ahead of row 1
+        {2112,   50,     Row::hit,       50,     60,   144},  // row 1 is the bank's last row again
+    });
+    DramBanks banks(c);
+    for (auto [addr, at] : {std::pair<uint64_t, Cycle>{0, 0}, {2048, 1}, {64, 2}}) banks.access(addr, 64, at);
+    const nlohmann::json j = banks.stats_json();
+    EXPECT_EQ(j["row_hits_first"], 1);
+    EXPECT_EQ(j["moved_back_cycles"], 4);
+    EXPECT_EQ(j["scheduler"], "frfcfs");
+    // First come, first served: request 3 waits behind the conflict and pays one of its own.
+    run_table(small(), {
+        {0,      0,      Row::miss,      10,     20,   104},
+        {2048,   1,      Row::conflict,  32,     42,   126},
+        {64,     2,      Row::conflict,  54,     64,   148},  // precharge 36, activate 44
+        {2112,   50,     Row::conflict,  76,     86,   170},  // precharge 58, activate 66
+    });
+}
+
 TEST(DramDetailed, ClosePageEveryAccessActivates) {
     run_table(small("close"), {
         {0,    0,   Row::miss, 10, 20, 104},  // bank 0 precharges after the burst: ready 10+4+8 = 22
