@@ -183,8 +183,10 @@ LevelResult run_statistical(RunInputs& in) {
         const auto form = std::make_shared<FormEstimator>(*p);
         v.estimate = [form](const SimConfig& x) {
             const ClosedForm f = (*form)(x);
-            return std::make_pair(f.cycles, f.binding);
+            return std::make_pair(f.steady_cycles, f.binding);
         };
+        const ClosedForm own = (*form)(in.config());
+        v.phase_cycles = std::max(0.0, own.cycles - own.steady_cycles);
         v.estimate_bytes = [form](const SimConfig& x) { return (*form)(x).dram_bytes; };
         v.estimate_method = "the analytic level's per-trace analysis (" + std::to_string(p->stepped_rays) +
                             " stepped rays)";

@@ -73,9 +73,12 @@ struct VerdictContext {
     /// The run's unit kind as the verdict needs it (the resolution step's, sim/resolve/resolve.h).
     UnitTraits unit = {};
     uint64_t sample_rays = 8192;  ///< rays the analytic estimates run on (evenly spread blocks)
-    /// When set, the analytic estimates (cycles, binding bound) come from it instead: the
-    /// analytic level passes its own per-trace analysis, so it needs no second pass over rays.
+    /// When set, the analytic estimates (steady-state cycles, binding bound) come from it instead:
+    /// the analytic level passes its own per-trace analysis, so it needs no second pass over rays.
     std::function<std::pair<double, std::string>(const SimConfig&)> estimate = {};
+    /// With `estimate`: the cycles the run's phases (fill and drain) add to its steady state at
+    /// the run's own config (VerdictEstimator::phase_cycles); unset (< 0): none known.
+    double phase_cycles = -1;
     std::string estimate_method = {};  ///< how `estimate` estimates, for the verdict's text
     /// With `estimate`: the DRAM bytes its estimate moves for a config (unset: not known).
     std::function<double(const SimConfig&)> estimate_bytes = {};

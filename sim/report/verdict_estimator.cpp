@@ -155,9 +155,10 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
         return out;
     }
     try {
-        // Steady-state cycles on both sides: an alternative's analysis may keep no phases
-        // (treelets, lock-step kinds), and a phased base against it would favour the alternative.
-        const double base = sample_form()(m_dram.apply(analytic_config(config, c.unit.estimate_as))).steady_cycles;
+        // Steady-state cycles on both sides plus the run's phases: an alternative's analysis may
+        // keep no phases (treelets, lock-step kinds), and a phased base against it would favour it.
+        const double base =
+            sample_form()(m_dram.apply(analytic_config(config, c.unit.estimate_as))).steady_cycles + phase_cycles();
         bool reused = false;
         double cycles = 0;
         if (k.trace) {
@@ -171,7 +172,7 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
             const SimConfig a = analytic_config(alt->config, stand_in_of(alt->config));
             const auto profile = sample_analysis(a, *alt->accel, *alt->map, alt->step, alt->sample_stream,
                                                  alt->identity, alt->path, 0, alt->rays, c.sample_rays, &reused);
-            cycles = FormEstimator(*profile)(m_dram.apply(a)).steady_cycles;
+            cycles = FormEstimator(*profile)(m_dram.apply(a)).steady_cycles + phase_cycles();
             out.method = "the analytic level on the same " + std::to_string(uint64_t(profile->stepped_rays)) +
                          " sampled rays of the alternative trace beside this one";
         } else {
@@ -183,7 +184,7 @@ StructuralEstimate VerdictEstimator::structural(const Knob& k, const SimConfig& 
             }
             const SimConfig a = analytic_config(relaxed, as);
             const auto profile = own_sample(a, &reused);
-            cycles = FormEstimator(*profile)(m_dram.apply(a)).steady_cycles;
+            cycles = FormEstimator(*profile)(m_dram.apply(a)).steady_cycles + phase_cycles();
             out.method = "the analytic level on the same " + std::to_string(uint64_t(profile->stepped_rays)) +
                          " sampled rays with " + setting_text(k.relax);
         }
@@ -208,14 +209,29 @@ double VerdictEstimator::dram_bytes(const SimConfig& config) const {
     return m_form ? (*m_form)(a).dram_bytes : 0.0;
 }
 
+double VerdictEstimator::phase_cycles() const {
+    if (m_phase_cycles >= 0) return m_phase_cycles;
+    m_phase_cycles = 0;
+    if (m_context.estimate) {
+        m_phase_cycles = std::max(0.0, m_context.phase_cycles);
+    } else if (m_form) {
+        const ClosedForm f = (*m_form)(estimated_config(m_context.config));
+        m_phase_cycles = std::max(0.0, f.cycles - f.steady_cycles);
+    }
+    return m_phase_cycles;
+}
+
 std::pair<double, std::string> VerdictEstimator::operator()(const SimConfig& config) const {
     const SimConfig a = estimated_config(config);
-    if (m_context.estimate) return m_context.estimate(a);
-    // Steady-state cycles, as the structural alternatives': a knob of more units or contexts has
-    // no phases on this analysis (its rounds are the analysed machine's), so a phased base
-    // against it would misstate the knob's gain.
+    // A steady state plus the run's phases, as the structural alternatives': the phases are the
+    // analysed machine's (a knob of more units or contexts has no windows of its own on this
+    // analysis), and fill and drain, bound by latency, stay when a knob speeds the steady state.
+    if (m_context.estimate) {
+        const auto [steady, binding] = m_context.estimate(a);
+        return {steady + phase_cycles(), binding};
+    }
     const ClosedForm form = (*m_form)(a);
-    return {form.steady_cycles, form.binding};
+    return {form.steady_cycles + phase_cycles(), form.binding};
 }
 
 }  // namespace rtsim

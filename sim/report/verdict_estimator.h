@@ -39,6 +39,11 @@ public:
     /// model or treelets flipped analyse the run's trace under the relaxed config. Both designs'
     /// analyses are stored beside their traces, so later runs load them.
     StructuralEstimate structural(const Knob& knob, const SimConfig& config) const;
+    /// The cycles the run's phases (fill and drain) add to its steady state, at the run's own
+    /// config: every estimate is a steady state plus these (0 when the analysis kept no phases).
+    /// The fill and drain are latency-bound, so a knob that speeds the steady state leaves them
+    /// (Amdahl): on a short trace its gain is that much smaller than the steady state's.
+    double phase_cycles() const;
     /// How the estimates are made, for the verdict's text.
     const std::string& method() const { return m_method; }
     /// True when the analysis was loaded from beside the trace (not stepped by this run).
@@ -63,6 +68,7 @@ private:
     std::unique_ptr<AnalyticProfile> own_sample(const SimConfig& config, bool* reused) const;
     std::string m_method;
     bool m_reused = false;
+    mutable double m_phase_cycles = -1;  ///< phase_cycles(), once computed
     DramLatencyCalibration m_dram;
     /// analytic_config of `config` with the calibrated DRAM latency: what every estimate times.
     SimConfig estimated_config(const SimConfig& config) const;
