@@ -48,8 +48,7 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
     std::fill(m_unit_pos.begin(), m_unit_pos.end(), 0);
     RayDealer dealer(m_c.dispatch, m_units, stream);
     // The phases are the run's only when one cluster holds the whole trace from its first ray.
-    m_record_phases = ++m_clusters_run == 1 && !m_partition && measure_first == 0 &&
-                      measure_end >= stream.total_rays();
+    m_record_phases = ++m_clusters_run == 1 && measure_first == 0 && measure_end >= stream.total_rays();
     m_phases.clear();
     m_window_rounds = 1;
     if (m_record_phases) m_phases.emplace_back();
@@ -101,7 +100,9 @@ void SampleProfiler::run_treelets(RayDealer& dealer, RaySinkIf& sink) {
             if (!m_contexts[i].active && !take_ray(unit, slot)) continue;
             step(dealer, unit, slot, sink);
             any = true;
+            if (m_record_phases) m_phases.back().contexts += 1;
         }
+        if (any && m_record_phases) end_round();
     }
 }
 
