@@ -267,6 +267,7 @@ const std::vector<Entry>& registry() {
         {{"obvh2", "binary BVH whose nodes may hold their child boxes in a rotated frame (oriented boxes, as RDNA 4)",
           tree_builder_names(),
           single_level(kBvhStackEntryBytes)
+              .with(&AccelCapabilities::packet_kernel)
               .with(&AccelCapabilities::anyhit_order)
               .with(&AccelCapabilities::stack_addresses)
               .with(&AccelCapabilities::curved)},

@@ -19,6 +19,7 @@ void detail::Bvh2LaneRules::plan(StepPlan& plan, uint32_t ref, uint32_t count) c
     if (count == 0) {
         plan.reset(ref);
         plan.add_fetch(view.node_base + uint64_t(ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+        if (view.oriented(ref)) plan.add_op(OpKind::obb, 1);
         plan.add_op(OpKind::box, 2);
     } else {
         plan.reset(kNoLocality);  // a leaf's triangles belong to its node's treelet
@@ -66,6 +67,7 @@ void Bvh2PacketStepper::plan_next() {
         ++m_counts.node_steps;
         m_plan.reset(m_ref);
         m_plan.add_fetch(m_view.node_base + uint64_t(m_ref) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+        if (m_view.oriented(m_ref)) m_plan.add_op(OpKind::obb, rays);  // each ray rotated first
         m_plan.add_op(OpKind::box, 2 * rays);
     } else {
         ++m_counts.leaf_steps;
@@ -82,14 +84,13 @@ StepOutcome Bvh2PacketStepper::execute() {
     if (m_plan.done) return out;
     if (m_split) {
         bool more = false;
-        out.add_op(OpKind::anyhit, detail::split_step(m_lanes, m_view.nodes, m_view.triangles, m_stack, m_walk, &m_ref,
-                                                      &m_count, &more));
+        out.add_op(OpKind::anyhit, detail::split_step(m_lanes, m_view, m_stack, m_walk, &m_ref, &m_count, &more));
         if (more) plan_next();
         else finish();
         return out;
     }
     if (m_count == 0) {
-        if (detail::packet_descend(m_lanes, m_active, m_view.nodes[m_ref], m_stack, m_stack_size, &m_ref, &m_count,
+        if (detail::packet_descend(m_lanes, m_active, m_view, m_ref, m_stack, m_stack_size, &m_ref, &m_count,
                                    &m_active))
             plan_next();
         else
@@ -135,11 +136,11 @@ void trace_packet_bvh2(const Bvh2View& bvh, const Ray* rays, const TraversalMode
         ++(count == 0 ? c.node_steps : c.leaf_steps);
         if (split) {
             ++c.split_steps;
-            detail::split_step(p, bvh.nodes, bvh.triangles, stack, walk, &ref, &count, &more);
+            detail::split_step(p, bvh, stack, walk, &ref, &count, &more);
             continue;
         }
         if (count == 0) {
-            if (detail::packet_descend(p, active, bvh.nodes[ref], stack, size, &ref, &count, &active)) continue;
+            if (detail::packet_descend(p, active, bvh, ref, stack, size, &ref, &count, &active)) continue;
         } else {
             detail::packet_leaf(p, active, bvh.triangles + ref, count);
         }

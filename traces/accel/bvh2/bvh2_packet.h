@@ -22,8 +22,7 @@ struct Bvh2LaneRules {
     Bvh2View view;
     bool descend(PacketLanes& p, uint32_t r, uint32_t* ref, uint32_t* count, std::vector<Entry>& stack,
                  int& size) const {
-        return detail::descend(p.box[r], view.nodes[*ref], p.ray[r].tmin, p.cull[r], p.work[r], stack.data(), size,
-                               ref, count, p.order_of(r));
+        return detail::lane_descend(p, r, view, ref, count, stack.data(), size);
     }
     void plan(StepPlan& plan, uint32_t ref, uint32_t count) const;
     const HwTriangle* leaf(uint32_t ref) const { return view.triangles + ref; }

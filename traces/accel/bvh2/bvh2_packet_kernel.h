@@ -25,15 +25,19 @@
 #include <cstdint>
 
 #include "traces/accel/bvh2/bvh2_kernel.h"
+#include "traces/accel/bvh2/bvh2_stepper.h"
 #include "traces/accel/packet_kernel.h"
 
 namespace rtsim::detail {
 
-/// The packet's node step over `active` rays: pushes the second child entered onto
-/// stack[size++] and names the first in *ref / *count / *mask. Returns false when no active ray
-/// hits a child (the caller pops).
-inline bool packet_descend(PacketLanes& p, LaneMask active, const HwNode& node, PacketStackEntry* stack,
+/// The packet's node step over `active` rays at node `at` of `view`: pushes the second child
+/// entered onto stack[size++] and names the first in *ref / *count / *mask. Returns false when no
+/// active ray hits a child (the caller pops). An oriented node (obvh2) is tested by each ray
+/// rotated into its frame, as a single ray tests it (one obb rotation per active ray).
+inline bool packet_descend(PacketLanes& p, LaneMask active, const Bvh2View& view, uint32_t at, PacketStackEntry* stack,
                            int& size, uint32_t* ref, uint32_t* count, LaneMask* mask) {
+    const HwNode& node = view.nodes[at];
+    const bool oriented = view.oriented(at);
     LaneMask hit[2] = {0, 0};
     float tn[2][kMaxPacketLanes];
     uint32_t both = 0, far_first = 0;  // rays hitting both children; those entering child 1 first
@@ -41,7 +45,14 @@ inline bool packet_descend(PacketLanes& p, LaneMask active, const HwNode& node, 
         p.work[r].steps += 1;
         p.work[r].box_tests += 2;
         float t[2];
-        const unsigned m = node_step(p.box[r], node, p.ray[r].tmin, p.cull[r], t);
+        unsigned m;
+        if (oriented) {
+            p.work[r].obb_rotations += 1;
+            const OrientedNode o = oriented_node(view, at, p.ray[r], obb_pad(p.ray[r].origin, view.scene_radius));
+            m = node_step(o.pre, o.node, p.ray[r].tmin, p.cull[r], t);
+        } else {
+            m = node_step(p.box[r], node, p.ray[r].tmin, p.cull[r], t);
+        }
         tn[0][r] = t[0];
         tn[1][r] = t[1];
         if (m & 1u) hit[0] |= lane_bit(r);
@@ -123,18 +134,29 @@ inline bool split_next_ray(const PacketLanes& p, const PacketStackEntry* shared,
 
 /// One step of ray s.ray alone at (ref, count): the single-ray node or leaf step. Returns the
 /// alpha tests it ran; sets *ref / *count to its next step, false in *more when every ray is done.
-inline uint32_t split_step(PacketLanes& p, const HwNode* nodes, const HwTriangle* triangles,
-                           const PacketStackEntry* shared, SplitWalk& s, uint32_t* ref, uint32_t* count, bool* more) {
+/// Ray r's single-ray node step at node `at` of `view` (rotated into an oriented node's frame).
+inline bool lane_descend(PacketLanes& p, uint32_t r, const Bvh2View& view, uint32_t* ref, uint32_t* count,
+                         Bvh2StackEntry* stack, int& size) {
+    const uint32_t at = *ref;
+    if (!view.oriented(at))
+        return descend(p.box[r], view.nodes[at], p.ray[r].tmin, p.cull[r], p.work[r], stack, size, ref, count,
+                       p.order_of(r));
+    p.work[r].obb_rotations += 1;
+    const OrientedNode o = oriented_node(view, at, p.ray[r], obb_pad(p.ray[r].origin, view.scene_radius));
+    return descend(o.pre, o.node, p.ray[r].tmin, p.cull[r], p.work[r], stack, size, ref, count, p.order_of(r));
+}
+
+inline uint32_t split_step(PacketLanes& p, const Bvh2View& view, const PacketStackEntry* shared, SplitWalk& s,
+                           uint32_t* ref, uint32_t* count, bool* more) {
     const uint32_t r = s.ray;
     uint32_t alpha = 0;
     if (*count == 0) {
-        if (descend(p.box[r], nodes[*ref], p.ray[r].tmin, p.cull[r], p.work[r], s.stack, s.size, ref, count,
-                    p.order_of(r))) {
+        if (lane_descend(p, r, view, ref, count, s.stack, s.size)) {
             *more = true;
             return 0;
         }
     } else {
-        alpha = packet_leaf(p, lane_bit(r), triangles + *ref, *count);
+        alpha = packet_leaf(p, lane_bit(r), view.triangles + *ref, *count);
     }
     *more = ((p.live & lane_bit(r)) && split_pop(p, s, ref, count)) || split_next_ray(p, shared, s, ref, count);
     return alpha;

@@ -100,17 +100,10 @@ uint32_t Bvh2Stepper::stack_reads(Fetch* out, uint32_t max) const {
     return tree_stack_reads(m_stack, m_stack_size, m_view.node_base, uint32_t(sizeof(HwNode)), m_view.tri_at, out, max);
 }
 
-bool Bvh2Stepper::descend_oriented(const HwNode& node, AnyHitOrder order) {
+bool Bvh2Stepper::descend_oriented(AnyHitOrder order) {
     m_work.obb_rotations += 1;
-    const float* m = m_view.rotation_table + 9 * size_t(m_view.rotations[m_ref]);
-    Ray local = m_ray;
-    local.origin = obb_rotate(m, m_ray.origin);
-    local.direction = obb_rotate(m, m_ray.direction);
-    const RayBoxPre pre = ray_box_precompute(local);
-    HwNode widened = node;
-    for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 2; ++c) widened.lo(c, a) -= m_obb_pad, widened.hi(c, a) += m_obb_pad;
-    return detail::descend(pre, widened, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count, order);
+    const detail::OrientedNode o = detail::oriented_node(m_view, m_ref, m_ray, m_obb_pad);
+    return detail::descend(o.pre, o.node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count, order);
 }
 
 void Bvh2Stepper::visit_node(const HwNode& node) {
@@ -121,7 +114,7 @@ void Bvh2Stepper::visit_node(const HwNode& node) {
     if (m_rp.enabled()) rp_tests(node, rp_tnear);
     const AnyHitOrder order = m_mode == TraversalMode::any_hit ? m_anyhit_order : AnyHitOrder::nearest;
     const bool entered = m_view.oriented(m_ref)
-                             ? descend_oriented(node, order)
+                             ? descend_oriented(order)
                              : detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size,
                                                &m_ref, &m_count, order);
     if (!entered) return pop_next();

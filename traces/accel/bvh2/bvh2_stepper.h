@@ -48,6 +48,26 @@ struct Bvh2View {
     bool oriented(uint32_t node) const { return rotations && rotations[node] != kNoRotation; }
 };
 
+namespace detail {
+/// Oriented node `ref` as a ray sees it (the single-ray and the packet steppers alike): the ray
+/// rotated into the node's frame with its box precompute, and the node's child boxes widened by
+/// the ray's pad (obb_pad), so the test stays conservative.
+struct OrientedNode {
+    RayBoxPre pre;
+    HwNode node;
+};
+inline OrientedNode oriented_node(const Bvh2View& v, uint32_t ref, const Ray& ray, float pad) {
+    const float* m = v.rotation_table + 9 * size_t(v.rotations[ref]);
+    Ray local = ray;
+    local.origin = obb_rotate(m, ray.origin);
+    local.direction = obb_rotate(m, ray.direction);
+    OrientedNode o{ray_box_precompute(local), v.nodes[ref]};
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 2; ++c) o.node.lo(c, a) -= pad, o.node.hi(c, a) += pad;
+    return o;
+}
+}  // namespace detail
+
 class Bvh2Stepper final : public Stepper {
 public:
     explicit Bvh2Stepper(const Bvh2View& view, uint32_t short_stack_entries = 0, uint32_t box_precision_bits = 0,
@@ -76,7 +96,7 @@ private:
     void rp_step();  ///< one step of the extra walk (rp_boxes.h)
     void finish();  ///< the plan is done; a ray without a hit reports Hit{} (t = +inf)
     /// An oriented node's step: the ray rotated into its frame, its boxes widened (obvh_rotate.h).
-    bool descend_oriented(const HwNode& node, AnyHitOrder order);
+    bool descend_oriented(AnyHitOrder order);
 
     Bvh2View m_view;
     AnyHitOrder m_anyhit_order;  ///< child order of any-hit rays (closest-hit: nearest first)

@@ -86,6 +86,10 @@ public:
     ObvhAccel(AccelImage image, const std::string& source);
 
     std::unique_ptr<Stepper> make_stepper(const StepOptions& options = {}) const override;
+    /// Packets as the binary BVH's (bvh2_packet.h), each ray rotated into an oriented node's frame.
+    std::unique_ptr<PacketStepper> make_packet_stepper(const StepOptions& options = {}) const override;
+    void trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
+                      PacketCounts* counts, float split_below, const StepOptions& options = {}) const override;
     LocalityPartition partition(uint64_t budget_bytes) const override;
     std::vector<OpKind> op_kinds() const override;
     uint32_t max_stack_entries() const override { return kTraversalStackSize; }

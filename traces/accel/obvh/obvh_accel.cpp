@@ -72,6 +72,17 @@ std::unique_ptr<Stepper> ObvhAccel::make_stepper(const StepOptions& options) con
     return std::make_unique<Bvh2Stepper>(m_view, 0, 0, options.anyhit_order);
 }
 
+std::unique_ptr<PacketStepper> ObvhAccel::make_packet_stepper(const StepOptions& options) const {
+    auto s = std::make_unique<Bvh2PacketStepper>(m_view);
+    s->set_anyhit_order(options.anyhit_order);
+    return s;
+}
+
+void ObvhAccel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,
+                             PacketCounts* counts, float split_below, const StepOptions& options) const {
+    trace_packet_bvh2(m_view, rays, modes, n, hits, work, counts, split_below, options.anyhit_order);
+}
+
 LocalityPartition ObvhAccel::partition(uint64_t budget_bytes) const {
     require(budget_bytes >= sizeof(HwObbNode), "treelet budget must be at least one node (64 bytes)");
     // A box's area is the same in every frame, so the binary BVH's locality tree serves.

@@ -81,7 +81,7 @@ StepOutcome TwoLevelPacketStepper::execute() {
         m_lanes.work[r].tlas_steps += 1;  // the TLAS's share (packet_descend counts steps and box tests)
         m_lanes.work[r].tlas_box_tests += 2;
     });
-    if (detail::packet_descend(m_lanes, stepping, m_accel.tlas().nodes[m_ref], m_stack, m_tlas_size, &m_ref, &m_count,
+    if (detail::packet_descend(m_lanes, stepping, m_accel.tlas(), m_ref, m_stack, m_tlas_size, &m_ref, &m_count,
                                &m_tlas_active))
         plan_tlas();
     else
