@@ -1,5 +1,6 @@
 """Oriented boxes (docs/accel.md, "obvh2") in two-level structures and over frames: the BLASes
-of an instanced scene built as obvh2 replay with zero mismatches on the oriented-box pipeline,
+of an instanced scene built as obvh2 replay with zero mismatches on the oriented-box pipeline
+(MIMD units and packets),
 and a deforming mesh's obvh2 BLAS refitted per frame (its rotations fitted again on the refitted
 tree) gives the closest hits a rebuild gives."""
 
@@ -21,8 +22,9 @@ def test_instanced_scene_with_oriented_blases_replays(sim_exe: Path, tmp_path: P
     assert made.returncode == 0, made.stderr
     accel = json.loads((out / "manifest.json").read_text())["accel"]
     assert accel["kind"] == "two_level" and accel["blas_kind"] == "obvh2"
-    stats = checked(sim_exe, out, tmp_path / "sim")
-    assert sum(p["tests"] for p in stats["model"]["obb"].values()) > 0
+    for sets in ([], ["traversal.model=packet"]):  # packets walk the oriented BLASes too
+        stats = checked(sim_exe, out, tmp_path / f"sim{len(sets)}", *sets)
+        assert sum(p["tests"] for p in stats["model"]["obb"].values()) > 0
 
 
 def test_refitted_oriented_blas_gives_the_rebuilt_ones_hits(tmp_path: Path) -> None:
