@@ -268,6 +268,7 @@ const std::vector<Entry>& registry() {
           tree_builder_names(),
           single_level(kBvhStackEntryBytes)
               .with(&AccelCapabilities::packet_kernel)
+              .with(&AccelCapabilities::restart_trail)
               .with(&AccelCapabilities::anyhit_order)
               .with(&AccelCapabilities::stack_addresses)
               .with(&AccelCapabilities::curved)},

@@ -185,6 +185,7 @@ void Bvh2Stepper::plan_replay() {
     const uint32_t node = m_short.replay_node();
     m_plan.reset(node);
     m_plan.add_fetch(m_view.node_base + uint64_t(node) * sizeof(HwNode), sizeof(HwNode), DataKind::node);
+    if (m_view.oriented(node)) m_plan.add_op(OpKind::obb, 1);  // the ray rotated to re-test its boxes
     m_plan.add_op(OpKind::box, 2);
 }
 
@@ -192,6 +193,7 @@ void Bvh2Stepper::replay_step() {
     // A revisit re-tests the node's child boxes to follow the trail; the walk's state is unchanged.
     m_work.restart_steps += 1;
     m_work.restart_box_tests += 2;
+    if (m_view.oriented(m_short.replay_node())) m_work.obb_rotations += 1;
     m_short.replay_advance();
     if (m_short.replaying()) plan_replay();
     else if (m_resume) plan_next();
