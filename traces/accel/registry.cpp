@@ -269,6 +269,7 @@ const std::vector<Entry>& registry() {
           single_level(kBvhStackEntryBytes)
               .with(&AccelCapabilities::packet_kernel)
               .with(&AccelCapabilities::restart_trail)
+              .with(&AccelCapabilities::reduced_precision_boxes)
               .with(&AccelCapabilities::anyhit_order)
               .with(&AccelCapabilities::stack_addresses)
               .with(&AccelCapabilities::curved)},

@@ -100,23 +100,24 @@ uint32_t Bvh2Stepper::stack_reads(Fetch* out, uint32_t max) const {
     return tree_stack_reads(m_stack, m_stack_size, m_view.node_base, uint32_t(sizeof(HwNode)), m_view.tri_at, out, max);
 }
 
-bool Bvh2Stepper::descend_oriented(AnyHitOrder order) {
-    m_work.obb_rotations += 1;
-    const detail::OrientedNode o = detail::oriented_node(m_view, m_ref, m_ray, m_obb_pad);
-    return detail::descend(o.pre, o.node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count, order);
-}
-
 void Bvh2Stepper::visit_node(const HwNode& node) {
     // Nearer child next (child 0 on equal entry distances; any-hit rays by their order); the other pushed.
     const int before = m_stack_size;
     if (m_short.enabled()) m_short.visit(m_ref, m_depth);
+    // An oriented node is tested by the ray rotated into its frame, against its widened boxes.
+    const bool oriented = m_view.oriented(m_ref);
+    detail::OrientedNode o{};
+    if (oriented) {
+        m_work.obb_rotations += 1;
+        o = detail::oriented_node(m_view, m_ref, m_ray, m_obb_pad);
+    }
+    const RayBoxPre& pre = oriented ? o.pre : m_box;
+    const HwNode& tested = oriented ? o.node : node;
     float rp_tnear[2];
-    if (m_rp.enabled()) rp_tests(node, rp_tnear);
+    if (m_rp.enabled()) rp_tests(tested, pre, rp_tnear);
     const AnyHitOrder order = m_mode == TraversalMode::any_hit ? m_anyhit_order : AnyHitOrder::nearest;
-    const bool entered = m_view.oriented(m_ref)
-                             ? descend_oriented(order)
-                             : detail::descend(m_box, node, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size,
-                                               &m_ref, &m_count, order);
+    const bool entered =
+        detail::descend(pre, tested, m_ray.tmin, m_cull_t, m_work, m_stack, m_stack_size, &m_ref, &m_count, order);
     if (!entered) return pop_next();
     if (m_rp.enabled() && m_stack_size > before) {
         const detail::Bvh2StackEntry& pushed = m_stack[m_stack_size - 1];
@@ -200,14 +201,14 @@ void Bvh2Stepper::replay_step() {
     else finish();
 }
 
-void Bvh2Stepper::rp_tests(const HwNode& node, float tnear[2]) {
+void Bvh2Stepper::rp_tests(const HwNode& node, const RayBoxPre& pre, float tnear[2]) {
     for (int c = 0; c < 2; ++c) {
         if (node.child_count[c] == kEmptyChild) continue;
         float lo[3], hi[3];
         child_box(node, c, lo, hi);
         float t32 = 0.0f;  // the fp32 test is the node kernel's arithmetic (ray_box_kernel.h)
-        const bool fp32 = detail::box_kernel(m_box, lo, hi, m_ray.tmin, m_cull_t, &t32);
-        if (intersect_box_rp(m_box, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &tnear[c]) && !fp32) {
+        const bool fp32 = detail::box_kernel(pre, lo, hi, m_ray.tmin, m_cull_t, &t32);
+        if (intersect_box_rp(pre, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &tnear[c]) && !fp32) {
             m_work.rp_box_hits += 1;
             m_rp.enter(node.child_ref[c], node.child_count[c]);
         }
@@ -219,7 +220,14 @@ void Bvh2Stepper::rp_step() {
     // hit (rp_boxes.h), so they are counted, not run.
     const ReducedPrecisionBoxes::Entry e = m_rp.pop();
     if (e.count == 0) {
-        const HwNode& node = m_view.nodes[e.ref];
+        const bool oriented = m_view.oriented(e.ref);
+        detail::OrientedNode o{};
+        if (oriented) {
+            m_work.obb_rotations += 1;  // its plan rotates the ray too (plan_at)
+            o = detail::oriented_node(m_view, e.ref, m_ray, m_obb_pad);
+        }
+        const HwNode& node = oriented ? o.node : m_view.nodes[e.ref];
+        const RayBoxPre& pre = oriented ? o.pre : m_box;
         m_work.rp_steps += 1;
         m_work.rp_box_tests += 2;
         for (int c = 0; c < 2; ++c) {
@@ -227,7 +235,7 @@ void Bvh2Stepper::rp_step() {
             float lo[3], hi[3];
             child_box(node, c, lo, hi);
             float t = 0.0f;
-            if (intersect_box_rp(m_box, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &t))
+            if (intersect_box_rp(pre, lo, hi, m_ray.tmin, m_cull_t, m_rp.bits(), &t))
                 m_rp.enter(node.child_ref[c], node.child_count[c]);
         }
     } else {

@@ -92,11 +92,10 @@ private:
     void replay_step();
     /// Reduced-precision boxes: tests both children with the narrower test, hands the boxes only
     /// it accepts to m_rp and writes its entry distances.
-    void rp_tests(const HwNode& node, float tnear[2]);
+    void rp_tests(const HwNode& node, const RayBoxPre& pre, float tnear[2]);
     void rp_step();  ///< one step of the extra walk (rp_boxes.h)
     void finish();  ///< the plan is done; a ray without a hit reports Hit{} (t = +inf)
     /// An oriented node's step: the ray rotated into its frame, its boxes widened (obvh_rotate.h).
-    bool descend_oriented(AnyHitOrder order);
 
     Bvh2View m_view;
     AnyHitOrder m_anyhit_order;  ///< child order of any-hit rays (closest-hit: nearest first)

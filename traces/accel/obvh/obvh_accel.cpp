@@ -65,10 +65,10 @@ ObvhAccel::ObvhAccel(AccelImage image, const std::string& source) : Accel(std::m
 }
 
 std::unique_ptr<Stepper> ObvhAccel::make_stepper(const StepOptions& options) const {
-    // The resolution step refuses these for obvh2 (registry.cpp's capabilities); a direct
-    // caller is told the same. A restart trail's revisit of an oriented node rotates the ray.
-    require(options.box_precision_bits == 0, "obvh2: reduced-precision boxes are not built for oriented nodes");
-    return std::make_unique<Bvh2Stepper>(m_view, options.short_stack_entries, 0, options.anyhit_order);
+    // The binary BVH's stepper: a restart trail's revisit of an oriented node, and the
+    // reduced-precision walk's steps at one, rotate the ray as its own steps do.
+    return std::make_unique<Bvh2Stepper>(m_view, options.short_stack_entries, options.box_precision_bits,
+                                         options.anyhit_order);
 }
 
 std::unique_ptr<PacketStepper> ObvhAccel::make_packet_stepper(const StepOptions& options) const {
