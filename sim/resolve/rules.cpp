@@ -38,9 +38,9 @@ std::vector<Rule> make_rules() {
          [](const RunFacts& f) { return f.structure.caps.packet_kernel; },
          "a packet's rays walk one shared traversal, which the structure provides as a packet stepper and a "
          "reference packet loop (the hit checker checks each packet's work against it); every registered "
-         "structure has one (the BVHs, kd-tree, BIH, B-Kd tree, octree, grid and two levels over them) but the "
-         "oriented BVH, whose packet would rotate every ray of the packet at each oriented node (not built)",
-         "traversal.model=mimd or simt, or trace a structure with a packet kernel (rtsim capabilities)", "obvh2",
+         "structure has one (the BVHs, the oriented BVH, kd-tree, BIH, B-Kd tree, octree, grid and two levels "
+         "over them), so only a structure registered without one meets this",
+         "traversal.model=mimd or simt, or trace a structure with a packet kernel (rtsim capabilities)", "",
          {"traversal.model=packet"}});
     add({"unit/groups", "traversal.ray_contexts",
          [](const RunFacts& f) { return f.config.traversal.ray_contexts != 0 && f.unit.group_size(f.config.traversal) > 1; },
