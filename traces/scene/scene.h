@@ -186,6 +186,9 @@ struct Scene {
     /// centre, twice); empty when the scene has no capsules (filled by flatten()).
     std::vector<std::array<Vec3, 2>> capsule_ends;
     uint64_t placed_triangles = 0;  ///< set by index_instances() (flatten() fills triangles instead)
+    /// Some mesh holds curved primitives (set by index_instances()): a scene kept as instances
+    /// looks a primitive up in its mesh only then (is_curved() is on every hit's path).
+    bool curved_meshes = false;
     Aabb bounds;
 
     /// Fills triangles/tri_material/tri_instance/bounds from meshes and instances. Vertices are
@@ -200,11 +203,12 @@ struct Scene {
     bool flattened() const { return !triangles.empty(); }
     /// Flattened or kept as instances (then looked up in the placing mesh, as world_triangle()).
     bool is_curved(uint32_t prim) const {
-        return flattened() ? !curved_radius.empty() && curved_radius[prim] > 0.0f : placed_is_curved(prim, false);
+        return flattened() ? !curved_radius.empty() && curved_radius[prim] > 0.0f
+                           : curved_meshes && placed_is_curved(prim, false);
     }
     bool is_capsule(uint32_t prim) const {
         return flattened() ? is_curved(prim) && !capsule_ends.empty() && capsule_ends[prim][0] != capsule_ends[prim][1]
-                           : placed_is_curved(prim, true);
+                           : curved_meshes && placed_is_curved(prim, true);
     }
     bool is_sphere(uint32_t prim) const { return is_curved(prim) && !is_capsule(prim); }
     /// Spheres and capsules among the flattened primitives.

@@ -26,8 +26,10 @@ void Scene::index_instances() {
     capsule_ends.clear();
     uint64_t total = 0;
     std::vector<Aabb> mesh_box(meshes.size());
+    curved_meshes = false;
     for (size_t m = 0; m < meshes.size(); ++m) {
         const Mesh& mesh = meshes[m];
+        curved_meshes = curved_meshes || !mesh.radii.empty();
         for (size_t k = 0; k < mesh.positions.size(); ++k) {
             const size_t prim = k / 3;
             const float r = mesh.is_curved(prim) ? std::max(mesh.radii[prim], mesh.end_radius(prim)) : 0.0f;
