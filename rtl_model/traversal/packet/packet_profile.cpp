@@ -36,7 +36,7 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
         p.lane_slots += steps * pc.lanes;
         p.active_lanes += double(counts.active_rays);
         p.requests += steps;  // one fetch serves the packet's active rays
-        double tri_tests = 0, sphere_tests = 0, capsule_tests = 0;
+        double tri_tests = 0, sphere_tests = 0, capsule_tests = 0, rotations = 0;
         double node_tests[3] = {0, 0, 0};  // box tests, plane tests, cell steps: what a node step runs
         for (size_t i = 0; i < n; ++i) {
             WorkCounts alone;
@@ -49,6 +49,7 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
             tri_tests += work[i].tri_tests, sphere_tests += work[i].sphere_tests;
             capsule_tests += work[i].capsule_tests;
             node_tests[0] += work[i].box_tests, node_tests[1] += work[i].plane_tests, node_tests[2] += work[i].cell_steps;
+            rotations += work[i].obb_rotations;
         }
         // Node steps by the operation kind they run: a BVH's box tests, a kd-tree's or BIH's plane
         // tests, a grid's cell steps (a structure's few others, such as a kd-tree's one clip
@@ -59,6 +60,12 @@ GroupProfile packets_of(const Accel& accel, const StepOptions& step, const Packe
         for (int k = 0; k < 3; ++k)
             p.kind_steps[size_t(node_kinds[k])] +=
                 node_all > 0 ? double(counts.node_steps) * node_tests[k] / node_all : (k == 0 ? double(counts.node_steps) : 0.0);
+        // An oriented node's step rotates its rays first (obvh2: one rotation and two box tests
+        // per ray): its share of the box steps also runs the obb pipeline ahead of the boxes.
+        if (rotations > 0 && node_tests[0] > 0) {
+            const double box_steps = double(counts.node_steps) * node_tests[0] / node_all;
+            p.kind_steps[size_t(OpKind::obb)] += box_steps * std::min(1.0, 2.0 * rotations / node_tests[0]);
+        }
         // Leaf steps by the kind of their tests: shared out by the packet's triangle, sphere and
         // capsule tests (a leaf of several kinds runs each; counted here as one, in proportion).
         const double tests = tri_tests + sphere_tests + capsule_tests;
