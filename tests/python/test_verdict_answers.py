@@ -222,3 +222,14 @@ def test_the_verdict_names_pipelines_to_share_where_they_idle(
     for k in savers:
         assert k["to"] == "shared" and k["added_mm2"] < 0 and k["speedup"] >= 0.98
     assert "same speed, less area: " in stats["verdict"]["text"]
+
+
+def test_the_verdict_prices_the_runs_phases_in_every_estimate(
+    trace_of: Callable[..., Path], sim_exe: Path, tmp_path: Path
+) -> None:
+    # A short trace analysed whole has fill and drain (phase_factor > 1): the verdict's base is
+    # the steady state plus those cycles, the analytic level's own cycles, not its steady state.
+    stats = sim_stats(sim_exe, trace_of(), tmp_path / "phased", "fidelity=analytic")
+    analytic = stats["model"]["analytic"]
+    assert analytic["phase_factor"] > 1.0
+    assert stats["verdict"]["estimate"]["base_cycles"] == pytest.approx(analytic["cycles"], rel=1e-6)

@@ -41,6 +41,18 @@ struct ProceduralMotion {
     uint64_t seed = 1;        ///< scatter: per-triangle speed stream
 };
 
+/// A scatter about the object's origin: each triangle (or sphere, or capsule) moves away from it
+/// at a speed in [speed_min, speed_max] m/s drawn from `seed`.
+inline ProceduralMotion scatter_motion(float speed_min, float speed_max, uint64_t seed) {
+    ProceduralMotion m;
+    m.kind = ProceduralMotion::Kind::scatter;
+    m.center = Vec3(0.0f);
+    m.speed_min = speed_min;
+    m.speed_max = speed_max;
+    m.seed = seed;
+    return m;
+}
+
 /// The motion as the glTF extras object the loader reads back (read_procedural_motion).
 tinygltf::Value procedural_motion_to_value(const ProceduralMotion& motion);
 /// Reads extras.rtsimMotion of a glTF mesh; false if `extras` has none. Throws rtsim::Error

@@ -81,13 +81,8 @@ std::string write_exploding_hairball(const std::string& dir, const ProceduralOpt
     int m_hair = w.add_material(make_material("hair", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
     int m_floor = w.add_material(make_material("floor", {0.6f, 0.6f, 0.6f}, 0.0f, 1.0f));
     int hair_mesh = w.add_mesh("exploding_hairball", {{&hair, m_hair}});
-    ProceduralMotion scatter;
-    scatter.kind = ProceduralMotion::Kind::scatter;
-    scatter.center = Vec3(0.0f);
-    scatter.speed_min = 0.2f;  // over 60 frames (1 s) the ball grows to about 2-3x its radius
-    scatter.speed_max = 2.0f;
-    scatter.seed = options.seed;
-    w.set_mesh_motion(hair_mesh, scatter);
+    // Over 60 frames (1 s) the ball grows to about 2-3x its radius.
+    w.set_mesh_motion(hair_mesh, scatter_motion(0.2f, 2.0f, options.seed));
     w.add_mesh_node("exploding_hairball", hair_mesh);
     w.add_mesh_node("floor", w.add_mesh("floor", {{&floor, m_floor}}));
     w.add_light("key_light", LightType::point, {2.5f, 3.0f, 2.5f}, {0, 0, 0}, {1, 1, 1}, 60.0f);

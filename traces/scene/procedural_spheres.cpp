@@ -133,6 +133,9 @@ Spheres fur_beads(const ProceduralOptions& options) {
     return fur_spheres;
 }
 
+/// The furball's material (strands and body alike).
+int add_fur_material(GltfWriter& w) { return w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f)); }
+
 /// The strands as a capsule mesh: each a chain of capsules through every kCapsuleBeads-th bead
 /// and its last one, a vertex's radius its bead's (a capsule tapers from one end's to the other's).
 int add_fur_capsules(GltfWriter& w, const Spheres& beads, int material) {
@@ -156,7 +159,7 @@ int add_fur_capsules(GltfWriter& w, const Spheres& beads, int material) {
 std::string write_furball(const std::string& dir, const ProceduralOptions& options, Fur as) {
     const Spheres fur_spheres = fur_beads(options);
     GltfWriter w;
-    const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
+    const int fur = add_fur_material(w);
     const bool tessellated = as == Fur::icosahedra;
     if (as == Fur::capsules) w.add_mesh_node("fur", add_fur_capsules(w, fur_spheres, fur));
     else add_spheres(w, "fur", fur_spheres, fur, tessellated);
@@ -173,16 +176,11 @@ std::string write_furball(const std::string& dir, const ProceduralOptions& optio
 std::string write_exploding_furball(const std::string& dir, const ProceduralOptions& options) {
     const Spheres beads = fur_beads(options);
     GltfWriter w;
-    const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
+    const int fur = add_fur_material(w);
     const int ground = w.add_material(make_material("floor", {0.6f, 0.6f, 0.6f}, 0.0f, 1.0f));
     const int fur_mesh = add_fur_capsules(w, beads, fur);
-    ProceduralMotion scatter;
-    scatter.kind = ProceduralMotion::Kind::scatter;
-    scatter.center = Vec3(0.0f);
-    scatter.speed_min = 0.1f;  // over 60 frames (1 s) the fur spreads to about 2-3x the ball
-    scatter.speed_max = 1.2f;
-    scatter.seed = options.seed;
-    w.set_mesh_motion(fur_mesh, scatter);
+    // Over 60 frames (1 s) the fur spreads to about 2-3x the ball.
+    w.set_mesh_motion(fur_mesh, scatter_motion(0.1f, 1.2f, options.seed));
     w.add_mesh_node("fur", fur_mesh);
     add_spheres(w, "body", Spheres{{{0.0f, 0.0f, 0.0f}}, {kCoreRadius}}, fur, false);
     TriangleSoup floor;
@@ -201,7 +199,7 @@ constexpr int kHerdSide = 3;  ///< furball_herd: kHerdSide^2 furballs
 std::string write_furball_herd(const std::string& dir, const ProceduralOptions& options) {
     const Spheres beads = fur_beads(options);
     GltfWriter w;
-    const int fur = w.add_material(make_material("fur", {0.45f, 0.3f, 0.18f}, 0.0f, 0.6f));
+    const int fur = add_fur_material(w);
     const int ground = w.add_material(make_material("floor", {0.55f, 0.6f, 0.5f}, 0.0f, 1.0f));
     const int fur_mesh = add_fur_capsules(w, beads, fur);
     const int body_mesh = w.add_sphere_mesh("body", {{0.0f, 0.0f, 0.0f}}, {kCoreRadius}, fur);

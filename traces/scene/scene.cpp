@@ -31,6 +31,15 @@ void check_flat_size(const std::string& source, uint64_t triangles, const std::s
     throw Error(source + ": " + what + text);
 }
 
+CurvedShape placed_curved_shape(const Mesh& mesh, size_t prim, const Vec3& a, const Vec3& b, double scale) {
+    CurvedShape s;
+    s.a = a, s.b = b;
+    s.r0 = float(double(mesh.radii[prim]) * scale);
+    s.r1 = float(double(mesh.end_radius(prim)) * scale);
+    if (a == b) s.r0 = s.r1 = std::max(s.r0, s.r1);
+    return s;
+}
+
 double largest_axis_scale(const glm::dmat4& m) {
     double s = 0.0;
     for (int c = 0; c < 3; ++c) s = std::max(s, glm::length(glm::dvec3(m[c])));
@@ -100,10 +109,8 @@ void Scene::flatten() {
             float radius = 0.0f, end_radius = 0.0f;
             const std::array<Vec3, 2> ends{tri.v0, tri.v1};
             if (mesh.is_curved(t)) {
-                radius = float(double(mesh.radii[t]) * scale);
-                end_radius = float(double(mesh.end_radius(t)) * scale);
-                // A capsule of zero length is the larger of its end spheres.
-                if (ends[0] == ends[1]) radius = end_radius = std::max(radius, end_radius);
+                const CurvedShape shape = placed_curved_shape(mesh, t, ends[0], ends[1], scale);
+                radius = shape.r0, end_radius = shape.r1;
                 tri = curved_primitive(ends[0], ends[1], radius, end_radius);
                 // A node scaled to 0 (how glTF hides nodes) leaves radius 0: never hit, as its
                 // triangles would be.

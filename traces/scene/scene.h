@@ -133,6 +133,11 @@ struct CurvedShape {
     float r0 = 0.0f, r1 = 0.0f;
     bool capsule() const { return a != b; }
 };
+/// Curved primitive `prim` of `mesh` as an instance places it: its ends already in world space
+/// (`a`, `b`), its radii scaled by the transform's largest axis (`scale`, largest_axis_scale);
+/// a capsule of zero length is the larger of its end spheres. flatten() and
+/// Scene::curved_shape() both take it from here.
+CurvedShape placed_curved_shape(const Mesh& mesh, size_t prim, const Vec3& a, const Vec3& b, double scale);
 struct Scene;
 /// Surface area of curved primitive `prim`: a sphere's 4 pi r^2, a capsule's 2 pi r L + 4 pi r^2
 /// (with two radii, its cone's band and the two end spheres' caps beyond it).
@@ -156,6 +161,9 @@ struct Scene;
 /// Refuses too, when `invertible`, an instance of spheres or capsules whose transform is not a
 /// similarity (is_similarity).
 void check_instance_transforms(const Scene& scene, bool invertible);
+/// Refuses (naming the node, and `when`, e.g. " in frame 3") instance `instance` of a mesh of
+/// spheres or capsules placed by `m` when `m` is not a similarity.
+void check_curved_similarity(const Scene& scene, size_t instance, const glm::dmat4& m, const std::string& when);
 /// True if the transform's linear part is a rotation (or reflection) times a uniform scale, to a
 /// relative 1e-5: a sphere stays a sphere under it.
 bool is_similarity(const glm::dmat4& m);

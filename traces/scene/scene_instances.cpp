@@ -100,14 +100,8 @@ CurvedShape Scene::curved_shape(uint32_t prim) const {
     const Mesh& mesh = meshes[inst.mesh];
     const size_t local = prim - inst.prim_base;
     const glm::dmat4& m = inst.object_to_world;
-    const double scale = largest_axis_scale(m);
-    CurvedShape s;
-    s.a = to_world(m, mesh.positions[3 * local]);
-    s.b = to_world(m, mesh.positions[3 * local + 1]);
-    s.r0 = float(double(mesh.radii[local]) * scale);
-    s.r1 = float(double(mesh.end_radius(local)) * scale);
-    if (s.a == s.b) s.r0 = s.r1 = std::max(s.r0, s.r1);
-    return s;
+    return placed_curved_shape(mesh, local, to_world(m, mesh.positions[3 * local]),
+                               to_world(m, mesh.positions[3 * local + 1]), largest_axis_scale(m));
 }
 
 uint32_t Scene::material_of(uint32_t prim) const {
@@ -159,6 +153,15 @@ bool keeps_area(const Scene& scene, const Instance& inst, bool* mesh_has_area) {
 
 }  // namespace
 
+void check_curved_similarity(const Scene& scene, size_t instance, const glm::dmat4& m, const std::string& when) {
+    const Mesh& mesh = scene.meshes[scene.instances[instance].mesh];
+    require(mesh.radii.empty() || is_similarity(m),
+            scene.source + ": " + instance_name(scene, instance) + when + " places mesh '" + mesh.name +
+                "' of spheres or capsules under a non-uniform scale or a shear; a two-level structure traces them "
+                "in object space, where that makes ellipsoids (a flattened scene takes the bounding sphere): scale "
+                "the node uniformly, or trace with --flatten");
+}
+
 bool is_similarity(const glm::dmat4& m) {
     const glm::dvec3 c[3] = {glm::dvec3(m[0]), glm::dvec3(m[1]), glm::dvec3(m[2])};
     const double s = glm::length(c[0]), tol = 1e-5 * s * s;
@@ -189,13 +192,7 @@ void check_instance_transforms(const Scene& scene, bool invertible) {
                             "two-level structure cannot invert; fix the node's scale or matrix, or trace "
                             "with --flatten");
         }
-        if (invertible && !scene.meshes[scene.instances[i].mesh].radii.empty())
-            require(is_similarity(m), scene.source + ": " + instance_name(scene, i) + " places mesh '" +
-                                          scene.meshes[scene.instances[i].mesh].name +
-                                          "' of spheres or capsules under a non-uniform scale or a shear; a two-level "
-                                          "structure traces them in object space, where that makes ellipsoids (a "
-                                          "flattened scene takes the bounding sphere): scale the node uniformly, or "
-                                          "trace with --flatten");
+        if (invertible) check_curved_similarity(scene, i, m, "");
         if (area_anywhere && !invertible) continue;
         bool mesh_area = false;
         if (keeps_area(scene, scene.instances[i], &mesh_area)) area_anywhere = true;

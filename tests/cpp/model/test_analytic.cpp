@@ -290,6 +290,23 @@ TEST(AnalyticLevel, WholeTraceAnalysisRecordsItsRoundsInPhaseWindows) {
     EXPECT_EQ(e.model["analytic"]["phase_factor"].get<double>(), e.form.phase_factor);
 }
 
+TEST(AnalyticLevel, TreeletSchedulingRecordsItsRoundsInPhaseWindowsToo) {
+    // A treelet run drains as its buffer empties: the whole-trace analysis keeps its rounds in
+    // windows as without treelets, every step in one of them.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    config_set(c, "treelets.enabled=true");
+    config_set(c, "treelets.treelet_kib=8");
+    RayList rays(w.jobs);
+    Discard sink;
+    const AnalyticProfile& p = analyze_stream(c, *w.accel, w.map(c), StepOptions{}, rays, sink);
+    ASSERT_FALSE(p.phases.empty());
+    double steps = 0;
+    for (const PhaseWindow& pw : p.phases) steps += pw.steps;
+    EXPECT_EQ(steps, p.sample_plan_steps);
+    EXPECT_GE(estimate_analytic(c, p).form.phase_factor, 1.0);
+}
+
 TEST(AnalyticLevel, TreeletContextsConvoyOnTheFillsTheyMergeOn) {
     // With treelets a unit's contexts walk one treelet and merge on its lines: a fill releases
     // more than one context, the closed form's customers are convoys of them.
@@ -391,6 +408,27 @@ TEST(AnalyticLevel, PacketStepsAreCountedByTheOperationKindTheyRun) {
         EXPECT_GT(g.kind_steps[size_t(node)], 0.9 * nodes) << kind;
         EXPECT_NEAR(nodes + g.kind_steps[size_t(OpKind::triangle)], g.group_steps, 1e-6 * g.group_steps) << kind;
     }
+}
+
+TEST(AnalyticLevel, PacketStepsAtOrientedNodesRunTheObbPipelineToo) {
+    // An oriented node's packet step rotates its rays before the box tests: the group profile
+    // counts those steps on the obb pipeline as well, never more of them than box steps.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    config_set(c, "traversal.model=packet");
+    const Scene scene = test::make_scene(test::random_triangles(3000, 5, 1.0f, 0.05f));
+    std::vector<std::vector<RayJob>> by_unit(c.traversal.units);
+    for (size_t i = 0; i < 2000; ++i) by_unit[i % c.traversal.units].push_back(w.jobs[i]);
+    AccelOptions o;
+    o.kind = "obvh2";
+    const auto accel = load_accel(build_accel(scene, o));
+    const GroupProfile g = packet_group_profile(*accel, StepOptions{}, c.traversal, by_unit, GroupSetup{});
+    EXPECT_GT(g.kind_steps[size_t(OpKind::obb)], 0.0);
+    EXPECT_LE(g.kind_steps[size_t(OpKind::obb)], g.kind_steps[size_t(OpKind::box)] * (1 + 1e-9));
+    o.kind = "bvh2";
+    const auto plain = load_accel(build_accel(scene, o));
+    EXPECT_EQ(packet_group_profile(*plain, StepOptions{}, c.traversal, by_unit, GroupSetup{}).kind_steps[size_t(OpKind::obb)],
+              0.0);
 }
 
 /// Demands of `misses` L2 misses of 64-byte lines (no writes) under the default DRAM config.

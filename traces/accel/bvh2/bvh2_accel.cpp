@@ -200,9 +200,7 @@ Hit Bvh2Accel::trace(const Ray& ray, TraversalMode mode, WorkCounts* work, const
 }
 
 std::unique_ptr<PacketStepper> Bvh2Accel::make_packet_stepper(const StepOptions& options) const {
-    auto s = std::make_unique<Bvh2PacketStepper>(m_view);
-    s->set_anyhit_order(options.anyhit_order);
-    return s;
+    return make_bvh2_packet_stepper(m_view, options.anyhit_order);
 }
 
 void Bvh2Accel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,

@@ -112,6 +112,12 @@ void Bvh2PacketStepper::pop_next() {
 
 void Bvh2PacketStepper::finish() { end_packet(); }
 
+std::unique_ptr<PacketStepper> make_bvh2_packet_stepper(const Bvh2View& view, AnyHitOrder anyhit_order) {
+    auto s = std::make_unique<Bvh2PacketStepper>(view);
+    s->set_anyhit_order(anyhit_order);
+    return s;
+}
+
 void trace_packet_bvh2(const Bvh2View& bvh, const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits,
                        WorkCounts* work, PacketCounts* counts, float split_below, AnyHitOrder anyhit_order) {
     static thread_local PacketLanes p;

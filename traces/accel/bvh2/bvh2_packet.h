@@ -8,6 +8,7 @@
 // the node), or fetches a leaf's HwTriangles once and runs one triangle test per triangle and
 // active ray, plus the alpha tests the hits call for.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "traces/accel/bvh2/bvh2_packet_kernel.h"
@@ -53,6 +54,10 @@ private:
     detail::PacketStackEntry m_stack[kTraversalStackSize];
     std::vector<LaneWalker<detail::Bvh2LaneRules>> m_walkers;  ///< SplitWalks::lanes: one per lane
 };
+
+/// The packet stepper of a binary BVH's view (bvh2, and obvh2's oriented nodes), walking
+/// any-hit packets in `anyhit_order`: what Accel::make_packet_stepper returns for both kinds.
+std::unique_ptr<PacketStepper> make_bvh2_packet_stepper(const Bvh2View& view, AnyHitOrder anyhit_order);
 
 /// The fused packet loop: rays[0, n) traced as one packet; each ray's hit and work, and the
 /// packet's counts (any of hits, work, counts may be null). `split_below`: the hybrid's threshold

@@ -106,7 +106,7 @@ void Bvh2Stepper::visit_node(const HwNode& node) {
     if (m_short.enabled()) m_short.visit(m_ref, m_depth);
     // An oriented node is tested by the ray rotated into its frame, against its widened boxes.
     const bool oriented = m_view.oriented(m_ref);
-    detail::OrientedNode o{};
+    detail::OrientedNode o;  // filled at an oriented node only (no zeroing on the hot path)
     if (oriented) {
         m_work.obb_rotations += 1;
         o = detail::oriented_node(m_view, m_ref, m_ray, m_obb_pad);
@@ -221,7 +221,7 @@ void Bvh2Stepper::rp_step() {
     const ReducedPrecisionBoxes::Entry e = m_rp.pop();
     if (e.count == 0) {
         const bool oriented = m_view.oriented(e.ref);
-        detail::OrientedNode o{};
+        detail::OrientedNode o;  // filled at an oriented node only (no zeroing on the hot path)
         if (oriented) {
             m_work.obb_rotations += 1;  // its plan rotates the ray too (plan_at)
             o = detail::oriented_node(m_view, e.ref, m_ray, m_obb_pad);

@@ -72,9 +72,7 @@ std::unique_ptr<Stepper> ObvhAccel::make_stepper(const StepOptions& options) con
 }
 
 std::unique_ptr<PacketStepper> ObvhAccel::make_packet_stepper(const StepOptions& options) const {
-    auto s = std::make_unique<Bvh2PacketStepper>(m_view);
-    s->set_anyhit_order(options.anyhit_order);
-    return s;
+    return make_bvh2_packet_stepper(m_view, options.anyhit_order);
 }
 
 void ObvhAccel::trace_packet(const Ray* rays, const TraversalMode* modes, uint32_t n, Hit* hits, WorkCounts* work,

@@ -334,11 +334,7 @@ AccelImage build_two_level_frames(const Scene& scene, const AccelOptions& option
                                                            std::to_string(pose.size()) + " of " +
                                                            std::to_string(scene.instances.size()) + " instances");
         // Spheres stay spheres only under similarities (check_instance_transforms, per frame).
-        for (size_t i = 0; i < pose.size(); ++i)
-            require(scene.meshes[scene.instances[i].mesh].radii.empty() || is_similarity(pose[i]),
-                    scene.source + ": frame " + std::to_string(f) + " poses instance " + std::to_string(i) +
-                        " of spheres or capsules with a non-uniform scale or a shear, which a two-level "
-                        "structure would trace as ellipsoids; animate a uniform scale");
+        for (size_t i = 0; i < pose.size(); ++i) check_curved_similarity(scene, i, pose[i], " in frame " + std::to_string(f));
         t0 = std::chrono::steady_clock::now();
         frames.push_back(build_tlas(scene, blases, blas_of_mesh[f], pose, options, tlas_tree.reuse_for(f)));
         frame_build[f]["tlas"] = tlas_tree.done(options.build);
