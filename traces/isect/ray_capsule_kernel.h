@@ -14,6 +14,7 @@
 #include <cmath>
 #include <utility>
 
+#include "traces/common/round_cone.h"
 #include "traces/isect/ray_sphere_kernel.h"
 
 namespace rtsim {
@@ -125,7 +126,7 @@ inline bool capsule_kernel(const RayTrianglePre& pre, const float p0[3], const f
     Dvec axis = length > 0.0 ? Dvec{ba.x / length, ba.y / length, ba.z / length} : Dvec{0, 0, 1};
     if (ra == rb) {
         capsule_crossings(fa, sub(o, b), d, axis, length, ra, &near);
-    } else if (length <= std::fabs(rb - ra)) {  // the larger end sphere holds the other
+    } else if (end_sphere_holds_other(length, ra, rb)) {
         if (rb > ra) a = b, fa = sub(o, a);
         length = 0.0;
         capsule_crossings(fa, fa, d, axis, 0.0, rmax, &near);

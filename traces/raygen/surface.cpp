@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "traces/common/round_cone.h"
+
 namespace rtsim {
 
 namespace {
@@ -46,7 +48,7 @@ SurfacePoint curved_surface_point(const Scene& scene, const Ray& ray, const Hit&
     if (shape.capsule()) {
         const glm::dvec3 a(shape.a), b(shape.b);
         const double r0 = shape.r0, r1 = shape.r1, length = glm::length(b - a);
-        if (length <= std::fabs(r1 - r0)) {  // the larger end sphere holds the other
+        if (end_sphere_holds_other(length, r0, r1)) {
             axis_point = r1 > r0 ? b : a;
             r = float(std::max(r0, r1));
         } else {

@@ -6,6 +6,7 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "traces/common/round_cone.h"
 #include "traces/raygen/surface.h"
 
 namespace rtsim {
@@ -151,7 +152,7 @@ Vec3 curved_light_point(const Scene& scene, uint32_t prim, float u1, float u2) {
     if (!shape.capsule()) return shape.a + r * on_sphere(u1, u2);
     const Vec3 a = shape.a, b = shape.b;
     const float r0 = shape.r0, r1 = shape.r1, length = glm::length(b - a);
-    if (length <= std::fabs(r1 - r0)) return (r1 > r0 ? b : a) + std::max(r0, r1) * on_sphere(u1, u2);
+    if (end_sphere_holds_other(length, r0, r1)) return (r1 > r0 ? b : a) + std::max(r0, r1) * on_sphere(u1, u2);
     const Vec3 axis = (b - a) / length;
     Vec3 e1, e2;
     make_basis(axis, &e1, &e2);

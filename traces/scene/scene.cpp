@@ -9,6 +9,7 @@
 
 #include "traces/common/error.h"
 #include "traces/common/float_rounding.h"
+#include "traces/common/round_cone.h"
 
 namespace rtsim {
 
@@ -140,7 +141,7 @@ double curved_area(const Scene& scene, uint32_t prim) {
     constexpr double kPi = 3.14159265358979323846;
     const CurvedShape s = scene.curved_shape(prim);
     const double r0 = s.r0, r1 = s.r1, length = glm::length(glm::dvec3(s.b) - glm::dvec3(s.a));
-    if (length <= std::fabs(r1 - r0)) return 4.0 * kPi * std::max(r0, r1) * std::max(r0, r1);  // one sphere holds the other
+    if (end_sphere_holds_other(length, r0, r1)) return 4.0 * kPi * std::max(r0, r1) * std::max(r0, r1);
     // With k = (r1 - r0) / L: the cone's band pi (r0 + r1) L (1 - k^2), and the caps beyond its
     // circles of contact, 2 pi r0^2 (1 - k) and 2 pi r1^2 (1 + k); 2 pi r L + 4 pi r^2 at k = 0.
     const double k = (r1 - r0) / length;

@@ -95,7 +95,8 @@ std::string vec_text(const Vec3& v) {
     return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
 }
 
-void validate(const TraceOptions& o) {
+/// Checks every option before the scene loads; returns the any-hit child order it parsed.
+AnyHitOrder validate(const TraceOptions& o) {
     require(!o.scene.empty(), "no scene given");
     require(!o.out_dir.empty(), "no output folder given");
     require_utf8_path(o.scene, "scene");
@@ -126,6 +127,7 @@ void validate(const TraceOptions& o) {
     require(std::isfinite(o.rebuild_threshold) && o.rebuild_threshold >= 1.0,
             "rebuild_threshold " + std::to_string(o.rebuild_threshold) + " must be at least 1 (a refitted tree's SAH "
             "cost over its rebuilt cost)");
+    return order;
 }
 
 /// The instancing effect of a two-level trace: simulated (BLASes, TLAS, transform stage).
@@ -143,7 +145,8 @@ void mark_instancing_simulated(WorkloadPlan& plan, const AccelImage& image) {
 }  // namespace
 
 json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
-    validate(o);
+    StepOptions walk;
+    walk.anyhit_order = validate(o);
     auto t_start = std::chrono::steady_clock::now();
     auto report = [&](uint64_t done, uint64_t total, const std::string& stage) {
         if (progress) progress(done, total, stage);
@@ -177,8 +180,6 @@ json trace_scene(const TraceOptions& o, const ProgressFn& progress) {
     else animated.image = build_accel(scene, accel_options);
     // Any-hit rays traced in another child order than nearest first: the structure says so (its
     // stats, read back with the trace by the simulator: StructureFacts::traced_anyhit_order).
-    StepOptions walk;
-    parse_anyhit_order(o.anyhit_order, &walk.anyhit_order);
     if (walk.anyhit_order != AnyHitOrder::nearest) {
         require(accel_capabilities(animated.image.kind, animated.image.params.value("blas_kind", "")).anyhit_order,
                 path + ": --anyhit-order " + o.anyhit_order + ": structure '" + animated.image.kind +
