@@ -49,8 +49,11 @@ FrameBuild BuildUnit::run(const std::vector<BuildJob>& jobs, Cycle start) {
         // Compute: triangles (rebuild) or nodes (refit) at the unit's throughput; the job's lines
         // are spread over that time, reads before writes (a refit writes a node once its
         // children are read; a rebuild emits its nodes after its passes).
-        const double compute = job.refit ? double(job.tree_nodes) / m_config.refit_nodes_per_cycle
-                                         : double(job.triangles) / m_config.rebuild_triangles_per_cycle;
+        // An oriented structure's fit follows either: a node's box in each table frame.
+        const uint64_t fit_frames = job.fit_nodes * job.fit_rotations;
+        const double compute = (job.refit ? double(job.tree_nodes) / m_config.refit_nodes_per_cycle
+                                          : double(job.triangles) / m_config.rebuild_triangles_per_cycle) +
+                               double(fit_frames) / m_config.fit_frames_per_cycle;
         uint64_t read_lines = 0, write_lines = 0;
         for (const auto& r : job.reads) read_lines += (r.bytes + m_line - 1) / m_line;
         for (const auto& r : job.writes) write_lines += (r.bytes + m_line - 1) / m_line;
@@ -64,6 +67,7 @@ FrameBuild BuildUnit::run(const std::vector<BuildJob>& jobs, Cycle start) {
         m_compute += Cycle(std::ceil(compute));
         m_stream += write_end - t;
         t = std::max({write_end, t + Cycle(std::ceil(compute))});
+        out.fit_node_frames += fit_frames;
         if (job.refit) {
             ++out.refits;
             out.refit_nodes += job.tree_nodes;
@@ -79,6 +83,7 @@ FrameBuild BuildUnit::run(const std::vector<BuildJob>& jobs, Cycle start) {
     m_total.written_bytes += out.written_bytes;
     m_total.rebuilt_triangles += out.rebuilt_triangles;
     m_total.refit_nodes += out.refit_nodes;
+    m_total.fit_node_frames += out.fit_node_frames;
     m_total.rebuilds += out.rebuilds;
     m_total.refits += out.refits;
     return out;
@@ -91,6 +96,7 @@ nlohmann::json BuildUnit::stats_json() const {
             {"stream_cycles", m_stream},
             {"rebuilt_triangles", m_total.rebuilt_triangles},
             {"refit_nodes", m_total.refit_nodes},
+            {"fit_node_frames", m_total.fit_node_frames},
             {"read_bytes", m_total.read_bytes},
             {"written_bytes", m_total.written_bytes},
             {"rebuilds", m_total.rebuilds},
@@ -111,6 +117,7 @@ const StatBlock& build_unit_stats() {
             {"stream_cycles", "cycles", "cycles its memory stream took (reads, then writes, through the L2), summed over its jobs: a job takes the longer of the two"},
             {"rebuilt_triangles", "triangles", "triangles of the structures it rebuilt"},
             {"refit_nodes", "nodes", "binary-tree nodes of the structures it refitted"},
+            {"fit_node_frames", "node frames", "oriented BVHs (obvh2): the nodes of the structures it built or refitted times the rotations their fit tries (each node's box in every table frame, at `fit_frames_per_cycle`); 0 without them"},
             {"read_bytes", "bytes", "bytes it read through the L2 (triangles; a rebuild's passes each)"},
             {"written_bytes", "bytes", "bytes it wrote through the L2 (the frames' nodes, triangle records, instances)"},
             {"rebuilds", "structures", "structures (BLASes and TLASes) it rebuilt"},

@@ -25,6 +25,11 @@ struct BuildJob {
     bool refit = false;
     uint64_t triangles = 0;   ///< triangles it reads (a rebuild's primitives)
     uint64_t tree_nodes = 0;  ///< binary-tree nodes a refit recomputes
+    /// An oriented BVH (obvh2): each build or refit fits every node's rotation again, the
+    /// subtree's box in each of the table's `fit_rotations` frames bottom-up (docs/accel.md,
+    /// "obvh2"), over its `fit_nodes` nodes; 0 for an axis-aligned structure.
+    uint64_t fit_nodes = 0;
+    uint32_t fit_rotations = 0;
     struct Range {
         uint64_t addr = 0, bytes = 0;
     };
@@ -36,6 +41,7 @@ struct FrameBuild {
     Cycle start = 0, end = 0;
     uint64_t read_bytes = 0, written_bytes = 0;
     uint64_t rebuilt_triangles = 0, refit_nodes = 0;
+    uint64_t fit_node_frames = 0;  ///< oriented fits: nodes x rotations tried
     uint32_t rebuilds = 0, refits = 0;
 };
 
@@ -45,8 +51,8 @@ public:
     BuildUnit(const BuildUnitConfig& config, MemIf& mem, uint32_t line_bytes);
     /// Runs `jobs` from cycle `start`; returns what it did (end: the cycle the last finished).
     FrameBuild run(const std::vector<BuildJob>& jobs, Cycle start);
-    /// {"frames", "busy_cycles", "compute_cycles", "stream_cycles", "rebuilt_triangles", "refit_nodes", "read_bytes", "written_bytes",
-    ///  "rebuilds", "refits"} (docs/stats.md, "build_unit").
+    /// {"frames", "busy_cycles", "compute_cycles", "stream_cycles", "rebuilt_triangles", "refit_nodes",
+    ///  "fit_node_frames", "read_bytes", "written_bytes", "rebuilds", "refits"} (docs/stats.md, "build_unit").
     nlohmann::json stats_json() const;
 
 private:

@@ -15,6 +15,12 @@ BuildJob blas_job(const AccelImage& image, const json& blas, const json& record)
     job.refit = record.value("action", std::string()) == "refit";
     job.triangles = record.value("triangles", uint64_t(0));
     job.tree_nodes = record["tree_nodes"].is_number() ? record["tree_nodes"].get<uint64_t>() : 0;
+    // An oriented BLAS fits its rotations again after each build and refit (obvh.h).
+    const json& params = blas.value("params", json::object());
+    if (params.contains("rotations") && blas.at("count").contains("nodes")) {
+        job.fit_rotations = uint32_t(params["rotations"].size());
+        job.fit_nodes = blas.at("count").at("nodes").get<uint64_t>();
+    }
     for (const auto& [name, first] : blas.at("first").items()) {
         const Region* r = nullptr;
         for (const Region& reg : image.regions)

@@ -68,6 +68,11 @@ constexpr double kStackPrefetchLineBytes = 8;
 constexpr double kBuildTriAdds = 6, kBuildTriMuls = 3, kBuildTriCmps = 12, kBuildKeyBytes = 12;
 /// A refitted node: its box is the union of its two children's (six min/max), staged in the SRAM.
 constexpr double kRefitCmps = 6, kRefitNodeBytes = 24;
+/// An oriented fit's node in one table frame: a binary tree has about as many nodes as
+/// triangles, so one triangle's three vertices rotated (27 multiplies, 18 adds) and boxed (12
+/// min/max), the union of the two children (6) and the area compare against the best so far
+/// (the half area: 3 multiplies, 2 adds; 1 compare).
+constexpr double kFitAdds = 20, kFitMuls = 30, kFitCmps = 19;
 
 bool is_built(const json& list, const char* block) {
     for (const json& b : list)
@@ -124,6 +129,7 @@ double prefetched_lines(const json& stats) { return unit_block_sum(stats, "prefe
 
 json structure_blocks(const std::string& kind, const std::string& blas_kind, bool compressed_leaves) {
     const bool nodes = kind.rfind("cwbvh", 0) == 0 || blas_kind.rfind("cwbvh", 0) == 0;
+    const bool oriented = kind.rfind("obvh", 0) == 0 || blas_kind.rfind("obvh", 0) == 0;
     return json::array(
         {{{"block", "node_decoder"}, {"instantiated", nodes},
           {"why", nodes ? "compressed nodes (" + (kind == "two_level" ? blas_kind : kind) +
@@ -131,7 +137,10 @@ json structure_blocks(const std::string& kind, const std::string& blas_kind, boo
                         : std::string("the structure's nodes hold fp32 boxes")}},
          {{"block", "leaf_decoder"}, {"instantiated", compressed_leaves},
           {"why", compressed_leaves ? "compressed leaves: triangles decoded from leaf blocks (Benthin et al. 2018)"
-                                    : std::string("triangles stored as plain records")}}});
+                                    : std::string("triangles stored as plain records")}},
+         {{"block", "obb_fit"}, {"instantiated", oriented},
+          {"why", oriented ? "oriented nodes: a build or refit on the build unit fits each node's rotation again"
+                           : std::string("the structure's boxes are axis-aligned")}}});
 }
 
 TechniqueArea technique_area(const SimConfig& s, const json& inst) {
@@ -189,6 +198,9 @@ TechniqueArea technique_area(const SimConfig& s, const json& inst) {
         a.logic_mm2["build_unit"] =
             std::ceil(b.rebuild_triangles_per_cycle) * logic_mm2(c, kBuildTriAdds, kBuildTriMuls, kBuildTriCmps + 1) +
             std::ceil(b.refit_nodes_per_cycle) * logic_mm2(c, 0, 0, kRefitCmps);
+        // Its fit datapath for oriented nodes, only where the structure has them.
+        if (is_built(inst, "obb_fit"))
+            a.logic_mm2["obb_fit"] = std::ceil(b.fit_frames_per_cycle) * logic_mm2(c, kFitAdds, kFitMuls, kFitCmps);
     }
     if (s.mailbox.entries)  // a lookup compares the reference with every entry at once, per unit
         a.logic_mm2["mailbox_compare"] = t.units * logic_mm2(c, 0, 0, s.mailbox.entries);
@@ -255,6 +267,8 @@ std::map<std::string, double> technique_energy_pj(const SimConfig& s, const Work
             triangles * (logic_pj(c, kBuildTriAdds, kBuildTriMuls, kBuildTriCmps) +
                          passes * (logic_pj(c, 0, 0, 1) + 2 * sram_access_pj(c, sram, kBuildKeyBytes * 8))) +
             nodes * (logic_pj(c, 0, 0, kRefitCmps) + sram_access_pj(c, sram, kRefitNodeBytes * 8));
+        const double fit = model["build_unit"].value("fit_node_frames", 0.0);
+        if (fit > 0) pj["obb_fit"] = fit * (logic_pj(c, kFitAdds, kFitMuls, kFitCmps) + sram_access_pj(c, sram, kRefitNodeBytes * 8));
     }
     if (s.mailbox.entries) pj["mailbox_compare"] = double(w[WorkField::mailbox_lookups]) * logic_pj(c, 0, 0, s.mailbox.entries);
     return pj;

@@ -6,12 +6,14 @@
 // scales), the work an oriented step adds, and validation of corrupt images.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
 #include "space_partition_util.h"
 #include "traces/accel/obvh/obvh.h"
 #include "traces/common/error.h"
+#include "traces/common/rng.h"
 #include "traces/scene/procedural.h"
 
 namespace rtsim {
@@ -22,21 +24,78 @@ using test::expect_structure_correct;
 
 const ObvhAccel& obvh(const Accel& a) { return static_cast<const ObvhAccel&>(a); }
 
+void expect_orthonormal(const std::vector<Rotation>& table) {
+    for (const Rotation& m : table)
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                double dot = 0;
+                for (int k = 0; k < 3; ++k) dot += double(m[3 * i + k]) * m[3 * j + k];
+                EXPECT_NEAR(dot, i == j ? 1.0 : 0.0, 1e-6);
+            }
+}
+
+/// A table of tilted frames only (no rotations about one axis).
+ObbConfig tilted(uint32_t turns, uint32_t tilts) {
+    ObbConfig c;
+    c.angle_steps = 1, c.turn_steps = turns, c.tilt_steps = tilts;
+    return c;
+}
+
 TEST(Obvh, RotationTableIsOrthonormalAndFitsSevenBits) {
     for (uint32_t steps : {2u, 16u, 32u, 43u}) {
-        const std::vector<Rotation> table = obb_rotation_table(steps);
+        ObbConfig c;
+        c.angle_steps = steps;
+        const std::vector<Rotation> table = obb_rotation_table(c);
         EXPECT_EQ(table.size(), 3 * (steps - 1));
         EXPECT_LT(table.size(), size_t(kNoRotation));
-        for (const Rotation& m : table)
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) {
-                    double dot = 0;
-                    for (int k = 0; k < 3; ++k) dot += double(m[3 * i + k]) * m[3 * j + k];
-                    EXPECT_NEAR(dot, i == j ? 1.0 : 0.0, 1e-6);
-                }
+        expect_orthonormal(table);
     }
-    EXPECT_THROW(obb_rotation_table(44), Error);
-    EXPECT_THROW(obb_rotation_table(1), Error);
+    // Tilted frames: every turn with every tilt but none, after the rotations about one axis.
+    for (auto [turns, tilts] : {std::pair{12u, 11u}, std::pair{1u, 2u}, std::pair{63u, 3u}}) {
+        const std::vector<Rotation> table = obb_rotation_table(tilted(turns, tilts));
+        EXPECT_EQ(table.size(), turns * (tilts - 1));
+        expect_orthonormal(table);
+    }
+    ObbConfig both = tilted(9, 9);
+    both.angle_steps = 16;
+    EXPECT_EQ(obb_rotation_table(both).size(), 45u + 72u);
+    EXPECT_EQ(obb_rotation_table(both)[0], obb_rotation_table(ObbConfig{both.angle_steps})[0]);
+    ObbConfig too_many = tilted(12, 11), none = tilted(14, 1);
+    too_many.angle_steps = 4;  // 9 + 120
+    for (const ObbConfig& c : {too_many, none})
+        try {
+            obb_rotation_table(c);
+            ADD_FAILURE() << "a table of " << 3 * (c.angle_steps - 1) + c.turn_steps * (c.tilt_steps - 1)
+                          << " rotations accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("obb_tilt_steps give"), std::string::npos) << e.what();
+        }
+}
+
+/// The largest |cosine| between `d` and an axis of any frame of `table` (1: one axis along `d`).
+double best_alignment(const std::vector<Rotation>& table, const Vec3& d) {
+    double best = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+    for (const Rotation& m : table) {
+        const Vec3 f = obb_rotate(m.data(), d);
+        best = std::max({best, double(std::fabs(f.x)), double(std::fabs(f.y)), double(std::fabs(f.z))});
+    }
+    return best;
+}
+
+TEST(Obvh, TiltedFramesBringEveryDirectionNearABoxAxis) {
+    const std::vector<Rotation> single = obb_rotation_table(ObbConfig{});
+    const std::vector<Rotation> both = obb_rotation_table(tilted(12, 11));
+    const Vec3 diagonal = glm::normalize(Vec3(1.0f, 1.0f, 1.0f));
+    EXPECT_LT(best_alignment(single, diagonal), std::cos(0.5));  // 35 degrees off every axis
+    EXPECT_GT(best_alignment(both, diagonal), std::cos(9.0 * M_PI / 180));
+    Rng rng(7);
+    double worst = 1.0;
+    for (int i = 0; i < 2000; ++i) {
+        const double z = 1.0 - 2.0 * rng.next(), phi = 2.0 * M_PI * rng.next(), ring = std::sqrt(1.0 - z * z);
+        const Vec3 d(float(ring * std::cos(phi)), float(ring * std::sin(phi)), float(z));
+        worst = std::min(worst, best_alignment(both, d));
+    }
+    EXPECT_GT(worst, std::cos(9.0 * M_PI / 180)) << "a direction more than 9 degrees off every frame's axes";
 }
 
 /// Every triangle of a subtree lies inside the box its parent holds for it, in the parent's frame
@@ -77,6 +136,9 @@ void expect_boxes_contain_triangles(const ObvhAccel& a, const std::string& what,
 TEST(Obvh, BoxesContainTheirTrianglesInEachFrame) {
     expect_boxes_contain_triangles(obvh(*build_named(test::random_soup(1, 1500), "obvh2", {{"obb_min_gain", 0.0}})),
                                    "soup");
+    expect_boxes_contain_triangles(
+        obvh(*build_named(test::random_soup(1, 1500), "obvh2", {{"obb_min_gain", 0.0}, {"obb_angle_steps", 1}, {"obb_turn_steps", 12}, {"obb_tilt_steps", 11}})),
+        "soup, tilted frames");
     for (const char* name : {"rotated_walls", "hairball", "teapot_stadium"})
         for (const char* kind : {"obvh2", "obvh2:sbvh"})
             expect_boxes_contain_triangles(obvh(*build_named(test::procedural(name), kind)), std::string(name) + " " + kind,
@@ -135,12 +197,12 @@ TEST(Obvh, AnOrientedStepAddsOneRotationAheadOfItsBoxTests) {
 /// A tessellated cube turned by table rotation `index` (world = m^T local) and its lattice rays
 /// turned alike: faces, edges and vertices lie on an oriented node's box planes.
 TEST(ObvhHardCases, FacesEdgesVerticesOfRotatedGeometryAndScales) {
-    const std::vector<Rotation> table = obb_rotation_table(ObbConfig{}.angle_steps);
     const std::vector<Vec3> unit = test::tessellated_cube(8);
+    for (const bool two : {false, true})
     for (size_t index : {size_t(5), size_t(40), size_t(77)})
         for (const auto& [scale, offset] : std::vector<std::pair<float, float>>{{1.0f, 0.0f}, {1e12f, 0.0f},
                                                                               {1e-12f, 0.0f}, {1.0f, 1e6f}}) {
-            const Rotation& m = table[index];
+            const Rotation& m = obb_rotation_table(two ? tilted(12, 11) : ObbConfig{})[index];
             const Rotation mt{m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8]};
             std::vector<Vec3> soup;
             for (const Vec3& v : unit) soup.push_back(Vec3(offset) + obb_rotate(mt.data(), scale * v));
@@ -152,9 +214,11 @@ TEST(ObvhHardCases, FacesEdgesVerticesOfRotatedGeometryAndScales) {
                 t.direction = obb_rotate(mt.data(), r.direction);
                 rays.push_back(t);
             }
-            const std::string what = "cube turned by rotation " + std::to_string(index) + " x " +
+            const std::string what = std::string(two ? "tilted " : "") + "cube turned by rotation " +
+                                     std::to_string(index) + " x " +
                                      std::to_string(scale) + " + " + std::to_string(offset);
-            const auto a = build_named(scene, "obvh2", {{"obb_min_gain", 0.0}});
+            const auto a = build_named(scene, "obvh2", two ? nlohmann::json{{"obb_min_gain", 0.0}, {"obb_angle_steps", 1}, {"obb_turn_steps", 12}, {"obb_tilt_steps", 11}}
+                                       : nlohmann::json{{"obb_min_gain", 0.0}});
             EXPECT_GT(a->image().stats["obvh2"]["oriented_nodes"].get<uint64_t>(), 0u) << what;
             EXPECT_GT(expect_structure_correct(*a, scene, rays, what), 300) << what;
         }

@@ -12,22 +12,42 @@
 
 namespace rtsim {
 
-std::vector<Rotation> obb_rotation_table(uint32_t angle_steps) {
-    require(angle_steps >= 2 && 3 * (angle_steps - 1) < kNoRotation,
-            "obvh2: obb_angle_steps must be 2 to 43 (at most 126 rotations and the 7-bit 'none')");
+namespace {
+
+/// Row-major rotation by `angle` about coordinate axis `axis`: the other two axes (u, v) turn.
+Rotation axis_rotation(int axis, double angle) {
+    const double c = std::cos(angle), s = std::sin(angle);
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    Rotation m{};
+    m[3 * axis + axis] = 1.0f;
+    m[3 * u + u] = float(c), m[3 * u + v] = float(-s);
+    m[3 * v + u] = float(s), m[3 * v + v] = float(c);
+    return m;
+}
+
+/// Tilt about x after a turn about z, in double then rounded once: Rx(tilt) Rz(turn).
+Rotation turn_then_tilt(double turn, double tilt) {
+    const double cz = std::cos(turn), sz = std::sin(turn), cx = std::cos(tilt), sx = std::sin(tilt);
+    return {float(cz), float(-sz), 0.0f, float(cx * sz), float(cx * cz), float(-sx),
+            float(sx * sz), float(sx * cz), float(cx)};
+}
+
+}  // namespace
+
+std::vector<Rotation> obb_rotation_table(const ObbConfig& obb) {
+    const uint64_t single = 3 * uint64_t(std::max(obb.angle_steps, 1u) - 1),
+                   tilted = uint64_t(obb.turn_steps) * (std::max(obb.tilt_steps, 1u) - 1);
+    require(single + tilted >= 1 && single + tilted < kNoRotation,
+            "obvh2: obb_angle_steps, obb_turn_steps and obb_tilt_steps give " + std::to_string(single) + " + " +
+                std::to_string(tilted) + " rotations: the table needs 1 to 126 (the node's 7-bit index less 'none')");
     std::vector<Rotation> table;
     for (int axis = 0; axis < 3; ++axis)
-        for (uint32_t k = 1; k < angle_steps; ++k) {
-            const double a = k * (M_PI / 2) / angle_steps;
-            const float c = float(std::cos(a)), s = float(std::sin(a));
-            // Rotation about `axis`: the other two axes (u, v) turn by the angle.
-            const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-            Rotation m{};
-            m[3 * axis + axis] = 1.0f;
-            m[3 * u + u] = c, m[3 * u + v] = -s;
-            m[3 * v + u] = s, m[3 * v + v] = c;
-            table.push_back(m);
-        }
+        for (uint32_t k = 1; k < obb.angle_steps; ++k) table.push_back(axis_rotation(axis, k * (M_PI / 2) / obb.angle_steps));
+    // Quarter turns map a box to a box, but a turn and a tilt each need a half turn here: over
+    // a quarter the tilted frames would miss half the directions' azimuths.
+    for (uint32_t i = 0; i < obb.turn_steps; ++i)
+        for (uint32_t j = 1; j < obb.tilt_steps; ++j)
+            table.push_back(turn_then_tilt(i * M_PI / obb.turn_steps, j * M_PI / obb.tilt_steps));
     return table;
 }
 
@@ -103,7 +123,7 @@ void fit_rotations(const HwNode* nodes, uint64_t count, const HwTriangle* tris, 
 
 AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildConfig& config, const ObbConfig& obb,
                        const std::string& builder, unsigned threads) {
-    const std::vector<Rotation> table = obb_rotation_table(obb.angle_steps);
+    const std::vector<Rotation> table = obb_rotation_table(obb);
     AccelImage flat = bvh2_image(tree, scene, config, builder);
     const Region& flat_nodes = flat.region("nodes");
     const Region& flat_tris = flat.region("triangles");
@@ -186,6 +206,8 @@ AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildCon
     // The fit's wall time is in the build's (build_ms): a trace holds no wall times.
     image.stats["obvh2"] = {{"rotations", table.size()},
                             {"angle_steps", obb.angle_steps},
+                            {"turn_steps", obb.turn_steps},
+                            {"tilt_steps", obb.tilt_steps},
                             {"min_gain", obb.min_gain},
                             {"oriented_nodes", oriented},
                             {"oriented_fraction", count ? double(oriented) / double(count) : 0.0},
