@@ -50,7 +50,7 @@ FrameBuild BuildUnit::run(const std::vector<BuildJob>& jobs, Cycle start) {
         // are spread over that time, reads before writes (a refit writes a node once its
         // children are read; a rebuild emits its nodes after its passes).
         // An oriented structure's fit follows either: a node's box in each table frame.
-        const uint64_t fit_frames = job.fit_nodes * job.fit_rotations;
+        const uint64_t fit_frames = job.fit_node_frames;
         const double compute = (job.refit ? double(job.tree_nodes) / m_config.refit_nodes_per_cycle
                                           : double(job.triangles) / m_config.rebuild_triangles_per_cycle) +
                                double(fit_frames) / m_config.fit_frames_per_cycle;

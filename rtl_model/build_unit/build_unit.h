@@ -25,11 +25,10 @@ struct BuildJob {
     bool refit = false;
     uint64_t triangles = 0;   ///< triangles it reads (a rebuild's primitives)
     uint64_t tree_nodes = 0;  ///< binary-tree nodes a refit recomputes
-    /// An oriented BVH (obvh2): each build or refit fits every node's rotation again, the
-    /// subtree's box in each of the table's `fit_rotations` frames bottom-up (docs/accel.md,
-    /// "obvh2"), over its `fit_nodes` nodes; 0 for an axis-aligned structure.
-    uint64_t fit_nodes = 0;
-    uint32_t fit_rotations = 0;
+    /// An oriented BVH (obvh2): the node boxes its fit computes, one per node and frame (every
+    /// rotation of the table, or with kept rotations each oriented ancestor's; docs/accel.md,
+    /// "obvh2"); 0 for an axis-aligned structure.
+    uint64_t fit_node_frames = 0;
     struct Range {
         uint64_t addr = 0, bytes = 0;
     };

@@ -10,17 +10,18 @@ using nlohmann::json;
 namespace {
 
 /// BLAS b's slices of the image's "blas_R" regions: written all, read where they hold triangles.
-BuildJob blas_job(const AccelImage& image, const json& blas, const json& record) {
+BuildJob blas_job(const AccelImage& image, const json& blas, const json& stats, const json& record) {
     BuildJob job;
     job.refit = record.value("action", std::string()) == "refit";
     job.triangles = record.value("triangles", uint64_t(0));
     job.tree_nodes = record["tree_nodes"].is_number() ? record["tree_nodes"].get<uint64_t>() : 0;
-    // An oriented BLAS fits its rotations again after each build and refit (obvh.h).
+    // An oriented BLAS fits its rotations after each build and refit (obvh.h): the node boxes
+    // its fit computed, or for a trace that did not record them, every node in every frame.
+    const json fit = stats.contains("obvh2") ? stats["obvh2"].value("fit_node_frames", json(nullptr)) : json(nullptr);
     const json& params = blas.value("params", json::object());
-    if (params.contains("rotations") && blas.at("count").contains("nodes")) {
-        job.fit_rotations = uint32_t(params["rotations"].size());
-        job.fit_nodes = blas.at("count").at("nodes").get<uint64_t>();
-    }
+    if (fit.is_number()) job.fit_node_frames = fit.get<uint64_t>();
+    else if (params.contains("rotations") && blas.at("count").contains("nodes"))
+        job.fit_node_frames = params["rotations"].size() * blas.at("count").at("nodes").get<uint64_t>();
     for (const auto& [name, first] : blas.at("first").items()) {
         const Region* r = nullptr;
         for (const Region& reg : image.regions)
@@ -61,12 +62,17 @@ std::vector<std::vector<BuildJob>> frame_build_jobs(const Accel& accel) {
     if (image.kind != "two_level" || !image.params.contains("frames")) return out;
     const json& frames = image.params.at("frames");
     const json& blases = image.params.at("blas");
+    const json no_stats = json::array();
+    const json& blas_stats = image.stats.contains("blas") && image.stats["blas"].is_array() ? image.stats["blas"] : no_stats;
     out.resize(frames.size());
     for (size_t f = 1; f < frames.size(); ++f) {
         const json& slice = frames[f];
         if (!slice.contains("build")) return {};  // a trace from before frames recorded builds
-        for (const json& record : slice["build"].value("blas", json::array()))
-            out[f].push_back(blas_job(image, blases.at(record.at("blas").get<size_t>()), record));
+        for (const json& record : slice["build"].value("blas", json::array())) {
+            const size_t b = record.at("blas").get<size_t>();
+            const json& stats = b < blas_stats.size() ? blas_stats[b] : json::object();
+            out[f].push_back(blas_job(image, blases.at(b), stats, record));
+        }
         out[f].push_back(tlas_job(image, slice));
     }
     return out;

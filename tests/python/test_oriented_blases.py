@@ -72,3 +72,28 @@ def test_build_unit_prices_an_oriented_blas_fit(sim_exe: Path, tmp_path: Path) -
     assert stats["obvh2"]["area"]["mm2"]["obb_fit"] > 0
     assert stats["obvh2"]["energy"]["per_ray_nj"]["obb_fit"] > 0
     assert analytic["model"]["build_unit"]["fit_node_frames"] == frames
+
+
+def test_refit_that_keeps_rotations_gives_the_rebuilt_hits_for_fewer_fit_frames(
+    sim_exe: Path, tmp_path: Path
+) -> None:
+    """With obb_refit_keeps_rotations a refit boxes each node in its kept frame only (every
+    subtree in its oriented ancestors' frames): the rebuilt trees' closest hits, and far fewer
+    node frames for the build unit than a refit that fits every rotation again."""
+    runs = {}
+    for name, sets in (("keep", ["--build-set", "obb_refit_keeps_rotations=true"]), ("fit", [])):
+        out = tmp_path / name
+        args = ["-o", str(out), "--resolution", "16x12", "--accel", "obvh2", "--frames", "3"]
+        made = run_rtsim("trace", "exploding_hairball", *args, "--frame-policy", "refit", *sets)
+        assert made.returncode == 0, made.stderr
+        runs[name] = (rtsim.open_trace(out), checked(sim_exe, out, tmp_path / f"sim-{name}"))
+    made = run_rtsim("trace", "exploding_hairball", "-o", str(tmp_path / "rebuild"),
+                     "--resolution", "16x12", "--accel", "obvh2", "--frames", "3")  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    rebuild = rtsim.open_trace(tmp_path / "rebuild")
+    keep = runs["keep"][0]
+    closest = keep.rays["kind"] != RAY_KINDS.index("shadow")
+    assert np.array_equal(keep.hits["prim"][closest], rebuild.hits["prim"][closest])
+    kept, fitted = (runs[n][1]["model"]["build_unit"] for n in ("keep", "fit"))
+    assert 0 < kept["fit_node_frames"] < fitted["fit_node_frames"] / 10
+    assert kept["busy_cycles"] < fitted["busy_cycles"] / 2

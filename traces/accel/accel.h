@@ -34,6 +34,9 @@ struct TreeReuse {
     /// The binary tree the build made or refitted (the next frame's topology); null for kinds
     /// built without one.
     std::shared_ptr<const BuildTree> built;
+    /// An oriented kind's rotation per node of the image it built (obvh2, in its node order,
+    /// which a refit keeps): what a refit that keeps the rotations boxes in; null for others.
+    std::shared_ptr<const std::vector<uint8_t>> rotations;
 };
 
 /// Bytes of a BVH's traversal stack entry in hardware: a node reference and its entry distance.

@@ -279,9 +279,15 @@ const std::vector<Entry>& registry() {
          },
          [](const Scene& scene, const AccelOptions& o, const BuildSettings& s) {
              nlohmann::json extra = nlohmann::json::object();
+             // A refit may keep the rotations of the image it refits (TreeReuse::rotations).
+             TreeReuse* reuse = o.tree_reuse;
+             const bool keep = s.obb.refit_keeps_rotations && reuse && reuse->refit_from && reuse->rotations;
+             const std::shared_ptr<const std::vector<uint8_t>> kept = keep ? reuse->rotations : nullptr;
              const BuildTree tree = build_tree(scene, o, s, &extra);
-             AccelImage image = obvh2_image(tree, scene, s.bvh, s.obb, o.builder, std::max(1u, o.build_threads));
+             AccelImage image =
+                 obvh2_image(tree, scene, s.bvh, s.obb, o.builder, std::max(1u, o.build_threads), kept.get());
              image.stats.update(extra);
+             if (reuse) reuse->rotations = std::make_shared<const std::vector<uint8_t>>(obvh2_rotations(image));
              return image;
          },
          loader<ObvhAccel>()},

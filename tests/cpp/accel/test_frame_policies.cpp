@@ -117,6 +117,50 @@ TEST(FramePolicies, EveryFrameHitsAsAFreshBuildOfItsPose) {
     }
 }
 
+TEST(FramePolicies, OrientedRefitsThatKeepTheirRotationsHitAsAFreshBuild) {
+    const Scene s = drift_scene(0.1f);
+    const uint32_t frames = 4;
+    AccelOptions o = two_level("obvh2");
+    o.settings = {{"obb_refit_keeps_rotations", true}, {"obb_min_gain", 0.0}};
+    const AccelImage image =
+        build_two_level_frames(s, o, still_poses(s, frames), nullptr, {s.animation.get(), {FramePolicy::refit, 1.1}});
+    const std::unique_ptr<Accel> animated = load_accel(image, "frames");
+    for (uint32_t f = 0; f < frames; ++f) {
+        const Scene frame_scene = posed(s, f);
+        AccelOptions fresh_options = two_level("obvh2");
+        fresh_options.settings = {{"obb_min_gain", 0.0}};
+        const std::unique_ptr<Accel> fresh = load_accel(build_two_level(frame_scene, fresh_options), "fresh");
+        animated->bind_frame(f);
+        Rng rng(60 + f);
+        int hits = 0;
+        for (int i = 0; i < 400; ++i) {
+            const Ray r = random_ray(rng, frame_scene.bounds, nullptr, 0);
+            WorkCounts wa, wf;
+            const Hit a = animated->trace(r, TraversalMode::closest_hit, &wa);
+            ASSERT_TRUE(same_hit(a, fresh->trace(r, TraversalMode::closest_hit, &wf))) << "frame " << f << " ray " << i;
+            ASSERT_EQ(animated->trace(r, TraversalMode::any_hit, &wa).valid(), a.valid()) << "frame " << f;
+            hits += a.valid();
+        }
+        EXPECT_GT(hits, 20) << "frame " << f;
+    }
+    // Each later frame's BLAS boxed its nodes only in their oriented ancestors' frames: fewer
+    // node frames than the full fit's every node in every rotation of the table.
+    const nlohmann::json& stats = image.stats.at("blas");
+    int kept = 0;
+    for (const nlohmann::json& b : stats) {
+        const nlohmann::json& fit = b.at("obvh2");
+        const uint64_t full = b.at("nodes").get<uint64_t>() * fit.at("rotations").get<uint64_t>();
+        if (!fit.at("rotations_kept").get<bool>()) {
+            EXPECT_EQ(fit.at("fit_node_frames").get<uint64_t>(), full);
+            continue;
+        }
+        ++kept;
+        EXPECT_GT(fit.at("fit_node_frames").get<uint64_t>(), 0u);
+        EXPECT_LT(fit.at("fit_node_frames").get<uint64_t>(), full / 4);
+    }
+    EXPECT_EQ(kept, int(frames) - 1);
+}
+
 TEST(FramePolicies, RefittedTreesBoundTheirTriangles) {
     const Scene s = drift_scene(0.2f);
     Scene a = posed(s, 0), b = posed(s, 5);

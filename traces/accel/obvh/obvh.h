@@ -69,12 +69,17 @@ struct ObbConfig {
     uint32_t turn_steps = 14, tilt_steps = 1;
     /// A node is oriented only if its children's summed surface area drops by this fraction.
     float min_gain = 0.1f;
+    /// A refit keeps each node's rotation (its children boxed in that frame, or on the world's
+    /// axes where those are smaller now) instead of fitting every rotation again: fewer node
+    /// frames for the build unit, rotations that age as the geometry moves.
+    bool refit_keeps_rotations = false;
 
     template <class V>
     void visit(V& v) {
         v.field("obb_angle_steps", angle_steps, "steps", "Rotations about one axis: k x 90/steps degrees about x, y, z (3 x (steps - 1) of them; 1: none)", 1, 43);
         v.field("obb_turn_steps", turn_steps, "steps", "Tilted frames: turns about z by i x 180/steps degrees", 1, 126);
         v.field("obb_tilt_steps", tilt_steps, "steps", "Tilted frames: tilts about x by j x 180/steps degrees after each turn (turns x (steps - 1) of them; 1: none); with the one-axis ones at most 126", 1, 126);
+        v.flag("obb_refit_keeps_rotations", refit_keeps_rotations, "A refit keeps each node's rotation, boxing its children in that frame (every subtree in each oriented ancestor's frame), instead of fitting every rotation again");
         v.field("obb_min_gain", min_gain, "fraction", "Orient a node only if its children's summed surface area drops by this fraction", 0, 1);
     }
 };
@@ -85,9 +90,14 @@ struct ObbConfig {
 std::vector<Rotation> obb_rotation_table(const ObbConfig& obb);
 
 /// The image of an oriented BVH from a binary build tree: regions "nodes" (HwObbNode) and
-/// "triangles" (HwTriangle, in leaf order), params.rotations the table, stats the fit's.
+/// "triangles" (HwTriangle, in leaf order), params.rotations the table, stats the fit's
+/// (`fit_node_frames`: the node boxes it computed, one per node and frame). With `kept` (a
+/// refitted tree's previous rotations, one per node) each node keeps its rotation instead of
+/// the fit trying the table.
 AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildConfig& config, const ObbConfig& obb,
-                       const std::string& builder, unsigned threads);
+                       const std::string& builder, unsigned threads, const std::vector<uint8_t>* kept = nullptr);
+/// The rotation per node of an obvh2 image (its "nodes" region), for TreeReuse::rotations.
+std::vector<uint8_t> obvh2_rotations(const AccelImage& image);
 
 /// The host's view of an oriented image: nodes as HwNode (boxes in each node's frame), the
 /// rotation of each and the table, read by the binary BVH's stepper (bvh2_stepper.h).

@@ -119,10 +119,67 @@ void fit_rotations(const HwNode* nodes, uint64_t count, const HwTriangle* tris, 
     }
 }
 
+/// Each node's fit with its kept rotation `kept[i]`, counting the node boxes computed in
+/// *node_frames. A node's children must be boxed in its frame, so every subtree is boxed in the
+/// frame of each oriented ancestor, bottom-up (exact: a box of a union is the union of the
+/// boxes): a node's frames are its parent's and its parent's rotation. A node whose kept frame
+/// no longer beats its axis-aligned children's area (the refit's, in `aabb_cost`) drops it.
+std::vector<ObbNodeFit> kept_rotation_fits(const HwNode* nodes, uint64_t count, const HwTriangle* tris,
+                                           const std::vector<Rotation>& table, const std::vector<uint8_t>& kept,
+                                           const std::vector<double>& aabb_cost, uint64_t* node_frames) {
+    require(kept.size() == count, "obvh2: the kept rotations are for " + std::to_string(kept.size()) +
+                                      " nodes, the refitted tree has " + std::to_string(count));
+    // Top-down (children after parents): the distinct oriented ancestors' rotations of each node.
+    std::vector<std::vector<uint8_t>> frames(count);
+    for (uint64_t i = 0; i < count; ++i) {
+        require(kept[i] == kNoRotation || kept[i] < table.size(), "obvh2: a kept rotation outside the table");
+        std::vector<uint8_t> mine = frames[i];
+        if (kept[i] != kNoRotation && std::find(mine.begin(), mine.end(), kept[i]) == mine.end()) mine.push_back(kept[i]);
+        for (int c = 0; c < 2; ++c)
+            if (nodes[i].child_count[c] == 0) frames[nodes[i].child_ref[c]] = mine;
+    }
+    // Bottom-up: each node's subtree boxed in each of its frames (children's freed once used).
+    std::vector<std::vector<Aabb>> subtree(count);
+    std::vector<ObbNodeFit> fits(count);
+    auto child_box = [&](const HwNode& n, int c, uint8_t r, size_t slot) {
+        Aabb box;
+        if (n.child_count[c] == kEmptyChild) return box;
+        if (n.child_count[c] == 0) return subtree[n.child_ref[c]][slot];
+        for (uint32_t t = n.child_ref[c]; t < n.child_ref[c] + n.child_count[c]; ++t) grow_rotated(box, table[r].data(), tris[t]);
+        return box;
+    };
+    for (uint64_t i = count; i-- > 0;) {
+        const HwNode& n = nodes[i];
+        // The children's frames are this node's plus its own rotation (last, if new).
+        const std::vector<uint8_t>& own = frames[i];
+        std::vector<uint8_t> below = own;
+        if (kept[i] != kNoRotation && std::find(below.begin(), below.end(), kept[i]) == below.end()) below.push_back(kept[i]);
+        auto slot_of = [&](uint8_t r) { return size_t(std::find(below.begin(), below.end(), r) - below.begin()); };
+        subtree[i].resize(own.size());
+        for (size_t f = 0; f < own.size(); ++f) {
+            const Aabb a = child_box(n, 0, own[f], slot_of(own[f])), b = child_box(n, 1, own[f], slot_of(own[f]));
+            subtree[i][f] = a;
+            subtree[i][f].grow(b);
+        }
+        *node_frames += own.size();
+        fits[i].cost = aabb_cost[i];
+        if (kept[i] != kNoRotation) {
+            const size_t slot = slot_of(kept[i]);
+            const Aabb a = child_box(n, 0, kept[i], slot), b = child_box(n, 1, kept[i], slot);
+            const double cost = obb_half_area(a) + obb_half_area(b);
+            *node_frames += std::find(own.begin(), own.end(), kept[i]) == own.end();  // else boxed above
+            if (cost < aabb_cost[i]) fits[i] = ObbNodeFit{cost, kept[i], {a, b}};
+        }
+        for (int c = 0; c < 2; ++c)
+            if (n.child_count[c] == 0) std::vector<Aabb>().swap(subtree[n.child_ref[c]]);
+    }
+    return fits;
+}
+
 }  // namespace
 
 AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildConfig& config, const ObbConfig& obb,
-                       const std::string& builder, unsigned threads) {
+                       const std::string& builder, unsigned threads, const std::vector<uint8_t>* kept) {
     const std::vector<Rotation> table = obb_rotation_table(obb);
     AccelImage flat = bvh2_image(tree, scene, config, builder);
     const Region& flat_nodes = flat.region("nodes");
@@ -138,17 +195,29 @@ AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildCon
         aabb_cost[i] = obb_half_area(obb_slot_aabb(nodes[i], 0)) + obb_half_area(obb_slot_aabb(nodes[i], 1));
         start[i].cost = aabb_cost[i] * (1.0 - double(obb.min_gain));
     }
-    // Rotations split among threads, each with its own fits, merged in rotation order.
-    const size_t workers = std::max<size_t>(1, std::min<size_t>(threads ? threads : 1, table.size()));
-    std::vector<std::vector<ObbNodeFit>> fits(workers, start);
-    std::vector<std::thread> pool;
-    for (size_t w = 0; w < workers; ++w) {
-        const size_t first = table.size() * w / workers, last = table.size() * (w + 1) / workers;
-        auto job = [&, w, first, last] { fit_rotations(nodes, count, tris, table, first, last, fits[w]); };
-        if (w + 1 == workers) job();
-        else pool.emplace_back(job);
+    // Each node's chosen frame: its kept rotation, or the best of the table.
+    std::vector<ObbNodeFit> chosen;
+    uint64_t node_frames = 0;
+    if (kept) {
+        chosen = kept_rotation_fits(nodes, count, tris, table, *kept, aabb_cost, &node_frames);
+    } else {
+        // Rotations split among threads, each with its own fits, merged in rotation order.
+        const size_t workers = std::max<size_t>(1, std::min<size_t>(threads ? threads : 1, table.size()));
+        std::vector<std::vector<ObbNodeFit>> fits(workers, start);
+        std::vector<std::thread> pool;
+        for (size_t w = 0; w < workers; ++w) {
+            const size_t first = table.size() * w / workers, last = table.size() * (w + 1) / workers;
+            auto job = [&, w, first, last] { fit_rotations(nodes, count, tris, table, first, last, fits[w]); };
+            if (w + 1 == workers) job();
+            else pool.emplace_back(job);
+        }
+        for (std::thread& t : pool) t.join();
+        chosen = start;
+        for (uint64_t i = 0; i < count; ++i)
+            for (const std::vector<ObbNodeFit>& f : fits)
+                if (f[i].cost < chosen[i].cost) chosen[i] = f[i];  // workers in rotation order: ties keep the lower
+        node_frames = count * table.size();
     }
-    for (std::thread& t : pool) t.join();
 
     AccelImage image;
     image.kind = "obvh2";
@@ -162,9 +231,7 @@ AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildCon
     std::vector<double> slot_area(2 * count, 0.0);  // each child slot's area in its node's frame
     for (uint64_t i = 0; i < count; ++i) {
         const HwNode& n = nodes[i];
-        const ObbNodeFit* best = &start[i];
-        for (const std::vector<ObbNodeFit>& f : fits)
-            if (f[i].cost < best->cost) best = &f[i];  // workers in rotation order: ties keep the lower
+        const ObbNodeFit* best = &chosen[i];
         const bool rotate = best->rotation != kNoRotation;
         o[i].rotation = best->rotation;
         for (int c = 0; c < 2; ++c) {
@@ -208,11 +275,21 @@ AccelImage obvh2_image(const BuildTree& tree, const Scene& scene, const BuildCon
                             {"angle_steps", obb.angle_steps},
                             {"turn_steps", obb.turn_steps},
                             {"tilt_steps", obb.tilt_steps},
+                            {"rotations_kept", kept != nullptr},
+                            {"fit_node_frames", node_frames},
                             {"min_gain", obb.min_gain},
                             {"oriented_nodes", oriented},
                             {"oriented_fraction", count ? double(oriented) / double(count) : 0.0},
                             {"child_area_ratio", area_before > 0 ? area_after / area_before : 1.0}};
     return image;
+}
+
+std::vector<uint8_t> obvh2_rotations(const AccelImage& image) {
+    const Region& nodes = image.region("nodes");
+    const HwObbNode* n = nodes.records<HwObbNode>();
+    std::vector<uint8_t> out(nodes.count);
+    for (uint64_t i = 0; i < nodes.count; ++i) out[i] = n[i].rotation;
+    return out;
 }
 
 }  // namespace rtsim
