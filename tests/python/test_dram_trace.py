@@ -3,6 +3,7 @@ of scripts/dram_compare.py."""
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import json
 import sys
@@ -91,3 +92,27 @@ def test_dramsim3_config_takes_rtsims_channels(tmp_path: Path) -> None:
     assert ini["system"]["channels"] == "4"
     assert "channels = 4" in (tmp_path / "out.ini").read_text()
     assert m.dramsim3_unloaded_ns(ini) == pytest.approx((16 + 16 + 4) * 0.94)
+
+
+def test_closed_loop_moves_rtsims_latency_to_the_simulators_mean(
+    cornell_small: Path,  # noqa: F811
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """scripts/dram_closed_loop.py against a stand-in simulator whose mean read latency is 400 ns
+    whatever the stream: the loop raises rtsim's latency until rtsim's own mean on its stream is
+    within the tolerance of it, and the slower memory costs the machine cycles."""
+    path = REPO / "scripts" / "dram_closed_loop.py"
+    spec = importlib.util.spec_from_file_location("dram_closed_loop", path)
+    assert spec and spec.loader
+    loop = importlib.util.module_from_spec(spec)
+    sys.modules["dram_closed_loop"] = loop
+    spec.loader.exec_module(loop)
+    monkeypatch.setattr(loop, "replay", lambda *_: 400.0)
+    args = argparse.Namespace(out=tmp_path, iterations=14, tolerance=0.03)
+    r = loop.close_loop("cornell", cornell_small, 1, "dramsim3", args)
+    last = r["best"]
+    assert r["converged"] and abs(last["rtsim_ns"] - 400.0) <= 12.0
+    assert 1 < len(r["steps"]) <= 14 and last["latency"] > r["steps"][0]["latency"]
+    assert last["cycles"] > r["banks_cycles"]
+    assert "| cornell | 1 | DRAMsim3 |" in loop.table([r])
