@@ -64,7 +64,8 @@ struct MergeKey {
 };
 
 /// A window of consecutive rounds of a whole-trace analysis (sample.h: every active context
-/// takes one step per round): what its steps asked for. The windows in order are the run's
+/// takes one step per round, or waits the rounds its last step's slowest line takes when served
+/// below the L1): what its steps asked for. The windows in order are the run's
 /// phases: the fill (every ray at the top of the tree at once), the steady state and the drain
 /// (fewer rays than contexts, the longest ray alone at the end), which a closed form over the
 /// whole run's totals averages away (estimate.cpp, "phases").

@@ -55,7 +55,8 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
     if (m_partition) return run_treelets(dealer, sink);
     for (uint32_t c = 0; c < m_slots; ++c)
         for (uint32_t u = 0; u < m_units; ++u) start_ray(dealer, u, c, sink);
-    // Rounds: every active context takes one step, context-major then unit.
+    // Rounds: every active context takes one step, context-major then unit, unless it still
+    // waits for its last step's line (wait_rounds).
     const size_t n = m_contexts.size();
     auto index = [&](size_t p) { return (p % m_units) * m_slots + p / m_units; };
     // Steps of a few hundred ns against a host miss of about 100 ns (2 and 8 measured alike).
@@ -66,7 +67,8 @@ void SampleProfiler::run_cluster(RayStream& stream, uint64_t measure_first, uint
             prefetch_ahead(index((p + kAhead) % n));
             const size_t i = index(p);
             if (!m_contexts[i].active) continue;
-            step(dealer, uint32_t(i / m_slots), uint32_t(i % m_slots), sink);
+            if (m_contexts[i].wait) --m_contexts[i].wait;
+            else step(dealer, uint32_t(i / m_slots), uint32_t(i % m_slots), sink);
             any = true;
             if (m_record_phases) m_phases.back().contexts += 1;  // busy this round, stepping or not
         }
@@ -90,15 +92,16 @@ void SampleProfiler::run_treelets(RayDealer& dealer, RaySinkIf& sink) {
     admit(dealer);
     const size_t n = m_contexts.size();
     auto index = [&](size_t p) { return (p % m_units) * m_slots + p / m_units; };
-    // Rounds as without treelets: every context with a ray takes one step; an idle one takes a
-    // ray of its unit's treelet first (other units' parks refill the queues).
+    // Rounds as without treelets, waits included: every context with a ray takes one step; an
+    // idle one takes a ray of its unit's treelet first (other units' parks refill the queues).
     for (bool any = true; any;) {
         any = false;
         for (size_t p = 0; p < n; ++p) {
             const size_t i = index(p);
             const uint32_t unit = uint32_t(i / m_slots), slot = uint32_t(i % m_slots);
             if (!m_contexts[i].active && !take_ray(unit, slot)) continue;
-            step(dealer, unit, slot, sink);
+            if (m_contexts[i].wait) --m_contexts[i].wait;
+            else step(dealer, unit, slot, sink);
             any = true;
             if (m_record_phases) m_phases.back().contexts += 1;
         }
@@ -201,6 +204,29 @@ bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, 
     return true;
 }
 
+namespace {
+
+/// Rounds a context waits after a step whose slowest line has reuse key `key`: a round is a step
+/// served by the L1 at the default machine (issue 1 + L1 4 + box pipeline 8 = 13 cycles), a line
+/// from the L2 adds its 20 cycles (2 rounds), one from DRAM the L2's and DRAM's 140 (10). Served
+/// below the L1: a first read in the unit's stream or a reuse past 4 x the default L1's 256
+/// lines; from DRAM: a first read in all units' stream or a reuse past 4 x the default L2's
+/// 16,384 lines (the reuse distance counts accesses, the stack distance fewer). Fixed at the
+/// defaults, since one analysis serves every cache size and latency (analysis_cache.h); the
+/// closed form prices each step at the config's own.
+uint32_t wait_rounds(uint32_t key) {
+    constexpr uint32_t kL2Rounds = 2, kDramRounds = 10;
+    constexpr double kL1Reuse = 4.0 * 256, kL2Reuse = 4.0 * 16384;
+    int ub, gb;
+    bool uc, gc;
+    JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
+    if (gc || DistanceBins::low(gb) > kL2Reuse) return kDramRounds;
+    if (uc || DistanceBins::low(ub) > kL1Reuse) return kL2Rounds;
+    return 0;
+}
+
+}  // namespace
+
 void SampleProfiler::finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink) {
     const Stepper& s = *ctx.stepper;
     write(m_map.hit(ctx.id), sizeof(HitRecord), DataKind::hit, ctx.measured);
@@ -249,6 +275,9 @@ void SampleProfiler::step(RayDealer& dealer, uint32_t unit, uint32_t slot, RaySi
         const Access a = read(unit, d.reads[i].addr, d.reads[i].bytes, d.reads[i].kind, ctx.measured);
         if (i == 0 || a.rank > critical.rank) critical = a;
     }
+    // Rounds as time: a step whose slowest line is likely served below the L1 holds its context
+    // for the rounds that takes (wait_rounds), so the rays left at the end are the slow ones.
+    if (d.read_count) ctx.wait = wait_rounds(critical.key);
     if (m_record_phases) {
         PhaseCounts& w = m_phases.back();
         w.steps += 1;

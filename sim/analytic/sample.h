@@ -57,6 +57,7 @@ private:
     };
     struct Context : Ray {
         bool active = false;
+        uint32_t wait = 0;  ///< rounds it still waits for its last step's slowest line
         uint32_t treelet = 0;  ///< treelet scheduling: the treelet its ray is in
     };
     /// A line read's reuse key (JointHistogram::pack) and its ordering weight for "slowest".

@@ -261,7 +261,7 @@ TEST(AnalyticLevel, SecondConfigurationOnTheSameRaysReusesTheAnalysis) {
 
 TEST(AnalyticLevel, WholeTraceAnalysisRecordsItsRoundsInPhaseWindows) {
     // Every step of the whole trace lies in one window; the windows' rounds are at least the
-    // longest ray's steps (a context takes one step per round) and their populations never
+    // longest ray's steps (a context takes at most one step per round) and their populations never
     // exceed the contexts; the drain (fewer rays than contexts) is the last windows'. A profile
     // with phases round-trips through the analysis file.
     const Workload& w = workload();
@@ -281,7 +281,8 @@ TEST(AnalyticLevel, WholeTraceAnalysisRecordsItsRoundsInPhaseWindows) {
     EXPECT_EQ(steps, p.sample_plan_steps);
     EXPECT_GE(rounds, p.longest_ray_steps * p.plan_steps_per[0] * 0.5);
     const PhaseWindow& last = p.phases.back();
-    EXPECT_LT(last.contexts / last.rounds, 0.5 * c.traversal.units * c.traversal.contexts());
+    // Below the steady state's population (every context busy, waiting for a line or stepping).
+    EXPECT_LT(last.contexts / last.rounds, 0.9 * c.traversal.units * c.traversal.contexts());
     const AnalyticProfile back = AnalyticProfile::from_json(p.to_json());
     EXPECT_EQ(back.to_json(), p.to_json());
     // Its estimate carries the phases: a drain makes the run longer than the whole run's form.
