@@ -117,7 +117,7 @@ const StatBlock& build_unit_stats() {
             {"stream_cycles", "cycles", "cycles its memory stream took (reads, then writes, through the L2), summed over its jobs: a job takes the longer of the two"},
             {"rebuilt_triangles", "triangles", "triangles of the structures it rebuilt"},
             {"refit_nodes", "nodes", "binary-tree nodes of the structures it refitted"},
-            {"fit_node_frames", "node frames", "oriented BVHs (obvh2): the nodes of the structures it built or refitted times the rotations their fit tries (each node's box in every table frame, at `fit_frames_per_cycle`); 0 without them"},
+            {"fit_node_frames", "node frames", "oriented BVHs (obvh2): the node boxes the fits of the structures it built or refitted computed, one per node and frame (every table frame; with kept rotations only the frames of each node's oriented ancestors), at `fit_frames_per_cycle`; 0 without them"},
             {"read_bytes", "bytes", "bytes it read through the L2 (triangles; a rebuild's passes each)"},
             {"written_bytes", "bytes", "bytes it wrote through the L2 (the frames' nodes, triangle records, instances)"},
             {"rebuilds", "structures", "structures (BLASes and TLASes) it rebuilt"},

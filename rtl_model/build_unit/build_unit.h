@@ -40,7 +40,7 @@ struct FrameBuild {
     Cycle start = 0, end = 0;
     uint64_t read_bytes = 0, written_bytes = 0;
     uint64_t rebuilt_triangles = 0, refit_nodes = 0;
-    uint64_t fit_node_frames = 0;  ///< oriented fits: nodes x rotations tried
+    uint64_t fit_node_frames = 0;  ///< oriented fits: the node boxes they computed (BuildJob's)
     uint32_t rebuilds = 0, refits = 0;
 };
 

@@ -33,7 +33,7 @@ struct BuildUnitConfig {
         v.flag("enabled", enabled, "Price each frame's build or refit on the build unit at the frame barrier (animated traces)");
         v.field("rebuild_triangles_per_cycle", rebuild_triangles_per_cycle, "triangles/cycle", "Rebuild throughput (LBVH-style unit about 1; a binned-SAH unit about 0.2)", 0.001, 64);
         v.field("refit_nodes_per_cycle", refit_nodes_per_cycle, "nodes/cycle", "Refit throughput: binary-tree nodes whose box is recomputed per cycle", 0.001, 64);
-        v.field("fit_frames_per_cycle", fit_frames_per_cycle, "node frames/cycle", "Oriented BVHs: a fit's throughput, node boxes computed in one table frame per cycle (every rotation of every node, each build and refit)", 0.001, 1024);
+        v.field("fit_frames_per_cycle", fit_frames_per_cycle, "node frames/cycle", "Oriented BVHs: a fit's throughput, node boxes computed in one frame per cycle (each build's and refit's fit_node_frames)", 0.001, 1024);
         v.field("rebuild_read_passes", rebuild_read_passes, "passes", "Times a rebuild reads its triangles (keys, sort passes, emit)", 1, 64);
         v.field("outstanding_lines", outstanding_lines, "lines", "Line requests the unit keeps in flight to the L2", 1, 4096);
         v.field("sram_kib", sram_kib, "KiB", "The unit's working SRAM (area only)", 1, 1u << 16);

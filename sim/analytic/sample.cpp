@@ -177,7 +177,7 @@ void SampleProfiler::park(Ray&& ray, uint32_t treelet) {
 }
 
 void SampleProfiler::prefetch_ahead(size_t index) const {
-    if (!m_contexts[index].active) return;
+    if (!m_contexts[index].active || m_contexts[index].wait) return;  // it does not step this round
     const HostAhead& a = m_ahead[index];
     a.prefetch_step();
     if (a.first_fetch() == HostAhead::kNoFetch) return;
@@ -216,12 +216,13 @@ namespace {
 /// closed form prices each step at the config's own.
 uint32_t wait_rounds(uint32_t key) {
     constexpr uint32_t kL2Rounds = 2, kDramRounds = 10;
-    constexpr double kL1Reuse = 4.0 * 256, kL2Reuse = 4.0 * 16384;
+    // The first bins whose distances all lie past 4 x the default L1's and L2's lines.
+    static const int l1_bin = DistanceBins::bin(4 * 256) + 1, l2_bin = DistanceBins::bin(4 * 16384) + 1;
     int ub, gb;
     bool uc, gc;
     JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
-    if (gc || DistanceBins::low(gb) > kL2Reuse) return kDramRounds;
-    if (uc || DistanceBins::low(ub) > kL1Reuse) return kL2Rounds;
+    if (gc || gb >= l2_bin) return kDramRounds;
+    if (uc || ub >= l1_bin) return kL2Rounds;
     return 0;
 }
 

@@ -62,15 +62,16 @@ std::vector<std::vector<BuildJob>> frame_build_jobs(const Accel& accel) {
     if (image.kind != "two_level" || !image.params.contains("frames")) return out;
     const json& frames = image.params.at("frames");
     const json& blases = image.params.at("blas");
-    const json no_stats = json::array();
-    const json& blas_stats = image.stats.contains("blas") && image.stats["blas"].is_array() ? image.stats["blas"] : no_stats;
+    static const json kNoBlases = json::array(), kNoStats = json::object();
+    const json& blas_stats =
+        image.stats.contains("blas") && image.stats["blas"].is_array() ? image.stats["blas"] : kNoBlases;
     out.resize(frames.size());
     for (size_t f = 1; f < frames.size(); ++f) {
         const json& slice = frames[f];
         if (!slice.contains("build")) return {};  // a trace from before frames recorded builds
         for (const json& record : slice["build"].value("blas", json::array())) {
             const size_t b = record.at("blas").get<size_t>();
-            const json& stats = b < blas_stats.size() ? blas_stats[b] : json::object();
+            const json& stats = b < blas_stats.size() ? blas_stats[b] : kNoStats;
             out[f].push_back(blas_job(image, blases.at(b), stats, record));
         }
         out[f].push_back(tlas_job(image, slice));

@@ -139,7 +139,7 @@ json structure_blocks(const std::string& kind, const std::string& blas_kind, boo
           {"why", compressed_leaves ? "compressed leaves: triangles decoded from leaf blocks (Benthin et al. 2018)"
                                     : std::string("triangles stored as plain records")}},
          {{"block", "obb_fit"}, {"instantiated", oriented},
-          {"why", oriented ? "oriented nodes: a build or refit on the build unit fits each node's rotation again"
+          {"why", oriented ? "oriented nodes: a build or refit on the build unit boxes each node in its fit's frames"
                            : std::string("the structure's boxes are axis-aligned")}}});
 }
 

@@ -64,8 +64,9 @@ struct ObbConfig {
     /// (1, 1, 1) stays 35 degrees off every axis of every frame.
     uint32_t angle_steps = 32;
     /// Tilted frames beside them: a turn about z by i x 180 / turn_steps degrees, then a tilt
-    /// about x by j x 180 / tilt_steps degrees (j >= 1; tilt_steps = 1: none), whose frames bring
-    /// any direction within a few degrees of a box axis (docs/accel.md, "obvh2").
+    /// about x by j x 180 / tilt_steps degrees (j >= 1, but not a quarter tilt, which gives a turn
+    /// about z again; tilt_steps = 1: none), whose frames bring any direction within a few
+    /// degrees of a box axis (docs/accel.md, "obvh2").
     uint32_t turn_steps = 14, tilt_steps = 1;
     /// A node is oriented only if its children's summed surface area drops by this fraction.
     float min_gain = 0.1f;
@@ -78,14 +79,14 @@ struct ObbConfig {
     void visit(V& v) {
         v.field("obb_angle_steps", angle_steps, "steps", "Rotations about one axis: k x 90/steps degrees about x, y, z (3 x (steps - 1) of them; 1: none)", 1, 43);
         v.field("obb_turn_steps", turn_steps, "steps", "Tilted frames: turns about z by i x 180/steps degrees", 1, 126);
-        v.field("obb_tilt_steps", tilt_steps, "steps", "Tilted frames: tilts about x by j x 180/steps degrees after each turn (turns x (steps - 1) of them; 1: none); with the one-axis ones at most 126", 1, 126);
+        v.field("obb_tilt_steps", tilt_steps, "steps", "Tilted frames: tilts about x by j x 180/steps degrees after each turn, j >= 1 but not a quarter tilt (turns x (steps - 1) of them, one fewer tilt for even steps; 1: none); with the one-axis ones at most 126", 1, 126);
         v.flag("obb_refit_keeps_rotations", refit_keeps_rotations, "A refit keeps each node's rotation, boxing its children in that frame (every subtree in each oriented ancestor's frame), instead of fitting every rotation again");
         v.field("obb_min_gain", min_gain, "fraction", "Orient a node only if its children's summed surface area drops by this fraction", 0, 1);
     }
 };
 
 /// The rotation table of `obb`: the 3 x (angle_steps - 1) rotations about one axis, then the
-/// turn_steps x (tilt_steps - 1) tilted frames; index kNoRotation is none. Throws naming the
+/// tilted frames (turn_steps x (tilt_steps - 1), less a quarter tilt's); index kNoRotation is none. Throws naming the
 /// settings when the table is empty or would not fit the node's 7-bit index.
 std::vector<Rotation> obb_rotation_table(const ObbConfig& obb);
 

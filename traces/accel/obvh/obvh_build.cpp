@@ -35,8 +35,8 @@ Rotation turn_then_tilt(double turn, double tilt) {
 }  // namespace
 
 std::vector<Rotation> obb_rotation_table(const ObbConfig& obb) {
-    const uint64_t single = 3 * uint64_t(std::max(obb.angle_steps, 1u) - 1),
-                   tilted = uint64_t(obb.turn_steps) * (std::max(obb.tilt_steps, 1u) - 1);
+    const uint32_t tilts = std::max(obb.tilt_steps, 1u) - 1 - (obb.tilt_steps % 2 == 0 && obb.tilt_steps >= 2);
+    const uint64_t single = 3 * uint64_t(std::max(obb.angle_steps, 1u) - 1), tilted = uint64_t(obb.turn_steps) * tilts;
     require(single + tilted >= 1 && single + tilted < kNoRotation,
             "obvh2: obb_angle_steps, obb_turn_steps and obb_tilt_steps give " + std::to_string(single) + " + " +
                 std::to_string(tilted) + " rotations: the table needs 1 to 126 (the node's 7-bit index less 'none')");
@@ -45,9 +45,10 @@ std::vector<Rotation> obb_rotation_table(const ObbConfig& obb) {
         for (uint32_t k = 1; k < obb.angle_steps; ++k) table.push_back(axis_rotation(axis, k * (M_PI / 2) / obb.angle_steps));
     // Quarter turns map a box to a box, but a turn and a tilt each need a half turn here: over
     // a quarter the tilted frames would miss half the directions' azimuths.
+    // A quarter tilt about x maps the turned box to itself turned about z (no new frame): skipped.
     for (uint32_t i = 0; i < obb.turn_steps; ++i)
         for (uint32_t j = 1; j < obb.tilt_steps; ++j)
-            table.push_back(turn_then_tilt(i * M_PI / obb.turn_steps, j * M_PI / obb.tilt_steps));
+            if (2 * j != obb.tilt_steps) table.push_back(turn_then_tilt(i * M_PI / obb.turn_steps, j * M_PI / obb.tilt_steps));
     return table;
 }
 
@@ -122,21 +123,28 @@ void fit_rotations(const HwNode* nodes, uint64_t count, const HwTriangle* tris, 
 /// Each node's fit with its kept rotation `kept[i]`, counting the node boxes computed in
 /// *node_frames. A node's children must be boxed in its frame, so every subtree is boxed in the
 /// frame of each oriented ancestor, bottom-up (exact: a box of a union is the union of the
-/// boxes): a node's frames are its parent's and its parent's rotation. A node whose kept frame
-/// no longer beats its axis-aligned children's area (the refit's, in `aabb_cost`) drops it.
+/// boxes): a node's frames are the distinct rotations above it, its children's those and its
+/// own. A node whose kept frame no longer beats its axis-aligned children's area (the refit's,
+/// in `aabb_cost`; without the build's `min_gain`, which decided whether to orient it) drops
+/// the rotation, and a later refit keeps it dropped: only a rebuild orients a node again.
 std::vector<ObbNodeFit> kept_rotation_fits(const HwNode* nodes, uint64_t count, const HwTriangle* tris,
                                            const std::vector<Rotation>& table, const std::vector<uint8_t>& kept,
                                            const std::vector<double>& aabb_cost, uint64_t* node_frames) {
     require(kept.size() == count, "obvh2: the kept rotations are for " + std::to_string(kept.size()) +
                                       " nodes, the refitted tree has " + std::to_string(count));
-    // Top-down (children after parents): the distinct oriented ancestors' rotations of each node.
-    std::vector<std::vector<uint8_t>> frames(count);
+    // Top-down: each node's frames (`frames`, its ancestors') and its children's (`below`).
+    std::vector<std::vector<uint8_t>> frames(count), below(count);
     for (uint64_t i = 0; i < count; ++i) {
         require(kept[i] == kNoRotation || kept[i] < table.size(), "obvh2: a kept rotation outside the table");
-        std::vector<uint8_t> mine = frames[i];
-        if (kept[i] != kNoRotation && std::find(mine.begin(), mine.end(), kept[i]) == mine.end()) mine.push_back(kept[i]);
+        below[i] = frames[i];
+        if (kept[i] != kNoRotation && std::find(below[i].begin(), below[i].end(), kept[i]) == below[i].end())
+            below[i].push_back(kept[i]);
         for (int c = 0; c < 2; ++c)
-            if (nodes[i].child_count[c] == 0) frames[nodes[i].child_ref[c]] = mine;
+            if (nodes[i].child_count[c] == 0) {
+                // The depth-first layout puts children after their parents: one pass each way.
+                require(nodes[i].child_ref[c] > i, "obvh2: node " + std::to_string(i) + " has a child before it");
+                frames[nodes[i].child_ref[c]] = below[i];
+            }
     }
     // Bottom-up: each node's subtree boxed in each of its frames (children's freed once used).
     std::vector<std::vector<Aabb>> subtree(count);
@@ -150,11 +158,8 @@ std::vector<ObbNodeFit> kept_rotation_fits(const HwNode* nodes, uint64_t count, 
     };
     for (uint64_t i = count; i-- > 0;) {
         const HwNode& n = nodes[i];
-        // The children's frames are this node's plus its own rotation (last, if new).
         const std::vector<uint8_t>& own = frames[i];
-        std::vector<uint8_t> below = own;
-        if (kept[i] != kNoRotation && std::find(below.begin(), below.end(), kept[i]) == below.end()) below.push_back(kept[i]);
-        auto slot_of = [&](uint8_t r) { return size_t(std::find(below.begin(), below.end(), r) - below.begin()); };
+        auto slot_of = [&](uint8_t r) { return size_t(std::find(below[i].begin(), below[i].end(), r) - below[i].begin()); };
         subtree[i].resize(own.size());
         for (size_t f = 0; f < own.size(); ++f) {
             const Aabb a = child_box(n, 0, own[f], slot_of(own[f])), b = child_box(n, 1, own[f], slot_of(own[f]));
