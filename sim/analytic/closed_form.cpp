@@ -177,12 +177,14 @@ ClosedForm closed_form(const SimConfig& c, const std::vector<OpKind>& ops, const
     for (auto& [name, value] : f.bounds.items())
         require(value.is_number() && std::isfinite(value.get<double>()),
                 "analytic: the closed form's '" + name + "' bound is not a finite number (a bug in its demands)");
+    // Bounds within a billionth of each other tie, and the first named binds: the L2's MSHRs held
+    // only by DRAM waits tie with the DRAM, their cause, which "dram" names first.
     f.binding = "latency";
-    for (auto& [name, value] : f.bounds.items())
-        if (value.get<double>() > f.roofline) {
-            f.roofline = value.get<double>();
-            f.binding = name;
-        }
+    for (auto& [name, value] : f.bounds.items()) {
+        const double v = value.get<double>();
+        if (v > f.roofline * (1.0 + 1e-9)) f.binding = name;
+        f.roofline = std::max(f.roofline, v);
+    }
     f.queueing = mva_cycles(c, ops, held, f.bounds);
     f.cycles = std::max(f.roofline, f.queueing);
     f.steady_cycles = std::ceil(f.cycles);

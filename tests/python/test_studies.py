@@ -18,7 +18,7 @@ SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
 #: they time, describe or export from the binaries one process at a time. hostile_corpus_study
 #: times the hostile-input tests (pytest), not the simulator: it runs no trace or simulation.
 KEPT_SCRIPTS = re.compile(r"^(bench_|gen_|analytic_sweep_speed|sampling_coverage|stats_identity|"
-                          r"make_fuzz_corpus|technique_costs_doc|dram_compare|"
+                          r"make_fuzz_corpus|technique_costs_doc|dram_compare|dram_closed_loop|"
                           r"hostile_corpus_study)")  # fmt: skip
 PRIVATE = re.compile(
     r"^def (trace|simulate|run_sim\w*)\(|rtsim-sim|rtsim-trace|from rtsim\.launcher import|"

@@ -37,6 +37,9 @@ struct TreeReuse {
     /// An oriented kind's rotation per node of the image it built (obvh2, in its node order,
     /// which a refit keeps): what a refit that keeps the rotations boxes in; null for others.
     std::shared_ptr<const std::vector<uint8_t>> rotations;
+    /// The SAH cost of the image built, when the kind's boxes are not the binary tree's
+    /// (oriented boxes, each as its parent holds it): what the frame policy weighs; 0 for others.
+    double image_sah_cost = 0.0;
 };
 
 /// Bytes of a BVH's traversal stack entry in hardware: a node reference and its entry distance.

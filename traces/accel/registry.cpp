@@ -287,7 +287,10 @@ const std::vector<Entry>& registry() {
              AccelImage image =
                  obvh2_image(tree, scene, s.bvh, s.obb, o.builder, std::max(1u, o.build_threads), kept.get());
              image.stats.update(extra);
-             if (reuse) reuse->rotations = std::make_shared<const std::vector<uint8_t>>(obvh2_rotations(image));
+             if (reuse) {
+                 reuse->rotations = std::make_shared<const std::vector<uint8_t>>(obvh2_rotations(image));
+                 reuse->image_sah_cost = image.stats["sah_cost"].get<double>();  // the oriented boxes'
+             }
              return image;
          },
          loader<ObvhAccel>()},

@@ -159,6 +159,12 @@ TEST(FramePolicies, OrientedRefitsThatKeepTheirRotationsHitAsAFreshBuild) {
         EXPECT_LT(fit.at("fit_node_frames").get<uint64_t>(), full / 4);
     }
     EXPECT_EQ(kept, int(frames) - 1);
+    // The policy weighs each frame's BLAS by its oriented boxes' SAH cost, which ages.
+    for (uint32_t f = 0; f < frames; ++f) {
+        const nlohmann::json& r = build_of(image, f)["blas"][0];
+        EXPECT_DOUBLE_EQ(r["sah_cost"].get<double>(), stats.at(r["blas"].get<size_t>())["sah_cost"].get<double>());
+        if (f > 0) EXPECT_GT(r["sah_ratio"].get<double>(), 1.0) << "frame " << f;
+    }
 }
 
 TEST(FramePolicies, RefittedTreesBoundTheirTriangles) {

@@ -47,7 +47,10 @@ TreeReuse* FrameTree::reuse_for(uint32_t frame) {
 nlohmann::json FrameTree::done(const BuildConfig& config) {
     // A kind built without a binary tree (kd-tree, grid, octree, GK-BVH) only rebuilds: no cost.
     if (!m_reuse.built) return {{"action", "build"}, {"tree_nodes", nullptr}, {"sah_cost", nullptr}, {"sah_ratio", nullptr}};
-    const double cost = sah_cost(*m_reuse.built, config);
+    // The structure's own boxes where they are not the tree's (oriented ones age as a refit
+    // keeps their rotations), else the tree's.
+    const double cost = m_reuse.image_sah_cost > 0.0 ? m_reuse.image_sah_cost : sah_cost(*m_reuse.built, config);
+    m_reuse.image_sah_cost = 0.0;  // the next frame's build sets its own
     if (m_rebuilt) m_rebuilt_cost = cost;
     m_ratio = m_rebuilt_cost > 0.0 ? cost / m_rebuilt_cost : 1.0;
     return {{"action", m_rebuilt ? "build" : "refit"},

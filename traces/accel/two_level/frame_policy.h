@@ -44,8 +44,9 @@ public:
     bool rebuilds(uint32_t frame) const;
     /// The reuse to pass in AccelOptions::tree_reuse for this frame's build (rebuilds(): none).
     TreeReuse* reuse_for(uint32_t frame);
-    /// After the frame's build (with reuse_for's reuse): records its SAH cost; returns the frame's
-    /// record {"action": "build"|"refit", "tree_nodes", "sah_cost", "sah_ratio"}.
+    /// After the frame's build (with reuse_for's reuse): records its SAH cost (the image's own
+    /// where its boxes are not the tree's: TreeReuse::image_sah_cost); returns the frame's record
+    /// {"action": "build"|"refit", "tree_nodes", "sah_cost", "sah_ratio"}.
     nlohmann::json done(const BuildConfig& config);
 
 private:
