@@ -207,7 +207,7 @@ bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, 
 namespace {
 
 /// Rounds a context waits after a step whose slowest line has reuse key `key`: a round is a step
-/// served by the L1 at the default machine (issue 1 + L1 4 + box pipeline 8 = 13 cycles), a line
+/// served by the L1 at the default machine (1 issue cycle, the L1's 4, the box pipeline's 8: 13), a line
 /// from the L2 adds its 20 cycles (2 rounds), one from DRAM the L2's and DRAM's 140 (10). Served
 /// below the L1: a first read in the unit's stream or a reuse past 4 x the default L1's 256
 /// lines; from DRAM: a first read in all units' stream or a reuse past 4 x the default L2's
