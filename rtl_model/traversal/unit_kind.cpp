@@ -48,6 +48,8 @@ const UnitKind& unit_kind(const std::string& name) {
 void GroupWindow::end_round(std::vector<GroupWindow>& windows, double* window_rounds) {
     end_window_round(windows, window_rounds, kMaxWindows, [](GroupWindow& into, const GroupWindow& other) {
         into.rounds += other.rounds, into.group_steps += other.group_steps, into.active_lanes += other.active_lanes;
+        into.groups += other.groups;
+        for (size_t i = 0; i < into.served.size(); ++i) into.served[i] += other.served[i];
     });
 }
 
@@ -77,7 +79,7 @@ nlohmann::json GroupProfile::to_json() const {
             {"kind_steps", kind_steps},
             {"phases", [&] {
                  nlohmann::json a = nlohmann::json::array();
-                 for (const GroupWindow& w : phases) a.push_back({w.rounds, w.group_steps, w.active_lanes});
+                 for (const GroupWindow& w : phases) a.push_back({w.rounds, w.group_steps, w.active_lanes, w.groups, w.served});
                  return a;
              }()}};
 }
@@ -92,7 +94,8 @@ GroupProfile GroupProfile::from_json(const nlohmann::json& j) {
     g.single_work = j.at("single_work").get<std::array<double, kWorkFieldCount>>();
     g.kind_steps = j.at("kind_steps").get<std::array<double, kOpKindCount>>();
     for (const nlohmann::json& w : j.at("phases"))
-        g.phases.push_back({w.at(0).get<double>(), w.at(1).get<double>(), w.at(2).get<double>()});
+        g.phases.push_back({w.at(0).get<double>(), w.at(1).get<double>(), w.at(2).get<double>(), w.at(3).get<double>(),
+                            w.at(4).get<std::array<double, 3>>()});
     return g;
 }
 

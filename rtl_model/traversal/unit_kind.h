@@ -10,6 +10,7 @@
 // stats schema, the resolution step's rules (sim/resolve/resolve.h) and `rtsim capabilities` all
 // read this registry. The kinds' folders are globbed by rtl_model/traversal/CMakeLists.txt and
 // linked whole, so a registration is never dropped by the linker.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -37,6 +38,12 @@ class TraversalUnit;
 /// (sim/analytic/estimate.cpp; MIMD contexts' windows are sim/analytic/profile.h's PhaseWindow).
 struct GroupWindow {
     double rounds = 0, group_steps = 0, active_lanes = 0;
+    /// Groups holding rays (stepping, or waiting for a step's line: GroupSetup::line_wait),
+    /// summed over rounds; 0: as group_steps (a stepping without waits).
+    double groups = 0;
+    /// Group steps by where their slowest line was likely served (the L1, the L2, DRAM:
+    /// LineWait::level); all 0 without waits.
+    std::array<double, 3> served{};
     /// Ends a round in the last of `windows` (its steps and lanes added by the caller): when the
     /// last holds `*window_rounds` rounds a new one opens, and at kMaxWindows neighbours merge and
     /// the windows double in length.
@@ -72,6 +79,12 @@ struct GroupProfile {
     static GroupProfile from_json(const nlohmann::json& j);
 };
 
+/// Where a group step's line is likely served (0: the L1, 1: the L2, 2: DRAM) and the rounds the
+/// group waits for it before its next step.
+struct LineWait {
+    uint32_t rounds = 0, level = 0;
+};
+
 /// What a group profile needs of the machine beyond its traversal section.
 struct GroupSetup {
     uint32_t line_bytes = 64;  ///< reads coalesced per line of this size
@@ -81,6 +94,9 @@ struct GroupSetup {
     const LocalityPartition* treelets = nullptr;
     uint64_t admit_limit = 0, capacity = 0;
     bool may_overflow = false;
+    /// Rounds a group waits after its step reads `line` (a line number) on `unit`, the
+    /// analysis's rounds as time (sim/analytic/round_waits.h); empty: no waits.
+    std::function<LineWait(uint32_t unit, uint64_t line)> line_wait;
 };
 
 /// A kind's functional group stepping on the machine `traversal` describes: `rays_by_unit[u]`

@@ -18,7 +18,7 @@ using nlohmann::json;
 namespace {
 
 /// Bumped whenever the analysis or its meaning changes: old files are then simply not found.
-constexpr int kAnalysisVersion = 14;  // 14: rounds as time (a step served below the L1 holds its context); 13: packets' oriented node steps; 12: phase windows under treelet scheduling; 11: windows' busy contexts; 10: the phases' machine; 9: frame samples; 8: packets' node steps by their operation kind; 7: phase windows, occupied lanes
+constexpr int kAnalysisVersion = 15;  // 15: lock-step groups wait for their lines (rounds as time); 14: rounds as time (a step served below the L1 holds its context); 13: packets' oriented node steps; 12: phase windows under treelet scheduling; 11: windows' busy contexts; 10: the phases' machine; 9: frame samples; 8: packets' node steps by their operation kind; 7: phase windows, occupied lanes
 
 struct Fnv {
     uint64_t h = 1469598103934665603ull;

@@ -4,12 +4,14 @@
 #include <chrono>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "rtl_model/common/ray_state.h"
 #include "sim/analytic/analysis_cache.h"
 #include "sim/analytic/estimate.h"
+#include "sim/analytic/round_waits.h"
 #include "sim/analytic/sample.h"
 #include "sim/sampling/sampling.h"
 #include "sim/harness/trace_stream.h"
@@ -165,6 +167,9 @@ void profile_groups(const SimConfig& c, const Accel& accel, const StepOptions& s
         setup.admit_limit = t.max_rays_in_flight ? t.max_rays_in_flight : setup.capacity + c.traversal.contexts();
         setup.may_overflow = t.max_rays_in_flight != 0;
     }
+    // Rounds as time: a group waits for its step's slowest line, judged by its reuse distances.
+    auto waits = std::make_shared<LineWaits>(c.traversal.units);
+    setup.line_wait = [waits](uint32_t unit, uint64_t line) { return waits->read(unit, line); };
     p.group += kind.group_profile(accel, step, c.traversal, by_unit, setup);
     p.has_group = true;
 }

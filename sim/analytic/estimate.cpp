@@ -458,28 +458,46 @@ void Estimator::phase_windows() {
     for (double& f : m_phase_fetch) f = mean > 0 ? f / mean : 1.0;
 }
 
-// A lock-step kind's windows come from its functional group stepping (GroupWindow), which has no
-// reuse distances: its memory demands are spread by the window's active lanes (each lane's reads),
-// its visits by its group steps, its latency by its group steps at the window's own group-step
-// time (the slowest of its active lanes' lines), its population is the groups stepping per round
-// and unit. The fill's cache-warm
-// top of the tree is not in them; the drain (groups running out of rays, a warp held by its
-// longest ray) is. Whole-trace analyses only, without treelet queues.
+// A lock-step kind's windows come from its functional group stepping (GroupWindow): its memory
+// demands are spread by the window's active lanes (each lane's reads), its visits by its group
+// steps, its population is the groups holding rays per round and unit (stepping, or waiting for
+// a line: rounds as time). Its latency is its group steps at the window's own group-step time:
+// the run's, scaled by where the window's slowest lines were served against the run's (the
+// drain's warps hold the rays whose lines miss), or without those counts the slowest of its
+// active lanes' lines. The fill's cache-warm top of the tree is not in them; the drain is.
+// Whole-trace analyses only, without treelet queues.
 void Estimator::group_phase_windows() {
     const std::vector<GroupWindow>& windows = m_p.group.phases;
     if (!m_p.whole_trace || m_c.treelets.enabled || windows.empty()) return;
     double steps = 0, lanes = 0;
     for (const GroupWindow& w : windows) steps += w.group_steps, lanes += w.active_lanes;
     if (steps <= 0 || lanes <= 0) return;
+    // Where each window's group steps found their slowest line (rounds as time: the L1, the L2,
+    // DRAM, judged at the default machine's caches), at this config's latencies.
+    const double lat[3] = {m_lat_l1, m_lat_l2, m_lat_dram};
+    auto served_latency = [&](const std::array<double, 3>& served) {
+        double n = 0, sum = 0;
+        for (int i = 0; i < 3; ++i) n += served[size_t(i)], sum += served[size_t(i)] * lat[i];
+        return n > 0 ? sum / n : 0.0;
+    };
+    std::array<double, 3> all{};
+    for (const GroupWindow& w : windows)
+        for (size_t i = 0; i < all.size(); ++i) all[i] += w.served[i];
+    const double run_served = served_latency(all);
     for (const GroupWindow& w : windows) {
         PhaseShare& s = m_phases.emplace_back();
         s.steps = w.group_steps / steps;
         s.work = s.l1_misses = s.l2_misses = s.reads = w.active_lanes / lanes;
-        s.population = w.rounds > 0 ? w.group_steps / w.rounds / m_c.traversal.units : 0.0;
+        // The groups holding rays per round and unit, those waiting for a line included.
+        const double groups = w.groups > 0 ? w.groups : w.group_steps;
+        s.population = w.rounds > 0 ? groups / w.rounds / m_c.traversal.units : 0.0;
         // A group step waits for the slowest of its active lanes' lines: fewer lanes, a
         // shorter wait (the drain's warps step with a lane or two).
         const double active = w.group_steps > 0 ? w.active_lanes / w.group_steps : 1.0;
-        const double fetch = max_latency(m_p.step_critical, std::max(1.0, active * m_coalesce), m_coalesce);
+        const double served = served_latency(w.served);
+        const double fetch = run_served > 0 && served > 0
+                                 ? m_group_fetch * served / run_served
+                                 : max_latency(m_p.step_critical, std::max(1.0, active * m_coalesce), m_coalesce);
         const double base = m_group_fetch + m_group_ops;
         m_phase_fetch.push_back(base > 0 ? (fetch + m_group_ops) / base : 1.0);
     }

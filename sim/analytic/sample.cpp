@@ -4,6 +4,7 @@
 
 #include "rtl_model/common/ray_state.h"
 #include "rtl_model/common/round_windows.h"
+#include "sim/analytic/round_waits.h"
 
 
 namespace rtsim {
@@ -204,29 +205,6 @@ bool SampleProfiler::start_ray(RayDealer& dealer, uint32_t unit, uint32_t slot, 
     return true;
 }
 
-namespace {
-
-/// Rounds a context waits after a step whose slowest line has reuse key `key`: a round is a step
-/// served by the L1 at the default machine (1 issue cycle, the L1's 4, the box pipeline's 8: 13), a line
-/// from the L2 adds its 20 cycles (2 rounds), one from DRAM the L2's and DRAM's 140 (10). Served
-/// below the L1: a first read in the unit's stream or a reuse past 4 x the default L1's 256
-/// lines; from DRAM: a first read in all units' stream or a reuse past 4 x the default L2's
-/// 16,384 lines (the reuse distance counts accesses, the stack distance fewer). Fixed at the
-/// defaults, since one analysis serves every cache size and latency (analysis_cache.h); the
-/// closed form prices each step at the config's own.
-uint32_t wait_rounds(uint32_t key) {
-    constexpr uint32_t kL2Rounds = 2, kDramRounds = 10;
-    // The first bins whose distances all lie past 4 x the default L1's and L2's lines.
-    static const int l1_bin = DistanceBins::bin(4 * 256) + 1, l2_bin = DistanceBins::bin(4 * 16384) + 1;
-    int ub, gb;
-    bool uc, gc;
-    JointHistogram::unpack(key, &ub, &uc, &gb, &gc);
-    if (gc || gb >= l2_bin) return kDramRounds;
-    if (uc || ub >= l1_bin) return kL2Rounds;
-    return 0;
-}
-
-}  // namespace
 
 void SampleProfiler::finish_ray(Context& ctx, uint32_t unit, uint32_t slot, RaySinkIf& sink) {
     const Stepper& s = *ctx.stepper;

@@ -1,5 +1,6 @@
 #include "rtl_model/traversal/simt/simt_profile.h"
 
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <memory>
@@ -41,7 +42,9 @@ public:
           m_accel(accel),
           m_step(step),
           // As the unit: with treelet queues a lane's ray may leave mid-walk, so no walk ahead.
-          m_cooperative(m_simt.cooperative && !setup.treelets) {
+          m_cooperative(m_simt.cooperative && !setup.treelets),
+          m_wait(m_last_class.size(), 0) {
+        while ((1u << m_line_shift) < setup.line_bytes) ++m_line_shift;
         for (const auto& r : rays_by_unit) m_p.rays += double(r.size());
         if (!setup.treelets) {
             for (Lane& l : m_lanes) l.stepper = accel.make_stepper(step);
@@ -67,10 +70,18 @@ public:
         for (bool any = true; any;) {
             any = false;
             const double steps = m_p.group_steps, lanes = m_p.active_lanes;
-            for (size_t w = 0; w < warps; ++w) any = step(w) || any;
+            uint32_t busy = 0;  // warps stepping or waiting for their last step's line
+            for (size_t w = 0; w < warps; ++w) {
+                if (m_wait[w]) {
+                    --m_wait[w], ++busy, any = true;
+                } else if (step(w)) {
+                    ++busy, any = true;
+                }
+            }
             if (!any || !phases) continue;
             m_p.phases.back().group_steps += m_p.group_steps - steps;
             m_p.phases.back().active_lanes += m_p.active_lanes - lanes;
+            m_p.phases.back().groups += busy;
             GroupWindow::end_round(m_p.phases, &window_rounds);
         }
         if (!m_p.phases.empty() && m_p.phases.back().rounds == 0) m_p.phases.pop_back();
@@ -139,7 +150,20 @@ private:
             ++active;
         }
         if (m_cooperative) active += lend_idle_lanes(w, cls);
-        m_p.requests += m_coalescer.issue([](uint64_t, uint32_t, DataKind) {});
+        // Rounds as time (GroupSetup::line_wait): the warp waits for its step's slowest line;
+        // only where the rounds' windows are kept (treelet queues keep none).
+        LineWait slowest;
+        bool read = false;
+        const uint32_t unit = uint32_t(w / m_warps_per_unit);
+        const bool waits = m_setup.line_wait && !m_setup.treelets;
+        m_p.requests += m_coalescer.issue([&](uint64_t addr, uint32_t, DataKind) {
+            if (!waits) return;
+            const LineWait l = m_setup.line_wait(unit, addr >> m_line_shift);
+            if (!read || l.level > slowest.level) slowest = l;
+            read = true;
+        });
+        m_wait[w] = slowest.rounds;
+        if (read && !m_p.phases.empty()) m_p.phases.back().served[slowest.level] += 1;
         m_p.group_steps += 1, m_p.scheduler_steps += 2;  // the step and its operations
         if (cls < kOpKindCount) m_p.kind_steps[cls] += 1;
         m_p.lane_slots += m_simt.lanes, m_p.active_lanes += active, m_p.occupied_lanes += occupied(w);
@@ -283,6 +307,8 @@ private:
     const Accel& m_accel;
     const StepOptions& m_step;
     bool m_cooperative;
+    std::vector<uint32_t> m_wait;  ///< per warp: rounds it still waits (GroupSetup::line_wait)
+    uint32_t m_line_shift = 0;
     // Treelet scheduling: the ray buffer's queues, the rays it admits and the warps' treelets.
     std::vector<std::deque<std::unique_ptr<Stepper>>> m_queues;
     std::vector<const RayJob*> m_admission;

@@ -7,6 +7,9 @@
 // With treelet scheduling (GroupSetup::treelets) lanes take rays from their warp's treelet queue
 // instead, lanes whose next step is in another treelet park there, and a warp left without rays
 // forms again from the largest queue, as simt_unit.cpp's treelet mode does.
+// Without treelet queues a warp whose step read a line likely served below the L1 waits the
+// rounds that line takes (GroupSetup::line_wait, the analysis's rounds as time), so the warps
+// left at the end are the ones whose lanes miss, as in the timed levels.
 #include <cstdint>
 #include <vector>
 

@@ -19,6 +19,7 @@
 #include "sim/analytic/closed_form.h"
 #include "sim/analytic/estimate.h"
 #include "sim/analytic/reuse.h"
+#include "sim/analytic/round_waits.h"
 #include "sim/analytic/sample.h"
 #include "traces/raygen/camera.h"
 
@@ -387,6 +388,56 @@ TEST(AnalyticLevel, SimtWarpsFormedFromTreeletQueuesWalkEveryRayOnce) {
     const GroupWindow &first = alone.phases.front(), &last = alone.phases.back();
     EXPECT_LT(last.group_steps / last.rounds, first.group_steps / first.rounds);
     EXPECT_EQ(GroupProfile::from_json(alone.to_json()).to_json(), alone.to_json());
+}
+
+TEST(AnalyticLevel, LineWaitsTellWhereAReadIsServedFromItsReuse) {
+    // A first read comes from DRAM; the same unit's next read of the line from its L1; another
+    // unit's first read of a line the first unit just read from the L2; a line read again past
+    // 4 x the default L2's lines from DRAM.
+    LineWaits waits(2);
+    EXPECT_EQ(waits.read(0, 7).level, 2u);
+    EXPECT_EQ(waits.read(0, 7).rounds, 0u);
+    const LineWait other = waits.read(1, 7);
+    EXPECT_EQ(other.level, 1u);
+    EXPECT_EQ(other.rounds, kWaitRounds[1]);
+    for (uint64_t line = 100; line < 100 + 8 * 16384; ++line) waits.read(0, line);
+    const LineWait far = waits.read(0, 7);
+    EXPECT_EQ(far.level, 2u);
+    EXPECT_EQ(far.rounds, kWaitRounds[2]);
+}
+
+TEST(AnalyticLevel, SimtWarpsWaitingForTheirLinesKeepEveryRaysWork) {
+    // Rounds as time on warps: a warp whose step read a line from below the L1 waits rounds for
+    // it. The rays' work is unchanged; the run takes more rounds; every window's busy warps lie
+    // between its stepping ones and every warp; its served counts are its reading steps'.
+    const Workload& w = workload();
+    SimConfig c = small_machine();
+    config_set(c, "traversal.model=simt");
+    std::vector<std::vector<RayJob>> by_unit(c.traversal.units);
+    for (size_t i = 0; i < w.jobs.size(); ++i) by_unit[i % c.traversal.units].push_back(w.jobs[i]);
+    const GroupProfile plain = simt_group_profile(*w.accel, StepOptions{}, c.traversal, by_unit, GroupSetup{});
+    GroupSetup setup;
+    auto waits = std::make_shared<LineWaits>(c.traversal.units);
+    setup.line_wait = [waits](uint32_t unit, uint64_t line) { return waits->read(unit, line); };
+    const GroupProfile waited = simt_group_profile(*w.accel, StepOptions{}, c.traversal, by_unit, setup);
+    EXPECT_EQ(waited.work, plain.work);
+    EXPECT_EQ(waited.rays, plain.rays);
+    double rounds = 0, plain_rounds = 0, served = 0;
+    const double warps = double(c.traversal.units) * c.traversal.groups();
+    for (const GroupWindow& gw : plain.phases) {
+        plain_rounds += gw.rounds;
+        EXPECT_EQ(gw.groups, gw.group_steps);  // without waits every busy warp steps
+    }
+    for (const GroupWindow& gw : waited.phases) {
+        rounds += gw.rounds;
+        EXPECT_GE(gw.groups, gw.group_steps);
+        EXPECT_LE(gw.groups, gw.rounds * warps);
+        for (double n : gw.served) served += n;
+    }
+    EXPECT_GT(rounds, plain_rounds);
+    EXPECT_GT(served, 0.0);
+    EXPECT_LE(served, waited.group_steps);
+    EXPECT_EQ(GroupProfile::from_json(waited.to_json()).to_json(), waited.to_json());
 }
 
 TEST(AnalyticLevel, PacketStepsAreCountedByTheOperationKindTheyRun) {
