@@ -59,16 +59,16 @@ json fidelity_band(const SimConfig& c, const json& stats, const std::string& str
                                                      "analysis's context-by-context reuse says (it is slow)"
                                                : std::string("the grid: its 3D-DDA walks were measured up to 18% fast"),
                                        "Packets on cell structures"));
-        // MIMD contexts' rounds wait for their slow lines (rounds as time), so their drain
-        // holds the slow rays; a lock-step kind's functional warps step alike.
+        // Contexts' and warps' rounds both wait for their slow lines (rounds as time), but a
+        // warp's drain is priced from where its lines were served at the default caches.
         if (lock_step && rays > 0 && per_context < kFewRaysPerContext) {
             char buf[32];
             std::snprintf(buf, sizeof buf, "%.1f", per_context);
             const std::string why =
                 std::string(buf) + " rays per ray context (" + std::to_string(uint64_t(rays)) + " rays, " +
                 std::to_string(uint64_t(contexts)) + " contexts): the fill and the drain are much of the run; " +
-                "the phases are priced, but the lock-step groups' rounds step alike, not by their lines' latency, so "
-                "the slowest rays are not the last (it can be fast)";
+                "the phases are priced and the groups wait for their lines, but a drain group's step is priced "
+                "from where its lines were served at the default caches (measured from 15% fast to 20% slow)";
             findings.push_back(finding("few_rays_per_context", why, "Where designs starve or fill slowly"));
         }
     }
