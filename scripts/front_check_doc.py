@@ -73,8 +73,9 @@ def table(sweep: Path) -> str:
         f"**{100 * median:.1f}%**. Measured by `rtsim sweep python/rtsim/specs/front_check.yaml "
         f"--check-front` on {platform.node()} ({platform.machine()}), {date}: {designs} designs "
         f"swept, {len(rows)} on the rays/s-against-SRAM fronts (one per scene, workload and "
-        "structure), each re-run with `--check-verdict` (its top three knobs and best co-limit) at "
-        "the approx level; table by `scripts/front_check_doc.py`.",
+        "structure), each re-run with `--check-verdict` (its top three knobs, best co-limit and "
+        "best structural alternatives, on the structures traced beside its trace) at the approx "
+        "level; the named knob is the verdict's `relax`; table by `scripts/front_check_doc.py`.",
     ]
     return "\n".join(lines) + "\n"
 

@@ -34,3 +34,8 @@ def test_check_front_measures_each_front_designs_named_knob(tmp_path: Path) -> N
         assert row["estimated"] > 0 and row["measured"] > 0 and row["best_measured"] > 0
         assert row["best_measured"] >= row["measured"]
         assert (out / "front_check" / row["run"] / "check" / "1" / "stats.json").is_file()
+        # The named knob is the one the verdict acts on: its `relax`, structural or not.
+        stats = json.loads((out / "front_check" / row["run"] / "stats.json").read_text())
+        relax = stats["verdict"]["relax"]
+        to = relax["to"] if isinstance(relax["to"], str) else json.dumps(relax["to"])
+        assert row["named"] == f"{relax['key']}={to}"

@@ -3,7 +3,8 @@
 A sweep's report draws a Pareto front of rays/s against on-chip SRAM per scene and workload.
 Each design on it has a verdict (docs/verdict.md) that names the knob to relax next with an
 estimated gain. This re-runs every front design with `--check-verdict` (rtsim-sim re-simulates
-its top three knobs and best co-limit, each in its own process) into SWEEP/front_check/<run>,
+its top three knobs, best co-limit and best structural alternatives, each in its own process)
+into SWEEP/front_check/<run>,
 and sets the named knob's estimate beside its measured gain and the best measured one, so a user
 can trust or overrule the front's verdicts in one command. The table is written to
 SWEEP/front_check.json.
@@ -56,7 +57,9 @@ def check_one(out: Path, rec: RunRecord, timeout: float | None = None) -> dict[s
                            "workload": rec.workload, "accel": rec.accel}  # fmt: skip
     verdict = (result.stats or {}).get("verdict") or {}
     checks = verdict.get("check") or []
-    top = (verdict.get("top") or [None])[0]
+    # The knob the verdict names: its best candidate, or a structural alternative that pays
+    # clearly more (`relax`); the first of `top` when it names none.
+    top = verdict.get("relax") or (verdict.get("top") or [None])[0]
     if result.returncode != 0 or not top or not checks:
         row["error"] = result.describe_failure() if result.returncode else "no verdict to check"
         return row
