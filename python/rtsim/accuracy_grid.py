@@ -101,15 +101,21 @@ def point_label(run: RunPlan) -> str:
     return " ".join(f"{k}={v}" for k, v in run.params.items())
 
 
-def run_level(exe: Path, trace: Path, run: RunPlan, level: str, folder: Path) -> GridRow:
+def run_level(
+    exe: Path, trace: Path, run: RunPlan, level: str, folder: Path, sets: list[str] | None = None
+) -> GridRow:
     row = GridRow(trace.name, point_label(run), level)
     fidelity, extra = PSEUDO.get(level, (level, []))
     folder.mkdir(parents=True, exist_ok=True)
     config = run.config.to_dict()
     (folder / "config.json").write_text(json.dumps(config))
-    sets = [f"fidelity={fidelity}", *extra]
+    # The user's overrides (--set) apply to every run; the level's own settings after them.
     job = SimJob(
-        trace=trace, out_dir=folder, config=folder / "config.json", sets=sets, verdict=False
+        trace=trace,
+        out_dir=folder,
+        config=folder / "config.json",
+        sets=[*(sets or []), f"fidelity={fidelity}", *extra],
+        verdict=False,
     )
     result = run_sim(job, exe=exe)
     row.wall_seconds = result.wall_seconds
@@ -145,7 +151,14 @@ def trace_of(run: RunPlan, out: Path) -> Path:
     return Path(task.trace_dir)
 
 
-def run_grid(spec_path: Path, out: Path, levels: list[str], console: Console) -> list[GridRow]:
+def run_grid(
+    spec_path: Path,
+    out: Path,
+    levels: list[str],
+    console: Console,
+    sets: list[str] | None = None,
+) -> list[GridRow]:
+    """Runs every point of the spec's grid at each level; `sets` (KEY=VALUE) override every run."""
     exe = find_sim()
     spec = load_spec(spec_path)
     rows: list[GridRow] = []
@@ -155,7 +168,7 @@ def run_grid(spec_path: Path, out: Path, levels: list[str], console: Console) ->
         trace = trace_of(run, out.resolve())
         for level in levels:
             folder = out / "runs" / trace.name / run.run_id[:12] / level
-            row = run_level(exe, trace, run, level, folder)
+            row = run_level(exe, trace, run, level, folder, sets)
             rows.append(row)
             what = (
                 f"{row.wall_seconds:7.2f} s  cycles {row.cycles}"

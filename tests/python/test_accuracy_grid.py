@@ -128,3 +128,27 @@ def test_by_point_table_groups_errors_by_named_point() -> None:
     assert len(lines) == 4  # header, rule, simt8, mimd: the reference level is left out
     assert lines[2].startswith("| analytic | simt8 | 2 | +1.0% | -2.0% / +4.0% | 4.0% |")
     assert lines[3].startswith("| analytic | mimd | 1 | -10.0%")
+
+
+def test_grid_overrides_reach_every_run(
+    tmp_path: Path, sim_exe: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # `rtsim accuracy --spec ... --set KEY=VALUE` overrides every run of the grid (it was once
+    # dropped silently with --spec); the level's own fidelity still wins.
+    from rich.console import Console
+
+    from rtsim.accuracy_grid import run_grid
+
+    monkeypatch.setenv("RTSIM_SIM", str(sim_exe))
+    spec = tmp_path / "one.yaml"
+    spec.write_text(
+        "name: one\nscenes: [cornell]\n"
+        "workloads:\n  - {name: primary, rays: [primary], resolution: 16x12}\n"
+        "grid:\n  traversal.units: [2]\n"
+    )
+    out = tmp_path / "grid"
+    rows = run_grid(spec, out, ["approx"], Console(quiet=True), ["quantum_cycles=32"])
+    assert [r.status for r in rows] == ["ok"]
+    (resolved,) = out.glob("runs/*/*/approx/config.resolved.json")
+    config = json.loads(resolved.read_text())
+    assert config["quantum_cycles"] == 32 and config["fidelity"] == "approx"
