@@ -168,17 +168,9 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", type=Path, default=REPO / "out" / "dram_closed_loop")
-    p.add_argument("--scenes", default="hairball,sponza", help="comma-separated scenes")
-    p.add_argument("--resolution", default="160x120")
-    p.add_argument("--dramsim3", type=Path, help="DRAMsim3's dramsim3main (built outside rtsim)")
-    p.add_argument("--ini", type=Path, help="the DRAMsim3 config to close the loop with")
-    p.add_argument("--ramulator2", type=Path, help="a Ramulator 2.1 checkout with its build")
-    p.add_argument("--ramulator2-timing", default="DDR4_2133P", help="its DDR4 timing preset")
-    p.add_argument("--ramulator2-ranks", type=int, default=2, help="ranks a channel")
+    dc.add_common_args(p, REPO / "out" / "dram_closed_loop")
     p.add_argument("--iterations", type=int, default=14, help="at most this many rtsim runs a loop")
     p.add_argument("--tolerance", type=float, default=0.03, help="relative latency gap to stop at")
-    p.add_argument("--docs", type=Path, help="write the table into DOCS/model.md")
     args = p.parse_args()
     if bool(args.dramsim3) != bool(args.ini):
         p.error("--dramsim3 and --ini go together")
@@ -198,10 +190,8 @@ def main() -> None:
     text += (
         f"\nMeasured by `python scripts/dram_closed_loop.py` on {platform.node()} "
         f"({platform.machine()}), {time.strftime('%Y-%m-%d', time.gmtime())}: {args.scenes} "
-        f"diffuse at {args.resolution}, detailed level, `dram.model=bandwidth` in the loop, "
-        f"DRAMsim3 config `{args.ini.name if args.ini else '-'}`, Ramulator 2 DDR4 "
-        f"`DDR4_8Gb_x8` x {args.ramulator2_ranks} ranks at `{args.ramulator2_timing}`, "
-        f"tolerance {args.tolerance:.0%}; "
+        f"diffuse at {args.resolution}, detailed level, `dram.model=bandwidth` in the loop"
+        f"{dc.simulator_configs(args)}, tolerance {args.tolerance:.0%}; "
         f"{time.perf_counter() - start:.0f} s wall.\n"
     )
     args.out.mkdir(parents=True, exist_ok=True)

@@ -334,9 +334,10 @@ def table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", type=Path, default=REPO / "out" / "dram_compare")
+def add_common_args(p: argparse.ArgumentParser, out: Path) -> None:
+    """The options both DRAM scripts take (this one and dram_closed_loop.py): where to write, which
+    rays, and the DRAM simulators the user built outside rtsim."""
+    p.add_argument("--out", type=Path, default=out)
     p.add_argument("--scenes", default="hairball,sponza", help="comma-separated scenes")
     p.add_argument("--resolution", default="160x120")
     p.add_argument("--dramsim3", type=Path, help="DRAMsim3's dramsim3main (built outside rtsim)")
@@ -350,6 +351,24 @@ def main() -> None:
         help="ranks a channel (2: the DRAMsim3 config's 16 GB of 8 Gb x8 devices)",
     )
     p.add_argument("--docs", type=Path, help="write the table into DOCS/model.md")
+
+
+def simulator_configs(args: argparse.Namespace) -> str:
+    """The DRAM simulators' configs a table was measured with, for its provenance line."""
+    parts = []
+    if args.ini:
+        parts.append(f"DRAMsim3 config `{args.ini.name}`")
+    if args.ramulator2:
+        parts.append(
+            f"Ramulator 2 DDR4 `DDR4_8Gb_x8` x {args.ramulator2_ranks} ranks at "
+            f"`{args.ramulator2_timing}`"
+        )
+    return "".join(f", {x}" for x in parts)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_common_args(p, REPO / "out" / "dram_compare")
     args = p.parse_args()
     if args.dramsim3 and not args.ini:
         p.error("--dramsim3 needs --ini (a DRAMsim3 config)")
@@ -359,16 +378,10 @@ def main() -> None:
         trace = make_trace(args.out, scene, args.resolution)
         rows += [compare(r, scene, trace, args) for r in RUNS]
     text = table(rows)
-    ini = f", DRAMsim3 config `{args.ini.name}`" if args.ini else ""
-    if args.ramulator2:
-        ini += (
-            f", Ramulator 2 DDR4 `DDR4_8Gb_x8` x {args.ramulator2_ranks} ranks at "
-            f"`{args.ramulator2_timing}`"
-        )
     text += (
         f"\nMeasured by `python scripts/dram_compare.py` on {platform.node()} "
         f"({platform.machine()}), {time.strftime('%Y-%m-%d', time.gmtime())}: {args.scenes} "
-        f"diffuse at {args.resolution}, detailed level{ini}, "
+        f"diffuse at {args.resolution}, detailed level{simulator_configs(args)}, "
         f"{time.perf_counter() - start:.0f} s wall.\n"
     )
     args.out.mkdir(parents=True, exist_ok=True)
