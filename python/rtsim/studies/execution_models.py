@@ -1,6 +1,7 @@
 """Execution models (docs/execution_models.md): MIMD units against SIMT warps of 8, 16 and 32
-lanes, with and without ray sorting at dispatch, on Cornell, hairball and Sponza, primary and
-diffuse rays, at the approx level (every hit and every ray's work checked).
+lanes, with and without ray sorting at dispatch, on Cornell, hairball and Sponza, primary,
+diffuse and shadow (any-hit) rays, a sun added to the scenes without lights (Sponza and the
+hairball), at the approx level (every hit and every ray's work checked).
 
 All runs share one machine: 8 units x 64 ray contexts (MIMD: 64 independent contexts; SIMT:
 64 / lanes warps), rays dealt to units 64 at a time (dispatch.block_rays), the default
@@ -18,7 +19,7 @@ from rtsim.study import Figure, Study, StudyRun, Table
 from rtsim.study.plots import bars_against_mimd
 from rtsim.study.tables import ByConfig, fmt, mismatches, scene, units
 
-KINDS = ["primary", "diffuse"]
+KINDS = ["primary", "diffuse", "shadow"]
 CONTEXTS = 64
 BLOCK = 64
 #: The sorting table's windows (4,096 is the default) on one larger trace.
@@ -68,12 +69,12 @@ def sort_points() -> list[dict[str, Any]]:
 
 
 def specs(o: dict[str, Any]) -> list[dict[str, Any]]:
-    """One spec per scene (primary and diffuse rays, every configuration), and the sorting
+    """One spec per scene (primary, diffuse and shadow rays, every configuration), and the sorting
     table's Sponza diffuse trace at `sort_resolution`."""
     out = [
         {
             "name": f"execution-models-{s}",
-            "scenes": [scene(s, o["hairball_triangles"])],
+            "scenes": [scene(s, o["hairball_triangles"], lights=o["lights"])],
             "workloads": [{"name": k, "rays": [k], "resolution": o["resolution"]} for k in KINDS],
             "points": points(),
         }
@@ -141,11 +142,17 @@ def trends(run: StudyRun) -> str:
     """Our figures beside the published trends, per scene."""
     by = ByConfig(main_rows(run))
     eff, speed = by.efficiency, by.speed
+
+    def shadow(t: str) -> str:
+        if (t, "MIMD") not in by.rows:
+            return "-"
+        return f"{eff(t, 'SIMT 32')}, {speed(t, 'SIMT 32', 'MIMD')}"
+
     lines = [
         "| scene | SIMD eff. SIMT 32, primary -> diffuse | SIMT 32 / MIMD, primary -> diffuse "
         "| sorting, MIMD diffuse | sorting, SIMT 32 diffuse | SIMD eff. SIMT 32 diffuse, "
-        "sorted |",
-        "|---|---|---|---:|---:|---:|",
+        "sorted | SIMD eff. and SIMT 32 / MIMD, shadow |",
+        "|---|---|---|---:|---:|---:|---|",
     ]
     for sc in run.options["scenes"]:
         p, d = f"{sc}_primary", f"{sc}_diffuse"
@@ -155,13 +162,14 @@ def trends(run: StudyRun) -> str:
             f"| {sc} | {eff(p, 'SIMT 32')} -> {eff(d, 'SIMT 32')} | "
             f"{speed(p, 'SIMT 32', 'MIMD')} -> {speed(d, 'SIMT 32', 'MIMD')} | "
             f"{speed(d, 'MIMD + sort', 'MIMD')} | {speed(d, 'SIMT 32 + sort', 'SIMT 32')} | "
-            f"{eff(d, 'SIMT 32 + sort')} |"
+            f"{eff(d, 'SIMT 32 + sort')} | {shadow(f'{sc}_shadow')} |"
         )
     lines.append(
         "| published | Aila & Laine 2009: high on primary rays, falling on diffuse | "
         "SIMT GPUs hide divergence with many more warps per core than here | "
         "Boulos et al. 2008, packet reordering: about 1.5x on diffuse paths | "
-        "Meister et al. 2020, sorting: 1.3-2.0x on incoherent rays | |"
+        "Meister et al. 2020, sorting: 1.3-2.0x on incoherent rays | | any-hit rays end at "
+        "their first hit: shorter, more divergent walks |"
     )
     return "\n".join(lines) + "\n"
 
@@ -219,6 +227,7 @@ STUDY = Study(
         "hairball_triangles": 50_000,
         "sort_study": True,
         "sort_resolution": "256x192",
+        "lights": "sun",
     },
     quick={"scenes": ["cornell"], "resolution": "16x12", "sort_study": False},
     extra={"coalesced_fraction": coalesced_fraction},
