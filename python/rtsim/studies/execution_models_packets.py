@@ -2,8 +2,8 @@
 rays (Wald et al. 2001), the hybrid that splits low-occupancy packets into single rays (Benthin et
 al. 2012), packets re-formed at dispatch by the sorting stage (Boulos et al. 2008's reordering,
 at dispatch), and single rays on a binary and an 8-wide BVH (Wald, Benthin & Boulos 2008), on
-Cornell, hairball and Sponza, primary and diffuse rays, at the approx level (packets' work checked
-against the reference packet loop).
+Cornell, hairball and Sponza, primary, diffuse and shadow rays, at the approx level (packets'
+work checked against the reference packet loop).
 
 The machine of the execution_models study (8 units x 64 ray contexts, rays dealt 64 at a time).
 Tables between the `execution-models-packets` and `execution-models-packet-trends` markers of
@@ -50,7 +50,7 @@ def packet_specs(o: dict[str, Any], configs: list[tuple], prefix: str) -> list[d
             out.append(
                 {
                     "name": f"{prefix}-{s}-{accel}",
-                    "scenes": [scene(s, o["hairball_triangles"])],
+                    "scenes": [scene(s, o["hairball_triangles"], lights=o["lights"])],
                     "workloads": [
                         {"name": k, "rays": [k], "resolution": o["resolution"]} for k in KINDS
                     ],
@@ -165,8 +165,9 @@ def plot(run: StudyRun, path: Path) -> None:
 
 
 #: The documented run (docs/execution_models.md, measured at 96x72).
+# A sun is added to the scenes without lights (Sponza, the hairball) for the shadow rays.
 OPTIONS = {"scenes": ["cornell", "hairball", "sponza"], "resolution": "96x72",
-           "hairball_triangles": 50_000}  # fmt: skip
+           "hairball_triangles": 50_000, "lights": "sun"}  # fmt: skip
 
 STUDY = Study(
     name="execution_models_packets",

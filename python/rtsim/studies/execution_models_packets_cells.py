@@ -2,8 +2,8 @@
 BIHs, octrees and grids"): packets of 4 and 16 rays and the hybrid with its split rays on the
 packet's free lanes, on the kd-tree (the structure Wald et al. 2001 built packet tracing on), the
 BIH, the octree and the uniform grid, each beside single rays (MIMD) on the same structure and
-beside MIMD and packets of 16 on the binary BVH; hairball and Sponza, primary and diffuse rays.
-Table between the `execution-models-packets-cells` markers of docs/execution_models.md."""
+beside MIMD and packets of 16 on the binary BVH; hairball and Sponza, primary, diffuse and shadow
+rays. Table between the `execution-models-packets-cells` markers of docs/execution_models.md."""
 
 from __future__ import annotations
 
@@ -75,7 +75,12 @@ STUDY = Study(
     specs=specs,
     tables=[Table("execution_models.md", "execution-models-packets-cells", table)],
     # The documented run (docs/execution_models.md, measured at 48x36).
-    options={"scenes": ["hairball", "sponza"], "resolution": "48x36", "hairball_triangles": 50_000},
+    options={
+        "scenes": ["hairball", "sponza"],
+        "resolution": "48x36",
+        "hairball_triangles": 50_000,
+        "lights": "sun",  # for the shadow rays
+    },
     quick={"scenes": ["hairball"], "resolution": "16x12", "hairball_triangles": 5_000},
     extra={"packet": packet_counters},
 )

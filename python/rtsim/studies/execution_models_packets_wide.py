@@ -1,6 +1,6 @@
 """Packets on wide BVHs (docs/execution_models.md, "Packets on wide BVHs"): packets of 4 and 16
 rays and the hybrid on 4- and 8-wide BVHs beside MIMD and packets on the binary BVH, on hairball
-and Sponza, primary and diffuse rays; "box x16": a box pipeline as wide as the packet
+and Sponza, primary, diffuse and shadow rays; "box x16": a box pipeline as wide as the packet
 (`box.width=16`) for every configuration so marked, single rays included, so neither side has
 more box throughput; "lanes": the hybrid's split rays walk at once on the packet's free lanes.
 Table between the `execution-models-packets-wide` markers of docs/execution_models.md."""
@@ -73,7 +73,12 @@ STUDY = Study(
     specs=specs,
     tables=[Table("execution_models.md", "execution-models-packets-wide", table)],
     # The documented run (docs/execution_models.md, measured at 48x36).
-    options={"scenes": ["hairball", "sponza"], "resolution": "48x36", "hairball_triangles": 50_000},
+    options={
+        "scenes": ["hairball", "sponza"],
+        "resolution": "48x36",
+        "hairball_triangles": 50_000,
+        "lights": "sun",  # for the shadow rays
+    },
     quick={"scenes": ["hairball"], "resolution": "16x12", "hairball_triangles": 5_000},
     extra={"packet": packet_counters},
 )
