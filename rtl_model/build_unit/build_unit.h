@@ -7,9 +7,12 @@
 // nodes and triangle records written at the addresses the frame's structures occupy, which
 // leaves them in the L2 for the traversal that follows. Compute is a throughput (triangles or
 // nodes per cycle); memory a window of outstanding line requests; the build ends when both
-// have. Not modelled: overlapping a frame's build with the previous frame's traversal (async
-// compute), and the skinning that produces the vertices (a shader's work).
+// have. With build_unit.overlap a frame's build runs beside the previous frame's rays (async
+// compute into a second buffer: build_streamer.h issues its requests in time, the harness's
+// FrameBuildSchedule orders the frames). Not modelled: the skinning that produces the vertices
+// (a shader's work).
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -50,21 +53,52 @@ public:
     BuildUnit(const BuildUnitConfig& config, MemIf& mem, uint32_t line_bytes);
     /// Runs `jobs` from cycle `start`; returns what it did (end: the cycle the last finished).
     FrameBuild run(const std::vector<BuildJob>& jobs, Cycle start);
+    /// The same in steps, for a build that runs beside the traversal (build_unit.overlap): begin
+    /// issues nothing, issue_until issues the line requests due by a cycle (the build_streamer's
+    /// process, in time with the units' requests), finish issues the rest and returns what it
+    /// did. One build at a time; run() is begin() then finish().
+    void begin(const std::vector<BuildJob>& jobs, Cycle start);
+    bool active() const { return m_active; }
+    /// A line request is left to issue (the build in progress until finish() either way).
+    bool has_requests() { return m_active && settle(); }
+    /// The issue cycle of the next line request (the build's end when none is left).
+    Cycle next_issue();
+    void issue_until(Cycle limit);
+    FrameBuild finish();
     /// {"frames", "busy_cycles", "compute_cycles", "stream_cycles", "rebuilt_triangles", "refit_nodes",
     ///  "fit_node_frames", "read_bytes", "written_bytes", "rebuilds", "refits"} (docs/stats.md, "build_unit").
     nlohmann::json stats_json() const;
 
 private:
-    /// Streams the ranges' lines through `m_mem` from `start`, paced at `cycles_per_line`
-    /// and at most outstanding_lines in flight; returns the last completion.
-    Cycle stream(const std::vector<BuildJob::Range>& ranges, bool write, Cycle start, double cycles_per_line,
-                 uint64_t* bytes);
+    /// Moves to the next line request (ending streams and jobs that have none left); false when
+    /// the build is done.
+    bool settle();
+    void start_job();
+    void start_stream(Cycle start);
+    void end_stream();
+    /// The current stream's next request: its cycle (paced at the job's cycles per line, at
+    /// most outstanding_lines in flight) and line.
+    Cycle due() const;
 
     const BuildUnitConfig& m_config;
     MemIf& m_mem;
     uint32_t m_line;
     FrameBuild m_total;
     uint64_t m_frames = 0, m_busy = 0, m_compute = 0, m_stream = 0;
+    // The build in progress: its jobs, the current job's streams (its read passes, then its
+    // writes), the current stream's position and requests in flight.
+    bool m_active = false;
+    const std::vector<BuildJob>* m_jobs = nullptr;
+    FrameBuild m_out;
+    size_t m_job = 0;
+    Cycle m_job_start = 0, m_read_end = 0;
+    double m_job_compute = 0, m_pace = 0;
+    uint32_t m_passes = 1, m_pass = 0;  ///< streams 0..passes-1 read, stream `passes` writes
+    bool m_in_stream = false;
+    size_t m_range = 0;
+    uint64_t m_line_at = 0, m_issued = 0;
+    Cycle m_stream_start = 0, m_previous = 0, m_stream_last = 0;
+    std::deque<Cycle> m_in_flight;  ///< completions of the stream's requests in flight, in issue order
 };
 
 /// model.build_unit in stats.json, declared once.

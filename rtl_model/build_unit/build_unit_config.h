@@ -27,6 +27,10 @@ struct BuildUnitConfig {
     uint32_t outstanding_lines = 32;
     /// On-chip working memory (Morton keys, the sort's runs, the emitted nodes' staging): area only.
     uint32_t sram_kib = 64;
+    /// Build the next frame's structures while the current frame's rays run (async compute into
+    /// a second buffer, as engines overlap BVH builds with the previous frame's rendering) instead
+    /// of at the barrier between them (sim/harness/frame_builds.h, FrameBuildSchedule).
+    bool overlap = false;
 
     template <class V>
     void visit(V& v) {
@@ -37,6 +41,7 @@ struct BuildUnitConfig {
         v.field("rebuild_read_passes", rebuild_read_passes, "passes", "Times a rebuild reads its triangles (keys, sort passes, emit)", 1, 64);
         v.field("outstanding_lines", outstanding_lines, "lines", "Line requests the unit keeps in flight to the L2", 1, 4096);
         v.field("sram_kib", sram_kib, "KiB", "The unit's working SRAM (area only)", 1, 1u << 16);
+        v.flag("overlap", overlap, "Build the next frame's structures into a second buffer while the current frame's rays run (async compute), instead of at the barrier between them");
     }
 };
 

@@ -7,6 +7,7 @@
 
 #include "rtl_model/common/interfaces.h"
 #include "rtl_model/top/top.h"
+#include "sim/harness/frame_builds.h"
 #include "sim/harness/frames.h"
 
 namespace rtsim {
@@ -29,6 +30,9 @@ public:
           m_line_bytes(c.l2.line_bytes),
           m_capacity(c.l2.lines()),
           m_ideal(c.ideal_memory) {}
+    /// Beside the traversal (build_unit.overlap): a miss waits `factor` times its unloaded
+    /// latency, as the traversal's own accesses do under its load.
+    void load_with(double factor) { m_miss *= factor; }
     Cycle access(const MemRequest& req) override {
         if (m_ideal) return req.time + 1;
         const uint64_t line = req.addr / m_line_bytes;
@@ -102,14 +106,42 @@ AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameR
     const json run1 = summary.value("l1_hit_rate", json(nullptr)), run2 = summary.value("l2_hit_rate", json(nullptr));
     const bool known1 = run1.is_number(), known2 = run2.is_number();
     double l1_reads = 0, l1_hits = 0, l2_reads = 0, l2_hits = 0;
-    for (uint32_t f = 0; f < frames.size(); ++f) {
-        if (f > 0 && unit && f < jobs.size() && !jobs[f].empty()) {
-            const FrameBuild b = unit->run(jobs[f], Cycle(std::ceil(t)));
+    // Beside a frame's rays the next frame's build shares the DRAM with them: the two take at
+    // least their DRAM reads at the channels' peak rate (a bound), and the build's misses wait as
+    // long as the traversal's own do under its load.
+    const double peak = double(config.dram.bytes_per_cycle) * config.dram.channels;
+    const bool overlap = config.build_unit.overlap && unit;
+    if (overlap) {
+        // The traversal's loaded ray latency over its unloaded one (Little: contexts x cycles /
+        // rays), which a build beside it sees on its misses too.
+        double rays = 0;
+        for (const FrameRecord& f : frames) rays += double(f.rays);
+        const double contexts = double(config.traversal.units) * config.traversal.contexts();
+        const double loaded = rays > 0 ? contexts * traversal_cycles / rays : 0.0;
+        if (mean_latency > 0) memory.load_with(std::clamp(loaded / mean_latency, 1.0, 4.0));
+    }
+    // Builds at each barrier, or beside the previous frame's rays (build_unit.overlap).
+    std::vector<Cycle> built(jobs.size(), 0);
+    std::vector<double> built_bytes(jobs.size(), 0.0);
+    FrameBuildSchedule schedule(
+        overlap, uint32_t(jobs.size()),
+        [&](uint32_t f, Cycle at) {
+            built[f] = at;
+            if (!unit || jobs[f].empty()) return;
+            const FrameBuild b = unit->run(jobs[f], at);
             recorder.set_build(f, b);
             build_bytes += double(b.read_bytes + b.written_bytes);
-            t = double(b.end);
-        }
+            built_bytes[f] = double(b.read_bytes);  // its writes are posted into the L2 here
+            built[f] = b.end;
+        },
+        [&](uint32_t f) { return built[f]; });
+    double shared_bound = 0;  // overlap: the next frame starts no earlier
+    for (uint32_t f = 0; f < frames.size(); ++f) {
+        if (f > 0) t = std::max({t, shared_bound, double(schedule.ready(f, Cycle(std::ceil(t))))});
+        const double start = t;
         t += per_work * step_work[f] + (f > 0 ? refill : 0.0);
+        if (overlap && f + 1 < built_bytes.size() && peak > 0)
+            shared_bound = start + (dram_per_work * step_work[f] + built_bytes[f + 1]) / peak;
         done_work += step_work[f];
         // The frame's memory figures: the closed form's shared out by work.
         const bool own = rates.size() == frames.size();
@@ -128,7 +160,7 @@ AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameR
     out.frames = recorder.to_json();
     if (unit) {
         out.build_unit = unit->stats_json();
-        out.build_unit["share"] = out.cycles ? double(out.build_unit["busy_cycles"].get<uint64_t>()) / double(out.cycles) : 0.0;
+        out.build_unit["share"] = out.cycles ? double(recorder.build_wait_cycles()) / double(out.cycles) : 0.0;
     }
     return out;
 }

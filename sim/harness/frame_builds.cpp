@@ -1,6 +1,7 @@
 // Each frame's build jobs (frame_builds.h).
 #include "sim/harness/frame_builds.h"
 
+#include <algorithm>
 #include <string>
 
 namespace rtsim {
@@ -77,6 +78,32 @@ std::vector<std::vector<BuildJob>> frame_build_jobs(const Accel& accel) {
         out[f].push_back(tlas_job(image, slice));
     }
     return out;
+}
+
+void move_to_second_buffer(std::vector<std::vector<BuildJob>>& jobs) {
+    // Far above any image (a trace's regions lie below 2^40): rows of their own in every bank.
+    constexpr uint64_t kSecondBuffer = uint64_t(1) << 44;
+    for (auto& frame : jobs)
+        for (BuildJob& job : frame) {
+            for (BuildJob::Range& r : job.reads) r.addr += kSecondBuffer;
+            for (BuildJob::Range& r : job.writes) r.addr += kSecondBuffer;
+        }
+}
+
+FrameBuildSchedule::FrameBuildSchedule(bool overlap, uint32_t frames, StartFn start, FinishFn finish)
+    : m_overlap(overlap), m_frames(frames), m_start(std::move(start)), m_finish(std::move(finish)) {
+    if (m_overlap && m_frames > 1) m_start(1, 0);
+}
+
+Cycle FrameBuildSchedule::ready(uint32_t f, Cycle end) {
+    if (f >= m_frames) return end;
+    if (!m_overlap) {
+        m_start(f, end);
+        return std::max(end, m_finish(f));
+    }
+    const Cycle begin = std::max(end, m_finish(f));  // its build ran beside the frame before
+    if (f + 1 < m_frames) m_start(f + 1, begin);
+    return begin;
 }
 
 }  // namespace rtsim

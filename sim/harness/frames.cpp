@@ -44,7 +44,7 @@ void FrameRecorder::untimed() {
     for (uint32_t f = 0; f < m_frames.size(); ++f) {
         frame_end(f, 0, MemoryTotals{});
         for (const char* key : {"start_cycle", "end_cycle", "cycles", "mrays_per_second", "dram_bytes",
-                                "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate", "build_cycles", "build_share",
+                                "dram_bytes_per_ray", "l1_hit_rate", "l2_hit_rate", "build_cycles", "build_wait_cycles", "build_share",
                                 "build_read_bytes", "build_written_bytes"})
             m_out.back()[key] = nullptr;
     }
@@ -74,6 +74,9 @@ void FrameRecorder::frame_end(uint32_t f, Cycle cycle, const MemoryTotals& total
     }
     const FrameBuild build = f < m_builds.size() ? m_builds[f] : FrameBuild{};
     const Cycle build_cycles = build.end - build.start;
+    // What the frame's rays waited for its build after the frame before it ended: all of it at
+    // the barrier, what was left of it beside the previous frame's rays (build_unit.overlap).
+    const Cycle build_wait = build_cycles && build.end > m_last_cycle ? build.end - m_last_cycle : 0;
     const bool memory = !m_config.ideal_memory;
     m_out.push_back({{"frame", f},
                      {"rays", rays},
@@ -92,11 +95,19 @@ void FrameRecorder::frame_end(uint32_t f, Cycle cycle, const MemoryTotals& total
                      {"blas_refit", blas_refit},
                      {"blas_sah_ratio", sah_ratio},
                      {"build_cycles", build_cycles},
+                     {"build_wait_cycles", build_wait},
                      {"build_share", cycles ? double(build_cycles) / double(cycles) : 0.0},
                      {"build_read_bytes", build.read_bytes},
                      {"build_written_bytes", build.written_bytes}});
     m_last = totals;
     m_last_cycle = cycle;
+}
+
+uint64_t FrameRecorder::build_wait_cycles() const {
+    uint64_t sum = 0;
+    for (const json& f : m_out)
+        if (f["build_wait_cycles"].is_number()) sum += f["build_wait_cycles"].get<uint64_t>();
+    return sum;
 }
 
 const StatBlock& frame_stats() {
@@ -120,7 +131,8 @@ const StatBlock& frame_stats() {
             {"blas_rebuilt", "structures", "deforming meshes' BLASes the frame built afresh (trace manifest; --frame-policy)"},
             {"blas_refit", "structures", "deforming meshes' BLASes the frame refitted"},
             {"blas_sah_ratio", "ratio", "largest SAH cost of the frame's deforming BLASes over their cost at their last rebuild; `null` without deforming geometry"},
-            {"build_cycles", "cycles", "the build unit's time before the frame's rays (its structures built or refitted; 0 for frame 0, whose exist before the run)", true},
+            {"build_cycles", "cycles", "the build unit's time on the frame's structures (built or refitted: before its rays, or with `build_unit.overlap` beside the previous frame's; 0 for frame 0, whose exist before the run)", true},
+            {"build_wait_cycles", "cycles", "what the frame's rays waited for its structures after the previous frame ended: `build_cycles` at the barrier, what was left of the build with `build_unit.overlap`", true},
             {"build_share", "fraction", "`build_cycles / cycles`", true},
             {"build_read_bytes", "bytes", "bytes the build unit read for the frame", true},
             {"build_written_bytes", "bytes", "bytes the build unit wrote for the frame", true},

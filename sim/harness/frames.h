@@ -46,6 +46,9 @@ public:
     void untimed();
     /// Frame f's build on the build unit (rtl_model/build_unit/build_unit.h), before its rays.
     void set_build(uint32_t f, const FrameBuild& build) { m_builds.resize(std::max<size_t>(m_builds.size(), f + 1)); m_builds[f] = build; }
+    /// The frames' build_wait_cycles summed: what the run's rays waited for builds (the build
+    /// unit's busy cycles when it builds at the barriers; less beside the traversal).
+    uint64_t build_wait_cycles() const;
     /// True once frame f's figures are recorded.
     bool recorded(uint32_t f) const { return f < m_out.size(); }
     /// [{frame, rays, start_cycle, cycles, mrays_per_second, dram_bytes_per_ray, l1_hit_rate,

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <memory>
 
+#include "rtl_model/build_unit/build_streamer.h"
 #include "rtl_model/shading/shading_block.h"
 #include "rtl_model/top/top.h"
 #include "sim/config/config.h"
@@ -95,8 +96,9 @@ LevelResult run_timed_level(RunInputs& in) {
     Top top("top", model_config, accel, s.step, map, sampled ? static_cast<RayStream&>(sampled->stream) : stream,
             checker, built.features, shading.get());
     // The build unit, where the trace's frames record their builds (frame_builds.h).
-    const std::vector<std::vector<BuildJob>> build_jobs =
+    std::vector<std::vector<BuildJob>> build_jobs =
         c.build_unit.enabled ? frame_build_jobs(accel) : std::vector<std::vector<BuildJob>>{};
+    if (c.build_unit.overlap) move_to_second_buffer(build_jobs);
     std::unique_ptr<BuildUnit> build_unit;
     if (!build_jobs.empty())
         build_unit = std::make_unique<BuildUnit>(c.build_unit, top.shared_memory(), c.l2.line_bytes);
@@ -106,12 +108,28 @@ LevelResult run_timed_level(RunInputs& in) {
     // Moving scenes: the next frame's structures are built at the barrier, before its rays
     // (rtl_model/build_unit/build_unit.h); the frame's figures are taken before the build.
     // Frame f's structures built from `at`; returns when they are (`at` when it builds none).
-    auto build_frame = [&](uint32_t f, Cycle at) {
-        if (f >= build_jobs.size() || build_jobs[f].empty()) return at;
+    // At the barrier before each frame (run at once: the units are idle), or beside the previous
+    // frame's rays (build_unit.overlap: streamed in time by a process of its own).
+    const bool overlap = c.build_unit.overlap && build_unit;
+    std::unique_ptr<BuildStreamer> streamer;
+    if (overlap) streamer = std::make_unique<BuildStreamer>("build_streamer", *build_unit);
+    std::vector<Cycle> build_end(build_jobs.size(), 0);
+    auto start_build = [&](uint32_t f, Cycle at) {
+        build_end[f] = at;
+        if (build_jobs[f].empty()) return;
+        if (overlap) return streamer->start(build_jobs[f], at);
         const FrameBuild b = build_unit->run(build_jobs[f], at);
         frame_figures.set_build(f, b);
-        return b.end;
+        build_end[f] = b.end;
     };
+    auto finish_build = [&](uint32_t f) {
+        if (!overlap || build_jobs[f].empty()) return build_end[f];
+        const FrameBuild b = streamer->finish();
+        frame_figures.set_build(f, b);
+        return build_end[f] = b.end;
+    };
+    FrameBuildSchedule schedule(overlap, uint32_t(build_jobs.size()), start_build, finish_build);
+    auto build_frame = [&](uint32_t f, Cycle at) { return schedule.ready(f, at); };
     auto build_at_barrier = [&](uint32_t f, Cycle end) {
         frame_figures.frame_end(f, end, top.memory_totals());
         return build_frame(f + 1, end);
@@ -210,12 +228,14 @@ LevelResult run_timed_level(RunInputs& in) {
     r.model = top.stats_json();
     if (build_unit) {
         r.model["build_unit"] = build_unit->stats_json();
-        r.model["build_unit"]["share"] = r.cycles ? double(r.model["build_unit"]["busy_cycles"].get<uint64_t>()) / double(r.cycles) : 0.0;
+        r.model["build_unit"]["share"] = r.cycles ? double(frame_figures.build_wait_cycles()) / double(r.cycles) : 0.0;
     }
     r.instantiated = top.instantiated();
     if (build_unit)
         r.instantiated.push_back({{"block", "build_unit"}, {"instantiated", true},
-                                  {"why", "a moving scene: each frame's structures are built or refit at its barrier"}});
+                                  {"why", overlap ? "a moving scene: each frame's structures are built or refit beside "
+                                                    "the previous frame's rays (build_unit.overlap)"
+                                                  : "a moving scene: each frame's structures are built or refit at its barrier"}});
     if (in.options.timeline && top.dram())
         timeline.write((fs::path(in.options.out_dir) / "timeline.json").string(), top.units(),
                        top.dram()->bytes_over_time(), Dram::bucket_cycles());

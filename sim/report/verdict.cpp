@@ -441,6 +441,15 @@ json build_knobs(const json& build_unit, const json& weighed, const SimConfig& c
     // More lines in flight halves the stream at best (when its latency, not DRAM, paces it).
     build.push_back(side_knob("build_unit.outstanding_lines", b.outstanding_lines, b.outstanding_lines * 2, "build",
                               stream_s, share, "run_speedup"));
+    if (!b.overlap && share > 0) {
+        // Building beside the previous frame's rays hides the build behind the traversal (or the
+        // traversal behind the build): the run becomes the longer of the two, an upper bound
+        // (their shared memory slows both). The build's part is then what stays exposed.
+        const double exposed = std::max(0.0, share - (1.0 - share));
+        build.push_back({{"key", "build_unit.overlap"}, {"from", false}, {"to", true}, {"part", "build"},
+                         {"part_speedup", exposed > 0 ? json(share / exposed) : json(nullptr)},
+                         {"run_speedup", 1.0 / std::max(share, 1.0 - share)}});
+    }
     return two_sides(weighed, 1.0 - share, "run_speedup", std::move(build));
 }
 
@@ -482,7 +491,7 @@ const StatBlock& verdict_stats() {
             {"estimate", "", "`method` (the analytic level on N sampled rays, or on the stored per-trace analysis), `reused` (the analysis was loaded from beside the trace, stored there by an earlier run, instead of stepped by this one), `base_cycles` (its cycles for the run's own config), `dram_latency` (timed runs with the bank model: `added_cycles`, what each DRAM access is charged beyond `dram.latency`, the run's own row outcome `row_cycles` rounded; `bank_wait_cycles`, its bank wait, reported but not charged; `null` otherwise), `wall_seconds` (the host time the estimates took)"},
             {"analytic_binding", "", "the analytic level's own binding bound for the same config (`model.analytic.binding`), a second opinion"},
             {"frame", "list", "only with `shading.enabled`: the shading side's knobs beside the RT unit's, weighed by what they buy the frame (Amdahl over `model.shading.breakdown`): `key`, `from`, `to`, `part` (traversal or shading), `part_speedup` (the RT knob's estimate; 2 for doubled shader cores; the divergence for sorting by shader, an upper bound), `frame_speedup`; best first", false, true},
-            {"build", "list", "only for a moving scene whose frames build (`model.build_unit`): the build unit's knobs beside the RT unit's, weighed by what they buy the run (Amdahl over `model.build_unit.share`): `key`, `from`, `to`, `part` (traversal or build), `part_speedup` (the RT knob's estimate; for a doubled build throughput `busy / max(compute / 2, stream)`, for doubled outstanding lines `busy / max(stream / 2, compute)`, over `model.build_unit`'s cycles: upper bounds), `run_speedup`; best first. When the build holds the run at least half its cycles and a build knob leads, `binding` is `build`", false, true},
+            {"build", "list", "only for a moving scene whose frames build (`model.build_unit`): the build unit's knobs beside the RT unit's, weighed by what they buy the run (Amdahl over `model.build_unit.share`): `key`, `from`, `to`, `part` (traversal or build), `part_speedup` (the RT knob's estimate; for a doubled build throughput `busy / max(compute / 2, stream)`, for doubled outstanding lines `busy / max(stream / 2, compute)`, over `model.build_unit`'s cycles: upper bounds; `build_unit.overlap` on: what stays exposed of the build, `null` when all of it hides behind the traversal), `run_speedup` (for `build_unit.overlap`, `1 / max(share, 1 - share)`: the run as the longer of its builds and its traversal, an upper bound); best first. When the build holds the run at least half its cycles and a build knob leads, `binding` is `build`", false, true},
             {"agreement", "", "the run's answers in one vocabulary: `binding`, `knob` (the named knob's key), `relaxes` (the resources it relaxes, directly or by what it removes), `roofline_bound` (`roofline.bound`), `roofline_reached` (achieved over that ceiling), `roofline_relaxed`, `analytic_binding`, `analytic_relaxed` (whether the knob relaxes each)"},
         }};
     return block;

@@ -165,3 +165,43 @@ def test_shaded_frame_loop_builds_between_frames(runs: dict[str, dict], sim_exe:
         plain, unit = runs["rebuild"]["stats"]["model"]["build_unit"], stats["model"]["build_unit"]
         assert (unit["rebuilds"], unit["refits"]) == (plain["rebuilds"], plain["refits"])
         assert unit["busy_cycles"] == pytest.approx(plain["busy_cycles"], rel=0.05), loop
+
+
+def test_overlapped_builds_run_beside_the_previous_frame(runs: dict[str, dict], sim_exe: Path,
+                                                         tmp_path: Path) -> None:  # fmt: skip
+    """build_unit.overlap (async compute into a second buffer): the next frame's structures
+    are built beside the current frame's rays. The same builds run and every hit is checked; a
+    frame waits only for what is left of its build, so the run is shorter than with builds at the
+    barriers, or no longer than a little contention makes it (a rebuild and the rays slow each
+    other's memory streams: docs/model.md, "Builds beside the traversal"), at every level and in
+    both shaded frame loops; the analytic level within its measured error of `detailed`'s."""
+    trace = Path(runs["rebuild"]["stats"]["provenance"]["trace"])
+    trace = trace.parent if trace.suffix == ".rtt" else trace
+    serial = runs["rebuild"]["stats"]
+    assert all(f["build_wait_cycles"] == f["build_cycles"] for f in serial["frames"])
+    overlapped: dict[str, int] = {}
+    for level in ("approx", "detailed", "analytic"):
+        at_barrier = serial if level == "approx" else sim_stats(
+            sim_exe, trace, tmp_path / f"serial_{level}", f"fidelity={level}")  # fmt: skip
+        stats = sim_stats(sim_exe, trace, tmp_path / f"overlap_{level}", f"fidelity={level}",
+                          "build_unit.overlap=true")  # fmt: skip
+        s = stats["summary"]
+        assert s["hit_mismatches"] == 0 and s["work_mismatches"] == 0, level
+        unit, plain = stats["model"]["build_unit"], at_barrier["model"]["build_unit"]
+        assert (unit["rebuilds"], unit["refits"]) == (plain["rebuilds"], plain["refits"]), level
+        frames = stats["frames"]
+        assert all(0 <= f["build_wait_cycles"] <= f["build_cycles"] for f in frames), level
+        waits = sum(f["build_wait_cycles"] for f in frames)
+        assert waits < sum(f["build_cycles"] for f in frames), level
+        if level != "analytic":
+            assert s["cycles"] < 1.02 * at_barrier["summary"]["cycles"], level
+        assert sum(f["cycles"] for f in frames) == pytest.approx(s["cycles"], abs=3), level
+        overlapped[level] = s["cycles"]
+    assert overlapped["analytic"] == pytest.approx(overlapped["detailed"], rel=0.25)
+    for loop in ("wavefront", "inflight"):
+        stats = sim_stats(sim_exe, trace, tmp_path / f"shaded_{loop}", "shading.enabled=true",
+                          f"shading.frame_loop={loop}", "build_unit.overlap=true")  # fmt: skip
+        assert stats["summary"]["hit_mismatches"] == 0, loop
+        shading = stats["model"]["shading"]
+        assert sum(shading["breakdown"].values()) == shading["frame_cycles"], loop
+        assert stats["model"]["build_unit"]["rebuilds"] == serial["model"]["build_unit"]["rebuilds"]

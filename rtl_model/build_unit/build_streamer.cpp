@@ -1,0 +1,33 @@
+// A build beside the traversal (build_streamer.h).
+#include "rtl_model/build_unit/build_streamer.h"
+
+namespace rtsim {
+
+BuildStreamer::BuildStreamer(sc_core::sc_module_name name, BuildUnit& unit) : sc_core::sc_module(name), m_unit(unit) {
+    SC_THREAD(run);
+}
+
+void BuildStreamer::start(const std::vector<BuildJob>& jobs, Cycle at) {
+    m_unit.begin(jobs, at);
+    m_started.notify(sc_core::SC_ZERO_TIME);
+}
+
+FrameBuild BuildStreamer::finish() { return m_unit.finish(); }
+
+void BuildStreamer::run() {
+    for (;;) {
+        const Cycle now = sc_core::sc_time_stamp().value();
+        m_unit.issue_until(now);
+        if (!m_unit.has_requests()) {  // idle, or issued in full: until the next build starts
+            wait(m_started);
+            continue;
+        }
+        const Cycle next = m_unit.next_issue();
+        // Asleep until the next request is due, or until a build finished at a barrier
+        // (finish) and a new one started.
+        if (next > now) wait(sc_core::sc_time::from_value(next - now), m_started);
+        else wait(sc_core::SC_ZERO_TIME);
+    }
+}
+
+}  // namespace rtsim
