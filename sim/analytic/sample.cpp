@@ -139,7 +139,10 @@ void SampleProfiler::admit(RayDealer& dealer) {
 }
 
 int64_t SampleProfiler::pick() const {
-    // As the ray buffer's scheduler: the largest queue, the oldest front, or round robin.
+    // As the ray buffer's scheduler: the largest queue, the oldest front, or round robin. No ray
+    // waiting, no queue to scan: the machine's idle contexts ask every round once rays run out
+    // (a 128-unit machine's verdict spent 85% of its 460 s scanning empty queues).
+    if (m_waiting == 0) return -1;
     int64_t best = -1;
     const TreeletPolicy policy = m_c.treelets.policy;
     for (size_t k = 0; k < m_queues.size(); ++k) {

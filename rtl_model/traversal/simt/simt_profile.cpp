@@ -263,6 +263,7 @@ private:
     }
 
     int64_t largest_queue() const {
+        if (m_waiting == 0) return -1;  // no ray waits: no queue to scan (idle warps ask every round)
         int64_t best = -1;
         for (size_t k = 0; k < m_queues.size(); ++k)
             if (!m_queues[k].empty() && (best < 0 || m_queues[k].size() > m_queues[size_t(best)].size())) best = int64_t(k);
