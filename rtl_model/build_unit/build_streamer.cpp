@@ -1,6 +1,8 @@
 // A build beside the traversal (build_streamer.h).
 #include "rtl_model/build_unit/build_streamer.h"
 
+#include <algorithm>
+
 namespace rtsim {
 
 BuildStreamer::BuildStreamer(sc_core::sc_module_name name, BuildUnit& unit) : sc_core::sc_module(name), m_unit(unit) {
@@ -23,10 +25,9 @@ void BuildStreamer::run() {
             continue;
         }
         const Cycle next = m_unit.next_issue();
-        // Asleep until the next request is due, or until a build finished at a barrier
-        // (finish) and a new one started.
-        if (next > now) wait(sc_core::sc_time::from_value(next - now), m_started);
-        else wait(sc_core::SC_ZERO_TIME);
+        // Asleep until the next request is due (after `now`: issue_until issued the rest), or
+        // until a build finished at a barrier (finish) and a new one started.
+        wait(sc_core::sc_time::from_value(std::max<Cycle>(1, next - now)), m_started);
     }
 }
 

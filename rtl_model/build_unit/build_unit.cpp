@@ -5,6 +5,8 @@
 #include <cmath>
 #include <deque>
 
+#include "traces/common/error.h"
+
 namespace rtsim {
 
 BuildUnit::BuildUnit(const BuildUnitConfig& config, MemIf& mem, uint32_t line_bytes)
@@ -16,6 +18,7 @@ FrameBuild BuildUnit::run(const std::vector<BuildJob>& jobs, Cycle start) {
 }
 
 void BuildUnit::begin(const std::vector<BuildJob>& jobs, Cycle start) {
+    require(!m_active, "build unit: a build began before the last one finished");
     m_active = true;
     m_jobs = &jobs;
     m_out = FrameBuild{};

@@ -33,6 +33,8 @@ public:
     /// Beside the traversal (build_unit.overlap): a miss waits `factor` times its unloaded
     /// latency, as the traversal's own accesses do under its load.
     void load_with(double factor) { m_miss *= factor; }
+    /// Bytes that took the DRAM bus so far (misses and write-backs).
+    double bus_bytes() const { return m_bus_bytes; }
     Cycle access(const MemRequest& req) override {
         if (m_ideal) return req.time + 1;
         const uint64_t line = req.addr / m_line_bytes;
@@ -45,6 +47,7 @@ public:
         if (!req.write && present) return req.time + Cycle(m_l2);
         const double start = std::max(double(req.time), m_bus);
         m_bus = start + m_line_cycles;
+        m_bus_bytes += m_line_bytes;
         return Cycle(std::ceil(req.write ? double(req.time) + m_l2 : start + m_miss));
     }
 
@@ -53,7 +56,7 @@ private:
     uint32_t m_line_bytes;
     uint64_t m_capacity;
     bool m_ideal;
-    double m_bus = 0;
+    double m_bus = 0, m_bus_bytes = 0;
     std::unordered_set<uint64_t> m_lines;
     std::deque<uint64_t> m_order;
 };
@@ -107,7 +110,7 @@ AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameR
     const bool known1 = run1.is_number(), known2 = run2.is_number();
     double l1_reads = 0, l1_hits = 0, l2_reads = 0, l2_hits = 0;
     // Beside a frame's rays the next frame's build shares the DRAM with them: the two take at
-    // least their DRAM reads at the channels' peak rate (a bound), and the build's misses wait as
+    // least their DRAM bytes at the channels' peak rate (a bound), and the build's misses wait as
     // long as the traversal's own do under its load.
     const double peak = double(config.dram.bytes_per_cycle) * config.dram.channels;
     const bool overlap = config.build_unit.overlap && unit;
@@ -118,6 +121,8 @@ AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameR
         for (const FrameRecord& f : frames) rays += double(f.rays);
         const double contexts = double(config.traversal.units) * config.traversal.contexts();
         const double loaded = rays > 0 ? contexts * traversal_cycles / rays : 0.0;
+        // (Clamped: a latency bound by the pipelines, not memory, would not slow the build's
+        // misses that much; 4x is past any ratio the grids measured.)
         if (mean_latency > 0) memory.load_with(std::clamp(loaded / mean_latency, 1.0, 4.0));
     }
     // Builds at each barrier, or beside the previous frame's rays (build_unit.overlap).
@@ -128,16 +133,22 @@ AnalyticFrames estimate_frames(const SimConfig& config, const std::vector<FrameR
         [&](uint32_t f, Cycle at) {
             built[f] = at;
             if (!unit || jobs[f].empty()) return;
+            const double bus = memory.bus_bytes();
             const FrameBuild b = unit->run(jobs[f], at);
             recorder.set_build(f, b);
             build_bytes += double(b.read_bytes + b.written_bytes);
-            built_bytes[f] = double(b.read_bytes);  // its writes are posted into the L2 here
+            built_bytes[f] = memory.bus_bytes() - bus;  // its DRAM share: misses and write-backs
             built[f] = b.end;
         },
         [&](uint32_t f) { return built[f]; });
     double shared_bound = 0;  // overlap: the next frame starts no earlier
     for (uint32_t f = 0; f < frames.size(); ++f) {
-        if (f > 0) t = std::max({t, shared_bound, double(schedule.ready(f, Cycle(std::ceil(t))))});
+        if (f > 0) {
+            // Kept fractional unless a build holds the frame (no drift of a cycle a frame).
+            const double ended = std::max(t, shared_bound);
+            const Cycle ready = schedule.ready(f, Cycle(std::ceil(ended)));
+            t = double(ready) > std::ceil(ended) ? double(ready) : ended;
+        }
         const double start = t;
         t += per_work * step_work[f] + (f > 0 ? refill : 0.0);
         if (overlap && f + 1 < built_bytes.size() && peak > 0)

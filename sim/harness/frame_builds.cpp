@@ -1,6 +1,8 @@
 // Each frame's build jobs (frame_builds.h).
 #include "sim/harness/frame_builds.h"
 
+#include "traces/common/error.h"
+
 #include <algorithm>
 #include <string>
 
@@ -81,12 +83,18 @@ std::vector<std::vector<BuildJob>> frame_build_jobs(const Accel& accel) {
 }
 
 void move_to_second_buffer(std::vector<std::vector<BuildJob>>& jobs) {
-    // Far above any image (a trace's regions lie below 2^40): rows of their own in every bank.
+    // The memory map's regions take a 4 GiB granule or more each from 4 GiB up (memory_map.h):
+    // 2^44 up stands clear of a map of fewer than 4,096 granules, and gives the second buffer
+    // rows of its own in every bank.
     constexpr uint64_t kSecondBuffer = uint64_t(1) << 44;
     for (auto& frame : jobs)
         for (BuildJob& job : frame) {
-            for (BuildJob::Range& r : job.reads) r.addr += kSecondBuffer;
-            for (BuildJob::Range& r : job.writes) r.addr += kSecondBuffer;
+            for (auto* ranges : {&job.reads, &job.writes})
+                for (BuildJob::Range& r : *ranges) {
+                    require(r.addr + r.bytes <= kSecondBuffer, "build_unit.overlap: a structure at or past 16 TiB has no "
+                                                               "room for its second buffer");
+                    r.addr += kSecondBuffer;
+                }
         }
 }
 

@@ -160,7 +160,7 @@ LevelResult run_statistical(RunInputs& in) {
                                       {"why", c.build_unit.overlap
                                                   ? "a moving scene: each frame's structures are built or refit beside "
                                                     "the previous frame's rays (closed form: the DRAM at its peak rate, "
-                                                    "no contention with the traversal)"
+                                                    "the traversal's loaded latency, both bound by the DRAM's bandwidth)"
                                                   : "a moving scene: each frame's structures are built or refit at its "
                                                     "barrier (closed form: the DRAM at its peak rate)"}});
         }

@@ -105,11 +105,11 @@ LevelResult run_timed_level(RunInputs& in) {
     // Frame barriers: record each frame's figures, then bind the structure's next frame.
     std::vector<uint64_t> frame_rays;
     for (const FrameRecord& f : segments) frame_rays.push_back(f.rays);
-    // Moving scenes: the next frame's structures are built at the barrier, before its rays
-    // (rtl_model/build_unit/build_unit.h); the frame's figures are taken before the build.
-    // Frame f's structures built from `at`; returns when they are (`at` when it builds none).
-    // At the barrier before each frame (run at once: the units are idle), or beside the previous
-    // frame's rays (build_unit.overlap: streamed in time by a process of its own).
+    // Moving scenes (rtl_model/build_unit/build_unit.h): each frame's structures are built at the
+    // barrier before its rays (run at once: the units are idle; the frame's figures are taken
+    // before the build), or beside the previous frame's rays (build_unit.overlap: streamed in
+    // time by a process of its own). build_frame(f, at): the cycle frame f may start, the frame
+    // before it having ended at `at`.
     const bool overlap = c.build_unit.overlap && build_unit;
     std::unique_ptr<BuildStreamer> streamer;
     if (overlap) streamer = std::make_unique<BuildStreamer>("build_streamer", *build_unit);
@@ -128,7 +128,12 @@ LevelResult run_timed_level(RunInputs& in) {
         frame_figures.set_build(f, b);
         return build_end[f] = b.end;
     };
-    FrameBuildSchedule schedule(overlap, uint32_t(build_jobs.size()), start_build, finish_build);
+    // The wavefront loop builds no frame after the last with rays: an overlapped build must not
+    // start one either (it would run beside that frame's rays and never be waited for).
+    uint32_t built_frames = uint32_t(build_jobs.size());
+    if (wavefront && !shading->wavefront_frame.empty())
+        built_frames = std::min(built_frames, shading->wavefront_frame.back() + 1);
+    FrameBuildSchedule schedule(overlap, built_frames, start_build, finish_build);
     auto build_frame = [&](uint32_t f, Cycle at) { return schedule.ready(f, at); };
     auto build_at_barrier = [&](uint32_t f, Cycle end) {
         frame_figures.frame_end(f, end, top.memory_totals());

@@ -394,10 +394,12 @@ std::vector<double> frame_barrier_tails(const nlohmann::json& frames, const Samp
     }
     for (double& t : tails)
         if (t < 0) t = n ? sum / n : 0.0;  // a frame without a cluster drains like the others
-    // The build unit's work before a frame's rays (moving scenes) is simulated in full.
+    // The build unit's work before a frame's rays (moving scenes) is simulated in full: what the
+    // frame waited for it (all of it at the barrier, what was left beside the previous frame's
+    // rays with build_unit.overlap).
     for (const nlohmann::json& f : frames) {
         const uint32_t i = f["frame"].get<uint32_t>();
-        if (i < frame_count) tails[i] += f.value("build_cycles", 0.0);
+        if (i < frame_count) tails[i] += f.value("build_wait_cycles", f.value("build_cycles", 0.0));
     }
     return tails;
 }
