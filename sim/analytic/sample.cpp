@@ -88,6 +88,8 @@ void SampleProfiler::end_round() {
 
 void SampleProfiler::run_treelets(RayDealer& dealer, RaySinkIf& sink) {
     for (auto& q : m_queues) q.clear();
+    m_by_size.clear();
+    m_nonempty.clear();
     std::fill(m_unit_treelet.begin(), m_unit_treelet.end(), -1);
     m_in_machine = m_waiting = 0;
     admit(dealer);
@@ -139,19 +141,25 @@ void SampleProfiler::admit(RayDealer& dealer) {
 }
 
 int64_t SampleProfiler::pick() const {
-    // As the ray buffer's scheduler: the largest queue, the oldest front, or round robin. No ray
-    // waiting, no queue to scan: the machine's idle contexts ask every round once rays run out
-    // (a 128-unit machine's verdict spent 85% of its 460 s scanning empty queues).
-    if (m_waiting == 0) return -1;
-    int64_t best = -1;
-    const TreeletPolicy policy = m_c.treelets.policy;
-    for (size_t k = 0; k < m_queues.size(); ++k) {
-        const size_t t = policy == TreeletPolicy::round_robin ? (m_round_robin + 1 + k) % m_queues.size() : k;
-        if (m_queues[t].empty()) continue;
-        if (policy == TreeletPolicy::round_robin) return int64_t(t);
-        if (best < 0 || m_queues[t].size() > m_queues[size_t(best)].size()) best = int64_t(t);
+    // As the ray buffer's scheduler: the largest queue (the lowest index of equal ones), or round
+    // robin from the last pick; the oldest front is judged as the largest here.
+    if (m_nonempty.empty()) return -1;
+    if (m_c.treelets.policy == TreeletPolicy::round_robin) {
+        auto it = m_nonempty.upper_bound(m_round_robin);
+        return int64_t(it == m_nonempty.end() ? *m_nonempty.begin() : *it);
     }
-    return best;
+    return int64_t(m_by_size.begin()->second);
+}
+
+void SampleProfiler::resize_queue_index(uint32_t t, int64_t delta) {
+    const int64_t before = int64_t(m_queues[t].size()) - delta;
+    if (before > 0) m_by_size.erase({-before, t});
+    if (m_queues[t].empty()) {
+        m_nonempty.erase(t);
+        return;
+    }
+    m_by_size.insert({-int64_t(m_queues[t].size()), t});
+    m_nonempty.insert(t);
 }
 
 bool SampleProfiler::take_ray(uint32_t unit, uint32_t slot) {
@@ -165,6 +173,7 @@ bool SampleProfiler::take_ray(uint32_t unit, uint32_t slot) {
     if (ctx.stepper) m_free.push_back(std::move(ctx.stepper));
     static_cast<Ray&>(ctx) = std::move(m_queues[size_t(current)].front());
     m_queues[size_t(current)].pop_front();
+    resize_queue_index(uint32_t(current), -1);
     --m_waiting;
     ctx.treelet = uint32_t(current);
     ctx.active = true;
@@ -177,6 +186,7 @@ void SampleProfiler::park(Ray&& ray, uint32_t treelet) {
     // Beyond the SRAM's rays a queued ray's state overflows to memory (written, read back).
     if (m_waiting >= m_capacity && ray.measured) m_p.treelet_overflows += 1;
     m_queues[treelet].push_back(std::move(ray));
+    resize_queue_index(treelet, +1);
     ++m_waiting;
 }
 

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <set>
 #include <vector>
 
 #include "rtl_model/common/interfaces.h"
@@ -116,6 +117,12 @@ private:
     // Treelet scheduling only (treelets.enabled).
     std::unique_ptr<LocalityPartition> m_partition;
     std::vector<std::deque<Ray>> m_queues;
+    /// The non-empty queues by size (largest first, then lowest index) and by index, kept with
+    /// every park and take so a pick does not scan every treelet (a grid's cells are thousands).
+    std::set<std::pair<int64_t, uint32_t>> m_by_size;
+    std::set<uint32_t> m_nonempty;
+    /// Queue t's size changes by `delta` (its entries in the indexes follow).
+    void resize_queue_index(uint32_t t, int64_t delta);
     std::vector<int64_t> m_unit_treelet;
     std::vector<std::unique_ptr<Stepper>> m_free;  ///< steppers of finished rays, reused
     const Accel* m_accel = nullptr;
