@@ -39,7 +39,7 @@ class TraversalUnit;
 struct GroupWindow {
     double rounds = 0, group_steps = 0, active_lanes = 0;
     /// Groups holding rays (stepping, or waiting for a step's line: GroupSetup::line_wait),
-    /// summed over rounds; 0: as group_steps (a stepping without waits).
+    /// summed over rounds.
     double groups = 0;
     /// Group steps by where their slowest line was likely served (the L1, the L2, DRAM:
     /// LineWait::level); all 0 without waits.

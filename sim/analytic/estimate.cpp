@@ -489,8 +489,7 @@ void Estimator::group_phase_windows() {
         s.steps = w.group_steps / steps;
         s.work = s.l1_misses = s.l2_misses = s.reads = w.active_lanes / lanes;
         // The groups holding rays per round and unit, those waiting for a line included.
-        const double groups = w.groups > 0 ? w.groups : w.group_steps;
-        s.population = w.rounds > 0 ? groups / w.rounds / m_c.traversal.units : 0.0;
+        s.population = w.rounds > 0 ? w.groups / w.rounds / m_c.traversal.units : 0.0;
         // A group step waits for the slowest of its active lanes' lines: fewer lanes, a
         // shorter wait (the drain's warps step with a lane or two).
         const double active = w.group_steps > 0 ? w.active_lanes / w.group_steps : 1.0;

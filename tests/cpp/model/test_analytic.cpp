@@ -309,6 +309,29 @@ TEST(AnalyticLevel, TreeletSchedulingRecordsItsRoundsInPhaseWindowsToo) {
     EXPECT_GE(estimate_analytic(c, p).form.phase_factor, 1.0);
 }
 
+TEST(AnalyticLevel, EveryTreeletPolicyHandsEachRayOutOnce) {
+    // The analysis's ray buffer picks its next queue from an index kept at every park and take:
+    // under each policy every ray is stepped to its end once (the rays' work is the walk without
+    // treelets), and treelet parks and takes happened.
+    const Workload& w = workload();
+    const SimConfig plain = small_machine();
+    RayList plain_rays(w.jobs);
+    Discard sink;
+    const AnalyticProfile alone = analyze_stream(plain, *w.accel, w.map(plain), StepOptions{}, plain_rays, sink);
+    for (const char* policy : {"largest", "oldest", "round_robin"}) {
+        SimConfig c = small_machine();
+        config_set(c, "treelets.enabled=true");
+        config_set(c, "treelets.treelet_kib=8");
+        config_set(c, std::string("treelets.policy=") + policy);
+        RayList rays(w.jobs);
+        const AnalyticProfile& p = analyze_stream(c, *w.accel, w.map(c), StepOptions{}, rays, sink);
+        EXPECT_EQ(p.stepped_rays, alone.stepped_rays) << policy;
+        EXPECT_EQ(p.sample_work, alone.sample_work) << policy;
+        EXPECT_GT(p.treelet_parks, 0.0) << policy;
+        EXPECT_GE(p.treelet_takes, p.treelet_parks) << policy;
+    }
+}
+
 TEST(AnalyticLevel, TreeletContextsConvoyOnTheFillsTheyMergeOn) {
     // With treelets a unit's contexts walk one treelet and merge on its lines: a fill releases
     // more than one context, the closed form's customers are convoys of them.
